@@ -1,0 +1,114 @@
+//! Errors of the integrators.
+
+/// Why a run could not be set up or did not finish.
+#[non_exhaustive]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum IntegrateError {
+    /// The columns of a record do not have the same length.
+    #[error("record columns differ in length: {what} has {found} values, expected {expected}")]
+    LengthMismatch {
+        /// Which column.
+        what: &'static str,
+        /// Its length.
+        found: usize,
+        /// The length of the time column.
+        expected: usize,
+    },
+    /// A record has too few samples.
+    #[error("record has {found} samples; at least {needed} are needed")]
+    TooShort {
+        /// Samples present.
+        found: usize,
+        /// Samples needed.
+        needed: usize,
+    },
+    /// A value in a record is NaN or infinite.
+    #[error("{what}[{index}] = {value} is not finite")]
+    NonFiniteInput {
+        /// Which column.
+        what: &'static str,
+        /// Zero-based sample index.
+        index: usize,
+        /// The value.
+        value: f64,
+    },
+    /// Time does not increase strictly.
+    #[error("time is not strictly increasing at sample {index}: {previous_s} s then {value_s} s")]
+    TimeNotIncreasing {
+        /// Zero-based sample index.
+        index: usize,
+        /// The previous time, s.
+        previous_s: f64,
+        /// The offending time, s.
+        value_s: f64,
+    },
+    /// A force record for the fixed-step integrator must be uniformly sampled.
+    #[error(
+        "force record is not uniformly sampled: interval before sample {index} is {found_s} s, \
+         expected {expected_s} s (within 1e-6 relative)"
+    )]
+    NonUniform {
+        /// Zero-based sample index.
+        index: usize,
+        /// The mean interval, s.
+        expected_s: f64,
+        /// The offending interval, s.
+        found_s: f64,
+    },
+    /// The integration step does not divide the sample interval.
+    #[error(
+        "step_s = {step_s} s does not divide the sample interval {sample_interval_s} s into a \
+         whole number of steps (use sample_interval / k for an integer k >= 1)"
+    )]
+    StepNotDivisor {
+        /// The requested step, s.
+        step_s: f64,
+        /// The record's sample interval, s.
+        sample_interval_s: f64,
+    },
+    /// A step size that is not a finite positive number.
+    #[error("step_s = {step_s} is invalid: expected a finite number > 0")]
+    InvalidStep {
+        /// The requested step, s.
+        step_s: f64,
+    },
+    /// More output samples were requested than the record holds.
+    #[error("{requested} samples requested but the record holds only {available}")]
+    RecordTooShort {
+        /// Requested sample count.
+        requested: usize,
+        /// Samples in the record.
+        available: usize,
+    },
+    /// The initial state is not finite.
+    #[error("initial state u = {u_m} m, v = {v_m_s} m/s is not finite")]
+    InvalidInitialState {
+        /// Initial displacement, m.
+        u_m: f64,
+        /// Initial velocity, m/s.
+        v_m_s: f64,
+    },
+    /// The state became NaN or infinite.
+    #[error(
+        "numerical failure at t = {t_s} s: state became non-finite (u = {u_m} m, v = {v_m_s} m/s)"
+    )]
+    NonFiniteState {
+        /// Time of the failure, s.
+        t_s: f64,
+        /// Displacement, m.
+        u_m: f64,
+        /// Velocity, m/s.
+        v_m_s: f64,
+    },
+    /// The stick-slip event loop stopped advancing inside one step.
+    #[error("numerical failure at t = {t_s} s: {events} stick-slip events inside one step; the event loop does not advance")]
+    EventLoopStalled {
+        /// Time of the failure, s.
+        t_s: f64,
+        /// Events handled inside the step.
+        events: u32,
+    },
+}
+
+/// Result alias of this crate.
+pub type Result<T, E = IntegrateError> = std::result::Result<T, E>;

@@ -1,0 +1,220 @@
+//! Output of a run: one [`Sample`] per input sample time, delivered to a [`SampleSink`].
+
+use platen_model::{ForceTerms, TableLimits};
+
+/// The state of the platen and the decomposition of the actuator force at one output time.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    /// Zero-based index of the input sample.
+    pub index: usize,
+    /// Time, s (the input record's own time stamp).
+    pub t_s: f64,
+    /// Displacement, m.
+    pub u_m: f64,
+    /// Velocity, m/s.
+    pub v_m_s: f64,
+    /// Acceleration, m/s² (0 while stuck; the right-hand limit after an event).
+    pub a_m_s2: f64,
+    /// Force decomposition `F_I + F_E + F_D = F_A`, N. While stuck `F_D` is the static
+    /// friction reaction `F_A − F_E(u)`.
+    pub terms: ForceTerms,
+    /// Whether the platen is stuck (friction holds it at rest).
+    pub stuck: bool,
+}
+
+/// Receives the samples of a run in time order.
+pub trait SampleSink {
+    /// Called once per output sample, in order of `index`.
+    fn accept(&mut self, sample: &Sample);
+}
+
+impl<A: SampleSink, B: SampleSink> SampleSink for (A, B) {
+    #[inline]
+    fn accept(&mut self, sample: &Sample) {
+        self.0.accept(sample);
+        self.1.accept(sample);
+    }
+}
+
+impl<S: SampleSink + ?Sized> SampleSink for &mut S {
+    #[inline]
+    fn accept(&mut self, sample: &Sample) {
+        (**self).accept(sample);
+    }
+}
+
+/// A run kept in memory as the contract's columns.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Trajectory {
+    /// Time, s.
+    pub t_s: Vec<f64>,
+    /// Displacement, m.
+    pub u_m: Vec<f64>,
+    /// Velocity, m/s.
+    pub v_m_s: Vec<f64>,
+    /// Acceleration, m/s².
+    pub a_m_s2: Vec<f64>,
+    /// Actuator force `F_A`, N.
+    pub force_n: Vec<f64>,
+    /// Inertial force `F_I`, N.
+    pub inertial_force_n: Vec<f64>,
+    /// Elastic force `F_E`, N.
+    pub elastic_force_n: Vec<f64>,
+    /// Dissipative force `F_D`, N.
+    pub dissipative_force_n: Vec<f64>,
+}
+
+impl Trajectory {
+    /// An empty trajectory with room for `n` samples.
+    pub fn with_capacity(n: usize) -> Self {
+        let v = || Vec::with_capacity(n);
+        Self {
+            t_s: v(),
+            u_m: v(),
+            v_m_s: v(),
+            a_m_s2: v(),
+            force_n: v(),
+            inertial_force_n: v(),
+            elastic_force_n: v(),
+            dissipative_force_n: v(),
+        }
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.t_s.len()
+    }
+
+    /// Whether no sample has been stored.
+    pub fn is_empty(&self) -> bool {
+        self.t_s.is_empty()
+    }
+
+    /// Column names of the contract, in the order of [`Trajectory::columns`].
+    pub const COLUMN_NAMES: [&'static str; 8] = [
+        "t_s",
+        "u_m",
+        "v_m_s",
+        "a_m_s2",
+        "force_n",
+        "inertial_force_n",
+        "elastic_force_n",
+        "dissipative_force_n",
+    ];
+
+    /// The columns in the order of [`Trajectory::COLUMN_NAMES`].
+    pub fn columns(&self) -> [&[f64]; 8] {
+        [
+            &self.t_s,
+            &self.u_m,
+            &self.v_m_s,
+            &self.a_m_s2,
+            &self.force_n,
+            &self.inertial_force_n,
+            &self.elastic_force_n,
+            &self.dissipative_force_n,
+        ]
+    }
+}
+
+impl SampleSink for Trajectory {
+    #[inline]
+    fn accept(&mut self, s: &Sample) {
+        self.t_s.push(s.t_s);
+        self.u_m.push(s.u_m);
+        self.v_m_s.push(s.v_m_s);
+        self.a_m_s2.push(s.a_m_s2);
+        self.force_n.push(s.terms.actuator_n);
+        self.inertial_force_n.push(s.terms.inertial_n);
+        self.elastic_force_n.push(s.terms.elastic_n);
+        self.dissipative_force_n.push(s.terms.dissipative_n);
+    }
+}
+
+/// The largest absolute value of a quantity and when it occurred.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Peak {
+    /// The signed value with the largest magnitude.
+    pub value: f64,
+    /// Its time, s.
+    pub t_s: f64,
+}
+
+impl Peak {
+    #[inline]
+    fn update(&mut self, value: f64, t_s: f64) {
+        if value.abs() > self.value.abs() {
+            self.value = value;
+            self.t_s = t_s;
+        }
+    }
+}
+
+/// Peaks of a run accumulated as samples stream past (memory does not grow with length).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Peaks {
+    /// Samples seen.
+    pub samples: usize,
+    /// First and last time seen, s.
+    pub span_s: (f64, f64),
+    /// Peak displacement, m.
+    pub u_m: Peak,
+    /// Peak velocity, m/s.
+    pub v_m_s: Peak,
+    /// Peak acceleration, m/s².
+    pub a_m_s2: Peak,
+    /// Peak actuator force, N.
+    pub force_n: Peak,
+    /// Samples at which the platen was stuck.
+    pub stuck_samples: usize,
+}
+
+impl SampleSink for Peaks {
+    #[inline]
+    fn accept(&mut self, s: &Sample) {
+        if self.samples == 0 {
+            self.span_s.0 = s.t_s;
+        }
+        self.samples += 1;
+        self.span_s.1 = s.t_s;
+        self.u_m.update(s.u_m, s.t_s);
+        self.v_m_s.update(s.v_m_s, s.t_s);
+        self.a_m_s2.update(s.a_m_s2, s.t_s);
+        self.force_n.update(s.terms.actuator_n, s.t_s);
+        self.stuck_samples += usize::from(s.stuck);
+    }
+}
+
+/// A table limit that a run exceeds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Exceedance {
+    /// Which limit: `"stroke"`, `"velocity"`, `"acceleration"` or `"force"`.
+    pub quantity: &'static str,
+    /// The run's peak (signed), in SI units.
+    pub peak: f64,
+    /// The limit, in SI units.
+    pub limit: f64,
+    /// When the peak occurred, s.
+    pub t_s: f64,
+}
+
+impl Peaks {
+    /// The limits of `limits` that these peaks exceed.
+    pub fn exceedances(&self, limits: &TableLimits) -> Vec<Exceedance> {
+        [
+            ("stroke", self.u_m, limits.stroke_m),
+            ("velocity", self.v_m_s, limits.velocity_m_s),
+            ("acceleration", self.a_m_s2, limits.acceleration_m_s2),
+            ("force", self.force_n, limits.force_n),
+        ]
+        .into_iter()
+        .filter(|(_, peak, limit)| peak.value.abs() > *limit)
+        .map(|(quantity, peak, limit)| Exceedance {
+            quantity,
+            peak: peak.value,
+            limit,
+            t_s: peak.t_s,
+        })
+        .collect()
+    }
+}

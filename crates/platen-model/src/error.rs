@@ -1,0 +1,80 @@
+//! Errors raised when model parameters are built.
+
+/// Why a set of model parameters was rejected.
+#[non_exhaustive]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ModelError {
+    /// A parameter is non-finite or outside its physical range.
+    #[error("parameter `{name}` = {value} is invalid: expected {expected}")]
+    InvalidParameter {
+        /// Name of the parameter, as in the contract (SI unit in the name).
+        name: &'static str,
+        /// The rejected value.
+        value: f64,
+        /// What a valid value looks like.
+        expected: &'static str,
+    },
+    /// A preset name that does not exist.
+    #[error("unknown preset `{name}`: expected one of {known}")]
+    UnknownPreset {
+        /// The name that was asked for.
+        name: String,
+        /// The preset names that exist, comma separated.
+        known: &'static str,
+    },
+}
+
+/// Result alias of this crate.
+pub type Result<T, E = ModelError> = std::result::Result<T, E>;
+
+/// Checks that `value` is finite and `> 0`.
+pub(crate) fn positive(name: &'static str, value: f64) -> Result<f64> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(ModelError::InvalidParameter {
+            name,
+            value,
+            expected: "a finite number > 0",
+        })
+    }
+}
+
+/// Checks that `value` is finite and `>= 0`.
+pub(crate) fn non_negative(name: &'static str, value: f64) -> Result<f64> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(ModelError::InvalidParameter {
+            name,
+            value,
+            expected: "a finite number >= 0",
+        })
+    }
+}
+
+/// Checks that `value` is finite (any sign).
+pub(crate) fn finite(name: &'static str, value: f64) -> Result<f64> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(ModelError::InvalidParameter {
+            name,
+            value,
+            expected: "a finite number",
+        })
+    }
+}
+
+/// Checks that an exponent lies in `[0, 1]`.
+pub(crate) fn unit_exponent(name: &'static str, value: f64) -> Result<f64> {
+    if value.is_finite() && (0.0..=1.0).contains(&value) {
+        Ok(value)
+    } else {
+        Err(ModelError::InvalidParameter {
+            name,
+            value,
+            expected: "an exponent in [0, 1]",
+        })
+    }
+}

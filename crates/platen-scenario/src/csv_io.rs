@@ -1,0 +1,1101 @@
+//! Time-series CSV reading and atomic writing.
+//!
+//! # Conventions
+//!
+//! * **Format.** Comma separated, UTF-8, one header row followed by one row per sample. Fields may
+//!   be quoted as usual in CSV. Line endings `\n` or `\r\n`. A UTF-8 byte-order mark before the
+//!   first header name is tolerated. Comment lines are **not** supported. Blank lines at the end of
+//!   the file are ignored; a blank line anywhere else is an error (so that line numbers in error
+//!   messages are always those a text editor shows).
+//! * **Columns are selected by name**, never by position: extra columns are allowed and ignored,
+//!   and column order does not matter. Header names are trimmed of surrounding whitespace.
+//! * **SI units, unit in the name**: `t_s` (time, s), `u_m` (displacement, m), `v_m_s`
+//!   (velocity, m/s), `a_m_s2` (acceleration, m/s²), `force_n` (force, N); simulated output adds
+//!   `inertial_force_n`, `elastic_force_n`, `dissipative_force_n`.
+//! * **Numbers.** Every selected cell must parse as a finite `f64` after trimming whitespace
+//!   (`1`, `-2.5`, `1e-3`, `.5`, …). `nan`, `inf`, `Infinity` and values that overflow `f64` are
+//!   rejected. Whenever `t_s` is selected it must increase strictly.
+//! * **Line numbers** in errors are 1-based as a text editor shows them; the header is line 1.
+//! * **Writing** prints numbers with Rust's `{}` formatting of `f64` (`0.001`, `-2.5`, `3`), or
+//!   with `{:e}` (`1e-300`, `1.7976931348623157e308`) when the magnitude is below 1e-5 or at
+//!   least 1e16, where `{}` would spell out hundreds of zeros. Both give the shortest text that
+//!   parses back to the identical value, so a write → read round trip is bit-exact and output is
+//!   deterministic. Files are replaced atomically: written to a temporary file in the same
+//!   directory, synced, then renamed over the destination.
+
+use std::fs::{self, File, OpenOptions};
+use std::io::{self, BufWriter, Read, Seek, SeekFrom, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use csv::{ReaderBuilder, StringRecord, Terminator};
+
+use crate::error::{Result, ScenarioError};
+
+/// Name of the time column, s. Whenever it is selected it must increase strictly.
+pub const TIME_COLUMN: &str = "t_s";
+
+/// Capacity of the read and write buffers, bytes.
+const BUFFER_BYTES: usize = 1 << 16;
+
+/// Longest cell text quoted verbatim in an error message, characters.
+const MAX_QUOTED_CHARS: usize = 80;
+
+/// Numeric columns read from a CSV file, selected by name.
+///
+/// All columns have the same length, [`Table::len`]. Columns appear in the order they were
+/// requested (required first, then the optional columns that were present).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Table {
+    path: PathBuf,
+    names: Vec<String>,
+    columns: Vec<Vec<f64>>,
+    rows: usize,
+}
+
+impl Table {
+    /// The values of column `name`, or `None` if that column was not read (an optional column
+    /// absent from the file, a column not requested, or one already taken with
+    /// [`Table::take_column`]).
+    pub fn column(&self, name: &str) -> Option<&[f64]> {
+        self.position(name).map(|i| self.columns[i].as_slice())
+    }
+
+    /// Removes column `name` from the table and returns its values without copying them.
+    pub fn take_column(&mut self, name: &str) -> Option<Vec<f64>> {
+        let i = self.position(name)?;
+        self.names.remove(i);
+        Some(self.columns.remove(i))
+    }
+
+    /// Whether column `name` was read.
+    pub fn has_column(&self, name: &str) -> bool {
+        self.position(name).is_some()
+    }
+
+    /// Names of the columns held, in the order they were requested.
+    pub fn column_names(&self) -> impl Iterator<Item = &str> + '_ {
+        self.names.iter().map(String::as_str)
+    }
+
+    /// Number of data rows (samples).
+    pub fn len(&self) -> usize {
+        self.rows
+    }
+
+    /// Whether the table has no data rows. Never true for a table returned by [`read_table`].
+    pub fn is_empty(&self) -> bool {
+        self.rows == 0
+    }
+
+    /// The file the table was read from, for error messages.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    fn position(&self, name: &str) -> Option<usize> {
+        self.names.iter().position(|n| n == name)
+    }
+}
+
+/// Reads the columns `required` and, where present, `optional` from the CSV file at `path`.
+///
+/// See the [module documentation](self) for the format. Errors:
+/// [`Io`](ScenarioError::Io) if the file cannot be read,
+/// [`CsvSyntax`](ScenarioError::CsvSyntax) for malformed CSV (invalid UTF-8, a blank line before
+/// the header or inside the data), [`MissingColumn`](ScenarioError::MissingColumn) if a required
+/// column is not in the header, [`DuplicateColumn`](ScenarioError::DuplicateColumn) if a
+/// selected name appears twice in the header, [`RaggedRow`](ScenarioError::RaggedRow) if a row's
+/// field count differs from the header's, [`NonNumeric`](ScenarioError::NonNumeric) /
+/// [`NonFinite`](ScenarioError::NonFinite) for a bad cell in a selected column,
+/// [`TimeNotIncreasing`](ScenarioError::TimeNotIncreasing) if `t_s` is selected and does not
+/// increase strictly, and [`Empty`](ScenarioError::Empty) if there is no data row.
+///
+/// A name listed twice (or in both lists) is read once.
+pub fn read_table(path: &Path, required: &[&str], optional: &[&str]) -> Result<Table> {
+    let read_error = |source| ScenarioError::Io {
+        path: path.to_path_buf(),
+        action: "reading",
+        source,
+    };
+    let mut file = File::open(path).map_err(read_error)?;
+    let unterminated_end = unterminated_end(&mut file).map_err(read_error)?;
+    // Only `\n` ends a record, so that every record consumes its own line end and the csv
+    // crate's line counts stay exact; the `\r` of a `\r\n` line end is trimmed with the field.
+    let mut reader = ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .terminator(Terminator::Any(b'\n'))
+        .buffer_capacity(BUFFER_BYTES)
+        .from_reader(file);
+    let mut record = StringRecord::new();
+
+    // Header row.
+    if !reader
+        .read_record(&mut record)
+        .map_err(|e| csv_error(path, e, 1))?
+    {
+        return Err(ScenarioError::Empty {
+            path: path.to_path_buf(),
+        });
+    }
+    let (_, skipped) = locate(&record, reader.position(), unterminated_end);
+    if skipped > 0 {
+        return Err(syntax(
+            path,
+            1,
+            "expected the header row on line 1, found a blank line",
+        ));
+    }
+    let header: Vec<String> = record
+        .iter()
+        .enumerate()
+        .map(|(i, name)| {
+            let name = if i == 0 {
+                name.trim_start_matches('\u{feff}')
+            } else {
+                name
+            };
+            name.trim().to_owned()
+        })
+        .collect();
+    let selection = select_columns(path, &header, required, optional)?;
+    let time_slot = selection.iter().position(|(_, name)| name == TIME_COLUMN);
+
+    let mut columns: Vec<Vec<f64>> = vec![Vec::new(); selection.len()];
+    let mut rows = 0usize;
+    let mut previous_t = f64::NEG_INFINITY;
+    // First blank line seen; an error unless only blank lines follow.
+    let mut blank_line: Option<u64> = None;
+
+    loop {
+        let more = reader
+            .read_record(&mut record)
+            .map_err(|e| csv_error(path, e, reader.position().line()))?;
+        if !more {
+            break;
+        }
+        let (line, skipped) = locate(&record, reader.position(), unterminated_end);
+        if skipped > 0 {
+            // The csv crate silently skips empty lines.
+            blank_line.get_or_insert(line - skipped);
+        }
+        if is_blank(&record) {
+            blank_line.get_or_insert(line);
+            continue;
+        }
+        if let Some(blank) = blank_line {
+            return Err(syntax(
+                path,
+                blank,
+                "blank line inside the data (only trailing blank lines are allowed)",
+            ));
+        }
+        if record.len() != header.len() {
+            return Err(ScenarioError::RaggedRow {
+                path: path.to_path_buf(),
+                line,
+                expected: header.len(),
+                found: record.len(),
+            });
+        }
+        for ((index, name), column) in selection.iter().zip(columns.iter_mut()) {
+            let cell = record.get(*index).unwrap_or_default();
+            column.push(parse_cell(path, line, name, cell)?);
+        }
+        if let Some(slot) = time_slot {
+            let t = columns[slot][rows];
+            if t <= previous_t {
+                return Err(ScenarioError::TimeNotIncreasing {
+                    path: path.to_path_buf(),
+                    line,
+                    previous_s: previous_t,
+                    value_s: t,
+                });
+            }
+            previous_t = t;
+        }
+        rows += 1;
+    }
+
+    if rows == 0 {
+        return Err(ScenarioError::Empty {
+            path: path.to_path_buf(),
+        });
+    }
+    Ok(Table {
+        path: path.to_path_buf(),
+        names: selection.into_iter().map(|(_, name)| name).collect(),
+        columns,
+        rows,
+    })
+}
+
+/// Resolves the requested names to header indices: `(index in the header, name)`.
+fn select_columns(
+    path: &Path,
+    header: &[String],
+    required: &[&str],
+    optional: &[&str],
+) -> Result<Vec<(usize, String)>> {
+    let mut selection: Vec<(usize, String)> = Vec::with_capacity(required.len() + optional.len());
+    let requests = required
+        .iter()
+        .map(|name| (*name, true))
+        .chain(optional.iter().map(|name| (*name, false)));
+    for (name, is_required) in requests {
+        if selection.iter().any(|(_, selected)| selected == name) {
+            continue;
+        }
+        let mut matches = header
+            .iter()
+            .enumerate()
+            .filter(|(_, h)| h.as_str() == name);
+        match (matches.next(), matches.next()) {
+            (Some((index, _)), None) => selection.push((index, name.to_owned())),
+            (Some(_), Some(_)) => {
+                return Err(ScenarioError::DuplicateColumn {
+                    path: path.to_path_buf(),
+                    column: name.to_owned(),
+                })
+            }
+            (None, _) if is_required => {
+                return Err(ScenarioError::MissingColumn {
+                    path: path.to_path_buf(),
+                    column: name.to_owned(),
+                    available: header.to_vec(),
+                })
+            }
+            (None, _) => {}
+        }
+    }
+    Ok(selection)
+}
+
+/// Parses one cell of a selected column as a finite `f64`.
+#[inline]
+fn parse_cell(path: &Path, line: u64, column: &str, cell: &str) -> Result<f64> {
+    let text = cell.trim();
+    match text.parse::<f64>() {
+        Ok(value) if value.is_finite() => Ok(value),
+        Ok(_) => Err(ScenarioError::NonFinite {
+            path: path.to_path_buf(),
+            line,
+            column: column.to_owned(),
+            value: quote_cell(text),
+        }),
+        Err(_) => Err(ScenarioError::NonNumeric {
+            path: path.to_path_buf(),
+            line,
+            column: column.to_owned(),
+            value: quote_cell(text),
+        }),
+    }
+}
+
+/// Cell text for an error message, shortened if very long.
+fn quote_cell(text: &str) -> String {
+    match text.char_indices().nth(MAX_QUOTED_CHARS) {
+        Some((end, _)) => format!("{}…", &text[..end]),
+        None => text.to_owned(),
+    }
+}
+
+/// If the regular file `file` does not end with `\n`, its length: the byte offset at which its
+/// last record ends without a line end. `None` for files ending with `\n`, empty files and
+/// files that cannot seek (pipes). Leaves `file` positioned at its start.
+fn unterminated_end(file: &mut File) -> io::Result<Option<u64>> {
+    let metadata = file.metadata()?;
+    if !metadata.is_file() || metadata.len() == 0 {
+        return Ok(None);
+    }
+    file.seek(SeekFrom::End(-1))?;
+    let mut last = [0u8];
+    file.read_exact(&mut last)?;
+    file.rewind()?;
+    Ok((last[0] != b'\n').then_some(metadata.len()))
+}
+
+/// Where the text of `record` starts: `(1-based line, empty lines skipped before it)`.
+///
+/// The csv crate sets a record's position *before* skipping empty lines, and counts every `\n`
+/// it consumes: the empty lines skipped, those inside quoted fields, and the record's own line
+/// end (absent only on an unterminated last line). `end` is the reader's position after the
+/// record; `unterminated_end` as returned by [`unterminated_end`].
+fn locate(record: &StringRecord, end: &csv::Position, unterminated_end: Option<u64>) -> (u64, u64) {
+    let start = record.position().map_or(end.line(), csv::Position::line);
+    let span = end.line().saturating_sub(start);
+    if span == 0 {
+        return (start, 0);
+    }
+    let terminated = u64::from(unterminated_end != Some(end.byte()));
+    let quoted = if span > terminated {
+        record.iter().map(|f| f.matches('\n').count() as u64).sum()
+    } else {
+        0
+    };
+    let skipped = span.saturating_sub(quoted + terminated);
+    (start + skipped, skipped)
+}
+
+/// Whether a record is a line holding nothing but whitespace.
+fn is_blank(record: &StringRecord) -> bool {
+    record.len() == 1 && record[0].trim().is_empty()
+}
+
+fn syntax(path: &Path, line: u64, message: &str) -> ScenarioError {
+    ScenarioError::CsvSyntax {
+        path: path.to_path_buf(),
+        line,
+        message: message.to_owned(),
+    }
+}
+
+/// Converts an error of the `csv` crate; `line` is used when the error carries no position.
+fn csv_error(path: &Path, error: csv::Error, line: u64) -> ScenarioError {
+    let position_line = error.position().map(csv::Position::line);
+    match error.into_kind() {
+        csv::ErrorKind::Io(source) => ScenarioError::Io {
+            path: path.to_path_buf(),
+            action: "reading",
+            source,
+        },
+        csv::ErrorKind::Utf8 { pos, err } => ScenarioError::CsvSyntax {
+            path: path.to_path_buf(),
+            line: pos.map_or(line, |p| p.line()),
+            message: format!("field {} is not valid UTF-8 text", err.field() + 1),
+        },
+        // Other kinds (unequal lengths, seek, serde) cannot occur when reading flexible
+        // `StringRecord`s; report them anyway.
+        other => ScenarioError::CsvSyntax {
+            path: path.to_path_buf(),
+            line: position_line.unwrap_or(line),
+            message: format!("{other:?}"),
+        },
+    }
+}
+
+/// Counter making temporary file names unique within the process.
+static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);
+
+/// Writes a time-series CSV file atomically: `header[j]` names `columns[j]`.
+///
+/// Numbers are printed as the shortest text that parses back to the same `f64` (`{}`
+/// formatting, or `{:e}` for magnitudes below 1e-5 or from 1e16 on); lines end with `\n`. All columns must have the same length
+/// ([`ColumnLengthMismatch`](ScenarioError::ColumnLengthMismatch)), there must be one name per
+/// column ([`HeaderMismatch`](ScenarioError::HeaderMismatch)), names must be non-empty and need no
+/// CSV quoting ([`InvalidColumnName`](ScenarioError::InvalidColumnName)), and every value must
+/// be finite ([`NonFinite`](ScenarioError::NonFinite), naming the line the value would have had),
+/// so that every file written can be read back by [`read_table`].
+///
+/// The data go to a temporary file in the same directory (`.NAME.PID.N.tmp`), which is flushed,
+/// synced and renamed over `path`. On any error the temporary file is removed and an existing
+/// file at `path` is left untouched.
+pub fn write_csv_atomic(path: &Path, header: &[&str], columns: &[&[f64]]) -> Result<()> {
+    if header.len() != columns.len() {
+        return Err(ScenarioError::HeaderMismatch {
+            path: path.to_path_buf(),
+            names: header.len(),
+            columns: columns.len(),
+        });
+    }
+    for name in header {
+        let needs_quoting = name.contains([',', '"', '\n', '\r']);
+        if name.is_empty() || needs_quoting || name.trim() != *name {
+            return Err(ScenarioError::InvalidColumnName {
+                path: path.to_path_buf(),
+                column: (*name).to_owned(),
+            });
+        }
+    }
+    let rows = columns.first().map_or(0, |c| c.len());
+    for (name, column) in header.iter().zip(columns) {
+        if column.len() != rows {
+            return Err(ScenarioError::ColumnLengthMismatch {
+                path: path.to_path_buf(),
+                column: (*name).to_owned(),
+                expected: rows,
+                found: column.len(),
+            });
+        }
+    }
+
+    write_atomic(path, |out| {
+        let io = |source| write_error(path, source);
+        out.write_all(header.join(",").as_bytes()).map_err(io)?;
+        out.write_all(b"\n").map_err(io)?;
+        for row in 0..rows {
+            for (j, (name, column)) in header.iter().zip(columns).enumerate() {
+                let value = column[row];
+                if !value.is_finite() {
+                    return Err(ScenarioError::NonFinite {
+                        path: path.to_path_buf(),
+                        line: row as u64 + 2,
+                        column: (*name).to_owned(),
+                        value: value.to_string(),
+                    });
+                }
+                if j > 0 {
+                    out.write_all(b",").map_err(io)?;
+                }
+                write_number(out, value).map_err(io)?;
+            }
+            out.write_all(b"\n").map_err(io)?;
+        }
+        Ok(())
+    })
+}
+
+/// Writes `bytes` to `path` atomically, as [`write_csv_atomic`] does (for JSON outputs).
+pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_atomic(path, |out| {
+        out.write_all(bytes)
+            .map_err(|source| write_error(path, source))
+    })
+}
+
+/// Writes a finite `value` as the shortest text that parses back to it (see the module docs).
+#[inline]
+fn write_number<W: Write>(out: &mut W, value: f64) -> io::Result<()> {
+    let magnitude = value.abs();
+    if magnitude == 0.0 || (1e-5..1e16).contains(&magnitude) {
+        write!(out, "{value}")
+    } else {
+        write!(out, "{value:e}")
+    }
+}
+
+fn write_error(path: &Path, source: io::Error) -> ScenarioError {
+    ScenarioError::Io {
+        path: path.to_path_buf(),
+        action: "writing",
+        source,
+    }
+}
+
+/// Runs `fill` on a buffered temporary file next to `path`, then syncs it and renames it over
+/// `path`. Removes the temporary file on any error.
+fn write_atomic<F>(path: &Path, fill: F) -> Result<()>
+where
+    F: FnOnce(&mut BufWriter<File>) -> Result<()>,
+{
+    let Some(file_name) = path.file_name() else {
+        return Err(write_error(
+            path,
+            io::Error::new(io::ErrorKind::InvalidInput, "the path names no file"),
+        ));
+    };
+    let dir = match path.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
+        _ => Path::new("."),
+    };
+    let temp = dir.join(format!(
+        ".{}.{}.{}.tmp",
+        file_name.to_string_lossy(),
+        std::process::id(),
+        TEMP_COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    let file = OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&temp)
+        .map_err(|source| ScenarioError::Io {
+            path: path.to_path_buf(),
+            action: "creating a temporary file next to",
+            source,
+        })?;
+
+    let result = (|| {
+        let mut out = BufWriter::with_capacity(BUFFER_BYTES, file);
+        fill(&mut out)?;
+        let file = out
+            .into_inner()
+            .map_err(|e| write_error(path, e.into_error()))?;
+        file.sync_all()
+            .map_err(|source| write_error(path, source))?;
+        drop(file);
+        fs::rename(&temp, path).map_err(|source| ScenarioError::Io {
+            path: path.to_path_buf(),
+            action: "renaming the temporary file onto",
+            source,
+        })
+    })();
+
+    match result {
+        Ok(()) => {
+            sync_directory(dir);
+            Ok(())
+        }
+        Err(error) => {
+            // Best effort: the original error is the one worth reporting.
+            let _ = fs::remove_file(&temp);
+            Err(error)
+        }
+    }
+}
+
+/// Makes the rename durable where the platform allows it (best effort).
+fn sync_directory(dir: &Path) {
+    #[cfg(unix)]
+    if let Ok(handle) = File::open(dir) {
+        let _ = handle.sync_all();
+    }
+    #[cfg(not(unix))]
+    let _ = dir;
+}
+
+/// Sample interval of the uniformly sampled time column `t_s` read from `path`, s.
+///
+/// The interval is the mean one, `(t_last − t_first) / (n − 1)`. Every interval must match it
+/// within `1e-6 × interval + 1e-12 s`, else [`NonUniform`](ScenarioError::NonUniform); intervals
+/// that are not positive give [`TimeNotIncreasing`](ScenarioError::TimeNotIncreasing). Fewer
+/// than 2 samples give [`TooShort`](ScenarioError::TooShort). `path` is used for messages only;
+/// line numbers assume the header on line 1 and one sample per line (sample `i`, 0-based, on
+/// line `i + 2`).
+pub fn uniform_step_s(path: &Path, t_s: &[f64]) -> Result<f64> {
+    let n = t_s.len();
+    if n < 2 {
+        return Err(ScenarioError::TooShort {
+            path: path.to_path_buf(),
+            rows: n,
+            needed: 2,
+        });
+    }
+    let step = (t_s[n - 1] - t_s[0]) / (n - 1) as f64;
+    let tolerance = 1e-6 * step.abs() + 1e-12;
+    for (i, pair) in t_s.windows(2).enumerate() {
+        let line = i as u64 + 3;
+        let interval = pair[1] - pair[0];
+        if interval <= 0.0 {
+            return Err(ScenarioError::TimeNotIncreasing {
+                path: path.to_path_buf(),
+                line,
+                previous_s: pair[0],
+                value_s: pair[1],
+            });
+        }
+        let deviation = (interval - step).abs();
+        if deviation.is_nan() || deviation > tolerance {
+            return Err(ScenarioError::NonUniform {
+                path: path.to_path_buf(),
+                line,
+                expected_s: step,
+                found_s: interval,
+            });
+        }
+    }
+    Ok(step)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tempfile::TempDir;
+
+    /// Writes `contents` to `name` in a fresh temporary directory.
+    fn file_with(name: &str, contents: &[u8]) -> (TempDir, PathBuf) {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join(name);
+        fs::write(&path, contents).unwrap();
+        (dir, path)
+    }
+
+    /// Reads `contents` (as file `name`) expecting an error; returns it with its message.
+    fn error_for(
+        name: &str,
+        contents: &str,
+        required: &[&str],
+        optional: &[&str],
+    ) -> (ScenarioError, String) {
+        let (_dir, path) = file_with(name, contents.as_bytes());
+        let error = read_table(&path, required, optional).unwrap_err();
+        let message = error.to_string();
+        assert!(message.contains(name), "no file name in: {message}");
+        (error, message)
+    }
+
+    fn temp_files_in(dir: &Path) -> Vec<String> {
+        fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.starts_with('.') && n.ends_with(".tmp"))
+            .collect()
+    }
+
+    #[test]
+    fn selected_columns_are_read_by_name_whatever_their_order_and_extras_are_ignored() {
+        let (_dir, path) = file_with(
+            "motion.csv",
+            b"note,u_m,t_s,v_m_s\nx,0.5,0,1\ny,0.25,0.001,-2e-3\n",
+        );
+        let table = read_table(&path, &["t_s", "u_m"], &["v_m_s", "a_m_s2"]).unwrap();
+        assert_eq!(table.len(), 2);
+        assert!(!table.is_empty());
+        assert_eq!(table.path(), path);
+        assert_eq!(table.column("t_s").unwrap(), &[0.0, 0.001]);
+        assert_eq!(table.column("u_m").unwrap(), &[0.5, 0.25]);
+        assert_eq!(table.column("v_m_s").unwrap(), &[1.0, -2e-3]);
+        assert_eq!(table.column("a_m_s2"), None);
+        assert_eq!(table.column("note"), None);
+        assert_eq!(
+            table.column_names().collect::<Vec<_>>(),
+            ["t_s", "u_m", "v_m_s"]
+        );
+    }
+
+    #[test]
+    fn a_taken_column_is_moved_out_of_the_table() {
+        let (_dir, path) = file_with("take.csv", b"t_s,force_n\n0,1\n1,2\n");
+        let mut table = read_table(&path, &["t_s", "force_n"], &[]).unwrap();
+        assert_eq!(table.take_column("force_n").unwrap(), vec![1.0, 2.0]);
+        assert!(!table.has_column("force_n"));
+        assert!(table.has_column("t_s"));
+        assert_eq!(table.len(), 2);
+    }
+
+    #[test]
+    fn bom_whitespace_crlf_quotes_and_trailing_blank_lines_are_tolerated() {
+        let (_dir, path) = file_with(
+            "tolerant.csv",
+            "\u{feff} t_s , force_n \r\n 0 ,\" 1.5 \"\r\n1,\"-2\"\r\n\r\n   \n\n".as_bytes(),
+        );
+        let table = read_table(&path, &["t_s", "force_n"], &[]).unwrap();
+        assert_eq!(table.column("t_s").unwrap(), &[0.0, 1.0]);
+        assert_eq!(table.column("force_n").unwrap(), &[1.5, -2.0]);
+    }
+
+    #[test]
+    fn line_numbers_are_exact_with_crlf_line_ends_and_quoted_line_breaks() {
+        let (error, message) = error_for(
+            "crlf.csv",
+            "t_s,u_m\r\n0,\"0\"\r\n1,x\r\n",
+            &["t_s", "u_m"],
+            &[],
+        );
+        assert!(
+            matches!(error, ScenarioError::NonNumeric { line: 3, .. }),
+            "{error:?}"
+        );
+        assert!(message.contains("line 3"), "{message}");
+
+        let (error, _) = error_for(
+            "quoted.csv",
+            "t_s,note,u_m\n0,\"two\nlines\",0\n1,,x",
+            &["t_s", "u_m"],
+            &[],
+        );
+        assert!(
+            matches!(error, ScenarioError::NonNumeric { line: 4, .. }),
+            "{error:?}"
+        );
+    }
+
+    #[test]
+    fn a_missing_file_is_an_io_error_that_says_reading_and_names_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("absent.csv");
+        let error = read_table(&path, &["t_s"], &[]).unwrap_err();
+        let message = error.to_string();
+        assert!(
+            matches!(error, ScenarioError::Io { action: "reading", ref source, .. }
+                if source.kind() == io::ErrorKind::NotFound),
+            "{error:?}"
+        );
+        assert!(
+            message.contains("absent.csv") && message.contains("reading"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn invalid_utf8_is_a_syntax_error_with_its_line() {
+        let (_dir, path) = file_with("bytes.csv", b"t_s,u_m\n0,0\n1,\xff\xfe\n");
+        let error = read_table(&path, &["t_s", "u_m"], &[]).unwrap_err();
+        let message = error.to_string();
+        assert!(
+            matches!(error, ScenarioError::CsvSyntax { line: 3, .. }),
+            "{error:?}"
+        );
+        assert!(
+            message.contains("bytes.csv") && message.contains("line 3"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn a_blank_line_inside_the_data_is_a_syntax_error_with_its_line() {
+        let (error, message) = error_for("gap.csv", "t_s,u_m\n0,0\n\n1,0\n", &["t_s"], &[]);
+        assert!(
+            matches!(error, ScenarioError::CsvSyntax { line: 3, .. }),
+            "{error:?}"
+        );
+        assert!(message.contains("line 3"), "{message}");
+
+        let (error, _) = error_for("gap2.csv", "t_s,u_m\n0,0\n  \n1,0\n", &["t_s"], &[]);
+        assert!(
+            matches!(error, ScenarioError::CsvSyntax { line: 3, .. }),
+            "{error:?}"
+        );
+
+        let (error, _) = error_for("gap_last.csv", "t_s,u_m\n0,0\n\n1,0", &["t_s"], &[]);
+        assert!(
+            matches!(error, ScenarioError::CsvSyntax { line: 3, .. }),
+            "{error:?}"
+        );
+
+        let (error, _) = error_for("gap_crlf.csv", "t_s\r\n0\r\n\r\n1\r\n", &["t_s"], &[]);
+        assert!(
+            matches!(error, ScenarioError::CsvSyntax { line: 3, .. }),
+            "{error:?}"
+        );
+
+        let (error, _) = error_for("gap3.csv", "\nt_s,u_m\n0,0\n", &["t_s"], &[]);
+        assert!(
+            matches!(error, ScenarioError::CsvSyntax { line: 1, .. }),
+            "{error:?}"
+        );
+    }
+
+    #[test]
+    fn a_missing_required_column_is_reported_with_the_available_names() {
+        let (error, message) =
+            error_for("force.csv", "time, force\n0,1\n", &["t_s", "force_n"], &[]);
+        match &error {
+            ScenarioError::MissingColumn {
+                column, available, ..
+            } => {
+                assert_eq!(column, "t_s");
+                assert_eq!(available, &["time", "force"]);
+            }
+            other => panic!("unexpected {other:?}"),
+        }
+        assert!(
+            message.contains("`t_s`") && message.contains("`time`") && message.contains("`force`"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn a_missing_optional_column_is_no_error() {
+        let (_dir, path) = file_with("opt.csv", b"t_s\n0\n");
+        let table = read_table(&path, &["t_s"], &["v_m_s"]).unwrap();
+        assert_eq!(table.column("v_m_s"), None);
+    }
+
+    #[test]
+    fn a_selected_column_appearing_twice_is_a_duplicate_column_error() {
+        let (error, message) = error_for("dup.csv", "t_s,u_m,u_m\n0,1,2\n", &["t_s"], &["u_m"]);
+        assert!(
+            matches!(error, ScenarioError::DuplicateColumn { ref column, .. } if column == "u_m"),
+            "{error:?}"
+        );
+        assert!(
+            message.contains("`u_m`") && message.contains("line 1"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn an_unselected_column_appearing_twice_is_ignored() {
+        let (_dir, path) = file_with("dup_ok.csv", b"x,t_s,x\na,0,b\n");
+        assert_eq!(read_table(&path, &["t_s"], &[]).unwrap().len(), 1);
+    }
+
+    #[test]
+    fn a_non_numeric_cell_is_reported_with_line_column_and_value() {
+        let (error, message) = error_for(
+            "motion.csv",
+            "t_s,u_m,comment\n0,0,a\n0.1,1.2.3,b\n",
+            &["t_s", "u_m"],
+            &[],
+        );
+        assert!(
+            matches!(error, ScenarioError::NonNumeric { line: 3, ref column, ref value, .. }
+                if column == "u_m" && value == "1.2.3"),
+            "{error:?}"
+        );
+        assert!(
+            message.contains("line 3") && message.contains("`u_m`") && message.contains("1.2.3"),
+            "{message}"
+        );
+
+        let (error, _) = error_for("empty_cell.csv", "t_s,u_m\n0, \n", &["t_s", "u_m"], &[]);
+        assert!(
+            matches!(error, ScenarioError::NonNumeric { line: 2, .. }),
+            "{error:?}"
+        );
+    }
+
+    #[test]
+    fn nan_and_infinite_cells_are_non_finite_errors() {
+        for text in [
+            "nan",
+            "NaN",
+            "inf",
+            "-inf",
+            "+inf",
+            "Infinity",
+            "-infinity",
+            "1e400",
+        ] {
+            let contents = format!("t_s,force_n\n0,1\n1,{text}\n");
+            let (error, message) = error_for("force.csv", &contents, &["t_s", "force_n"], &[]);
+            assert!(
+                matches!(error, ScenarioError::NonFinite { line: 3, ref column, ref value, .. }
+                    if column == "force_n" && value == text),
+                "{text}: {error:?}"
+            );
+            assert!(
+                message.contains("line 3")
+                    && message.contains("`force_n`")
+                    && message.contains(text),
+                "{message}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_file_without_data_rows_is_empty() {
+        for contents in ["", "t_s,u_m\n", "t_s,u_m\n\n \n"] {
+            let (error, message) = error_for("nothing.csv", contents, &["t_s"], &[]);
+            assert!(matches!(error, ScenarioError::Empty { .. }), "{error:?}");
+            assert!(message.contains("no data rows"), "{message}");
+        }
+    }
+
+    #[test]
+    fn time_that_does_not_increase_strictly_is_reported_with_both_values() {
+        let (error, message) = error_for(
+            "time.csv",
+            "t_s,u_m\n0,0\n0.5,0\n0.25,0\n",
+            &["u_m"],
+            &["t_s"],
+        );
+        assert!(
+            matches!(error, ScenarioError::TimeNotIncreasing { line: 4, previous_s, value_s, .. }
+                if previous_s == 0.5 && value_s == 0.25),
+            "{error:?}"
+        );
+        assert!(
+            message.contains("line 4")
+                && message.contains("`t_s`")
+                && message.contains("0.5")
+                && message.contains("0.25"),
+            "{message}"
+        );
+
+        let (error, _) = error_for("repeat.csv", "t_s\n0\n1\n1\n", &["t_s"], &[]);
+        assert!(
+            matches!(error, ScenarioError::TimeNotIncreasing { line: 4, .. }),
+            "{error:?}"
+        );
+    }
+
+    #[test]
+    fn rows_with_too_many_or_too_few_fields_are_ragged() {
+        let (error, message) =
+            error_for("ragged.csv", "t_s,u_m\n0,0\n1,0,9\n", &["t_s", "u_m"], &[]);
+        assert!(
+            matches!(
+                error,
+                ScenarioError::RaggedRow {
+                    line: 3,
+                    expected: 2,
+                    found: 3,
+                    ..
+                }
+            ),
+            "{error:?}"
+        );
+        assert!(message.contains("line 3"), "{message}");
+
+        let (error, _) = error_for("short.csv", "t_s,u_m,x\n0,0\n", &["t_s"], &[]);
+        assert!(
+            matches!(
+                error,
+                ScenarioError::RaggedRow {
+                    line: 2,
+                    expected: 3,
+                    found: 2,
+                    ..
+                }
+            ),
+            "{error:?}"
+        );
+    }
+
+    #[test]
+    fn write_then_read_is_bit_exact_for_awkward_values() {
+        let awkward = [
+            1e-300,
+            -0.0,
+            0.1 + 0.2,
+            // More digits than an f64 holds (a literal would trip clippy).
+            "123456789.123456789".parse().unwrap(),
+            f64::MIN_POSITIVE,
+            5e-324,
+            f64::MAX,
+            -1.0 / 3.0,
+            0.0,
+        ];
+        let t: Vec<f64> = (0..awkward.len()).map(|i| i as f64 / 1024.0).collect();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("round_trip.csv");
+        write_csv_atomic(&path, &["t_s", "force_n"], &[&t, &awkward]).unwrap();
+        let table = read_table(&path, &["force_n", "t_s"], &[]).unwrap();
+        let back = table.column("force_n").unwrap();
+        assert_eq!(back.len(), awkward.len());
+        for (a, b) in awkward.iter().zip(back) {
+            assert_eq!(a.to_bits(), b.to_bits(), "{a:e} came back as {b:e}");
+        }
+        assert_eq!(table.column("t_s").unwrap(), t.as_slice());
+        let text = fs::read_to_string(&path).unwrap();
+        assert!(
+            text.starts_with(
+                "t_s,force_n\n0,1e-300\n0.0009765625,-0\n0.001953125,0.30000000000000004\n"
+            ),
+            "{text}"
+        );
+        assert!(text.contains(",1.7976931348623157e308\n"), "{text}");
+        assert!(temp_files_in(dir.path()).is_empty());
+    }
+
+    #[test]
+    fn writing_replaces_an_existing_file_and_leaves_no_temporary_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.json");
+        fs::write(&path, "old").unwrap();
+        write_bytes_atomic(&path, b"{\"new\": true}\n").unwrap();
+        assert_eq!(fs::read_to_string(&path).unwrap(), "{\"new\": true}\n");
+        write_csv_atomic(&dir.path().join("out.csv"), &["t_s"], &[&[0.0]]).unwrap();
+        assert!(temp_files_in(dir.path()).is_empty());
+    }
+
+    #[test]
+    fn a_write_that_cannot_create_its_temporary_file_fails_and_touches_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let existing = dir.path().join("keep.csv");
+        fs::write(&existing, "t_s\n0\n").unwrap();
+        let target = dir.path().join("no_such_dir").join("out.csv");
+        let error = write_csv_atomic(&target, &["t_s"], &[&[1.0]]).unwrap_err();
+        let message = error.to_string();
+        assert!(matches!(error, ScenarioError::Io { .. }), "{error:?}");
+        assert!(
+            message.contains("out.csv") && message.contains("temporary"),
+            "{message}"
+        );
+        assert!(!target.exists());
+        assert_eq!(fs::read_to_string(&existing).unwrap(), "t_s\n0\n");
+        assert!(write_bytes_atomic(&target, b"x").is_err());
+        assert!(temp_files_in(dir.path()).is_empty());
+    }
+
+    #[test]
+    fn a_write_that_fails_midway_leaves_the_previous_file_intact() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("result.csv");
+        fs::write(&path, "t_s,u_m\n0,1\n").unwrap();
+        let error = write_csv_atomic(
+            &path,
+            &["t_s", "u_m"],
+            &[&[0.0, 1.0, 2.0], &[0.0, 1.0, f64::NAN]],
+        )
+        .unwrap_err();
+        let message = error.to_string();
+        assert!(
+            matches!(error, ScenarioError::NonFinite { line: 4, ref column, .. } if column == "u_m"),
+            "{error:?}"
+        );
+        assert!(
+            message.contains("result.csv")
+                && message.contains("line 4")
+                && message.contains("`u_m`"),
+            "{message}"
+        );
+        assert_eq!(fs::read_to_string(&path).unwrap(), "t_s,u_m\n0,1\n");
+        assert!(temp_files_in(dir.path()).is_empty());
+    }
+
+    #[test]
+    fn writing_inconsistent_columns_is_refused_before_touching_the_disk() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("bad.csv");
+
+        let error = write_csv_atomic(&path, &["t_s", "u_m"], &[&[0.0]]).unwrap_err();
+        assert!(
+            matches!(
+                error,
+                ScenarioError::HeaderMismatch {
+                    names: 2,
+                    columns: 1,
+                    ..
+                }
+            ),
+            "{error:?}"
+        );
+        assert!(error.to_string().contains("bad.csv"));
+
+        let error = write_csv_atomic(&path, &["t_s", "u_m"], &[&[0.0, 1.0], &[0.0]]).unwrap_err();
+        assert!(
+            matches!(error, ScenarioError::ColumnLengthMismatch { ref column, expected: 2, found: 1, .. }
+                if column == "u_m"),
+            "{error:?}"
+        );
+        assert!(error.to_string().contains("`u_m`"));
+
+        for name in ["", "a,b", "q\"", " t_s", "x\ny"] {
+            let error = write_csv_atomic(&path, &[name], &[&[0.0]]).unwrap_err();
+            assert!(
+                matches!(error, ScenarioError::InvalidColumnName { .. }),
+                "{name:?}: {error:?}"
+            );
+        }
+        assert!(fs::read_dir(dir.path()).unwrap().next().is_none());
+    }
+
+    #[test]
+    fn the_step_of_a_uniform_time_column_is_its_mean_interval() {
+        let t: Vec<f64> = (0..10_000).map(|i| i as f64 / 1024.0).collect();
+        let step = uniform_step_s(Path::new("rec.csv"), &t).unwrap();
+        assert_eq!(step, 1.0 / 1024.0);
+
+        let t: Vec<f64> = (0..3_600_000).map(|i| i as f64 * 0.001).collect();
+        let step = uniform_step_s(Path::new("rec.csv"), &t).unwrap();
+        assert!((step - 0.001).abs() < 1e-15);
+    }
+
+    #[test]
+    fn a_non_uniform_time_column_is_reported_with_the_line_of_the_odd_interval() {
+        let t = [0.0, 0.01, 0.02, 0.035, 0.04];
+        let error = uniform_step_s(Path::new("irregular.csv"), &t).unwrap_err();
+        let message = error.to_string();
+        assert!(
+            matches!(error, ScenarioError::NonUniform { line: 5, expected_s, found_s, .. }
+                if expected_s == 0.01 && (found_s - 0.015).abs() < 1e-15),
+            "{error:?}"
+        );
+        assert!(
+            message.contains("irregular.csv")
+                && message.contains("line 5")
+                && message.contains("`t_s`"),
+            "{message}"
+        );
+        let error = uniform_step_s(Path::new("back.csv"), &[0.0, 1.0, 1.0, 3.0]).unwrap_err();
+        assert!(
+            matches!(error, ScenarioError::TimeNotIncreasing { line: 4, .. }),
+            "{error:?}"
+        );
+    }
+
+    #[test]
+    fn a_time_column_with_fewer_than_two_samples_is_too_short() {
+        for t in [&[][..], &[0.0][..]] {
+            let error = uniform_step_s(Path::new("one.csv"), t).unwrap_err();
+            assert!(
+                matches!(error, ScenarioError::TooShort { rows, needed: 2, .. } if rows == t.len()),
+                "{error:?}"
+            );
+            assert!(error.to_string().contains("one.csv"));
+        }
+    }
+}
