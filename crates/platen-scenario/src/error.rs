@@ -216,6 +216,39 @@ pub enum ScenarioError {
         /// The offending column name.
         column: String,
     },
+
+    /// A scenario file is not valid JSON or does not match the scenario format.
+    #[error("`{}`: {json_path}: {message}", path.display())]
+    Json {
+        /// Scenario file.
+        path: PathBuf,
+        /// Where in the document (`model.identified.effective_mass_kg`, or `line L column C`).
+        json_path: String,
+        /// What is wrong and what was expected.
+        message: String,
+    },
+
+    /// A scenario field has a value that cannot be used.
+    #[error("`{}`: {json_path} = {value}: expected {expected}", path.display())]
+    InvalidField {
+        /// Scenario file.
+        path: PathBuf,
+        /// JSON path of the field.
+        json_path: String,
+        /// The offending value, as written.
+        value: String,
+        /// What a valid value looks like.
+        expected: String,
+    },
+
+    /// A record referenced by a scenario cannot serve it.
+    #[error("`{}`: {message}", path.display())]
+    Record {
+        /// The record file (or the scenario, for generated records).
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
 }
 
 /// Formats header names as a comma-separated list of back-quoted names.

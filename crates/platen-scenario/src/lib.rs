@@ -1,6 +1,20 @@
 //! Scenario files, time-series CSV readers and writers for `platen`.
+//!
+//! * [`scenario`]: the scenario JSON format ([`Scenario::load`] validates a file and loads
+//!   its records before anything is simulated);
+//! * [`csv_io`]: time-series CSV by column name, written atomically.
+//!
+//! # Conventions
+//!
+//! SI units inside; the unit is in every column and key name (`t_s`, `u_m`, `v_m_s`,
+//! `a_m_s2`, `force_n`, `hold_down_pressure_mpa`). Errors name the file and the line (CSV) or
+//! the JSON path (scenario), the value, and what was expected.
+
+#![warn(missing_docs)]
 
 pub mod csv_io;
 pub mod error;
+pub mod scenario;
 
 pub use error::{Result, ScenarioError};
+pub use scenario::{Model, Run, Scenario};

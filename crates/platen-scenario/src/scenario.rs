@@ -1,0 +1,653 @@
+//! The scenario file: which model, which excitation, which integrator.
+//!
+//! ```json
+//! {
+//!   "name": "SR9-like sine force",
+//!   "model": { "preset": "lhpost-2008", "hold_down_pressure_mpa": 13.8 },
+//!   "excitation": { "sine_force": { "amplitude_n": 6e5, "frequency_hz": 0.5 } },
+//!   "integrator": { "method": "rk4", "step_s": 0.0009765625 },
+//!   "initial": { "u_m": 0.0, "v_m_s": 0.0 },
+//!   "duration_s": 20.0
+//! }
+//! ```
+//!
+//! * `model.preset` names the table (`lhpost-2008`). By default the **identified** model of
+//!   Eq. 22/23 runs; an `identified` object lays its values (the contract's seven keys) over
+//!   the preset's. A `full` object selects the **full Lagrangian** model of Eq. 1–8 and lays
+//!   its physical parameters (names as in [`platen_model::PhysicalParams`]) over the preset's;
+//!   `"full": {}` runs the preset's physical parameters. `hold_down_pressure_mpa` (default
+//!   13.8) sets the nitrogen pressure of either form.
+//! * `excitation` holds exactly one of `force_csv` (columns `t_s`, `force_n`, uniformly
+//!   sampled, linear between samples: a forward run), `motion_csv` (`t_s`, `u_m`, optional
+//!   `v_m_s`, `a_m_s2`: an inverse run), `sine_force` or `sine_motion` (generated).
+//!   Paths are relative to the scenario file.
+//! * `integrator` (forward runs only; default RK4 at the record's sample interval):
+//!   `{"method": "rk4", "step_s": Δt/k}`.
+//! * `initial` (forward runs only; default at rest at 0).
+//! * `duration_s` defaults to the record's span; required for generated excitations.
+//!
+//! Unknown keys are errors, reported with their JSON path.
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use platen_integrate::{ForceRecord, Motion, Rk4, State};
+use platen_model::{
+    FullModel, IdentifiedModel, IdentifiedParams, ModelError, PhysicalParams, Preset, TableLimits,
+};
+
+use crate::csv_io::{read_table, uniform_step_s};
+use crate::error::{Result, ScenarioError};
+
+/// The scenario file as written (after JSON parsing, before validation).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScenarioFile {
+    /// A short name for reports (default: the file stem).
+    pub name: Option<String>,
+    /// Free text.
+    pub description: Option<String>,
+    /// The model.
+    pub model: ModelSpec,
+    /// The excitation.
+    pub excitation: ExcitationSpec,
+    /// The integrator (forward runs).
+    pub integrator: Option<IntegratorSpec>,
+    /// The initial state (forward runs).
+    pub initial: Option<InitialSpec>,
+    /// Simulated duration, s (default: the record's span).
+    pub duration_s: Option<f64>,
+}
+
+/// `model`: a preset, its hold-down pressure, and the form with overrides.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelSpec {
+    /// Preset name (`lhpost-2008`).
+    pub preset: String,
+    /// Hold-down nitrogen pressure, MPa (default: the preset's nominal 13.8 MPa).
+    pub hold_down_pressure_mpa: Option<f64>,
+    /// Identified-model values laid over the preset's (Eq. 22/23).
+    pub identified: Option<IdentifiedOverrides>,
+    /// Selects the full Lagrangian model; physical values laid over the preset's.
+    pub full: Option<PhysicalOverrides>,
+}
+
+/// Overrides of the identified model; the contract's keys.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(missing_docs)]
+pub struct IdentifiedOverrides {
+    pub effective_mass_kg: Option<f64>,
+    pub stiffness_n_per_m: Option<f64>,
+    pub coulomb_force_n: Option<f64>,
+    pub viscous_coefficient: Option<f64>,
+    pub viscous_exponent: Option<f64>,
+    pub low_velocity_force_n: Option<f64>,
+    pub low_velocity_decay_s_per_m: Option<f64>,
+}
+
+/// Overrides of the physical parameters of the full model (see
+/// [`platen_model::PhysicalParams`] for meanings and units). The hold-down pressure is set by
+/// `model.hold_down_pressure_mpa`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(missing_docs)]
+pub struct PhysicalOverrides {
+    pub platen_mass_kg: Option<f64>,
+    pub actuator_moving_mass_kg: Option<f64>,
+    pub strut_piston_mass_kg: Option<f64>,
+    pub strut_cylinder_mass_kg: Option<f64>,
+    pub strut_height_m: Option<f64>,
+    pub strut_piston_length_m: Option<f64>,
+    pub strut_area_m2: Option<f64>,
+    pub gas_heat_capacity_ratio: Option<f64>,
+    pub supported_weight_n: Option<f64>,
+    pub bearing_friction_coefficient: Option<f64>,
+    pub lateral_friction_coefficient: Option<f64>,
+    pub lateral_normal_force_n: Option<f64>,
+    pub hinge_swivel_friction_coefficient: Option<f64>,
+    pub hinge_radius_m: Option<f64>,
+    pub hinge_force_distribution_factor: Option<f64>,
+    pub viscous_coefficient: Option<f64>,
+    pub viscous_exponent: Option<f64>,
+    pub strut_viscous_coefficient: Option<f64>,
+    pub strut_viscous_exponent: Option<f64>,
+    pub low_velocity_force_n: Option<f64>,
+    pub low_velocity_decay_s_per_m: Option<f64>,
+}
+
+/// `excitation`: exactly one source.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExcitationSpec {
+    /// Recorded actuator force (`t_s`, `force_n`): forward run.
+    pub force_csv: Option<PathBuf>,
+    /// Prescribed motion (`t_s`, `u_m`, optional `v_m_s`, `a_m_s2`): inverse run.
+    pub motion_csv: Option<PathBuf>,
+    /// Generated sine force: forward run.
+    pub sine_force: Option<SineForce>,
+    /// Generated sine displacement: inverse run.
+    pub sine_motion: Option<SineMotion>,
+}
+
+/// `F(t) = r(t)·amplitude_n·sin(2π·frequency_hz·t)`, with `r` a linear ramp from 0 to 1 over
+/// `ramp_s` (0: none), sampled at `sample_rate_hz` from `t = 0`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SineForce {
+    /// Force amplitude, N.
+    pub amplitude_n: f64,
+    /// Frequency, Hz.
+    pub frequency_hz: f64,
+    /// Sample rate, Hz (default 1024, the LHPOST data acquisition rate).
+    #[serde(default = "default_rate")]
+    pub sample_rate_hz: f64,
+    /// Length of the initial amplitude ramp, s (default 0).
+    #[serde(default)]
+    pub ramp_s: f64,
+}
+
+/// `u(t) = amplitude_m·sin(2π·frequency_hz·t)` with its exact velocity and acceleration,
+/// sampled at `sample_rate_hz` from `t = 0` (the paper's S tests).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SineMotion {
+    /// Displacement amplitude, m.
+    pub amplitude_m: f64,
+    /// Frequency, Hz.
+    pub frequency_hz: f64,
+    /// Sample rate, Hz (default 1024).
+    #[serde(default = "default_rate")]
+    pub sample_rate_hz: f64,
+}
+
+fn default_rate() -> f64 {
+    1024.0
+}
+
+/// `integrator`, selected by `method`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(tag = "method", rename_all = "lowercase")]
+pub enum IntegratorSpec {
+    /// Fixed-step RK4 with exact stick-slip.
+    Rk4(Rk4Spec),
+}
+
+/// `{"method": "rk4", "step_s": …}`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Rk4Spec {
+    /// Step, s; must divide the record's sample interval (default: the sample interval).
+    pub step_s: Option<f64>,
+}
+
+/// `initial`: the state at the record's first sample.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InitialSpec {
+    /// Displacement, m (default 0).
+    #[serde(default)]
+    pub u_m: f64,
+    /// Velocity, m/s (default 0).
+    #[serde(default)]
+    pub v_m_s: f64,
+}
+
+/// A validated model in one of its two forms.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Model {
+    /// The identified model (Eq. 22/23).
+    Identified(IdentifiedModel),
+    /// The full Lagrangian model (Eq. 1–8).
+    Full(FullModel),
+}
+
+impl Model {
+    /// `"identified"` or `"full"`.
+    pub fn form(&self) -> &'static str {
+        match self {
+            Model::Identified(_) => "identified",
+            Model::Full(_) => "full",
+        }
+    }
+}
+
+/// What a scenario runs.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Run {
+    /// Force-driven: the force record drives the model forward.
+    Forward {
+        /// The actuator force.
+        record: ForceRecord,
+        /// Integrator settings.
+        rk4: Rk4,
+        /// State at the first sample.
+        initial: State,
+        /// Output samples (the first `samples` of the record).
+        samples: usize,
+    },
+    /// Motion-driven: the force the motion needs.
+    Inverse {
+        /// The prescribed motion (already cut to the duration).
+        motion: Motion,
+    },
+}
+
+/// A validated scenario, ready to run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scenario {
+    /// The scenario's name.
+    pub name: String,
+    /// The preset it is based on.
+    pub preset: Preset,
+    /// The hold-down pressure, Pa.
+    pub hold_down_pressure_pa: f64,
+    /// The model.
+    pub model: Model,
+    /// The table's limits.
+    pub limits: TableLimits,
+    /// What to run.
+    pub run: Run,
+}
+
+impl Scenario {
+    /// Reads, parses and validates the scenario at `path`, and loads every record it names.
+    /// Nothing is simulated.
+    ///
+    /// # Errors
+    /// Any [`ScenarioError`]: unreadable file, malformed JSON or unknown key (with its JSON
+    /// path), invalid values (with their JSON path and what was expected), and every error of
+    /// the records it references (with file and line).
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
+            path: path.to_owned(),
+            action: "reading",
+            source,
+        })?;
+        let file = parse(path, &text)?;
+        Self::from_file(path, file)
+    }
+
+    /// Validates a parsed scenario; relative paths are resolved against `path`'s folder.
+    ///
+    /// # Errors
+    /// As [`Scenario::load`].
+    pub fn from_file(path: &Path, file: ScenarioFile) -> Result<Self> {
+        let ctx = Ctx { path };
+        let preset = Preset::from_name(&file.model.preset).map_err(|e| {
+            ctx.invalid(
+                "model.preset",
+                format!("{:?}", file.model.preset),
+                e.to_string(),
+            )
+        })?;
+        let pressure_pa = match file.model.hold_down_pressure_mpa {
+            Some(p) if !(p.is_finite() && p >= 0.0) => {
+                return Err(ctx.invalid("model.hold_down_pressure_mpa", p, "a pressure >= 0 MPa"))
+            }
+            Some(p) => p * 1e6,
+            None => preset.nominal_pressure_pa(),
+        };
+        let model = build_model(&ctx, preset, pressure_pa, &file.model)?;
+        let run = build_run(&ctx, &file)?;
+        let name = file.name.clone().unwrap_or_else(|| {
+            path.file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        });
+        Ok(Self {
+            name,
+            preset,
+            hold_down_pressure_pa: pressure_pa,
+            model,
+            limits: preset.limits(),
+            run,
+        })
+    }
+}
+
+/// Parses scenario JSON, reporting the JSON path (or line and column) of any error.
+///
+/// # Errors
+/// [`ScenarioError::Json`].
+pub fn parse(path: &Path, text: &str) -> Result<ScenarioFile> {
+    let de = &mut serde_json::Deserializer::from_str(text);
+    serde_path_to_error::deserialize(de).map_err(|e| {
+        let inner = e.inner();
+        let json_path = e.path().to_string();
+        let json_path = if json_path == "." || json_path.is_empty() {
+            format!("line {} column {}", inner.line(), inner.column())
+        } else {
+            format!(
+                "{json_path} (line {} column {})",
+                inner.line(),
+                inner.column()
+            )
+        };
+        // serde_json appends " at line L column C"; the location is already in json_path.
+        let mut message = inner.to_string();
+        if let Some(pos) = message.rfind(" at line ") {
+            message.truncate(pos);
+        }
+        ScenarioError::Json {
+            path: path.to_owned(),
+            json_path,
+            message,
+        }
+    })
+}
+
+struct Ctx<'a> {
+    path: &'a Path,
+}
+
+impl Ctx<'_> {
+    fn invalid(
+        &self,
+        json_path: &str,
+        value: impl ToString,
+        expected: impl Into<String>,
+    ) -> ScenarioError {
+        ScenarioError::InvalidField {
+            path: self.path.to_owned(),
+            json_path: json_path.to_owned(),
+            value: value.to_string(),
+            expected: expected.into(),
+        }
+    }
+
+    fn resolve(&self, relative: &Path) -> PathBuf {
+        match self.path.parent() {
+            Some(dir) if relative.is_relative() => dir.join(relative),
+            _ => relative.to_owned(),
+        }
+    }
+
+    fn model_error(&self, section: &str, e: ModelError) -> ScenarioError {
+        match e {
+            ModelError::InvalidParameter {
+                name: "hold_down_pressure_pa",
+                value,
+                expected,
+            } => self.invalid("model.hold_down_pressure_mpa", value / 1e6, expected),
+            ModelError::InvalidParameter {
+                name,
+                value,
+                expected,
+            } => self.invalid(&format!("{section}.{name}"), value, expected),
+            other => self.invalid(section, "", other.to_string()),
+        }
+    }
+}
+
+macro_rules! lay_over {
+    ($target:expr, $over:expr, [$($field:ident),* $(,)?]) => {
+        $( if let Some(v) = $over.$field { $target.$field = v; } )*
+    };
+}
+
+fn build_model(ctx: &Ctx, preset: Preset, pressure_pa: f64, spec: &ModelSpec) -> Result<Model> {
+    match (&spec.identified, &spec.full) {
+        (Some(_), Some(_)) => Err(ctx.invalid(
+            "model",
+            "{identified, full}",
+            "either an `identified` object (identified model) or a `full` object (full Lagrangian model), not both",
+        )),
+        (_, Some(over)) => {
+            let mut p: PhysicalParams = preset.physical(pressure_pa).map_err(|e| ctx.model_error("model.full", e))?;
+            lay_over!(p, over, [
+                platen_mass_kg, actuator_moving_mass_kg, strut_piston_mass_kg, strut_cylinder_mass_kg,
+                strut_height_m, strut_piston_length_m, strut_area_m2, gas_heat_capacity_ratio,
+                supported_weight_n, bearing_friction_coefficient, lateral_friction_coefficient,
+                lateral_normal_force_n, hinge_swivel_friction_coefficient, hinge_radius_m,
+                hinge_force_distribution_factor, viscous_coefficient, viscous_exponent,
+                strut_viscous_coefficient, strut_viscous_exponent, low_velocity_force_n,
+                low_velocity_decay_s_per_m,
+            ]);
+            p.build().map(Model::Full).map_err(|e| ctx.model_error("model.full", e))
+        }
+        (over, None) => {
+            let mut p: IdentifiedParams =
+                preset.identified(pressure_pa).map_err(|e| ctx.model_error("model.identified", e))?;
+            if let Some(over) = over {
+                lay_over!(p, over, [
+                    effective_mass_kg, stiffness_n_per_m, coulomb_force_n, viscous_coefficient,
+                    viscous_exponent, low_velocity_force_n, low_velocity_decay_s_per_m,
+                ]);
+            }
+            p.build().map(Model::Identified).map_err(|e| ctx.model_error("model.identified", e))
+        }
+    }
+}
+
+fn check_positive(ctx: &Ctx, json_path: &str, value: f64) -> Result<f64> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(ctx.invalid(json_path, value, "a finite number > 0"))
+    }
+}
+
+/// Number of samples of a record of `len` samples at interval `dt` that `duration_s` covers.
+fn samples_for(
+    ctx: &Ctx,
+    record_path: &Path,
+    duration_s: Option<f64>,
+    dt: f64,
+    len: usize,
+) -> Result<usize> {
+    let Some(d) = duration_s else { return Ok(len) };
+    check_positive(ctx, "duration_s", d)?;
+    // Tolerate rounding of the duration to about a millionth of a sample.
+    let n = (d / dt + 1e-6).floor() as usize + 1;
+    if n > len {
+        return Err(ScenarioError::Record {
+            path: record_path.to_owned(),
+            message: format!(
+                "record spans {} s ({len} samples) but the scenario's duration_s is {d} s",
+                (len - 1) as f64 * dt
+            ),
+        });
+    }
+    Ok(n)
+}
+
+fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
+    let ex = &file.excitation;
+    let given: Vec<&str> = [
+        ("force_csv", ex.force_csv.is_some()),
+        ("motion_csv", ex.motion_csv.is_some()),
+        ("sine_force", ex.sine_force.is_some()),
+        ("sine_motion", ex.sine_motion.is_some()),
+    ]
+    .iter()
+    .filter(|(_, present)| *present)
+    .map(|(name, _)| *name)
+    .collect();
+    if given.len() != 1 {
+        return Err(ctx.invalid(
+            "excitation",
+            format!("{{{}}}", given.join(", ")),
+            "exactly one of force_csv, motion_csv, sine_force, sine_motion",
+        ));
+    }
+    let forward = ex.force_csv.is_some() || ex.sine_force.is_some();
+    if !forward {
+        if file.integrator.is_some() {
+            return Err(ctx.invalid(
+                "integrator",
+                "{…}",
+                "no integrator: a motion-driven (inverse) run integrates nothing",
+            ));
+        }
+        if file.initial.is_some() {
+            return Err(ctx.invalid(
+                "initial",
+                "{…}",
+                "no initial state: a motion-driven (inverse) run starts from its motion",
+            ));
+        }
+    }
+    if let Some(rel) = &ex.force_csv {
+        let path = ctx.resolve(rel);
+        let mut table = read_table(&path, &["t_s", "force_n"], &[])?;
+        let t = table.take_column("t_s").unwrap_or_default();
+        let f = table.take_column("force_n").unwrap_or_default();
+        let dt = uniform_step_s(&path, &t)?;
+        let samples = samples_for(ctx, &path, file.duration_s, dt, t.len())?;
+        let record = ForceRecord::new(t, f).map_err(|e| ScenarioError::Record {
+            path: path.clone(),
+            message: e.to_string(),
+        })?;
+        forward_run(ctx, file, record, samples)
+    } else if let Some(sine) = &ex.sine_force {
+        let rate = check_positive(
+            ctx,
+            "excitation.sine_force.sample_rate_hz",
+            sine.sample_rate_hz,
+        )?;
+        let freq = check_finite_non_negative(
+            ctx,
+            "excitation.sine_force.frequency_hz",
+            sine.frequency_hz,
+        )?;
+        let amp = check_finite(ctx, "excitation.sine_force.amplitude_n", sine.amplitude_n)?;
+        let ramp = check_finite_non_negative(ctx, "excitation.sine_force.ramp_s", sine.ramp_s)?;
+        let n = generated_samples(ctx, file.duration_s, rate, "excitation.sine_force")?;
+        let force: Vec<f64> = (0..n)
+            .map(|j| {
+                let t = j as f64 / rate;
+                let r = if ramp > 0.0 { (t / ramp).min(1.0) } else { 1.0 };
+                r * amp * (2.0 * std::f64::consts::PI * freq * t).sin()
+            })
+            .collect();
+        let record = ForceRecord::from_rate(rate, force).map_err(|e| ScenarioError::Record {
+            path: ctx.path.to_owned(),
+            message: e.to_string(),
+        })?;
+        forward_run(ctx, file, record, n)
+    } else if let Some(rel) = &ex.motion_csv {
+        let path = ctx.resolve(rel);
+        let mut table = read_table(&path, &["t_s", "u_m"], &["v_m_s", "a_m_s2"])?;
+        let t = table.take_column("t_s").unwrap_or_default();
+        let u = table.take_column("u_m").unwrap_or_default();
+        let v = table.take_column("v_m_s");
+        let a = table.take_column("a_m_s2");
+        let samples = match file.duration_s {
+            None => t.len(),
+            Some(d) => {
+                check_positive(ctx, "duration_s", d)?;
+                let end = t[0] + d;
+                let n = t.partition_point(|&x| x <= end + 1e-9 * d.abs());
+                if t[t.len() - 1] < end - 1e-9 * d.abs() {
+                    return Err(ScenarioError::Record {
+                        path,
+                        message: format!(
+                            "record spans {} s but the scenario's duration_s is {d} s",
+                            t[t.len() - 1] - t[0]
+                        ),
+                    });
+                }
+                n
+            }
+        };
+        let cut = |c: Vec<f64>| c[..samples].to_vec();
+        let motion = match (v, a) {
+            (Some(v), Some(a)) => Motion::new(cut(t), cut(u), cut(v), cut(a)),
+            (Some(v), None) => Motion::from_displacement_velocity(cut(t), cut(u), cut(v)),
+            (None, Some(_)) | (None, None) => Motion::from_displacement(cut(t), cut(u)),
+        }
+        .map_err(|e| ScenarioError::Record {
+            path,
+            message: e.to_string(),
+        })?;
+        Ok(Run::Inverse { motion })
+    } else {
+        let sine = ex
+            .sine_motion
+            .as_ref()
+            .expect("exactly one excitation is present");
+        let rate = check_positive(
+            ctx,
+            "excitation.sine_motion.sample_rate_hz",
+            sine.sample_rate_hz,
+        )?;
+        let freq = check_finite_non_negative(
+            ctx,
+            "excitation.sine_motion.frequency_hz",
+            sine.frequency_hz,
+        )?;
+        let amp = check_finite(ctx, "excitation.sine_motion.amplitude_m", sine.amplitude_m)?;
+        let n = generated_samples(ctx, file.duration_s, rate, "excitation.sine_motion")?;
+        let w = 2.0 * std::f64::consts::PI * freq;
+        let t: Vec<f64> = (0..n).map(|j| j as f64 / rate).collect();
+        let u = t.iter().map(|&t| amp * (w * t).sin()).collect();
+        let v = t.iter().map(|&t| amp * w * (w * t).cos()).collect();
+        let a = t.iter().map(|&t| -amp * w * w * (w * t).sin()).collect();
+        let motion = Motion::new(t, u, v, a).map_err(|e| ScenarioError::Record {
+            path: ctx.path.to_owned(),
+            message: e.to_string(),
+        })?;
+        Ok(Run::Inverse { motion })
+    }
+}
+
+fn check_finite(ctx: &Ctx, json_path: &str, value: f64) -> Result<f64> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(ctx.invalid(json_path, value, "a finite number"))
+    }
+}
+
+fn check_finite_non_negative(ctx: &Ctx, json_path: &str, value: f64) -> Result<f64> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(ctx.invalid(json_path, value, "a finite number >= 0"))
+    }
+}
+
+/// Sample count of a generated excitation: `duration_s` is required.
+fn generated_samples(ctx: &Ctx, duration_s: Option<f64>, rate: f64, what: &str) -> Result<usize> {
+    let Some(d) = duration_s else {
+        return Err(ctx.invalid(
+            "duration_s",
+            "(missing)",
+            format!("a duration in s: {what} has no length of its own"),
+        ));
+    };
+    check_positive(ctx, "duration_s", d)?;
+    let n = (d * rate + 1e-6).floor() + 1.0;
+    if n > 1e9 {
+        return Err(ctx.invalid("duration_s", d, "at most 1e9 samples at the sample rate"));
+    }
+    Ok(n as usize)
+}
+
+fn forward_run(ctx: &Ctx, file: &ScenarioFile, record: ForceRecord, samples: usize) -> Result<Run> {
+    let rk4 = match &file.integrator {
+        None | Some(IntegratorSpec::Rk4(Rk4Spec { step_s: None })) => Rk4::with_steps_per_sample(1),
+        Some(IntegratorSpec::Rk4(Rk4Spec { step_s: Some(step) })) => {
+            Rk4::from_step(*step, record.dt_s())
+        }
+    }
+    .map_err(|e| {
+        let step = match &file.integrator {
+            Some(IntegratorSpec::Rk4(Rk4Spec { step_s: Some(step) })) => *step,
+            _ => record.dt_s(),
+        };
+        ctx.invalid("integrator.step_s", step, e.to_string())
+    })?;
+    let initial = file.initial.clone().unwrap_or_default();
+    let u_m = check_finite(ctx, "initial.u_m", initial.u_m)?;
+    let v_m_s = check_finite(ctx, "initial.v_m_s", initial.v_m_s)?;
+    Ok(Run::Forward {
+        record,
+        rk4,
+        initial: State { u_m, v_m_s },
+        samples,
+    })
+}
