@@ -45,7 +45,7 @@ pub enum IntegrateError {
     /// A force record for the fixed-step integrator must be uniformly sampled.
     #[error(
         "force record is not uniformly sampled: interval before sample {index} is {found_s} s, \
-         expected {expected_s} s (within 1e-6 relative)"
+         expected {expected_s} s (within 0.1 %)"
     )]
     NonUniform {
         /// Zero-based sample index.

@@ -36,5 +36,8 @@ mod rk4;
 pub use error::{IntegrateError, Result};
 pub use inverse::inverse;
 pub use output::{Exceedance, Peak, Peaks, Sample, SampleSink, Trajectory};
-pub use record::{derivative, second_derivative, ForceRecord, Motion, UNIFORM_RELATIVE_TOLERANCE};
+pub use record::{
+    derivative, second_derivative, uniform_interval_s, ForceRecord, Motion,
+    UNIFORM_RELATIVE_TOLERANCE,
+};
 pub use rk4::{forward_rk4, Rk4, RunStats, State};

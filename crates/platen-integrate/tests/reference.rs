@@ -121,36 +121,3 @@ fn nonpaper_identified() -> IdentifiedParams {
         low_velocity_decay_s_per_m: 50.0,
     }
 }
-
-#[test]
-#[ignore]
-fn debug_convergence() {
-    let model = platen_model::preset::lhpost_2008_identified(13.8e6)
-        .build()
-        .unwrap();
-    let reference = read_columns("paper_forward_reference.csv");
-    for k in [1, 2, 4, 8, 16, 32] {
-        let (out, _) = run(&model, "paper_forward_force.csv", k);
-        let du = max_abs_diff(&out.u_m, &reference[1]);
-        let mut worst = 0;
-        let mut w = 0.0;
-        for i in 0..out.len() {
-            let d = (out.u_m[i] - reference[1][i]).abs();
-            if d > w {
-                w = d;
-                worst = i;
-            }
-        }
-        eprintln!("k={k}: max|Δu| = {du:.3e} at t={}", out.t_s[worst]);
-        if k == 1 {
-            for i in (0..out.len()).step_by(512) {
-                eprintln!(
-                    "  t={:.2} du={:.3e} v={:.4}",
-                    out.t_s[i],
-                    out.u_m[i] - reference[1][i],
-                    out.v_m_s[i]
-                );
-            }
-        }
-    }
-}

@@ -546,45 +546,44 @@ fn sync_directory(dir: &Path) {
 
 /// Sample interval of the uniformly sampled time column `t_s` read from `path`, s.
 ///
-/// The interval is the mean one, `(t_last − t_first) / (n − 1)`. Every interval must match it
-/// within `1e-6 × interval + 1e-12 s`, else [`NonUniform`](ScenarioError::NonUniform); intervals
+/// The interval is the mean one, `(t_last − t_first) / (n − 1)`. Every interval must match the
+/// median interval within [`platen_integrate::UNIFORM_RELATIVE_TOLERANCE`] (0.1 %), else
+/// [`NonUniform`](ScenarioError::NonUniform) names the line that ends the odd interval; intervals
 /// that are not positive give [`TimeNotIncreasing`](ScenarioError::TimeNotIncreasing). Fewer
 /// than 2 samples give [`TooShort`](ScenarioError::TooShort). `path` is used for messages only;
 /// line numbers assume the header on line 1 and one sample per line (sample `i`, 0-based, on
 /// line `i + 2`).
 pub fn uniform_step_s(path: &Path, t_s: &[f64]) -> Result<f64> {
-    let n = t_s.len();
-    if n < 2 {
-        return Err(ScenarioError::TooShort {
+    use platen_integrate::IntegrateError;
+    platen_integrate::uniform_interval_s(t_s).map_err(|e| match e {
+        IntegrateError::TooShort { found, needed } => ScenarioError::TooShort {
             path: path.to_path_buf(),
-            rows: n,
-            needed: 2,
-        });
-    }
-    let step = (t_s[n - 1] - t_s[0]) / (n - 1) as f64;
-    let tolerance = 1e-6 * step.abs() + 1e-12;
-    for (i, pair) in t_s.windows(2).enumerate() {
-        let line = i as u64 + 3;
-        let interval = pair[1] - pair[0];
-        if interval <= 0.0 {
-            return Err(ScenarioError::TimeNotIncreasing {
+            rows: found,
+            needed,
+        },
+        IntegrateError::NonUniform { index, found_s, .. } if found_s <= 0.0 => {
+            ScenarioError::TimeNotIncreasing {
                 path: path.to_path_buf(),
-                line,
-                previous_s: pair[0],
-                value_s: pair[1],
-            });
+                line: index as u64 + 2,
+                previous_s: t_s[index - 1],
+                value_s: t_s[index],
+            }
         }
-        let deviation = (interval - step).abs();
-        if deviation.is_nan() || deviation > tolerance {
-            return Err(ScenarioError::NonUniform {
-                path: path.to_path_buf(),
-                line,
-                expected_s: step,
-                found_s: interval,
-            });
-        }
-    }
-    Ok(step)
+        IntegrateError::NonUniform {
+            index,
+            expected_s,
+            found_s,
+        } => ScenarioError::NonUniform {
+            path: path.to_path_buf(),
+            line: index as u64 + 2,
+            expected_s,
+            found_s,
+        },
+        other => ScenarioError::Record {
+            path: path.to_path_buf(),
+            message: other.to_string(),
+        },
+    })
 }
 
 #[cfg(test)]

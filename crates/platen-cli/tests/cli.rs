@@ -1,0 +1,374 @@
+//! End-to-end tests of the `platen` binary on the shipped scenarios and on bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn platen(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_platen"))
+        .args(args)
+        .output()
+        .expect("run platen")
+}
+
+fn workspace() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn scenario(name: &str) -> String {
+    workspace()
+        .join("scenarios")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Reads a CSV written by platen into (header, rows).
+fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_owned)
+        .collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|c| c.parse().unwrap()).collect())
+        .collect();
+    (header, rows)
+}
+
+const CONTRACT_COLUMNS: [&str; 8] = [
+    "t_s",
+    "u_m",
+    "v_m_s",
+    "a_m_s2",
+    "force_n",
+    "inertial_force_n",
+    "elastic_force_n",
+    "dissipative_force_n",
+];
+
+#[test]
+fn every_shipped_scenario_runs_and_writes_every_input_sample_with_the_contract_columns() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut count = 0;
+    for entry in std::fs::read_dir(workspace().join("scenarios")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "json") {
+            continue;
+        }
+        count += 1;
+        let out = dir.path().join("out.csv");
+        let o = platen(&[
+            "simulate",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--json",
+        ]);
+        assert!(o.status.success(), "{}: {}", path.display(), stderr(&o));
+        let summary: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let (header, rows) = read_csv(&out);
+        assert_eq!(header, CONTRACT_COLUMNS, "{}", path.display());
+        assert_eq!(rows.len() as u64, summary["samples"].as_u64().unwrap());
+        // Sample times are uniform and start at 0 for every shipped scenario.
+        assert_eq!(rows[0][0], 0.0);
+        for key in [
+            "peak_u_m",
+            "peak_v_m_s",
+            "peak_a_m_s2",
+            "peak_force_n",
+            "limit_exceedances",
+            "direction",
+        ] {
+            assert!(
+                summary.get(key).is_some(),
+                "{}: summary lacks {key}",
+                path.display()
+            );
+        }
+    }
+    assert!(
+        count >= 3,
+        "expected at least three shipped scenarios, found {count}"
+    );
+}
+
+#[test]
+fn a_forward_summary_reports_stick_phases_and_solver_statistics() {
+    let o = platen(&["simulate", &scenario("paper-forward-force.json"), "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(s["direction"], "forward");
+    assert_eq!(s["samples"], 10241);
+    assert_eq!(s["breakaways"], 1);
+    let stick = s["stick_time_s"].as_f64().unwrap();
+    assert!((stick - 0.3633).abs() < 1e-3, "{stick}");
+    assert_eq!(s["solver"]["steps"], 10240);
+    assert_eq!(s["limit_exceedances"].as_array().unwrap().len(), 0);
+}
+
+/// The inverse of the identified model is Eq. 23 (plus Eq. 22's low-velocity term, switched
+/// off here): F_A = Mₑü + Kₑu + (Cₑ|u̇|^α + F_μ)·sign(u̇), recomputed from the written u, v, a.
+/// Both sides are the same arithmetic on the same numbers, so 1e-9 relative is loose.
+#[test]
+fn the_inverse_reproduces_eq_23_to_1e_9_relative() {
+    let dir = tempfile::tempdir().unwrap();
+    let sc = dir.path().join("s.json");
+    std::fs::write(
+        &sc,
+        r#"{"model": {"preset": "lhpost-2008", "identified": {"low_velocity_force_n": 0}},
+            "excitation": {"sine_motion": {"amplitude_m": 0.2, "frequency_hz": 0.6}},
+            "duration_s": 5}"#,
+    )
+    .unwrap();
+    let out = dir.path().join("f.csv");
+    let o = platen(&[
+        "simulate",
+        sc.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (_, rows) = read_csv(&out);
+    let (m, k, f_mu, c) = (144e3, 1.266e6, 0.0044 * 5783e3, 44.58e3);
+    let peak = rows.iter().map(|r| r[4].abs()).fold(0.0, f64::max);
+    for r in &rows {
+        let (u, v, a, f) = (r[1], r[2], r[3], r[4]);
+        let eq23 = m * a + k * u + (c * v.abs().sqrt() + f_mu) * v.signum() * f64::from(v != 0.0);
+        assert!(
+            (f - eq23).abs() <= 1e-9 * peak,
+            "t = {}: {f} vs {eq23}",
+            r[0]
+        );
+    }
+}
+
+#[test]
+fn the_same_scenario_gives_the_same_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("a.csv");
+    let b = dir.path().join("b.csv");
+    for out in [&a, &b] {
+        let o = platen(&[
+            "simulate",
+            &scenario("full-model-large-stroke.json"),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+}
+
+#[test]
+fn model_json_prints_the_identified_keys_and_derived_quantities() {
+    let o = platen(&[
+        "model",
+        "--preset",
+        "lhpost-2008",
+        "--pressure-mpa",
+        "13.8",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let m: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    for key in [
+        "effective_mass_kg",
+        "stiffness_n_per_m",
+        "coulomb_force_n",
+        "viscous_coefficient",
+        "viscous_exponent",
+        "low_velocity_force_n",
+        "low_velocity_decay_s_per_m",
+        "cubic_stiffness_n_per_m",
+        "strut_effective_mass_kg",
+        "strut_rotational_mass_kg",
+        "hold_down_force_n",
+        "hinge_friction_coefficient",
+    ] {
+        assert!(m[key].is_number(), "missing {key}");
+    }
+    assert_eq!(m["effective_mass_kg"], 144000.0);
+    assert!((m["coulomb_force_n"].as_f64().unwrap() - 25445.2).abs() < 0.01);
+    let half = platen(&["model", "--pressure-mpa", "6.9", "--json"]);
+    let h: serde_json::Value = serde_json::from_slice(&half.stdout).unwrap();
+    assert_eq!(
+        h["stiffness_n_per_m"].as_f64().unwrap() * 2.0,
+        m["stiffness_n_per_m"].as_f64().unwrap()
+    );
+}
+
+/// Writes `json` as a scenario in a fresh folder, runs simulate with --out, and returns the
+/// exit code, stderr and whether an output file appeared.
+fn run_bad(json: &str) -> (i32, String, bool) {
+    let dir = tempfile::tempdir().unwrap();
+    let sc = dir.path().join("bad.json");
+    std::fs::write(&sc, json).unwrap();
+    std::fs::write(
+        dir.path().join("force.csv"),
+        "t_s,force_n\n0,0\n0.5,1\n1,2\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out.csv");
+    let o = platen(&[
+        "simulate",
+        sc.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    (o.status.code().unwrap_or(-1), stderr(&o), out.exists())
+}
+
+#[test]
+fn bad_scenarios_fail_with_the_json_path_and_no_output() {
+    let cases: &[(&str, &str)] = &[
+        (
+            r#"{"model": {"preset": "lhpost-2008", "colour": 1}, "excitation": {"force_csv": "force.csv"}}"#,
+            "model",
+        ),
+        (
+            r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"force_csv": "force.csv"}, "extra": 1}"#,
+            "extra",
+        ),
+        (
+            r#"{"model": {"preset": "lhpost-1999"}, "excitation": {"force_csv": "force.csv"}}"#,
+            "model.preset",
+        ),
+        (
+            r#"{"model": {"preset": "lhpost-2008", "identified": {"effective_mass_kg": -5}}, "excitation": {"force_csv": "force.csv"}}"#,
+            "model.identified.effective_mass_kg",
+        ),
+        (
+            r#"{"model": {"preset": "lhpost-2008", "full": {"strut_viscous_exponent": 2}}, "excitation": {"force_csv": "force.csv"}}"#,
+            "model.full.strut_viscous_exponent",
+        ),
+        (
+            r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"force_csv": "force.csv"}, "integrator": {"method": "rk4", "step_s": 0}}"#,
+            "integrator.step_s",
+        ),
+        (
+            r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"force_csv": "force.csv"}, "integrator": {"method": "rk4", "step_s": 0.3}}"#,
+            "integrator.step_s",
+        ),
+        (
+            r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"force_csv": "missing.csv"}}"#,
+            "missing.csv",
+        ),
+        (
+            r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"force_csv": "force.csv"}, "duration_s": 5}"#,
+            "duration_s",
+        ),
+        (
+            r#"{"model": {"preset": "lhpost-2008"}, "excitation": {}}"#,
+            "excitation",
+        ),
+        (
+            r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"force_csv": "force.csv""#,
+            "line 1",
+        ),
+        (
+            r#"{"model": {"preset": "lhpost-2008", "hold_down_pressure_mpa": -1}, "excitation": {"force_csv": "force.csv"}}"#,
+            "hold_down_pressure_mpa",
+        ),
+        (
+            r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"sine_force": {"amplitude_n": 1, "frequency_hz": 1}}}"#,
+            "duration_s",
+        ),
+    ];
+    for (json, location) in cases {
+        let (code, err, wrote) = run_bad(json);
+        assert_eq!(code, 3, "{json}: exit {code}, {err}");
+        assert!(
+            err.contains(location),
+            "{json}: message does not name {location}: {err}"
+        );
+        assert!(
+            err.contains("bad.json") || err.contains(".csv"),
+            "{json}: message does not name the file: {err}"
+        );
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(!wrote, "{json}: output written despite the error");
+    }
+}
+
+#[test]
+fn a_bad_force_record_is_reported_with_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let sc = dir.path().join("s.json");
+    std::fs::write(
+        &sc,
+        r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"force_csv": "f.csv"}}"#,
+    )
+    .unwrap();
+    for (csv, needle) in [
+        ("t_s,force_n\n0,0\n0.5,abc\n1,2\n", "line 3"),
+        ("t_s,force_n\n0,0\n0.5,NaN\n1,2\n", "line 3"),
+        ("t_s,force_n\n0,0\n0.5,1\n0.4,2\n", "line 4"),
+        ("t_s,force\n0,0\n0.5,1\n", "force_n"),
+    ] {
+        std::fs::write(dir.path().join("f.csv"), csv).unwrap();
+        let o = platen(&["simulate", sc.to_str().unwrap()]);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(3), "{csv}: {err}");
+        assert!(
+            err.contains("f.csv") && err.contains(needle),
+            "{csv}: {err}"
+        );
+    }
+    // A dropped sample in a 1024 Hz record: the interval that ends on line 13 is doubled.
+    let mut csv = String::from("t_s,force_n\n");
+    for j in (0..40).filter(|&j| j != 11) {
+        csv.push_str(&format!("{},{}\n", j as f64 / 1024.0, j));
+    }
+    std::fs::write(dir.path().join("f.csv"), csv).unwrap();
+    let o = platen(&["simulate", sc.to_str().unwrap()]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(3), "{err}");
+    assert!(err.contains("line 13") && err.contains("uniform"), "{err}");
+}
+
+#[test]
+fn a_failed_run_leaves_the_previous_output_untouched() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.csv");
+    std::fs::write(&out, "previous result\n").unwrap();
+    let sc = dir.path().join("s.json");
+    std::fs::write(
+        &sc,
+        r#"{"model": {"preset": "nope"}, "excitation": {"force_csv": "f.csv"}}"#,
+    )
+    .unwrap();
+    let o = platen(&[
+        "simulate",
+        sc.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(3));
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "previous result\n");
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        2,
+        "no temporary file left behind"
+    );
+}
+
+#[test]
+fn an_unwritable_output_path_is_an_io_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("no/such/folder/out.csv");
+    let o = platen(&[
+        "simulate",
+        &scenario("s9-sine-motion.json"),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(5), "{}", stderr(&o));
+    assert!(stderr(&o).contains("out.csv"));
+}
