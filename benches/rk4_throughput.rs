@@ -7,6 +7,9 @@
 //! force interpolated, no stick logic, no output. The ratio of the two medians is what the
 //! README quotes.
 
+// criterion's macros generate undocumented items.
+#![allow(missing_docs)]
+
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};

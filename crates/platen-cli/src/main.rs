@@ -116,7 +116,7 @@ fn simulate(path: &Path, out: Option<&Path>, json_out: bool) -> Result<()> {
     let scenario = Scenario::load(path)?;
     let (trajectory, peaks, stats) = match &scenario.model {
         Model::Identified(m) => execute(m, &scenario.run)?,
-        Model::Full(m) => execute(m, &scenario.run)?,
+        Model::Full(m) => execute(&**m, &scenario.run)?,
     };
     if let Some(out) = out {
         let names = Trajectory::COLUMN_NAMES;

@@ -71,7 +71,9 @@ pub fn uniform_interval_s(t_s: &[f64]) -> Result<f64> {
     let tolerance = UNIFORM_RELATIVE_TOLERANCE * median.abs();
     for i in 1..n {
         let found_s = t_s[i] - t_s[i - 1];
-        if !((found_s - median).abs() <= tolerance) {
+        // Written so that a NaN interval fails the check too.
+        let within = (found_s - median).abs() <= tolerance;
+        if !within {
             return Err(IntegrateError::NonUniform {
                 index: i,
                 expected_s: median,

@@ -201,7 +201,7 @@ pub enum Model {
     /// The identified model (Eq. 22/23).
     Identified(IdentifiedModel),
     /// The full Lagrangian model (Eq. 1–8).
-    Full(FullModel),
+    Full(Box<FullModel>),
 }
 
 impl Model {
@@ -406,7 +406,7 @@ fn build_model(ctx: &Ctx, preset: Preset, pressure_pa: f64, spec: &ModelSpec) ->
                 strut_viscous_coefficient, strut_viscous_exponent, low_velocity_force_n,
                 low_velocity_decay_s_per_m,
             ]);
-            p.build().map(Model::Full).map_err(|e| ctx.model_error("model.full", e))
+            p.build().map(|m| Model::Full(Box::new(m))).map_err(|e| ctx.model_error("model.full", e))
         }
         (over, None) => {
             let mut p: IdentifiedParams =
