@@ -372,3 +372,42 @@ fn an_unwritable_output_path_is_an_io_error() {
     assert_eq!(o.status.code(), Some(5), "{}", stderr(&o));
     assert!(stderr(&o).contains("out.csv"));
 }
+
+/// An inverse run from a motion CSV with displacement only (a lab's displacement channel):
+/// the force follows from the derived velocity and acceleration.
+#[test]
+fn an_inverse_run_accepts_a_displacement_only_motion_csv() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut csv = String::from("t_s,u_m,extra\n");
+    for j in 0..=2048 {
+        let t = j as f64 / 1024.0;
+        csv.push_str(&format!(
+            "{t},{},7\n",
+            0.1 * (std::f64::consts::PI * t).sin()
+        ));
+    }
+    std::fs::write(dir.path().join("m.csv"), csv).unwrap();
+    let sc = dir.path().join("s.json");
+    std::fs::write(
+        &sc,
+        r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"motion_csv": "m.csv"}}"#,
+    )
+    .unwrap();
+    let out = dir.path().join("f.csv");
+    let o = platen(&[
+        "simulate",
+        sc.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (_, rows) = read_csv(&out);
+    assert_eq!(rows.len(), 2049);
+    // Mid-record, v and a are the derivatives of 0.1·sin(πt) to second order in Δt.
+    let r = &rows[700];
+    let t = r[0];
+    let w = std::f64::consts::PI;
+    assert!((r[2] - 0.1 * w * (w * t).cos()).abs() < 1e-6, "{r:?}");
+    assert!((r[3] + 0.1 * w * w * (w * t).sin()).abs() < 1e-5, "{r:?}");
+}
