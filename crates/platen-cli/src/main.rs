@@ -12,10 +12,12 @@ use anyhow::{Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 use serde_json::{json, Map, Value};
 
-use platen_integrate::{forward_rk4, inverse, IntegrateError, Peaks, RunStats, Trajectory};
+use platen_integrate::{
+    forward_dopri5, forward_rk4, inverse, IntegrateError, Peaks, RunStats, Trajectory,
+};
 use platen_model::{PlatenModel, Preset, STANDARD_GRAVITY_M_S2};
 use platen_scenario::csv_io::write_csv_atomic;
-use platen_scenario::{Model, Run, Scenario, ScenarioError};
+use platen_scenario::{Integrator, Model, Run, Scenario, ScenarioError};
 
 #[derive(Parser)]
 #[command(
@@ -135,13 +137,20 @@ fn execute<M: PlatenModel>(model: &M, run: &Run) -> Result<(Trajectory, Peaks, O
     match run {
         Run::Forward {
             record,
-            rk4,
+            integrator,
             initial,
             samples,
         } => {
             let mut sink = (Trajectory::with_capacity(*samples), Peaks::default());
-            let stats = forward_rk4(model, record, *rk4, *initial, *samples, &mut sink)
-                .context("forward run failed; no output was written")?;
+            let stats = match integrator {
+                Integrator::Rk4(rk4) => {
+                    forward_rk4(model, record, *rk4, *initial, *samples, &mut sink)
+                }
+                Integrator::Dopri5(settings) => {
+                    forward_dopri5(model, record, *settings, *initial, *samples, &mut sink)
+                }
+            }
+            .context("forward run failed; no output was written")?;
             Ok((sink.0, sink.1, Some(stats)))
         }
         Run::Inverse { motion } => {
@@ -192,14 +201,34 @@ fn summary_json(
         m.insert("stick_events".into(), json!(st.stick_events));
         m.insert("breakaways".into(), json!(st.breakaways));
         m.insert("reversals".into(), json!(st.reversals));
+        let method = match &s.run {
+            Run::Forward { integrator, .. } => integrator.name(),
+            Run::Inverse { .. } => "none",
+        };
         m.insert(
             "solver".into(),
             json!({
-                "method": "rk4",
+                "method": method,
                 "steps": st.steps,
+                "accepted_steps": st.accepted_steps,
+                "rejected_steps": st.rejected_steps,
                 "rhs_evaluations": st.rhs_evaluations,
                 "events_located": st.events(),
                 "root_iterations": st.root_iterations,
+            }),
+        );
+        let e = &st.energy;
+        m.insert(
+            "energy".into(),
+            json!({
+                "actuator_work_j": e.actuator_work_j,
+                "kinetic_start_j": e.kinetic_start_j,
+                "kinetic_end_j": e.kinetic_end_j,
+                "elastic_start_j": e.elastic_start_j,
+                "elastic_end_j": e.elastic_end_j,
+                "dissipated_j": e.dissipated_j,
+                "residual_j": e.residual_j(),
+                "relative_residual": e.relative_residual(),
             }),
         );
     }
@@ -250,10 +279,25 @@ fn print_summary(s: &Scenario, peaks: &Peaks, stats: Option<&RunStats>, out: Opt
         peaks.force_n.value / 1e3,
         peaks.force_n.t_s
     );
-    if let Some(st) = stats {
+    if let (Some(st), Run::Forward { integrator, .. }) = (stats, &s.run) {
         println!(
-            "  stick: {:.3} s in all, {} stops, {} breakaways, {} reversals; {} RK4 steps",
-            st.stick_time_s, st.stick_events, st.breakaways, st.reversals, st.steps
+            "  stick: {:.3} s in all, {} stops, {} breakaways, {} reversals",
+            st.stick_time_s, st.stick_events, st.breakaways, st.reversals
+        );
+        println!(
+            "  solver: {}, {} steps ({} rejected), {} right-hand-side evaluations, {} events located",
+            integrator.name(),
+            st.steps,
+            st.rejected_steps,
+            st.rhs_evaluations,
+            st.events()
+        );
+        println!(
+            "  energy: actuator work {:.4e} J = ΔE_kin + ΔE_el + dissipated {:.4e} J; residual {:.2e} J ({:.1e} relative)",
+            st.energy.actuator_work_j,
+            st.energy.dissipated_j,
+            st.energy.residual_j(),
+            st.energy.relative_residual()
         );
     }
     let ex = peaks.exceedances(&s.limits);

@@ -411,3 +411,66 @@ fn an_inverse_run_accepts_a_displacement_only_motion_csv() {
     assert!((r[2] - 0.1 * w * (w * t).cos()).abs() < 1e-6, "{r:?}");
     assert!((r[3] + 0.1 * w * w * (w * t).sin()).abs() < 1e-5, "{r:?}");
 }
+
+/// A Dopri5 scenario reports its solver statistics and an energy residual, and agrees with
+/// the RK4 run of the same record (both within 1e-8 m of the reference).
+#[test]
+fn a_dopri5_scenario_reports_statistics_and_energy_and_agrees_with_rk4() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a.csv"), dir.path().join("b.csv"));
+    let o = platen(&[
+        "simulate",
+        &scenario("paper-forward-force-dopri5.json"),
+        "--out",
+        a.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(s["solver"]["method"], "dopri5");
+    for key in [
+        "steps",
+        "accepted_steps",
+        "rejected_steps",
+        "rhs_evaluations",
+        "events_located",
+    ] {
+        assert!(s["solver"][key].is_u64(), "solver.{key}");
+    }
+    assert!(s["energy"]["relative_residual"].as_f64().unwrap().abs() < 1e-9);
+    let o = platen(&[
+        "simulate",
+        &scenario("paper-forward-force.json"),
+        "--out",
+        b.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (_, ra) = read_csv(&a);
+    let (_, rb) = read_csv(&b);
+    let du = ra
+        .iter()
+        .zip(&rb)
+        .map(|(x, y)| (x[1] - y[1]).abs())
+        .fold(0.0, f64::max);
+    assert!(du < 2e-8, "{du}");
+}
+
+#[test]
+fn bad_dopri5_tolerances_name_their_json_path() {
+    for (json, path) in [
+        (r#"{"method": "dopri5", "rtol": 0}"#, "integrator.rtol"),
+        (
+            r#"{"method": "dopri5", "rtol": 1e-6, "atol": -1}"#,
+            "integrator.atol",
+        ),
+        (r#"{"method": "dopri5", "tol": 1e-6}"#, "integrator"),
+        (r#"{"method": "dop853"}"#, "integrator"),
+    ] {
+        let (code, err, wrote) = run_bad(&format!(
+            r#"{{"model": {{"preset": "lhpost-2008"}}, "excitation": {{"force_csv": "force.csv"}}, "integrator": {json}}}"#
+        ));
+        assert_eq!(code, 3, "{json}: {err}");
+        assert!(err.contains(path), "{json}: {err}");
+        assert!(!wrote);
+    }
+}

@@ -100,6 +100,22 @@ pub enum IntegrateError {
         /// Velocity, m/s.
         v_m_s: f64,
     },
+    /// A tolerance of the adaptive integrator that is not usable.
+    #[error("{name} = {value} is invalid: expected a finite number > 0 (and rtol < 1)")]
+    InvalidTolerance {
+        /// `rtol` or `atol`.
+        name: &'static str,
+        /// The value.
+        value: f64,
+    },
+    /// The adaptive integrator gave up.
+    #[error("numerical failure at t = {t_s} s: the adaptive integrator (Dopri5) failed: {reason}")]
+    AdaptiveFailed {
+        /// Time of the failure, s.
+        t_s: f64,
+        /// What ode_solvers reported.
+        reason: String,
+    },
     /// The stick-slip event loop stopped advancing inside one step.
     #[error("numerical failure at t = {t_s} s: {events} stick-slip events inside one step; the event loop does not advance")]
     EventLoopStalled {

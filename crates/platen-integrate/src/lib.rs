@@ -27,12 +27,14 @@
 
 #![warn(missing_docs)]
 
+mod dopri5;
 mod error;
 mod inverse;
 mod output;
 mod record;
 mod rk4;
 
+pub use dopri5::{forward_dopri5, Dopri5Settings};
 pub use error::{IntegrateError, Result};
 pub use inverse::inverse;
 pub use output::{Exceedance, Peak, Peaks, Sample, SampleSink, Trajectory};
@@ -40,4 +42,4 @@ pub use record::{
     derivative, second_derivative, uniform_interval_s, ForceRecord, Motion,
     UNIFORM_RELATIVE_TOLERANCE,
 };
-pub use rk4::{forward_rk4, Rk4, RunStats, State};
+pub use rk4::{forward_rk4, EnergyBalance, Rk4, RunStats, State};

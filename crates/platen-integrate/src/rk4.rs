@@ -21,7 +21,7 @@
 //!
 //! No allocation happens per step; a run allocates only what its [`SampleSink`] stores.
 
-use platen_model::{ForceTerms, PlatenModel};
+use platen_model::{ForceTerms, PlatenModel, SlipRates};
 
 use crate::error::{IntegrateError, Result};
 use crate::output::{Sample, SampleSink};
@@ -99,7 +99,8 @@ pub struct State {
 /// Counters of a forward run.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct RunStats {
-    /// Integration steps (grid steps of length `h`).
+    /// Integration steps attempted: grid steps of length `h` for the RK4, accepted plus
+    /// rejected steps for Dopri5 (root-finding trials are counted in `root_iterations`).
     pub steps: u64,
     /// Evaluations of the right-hand side.
     pub rhs_evaluations: u64,
@@ -113,6 +114,83 @@ pub struct RunStats {
     pub root_iterations: u64,
     /// Total time spent stuck, s.
     pub stick_time_s: f64,
+    /// Accepted steps of an adaptive integrator (equal to `steps` for the fixed-step RK4).
+    pub accepted_steps: u64,
+    /// Rejected steps of an adaptive integrator (0 for the fixed-step RK4).
+    pub rejected_steps: u64,
+    /// The energy balance of the run.
+    pub energy: EnergyBalance,
+}
+
+/// Energy balance of a forward run: the work done by the actuator equals the change of
+/// kinetic and elastic energy plus the energy dissipated. The work and the dissipated energy
+/// are integrated by the same stages as the motion, so the residual measures the integration
+/// error (it is not forced to zero by construction).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct EnergyBalance {
+    /// Work done by the actuator force, `∫F_A·v dt`, J.
+    pub actuator_work_j: f64,
+    /// Kinetic energy at the start, J.
+    pub kinetic_start_j: f64,
+    /// Kinetic energy at the end, `½M(u)v²`, J.
+    pub kinetic_end_j: f64,
+    /// Elastic energy at the start, J.
+    pub elastic_start_j: f64,
+    /// Elastic energy at the end, J.
+    pub elastic_end_j: f64,
+    /// Energy dissipated, `∫D·|v| dt`, J.
+    pub dissipated_j: f64,
+}
+
+impl EnergyBalance {
+    pub(crate) fn start<M: PlatenModel>(model: &M, u: f64, v: f64) -> Self {
+        let kinetic = model.kinetic_energy_j(u, v);
+        let elastic = model.elastic_energy_j(u);
+        Self {
+            kinetic_start_j: kinetic,
+            kinetic_end_j: kinetic,
+            elastic_start_j: elastic,
+            elastic_end_j: elastic,
+            ..Self::default()
+        }
+    }
+
+    pub(crate) fn close<M: PlatenModel>(
+        &mut self,
+        model: &M,
+        u: f64,
+        v: f64,
+        work: f64,
+        dissipated: f64,
+    ) {
+        self.actuator_work_j = work;
+        self.dissipated_j = dissipated;
+        self.kinetic_end_j = model.kinetic_energy_j(u, v);
+        self.elastic_end_j = model.elastic_energy_j(u);
+    }
+
+    /// `W − ΔE_kin − ΔE_el − E_diss`, J: zero for an exact solution.
+    pub fn residual_j(&self) -> f64 {
+        self.actuator_work_j
+            - (self.kinetic_end_j - self.kinetic_start_j)
+            - (self.elastic_end_j - self.elastic_start_j)
+            - self.dissipated_j
+    }
+
+    /// The residual relative to the largest energy flow of the run (actuator work or
+    /// dissipated energy), or 0 for a run in which nothing moved.
+    pub fn relative_residual(&self) -> f64 {
+        let scale = self
+            .actuator_work_j
+            .abs()
+            .max(self.dissipated_j)
+            .max(self.kinetic_start_j + self.elastic_start_j);
+        if scale > 0.0 {
+            self.residual_j() / scale
+        } else {
+            0.0
+        }
+    }
 }
 
 impl RunStats {
@@ -123,7 +201,7 @@ impl RunStats {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Mode {
+pub(crate) enum Mode {
     Stick,
     /// Slip with friction direction `+1.0` or `−1.0`.
     Slip(f64),
@@ -158,33 +236,52 @@ impl Grid<'_> {
     }
 }
 
-/// One classical RK4 step of length `h` in slip with direction `dir`, given the
-/// acceleration `a0` at the start (so the caller can reuse it) and the forces at the start,
-/// middle and end of the step.
+/// The integrated state of a slipping platen: displacement, velocity, and the two energy
+/// integrals carried along with them (same RK4 stages, so the energy balance measures the
+/// integration error).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(crate) struct Kin {
+    pub u: f64,
+    pub v: f64,
+    /// Work done by the actuator force, `∫F_A·v dt`, J.
+    pub work: f64,
+    /// Energy dissipated, `∫D·|v| dt`, J.
+    pub dissipated: f64,
+}
+
+/// One classical RK4 step of length `h` in slip with direction `dir` from `y`, given the rates
+/// at the start `r0` (so the caller can reuse them) and the forces at the start, middle and
+/// end of the step.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn rk4_slip<M: PlatenModel>(
     m: &M,
-    u: f64,
-    v: f64,
-    a0: f64,
+    y: Kin,
+    r0: SlipRates,
     dir: f64,
     h: f64,
+    f_start: f64,
     f_mid: f64,
     f_end: f64,
-) -> (f64, f64) {
+) -> Kin {
+    let (u, v) = (y.u, y.v);
     let hh = 0.5 * h;
-    let v2 = v + hh * a0;
-    let a2 = m.slip_acceleration_m_s2(f_mid, u + hh * v, v2, dir);
-    let v3 = v + hh * a2;
-    let a3 = m.slip_acceleration_m_s2(f_mid, u + hh * v2, v3, dir);
-    let v4 = v + h * a3;
-    let a4 = m.slip_acceleration_m_s2(f_end, u + h * v3, v4, dir);
+    let v2 = v + hh * r0.a_m_s2;
+    let r2 = m.slip_rates(f_mid, u + hh * v, v2, dir);
+    let v3 = v + hh * r2.a_m_s2;
+    let r3 = m.slip_rates(f_mid, u + hh * v2, v3, dir);
+    let v4 = v + h * r3.a_m_s2;
+    let r4 = m.slip_rates(f_end, u + h * v3, v4, dir);
     let h6 = h / 6.0;
-    (
-        u + h6 * (v + 2.0 * (v2 + v3) + v4),
-        v + h6 * (a0 + 2.0 * (a2 + a3) + a4),
-    )
+    Kin {
+        u: u + h6 * (v + 2.0 * (v2 + v3) + v4),
+        v: v + h6 * (r0.a_m_s2 + 2.0 * (r2.a_m_s2 + r3.a_m_s2) + r4.a_m_s2),
+        work: y.work + h6 * (f_start * v + 2.0 * f_mid * (v2 + v3) + f_end * v4),
+        dissipated: y.dissipated
+            + h6 * (r0.dissipated_power_w
+                + 2.0 * (r2.dissipated_power_w + r3.dissipated_power_w)
+                + r4.dissipated_power_w),
+    }
 }
 
 /// Runs the model forward under the recorded force `record` from `initial`, with fixed-step
@@ -228,7 +325,7 @@ pub fn forward_rk4<M: PlatenModel, S: SampleSink>(
     let mut stepper = Stepper::new(model, grid, initial);
     let times = record.t_s();
     if samples == 0 {
-        return Ok(stepper.stats);
+        return Ok(stepper.finish());
     }
     sink.accept(&stepper.sample(0, times[0]));
     let total_steps = (samples as u64 - 1) * k;
@@ -239,7 +336,7 @@ pub fn forward_rk4<M: PlatenModel, S: SampleSink>(
             sink.accept(&stepper.sample(n + 1, times[j]));
         }
     }
-    Ok(stepper.stats)
+    Ok(stepper.finish())
 }
 
 /// How a slip interval that touches `v = 0` is split into RK4 sub-steps.
@@ -304,82 +401,68 @@ impl Grading {
 struct Stepper<'a, M> {
     model: &'a M,
     grid: Grid<'a>,
-    u: f64,
-    v: f64,
+    y: Kin,
     mode: Mode,
-    /// Acceleration at the current state in the current mode (0 in stick).
-    a: f64,
+    /// Rates at the current state in the current mode (zero in stick).
+    rates: SlipRates,
     stats: RunStats,
 }
+
+const AT_REST: SlipRates = SlipRates {
+    a_m_s2: 0.0,
+    dissipated_power_w: 0.0,
+};
 
 impl<'a, M: PlatenModel> Stepper<'a, M> {
     fn new(model: &'a M, grid: Grid<'a>, initial: State) -> Self {
         let mut s = Self {
             model,
             grid,
-            u: initial.u_m,
-            v: initial.v_m_s,
+            y: Kin {
+                u: initial.u_m,
+                v: initial.v_m_s,
+                work: 0.0,
+                dissipated: 0.0,
+            },
             mode: Mode::Stick,
-            a: 0.0,
+            rates: AT_REST,
             stats: RunStats::default(),
         };
         let f0 = s.grid.force(0, 0.0);
-        s.mode = if s.v > 0.0 {
+        s.mode = if s.y.v > 0.0 {
             Mode::Slip(1.0)
-        } else if s.v < 0.0 {
+        } else if s.y.v < 0.0 {
             Mode::Slip(-1.0)
         } else {
-            s.mode_at_rest(f0)
+            mode_at_rest(model, s.y.u, f0)
         };
-        s.refresh_acceleration(f0);
+        s.refresh_rates(f0);
+        s.stats.energy = EnergyBalance::start(model, s.y.u, s.y.v);
         s
     }
 
-    /// Mode of a platen at rest under actuator force `f`: stick inside the friction cone,
-    /// otherwise slip towards the net force.
-    #[inline]
-    fn mode_at_rest(&self, f: f64) -> Mode {
-        let net = f - self.model.elastic_force_n(self.u);
-        if net.abs() <= self.model.static_threshold_n(self.u) {
-            Mode::Stick
-        } else {
-            Mode::Slip(1.0f64.copysign(net))
-        }
-    }
-
     #[inline(always)]
-    fn refresh_acceleration(&mut self, f: f64) {
-        self.a = match self.mode {
-            Mode::Stick => 0.0,
+    fn refresh_rates(&mut self, f: f64) {
+        self.rates = match self.mode {
+            Mode::Stick => AT_REST,
             Mode::Slip(dir) => {
                 self.stats.rhs_evaluations += 1;
-                self.model.slip_acceleration_m_s2(f, self.u, self.v, dir)
+                self.model.slip_rates(f, self.y.u, self.y.v, dir)
             }
         };
     }
 
     /// The output sample at grid point `n` (τ = 0).
     fn sample(&self, n: u64, t_s: f64) -> Sample {
-        let f = self.grid.force(n, 0.0);
-        let inertial_n = self.model.mass_kg(self.u) * self.a
-            + self.model.velocity_inertial_force_n(self.u, self.v);
-        let elastic_n = self.model.elastic_force_n(self.u);
-        Sample {
-            index: (n / self.grid.k) as usize,
+        sample_at(
+            self.model,
+            (n / self.grid.k) as usize,
             t_s,
-            u_m: self.u,
-            v_m_s: self.v,
-            a_m_s2: self.a,
-            // F_D is the remainder of Eq. 1: the dissipative force in slip (to rounding), the
-            // static friction reaction in stick.
-            terms: ForceTerms {
-                inertial_n,
-                elastic_n,
-                dissipative_n: f - inertial_n - elastic_n,
-                actuator_n: f,
-            },
-            stuck: self.mode == Mode::Stick,
-        }
+            self.grid.force(n, 0.0),
+            self.y,
+            self.rates.a_m_s2,
+            self.mode == Mode::Stick,
+        )
     }
 
     /// Advances from grid point `n` to `n + 1`, handling every event inside the step.
@@ -395,29 +478,30 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
                     let rem = 1.0 - tau;
                     // Leaving v = 0 (after a breakaway or reversal) the √|v| law is singular:
                     // grade the sub-steps towards the start.
-                    let from_rest = self.v == 0.0;
-                    let (u1, v1) = if from_rest {
+                    let from_rest = self.y.v == 0.0;
+                    let y1 = if from_rest {
                         self.advance(n, tau, rem, dir, Grading::Start)
                     } else {
+                        let f_start = self.grid.force(n, tau);
                         let f_mid = self.grid.force(n, tau + 0.5 * rem);
                         let f_end = self.grid.force(n, 1.0);
                         self.stats.rhs_evaluations += 3;
                         rk4_slip(
                             self.model,
-                            self.u,
-                            self.v,
-                            self.a,
+                            self.y,
+                            self.rates,
                             dir,
                             rem * h,
+                            f_start,
                             f_mid,
                             f_end,
                         )
                     };
-                    if !(u1.is_finite() && v1.is_finite()) {
+                    if !(y1.u.is_finite() && y1.v.is_finite()) {
                         return Err(self.non_finite(n, tau));
                     }
-                    if dir * v1 > 0.0 {
-                        return self.commit(n, u1, v1);
+                    if dir * y1.v > 0.0 {
+                        return self.commit(n, y1);
                     }
                     // v reaches zero inside the step. Arriving at v = 0 is singular too:
                     // redo the remainder graded towards the end, then locate the crossing on
@@ -427,40 +511,39 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
                     } else {
                         Grading::End
                     };
-                    let (u2, v2) = self.advance(n, tau, rem, dir, grading);
-                    if dir * v2 > 0.0 {
-                        return self.commit(n, u2, v2);
+                    let y2 = self.advance(n, tau, rem, dir, grading);
+                    if dir * y2.v > 0.0 {
+                        return self.commit(n, y2);
                     }
-                    match self.locate_zero_velocity(n, tau, rem, dir, v2, grading) {
-                        Some((x, u_event)) => {
+                    match self.locate_zero_velocity(n, tau, rem, dir, y2, grading) {
+                        Some((x, y_event)) => {
                             tau += x;
                             if 1.0 - tau < 1e-12 {
                                 tau = 1.0;
                             }
-                            self.u = u_event;
-                            self.v = 0.0;
+                            self.y = Kin { v: 0.0, ..y_event };
                             let f = self.grid.force(n, tau);
-                            self.mode = self.mode_at_rest(f);
+                            self.mode = mode_at_rest(self.model, self.y.u, f);
                             match self.mode {
                                 Mode::Stick => self.stats.stick_events += 1,
                                 Mode::Slip(_) => self.stats.reversals += 1,
                             }
-                            self.refresh_acceleration(f);
+                            self.refresh_rates(f);
                         }
                         None => {
                             // Started at v = 0 and no step length moves the platen in `dir`:
                             // friction holds it.
-                            self.v = 0.0;
+                            self.y.v = 0.0;
                             self.mode = Mode::Stick;
                             self.stats.stick_events += 1;
-                            self.a = 0.0;
+                            self.rates = AT_REST;
                         }
                     }
                 }
                 Mode::Stick => {
                     let model = self.model;
-                    let elastic = model.elastic_force_n(self.u);
-                    let threshold = model.static_threshold_n(self.u);
+                    let elastic = model.elastic_force_n(self.y.u);
+                    let threshold = model.static_threshold_n(self.y.u);
                     let net_end = self.grid.force(n, 1.0) - elastic;
                     if net_end.abs() <= threshold {
                         self.stats.stick_time_s += (1.0 - tau) * h;
@@ -476,7 +559,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
                     tau = tau_b;
                     self.mode = Mode::Slip(1.0f64.copysign(net_end));
                     let f = self.grid.force(n, tau);
-                    self.refresh_acceleration(f);
+                    self.refresh_rates(f);
                 }
             }
             events += 1;
@@ -494,11 +577,10 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
 
     /// Accepts the state at the end of step `n`.
     #[inline(always)]
-    fn commit(&mut self, n: u64, u: f64, v: f64) -> Result<()> {
-        self.u = u;
-        self.v = v;
-        self.refresh_acceleration(self.grid.force(n, 1.0));
-        if !self.a.is_finite() {
+    fn commit(&mut self, n: u64, y: Kin) -> Result<()> {
+        self.y = y;
+        self.refresh_rates(self.grid.force(n, 1.0));
+        if !self.rates.a_m_s2.is_finite() {
             return Err(self.non_finite(n, 1.0));
         }
         Ok(())
@@ -506,71 +588,75 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
 
     /// RK4 in slip from the current state at fraction `tau` of step `n` over a length `x·h`,
     /// split into the sub-steps of `grading`.
-    fn advance(&mut self, n: u64, tau: f64, x: f64, dir: f64, grading: Grading) -> (f64, f64) {
-        let (mut u, mut v, mut a) = (self.u, self.v, self.a);
+    fn advance(&mut self, n: u64, tau: f64, x: f64, dir: f64, grading: Grading) -> Kin {
+        let (mut y, mut r) = (self.y, self.rates);
         let mut s = tau;
         for (i, &p) in grading.pieces().iter().enumerate() {
             let len = p * x;
+            let f_start = self.grid.force(n, s);
             if i > 0 {
-                a = self
-                    .model
-                    .slip_acceleration_m_s2(self.grid.force(n, s), u, v, dir);
+                r = self.model.slip_rates(f_start, y.u, y.v, dir);
                 self.stats.rhs_evaluations += 1;
             }
             let f_mid = self.grid.force(n, s + 0.5 * len);
             let f_end = self.grid.force(n, s + len);
-            (u, v) = rk4_slip(self.model, u, v, a, dir, len * self.grid.h, f_mid, f_end);
+            y = rk4_slip(
+                self.model,
+                y,
+                r,
+                dir,
+                len * self.grid.h,
+                f_start,
+                f_mid,
+                f_end,
+            );
             self.stats.rhs_evaluations += 3;
             s += len;
         }
-        (u, v)
+        y
     }
 
     fn non_finite(&self, n: u64, tau: f64) -> IntegrateError {
         IntegrateError::NonFiniteState {
             t_s: self.grid.time_s(n, tau),
-            u_m: self.u,
-            v_m_s: self.v,
+            u_m: self.y.u,
+            v_m_s: self.y.v,
         }
     }
 
-    /// A root-finding trial: [`Stepper::advance`] over `x`, counted as an iteration.
-    #[inline]
-    fn trial(&mut self, n: u64, tau: f64, x: f64, dir: f64, grading: Grading) -> (f64, f64) {
-        self.stats.root_iterations += 1;
-        self.advance(n, tau, x, dir, grading)
-    }
-
-    /// Finds the step length `x ∈ (0, rem]` (fraction of `h`) at which the RK4 velocity from
-    /// the current state reaches zero, given that the full remainder ends at `v_rem` with
-    /// `dir·v_rem ≤ 0`. Returns `x` and the displacement there, or `None` if the platen
-    /// starts at rest and does not move in `dir` for any step length.
+    /// Finds the step length `x ∈ (0, rem]` (fraction of `h`) at which the graded RK4
+    /// velocity from the current state reaches zero, given that the full remainder ends at
+    /// `y_rem` with `dir·v ≤ 0`. Returns `x` and the state there (velocity not yet zeroed),
+    /// or `None` if the platen starts at rest and does not move in `dir` for any step length.
     fn locate_zero_velocity(
         &mut self,
         n: u64,
         tau: f64,
         rem: f64,
         dir: f64,
-        v_rem: f64,
+        y_rem: Kin,
         grading: Grading,
-    ) -> Option<(f64, f64)> {
+    ) -> Option<(f64, Kin)> {
+        let trial = |s: &mut Self, x: f64| {
+            s.stats.root_iterations += 1;
+            s.advance(n, tau, x, dir, grading)
+        };
         // g(x) = dir·v(x): positive before the crossing, ≤ 0 after it.
-        let mut hi = rem;
-        let mut g_hi = dir * v_rem;
+        let (mut hi, mut y_hi) = (rem, y_rem);
+        let mut g_hi = dir * y_rem.v;
         let mut lo = 0.0;
-        let mut g_lo = dir * self.v;
+        let mut g_lo = dir * self.y.v;
         if g_lo <= 0.0 {
             // Starting at rest (after a breakaway or reversal): find a length that moves.
             let mut x = 0.5 * rem;
             loop {
-                let (_, v) = self.trial(n, tau, x, dir, grading);
-                if dir * v > 0.0 {
+                let y = trial(self, x);
+                if dir * y.v > 0.0 {
                     lo = x;
-                    g_lo = dir * v;
+                    g_lo = dir * y.v;
                     break;
                 }
-                hi = x;
-                g_hi = dir * v;
+                (hi, y_hi, g_hi) = (x, y, dir * y.v);
                 x *= 0.5;
                 if x < 1e-15 * rem {
                     return None;
@@ -579,7 +665,6 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
         }
         // Illinois variant of regula falsi: bracketing, superlinear.
         let mut side = 0i8;
-        let mut u_hi = None;
         for _ in 0..MAX_ROOT_ITERATIONS {
             if g_hi == 0.0 || hi - lo <= 4.0 * f64::EPSILON * rem {
                 break;
@@ -588,8 +673,8 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
             if !(x > lo && x < hi) {
                 x = 0.5 * (lo + hi);
             }
-            let (u, v) = self.trial(n, tau, x, dir, grading);
-            let g = dir * v;
+            let y = trial(self, x);
+            let g = dir * y.v;
             if g > 0.0 {
                 lo = x;
                 g_lo = g;
@@ -598,19 +683,68 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
                 }
                 side = 1;
             } else {
-                hi = x;
-                g_hi = g;
-                u_hi = Some(u);
+                (hi, y_hi, g_hi) = (x, y, g);
                 if side == -1 {
                     g_lo *= 0.5;
                 }
                 side = -1;
             }
         }
-        let u = match u_hi {
-            Some(u) => u,
-            None => self.trial(n, tau, hi, dir, grading).0,
-        };
-        Some((hi, u))
+        Some((hi, y_hi))
+    }
+
+    /// Closes the energy balance at the current state.
+    fn finish(&mut self) -> RunStats {
+        self.stats.energy.close(
+            self.model,
+            self.y.u,
+            self.y.v,
+            self.y.work,
+            self.y.dissipated,
+        );
+        self.stats.accepted_steps = self.stats.steps;
+        self.stats
+    }
+}
+
+/// Mode of a platen at rest at `u` under actuator force `f`: stick inside the friction cone,
+/// otherwise slip towards the net force.
+#[inline]
+pub(crate) fn mode_at_rest<M: PlatenModel>(model: &M, u: f64, f: f64) -> Mode {
+    let net = f - model.elastic_force_n(u);
+    if net.abs() <= model.static_threshold_n(u) {
+        Mode::Stick
+    } else {
+        Mode::Slip(1.0f64.copysign(net))
+    }
+}
+
+/// An output sample from a state; F_D is the remainder of Eq. 1: the dissipative force in slip
+/// (to rounding), the static friction reaction in stick.
+#[inline]
+pub(crate) fn sample_at<M: PlatenModel>(
+    model: &M,
+    index: usize,
+    t_s: f64,
+    f: f64,
+    y: Kin,
+    a: f64,
+    stuck: bool,
+) -> Sample {
+    let inertial_n = model.mass_kg(y.u) * a + model.velocity_inertial_force_n(y.u, y.v);
+    let elastic_n = model.elastic_force_n(y.u);
+    Sample {
+        index,
+        t_s,
+        u_m: y.u,
+        v_m_s: y.v,
+        a_m_s2: a,
+        terms: ForceTerms {
+            inertial_n,
+            elastic_n,
+            dissipative_n: f - inertial_n - elastic_n,
+            actuator_n: f,
+        },
+        stuck,
     }
 }

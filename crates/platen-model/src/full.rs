@@ -257,6 +257,15 @@ impl PlatenModel for FullModel {
     }
 
     #[inline(always)]
+    fn elastic_energy_j(&self, u_m: f64) -> f64 {
+        // ∫(Kₑu + K′ₑu³/h²)du = ½Kₑu² + K′ₑu⁴/(4h²).
+        let r = u_m * self.inv_h;
+        (0.5 * self.derived.stiffness_n_per_m + 0.25 * self.derived.cubic_stiffness_n_per_m * r * r)
+            * u_m
+            * u_m
+    }
+
+    #[inline(always)]
     fn velocity_inertial_force_n(&self, u_m: f64, v_m_s: f64) -> f64 {
         let w = v_m_s * self.inv_h;
         self.two_mp * w * w * u_m

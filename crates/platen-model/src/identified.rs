@@ -1,7 +1,7 @@
 //! The identified model of the paper (Eq. 22/23).
 
 use crate::error::{non_negative, positive, unit_exponent, Result};
-use crate::{Exponent, PlatenModel};
+use crate::{Exponent, PlatenModel, SlipRates};
 
 /// The seven parameters of the identified model (Eq. 22/23), named as in the contract.
 ///
@@ -99,9 +99,17 @@ impl PlatenModel for IdentifiedModel {
     }
 
     #[inline(always)]
-    fn slip_acceleration_m_s2(&self, force_n: f64, u_m: f64, v_m_s: f64, direction: f64) -> f64 {
+    fn elastic_energy_j(&self, u_m: f64) -> f64 {
+        0.5 * self.params.stiffness_n_per_m * u_m * u_m
+    }
+
+    #[inline(always)]
+    fn slip_rates(&self, force_n: f64, u_m: f64, v_m_s: f64, direction: f64) -> SlipRates {
         let speed = (direction * v_m_s).max(0.0);
-        (force_n - self.elastic_force_n(u_m) - direction * self.dissipative_magnitude_n(u_m, speed))
-            * self.inv_mass
+        let d = self.dissipative_magnitude_n(u_m, speed);
+        SlipRates {
+            a_m_s2: (force_n - self.elastic_force_n(u_m) - direction * d) * self.inv_mass,
+            dissipated_power_w: d * speed,
+        }
     }
 }

@@ -77,20 +77,54 @@ pub trait PlatenModel {
         self.dissipative_magnitude_n(u_m, 0.0)
     }
 
-    /// Acceleration in slip with the friction direction fixed to `direction` (`+1.0` or
-    /// `−1.0`), m/s²: `(F_A − F_E − direction·D(u, max(direction·v, 0)) − 2M̄′ₑ(v/h)²u) / M(u)`.
+    /// Elastic (potential) energy stored at displacement `u`, J: the integral of
+    /// [`PlatenModel::elastic_force_n`] from 0 to `u`.
+    fn elastic_energy_j(&self, u_m: f64) -> f64;
+
+    /// Kinetic energy `½·M(u)·v²`, J. With the displacement-dependent mass of Eq. 2 its rate is
+    /// `v·(M(u)·a + 2M̄′ₑ(v/h)²u)`, the power of the inertial force.
+    #[inline]
+    fn kinetic_energy_j(&self, u_m: f64, v_m_s: f64) -> f64 {
+        0.5 * self.mass_kg(u_m) * v_m_s * v_m_s
+    }
+
+    /// Acceleration and dissipated power in slip with the friction direction fixed to
+    /// `direction` (`+1.0` or `−1.0`):
+    /// `a = (F_A − F_E − direction·D(u, w) − 2M̄′ₑ(v/h)²u) / M(u)` and `P_D = D(u, w)·w`, with
+    /// the speed `w = max(direction·v, 0)`.
     ///
     /// The speed is clamped at zero so that the right-hand side stays continuous when an
     /// integrator stage overshoots `v = 0`; locating that crossing is the integrator's job.
     #[inline]
-    fn slip_acceleration_m_s2(&self, force_n: f64, u_m: f64, v_m_s: f64, direction: f64) -> f64 {
+    fn slip_rates(&self, force_n: f64, u_m: f64, v_m_s: f64, direction: f64) -> SlipRates {
         let speed = (direction * v_m_s).max(0.0);
-        (force_n
+        let d = self.dissipative_magnitude_n(u_m, speed);
+        let a_m_s2 = (force_n
             - self.elastic_force_n(u_m)
-            - direction * self.dissipative_magnitude_n(u_m, speed)
+            - direction * d
             - self.velocity_inertial_force_n(u_m, v_m_s))
-            / self.mass_kg(u_m)
+            / self.mass_kg(u_m);
+        SlipRates {
+            a_m_s2,
+            dissipated_power_w: d * speed,
+        }
     }
+
+    /// Acceleration in slip with the friction direction fixed to `direction`, m/s²: the
+    /// acceleration of [`PlatenModel::slip_rates`].
+    #[inline]
+    fn slip_acceleration_m_s2(&self, force_n: f64, u_m: f64, v_m_s: f64, direction: f64) -> f64 {
+        self.slip_rates(force_n, u_m, v_m_s, direction).a_m_s2
+    }
+}
+
+/// Rates of a slipping platen: see [`PlatenModel::slip_rates`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SlipRates {
+    /// Acceleration, m/s².
+    pub a_m_s2: f64,
+    /// Power dissipated by the dissipative force, `D·|v| ≥ 0`, W.
+    pub dissipated_power_w: f64,
 }
 
 /// The decomposition of the actuator force of Eq. 1 at one instant, N.

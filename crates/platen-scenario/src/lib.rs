@@ -17,4 +17,4 @@ pub mod error;
 pub mod scenario;
 
 pub use error::{Result, ScenarioError};
-pub use scenario::{Model, Run, Scenario};
+pub use scenario::{Integrator, Model, Run, Scenario};

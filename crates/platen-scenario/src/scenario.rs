@@ -22,7 +22,7 @@
 //!   `v_m_s`, `a_m_s2`: an inverse run), `sine_force` or `sine_motion` (generated).
 //!   Paths are relative to the scenario file.
 //! * `integrator` (forward runs only; default RK4 at the record's sample interval):
-//!   `{"method": "rk4", "step_s": Δt/k}`.
+//!   `{"method": "rk4", "step_s": Δt/k}` or `{"method": "dopri5", "rtol": 1e-8, "atol": 1e-11}`.
 //! * `initial` (forward runs only; default at rest at 0).
 //! * `duration_s` defaults to the record's span; required for generated excitations.
 //!
@@ -32,7 +32,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use platen_integrate::{ForceRecord, Motion, Rk4, State};
+use platen_integrate::{Dopri5Settings, ForceRecord, Motion, Rk4, State};
 use platen_model::{
     FullModel, IdentifiedModel, IdentifiedParams, ModelError, PhysicalParams, Preset, TableLimits,
 };
@@ -173,6 +173,42 @@ fn default_rate() -> f64 {
 pub enum IntegratorSpec {
     /// Fixed-step RK4 with exact stick-slip.
     Rk4(Rk4Spec),
+    /// Adaptive Dormand–Prince 5(4) (ode_solvers' Dopri5) with exact stick-slip.
+    Dopri5(Dopri5Spec),
+}
+
+/// `{"method": "dopri5", "rtol": …, "atol": …}`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Dopri5Spec {
+    /// Relative tolerance (default 1e-8).
+    pub rtol: Option<f64>,
+    /// Absolute tolerance, in the state's units (m, m/s) (default 1e-11).
+    pub atol: Option<f64>,
+}
+
+/// Default relative tolerance of `dopri5`.
+pub const DEFAULT_RTOL: f64 = 1e-8;
+/// Default absolute tolerance of `dopri5`.
+pub const DEFAULT_ATOL: f64 = 1e-11;
+
+/// The integrator of a forward run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Integrator {
+    /// Fixed-step RK4.
+    Rk4(Rk4),
+    /// Adaptive Dopri5.
+    Dopri5(Dopri5Settings),
+}
+
+impl Integrator {
+    /// `"rk4"` or `"dopri5"`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Integrator::Rk4(_) => "rk4",
+            Integrator::Dopri5(_) => "dopri5",
+        }
+    }
 }
 
 /// `{"method": "rk4", "step_s": …}`.
@@ -222,7 +258,7 @@ pub enum Run {
         /// The actuator force.
         record: ForceRecord,
         /// Integrator settings.
-        rk4: Rk4,
+        integrator: Integrator,
         /// State at the first sample.
         initial: State,
         /// Output samples (the first `samples` of the record).
@@ -628,25 +664,35 @@ fn generated_samples(ctx: &Ctx, duration_s: Option<f64>, rate: f64, what: &str) 
 }
 
 fn forward_run(ctx: &Ctx, file: &ScenarioFile, record: ForceRecord, samples: usize) -> Result<Run> {
-    let rk4 = match &file.integrator {
-        None | Some(IntegratorSpec::Rk4(Rk4Spec { step_s: None })) => Rk4::with_steps_per_sample(1),
-        Some(IntegratorSpec::Rk4(Rk4Spec { step_s: Some(step) })) => {
-            Rk4::from_step(*step, record.dt_s())
+    let integrator = match &file.integrator {
+        None => Integrator::Rk4(Rk4::with_steps_per_sample(1).expect("k = 1 is valid")),
+        Some(IntegratorSpec::Rk4(Rk4Spec { step_s })) => {
+            let step = step_s.unwrap_or(record.dt_s());
+            Integrator::Rk4(
+                Rk4::from_step(step, record.dt_s())
+                    .map_err(|e| ctx.invalid("integrator.step_s", step, e.to_string()))?,
+            )
         }
-    }
-    .map_err(|e| {
-        let step = match &file.integrator {
-            Some(IntegratorSpec::Rk4(Rk4Spec { step_s: Some(step) })) => *step,
-            _ => record.dt_s(),
-        };
-        ctx.invalid("integrator.step_s", step, e.to_string())
-    })?;
+        Some(IntegratorSpec::Dopri5(spec)) => {
+            let rtol = spec.rtol.unwrap_or(DEFAULT_RTOL);
+            let atol = spec.atol.unwrap_or(DEFAULT_ATOL);
+            let settings = Dopri5Settings::new(rtol, atol).map_err(|e| match e {
+                platen_integrate::IntegrateError::InvalidTolerance { name, value } => ctx.invalid(
+                    &format!("integrator.{name}"),
+                    value,
+                    "a finite number > 0 (rtol < 1)",
+                ),
+                other => ctx.invalid("integrator", "", other.to_string()),
+            })?;
+            Integrator::Dopri5(settings)
+        }
+    };
     let initial = file.initial.clone().unwrap_or_default();
     let u_m = check_finite(ctx, "initial.u_m", initial.u_m)?;
     let v_m_s = check_finite(ctx, "initial.v_m_s", initial.v_m_s)?;
     Ok(Run::Forward {
         record,
-        rk4,
+        integrator,
         initial: State { u_m, v_m_s },
         samples,
     })
