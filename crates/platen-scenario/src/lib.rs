@@ -14,6 +14,8 @@
 
 pub mod csv_io;
 pub mod error;
+pub mod generate;
+pub mod peer;
 pub mod scenario;
 
 pub use error::{Result, ScenarioError};

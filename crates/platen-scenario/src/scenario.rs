@@ -19,7 +19,8 @@
 //!   13.8) sets the nitrogen pressure of either form.
 //! * `excitation` holds exactly one of `force_csv` (columns `t_s`, `force_n`, uniformly
 //!   sampled, linear between samples: a forward run), `motion_csv` (`t_s`, `u_m`, optional
-//!   `v_m_s`, `a_m_s2`: an inverse run), `sine_force` or `sine_motion` (generated).
+//!   `v_m_s`, `a_m_s2`: an inverse run), or a generated `sine_force` (forward),
+//!   `sine_motion`, `triangle_motion` or `white_noise_motion` (inverse).
 //!   Paths are relative to the scenario file.
 //! * `integrator` (forward runs only; default RK4 at the record's sample interval):
 //!   `{"method": "rk4", "step_s": Δt/k}` or `{"method": "dopri5", "rtol": 1e-8, "atol": 1e-11}`.
@@ -35,10 +36,12 @@ use serde::Deserialize;
 use platen_integrate::{Dopri5Settings, ForceRecord, Motion, Rk4, State};
 use platen_model::{
     FullModel, IdentifiedModel, IdentifiedParams, ModelError, PhysicalParams, Preset, TableLimits,
+    STANDARD_GRAVITY_M_S2,
 };
 
 use crate::csv_io::{read_table, uniform_step_s};
 use crate::error::{Result, ScenarioError};
+use crate::generate::{self, GenerateError};
 
 /// The scenario file as written (after JSON parsing, before validation).
 #[derive(Debug, Clone, Deserialize)]
@@ -128,8 +131,12 @@ pub struct ExcitationSpec {
     pub motion_csv: Option<PathBuf>,
     /// Generated sine force: forward run.
     pub sine_force: Option<SineForce>,
-    /// Generated sine displacement: inverse run.
+    /// Generated sine displacement (the paper's S tests): inverse run.
     pub sine_motion: Option<SineMotion>,
+    /// Generated triangle displacement with rounded reversals (the paper's T tests): inverse run.
+    pub triangle_motion: Option<TriangleMotion>,
+    /// Generated band-limited white-noise motion (the paper's WN tests): inverse run.
+    pub white_noise_motion: Option<WhiteNoiseMotion>,
 }
 
 /// `F(t) = r(t)·amplitude_n·sin(2π·frequency_hz·t)`, with `r` a linear ramp from 0 to 1 over
@@ -161,6 +168,50 @@ pub struct SineMotion {
     /// Sample rate, Hz (default 1024).
     #[serde(default = "default_rate")]
     pub sample_rate_hz: f64,
+}
+
+/// A triangle displacement wave with constant-acceleration rounded reversals
+/// ([`crate::generate::triangle_motion`]): peak `amplitude_m`, constant velocity
+/// `velocity_m_s`, reversal arcs at `reversal_acceleration_m_s2`; period
+/// `4U/V + 2V/A_r`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TriangleMotion {
+    /// Peak displacement, m.
+    pub amplitude_m: f64,
+    /// Constant velocity between reversals, m/s.
+    pub velocity_m_s: f64,
+    /// Acceleration of the rounded reversals, m/s².
+    pub reversal_acceleration_m_s2: f64,
+    /// Sample rate, Hz (default 1024).
+    #[serde(default = "default_rate")]
+    pub sample_rate_hz: f64,
+}
+
+/// Band-limited white-noise motion ([`crate::generate::white_noise_motion`]).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WhiteNoiseMotion {
+    /// RMS acceleration, in g (`0.1` for the paper's WN10%g).
+    pub rms_acceleration_g: f64,
+    /// Band of the flat acceleration spectrum, Hz (default `[0.5, 20]`: up to the table's
+    /// 20 Hz bandwidth; the lower edge keeps the displacement within the stroke).
+    #[serde(default = "default_band")]
+    pub band_hz: [f64; 2],
+    /// Seed of the random phases (default 1).
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    /// Sample rate, Hz (default 1024).
+    #[serde(default = "default_rate")]
+    pub sample_rate_hz: f64,
+}
+
+fn default_band() -> [f64; 2] {
+    [0.5, 20.0]
+}
+
+fn default_seed() -> u64 {
+    1
 }
 
 fn default_rate() -> f64 {
@@ -497,6 +548,8 @@ fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
         ("motion_csv", ex.motion_csv.is_some()),
         ("sine_force", ex.sine_force.is_some()),
         ("sine_motion", ex.sine_motion.is_some()),
+        ("triangle_motion", ex.triangle_motion.is_some()),
+        ("white_noise_motion", ex.white_noise_motion.is_some()),
     ]
     .iter()
     .filter(|(_, present)| *present)
@@ -506,9 +559,10 @@ fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
         return Err(ctx.invalid(
             "excitation",
             format!("{{{}}}", given.join(", ")),
-            "exactly one of force_csv, motion_csv, sine_force, sine_motion",
+            "exactly one of force_csv, motion_csv, sine_force, sine_motion, triangle_motion, white_noise_motion",
         ));
     }
+    let kind = given[0];
     let forward = ex.force_csv.is_some() || ex.sine_force.is_some();
     if !forward {
         if file.integrator.is_some() {
@@ -526,6 +580,28 @@ fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
             ));
         }
     }
+    // Generated excitations have no length of their own.
+    let duration = || -> Result<f64> {
+        file.duration_s.ok_or_else(|| {
+            ctx.invalid(
+                "duration_s",
+                "(missing)",
+                format!("a duration in s: excitation.{kind} has no length of its own"),
+            )
+        })
+    };
+    let generated = |e: GenerateError| match e {
+        GenerateError::Invalid {
+            name: "duration_s",
+            value,
+            expected,
+        } => ctx.invalid("duration_s", value, expected),
+        GenerateError::Invalid {
+            name,
+            value,
+            expected,
+        } => ctx.invalid(&format!("excitation.{kind}.{name}"), value, expected),
+    };
     if let Some(rel) = &ex.force_csv {
         let path = ctx.resolve(rel);
         let mut table = read_table(&path, &["t_s", "force_n"], &[])?;
@@ -537,34 +613,21 @@ fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
             path: path.clone(),
             message: e.to_string(),
         })?;
-        forward_run(ctx, file, record, samples)
-    } else if let Some(sine) = &ex.sine_force {
-        let rate = check_positive(
-            ctx,
-            "excitation.sine_force.sample_rate_hz",
-            sine.sample_rate_hz,
-        )?;
-        let freq = check_finite_non_negative(
-            ctx,
-            "excitation.sine_force.frequency_hz",
-            sine.frequency_hz,
-        )?;
-        let amp = check_finite(ctx, "excitation.sine_force.amplitude_n", sine.amplitude_n)?;
-        let ramp = check_finite_non_negative(ctx, "excitation.sine_force.ramp_s", sine.ramp_s)?;
-        let n = generated_samples(ctx, file.duration_s, rate, "excitation.sine_force")?;
-        let force: Vec<f64> = (0..n)
-            .map(|j| {
-                let t = j as f64 / rate;
-                let r = if ramp > 0.0 { (t / ramp).min(1.0) } else { 1.0 };
-                r * amp * (2.0 * std::f64::consts::PI * freq * t).sin()
-            })
-            .collect();
-        let record = ForceRecord::from_rate(rate, force).map_err(|e| ScenarioError::Record {
-            path: ctx.path.to_owned(),
-            message: e.to_string(),
-        })?;
-        forward_run(ctx, file, record, n)
-    } else if let Some(rel) = &ex.motion_csv {
+        return forward_run(ctx, file, record, samples);
+    }
+    if let Some(g) = &ex.sine_force {
+        let record = generate::sine_force(
+            g.amplitude_n,
+            g.frequency_hz,
+            g.ramp_s,
+            g.sample_rate_hz,
+            duration()?,
+        )
+        .map_err(generated)?;
+        let samples = record.len();
+        return forward_run(ctx, file, record, samples);
+    }
+    let motion = if let Some(rel) = &ex.motion_csv {
         let path = ctx.resolve(rel);
         let mut table = read_table(&path, &["t_s", "u_m"], &["v_m_s", "a_m_s2"])?;
         let t = table.take_column("t_s").unwrap_or_default();
@@ -576,7 +639,6 @@ fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
             Some(d) => {
                 check_positive(ctx, "duration_s", d)?;
                 let end = t[0] + d;
-                let n = t.partition_point(|&x| x <= end + 1e-9 * d.abs());
                 if t[t.len() - 1] < end - 1e-9 * d.abs() {
                     return Err(ScenarioError::Record {
                         path,
@@ -586,11 +648,11 @@ fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
                         ),
                     });
                 }
-                n
+                t.partition_point(|&x| x <= end + 1e-9 * d.abs())
             }
         };
         let cut = |c: Vec<f64>| c[..samples].to_vec();
-        let motion = match (v, a) {
+        match (v, a) {
             (Some(v), Some(a)) => Motion::new(cut(t), cut(u), cut(v), cut(a)),
             (Some(v), None) => Motion::from_displacement_velocity(cut(t), cut(u), cut(v)),
             (None, Some(_)) | (None, None) => Motion::from_displacement(cut(t), cut(u)),
@@ -598,36 +660,39 @@ fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
         .map_err(|e| ScenarioError::Record {
             path,
             message: e.to_string(),
-        })?;
-        Ok(Run::Inverse { motion })
+        })?
+    } else if let Some(g) = &ex.sine_motion {
+        generate::sine_motion(g.amplitude_m, g.frequency_hz, g.sample_rate_hz, duration()?)
+            .map_err(generated)?
+    } else if let Some(g) = &ex.triangle_motion {
+        generate::triangle_motion(
+            g.amplitude_m,
+            g.velocity_m_s,
+            g.reversal_acceleration_m_s2,
+            g.sample_rate_hz,
+            duration()?,
+        )
+        .map_err(generated)?
     } else {
-        let sine = ex
-            .sine_motion
+        let g = ex
+            .white_noise_motion
             .as_ref()
             .expect("exactly one excitation is present");
-        let rate = check_positive(
+        let rms = check_positive(
             ctx,
-            "excitation.sine_motion.sample_rate_hz",
-            sine.sample_rate_hz,
+            "excitation.white_noise_motion.rms_acceleration_g",
+            g.rms_acceleration_g,
         )?;
-        let freq = check_finite_non_negative(
-            ctx,
-            "excitation.sine_motion.frequency_hz",
-            sine.frequency_hz,
-        )?;
-        let amp = check_finite(ctx, "excitation.sine_motion.amplitude_m", sine.amplitude_m)?;
-        let n = generated_samples(ctx, file.duration_s, rate, "excitation.sine_motion")?;
-        let w = 2.0 * std::f64::consts::PI * freq;
-        let t: Vec<f64> = (0..n).map(|j| j as f64 / rate).collect();
-        let u = t.iter().map(|&t| amp * (w * t).sin()).collect();
-        let v = t.iter().map(|&t| amp * w * (w * t).cos()).collect();
-        let a = t.iter().map(|&t| -amp * w * w * (w * t).sin()).collect();
-        let motion = Motion::new(t, u, v, a).map_err(|e| ScenarioError::Record {
-            path: ctx.path.to_owned(),
-            message: e.to_string(),
-        })?;
-        Ok(Run::Inverse { motion })
-    }
+        generate::white_noise_motion(
+            rms * STANDARD_GRAVITY_M_S2,
+            (g.band_hz[0], g.band_hz[1]),
+            g.seed,
+            g.sample_rate_hz,
+            duration()?,
+        )
+        .map_err(generated)?
+    };
+    Ok(Run::Inverse { motion })
 }
 
 fn check_finite(ctx: &Ctx, json_path: &str, value: f64) -> Result<f64> {
@@ -636,31 +701,6 @@ fn check_finite(ctx: &Ctx, json_path: &str, value: f64) -> Result<f64> {
     } else {
         Err(ctx.invalid(json_path, value, "a finite number"))
     }
-}
-
-fn check_finite_non_negative(ctx: &Ctx, json_path: &str, value: f64) -> Result<f64> {
-    if value.is_finite() && value >= 0.0 {
-        Ok(value)
-    } else {
-        Err(ctx.invalid(json_path, value, "a finite number >= 0"))
-    }
-}
-
-/// Sample count of a generated excitation: `duration_s` is required.
-fn generated_samples(ctx: &Ctx, duration_s: Option<f64>, rate: f64, what: &str) -> Result<usize> {
-    let Some(d) = duration_s else {
-        return Err(ctx.invalid(
-            "duration_s",
-            "(missing)",
-            format!("a duration in s: {what} has no length of its own"),
-        ));
-    };
-    check_positive(ctx, "duration_s", d)?;
-    let n = (d * rate + 1e-6).floor() + 1.0;
-    if n > 1e9 {
-        return Err(ctx.invalid("duration_s", d, "at most 1e9 samples at the sample rate"));
-    }
-    Ok(n as usize)
 }
 
 fn forward_run(ctx: &Ctx, file: &ScenarioFile, record: ForceRecord, samples: usize) -> Result<Run> {
