@@ -1,0 +1,195 @@
+//! Power spectral density by Welch's method.
+
+use std::fmt;
+use std::sync::Arc;
+
+use rustfft::num_complex::Complex;
+use rustfft::{Fft, FftPlanner};
+
+use crate::error::{Result, SignalError};
+use crate::{SampleRate, Window};
+
+/// Welch's averaged periodogram: Hann-windowed segments of a fixed length with 50 % overlap,
+/// each with its mean removed, one-sided, scaled as a density.
+///
+/// Scaling: `P[k] = c_k·⟨|X_k|²⟩ / (f_s·Σw²)` with `c_k = 2` except at DC and at the Nyquist
+/// bin (`c_k = 1`), so that `Σ_k P[k]·Δf` equals the (window-weighted) mean square of the
+/// de-meaned segments, i.e. the variance: `∫ PSD df = σ²`. A white noise of variance `σ²`
+/// has the flat level `σ²/(f_s/2)`. This is `scipy.signal.welch(x, fs, nperseg=len)` with its
+/// defaults (periodic Hann window, `noverlap = len/2`, `detrend='constant'`,
+/// `scaling='density'`, mean averaging). Samples after the last whole segment are not used.
+#[derive(Clone)]
+pub struct Welch {
+    segment_len: usize,
+    rate: SampleRate,
+    window: Vec<f64>,
+    /// `1/(f_s·Σw²)`.
+    scale: f64,
+    fft: Arc<dyn Fft<f64>>,
+}
+
+impl fmt::Debug for Welch {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Welch")
+            .field("segment_len", &self.segment_len)
+            .field("sample_rate_hz", &self.rate.hz())
+            .finish()
+    }
+}
+
+impl Welch {
+    /// Plans the estimate: `segment_len ≥ 4` samples per segment (frequency resolution
+    /// `sample_rate_hz/segment_len`), `sample_rate_hz` finite and > 0.
+    ///
+    /// # Errors
+    /// [`SignalError::InvalidCount`] for `segment_len < 4`, [`SignalError::InvalidParameter`]
+    /// for a bad sample rate.
+    pub fn new(segment_len: usize, sample_rate_hz: f64) -> Result<Self> {
+        let rate = SampleRate::new(sample_rate_hz)?;
+        if segment_len < 4 {
+            return Err(SignalError::InvalidCount {
+                name: "segment_len",
+                value: segment_len,
+                expected: "at least 4 samples per segment",
+            });
+        }
+        let window = Window::Hann.periodic(segment_len);
+        let power: f64 = window.iter().map(|w| w * w).sum();
+        let fft = FftPlanner::<f64>::new().plan_fft_forward(segment_len);
+        Ok(Welch {
+            segment_len,
+            rate,
+            window,
+            scale: 1.0 / (rate.hz() * power),
+            fft,
+        })
+    }
+
+    /// Samples per segment.
+    pub fn segment_len(&self) -> usize {
+        self.segment_len
+    }
+
+    /// Bin spacing `f_s/segment_len`, Hz.
+    pub fn resolution_hz(&self) -> f64 {
+        self.rate.hz() / self.segment_len as f64
+    }
+
+    /// Estimates the one-sided PSD of `x` (unit²/Hz for `x` in a unit).
+    ///
+    /// # Errors
+    /// [`SignalError::RecordTooShort`] if `x` is shorter than one segment.
+    pub fn estimate(&self, x: &[f64]) -> Result<Psd> {
+        let len = self.segment_len;
+        if x.len() < len {
+            return Err(SignalError::RecordTooShort {
+                what: "record (one Welch segment)",
+                found: x.len(),
+                min: len,
+            });
+        }
+        let step = len - len / 2;
+        let segments = (x.len() - len) / step + 1;
+        let bins = len / 2 + 1;
+        let mut density = vec![0.0; bins];
+        let mut buf = vec![Complex::new(0.0, 0.0); len];
+        let mut scratch = vec![Complex::new(0.0, 0.0); self.fft.get_inplace_scratch_len()];
+        for s in 0..segments {
+            let seg = &x[s * step..s * step + len];
+            let mean = seg.iter().sum::<f64>() / len as f64;
+            for ((c, v), w) in buf.iter_mut().zip(seg).zip(&self.window) {
+                *c = Complex::new((v - mean) * w, 0.0);
+            }
+            self.fft.process_with_scratch(&mut buf, &mut scratch);
+            for (p, c) in density.iter_mut().zip(&buf) {
+                *p += c.norm_sqr();
+            }
+        }
+        let base = self.scale / segments as f64;
+        for (k, p) in density.iter_mut().enumerate() {
+            let nyquist = len % 2 == 0 && k == len / 2;
+            let one_sided = if k == 0 || nyquist { 1.0 } else { 2.0 };
+            *p *= base * one_sided;
+        }
+        Ok(Psd {
+            resolution_hz: self.resolution_hz(),
+            density,
+            segments,
+        })
+    }
+}
+
+/// A one-sided power spectral density on the bins `f_k = k·Δf`, `k = 0..=segment_len/2`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Psd {
+    resolution_hz: f64,
+    density: Vec<f64>,
+    segments: usize,
+}
+
+impl Psd {
+    /// Bin spacing `Δf`, Hz.
+    pub fn resolution_hz(&self) -> f64 {
+        self.resolution_hz
+    }
+
+    /// The density at each bin, unit²/Hz.
+    pub fn density(&self) -> &[f64] {
+        &self.density
+    }
+
+    /// Frequency of bin `k`, Hz.
+    pub fn frequency_hz(&self, k: usize) -> f64 {
+        k as f64 * self.resolution_hz
+    }
+
+    /// Frequencies of all bins, Hz.
+    pub fn frequencies_hz(&self) -> impl Iterator<Item = f64> + '_ {
+        (0..self.density.len()).map(|k| self.frequency_hz(k))
+    }
+
+    /// Number of segments averaged.
+    pub fn segments(&self) -> usize {
+        self.segments
+    }
+
+    /// `Σ_k P[k]·Δf` over all bins: the variance of the record (rectangle rule).
+    pub fn variance(&self) -> f64 {
+        self.density.iter().sum::<f64>() * self.resolution_hz
+    }
+
+    /// Root mean square of the content between `f_lo_hz` and `f_hi_hz`:
+    /// `√(Σ P[k]·Δf)` over the bins with `f_lo_hz ≤ f_k ≤ f_hi_hz` (each bin counts its full
+    /// width; `rms_in_band(0, ∞)` is the standard deviation of the record).
+    ///
+    /// # Errors
+    /// [`SignalError::InvalidParameter`] unless `0 ≤ f_lo_hz ≤ f_hi_hz` (`f_hi_hz` may be
+    /// `+∞`; NaN is rejected).
+    pub fn rms_in_band(&self, f_lo_hz: f64, f_hi_hz: f64) -> Result<f64> {
+        if !(f_lo_hz.is_finite() && f_lo_hz >= 0.0) {
+            return Err(SignalError::InvalidParameter {
+                name: "f_lo_hz",
+                value: f_lo_hz,
+                expected: "a finite frequency >= 0",
+            });
+        }
+        if f_hi_hz.is_nan() || f_hi_hz < f_lo_hz {
+            return Err(SignalError::InvalidParameter {
+                name: "f_hi_hz",
+                value: f_hi_hz,
+                expected: "a frequency >= f_lo_hz",
+            });
+        }
+        let power: f64 = self
+            .density
+            .iter()
+            .enumerate()
+            .filter(|&(k, _)| {
+                let f = self.frequency_hz(k);
+                f >= f_lo_hz && f <= f_hi_hz
+            })
+            .map(|(_, p)| p)
+            .sum();
+        Ok((power * self.resolution_hz).sqrt())
+    }
+}
