@@ -12,6 +12,14 @@ fn every_shipped_scenario_validates_through_the_facade() {
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|e| e == "json") {
+            let text = std::fs::read_to_string(&path).unwrap();
+            if text.contains("ground_motion") && std::env::var_os("PLATEN_RECORDS_DIR").is_none() {
+                eprintln!(
+                    "SKIPPED {}: set PLATEN_RECORDS_DIR to load it",
+                    path.display()
+                );
+                continue;
+            }
             let s = Scenario::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
             match s.run {
                 Run::Forward { .. } => forward += 1,

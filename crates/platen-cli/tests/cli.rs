@@ -57,8 +57,19 @@ const CONTRACT_COLUMNS: [&str; 8] = [
 fn every_shipped_scenario_runs_and_writes_every_input_sample_with_the_contract_columns() {
     let dir = tempfile::tempdir().unwrap();
     let mut count = 0;
+    // The paper's periodic program (scenarios/paper-tests, 72 files) runs in
+    // tests/paper_program.rs at the workspace root; every other scenario runs here.
+    let mut paths = Vec::new();
     for entry in std::fs::read_dir(workspace().join("scenarios")).unwrap() {
         let path = entry.unwrap().path();
+        if path.is_dir() && path.file_name().is_some_and(|n| n != "paper-tests") {
+            paths.extend(std::fs::read_dir(&path).unwrap().map(|e| e.unwrap().path()));
+        } else {
+            paths.push(path);
+        }
+    }
+    paths.sort();
+    for path in paths {
         if path.extension().is_none_or(|e| e != "json") {
             continue;
         }
@@ -71,6 +82,19 @@ fn every_shipped_scenario_runs_and_writes_every_input_sample_with_the_contract_c
             out.to_str().unwrap(),
             "--json",
         ]);
+        let needs_records = std::fs::read_to_string(&path)
+            .unwrap()
+            .contains("ground_motion");
+        if needs_records && std::env::var_os("PLATEN_RECORDS_DIR").is_none() {
+            // Without the records the run must fail cleanly and say where to get them.
+            assert_eq!(o.status.code(), Some(3), "{}", path.display());
+            assert!(stderr(&o).contains("PLATEN_RECORDS_DIR"), "{}", stderr(&o));
+            eprintln!(
+                "SKIPPED {}: set PLATEN_RECORDS_DIR to run it",
+                path.display()
+            );
+            continue;
+        }
         assert!(o.status.success(), "{}: {}", path.display(), stderr(&o));
         let summary: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
         let (header, rows) = read_csv(&out);
@@ -483,4 +507,34 @@ fn bad_dopri5_tolerances_name_their_json_path() {
         assert!(err.contains(path), "{json}: {err}");
         assert!(!wrote);
     }
+}
+
+/// The paper's earthquake test: Northridge 1994 Tarzana at 100 % from the real record. The
+/// table respects all four limits: PGD 0.32 m < 0.75 m, PGV 1.15 m/s < 1.8 m/s,
+/// PGA 1.78 g < 4.2 g, and the force 144 t × 17.4 m/s² ≈ 2.5 MN < 6.8 MN.
+#[test]
+fn the_tarzana_scenario_runs_from_the_real_record_within_the_table_limits() {
+    if std::env::var_os("PLATEN_RECORDS_DIR").is_none() {
+        eprintln!("SKIPPED: set PLATEN_RECORDS_DIR to a folder holding RSN1087_NORTHR_TAR090.AT2");
+        return;
+    }
+    let o = platen(&[
+        "simulate",
+        &scenario("northridge-tarzana-100.json"),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let g = 9.80665;
+    assert!(
+        (s["peak_a_m_s2"].as_f64().unwrap() / g - 1.7794).abs() < 0.01,
+        "{s}"
+    );
+    assert!(
+        (s["peak_u_m"].as_f64().unwrap().abs() - 0.3241).abs() < 0.01,
+        "{s}"
+    );
+    let f = s["peak_force_n"].as_f64().unwrap();
+    assert!((2.3e6..2.8e6).contains(&f.abs()), "{f}");
+    assert_eq!(s["limit_exceedances"].as_array().unwrap().len(), 0);
 }

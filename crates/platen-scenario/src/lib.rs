@@ -16,6 +16,7 @@ pub mod csv_io;
 pub mod error;
 pub mod generate;
 pub mod peer;
+pub mod recorded;
 pub mod scenario;
 
 pub use error::{Result, ScenarioError};

@@ -137,6 +137,76 @@ pub struct ExcitationSpec {
     pub triangle_motion: Option<TriangleMotion>,
     /// Generated band-limited white-noise motion (the paper's WN tests): inverse run.
     pub white_noise_motion: Option<WhiteNoiseMotion>,
+    /// Table motion from a ground-acceleration record (an earthquake test): inverse run.
+    pub ground_motion: Option<GroundMotion>,
+    /// Zero-phase low-pass of a force excitation before it drives the model, Hz (the paper
+    /// low-passed the SR9 force at 0.6 Hz). Forward runs only.
+    pub lowpass_hz: Option<f64>,
+    /// The filter of `lowpass_hz` (default `brickwall`).
+    pub lowpass_filter: Option<LowpassFilter>,
+}
+
+/// Zero-phase low-pass filters for `lowpass_hz`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LowpassFilter {
+    /// Frequency-domain brick wall: unit gain and zero phase below the cut-off, nothing above.
+    /// Exact for a record holding whole periods of a periodic test; on other records the
+    /// wrap-around from the last sample to the first leaks near the ends.
+    Brickwall,
+    /// Windowed-sinc FIR of order 1024 (Hamming), zero phase: gain 1 ± 0.5 % in the pass
+    /// band, 0.5 at the cut-off (the transition is about 3.3·fs/1024 wide).
+    Fir,
+    /// 4th-order Butterworth run forward and backward: gain |H(f)|², 0.5 at the cut-off (so
+    /// NOT unit gain near it: 0.81 at 5/6 of the cut-off).
+    Butterworth,
+}
+
+/// A table motion that reproduces a ground-acceleration record: the PEER `.AT2` record is
+/// scaled, resampled (not-a-knot cubic spline; anti-aliased when downsampling),
+/// baseline-corrected and integrated (trapezoidal) to table velocity and displacement, from
+/// rest at 0.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GroundMotion {
+    /// The record's file name: looked up next to the scenario, then in the folder named by
+    /// `PLATEN_RECORDS_DIR`.
+    pub record: PathBuf,
+    /// Scale factor on the acceleration (default 1: "100 %").
+    #[serde(default = "default_scale")]
+    pub scale: f64,
+    /// Sample rate of the table motion, Hz (default 1024).
+    #[serde(default = "default_rate")]
+    pub sample_rate_hz: f64,
+    /// Baseline correction before integrating: `none`, `acceleration` (remove the
+    /// least-squares polynomial of `baseline_order` from the acceleration) or `velocity` (from
+    /// the velocity). Default `acceleration` of order 0: the mean acceleration is removed, so
+    /// the table ends at rest.
+    #[serde(default = "default_baseline")]
+    pub baseline: BaselineKind,
+    /// Polynomial order of the baseline correction (default 0, at most 8).
+    #[serde(default)]
+    pub baseline_order: usize,
+}
+
+/// Baseline correction of a ground-motion record.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BaselineKind {
+    /// None.
+    None,
+    /// Remove a polynomial from the acceleration.
+    Acceleration,
+    /// Remove a polynomial from the velocity.
+    Velocity,
+}
+
+fn default_scale() -> f64 {
+    1.0
+}
+
+fn default_baseline() -> BaselineKind {
+    BaselineKind::Acceleration
 }
 
 /// `F(t) = r(t)·amplitude_n·sin(2π·frequency_hz·t)`, with `r` a linear ramp from 0 to 1 over
@@ -270,16 +340,19 @@ pub struct Rk4Spec {
     pub step_s: Option<f64>,
 }
 
-/// `initial`: the state at the record's first sample.
+/// `initial`: the state at the record's first sample, given (`{"u_m": …, "v_m_s": …}`) or
+/// taken from the force record's own `u_m` and `v_m_s` columns (`{"from_record": true}`, for
+/// a recorded test that did not start at rest, like the paper's SR9).
 #[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct InitialSpec {
     /// Displacement, m (default 0).
-    #[serde(default)]
-    pub u_m: f64,
+    pub u_m: Option<f64>,
     /// Velocity, m/s (default 0).
+    pub v_m_s: Option<f64>,
+    /// Take the state from the first row of the force CSV's `u_m` and `v_m_s` columns.
     #[serde(default)]
-    pub v_m_s: f64,
+    pub from_record: bool,
 }
 
 /// A validated model in one of its two forms.
@@ -550,6 +623,7 @@ fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
         ("sine_motion", ex.sine_motion.is_some()),
         ("triangle_motion", ex.triangle_motion.is_some()),
         ("white_noise_motion", ex.white_noise_motion.is_some()),
+        ("ground_motion", ex.ground_motion.is_some()),
     ]
     .iter()
     .filter(|(_, present)| *present)
@@ -559,11 +633,19 @@ fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
         return Err(ctx.invalid(
             "excitation",
             format!("{{{}}}", given.join(", ")),
-            "exactly one of force_csv, motion_csv, sine_force, sine_motion, triangle_motion, white_noise_motion",
+            "exactly one of force_csv, motion_csv, sine_force, sine_motion, triangle_motion, white_noise_motion, ground_motion",
         ));
     }
     let kind = given[0];
     let forward = ex.force_csv.is_some() || ex.sine_force.is_some();
+    if !forward && (ex.lowpass_hz.is_some() || ex.lowpass_filter.is_some()) {
+        return Err(ctx.invalid(
+            "excitation.lowpass_hz",
+            ex.lowpass_hz
+                .map_or("(filter only)".to_owned(), |f| f.to_string()),
+            "no low-pass on a motion: it applies to force excitations (force_csv, sine_force)",
+        ));
+    }
     if !forward {
         if file.integrator.is_some() {
             return Err(ctx.invalid(
@@ -604,16 +686,21 @@ fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
     };
     if let Some(rel) = &ex.force_csv {
         let path = ctx.resolve(rel);
-        let mut table = read_table(&path, &["t_s", "force_n"], &[])?;
+        let mut table = read_table(&path, &["t_s", "force_n"], &["u_m", "v_m_s"])?;
         let t = table.take_column("t_s").unwrap_or_default();
         let f = table.take_column("force_n").unwrap_or_default();
+        let recorded_state = match (table.column("u_m"), table.column("v_m_s")) {
+            (Some(u), Some(v)) => Some((u[0], v[0])),
+            _ => None,
+        };
         let dt = uniform_step_s(&path, &t)?;
         let samples = samples_for(ctx, &path, file.duration_s, dt, t.len())?;
         let record = ForceRecord::new(t, f).map_err(|e| ScenarioError::Record {
             path: path.clone(),
             message: e.to_string(),
         })?;
-        return forward_run(ctx, file, record, samples);
+        let record = lowpass(ctx, ex, record, samples)?;
+        return forward_run(ctx, file, record, samples, recorded_state);
     }
     if let Some(g) = &ex.sine_force {
         let record = generate::sine_force(
@@ -625,7 +712,8 @@ fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
         )
         .map_err(generated)?;
         let samples = record.len();
-        return forward_run(ctx, file, record, samples);
+        let record = lowpass(ctx, ex, record, samples)?;
+        return forward_run(ctx, file, record, samples, None);
     }
     let motion = if let Some(rel) = &ex.motion_csv {
         let path = ctx.resolve(rel);
@@ -673,6 +761,8 @@ fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
             duration()?,
         )
         .map_err(generated)?
+    } else if let Some(g) = &ex.ground_motion {
+        ground_motion(ctx, g, file.duration_s)?
     } else {
         let g = ex
             .white_noise_motion
@@ -695,6 +785,121 @@ fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
     Ok(Run::Inverse { motion })
 }
 
+/// Applies `excitation.lowpass_hz` to the first `samples` samples of a force record (the part
+/// that runs), with the chosen zero-phase filter.
+fn lowpass(
+    ctx: &Ctx,
+    ex: &ExcitationSpec,
+    record: ForceRecord,
+    samples: usize,
+) -> Result<ForceRecord> {
+    let Some(cutoff) = ex.lowpass_hz else {
+        if ex.lowpass_filter.is_some() {
+            return Err(ctx.invalid(
+                "excitation.lowpass_filter",
+                "(set)",
+                "a lowpass_hz for the filter to use",
+            ));
+        }
+        return Ok(record);
+    };
+    let rate = 1.0 / record.dt_s();
+    if !(cutoff.is_finite() && cutoff > 0.0 && cutoff < 0.5 * rate) {
+        return Err(ctx.invalid(
+            "excitation.lowpass_hz",
+            cutoff,
+            format!(
+                "a cut-off between 0 and the record's Nyquist frequency {} Hz",
+                0.5 * rate
+            ),
+        ));
+    }
+    let input = &record.force_n()[..samples];
+    let signal =
+        |e: platen_signal::SignalError| ctx.invalid("excitation.lowpass_hz", cutoff, e.to_string());
+    use platen_signal::ZeroPhaseFilter;
+    let filtered = match ex.lowpass_filter.unwrap_or(LowpassFilter::Brickwall) {
+        LowpassFilter::Brickwall => platen_signal::SpectralLowpass::new(samples, cutoff, rate)
+            .map_err(signal)?
+            .apply(input)
+            .map_err(signal)?,
+        LowpassFilter::Fir => {
+            platen_signal::FirLowpass::new(1024, cutoff, rate, platen_signal::Window::Hamming)
+                .map_err(signal)?
+                .apply(input)
+                .map_err(signal)?
+        }
+        LowpassFilter::Butterworth => platen_signal::ButterworthLowpass::new(4, cutoff, rate)
+            .map_err(signal)?
+            .apply(input)
+            .map_err(signal)?,
+    };
+    ForceRecord::new(record.t_s()[..samples].to_vec(), filtered)
+        .map_err(|e| ctx.invalid("excitation.lowpass_hz", cutoff, e.to_string()))
+}
+
+/// The table motion of an `excitation.ground_motion`.
+fn ground_motion(ctx: &Ctx, g: &GroundMotion, duration_s: Option<f64>) -> Result<Motion> {
+    let here = "excitation.ground_motion";
+    let scale = check_finite(ctx, &format!("{here}.scale"), g.scale)?;
+    let rate = check_positive(ctx, &format!("{here}.sample_rate_hz"), g.sample_rate_hz)?;
+    let path = crate::peer::find_record(ctx.path.parent(), &g.record)?;
+    let rec = crate::peer::read_peer(&path)?;
+    if rec.quantity != crate::peer::Quantity::Acceleration {
+        return Err(ScenarioError::Record {
+            path,
+            message: "ground_motion needs an acceleration record (.AT2); this one holds velocity or displacement".into(),
+        });
+    }
+    let signal = |name: &str, e: platen_signal::SignalError| {
+        ctx.invalid(&format!("{here}.{name}"), "", e.to_string())
+    };
+    let a: Vec<f64> = rec.values.iter().map(|x| x * scale).collect();
+    let resampler = platen_signal::Resampler::new(
+        1.0 / rec.dt_s,
+        rate,
+        platen_signal::Interpolation::default(),
+    )
+    .map_err(|e| signal("sample_rate_hz", e))?;
+    let mut a = resampler
+        .apply(&a)
+        .map_err(|e| signal("sample_rate_hz", e))?;
+    if let Some(d) = duration_s {
+        check_positive(ctx, "duration_s", d)?;
+        let n = (d * rate + 1e-6).floor() as usize + 1;
+        if n > a.len() {
+            return Err(ScenarioError::Record {
+                path,
+                message: format!(
+                    "record spans {} s but the scenario's duration_s is {d} s",
+                    (a.len() - 1) as f64 / rate
+                ),
+            });
+        }
+        a.truncate(n);
+    }
+    let baseline = match g.baseline {
+        BaselineKind::None => platen_signal::Baseline::None,
+        BaselineKind::Acceleration => platen_signal::Baseline::Acceleration {
+            order: g.baseline_order,
+        },
+        BaselineKind::Velocity => platen_signal::Baseline::Velocity {
+            order: g.baseline_order,
+        },
+    };
+    let integrator = platen_signal::MotionIntegrator::new(rate, baseline)
+        .map_err(|e| signal("baseline_order", e))?;
+    if matches!(g.baseline, BaselineKind::Acceleration) {
+        platen_signal::remove_polynomial(&mut a, g.baseline_order);
+    }
+    let m = integrator.integrate(&a, platen_signal::InitialMotion::default());
+    let t = (0..a.len()).map(|j| j as f64 / rate).collect();
+    Motion::new(t, m.u_m, m.v_m_s, a).map_err(|e| ScenarioError::Record {
+        path,
+        message: e.to_string(),
+    })
+}
+
 fn check_finite(ctx: &Ctx, json_path: &str, value: f64) -> Result<f64> {
     if value.is_finite() {
         Ok(value)
@@ -703,7 +908,13 @@ fn check_finite(ctx: &Ctx, json_path: &str, value: f64) -> Result<f64> {
     }
 }
 
-fn forward_run(ctx: &Ctx, file: &ScenarioFile, record: ForceRecord, samples: usize) -> Result<Run> {
+fn forward_run(
+    ctx: &Ctx,
+    file: &ScenarioFile,
+    record: ForceRecord,
+    samples: usize,
+    recorded_state: Option<(f64, f64)>,
+) -> Result<Run> {
     let integrator = match &file.integrator {
         None => Integrator::Rk4(Rk4::with_steps_per_sample(1).expect("k = 1 is valid")),
         Some(IntegratorSpec::Rk4(Rk4Spec { step_s })) => {
@@ -728,8 +939,29 @@ fn forward_run(ctx: &Ctx, file: &ScenarioFile, record: ForceRecord, samples: usi
         }
     };
     let initial = file.initial.clone().unwrap_or_default();
-    let u_m = check_finite(ctx, "initial.u_m", initial.u_m)?;
-    let v_m_s = check_finite(ctx, "initial.v_m_s", initial.v_m_s)?;
+    let (u0, v0) = if initial.from_record {
+        if initial.u_m.is_some() || initial.v_m_s.is_some() {
+            return Err(ctx.invalid(
+                "initial",
+                "{from_record, u_m/v_m_s}",
+                "either from_record or u_m/v_m_s, not both",
+            ));
+        }
+        match recorded_state {
+            Some(state) => state,
+            None => {
+                return Err(ctx.invalid(
+                    "initial.from_record",
+                    "true",
+                    "a force_csv with u_m and v_m_s columns to take the initial state from",
+                ))
+            }
+        }
+    } else {
+        (initial.u_m.unwrap_or(0.0), initial.v_m_s.unwrap_or(0.0))
+    };
+    let u_m = check_finite(ctx, "initial.u_m", u0)?;
+    let v_m_s = check_finite(ctx, "initial.v_m_s", v0)?;
     Ok(Run::Forward {
         record,
         integrator,
