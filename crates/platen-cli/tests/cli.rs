@@ -538,3 +538,73 @@ fn the_tarzana_scenario_runs_from_the_real_record_within_the_table_limits() {
     assert!((2.3e6..2.8e6).contains(&f.abs()), "{f}");
     assert_eq!(s["limit_exceedances"].as_array().unwrap().len(), 0);
 }
+
+/// A lab's export: its own headers and units (time in ms, displacement in mm, acceleration in
+/// g) mapped by `columns`; the run equals the one from the same data in SI columns.
+#[test]
+fn a_lab_export_with_its_own_channel_names_and_units_is_mapped() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mut lab, mut si) = (
+        String::from("Time,Table disp,Table acc,Other\n"),
+        String::from("t_s,u_m,a_m_s2\n"),
+    );
+    for j in 0..=1024 {
+        let t = j as f64 / 256.0;
+        let w = std::f64::consts::PI;
+        let (u, a) = (0.05 * (w * t).sin(), -0.05 * w * w * (w * t).sin());
+        lab.push_str(&format!(
+            "{},{},{},1\n",
+            t * 1000.0,
+            u * 1000.0,
+            a / 9.80665
+        ));
+        si.push_str(&format!("{t},{u},{a}\n"));
+    }
+    std::fs::write(dir.path().join("lab.csv"), lab).unwrap();
+    std::fs::write(dir.path().join("si.csv"), si).unwrap();
+    let lab_json = r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"motion_csv": "lab.csv", "columns": {
+        "t_s": {"name": "Time", "unit": "ms"}, "u_m": {"name": "Table disp", "unit": "mm"},
+        "a_m_s2": {"name": "Table acc", "unit": "g"}}}}"#;
+    std::fs::write(dir.path().join("lab.json"), lab_json).unwrap();
+    std::fs::write(
+        dir.path().join("si.json"),
+        r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"motion_csv": "si.csv"}}"#,
+    )
+    .unwrap();
+    let run = |name: &str| {
+        let out = dir.path().join(format!("{name}.out.csv"));
+        let o = platen(&[
+            "simulate",
+            dir.path().join(format!("{name}.json")).to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        read_csv(&out).1
+    };
+    let (a, b) = (run("lab"), run("si"));
+    assert_eq!(a.len(), b.len());
+    // Unit conversions round in the last bits: compare each column to 1e-9 of its own scale.
+    for c in 0..b[0].len() {
+        let scale = b.iter().map(|r| r[c].abs()).fold(0.0, f64::max).max(1e-12);
+        for (x, y) in a.iter().zip(&b) {
+            assert!(
+                (x[c] - y[c]).abs() <= 1e-9 * scale,
+                "column {c}: {x:?} vs {y:?}"
+            );
+        }
+    }
+    // A unit of the wrong kind is an input error naming its JSON path.
+    std::fs::write(
+        dir.path().join("bad.json"),
+        lab_json.replace(r#""unit": "mm""#, r#""unit": "g""#),
+    )
+    .unwrap();
+    let o = platen(&["simulate", dir.path().join("bad.json").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(3));
+    assert!(
+        stderr(&o).contains("excitation.columns.u_m.unit"),
+        "{}",
+        stderr(&o)
+    );
+}

@@ -12,6 +12,7 @@
 
 #![warn(missing_docs)]
 
+pub mod columns;
 pub mod csv_io;
 pub mod error;
 pub mod generate;

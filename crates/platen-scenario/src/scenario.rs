@@ -29,6 +29,7 @@
 //!
 //! Unknown keys are errors, reported with their JSON path.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
@@ -39,6 +40,7 @@ use platen_model::{
     STANDARD_GRAVITY_M_S2,
 };
 
+use crate::columns::{ColumnMap, ColumnSpec};
 use crate::csv_io::{read_table, uniform_step_s};
 use crate::error::{Result, ScenarioError};
 use crate::generate::{self, GenerateError};
@@ -144,6 +146,9 @@ pub struct ExcitationSpec {
     pub lowpass_hz: Option<f64>,
     /// The filter of `lowpass_hz` (default `brickwall`).
     pub lowpass_filter: Option<LowpassFilter>,
+    /// A lab's own channel names and units for `force_csv` / `motion_csv`
+    /// (see [`crate::columns`]).
+    pub columns: Option<BTreeMap<String, ColumnSpec>>,
 }
 
 /// Zero-phase low-pass filters for `lowpass_hz`.
@@ -187,6 +192,9 @@ pub struct GroundMotion {
     /// Polynomial order of the baseline correction (default 0, at most 8).
     #[serde(default)]
     pub baseline_order: usize,
+    /// For a record given as CSV (a `.csv` file): the time and acceleration columns' names and
+    /// units, e.g. `{"t_s": {"name": "time"}, "a_m_s2": {"name": "acc (g)", "unit": "g"}}`.
+    pub columns: Option<BTreeMap<String, ColumnSpec>>,
 }
 
 /// Baseline correction of a ground-motion record.
@@ -686,10 +694,10 @@ fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
     };
     if let Some(rel) = &ex.force_csv {
         let path = ctx.resolve(rel);
-        let mut table = read_table(&path, &["t_s", "force_n"], &["u_m", "v_m_s"])?;
-        let t = table.take_column("t_s").unwrap_or_default();
-        let f = table.take_column("force_n").unwrap_or_default();
-        let recorded_state = match (table.column("u_m"), table.column("v_m_s")) {
+        let mut cols = read_mapped(ctx, &path, ex, &["t_s", "force_n"], &["u_m", "v_m_s"])?;
+        let t = cols.remove("t_s").unwrap_or_default();
+        let f = cols.remove("force_n").unwrap_or_default();
+        let recorded_state = match (cols.get("u_m"), cols.get("v_m_s")) {
             (Some(u), Some(v)) => Some((u[0], v[0])),
             _ => None,
         };
@@ -717,11 +725,11 @@ fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
     }
     let motion = if let Some(rel) = &ex.motion_csv {
         let path = ctx.resolve(rel);
-        let mut table = read_table(&path, &["t_s", "u_m"], &["v_m_s", "a_m_s2"])?;
-        let t = table.take_column("t_s").unwrap_or_default();
-        let u = table.take_column("u_m").unwrap_or_default();
-        let v = table.take_column("v_m_s");
-        let a = table.take_column("a_m_s2");
+        let mut cols = read_mapped(ctx, &path, ex, &["t_s", "u_m"], &["v_m_s", "a_m_s2"])?;
+        let t = cols.remove("t_s").unwrap_or_default();
+        let u = cols.remove("u_m").unwrap_or_default();
+        let v = cols.remove("v_m_s");
+        let a = cols.remove("a_m_s2");
         let samples = match file.duration_s {
             None => t.len(),
             Some(d) => {
@@ -785,6 +793,47 @@ fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
     Ok(Run::Inverse { motion })
 }
 
+/// Reads platen's columns `required` and `optional` from `path` through the excitation's
+/// `columns` mapping (file headers and units), in SI units. The time column must increase
+/// strictly; a violation names its line.
+fn read_mapped(
+    ctx: &Ctx,
+    path: &Path,
+    ex: &ExcitationSpec,
+    required: &[&'static str],
+    optional: &[&'static str],
+) -> Result<BTreeMap<&'static str, Vec<f64>>> {
+    let map = match &ex.columns {
+        Some(spec) => ColumnMap::new(spec, "excitation.columns")
+            .map_err(|(json_path, value, expected)| ctx.invalid(&json_path, value, expected))?,
+        None => ColumnMap::default(),
+    };
+    let req: Vec<&str> = required.iter().map(|c| map.header(c)).collect();
+    let opt: Vec<&str> = optional.iter().map(|c| map.header(c)).collect();
+    let mut table = read_table(path, &req, &opt)?;
+    let mut out = BTreeMap::new();
+    for &ours in required.iter().chain(optional) {
+        if let Some(mut col) = table.take_column(map.header(ours)) {
+            let f = map.factor(ours);
+            if f != 1.0 {
+                col.iter_mut().for_each(|x| *x *= f);
+            }
+            out.insert(ours, col);
+        }
+    }
+    if let Some(t) = out.get("t_s") {
+        if let Some(i) = (1..t.len()).find(|&i| t[i] <= t[i - 1]) {
+            return Err(ScenarioError::TimeNotIncreasing {
+                path: path.to_owned(),
+                line: i as u64 + 2,
+                previous_s: t[i - 1],
+                value_s: t[i],
+            });
+        }
+    }
+    Ok(out)
+}
+
 /// Applies `excitation.lowpass_hz` to the first `samples` samples of a force record (the part
 /// that runs), with the chosen zero-phase filter.
 fn lowpass(
@@ -844,23 +893,43 @@ fn ground_motion(ctx: &Ctx, g: &GroundMotion, duration_s: Option<f64>) -> Result
     let scale = check_finite(ctx, &format!("{here}.scale"), g.scale)?;
     let rate = check_positive(ctx, &format!("{here}.sample_rate_hz"), g.sample_rate_hz)?;
     let path = crate::peer::find_record(ctx.path.parent(), &g.record)?;
-    let rec = crate::peer::read_peer(&path)?;
-    if rec.quantity != crate::peer::Quantity::Acceleration {
-        return Err(ScenarioError::Record {
-            path,
-            message: "ground_motion needs an acceleration record (.AT2); this one holds velocity or displacement".into(),
-        });
-    }
+    let is_csv = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
+    let (acc, dt_s) = if is_csv {
+        let ex = ExcitationSpec {
+            columns: g.columns.clone(),
+            ..ExcitationSpec::default()
+        };
+        let mut cols = read_mapped(ctx, &path, &ex, &["t_s", "a_m_s2"], &[])?;
+        let t = cols.remove("t_s").unwrap_or_default();
+        let dt = uniform_step_s(&path, &t)?;
+        (cols.remove("a_m_s2").unwrap_or_default(), dt)
+    } else {
+        if g.columns.is_some() {
+            return Err(ctx.invalid(
+                &format!("{here}.columns"),
+                "(set)",
+                "columns only for a record given as .csv",
+            ));
+        }
+        let rec = crate::peer::read_peer(&path)?;
+        if rec.quantity != crate::peer::Quantity::Acceleration {
+            return Err(ScenarioError::Record {
+                path,
+                message: "ground_motion needs an acceleration record (.AT2); this one holds velocity or displacement"
+                    .into(),
+            });
+        }
+        (rec.values, rec.dt_s)
+    };
     let signal = |name: &str, e: platen_signal::SignalError| {
         ctx.invalid(&format!("{here}.{name}"), "", e.to_string())
     };
-    let a: Vec<f64> = rec.values.iter().map(|x| x * scale).collect();
-    let resampler = platen_signal::Resampler::new(
-        1.0 / rec.dt_s,
-        rate,
-        platen_signal::Interpolation::default(),
-    )
-    .map_err(|e| signal("sample_rate_hz", e))?;
+    let a: Vec<f64> = acc.iter().map(|x| x * scale).collect();
+    let resampler =
+        platen_signal::Resampler::new(1.0 / dt_s, rate, platen_signal::Interpolation::default())
+            .map_err(|e| signal("sample_rate_hz", e))?;
     let mut a = resampler
         .apply(&a)
         .map_err(|e| signal("sample_rate_hz", e))?;

@@ -1,0 +1,262 @@
+//! Mapping a lab's own channel names and units to platen's columns.
+//!
+//! Data systems export their own headers (`Table disp` in mm, acceleration in g, a
+//! differential pressure instead of a force). A scenario maps them with a `columns` object
+//! next to the file it names:
+//!
+//! ```json
+//! "excitation": {
+//!   "motion_csv": "lab.csv",
+//!   "columns": {
+//!     "t_s": { "name": "Time", "unit": "ms" },
+//!     "u_m": { "name": "Table disp", "unit": "mm" },
+//!     "a_m_s2": { "name": "Table acc", "unit": "g" }
+//!   }
+//! }
+//! ```
+//!
+//! A force can come from a pressure: `"force_n": {"name": "dP", "unit": "MPa",
+//! "times_area_m2": 0.33}`. Columns not mapped are read under platen's own name in SI units.
+//!
+//! Units: time `s`, `ms`; displacement `m`, `mm`, `cm`, `in`; velocity `m/s`, `mm/s`, `cm/s`,
+//! `in/s`; acceleration `m/s2`, `mm/s2`, `cm/s2` (`gal`), `in/s2`, `g` (9.80665 m/s²); force `N`,
+//! `kN`, `MN`, `lbf`, `kip`; pressure (with `times_area_m2`) `Pa`, `kPa`, `MPa`, `bar`, `psi`.
+
+use std::collections::BTreeMap;
+
+use serde::Deserialize;
+
+use platen_model::STANDARD_GRAVITY_M_S2;
+
+/// How one of platen's columns is found in a file.
+#[derive(Debug, Clone, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ColumnSpec {
+    /// The header in the file (default: platen's own column name).
+    pub name: Option<String>,
+    /// The unit of the values in the file (default: platen's SI unit).
+    pub unit: Option<String>,
+    /// For a force given as a pressure: the area it acts on, m².
+    pub times_area_m2: Option<f64>,
+}
+
+/// platen's column names and the kind of quantity each holds.
+const QUANTITIES: [(&str, Kind); 5] = [
+    ("t_s", Kind::Time),
+    ("u_m", Kind::Displacement),
+    ("v_m_s", Kind::Velocity),
+    ("a_m_s2", Kind::Acceleration),
+    ("force_n", Kind::Force),
+];
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Time,
+    Displacement,
+    Velocity,
+    Acceleration,
+    Force,
+}
+
+/// A validated mapping: for each platen column, the header to read and the factor to SI.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ColumnMap {
+    entries: BTreeMap<String, (String, f64)>,
+}
+
+impl ColumnMap {
+    /// Validates a `columns` object. `json_path` prefixes error locations.
+    ///
+    /// # Errors
+    /// `(json path, value, expected)` for an unknown platen column, an unknown unit, a unit of
+    /// the wrong kind, or a pressure without (or an area with a non-pressure) unit.
+    pub fn new(
+        spec: &BTreeMap<String, ColumnSpec>,
+        json_path: &str,
+    ) -> Result<Self, (String, String, String)> {
+        let mut entries = BTreeMap::new();
+        for (ours, s) in spec {
+            let kind = QUANTITIES
+                .iter()
+                .find(|(n, _)| n == ours)
+                .map(|(_, k)| *k)
+                .ok_or_else(|| {
+                    (
+                        format!("{json_path}.{ours}"),
+                        format!("{ours:?}"),
+                        format!(
+                            "one of platen's columns: {}",
+                            QUANTITIES.map(|(n, _)| n).join(", ")
+                        ),
+                    )
+                })?;
+            let here = format!("{json_path}.{ours}");
+            let factor = match (&s.unit, s.times_area_m2) {
+                (None, None) => 1.0,
+                (None, Some(_)) => {
+                    return Err((
+                        format!("{here}.unit"),
+                        "(missing)".into(),
+                        "a pressure unit for times_area_m2".into(),
+                    ))
+                }
+                (Some(u), area) => {
+                    let (unit_kind, f) = unit_factor(u).ok_or_else(|| {
+                        (
+                            format!("{here}.unit"),
+                            format!("{u:?}"),
+                            "a known unit (see the scenario documentation)".into(),
+                        )
+                    })?;
+                    match (unit_kind, area) {
+                        (UnitKind::Pressure, Some(a)) if kind == Kind::Force => {
+                            if !(a.is_finite() && a > 0.0) {
+                                return Err((
+                                    format!("{here}.times_area_m2"),
+                                    a.to_string(),
+                                    "an area > 0 m²".into(),
+                                ));
+                            }
+                            f * a
+                        }
+                        (UnitKind::Pressure, _) => {
+                            return Err((
+                                format!("{here}.unit"),
+                                format!("{u:?}"),
+                                "a pressure unit only for force_n, with times_area_m2".into(),
+                            ))
+                        }
+                        (UnitKind::Of(k), None) if k == kind => f,
+                        (UnitKind::Of(_), Some(_)) => {
+                            return Err((
+                                format!("{here}.times_area_m2"),
+                                "(set)".into(),
+                                "times_area_m2 only with a pressure unit".into(),
+                            ))
+                        }
+                        (UnitKind::Of(_), None) => {
+                            return Err((
+                                format!("{here}.unit"),
+                                format!("{u:?}"),
+                                format!("a unit of {}", kind_name(kind)),
+                            ))
+                        }
+                    }
+                }
+            };
+            let header = s.name.clone().unwrap_or_else(|| ours.clone());
+            entries.insert(ours.clone(), (header, factor));
+        }
+        Ok(Self { entries })
+    }
+
+    /// The header to read for platen's column `ours`.
+    pub fn header<'a>(&'a self, ours: &'a str) -> &'a str {
+        self.entries.get(ours).map_or(ours, |(h, _)| h.as_str())
+    }
+
+    /// The factor from the file's unit to SI for platen's column `ours`.
+    pub fn factor(&self, ours: &str) -> f64 {
+        self.entries.get(ours).map_or(1.0, |(_, f)| *f)
+    }
+}
+
+enum UnitKind {
+    Of(Kind),
+    Pressure,
+}
+
+fn kind_name(k: Kind) -> &'static str {
+    match k {
+        Kind::Time => "time (s, ms)",
+        Kind::Displacement => "displacement (m, mm, cm, in)",
+        Kind::Velocity => "velocity (m/s, mm/s, cm/s, in/s)",
+        Kind::Acceleration => "acceleration (m/s2, mm/s2, cm/s2, gal, in/s2, g)",
+        Kind::Force => {
+            "force (N, kN, MN, lbf, kip) or a pressure (Pa, kPa, MPa, bar, psi) with times_area_m2"
+        }
+    }
+}
+
+fn unit_factor(unit: &str) -> Option<(UnitKind, f64)> {
+    use Kind::*;
+    let inch = 0.0254;
+    Some(match unit.trim() {
+        "s" => (UnitKind::Of(Time), 1.0),
+        "ms" => (UnitKind::Of(Time), 1e-3),
+        "m" => (UnitKind::Of(Displacement), 1.0),
+        "mm" => (UnitKind::Of(Displacement), 1e-3),
+        "cm" => (UnitKind::Of(Displacement), 1e-2),
+        "in" => (UnitKind::Of(Displacement), inch),
+        "m/s" => (UnitKind::Of(Velocity), 1.0),
+        "mm/s" => (UnitKind::Of(Velocity), 1e-3),
+        "cm/s" => (UnitKind::Of(Velocity), 1e-2),
+        "in/s" => (UnitKind::Of(Velocity), inch),
+        "m/s2" | "m/s^2" | "m/s²" => (UnitKind::Of(Acceleration), 1.0),
+        "mm/s2" | "mm/s^2" | "mm/s²" => (UnitKind::Of(Acceleration), 1e-3),
+        "cm/s2" | "cm/s^2" | "cm/s²" | "gal" => (UnitKind::Of(Acceleration), 1e-2),
+        "in/s2" | "in/s^2" | "in/s²" => (UnitKind::Of(Acceleration), inch),
+        "g" => (UnitKind::Of(Acceleration), STANDARD_GRAVITY_M_S2),
+        "N" => (UnitKind::Of(Force), 1.0),
+        "kN" => (UnitKind::Of(Force), 1e3),
+        "MN" => (UnitKind::Of(Force), 1e6),
+        "lbf" => (UnitKind::Of(Force), 4.448_221_615_260_5),
+        "kip" => (UnitKind::Of(Force), 4_448.221_615_260_5),
+        "Pa" => (UnitKind::Pressure, 1.0),
+        "kPa" => (UnitKind::Pressure, 1e3),
+        "MPa" => (UnitKind::Pressure, 1e6),
+        "bar" => (UnitKind::Pressure, 1e5),
+        "psi" => (UnitKind::Pressure, 6_894.757_293_168),
+        _ => return None,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn map(json: &str) -> Result<ColumnMap, (String, String, String)> {
+        let spec: BTreeMap<String, ColumnSpec> = serde_json::from_str(json).unwrap();
+        ColumnMap::new(&spec, "excitation.columns")
+    }
+
+    #[test]
+    fn lab_channels_map_to_si_columns() {
+        let m = map(r#"{"u_m": {"name": "Table disp", "unit": "mm"}, "a_m_s2": {"name": "acc (g)", "unit": "g"},
+                        "force_n": {"name": "dP", "unit": "MPa", "times_area_m2": 0.33}}"#)
+        .unwrap();
+        assert_eq!(m.header("u_m"), "Table disp");
+        assert_eq!(m.factor("u_m"), 1e-3);
+        assert_eq!(m.factor("a_m_s2"), 9.80665);
+        assert!((m.factor("force_n") - 0.33e6).abs() < 1e-6);
+        assert_eq!(m.header("t_s"), "t_s");
+        assert_eq!(m.factor("t_s"), 1.0);
+    }
+
+    #[test]
+    fn wrong_units_name_their_json_path() {
+        for (json, path) in [
+            (r#"{"u_m": {"unit": "g"}}"#, "excitation.columns.u_m.unit"),
+            (
+                r#"{"u_m": {"unit": "furlong"}}"#,
+                "excitation.columns.u_m.unit",
+            ),
+            (r#"{"disp": {"unit": "mm"}}"#, "excitation.columns.disp"),
+            (
+                r#"{"force_n": {"unit": "MPa"}}"#,
+                "excitation.columns.force_n.unit",
+            ),
+            (
+                r#"{"force_n": {"unit": "kN", "times_area_m2": 0.3}}"#,
+                "excitation.columns.force_n.times_area_m2",
+            ),
+            (
+                r#"{"force_n": {"unit": "MPa", "times_area_m2": -1}}"#,
+                "excitation.columns.force_n.times_area_m2",
+            ),
+        ] {
+            let e = map(json).unwrap_err();
+            assert_eq!(e.0, path, "{json}: {e:?}");
+        }
+    }
+}
