@@ -29,7 +29,7 @@ use serde::Deserialize;
 use platen_model::STANDARD_GRAVITY_M_S2;
 
 /// How one of platen's columns is found in a file.
-#[derive(Debug, Clone, Default, Deserialize, PartialEq)]
+#[derive(Debug, Clone, Default, Deserialize, PartialEq, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ColumnSpec {
     /// The header in the file (default: platen's own column name).

@@ -35,6 +35,11 @@ fn check(name: &'static str, value: f64, ok: bool, expected: &str) -> Result<f64
     }
 }
 
+/// The longest generated record, in samples: 13.5 h at 1024 Hz. A run holds a few columns of
+/// this length in memory, so a larger request is an input error rather than an allocation
+/// failure.
+pub const MAX_GENERATED_SAMPLES: usize = 50_000_000;
+
 /// Number of samples covering `duration_s` at `rate_hz` (both ends included).
 fn sample_count(rate_hz: f64, duration_s: f64) -> Result<usize, GenerateError> {
     check(
@@ -48,8 +53,8 @@ fn sample_count(rate_hz: f64, duration_s: f64) -> Result<usize, GenerateError> {
     check(
         "duration_s",
         duration_s,
-        n <= 1e9,
-        "at most 1e9 samples at the sample rate",
+        n <= MAX_GENERATED_SAMPLES as f64,
+        &format!("at most {MAX_GENERATED_SAMPLES} samples at the sample rate (13.5 h at 1024 Hz)"),
     )?;
     check(
         "duration_s",

@@ -123,7 +123,9 @@ pub fn read_peer(path: &Path) -> Result<PeerRecord> {
     };
     let l4 = next(4)?;
     let (npts, dt_s) = parse_npts_dt(l4).map_err(|m| header_error(path, 4, m))?;
-    let mut values = Vec::with_capacity(npts);
+    // NPTS comes from the file: never trust it for an allocation (a value needs at least two
+    // bytes of text, so the text bounds the count).
+    let mut values = Vec::with_capacity(npts.min(text.len() / 2));
     for (i, line) in text.lines().enumerate().skip(4) {
         let line_no = i as u64 + 1;
         for token in line.split_whitespace() {
@@ -269,6 +271,22 @@ mod tests {
         }
         assert!(parse_npts_dt("NPTS= , DT= .02").is_err());
         assert!(parse_npts_dt("NPTS= 10, DT= 0").is_err());
+    }
+
+    /// Found by the `peer_reader` fuzz target: `NPTS=99999999999999` made the reader reserve
+    /// that many values up front and abort on capacity overflow.
+    #[test]
+    fn a_huge_npts_header_is_an_error_not_an_allocation_failure() {
+        let dir = tempfile::tempdir().unwrap();
+        let head =
+            "PEER NGA STRONG MOTION DATABASE RECORD\nx\nACCELERATION TIME SERIES IN UNITS OF G\n";
+        let p = write(
+            dir.path(),
+            "huge.AT2",
+            &format!("{head}NPTS= 18446744073709551615, DT= .01 SEC\n .1E+00\n"),
+        );
+        let e = read_peer(&p).unwrap_err().to_string();
+        assert!(e.contains("huge.AT2") && e.contains("line 4"), "{e}");
     }
 
     #[test]

@@ -32,6 +32,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use schemars::JsonSchema;
 use serde::Deserialize;
 
 use platen_integrate::{Dopri5Settings, ForceRecord, Motion, Rk4, State};
@@ -46,7 +47,7 @@ use crate::error::{Result, ScenarioError};
 use crate::generate::{self, GenerateError};
 
 /// The scenario file as written (after JSON parsing, before validation).
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ScenarioFile {
     /// A short name for reports (default: the file stem).
@@ -66,7 +67,7 @@ pub struct ScenarioFile {
 }
 
 /// `model`: a preset, its hold-down pressure, and the form with overrides.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ModelSpec {
     /// Preset name (`lhpost-2008`).
@@ -80,7 +81,7 @@ pub struct ModelSpec {
 }
 
 /// Overrides of the identified model; the contract's keys.
-#[derive(Debug, Clone, Default, Deserialize)]
+#[derive(Debug, Clone, Default, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 #[allow(missing_docs)]
 pub struct IdentifiedOverrides {
@@ -96,7 +97,7 @@ pub struct IdentifiedOverrides {
 /// Overrides of the physical parameters of the full model (see
 /// [`platen_model::PhysicalParams`] for meanings and units). The hold-down pressure is set by
 /// `model.hold_down_pressure_mpa`.
-#[derive(Debug, Clone, Default, Deserialize)]
+#[derive(Debug, Clone, Default, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 #[allow(missing_docs)]
 pub struct PhysicalOverrides {
@@ -124,7 +125,7 @@ pub struct PhysicalOverrides {
 }
 
 /// `excitation`: exactly one source.
-#[derive(Debug, Clone, Default, Deserialize)]
+#[derive(Debug, Clone, Default, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ExcitationSpec {
     /// Recorded actuator force (`t_s`, `force_n`): forward run.
@@ -152,7 +153,7 @@ pub struct ExcitationSpec {
 }
 
 /// Zero-phase low-pass filters for `lowpass_hz`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, JsonSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum LowpassFilter {
     /// Frequency-domain brick wall: unit gain and zero phase below the cut-off, nothing above.
@@ -171,7 +172,7 @@ pub enum LowpassFilter {
 /// scaled, resampled (not-a-knot cubic spline; anti-aliased when downsampling),
 /// baseline-corrected and integrated (trapezoidal) to table velocity and displacement, from
 /// rest at 0.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GroundMotion {
     /// The record's file name: looked up next to the scenario, then in the folder named by
@@ -198,7 +199,7 @@ pub struct GroundMotion {
 }
 
 /// Baseline correction of a ground-motion record.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, JsonSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum BaselineKind {
     /// None.
@@ -219,7 +220,7 @@ fn default_baseline() -> BaselineKind {
 
 /// `F(t) = r(t)·amplitude_n·sin(2π·frequency_hz·t)`, with `r` a linear ramp from 0 to 1 over
 /// `ramp_s` (0: none), sampled at `sample_rate_hz` from `t = 0`.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SineForce {
     /// Force amplitude, N.
@@ -236,7 +237,7 @@ pub struct SineForce {
 
 /// `u(t) = amplitude_m·sin(2π·frequency_hz·t)` with its exact velocity and acceleration,
 /// sampled at `sample_rate_hz` from `t = 0` (the paper's S tests).
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SineMotion {
     /// Displacement amplitude, m.
@@ -252,7 +253,7 @@ pub struct SineMotion {
 /// ([`crate::generate::triangle_motion`]): peak `amplitude_m`, constant velocity
 /// `velocity_m_s`, reversal arcs at `reversal_acceleration_m_s2`; period
 /// `4U/V + 2V/A_r`.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TriangleMotion {
     /// Peak displacement, m.
@@ -267,7 +268,7 @@ pub struct TriangleMotion {
 }
 
 /// Band-limited white-noise motion ([`crate::generate::white_noise_motion`]).
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct WhiteNoiseMotion {
     /// RMS acceleration, in g (`0.1` for the paper's WN10%g).
@@ -297,7 +298,7 @@ fn default_rate() -> f64 {
 }
 
 /// `integrator`, selected by `method`.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(tag = "method", rename_all = "lowercase")]
 pub enum IntegratorSpec {
     /// Fixed-step RK4 with exact stick-slip.
@@ -307,7 +308,7 @@ pub enum IntegratorSpec {
 }
 
 /// `{"method": "dopri5", "rtol": …, "atol": …}`.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Dopri5Spec {
     /// Relative tolerance (default 1e-8).
@@ -341,7 +342,7 @@ impl Integrator {
 }
 
 /// `{"method": "rk4", "step_s": …}`.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Rk4Spec {
     /// Step, s; must divide the record's sample interval (default: the sample interval).
@@ -351,7 +352,7 @@ pub struct Rk4Spec {
 /// `initial`: the state at the record's first sample, given (`{"u_m": …, "v_m_s": …}`) or
 /// taken from the force record's own `u_m` and `v_m_s` columns (`{"from_record": true}`, for
 /// a recorded test that did not start at rest, like the paper's SR9).
-#[derive(Debug, Clone, Default, Deserialize)]
+#[derive(Debug, Clone, Default, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct InitialSpec {
     /// Displacement, m (default 0).
@@ -930,6 +931,16 @@ fn ground_motion(ctx: &Ctx, g: &GroundMotion, duration_s: Option<f64>) -> Result
     let resampler =
         platen_signal::Resampler::new(1.0 / dt_s, rate, platen_signal::Interpolation::default())
             .map_err(|e| signal("sample_rate_hz", e))?;
+    if resampler.output_len(a.len()) > generate::MAX_GENERATED_SAMPLES {
+        return Err(ctx.invalid(
+            &format!("{here}.sample_rate_hz"),
+            rate,
+            format!(
+                "a rate giving at most {} samples for this record",
+                generate::MAX_GENERATED_SAMPLES
+            ),
+        ));
+    }
     let mut a = resampler
         .apply(&a)
         .map_err(|e| signal("sample_rate_hz", e))?;
@@ -1037,4 +1048,20 @@ fn forward_run(
         initial: State { u_m, v_m_s },
         samples,
     })
+}
+
+/// The JSON Schema (draft 2020-12) of the scenario format, generated from the types above.
+/// `platen schema` prints it; point an editor's JSON-schema support at the printed file.
+pub fn json_schema() -> serde_json::Value {
+    let mut schema = serde_json::to_value(schemars::schema_for!(ScenarioFile)).unwrap_or_default();
+    if let Some(obj) = schema.as_object_mut() {
+        obj.insert("title".into(), "platen scenario".into());
+        obj.insert(
+            "description".into(),
+            "A platen scenario: model (preset, identified or full form), excitation, integrator, initial \
+             state and duration. SI units; the unit is in every key's name."
+                .into(),
+        );
+    }
+    schema
 }
