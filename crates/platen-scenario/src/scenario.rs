@@ -50,6 +50,9 @@ use crate::generate::{self, GenerateError};
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ScenarioFile {
+    /// The JSON Schema this file follows (ignored; lets editors find `platen schema`'s output).
+    #[serde(rename = "$schema")]
+    pub schema: Option<String>,
     /// A short name for reports (default: the file stem).
     pub name: Option<String>,
     /// Free text.
