@@ -5,8 +5,12 @@
 
 #![recursion_limit = "256"]
 
+mod bench;
+mod generate;
 mod model;
+mod schema;
 mod simulate;
+mod sweep;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -56,6 +60,73 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Time the standard workloads (forward RK4 on both model forms, Dopri5, inverse) on the
+    /// lhpost-2008 preset next to a plain-loop RK4 baseline measured in the same run.
+    Bench {
+        /// Print a machine-readable summary on stdout (keys rk4_ns_per_step, …).
+        #[arg(long)]
+        json: bool,
+        /// Simulated seconds of every workload's 1024 Hz record.
+        #[arg(long, default_value_t = 600.0, value_parser = bench::parse_seconds)]
+        seconds: f64,
+        /// Runs of each workload (round-robin); the median is reported.
+        #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
+        repeats: u32,
+    },
+    /// Print the JSON Schema of the scenario format (point an editor at it to get completion
+    /// and checking while writing scenarios).
+    Schema {
+        /// Write the schema to this file instead of standard output.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Write a scenario's excitation, or recorded-like data for a motion scenario.
+    Generate {
+        /// What to write.
+        #[arg(value_enum)]
+        what: generate::What,
+        /// Scenario JSON file.
+        scenario: PathBuf,
+        /// Output CSV file.
+        #[arg(long)]
+        out: PathBuf,
+        /// Seed of the noise of recorded-like data.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Print a machine-readable summary on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Run a grid of variants of a scenario in parallel on every core, one summary row per case.
+    ///
+    /// The cases are the Cartesian product of the axes given (scale outermost, then pressure,
+    /// then each --set in order, the last varying fastest); an axis not given holds the
+    /// scenario's own value. Cases run in parallel on every core (RAYON_NUM_THREADS sets the
+    /// number of threads; the output is the same whatever it is), with a progress bar on
+    /// stderr when it is a terminal and CI is unset. Each row: case, scale,
+    /// hold_down_pressure_mpa, one column per --set, peak_u_m, peak_v_m_s, peak_a_m_s2,
+    /// peak_force_n (signed), stick_time_s, events, limits_exceeded, status.
+    Sweep {
+        /// Scenario JSON file.
+        scenario: PathBuf,
+        /// Factors multiplying the excitation (the force record, or the prescribed motion),
+        /// comma separated: --scale 0.5,1,1.5.
+        #[arg(long, value_delimiter = ',', allow_hyphen_values = true, value_parser = sweep::parse_scale)]
+        scale: Vec<f64>,
+        /// Hold-down nitrogen pressures, MPa, comma separated: --pressure-mpa 0,6.9,13.8.
+        #[arg(long, value_delimiter = ',', allow_negative_numbers = true, value_parser = sweep::parse_pressure_mpa)]
+        pressure_mpa: Vec<f64>,
+        /// A model parameter and its values, repeatable: --set identified.coulomb_force_n=20e3,25e3
+        /// or --set full.platen_mass_kg=130e3,140e3 (the scenario's form: identified or full).
+        #[arg(long = "set", value_name = "FORM.NAME=V1,V2,…", value_parser = sweep::parse_set)]
+        set: Vec<sweep::SetAxis>,
+        /// Write one row per case to this CSV file (written atomically when all cases are done).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Print a machine-readable summary of every case on stdout.
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -80,6 +151,27 @@ fn main() -> ExitCode {
             form,
             json,
         } => model::run(&preset, pressure_mpa, form, json),
+        Command::Schema { out } => schema::run(out.as_deref()),
+        Command::Generate {
+            what,
+            scenario,
+            out,
+            seed,
+            json,
+        } => generate::run(what, &scenario, &out, seed, json),
+        Command::Bench {
+            json,
+            seconds,
+            repeats,
+        } => bench::run(seconds, repeats, json),
+        Command::Sweep {
+            scenario,
+            scale,
+            pressure_mpa,
+            set,
+            out,
+            json,
+        } => sweep::run(&scenario, &scale, &pressure_mpa, &set, out.as_deref(), json),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -27,6 +27,7 @@
 
 #![warn(missing_docs)]
 
+pub mod baseline;
 mod dopri5;
 mod error;
 mod inverse;

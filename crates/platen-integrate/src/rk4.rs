@@ -207,10 +207,19 @@ pub(crate) enum Mode {
     Slip(f64),
 }
 
+/// Grid step `n` (from `t₀`), which is sub-step `i` of the sample interval that starts at
+/// sample `j` (`n = j·k + i`). Carried together so that the hot loop never divides.
+#[derive(Debug, Clone, Copy)]
+struct GridStep {
+    n: u64,
+    j: usize,
+    /// `i` as a number (exact: `i < k ≤ 1e9`).
+    i: f64,
+}
+
 /// The force record seen from the integer time grid.
 struct Grid<'a> {
     force: &'a [f64],
-    k: u64,
     inv_k: f64,
     h: f64,
     t0: f64,
@@ -220,9 +229,9 @@ impl Grid<'_> {
     /// Force at fraction `tau ∈ [0, 1]` of grid step `n`: linear between the two samples
     /// that bracket the step, exact at both samples.
     #[inline(always)]
-    fn force(&self, n: u64, tau: f64) -> f64 {
-        let j = (n / self.k) as usize;
-        let w = ((n % self.k) as f64 + tau) * self.inv_k;
+    fn force(&self, n: GridStep, tau: f64) -> f64 {
+        let j = n.j;
+        let w = (n.i + tau) * self.inv_k;
         if w == 0.0 {
             self.force[j]
         } else {
@@ -231,8 +240,8 @@ impl Grid<'_> {
     }
 
     #[inline]
-    fn time_s(&self, n: u64, tau: f64) -> f64 {
-        self.t0 + (n as f64 + tau) * self.h
+    fn time_s(&self, n: GridStep, tau: f64) -> f64 {
+        self.t0 + (n.n as f64 + tau) * self.h
     }
 }
 
@@ -249,21 +258,35 @@ pub(crate) struct Kin {
     pub dissipated: f64,
 }
 
-/// One classical RK4 step of length `h` in slip with direction `dir` from `y`, given the rates
-/// at the start `r0` (so the caller can reuse them) and the forces at the start, middle and
-/// end of the step.
+/// The friction direction of slip as a number: `+1.0` for `POSITIVE`, `−1.0` otherwise.
+///
+/// The slip path is monomorphised over the direction so that, once the model's
+/// `slip_rates` is inlined, `direction·v` and `direction·D` fold to `v`/`−v` and `D`/`−D`
+/// (exact for ±1, so the results are bit for bit those of a run-time direction) and two
+/// multiplications leave the dependency chain of every stage.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn rk4_slip<M: PlatenModel>(
+const fn direction<const POSITIVE: bool>() -> f64 {
+    if POSITIVE {
+        1.0
+    } else {
+        -1.0
+    }
+}
+
+/// One classical RK4 step of length `h` in slip with direction `direction::<POSITIVE>()`
+/// from `y`, given the rates at the start `r0` (so the caller can reuse them) and the forces
+/// at the start, middle and end of the step.
+#[inline(always)]
+fn rk4_slip<M: PlatenModel, const POSITIVE: bool>(
     m: &M,
     y: Kin,
     r0: SlipRates,
-    dir: f64,
     h: f64,
     f_start: f64,
     f_mid: f64,
     f_end: f64,
 ) -> Kin {
+    let dir = direction::<POSITIVE>();
     let (u, v) = (y.u, y.v);
     let hh = 0.5 * h;
     let v2 = v + hh * r0.a_m_s2;
@@ -317,7 +340,6 @@ pub fn forward_rk4<M: PlatenModel, S: SampleSink>(
     let k = u64::from(rk4.steps_per_sample);
     let grid = Grid {
         force: record.force_n(),
-        k,
         inv_k: 1.0 / k as f64,
         h: record.dt_s() / k as f64,
         t0: record.t_s()[0],
@@ -328,13 +350,13 @@ pub fn forward_rk4<M: PlatenModel, S: SampleSink>(
         return Ok(stepper.finish());
     }
     sink.accept(&stepper.sample(0, times[0]));
-    let total_steps = (samples as u64 - 1) * k;
-    for n in 0..total_steps {
-        stepper.step(n)?;
-        if (n + 1) % k == 0 {
-            let j = ((n + 1) / k) as usize;
-            sink.accept(&stepper.sample(n + 1, times[j]));
+    let mut n = 0u64;
+    for j in 0..samples - 1 {
+        for i in 0..k {
+            stepper.step(GridStep { n, j, i: i as f64 })?;
+            n += 1;
         }
+        sink.accept(&stepper.sample(j + 1, times[j + 1]));
     }
     Ok(stepper.finish())
 }
@@ -428,7 +450,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
             rates: AT_REST,
             stats: RunStats::default(),
         };
-        let f0 = s.grid.force(0, 0.0);
+        let f0 = s.grid.force[0];
         s.mode = if s.y.v > 0.0 {
             Mode::Slip(1.0)
         } else if s.y.v < 0.0 {
@@ -452,13 +474,13 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
         };
     }
 
-    /// The output sample at grid point `n` (τ = 0).
-    fn sample(&self, n: u64, t_s: f64) -> Sample {
+    /// The output sample at sample `j` of the record (grid point `j·k`, τ = 0).
+    fn sample(&self, j: usize, t_s: f64) -> Sample {
         sample_at(
             self.model,
-            (n / self.grid.k) as usize,
+            j,
             t_s,
-            self.grid.force(n, 0.0),
+            self.grid.force[j],
             self.y,
             self.rates.a_m_s2,
             self.mode == Mode::Stick,
@@ -467,7 +489,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
 
     /// Advances from grid point `n` to `n + 1`, handling every event inside the step.
     #[inline]
-    fn step(&mut self, n: u64) -> Result<()> {
+    fn step(&mut self, n: GridStep) -> Result<()> {
         self.stats.steps += 1;
         let h = self.grid.h;
         let mut tau = 0.0;
@@ -475,69 +497,13 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
         loop {
             match self.mode {
                 Mode::Slip(dir) => {
-                    let rem = 1.0 - tau;
-                    // Leaving v = 0 (after a breakaway or reversal) the √|v| law is singular:
-                    // grade the sub-steps towards the start.
-                    let from_rest = self.y.v == 0.0;
-                    let y1 = if from_rest {
-                        self.advance(n, tau, rem, dir, Grading::Start)
+                    let committed = if dir > 0.0 {
+                        self.slip::<true>(n, &mut tau)?
                     } else {
-                        let f_start = self.grid.force(n, tau);
-                        let f_mid = self.grid.force(n, tau + 0.5 * rem);
-                        let f_end = self.grid.force(n, 1.0);
-                        self.stats.rhs_evaluations += 3;
-                        rk4_slip(
-                            self.model,
-                            self.y,
-                            self.rates,
-                            dir,
-                            rem * h,
-                            f_start,
-                            f_mid,
-                            f_end,
-                        )
+                        self.slip::<false>(n, &mut tau)?
                     };
-                    if !(y1.u.is_finite() && y1.v.is_finite()) {
-                        return Err(self.non_finite(n, tau));
-                    }
-                    if dir * y1.v > 0.0 {
-                        return self.commit(n, y1);
-                    }
-                    // v reaches zero inside the step. Arriving at v = 0 is singular too:
-                    // redo the remainder graded towards the end, then locate the crossing on
-                    // that graded map.
-                    let grading = if from_rest {
-                        Grading::Both
-                    } else {
-                        Grading::End
-                    };
-                    let y2 = self.advance(n, tau, rem, dir, grading);
-                    if dir * y2.v > 0.0 {
-                        return self.commit(n, y2);
-                    }
-                    match self.locate_zero_velocity(n, tau, rem, dir, y2, grading) {
-                        Some((x, y_event)) => {
-                            tau += x;
-                            if 1.0 - tau < 1e-12 {
-                                tau = 1.0;
-                            }
-                            self.y = Kin { v: 0.0, ..y_event };
-                            let f = self.grid.force(n, tau);
-                            self.mode = mode_at_rest(self.model, self.y.u, f);
-                            match self.mode {
-                                Mode::Stick => self.stats.stick_events += 1,
-                                Mode::Slip(_) => self.stats.reversals += 1,
-                            }
-                            self.refresh_rates(f);
-                        }
-                        None => {
-                            // Started at v = 0 and no step length moves the platen in `dir`:
-                            // friction holds it.
-                            self.y.v = 0.0;
-                            self.mode = Mode::Stick;
-                            self.stats.stick_events += 1;
-                            self.rates = AT_REST;
-                        }
+                    if committed {
+                        return Ok(());
                     }
                 }
                 Mode::Stick => {
@@ -575,11 +541,91 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
         }
     }
 
+    /// The slip part of [`Stepper::step`] in direction `direction::<POSITIVE>()`, from
+    /// fraction `tau` of step `n`: either completes the step (`Ok(true)`) or stops at the
+    /// located `v = 0` event with `tau` and the mode updated (`Ok(false)`).
+    #[inline(always)]
+    fn slip<const POSITIVE: bool>(&mut self, n: GridStep, tau: &mut f64) -> Result<bool> {
+        let dir = direction::<POSITIVE>();
+        let h = self.grid.h;
+        let rem = 1.0 - *tau;
+        // Leaving v = 0 (after a breakaway or reversal) the √|v| law is singular:
+        // grade the sub-steps towards the start.
+        let from_rest = self.y.v == 0.0;
+        let y1 = if from_rest {
+            self.advance::<POSITIVE>(n, *tau, rem, Grading::Start)
+        } else {
+            let f_start = self.grid.force(n, *tau);
+            let f_mid = self.grid.force(n, *tau + 0.5 * rem);
+            let f_end = self.grid.force(n, 1.0);
+            self.stats.rhs_evaluations += 3;
+            rk4_slip::<M, POSITIVE>(
+                self.model,
+                self.y,
+                self.rates,
+                rem * h,
+                f_start,
+                f_mid,
+                f_end,
+            )
+        };
+        if !(y1.u.is_finite() && y1.v.is_finite()) {
+            return Err(self.non_finite(n, *tau));
+        }
+        if dir * y1.v > 0.0 {
+            self.commit::<POSITIVE>(n, y1)?;
+            return Ok(true);
+        }
+        // v reaches zero inside the step. Arriving at v = 0 is singular too:
+        // redo the remainder graded towards the end, then locate the crossing on
+        // that graded map.
+        let grading = if from_rest {
+            Grading::Both
+        } else {
+            Grading::End
+        };
+        let y2 = self.advance::<POSITIVE>(n, *tau, rem, grading);
+        if dir * y2.v > 0.0 {
+            self.commit::<POSITIVE>(n, y2)?;
+            return Ok(true);
+        }
+        match self.locate_zero_velocity::<POSITIVE>(n, *tau, rem, y2, grading) {
+            Some((x, y_event)) => {
+                *tau += x;
+                if 1.0 - *tau < 1e-12 {
+                    *tau = 1.0;
+                }
+                self.y = Kin { v: 0.0, ..y_event };
+                let f = self.grid.force(n, *tau);
+                self.mode = mode_at_rest(self.model, self.y.u, f);
+                match self.mode {
+                    Mode::Stick => self.stats.stick_events += 1,
+                    Mode::Slip(_) => self.stats.reversals += 1,
+                }
+                self.refresh_rates(f);
+            }
+            None => {
+                // Started at v = 0 and no step length moves the platen in `dir`:
+                // friction holds it.
+                self.y.v = 0.0;
+                self.mode = Mode::Stick;
+                self.stats.stick_events += 1;
+                self.rates = AT_REST;
+            }
+        }
+        Ok(false)
+    }
+
     /// Accepts the state at the end of step `n`.
     #[inline(always)]
-    fn commit(&mut self, n: u64, y: Kin) -> Result<()> {
+    fn commit<const POSITIVE: bool>(&mut self, n: GridStep, y: Kin) -> Result<()> {
         self.y = y;
-        self.refresh_rates(self.grid.force(n, 1.0));
+        // The mode is slip in this direction: refresh_rates with the direction known.
+        let f = self.grid.force(n, 1.0);
+        self.stats.rhs_evaluations += 1;
+        self.rates = self
+            .model
+            .slip_rates(f, self.y.u, self.y.v, direction::<POSITIVE>());
         if !self.rates.a_m_s2.is_finite() {
             return Err(self.non_finite(n, 1.0));
         }
@@ -588,7 +634,14 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
 
     /// RK4 in slip from the current state at fraction `tau` of step `n` over a length `x·h`,
     /// split into the sub-steps of `grading`.
-    fn advance(&mut self, n: u64, tau: f64, x: f64, dir: f64, grading: Grading) -> Kin {
+    fn advance<const POSITIVE: bool>(
+        &mut self,
+        n: GridStep,
+        tau: f64,
+        x: f64,
+        grading: Grading,
+    ) -> Kin {
+        let dir = direction::<POSITIVE>();
         let (mut y, mut r) = (self.y, self.rates);
         let mut s = tau;
         for (i, &p) in grading.pieces().iter().enumerate() {
@@ -600,23 +653,14 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
             }
             let f_mid = self.grid.force(n, s + 0.5 * len);
             let f_end = self.grid.force(n, s + len);
-            y = rk4_slip(
-                self.model,
-                y,
-                r,
-                dir,
-                len * self.grid.h,
-                f_start,
-                f_mid,
-                f_end,
-            );
+            y = rk4_slip::<M, POSITIVE>(self.model, y, r, len * self.grid.h, f_start, f_mid, f_end);
             self.stats.rhs_evaluations += 3;
             s += len;
         }
         y
     }
 
-    fn non_finite(&self, n: u64, tau: f64) -> IntegrateError {
+    fn non_finite(&self, n: GridStep, tau: f64) -> IntegrateError {
         IntegrateError::NonFiniteState {
             t_s: self.grid.time_s(n, tau),
             u_m: self.y.u,
@@ -628,18 +672,18 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
     /// velocity from the current state reaches zero, given that the full remainder ends at
     /// `y_rem` with `dir·v ≤ 0`. Returns `x` and the state there (velocity not yet zeroed),
     /// or `None` if the platen starts at rest and does not move in `dir` for any step length.
-    fn locate_zero_velocity(
+    fn locate_zero_velocity<const POSITIVE: bool>(
         &mut self,
-        n: u64,
+        n: GridStep,
         tau: f64,
         rem: f64,
-        dir: f64,
         y_rem: Kin,
         grading: Grading,
     ) -> Option<(f64, Kin)> {
+        let dir = direction::<POSITIVE>();
         let trial = |s: &mut Self, x: f64| {
             s.stats.root_iterations += 1;
-            s.advance(n, tau, x, dir, grading)
+            s.advance::<POSITIVE>(n, tau, x, grading)
         };
         // g(x) = dir·v(x): positive before the crossing, ≤ 0 after it.
         let (mut hi, mut y_hi) = (rem, y_rem);

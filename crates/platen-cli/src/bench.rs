@@ -1,0 +1,355 @@
+//! `platen bench`: time the standard workloads on the `lhpost-2008` preset, next to the
+//! plain-loop baseline measured in the same run.
+//!
+//! Workloads, all at 1024 Hz over the same number of simulated seconds (default 600, i.e.
+//! 10 minutes), from rest, at 13.8 MPa:
+//!
+//! * `baseline`: [`platen_integrate::baseline::baseline_rk4`], the plain RK4 loop on the
+//!   identified model (no stick logic, no output) under a 600 kN, 0.5 Hz sine force;
+//! * `rk4`: [`forward_rk4`] on the identified model, exact stick-slip, one step per sample,
+//!   every output sample kept in memory in a [`Trajectory`] (no file I/O), same force;
+//! * `rk4_full`: the same on the full Lagrangian model;
+//! * `dopri5`: [`forward_dopri5`] at rtol 1e-8, atol 1e-11 on the identified model, same
+//!   force, timed per accepted step;
+//! * `inverse`: [`inverse`] of the paper's S9 sine motion (0.2 m, 0.6 Hz) on the identified
+//!   model, timed per sample.
+//!
+//! The workloads run round-robin `repeats` times and the median wall time of each is
+//! reported, so that a slow phase of the machine affects all of them alike. The output
+//! buffers are allocated once, outside the timed region, and reused.
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use anyhow::{ensure, Context, Result};
+use serde_json::{json, Map, Value};
+
+use platen_integrate::baseline::baseline_rk4;
+use platen_integrate::{
+    forward_dopri5, forward_rk4, inverse, Dopri5Settings, ForceRecord, Motion, Rk4, State,
+    Trajectory,
+};
+use platen_model::preset;
+
+/// Sample rate of every workload, Hz (one RK4 step per sample: h = 1/1024 s).
+const RATE_HZ: f64 = 1024.0;
+/// Hold-down pressure of every workload, Pa.
+const PRESSURE_PA: f64 = 13.8e6;
+/// Sine force of the forward workloads: amplitude, N, and frequency, Hz.
+const FORCE_AMPLITUDE_N: f64 = 600e3;
+const FORCE_FREQUENCY_HZ: f64 = 0.5;
+/// Sine motion of the inverse workload (the paper's S9): amplitude, m, and frequency, Hz.
+const MOTION_AMPLITUDE_M: f64 = 0.2;
+const MOTION_FREQUENCY_HZ: f64 = 0.6;
+/// Tolerances of the Dopri5 workload.
+const DOPRI5_RTOL: f64 = 1e-8;
+const DOPRI5_ATOL: f64 = 1e-11;
+
+/// One timed workload.
+struct Workload {
+    key: &'static str,
+    title: &'static str,
+    /// What one unit of work is ("step", "accepted step", "sample").
+    unit: &'static str,
+    /// Units of work per run (steps, accepted steps or samples).
+    units: u64,
+    /// Wall time of each run, s.
+    times_s: Vec<f64>,
+}
+
+impl Workload {
+    fn new(key: &'static str, title: &'static str, unit: &'static str) -> Self {
+        Self {
+            key,
+            title,
+            unit,
+            units: 0,
+            times_s: Vec::new(),
+        }
+    }
+
+    fn median_s(&self) -> f64 {
+        let mut t = self.times_s.clone();
+        t.sort_by(f64::total_cmp);
+        let n = t.len();
+        if n % 2 == 1 {
+            t[n / 2]
+        } else {
+            0.5 * (t[n / 2 - 1] + t[n / 2])
+        }
+    }
+
+    fn ns_per_unit(&self) -> f64 {
+        self.median_s() * 1e9 / self.units as f64
+    }
+
+    fn json(&self, simulated_s: f64) -> Value {
+        let median = self.median_s();
+        json!({
+            "unit": self.unit,
+            "units_per_run": self.units,
+            "runs": self.times_s.len(),
+            "median_wall_s": median,
+            "min_wall_s": self.times_s.iter().copied().fold(f64::INFINITY, f64::min),
+            "ns_per_unit": self.ns_per_unit(),
+            "units_per_s": self.units as f64 / median,
+            "simulated_s_per_wall_s": simulated_s / median,
+        })
+    }
+}
+
+/// Times `f` once, s.
+fn time<T>(f: impl FnOnce() -> T) -> (f64, T) {
+    let start = Instant::now();
+    let out = f();
+    (start.elapsed().as_secs_f64(), out)
+}
+
+pub fn run(seconds: f64, repeats: u32, json_out: bool) -> Result<()> {
+    let samples = (seconds * RATE_HZ).round() as usize + 1;
+    ensure!(
+        samples >= 3,
+        "--seconds {seconds} gives {samples} samples at 1024 Hz; at least 3 are needed"
+    );
+    let simulated_s = (samples - 1) as f64 / RATE_HZ;
+    let w_force = 2.0 * std::f64::consts::PI * FORCE_FREQUENCY_HZ;
+    let force: Vec<f64> = (0..samples)
+        .map(|j| FORCE_AMPLITUDE_N * (w_force * j as f64 / RATE_HZ).sin())
+        .collect();
+    let record = ForceRecord::from_rate(RATE_HZ, force.clone()).context("bench force record")?;
+    let w_motion = 2.0 * std::f64::consts::PI * MOTION_FREQUENCY_HZ;
+    let t: Vec<f64> = (0..samples).map(|j| j as f64 / RATE_HZ).collect();
+    let motion = Motion::new(
+        t.clone(),
+        t.iter()
+            .map(|&t| MOTION_AMPLITUDE_M * (w_motion * t).sin())
+            .collect(),
+        t.iter()
+            .map(|&t| MOTION_AMPLITUDE_M * w_motion * (w_motion * t).cos())
+            .collect(),
+        t.iter()
+            .map(|&t| -MOTION_AMPLITUDE_M * w_motion * w_motion * (w_motion * t).sin())
+            .collect(),
+    )
+    .context("bench motion")?;
+
+    let identified_params = preset::lhpost_2008_identified(PRESSURE_PA);
+    let identified = identified_params.build()?;
+    let full = preset::lhpost_2008_physical(PRESSURE_PA).build()?;
+    let rk4 = Rk4::with_steps_per_sample(1)?;
+    let dopri5 = Dopri5Settings::new(DOPRI5_RTOL, DOPRI5_ATOL)?;
+    let dt = 1.0 / RATE_HZ;
+
+    let mut baseline = Workload::new(
+        "baseline",
+        "baseline: plain RK4 loop, no stick logic, no output",
+        "step",
+    );
+    let mut rk4_identified = Workload::new(
+        "rk4",
+        "rk4: identified model, exact stick-slip, output kept",
+        "step",
+    );
+    let mut rk4_full = Workload::new(
+        "rk4_full",
+        "rk4_full: full model, exact stick-slip, output kept",
+        "step",
+    );
+    let mut dopri5_identified = Workload::new(
+        "dopri5",
+        "dopri5: rtol 1e-8, identified model, output kept",
+        "accepted step",
+    );
+    let mut inverse_identified = Workload::new(
+        "inverse",
+        "inverse: S9 sine motion, identified model, output kept",
+        "sample",
+    );
+    let mut out = Trajectory::with_capacity(samples);
+    let mut baseline_end = State::default();
+
+    for _ in 0..repeats.max(1) {
+        let (s, end) = time(|| {
+            baseline_rk4(
+                black_box(&identified_params),
+                black_box(&force),
+                black_box(dt),
+                State::default(),
+            )
+        });
+        baseline_end = black_box(end);
+        baseline.times_s.push(s);
+        baseline.units = (samples - 1) as u64;
+
+        for (model_is_full, workload) in [(false, &mut rk4_identified), (true, &mut rk4_full)] {
+            out = clear(out);
+            let (s, stats) = time(|| {
+                if model_is_full {
+                    forward_rk4(
+                        black_box(&full),
+                        black_box(&record),
+                        rk4,
+                        State::default(),
+                        samples,
+                        &mut out,
+                    )
+                } else {
+                    forward_rk4(
+                        black_box(&identified),
+                        black_box(&record),
+                        rk4,
+                        State::default(),
+                        samples,
+                        &mut out,
+                    )
+                }
+            });
+            let stats = stats.context("bench forward RK4 run")?;
+            black_box(&out);
+            workload.times_s.push(s);
+            workload.units = stats.steps;
+        }
+
+        out = clear(out);
+        let (s, stats) = time(|| {
+            forward_dopri5(
+                black_box(&identified),
+                black_box(&record),
+                dopri5,
+                State::default(),
+                samples,
+                &mut out,
+            )
+        });
+        let stats = stats.context("bench forward Dopri5 run")?;
+        black_box(&out);
+        dopri5_identified.times_s.push(s);
+        dopri5_identified.units = stats.accepted_steps;
+
+        out = clear(out);
+        let (s, ()) = time(|| inverse(black_box(&identified), black_box(&motion), &mut out));
+        black_box(&out);
+        inverse_identified.times_s.push(s);
+        inverse_identified.units = motion.len() as u64;
+    }
+
+    let base = baseline.ns_per_unit();
+    let workloads = [
+        &baseline,
+        &rk4_identified,
+        &rk4_full,
+        &dopri5_identified,
+        &inverse_identified,
+    ];
+    if json_out {
+        let mut m = Map::new();
+        m.insert("preset".into(), json!("lhpost-2008"));
+        m.insert("hold_down_pressure_mpa".into(), json!(PRESSURE_PA / 1e6));
+        m.insert("simulated_s".into(), json!(simulated_s));
+        m.insert("sample_rate_hz".into(), json!(RATE_HZ));
+        m.insert("repeats".into(), json!(repeats.max(1)));
+        m.insert(
+            "rk4_ns_per_step".into(),
+            json!(rk4_identified.ns_per_unit()),
+        );
+        m.insert("rk4_full_ns_per_step".into(), json!(rk4_full.ns_per_unit()));
+        m.insert(
+            "dopri5_ns_per_accepted_step".into(),
+            json!(dopri5_identified.ns_per_unit()),
+        );
+        m.insert(
+            "inverse_ns_per_sample".into(),
+            json!(inverse_identified.ns_per_unit()),
+        );
+        m.insert("baseline_ns_per_step".into(), json!(base));
+        m.insert(
+            "rk4_ratio_to_baseline".into(),
+            json!(rk4_identified.ns_per_unit() / base),
+        );
+        m.insert(
+            "rk4_full_ratio_to_baseline".into(),
+            json!(rk4_full.ns_per_unit() / base),
+        );
+        m.insert(
+            "rk4_steps_per_s".into(),
+            json!(1e9 / rk4_identified.ns_per_unit()),
+        );
+        m.insert(
+            "rk4_simulated_s_per_wall_s".into(),
+            json!(simulated_s / rk4_identified.median_s()),
+        );
+        // The same loop in C (benches/c/rk4_baseline.c) ends in the same state, to the bit.
+        m.insert(
+            "baseline_final_state".into(),
+            json!({"u_m": baseline_end.u_m, "v_m_s": baseline_end.v_m_s}),
+        );
+        let mut detail = Map::new();
+        for w in workloads {
+            detail.insert(w.key.into(), w.json(simulated_s));
+        }
+        m.insert("workloads".into(), Value::Object(detail));
+        println!("{}", serde_json::to_string_pretty(&Value::Object(m))?);
+    } else {
+        println!(
+            "platen bench: lhpost-2008 at {} MPa, {simulated_s} s records at {RATE_HZ} Hz from rest, \
+             median of {} runs",
+            PRESSURE_PA / 1e6,
+            repeats.max(1)
+        );
+        println!(
+            "  {:<54} {:>14} {:>10} {:>10} {:>12} {:>6}",
+            "workload", "unit", "ns/unit", "units/s", "sim s/wall s", "ratio"
+        );
+        for w in workloads {
+            let ratio = if w.unit == "step" {
+                format!("{:.3}", w.ns_per_unit() / base)
+            } else {
+                "-".to_owned()
+            };
+            println!(
+                "  {:<54} {:>14} {:>10.1} {:>10.3e} {:>12.0} {:>6}",
+                w.title,
+                w.unit,
+                w.ns_per_unit(),
+                w.units as f64 / w.median_s(),
+                simulated_s / w.median_s(),
+                ratio
+            );
+        }
+        println!("  ratio: ns/step over the baseline's, measured in the same run");
+    }
+    Ok(())
+}
+
+/// Empties a trajectory, keeping its buffers (their pages are already mapped).
+fn clear(mut t: Trajectory) -> Trajectory {
+    for column in [
+        &mut t.t_s,
+        &mut t.u_m,
+        &mut t.v_m_s,
+        &mut t.a_m_s2,
+        &mut t.force_n,
+        &mut t.inertial_force_n,
+        &mut t.elastic_force_n,
+        &mut t.dissipative_force_n,
+    ] {
+        column.clear();
+    }
+    t
+}
+
+/// `--seconds`: a finite number of simulated seconds, at least 2/1024 and at most 1e6.
+pub fn parse_seconds(s: &str) -> std::result::Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number of seconds"))?;
+    if v.is_finite() && (2.0 / RATE_HZ..=1e6).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!(
+            "{v} s: expected a duration from {} s to 1e6 s",
+            2.0 / RATE_HZ
+        ))
+    }
+}
