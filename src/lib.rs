@@ -4,3 +4,4 @@
 pub use platen_integrate as integrate;
 pub use platen_model as model;
 pub use platen_scenario as scenario;
+pub use platen_signal as signal;

@@ -9,7 +9,11 @@ use std::process::Command;
 fn good_force() -> String {
     let mut s = String::from("t_s,force_n\n");
     for j in 0..=1024 {
-        s.push_str(&format!("{},{}\n", j as f64 / 1024.0, 1e4 * (j as f64 / 100.0).sin()));
+        s.push_str(&format!(
+            "{},{}\n",
+            j as f64 / 1024.0,
+            1e4 * (j as f64 / 100.0).sin()
+        ));
     }
     s
 }
@@ -17,7 +21,11 @@ fn good_force() -> String {
 fn good_motion() -> String {
     let mut s = String::from("t_s,u_m\n");
     for j in 0..=1024 {
-        s.push_str(&format!("{},{}\n", j as f64 / 1024.0, 0.01 * (j as f64 / 100.0).sin()));
+        s.push_str(&format!(
+            "{},{}\n",
+            j as f64 / 1024.0,
+            0.01 * (j as f64 / 100.0).sin()
+        ));
     }
     s
 }
@@ -34,7 +42,9 @@ struct Case {
 }
 
 fn force_scenario(extra: &str) -> String {
-    format!(r#"{{"model": {{"preset": "lhpost-2008"}}, "excitation": {{"force_csv": "f.csv"}}{extra}}}"#)
+    format!(
+        r#"{{"model": {{"preset": "lhpost-2008"}}, "excitation": {{"force_csv": "f.csv"}}{extra}}}"#
+    )
 }
 
 fn motion_scenario(excitation: &str) -> String {
@@ -43,32 +53,107 @@ fn motion_scenario(excitation: &str) -> String {
 
 fn cases() -> Vec<Case> {
     let mut v = Vec::new();
-    let mut add = |what: &'static str, scenario: String, files: Vec<(&'static str, String)>, needle: &'static str| {
-        v.push(Case { what, scenario, files, needle })
+    let mut add = |what: &'static str,
+                   scenario: String,
+                   files: Vec<(&'static str, String)>,
+                   needle: &'static str| {
+        v.push(Case {
+            what,
+            scenario,
+            files,
+            needle,
+        })
     };
     let f = || vec![("f.csv", good_force())];
     // Malformed JSON.
-    add("truncated JSON", r#"{"model": {"preset": "lhpost-2008""#.into(), f(), "line 1");
-    add("trailing comma", force_scenario(",").replace("}}}", "}},}"), f(), "line 1");
+    add(
+        "truncated JSON",
+        r#"{"model": {"preset": "lhpost-2008""#.into(),
+        f(),
+        "line 1",
+    );
+    add(
+        "trailing comma",
+        force_scenario(",").replace("}}}", "}},}"),
+        f(),
+        "line 1",
+    );
     add("not an object", "[1, 2, 3]".into(), f(), "line 1");
     add("empty file", String::new(), f(), "line 1");
     add("binary garbage", "\u{0}\u{1}\u{2}".into(), f(), "line 1");
     // Unknown keys.
-    add("unknown top key", force_scenario(r#", "extra": 1"#), f(), "extra");
-    add("unknown model key", r#"{"model": {"preset": "lhpost-2008", "mass": 1}, "excitation": {"force_csv": "f.csv"}}"#.into(), f(), "model");
+    add(
+        "unknown top key",
+        force_scenario(r#", "extra": 1"#),
+        f(),
+        "extra",
+    );
+    add(
+        "unknown model key",
+        r#"{"model": {"preset": "lhpost-2008", "mass": 1}, "excitation": {"force_csv": "f.csv"}}"#
+            .into(),
+        f(),
+        "model",
+    );
     add("unknown identified key", r#"{"model": {"preset": "lhpost-2008", "identified": {"mass_kg": 1}}, "excitation": {"force_csv": "f.csv"}}"#.into(), f(), "model.identified");
     add("unknown full key", r#"{"model": {"preset": "lhpost-2008", "full": {"platen_kg": 1}}, "excitation": {"force_csv": "f.csv"}}"#.into(), f(), "model.full");
-    add("unknown excitation key", r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"force_csv": "f.csv", "gain": 2}}"#.into(), f(), "excitation");
-    add("unknown integrator key", force_scenario(r#", "integrator": {"method": "rk4", "h": 0.001}"#), f(), "integrator");
-    add("unknown initial key", force_scenario(r#", "initial": {"x_m": 0}"#), f(), "initial");
-    add("unknown sine key", motion_scenario(r#"{"sine_motion": {"amplitude_m": 0.1, "frequency_hz": 1, "phase": 0}}"#), vec![], "excitation.sine_motion");
+    add(
+        "unknown excitation key",
+        r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"force_csv": "f.csv", "gain": 2}}"#
+            .into(),
+        f(),
+        "excitation",
+    );
+    add(
+        "unknown integrator key",
+        force_scenario(r#", "integrator": {"method": "rk4", "h": 0.001}"#),
+        f(),
+        "integrator",
+    );
+    add(
+        "unknown initial key",
+        force_scenario(r#", "initial": {"x_m": 0}"#),
+        f(),
+        "initial",
+    );
+    add(
+        "unknown sine key",
+        motion_scenario(r#"{"sine_motion": {"amplitude_m": 0.1, "frequency_hz": 1, "phase": 0}}"#),
+        vec![],
+        "excitation.sine_motion",
+    );
     // Wrong types.
-    add("preset not a string", r#"{"model": {"preset": 2008}, "excitation": {"force_csv": "f.csv"}}"#.into(), f(), "model.preset");
+    add(
+        "preset not a string",
+        r#"{"model": {"preset": 2008}, "excitation": {"force_csv": "f.csv"}}"#.into(),
+        f(),
+        "model.preset",
+    );
     add("mass as string", r#"{"model": {"preset": "lhpost-2008", "identified": {"effective_mass_kg": "heavy"}}, "excitation": {"force_csv": "f.csv"}}"#.into(), f(), "model.identified.effective_mass_kg");
-    add("duration as array", force_scenario(r#", "duration_s": [1]"#), f(), "duration_s");
-    add("step as bool", force_scenario(r#", "integrator": {"method": "rk4", "step_s": true}"#), f(), "integrator");
-    add("missing model", r#"{"excitation": {"force_csv": "f.csv"}}"#.into(), f(), "model");
-    add("missing excitation", r#"{"model": {"preset": "lhpost-2008"}}"#.into(), f(), "excitation");
+    add(
+        "duration as array",
+        force_scenario(r#", "duration_s": [1]"#),
+        f(),
+        "duration_s",
+    );
+    add(
+        "step as bool",
+        force_scenario(r#", "integrator": {"method": "rk4", "step_s": true}"#),
+        f(),
+        "integrator",
+    );
+    add(
+        "missing model",
+        r#"{"excitation": {"force_csv": "f.csv"}}"#.into(),
+        f(),
+        "model",
+    );
+    add(
+        "missing excitation",
+        r#"{"model": {"preset": "lhpost-2008"}}"#.into(),
+        f(),
+        "excitation",
+    );
     // Impossible parameters.
     add("negative mass", r#"{"model": {"preset": "lhpost-2008", "identified": {"effective_mass_kg": -1}}, "excitation": {"force_csv": "f.csv"}}"#.into(), f(), "model.identified.effective_mass_kg");
     add("zero mass", r#"{"model": {"preset": "lhpost-2008", "identified": {"effective_mass_kg": 0}}, "excitation": {"force_csv": "f.csv"}}"#.into(), f(), "model.identified.effective_mass_kg");
@@ -78,47 +163,221 @@ fn cases() -> Vec<Case> {
     add("zero strut height", r#"{"model": {"preset": "lhpost-2008", "full": {"strut_height_m": 0}}, "excitation": {"force_csv": "f.csv"}}"#.into(), f(), "model.full.strut_height_m");
     add("gamma below 1", r#"{"model": {"preset": "lhpost-2008", "full": {"gas_heat_capacity_ratio": 0.5}}, "excitation": {"force_csv": "f.csv"}}"#.into(), f(), "model.full.gas_heat_capacity_ratio");
     add("negative pressure", r#"{"model": {"preset": "lhpost-2008", "hold_down_pressure_mpa": -2}, "excitation": {"force_csv": "f.csv"}}"#.into(), f(), "model.hold_down_pressure_mpa");
-    add("unknown preset", r#"{"model": {"preset": "lhpost-2099"}, "excitation": {"force_csv": "f.csv"}}"#.into(), f(), "model.preset");
+    add(
+        "unknown preset",
+        r#"{"model": {"preset": "lhpost-2099"}, "excitation": {"force_csv": "f.csv"}}"#.into(),
+        f(),
+        "model.preset",
+    );
     add("both forms", r#"{"model": {"preset": "lhpost-2008", "identified": {}, "full": {}}, "excitation": {"force_csv": "f.csv"}}"#.into(), f(), "model");
-    add("zero step", force_scenario(r#", "integrator": {"method": "rk4", "step_s": 0}"#), f(), "integrator.step_s");
-    add("negative step", force_scenario(r#", "integrator": {"method": "rk4", "step_s": -0.001}"#), f(), "integrator.step_s");
-    add("step not dividing", force_scenario(r#", "integrator": {"method": "rk4", "step_s": 0.0007}"#), f(), "integrator.step_s");
-    add("zero rtol", force_scenario(r#", "integrator": {"method": "dopri5", "rtol": 0}"#), f(), "integrator.rtol");
-    add("negative atol", force_scenario(r#", "integrator": {"method": "dopri5", "atol": -1}"#), f(), "integrator.atol");
-    add("dop853 not offered", force_scenario(r#", "integrator": {"method": "dop853"}"#), f(), "integrator");
-    add("zero duration", force_scenario(r#", "duration_s": 0"#), f(), "duration_s");
-    add("duration longer than record", force_scenario(r#", "duration_s": 5"#), f(), "f.csv");
+    add(
+        "zero step",
+        force_scenario(r#", "integrator": {"method": "rk4", "step_s": 0}"#),
+        f(),
+        "integrator.step_s",
+    );
+    add(
+        "negative step",
+        force_scenario(r#", "integrator": {"method": "rk4", "step_s": -0.001}"#),
+        f(),
+        "integrator.step_s",
+    );
+    add(
+        "step not dividing",
+        force_scenario(r#", "integrator": {"method": "rk4", "step_s": 0.0007}"#),
+        f(),
+        "integrator.step_s",
+    );
+    add(
+        "zero rtol",
+        force_scenario(r#", "integrator": {"method": "dopri5", "rtol": 0}"#),
+        f(),
+        "integrator.rtol",
+    );
+    add(
+        "negative atol",
+        force_scenario(r#", "integrator": {"method": "dopri5", "atol": -1}"#),
+        f(),
+        "integrator.atol",
+    );
+    add(
+        "dop853 not offered",
+        force_scenario(r#", "integrator": {"method": "dop853"}"#),
+        f(),
+        "integrator",
+    );
+    add(
+        "zero duration",
+        force_scenario(r#", "duration_s": 0"#),
+        f(),
+        "duration_s",
+    );
+    add(
+        "duration longer than record",
+        force_scenario(r#", "duration_s": 5"#),
+        f(),
+        "f.csv",
+    );
     add("lowpass above Nyquist", r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"force_csv": "f.csv", "lowpass_hz": 600}}"#.into(), f(), "excitation.lowpass_hz");
-    add("lowpass on a motion", motion_scenario(r#"{"sine_motion": {"amplitude_m": 0.1, "frequency_hz": 1}, "lowpass_hz": 2}"#), vec![], "excitation.lowpass_hz");
-    add("two excitations", motion_scenario(r#"{"force_csv": "f.csv", "motion_csv": "m.csv"}"#), f(), "excitation");
+    add(
+        "lowpass on a motion",
+        motion_scenario(
+            r#"{"sine_motion": {"amplitude_m": 0.1, "frequency_hz": 1}, "lowpass_hz": 2}"#,
+        ),
+        vec![],
+        "excitation.lowpass_hz",
+    );
+    add(
+        "two excitations",
+        motion_scenario(r#"{"force_csv": "f.csv", "motion_csv": "m.csv"}"#),
+        f(),
+        "excitation",
+    );
     add("integrator on inverse", r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"motion_csv": "m.csv"}, "integrator": {"method": "rk4"}}"#.into(), vec![("m.csv", good_motion())], "integrator");
     add("negative frequency", r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"sine_motion": {"amplitude_m": 0.1, "frequency_hz": -1}}, "duration_s": 1}"#.into(), vec![], "excitation.sine_motion.frequency_hz");
     add("triangle arc too big", r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"triangle_motion": {"amplitude_m": 0.01, "velocity_m_s": 1, "reversal_acceleration_m_s2": 1}}, "duration_s": 1}"#.into(), vec![], "excitation.triangle_motion.reversal_acceleration_m_s2");
     add("bad unit", r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"motion_csv": "m.csv", "columns": {"u_m": {"unit": "parsec"}}}}"#.into(), vec![("m.csv", good_motion())], "excitation.columns.u_m.unit");
     // Paths.
-    add("missing record file", r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"force_csv": "nope.csv"}}"#.into(), vec![], "nope.csv");
-    add("record is a directory", r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"force_csv": "."}}"#.into(), vec![], "reading");
-    add("missing ground-motion record", motion_scenario(r#"{"ground_motion": {"record": "NOPE.AT2"}}"#), vec![], "NOPE.AT2");
+    add(
+        "missing record file",
+        r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"force_csv": "nope.csv"}}"#.into(),
+        vec![],
+        "nope.csv",
+    );
+    add(
+        "record is a directory",
+        r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"force_csv": "."}}"#.into(),
+        vec![],
+        "reading",
+    );
+    add(
+        "missing ground-motion record",
+        motion_scenario(r#"{"ground_motion": {"record": "NOPE.AT2"}}"#),
+        vec![],
+        "NOPE.AT2",
+    );
     // CSV contents.
-    add("missing column", force_scenario(""), vec![("f.csv", "t_s,force\n0,0\n1,1\n".into())], "force_n");
-    add("duplicated column", force_scenario(""), vec![("f.csv", "t_s,force_n,force_n\n0,0,0\n1,1,1\n".into())], "force_n");
-    add("non-numeric cell", force_scenario(""), vec![("f.csv", "t_s,force_n\n0,0\n1,one\n".into())], "line 3");
-    add("NaN cell", force_scenario(""), vec![("f.csv", "t_s,force_n\n0,0\n1,NaN\n".into())], "line 3");
-    add("infinite cell", force_scenario(""), vec![("f.csv", "t_s,force_n\n0,0\n1,inf\n".into())], "line 3");
-    add("empty record", force_scenario(""), vec![("f.csv", "t_s,force_n\n".into())], "f.csv");
-    add("header only, no newline", force_scenario(""), vec![("f.csv", "t_s,force_n".into())], "f.csv");
-    add("single sample", force_scenario(""), vec![("f.csv", "t_s,force_n\n0,1\n".into())], "f.csv");
-    add("unsorted time", force_scenario(""), vec![("f.csv", "t_s,force_n\n0,0\n2,1\n1,2\n3,3\n".into())], "line 4");
-    add("duplicate time", force_scenario(""), vec![("f.csv", "t_s,force_n\n0,0\n1,1\n1,2\n".into())], "line 4");
-    add("ragged row", force_scenario(""), vec![("f.csv", "t_s,force_n\n0,0\n1\n".into())], "line 3");
-    add("non-uniform sampling", force_scenario(""), vec![("f.csv", "t_s,force_n\n0,0\n1,1\n2,2\n3.5,3\n4.5,4\n5.5,5\n".into())], "line 5");
-    add("empty motion", motion_scenario(r#"{"motion_csv": "m.csv"}"#), vec![("m.csv", "t_s,u_m\n".into())], "m.csv");
-    add("motion NaN", motion_scenario(r#"{"motion_csv": "m.csv"}"#), vec![("m.csv", "t_s,u_m\n0,0\n1,nan\n2,0\n".into())], "line 3");
+    add(
+        "missing column",
+        force_scenario(""),
+        vec![("f.csv", "t_s,force\n0,0\n1,1\n".into())],
+        "force_n",
+    );
+    add(
+        "duplicated column",
+        force_scenario(""),
+        vec![("f.csv", "t_s,force_n,force_n\n0,0,0\n1,1,1\n".into())],
+        "force_n",
+    );
+    add(
+        "non-numeric cell",
+        force_scenario(""),
+        vec![("f.csv", "t_s,force_n\n0,0\n1,one\n".into())],
+        "line 3",
+    );
+    add(
+        "NaN cell",
+        force_scenario(""),
+        vec![("f.csv", "t_s,force_n\n0,0\n1,NaN\n".into())],
+        "line 3",
+    );
+    add(
+        "infinite cell",
+        force_scenario(""),
+        vec![("f.csv", "t_s,force_n\n0,0\n1,inf\n".into())],
+        "line 3",
+    );
+    add(
+        "empty record",
+        force_scenario(""),
+        vec![("f.csv", "t_s,force_n\n".into())],
+        "f.csv",
+    );
+    add(
+        "header only, no newline",
+        force_scenario(""),
+        vec![("f.csv", "t_s,force_n".into())],
+        "f.csv",
+    );
+    add(
+        "single sample",
+        force_scenario(""),
+        vec![("f.csv", "t_s,force_n\n0,1\n".into())],
+        "f.csv",
+    );
+    add(
+        "unsorted time",
+        force_scenario(""),
+        vec![("f.csv", "t_s,force_n\n0,0\n2,1\n1,2\n3,3\n".into())],
+        "line 4",
+    );
+    add(
+        "duplicate time",
+        force_scenario(""),
+        vec![("f.csv", "t_s,force_n\n0,0\n1,1\n1,2\n".into())],
+        "line 4",
+    );
+    add(
+        "ragged row",
+        force_scenario(""),
+        vec![("f.csv", "t_s,force_n\n0,0\n1\n".into())],
+        "line 3",
+    );
+    add(
+        "non-uniform sampling",
+        force_scenario(""),
+        vec![(
+            "f.csv",
+            "t_s,force_n\n0,0\n1,1\n2,2\n3.5,3\n4.5,4\n5.5,5\n".into(),
+        )],
+        "line 5",
+    );
+    add(
+        "empty motion",
+        motion_scenario(r#"{"motion_csv": "m.csv"}"#),
+        vec![("m.csv", "t_s,u_m\n".into())],
+        "m.csv",
+    );
+    add(
+        "motion NaN",
+        motion_scenario(r#"{"motion_csv": "m.csv"}"#),
+        vec![("m.csv", "t_s,u_m\n0,0\n1,nan\n2,0\n".into())],
+        "line 3",
+    );
     // PEER records.
-    add("AT2 count mismatch", motion_scenario(r#"{"ground_motion": {"record": "r.AT2"}}"#), vec![("r.AT2", format!("{AT2_HEAD}NPTS= 3, DT= .01 SEC\n .1E+00 .2E+00\n"))], "line 4");
-    add("AT2 bad value", motion_scenario(r#"{"ground_motion": {"record": "r.AT2"}}"#), vec![("r.AT2", format!("{AT2_HEAD}NPTS= 2, DT= .01 SEC\n .1E+00 x\n"))], "line 5");
-    add("AT2 bad header", motion_scenario(r#"{"ground_motion": {"record": "r.AT2"}}"#), vec![("r.AT2", "hello\n".into())], "line 1");
-    add("AT2 zero DT", motion_scenario(r#"{"ground_motion": {"record": "r.AT2"}}"#), vec![("r.AT2", format!("{AT2_HEAD}NPTS= 2, DT= 0 SEC\n .1E+00 .2E+00\n"))], "line 4");
+    add(
+        "AT2 count mismatch",
+        motion_scenario(r#"{"ground_motion": {"record": "r.AT2"}}"#),
+        vec![(
+            "r.AT2",
+            format!("{AT2_HEAD}NPTS= 3, DT= .01 SEC\n .1E+00 .2E+00\n"),
+        )],
+        "line 4",
+    );
+    add(
+        "AT2 bad value",
+        motion_scenario(r#"{"ground_motion": {"record": "r.AT2"}}"#),
+        vec![(
+            "r.AT2",
+            format!("{AT2_HEAD}NPTS= 2, DT= .01 SEC\n .1E+00 x\n"),
+        )],
+        "line 5",
+    );
+    add(
+        "AT2 bad header",
+        motion_scenario(r#"{"ground_motion": {"record": "r.AT2"}}"#),
+        vec![("r.AT2", "hello\n".into())],
+        "line 1",
+    );
+    add(
+        "AT2 zero DT",
+        motion_scenario(r#"{"ground_motion": {"record": "r.AT2"}}"#),
+        vec![(
+            "r.AT2",
+            format!("{AT2_HEAD}NPTS= 2, DT= 0 SEC\n .1E+00 .2E+00\n"),
+        )],
+        "line 4",
+    );
     v
 }
 
@@ -135,15 +394,35 @@ fn every_malformed_input_fails_cleanly_with_its_location_and_writes_nothing() {
         }
         let out = dir.path().join("out.csv");
         let o = Command::new(env!("CARGO_BIN_EXE_platen"))
-            .args(["simulate", sc.to_str().unwrap(), "--out", out.to_str().unwrap()])
+            .args([
+                "simulate",
+                sc.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ])
             .env_remove("PLATEN_RECORDS_DIR")
             .env("RUST_BACKTRACE", "1")
             .output()
             .unwrap();
         let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(3), "{}: exit {:?}: {err}", c.what, o.status.code());
-        assert!(err.contains(c.needle), "{}: message lacks {:?}: {err}", c.what, c.needle);
-        assert!(!err.contains("panicked") && !err.contains("stack backtrace"), "{}: {err}", c.what);
+        assert_eq!(
+            o.status.code(),
+            Some(3),
+            "{}: exit {:?}: {err}",
+            c.what,
+            o.status.code()
+        );
+        assert!(
+            err.contains(c.needle),
+            "{}: message lacks {:?}: {err}",
+            c.what,
+            c.needle
+        );
+        assert!(
+            !err.contains("panicked") && !err.contains("stack backtrace"),
+            "{}: {err}",
+            c.what
+        );
         assert!(err.starts_with("error: "), "{}: {err}", c.what);
         assert!(!Path::new(&out).exists(), "{}: output written", c.what);
         let leftovers: Vec<_> = std::fs::read_dir(dir.path())
@@ -151,6 +430,10 @@ fn every_malformed_input_fails_cleanly_with_its_location_and_writes_nothing() {
             .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
             .filter(|n| n.starts_with('.'))
             .collect();
-        assert!(leftovers.is_empty(), "{}: temporary files left: {leftovers:?}", c.what);
+        assert!(
+            leftovers.is_empty(),
+            "{}: temporary files left: {leftovers:?}",
+            c.what
+        );
     }
 }
