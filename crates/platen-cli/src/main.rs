@@ -7,6 +7,7 @@
 
 mod bench;
 mod generate;
+mod identify;
 mod model;
 mod schema;
 mod simulate;
@@ -127,6 +128,37 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Identify the platen's parameters from periodic sine and triangle tests (the paper's
+    /// hysteresis-loop method, §3): mass, stiffness, Coulomb friction, viscous law, and a
+    /// global fit of Eq. 23 as a cross-check.
+    ///
+    /// Each FILE is a recorded CSV with t_s, u_m, a_m_s2, force_n and optionally v_m_s
+    /// (otherwise the crossover estimate is made). Sine or triangle is recognised from the
+    /// data; file names play no part.
+    Identify {
+        /// Recorded test CSV files.
+        #[arg(required_unless_present = "manifest")]
+        files: Vec<PathBuf>,
+        /// Hold-down pressure, MPa: one value for every file (and for manifest entries without
+        /// one), or one per FILE in order (comma separated). Tests without a pressure form
+        /// their own group.
+        #[arg(long, value_delimiter = ',', allow_negative_numbers = true, value_parser = identify::parse_pressure_mpa)]
+        pressure_mpa: Vec<f64>,
+        /// JSON manifest: {"tests": [{"file": PATH, "kind": "sine"|"triangle",
+        /// "pressure_mpa": P, "name": NAME}]}, paths relative to the manifest.
+        #[arg(long)]
+        manifest: Option<PathBuf>,
+        /// Hold the viscous exponent α at this value (Eq. 21: 0.5) instead of fitting it.
+        #[arg(long, value_parser = identify::parse_exponent)]
+        viscous_exponent: Option<f64>,
+        /// Do not fit the low-velocity term a·e^(−b|v|) (set it to zero).
+        #[arg(long)]
+        no_low_velocity_term: bool,
+        /// Print the seven identified keys, their uncertainties and the per-test tables as
+        /// JSON on stdout.
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -172,6 +204,21 @@ fn main() -> ExitCode {
             out,
             json,
         } => sweep::run(&scenario, &scale, &pressure_mpa, &set, out.as_deref(), json),
+        Command::Identify {
+            files,
+            pressure_mpa,
+            manifest,
+            viscous_exponent,
+            no_low_velocity_term,
+            json,
+        } => identify::run(&identify::Options {
+            files: &files,
+            pressure_mpa: &pressure_mpa,
+            manifest: manifest.as_deref(),
+            viscous_exponent,
+            no_low_velocity_term,
+            json,
+        }),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,735 @@
+//! `platen identify`: the platen's parameters from periodic sine and triangle tests (the
+//! paper's hysteresis-loop method, §3, with its fits and a global fit as a cross-check).
+//!
+//! Input: recorded CSVs with `t_s`, `u_m`, `a_m_s2`, `force_n` and optionally `v_m_s`. Whether
+//! a test is a sine or a triangle is recognised from its data, and file names play no part;
+//! a manifest may say it, and the hold-down pressure, per file:
+//!
+//! ```json
+//! { "tests": [ { "file": "run-017.csv", "kind": "triangle", "pressure_mpa": 13.8 } ] }
+//! ```
+//!
+//! (`file` relative to the manifest; `kind` `sine` or `triangle`; every key but `file`
+//! optional). Files listed only in the manifest are identified too.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use serde::Deserialize;
+use serde_json::{json, Map, Value};
+
+use platen_ident::{
+    identify, Estimate, Flag, Identification, Parameter, Settings, TestKind, TestRecord, TestResult,
+};
+use platen_scenario::csv_io::{read_table, uniform_step_s};
+
+/// Options of `platen identify`.
+pub struct Options<'a> {
+    pub files: &'a [PathBuf],
+    pub pressure_mpa: &'a [f64],
+    pub manifest: Option<&'a Path>,
+    pub viscous_exponent: Option<f64>,
+    pub no_low_velocity_term: bool,
+    pub json: bool,
+}
+
+/// The manifest file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Manifest {
+    tests: Vec<ManifestEntry>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ManifestEntry {
+    file: PathBuf,
+    #[serde(default)]
+    kind: Option<KindName>,
+    #[serde(default)]
+    pressure_mpa: Option<f64>,
+    #[serde(default)]
+    name: Option<String>,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(rename_all = "lowercase")]
+enum KindName {
+    Sine,
+    Triangle,
+}
+
+/// One input file with what is known about it.
+struct Input {
+    path: PathBuf,
+    /// The test's name in messages (the path as given, or the manifest's name).
+    name: String,
+    /// The name in the report's tables (the file name, or the manifest's name).
+    label: String,
+    kind: Option<TestKind>,
+    pressure_mpa: Option<f64>,
+}
+
+/// Checks a `--pressure-mpa` value: finite and ≥ 0.
+pub fn parse_pressure_mpa(s: &str) -> Result<f64, String> {
+    let p: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number"))?;
+    if p.is_finite() && p >= 0.0 {
+        Ok(p)
+    } else {
+        Err(format!("{p}: expected a pressure >= 0 MPa"))
+    }
+}
+
+/// Checks a `--viscous-exponent` value: in [0, 1].
+pub fn parse_exponent(s: &str) -> Result<f64, String> {
+    let a: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number"))?;
+    if a.is_finite() && (0.0..=1.0).contains(&a) {
+        Ok(a)
+    } else {
+        Err(format!("{a}: expected an exponent in [0, 1]"))
+    }
+}
+
+/// Runs `platen identify`.
+pub fn run(opts: &Options) -> Result<()> {
+    let inputs = inputs(opts)?;
+    let mut records = Vec::with_capacity(inputs.len());
+    for input in &inputs {
+        records.push(read_record(input)?);
+    }
+    let settings = Settings {
+        viscous_exponent: opts.viscous_exponent,
+        low_velocity_term: !opts.no_low_velocity_term,
+        ..Settings::default()
+    };
+    let id = identify(&records, &settings).context("identification failed")?;
+    if opts.json {
+        println!("{}", serde_json::to_string_pretty(&to_json(&id, &inputs))?);
+    } else {
+        print!("{}", report(&id, &inputs));
+    }
+    Ok(())
+}
+
+/// The files to read: the command line's, then the manifest's not already given, with
+/// kinds and pressures from the manifest and `--pressure-mpa`.
+fn inputs(opts: &Options) -> Result<Vec<Input>> {
+    if !opts.pressure_mpa.is_empty()
+        && opts.pressure_mpa.len() != 1
+        && opts.pressure_mpa.len() != opts.files.len()
+    {
+        bail!(
+            "--pressure-mpa has {} values for {} files: give one value for all files, or one per file in order",
+            opts.pressure_mpa.len(),
+            opts.files.len()
+        );
+    }
+    let mut inputs: Vec<Input> = opts
+        .files
+        .iter()
+        .enumerate()
+        .map(|(i, f)| Input {
+            path: f.clone(),
+            name: f.display().to_string(),
+            label: file_label(f),
+            kind: None,
+            pressure_mpa: match opts.pressure_mpa.len() {
+                0 => None,
+                1 => Some(opts.pressure_mpa[0]),
+                _ => Some(opts.pressure_mpa[i]),
+            },
+        })
+        .collect();
+    if let Some(mpath) = opts.manifest {
+        let text = std::fs::read_to_string(mpath)
+            .with_context(|| format!("`{}`: cannot read the manifest", mpath.display()))?;
+        let manifest: Manifest = serde_json::from_str(&text).map_err(|e| {
+            anyhow::anyhow!(
+                "`{}`: {e} (expected {{\"tests\": [{{\"file\": PATH, \"kind\": \"sine\"|\"triangle\", \"pressure_mpa\": P, \"name\": NAME}}]}}, with only `file` required)",
+                mpath.display()
+            )
+        })?;
+        let base = mpath.parent().unwrap_or(Path::new("."));
+        for (k, entry) in manifest.tests.into_iter().enumerate() {
+            if let Some(p) = entry.pressure_mpa {
+                if !(p.is_finite() && p >= 0.0) {
+                    bail!(
+                        "`{}`, at `tests[{k}].pressure_mpa`: {p}: expected a pressure >= 0 MPa",
+                        mpath.display()
+                    );
+                }
+            }
+            let path = if entry.file.is_absolute() {
+                entry.file.clone()
+            } else {
+                base.join(&entry.file)
+            };
+            let kind = entry.kind.map(|k| match k {
+                KindName::Sine => TestKind::Sine,
+                KindName::Triangle => TestKind::Triangle,
+            });
+            let canon = std::fs::canonicalize(&path).ok();
+            let existing = inputs
+                .iter_mut()
+                .find(|i| canon.is_some() && std::fs::canonicalize(&i.path).ok() == canon);
+            match existing {
+                Some(input) => {
+                    if let (Some(a), Some(b)) = (input.pressure_mpa, entry.pressure_mpa) {
+                        if a != b {
+                            bail!(
+                                "`{}`: hold-down pressure {a} MPa from --pressure-mpa but {b} MPa in the manifest `{}`",
+                                input.path.display(),
+                                mpath.display()
+                            );
+                        }
+                    }
+                    input.pressure_mpa = entry.pressure_mpa.or(input.pressure_mpa);
+                    input.kind = kind;
+                    if let Some(n) = entry.name {
+                        input.label = n.clone();
+                        input.name = n;
+                    }
+                }
+                None => inputs.push(Input {
+                    label: entry.name.clone().unwrap_or_else(|| file_label(&path)),
+                    name: entry.name.unwrap_or_else(|| path.display().to_string()),
+                    path,
+                    kind,
+                    // A single --pressure-mpa is the default for every file.
+                    pressure_mpa: entry.pressure_mpa.or(match opts.pressure_mpa {
+                        [p] => Some(*p),
+                        _ => None,
+                    }),
+                }),
+            }
+        }
+    }
+    if inputs.is_empty() {
+        bail!("no test files: give recorded CSV files, or a manifest that lists them");
+    }
+    Ok(inputs)
+}
+
+fn file_label(path: &Path) -> String {
+    path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    )
+}
+
+fn read_record(input: &Input) -> Result<TestRecord> {
+    let path = &input.path;
+    let mut table = read_table(path, &["t_s", "u_m", "a_m_s2", "force_n"], &["v_m_s"])?;
+    let t = table.take_column("t_s").expect("required column");
+    let dt = uniform_step_s(path, &t)?;
+    let take = |table: &mut platen_scenario::csv_io::Table, c: &str| {
+        table.take_column(c).expect("required column")
+    };
+    let u = take(&mut table, "u_m");
+    let a = take(&mut table, "a_m_s2");
+    let f = take(&mut table, "force_n");
+    let v = table.take_column("v_m_s");
+    let context = || format!("`{}`", path.display());
+    let mut rec =
+        TestRecord::from_rate(input.name.clone(), 1.0 / dt, u, a, f).with_context(context)?;
+    if let Some(v) = v {
+        rec = rec.with_velocity(v).with_context(context)?;
+    }
+    if let Some(p) = input.pressure_mpa {
+        rec = rec.with_pressure_pa(p * 1e6).with_context(context)?;
+    }
+    if let Some(k) = input.kind {
+        rec = rec.with_kind(k);
+    }
+    Ok(rec)
+}
+
+/// A finite number, or null.
+fn num(x: f64) -> Value {
+    if x.is_finite() {
+        json!(x)
+    } else {
+        Value::Null
+    }
+}
+
+fn estimate_json(e: &Estimate) -> Value {
+    json!({
+        "value": num(e.value),
+        "std_error": num(e.std_error),
+        "ci95": [num(e.ci95_low), num(e.ci95_high)],
+        "dof": num(e.dof),
+    })
+}
+
+fn parameter_json(p: &Parameter) -> Value {
+    match p {
+        Parameter::Estimated(e) => json!({
+            "status": "estimated",
+            "std_error": num(e.std_error),
+            "ci95": [num(e.ci95_low), num(e.ci95_high)],
+            "dof": num(e.dof),
+        }),
+        Parameter::Fixed { value, reason } => json!({
+            "status": "fixed",
+            "value": num(*value),
+            "reason": reason,
+        }),
+        Parameter::NotIdentifiable { reason } => json!({
+            "status": "not_identifiable",
+            "reason": reason,
+        }),
+    }
+}
+
+/// Up to `max` evenly spaced points of a curve, as `[x, y]` pairs.
+fn decimate(curve: &[[f64; 2]], max: usize) -> Value {
+    if curve.is_empty() {
+        return json!([]);
+    }
+    let step = curve.len().div_ceil(max).max(1);
+    Value::Array(
+        curve
+            .iter()
+            .step_by(step)
+            .map(|[x, y]| json!([num(*x), num(*y)]))
+            .collect(),
+    )
+}
+
+fn flags_json(flags: &[Flag]) -> Value {
+    Value::Array(
+        flags
+            .iter()
+            .map(|f| json!({"code": f.code(), "message": f.message()}))
+            .collect(),
+    )
+}
+
+/// Points per curve in the JSON output.
+const CURVE_POINTS: usize = 40;
+
+fn test_json(t: &TestResult, input: &Input) -> Map<String, Value> {
+    let c = &t.cycle;
+    let mut m = Map::new();
+    m.insert("file".into(), json!(input.path.display().to_string()));
+    m.insert("name".into(), json!(t.name));
+    m.insert("kind".into(), json!(t.kind.name()));
+    m.insert(
+        "kind_source".into(),
+        json!(if t.kind_given { "manifest" } else { "data" }),
+    );
+    m.insert(
+        "pressure_mpa".into(),
+        t.pressure_pa.map_or(Value::Null, |p| num(p / 1e6)),
+    );
+    m.insert("frequency_hz".into(), num(c.frequency_hz));
+    m.insert("period_s".into(), num(c.period_s));
+    m.insert("full_cycles".into(), json!(c.full_cycles));
+    m.insert("cycle_used".into(), json!(c.cycle_used));
+    m.insert("cycle_start_s".into(), num(c.cycle_start_s));
+    m.insert("amplitude_m".into(), num(c.amplitude_m));
+    m.insert("peak_velocity_m_s".into(), num(t.peak_velocity_m_s));
+    m.insert(
+        "peak_acceleration_m_s2".into(),
+        num(t.peak_acceleration_m_s2),
+    );
+    m.insert("plateau_fraction".into(), num(c.plateau_fraction));
+    m.insert("harmonic_distortion".into(), num(c.harmonic_distortion));
+    m.insert(
+        "dissipative_force_at_peak_n".into(),
+        t.peak_dissipative.map_or(Value::Null, |p| num(p.force_n)),
+    );
+    m.insert(
+        "velocity_at_peak_m_s".into(),
+        t.peak_dissipative
+            .map_or(Value::Null, |p| num(p.velocity_m_s)),
+    );
+    m.insert("flags".into(), flags_json(&t.flags));
+    m
+}
+
+fn to_json(id: &Identification, inputs: &[Input]) -> Value {
+    let mut top = Map::new();
+    let mut unc = Map::new();
+    for (name, p) in id.parameters() {
+        top.insert(name.into(), p.value().map_or(Value::Null, num));
+        unc.insert(name.into(), parameter_json(p));
+    }
+    top.insert(
+        "reference_pressure_mpa".into(),
+        id.reference_pressure_pa
+            .map_or(Value::Null, |p| num(p / 1e6)),
+    );
+    top.insert("uncertainty".into(), Value::Object(unc));
+    top.insert(
+        "friction_coefficient".into(),
+        id.friction_coefficient
+            .as_ref()
+            .map_or(Value::Null, estimate_json),
+    );
+    let mut triangles = Vec::new();
+    let mut sines = Vec::new();
+    for (t, input) in id.tests.iter().zip(inputs) {
+        let mut m = test_json(t, input);
+        match t.kind {
+            TestKind::Triangle => {
+                m.insert(
+                    "stiffness_n_per_m".into(),
+                    t.stiffness.map_or(Value::Null, |e| num(e.value)),
+                );
+                m.insert(
+                    "stiffness_std_error".into(),
+                    t.stiffness.map_or(Value::Null, |e| num(e.std_error)),
+                );
+                m.insert("used".into(), json!(t.used_for_stiffness));
+                m.insert(
+                    "elastic_curve".into(),
+                    decimate(&t.elastic_curve, CURVE_POINTS),
+                );
+                m.insert(
+                    "dissipative_curve".into(),
+                    decimate(&t.dissipative_curve, CURVE_POINTS),
+                );
+                triangles.push(Value::Object(m));
+            }
+            TestKind::Sine => {
+                m.insert(
+                    "effective_mass_kg".into(),
+                    t.effective_mass.map_or(Value::Null, |e| num(e.value)),
+                );
+                m.insert(
+                    "effective_mass_std_error".into(),
+                    t.effective_mass.map_or(Value::Null, |e| num(e.std_error)),
+                );
+                m.insert("used".into(), json!(t.used_for_mass));
+                m.insert(
+                    "inertial_curve".into(),
+                    decimate(&t.inertial_curve, CURVE_POINTS),
+                );
+                m.insert(
+                    "dissipative_curve".into(),
+                    decimate(&t.dissipative_curve, CURVE_POINTS),
+                );
+                sines.push(Value::Object(m));
+            }
+        }
+    }
+    top.insert("triangle_tests".into(), Value::Array(triangles));
+    top.insert("sine_tests".into(), Value::Array(sines));
+    let opt = |e: &Option<Estimate>| e.as_ref().map_or(Value::Null, estimate_json);
+    top.insert(
+        "pressures".into(),
+        Value::Array(
+            id.pressures
+                .iter()
+                .map(|g| {
+                    json!({
+                        "pressure_mpa": g.pressure_pa.map_or(Value::Null, |p| num(p / 1e6)),
+                        "vertical_force_n": g.vertical_force_n.map_or(Value::Null, num),
+                        "sine_tests": g.sine_tests,
+                        "triangle_tests": g.triangle_tests,
+                        "stiffness_n_per_m": opt(&g.stiffness),
+                        "stiffness_source": g.stiffness_source,
+                        "coulomb_force_n": opt(&g.coulomb_force),
+                        "paper_coulomb_force_sine_n": opt(&g.paper_coulomb_force_sine),
+                        "paper_coulomb_force_triangle_n": opt(&g.paper_coulomb_force_triangle),
+                    })
+                })
+                .collect(),
+        ),
+    );
+    top.insert(
+        "paper_eq21".into(),
+        id.paper_fit.as_ref().map_or(Value::Null, |p| {
+            json!({
+                "coulomb_force_n": estimate_json(&p.coulomb_force),
+                "viscous_coefficient": estimate_json(&p.viscous_coefficient),
+                "viscous_exponent": 0.5,
+                "points": p.points,
+                "sine_tests_only": p.sine_only,
+                "friction_coefficient": p.friction_coefficient.as_ref().map_or(Value::Null, estimate_json),
+            })
+        }),
+    );
+    top.insert(
+        "dissipative_fit".into(),
+        id.law.as_ref().map_or(Value::Null, |l| {
+            json!({
+                "points": l.points,
+                "rms_n": num(l.rms_n),
+                "condition_number": num(l.condition_number),
+                "speed_range_m_s": [num(l.speed_range_m_s[0]), num(l.speed_range_m_s[1])],
+            })
+        }),
+    );
+    top.insert(
+        "global_fit".into(),
+        id.global.as_ref().map_or(Value::Null, |g| {
+            let mut m = Map::new();
+            let mut u = Map::new();
+            for (k, p) in platen_ident::PARAMETER_NAMES.iter().zip(&g.parameters) {
+                m.insert((*k).into(), p.value().map_or(Value::Null, num));
+                u.insert((*k).into(), parameter_json(p));
+            }
+            m.insert("uncertainty".into(), Value::Object(u));
+            m.insert(
+                "pressures".into(),
+                Value::Array(
+                    g.groups
+                        .iter()
+                        .map(|(p, k, f)| {
+                            json!({
+                                "pressure_mpa": p.map_or(Value::Null, |p| num(p / 1e6)),
+                                "stiffness_n_per_m": estimate_json(k),
+                                "coulomb_force_n": estimate_json(f),
+                            })
+                        })
+                        .collect(),
+                ),
+            );
+            m.insert("rms_residual_n".into(), num(g.rms_residual_n));
+            m.insert("points".into(), json!(g.points));
+            m.insert("converged".into(), json!(g.converged));
+            m.insert("iterations".into(), json!(g.iterations));
+            m.insert("condition_number".into(), num(g.condition_number));
+            Value::Object(m)
+        }),
+    );
+    top.insert("warnings".into(), json!(id.warnings));
+    Value::Object(top)
+}
+
+/// `value ± se` in a unit with `digits` decimals.
+fn pm(e: Option<&Estimate>, scale: f64, digits: usize) -> String {
+    match e {
+        Some(e) if e.std_error.is_finite() => format!(
+            "{:.d$} ± {:.d$}",
+            e.value / scale,
+            e.std_error / scale,
+            d = digits
+        ),
+        Some(e) => format!("{:.d$}", e.value / scale, d = digits),
+        None => "—".to_owned(),
+    }
+}
+
+fn pressure_text(p: Option<f64>) -> String {
+    p.map_or_else(|| "—".to_owned(), |p| format!("{:.1}", p / 1e6))
+}
+
+fn flag_codes(flags: &[Flag]) -> String {
+    flags.iter().map(Flag::code).collect::<Vec<_>>().join(",")
+}
+
+/// The human-readable report.
+fn report(id: &Identification, inputs: &[Input]) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "Identified parameters ({} tests; {})",
+        id.tests.len(),
+        match id.reference_pressure_pa {
+            Some(p) => format!("reference hold-down pressure {} MPa", p / 1e6),
+            None => "hold-down pressure not given".to_owned(),
+        }
+    );
+    let w = inputs
+        .iter()
+        .map(|i| i.label.chars().count())
+        .max()
+        .unwrap_or(4)
+        .max(4);
+    let units = [
+        ("t", 1e3, 2),
+        ("MN/m", 1e6, 4),
+        ("kN", 1e3, 2),
+        ("kN/(m/s)^α", 1e3, 2),
+        ("", 1.0, 3),
+        ("kN", 1e3, 2),
+        ("s/m", 1.0, 1),
+    ];
+    for ((name, p), (unit, scale, digits)) in id.parameters().iter().zip(units) {
+        let text = match p {
+            Parameter::Estimated(e) => format!(
+                "{} {unit}   (95 % CI {:.d$} – {:.d$})",
+                pm(Some(e), scale, digits),
+                e.ci95_low / scale,
+                e.ci95_high / scale,
+                d = digits
+            ),
+            Parameter::Fixed { value, reason } => {
+                format!(
+                    "{:.d$} {unit}   (fixed: {reason})",
+                    value / scale,
+                    d = digits
+                )
+            }
+            Parameter::NotIdentifiable { reason } => format!("not identifiable: {reason}"),
+        };
+        let _ = writeln!(s, "  {name:<28} {text}");
+    }
+    if let Some(mu) = &id.friction_coefficient {
+        let _ = writeln!(
+            s,
+            "  {:<28} {} %   (F_μ = μₑ·F_z over the pressures)",
+            "friction_coefficient",
+            pm(Some(mu), 0.01, 4)
+        );
+    }
+
+    let _ = writeln!(s, "\nStiffness from triangle tests (Eq. 16/17, Table I)");
+    let _ = writeln!(
+        s,
+        "  {:<w$} {:>5} {:>7} {:>8} {:>8}  {:>20} {:>5}  flags",
+        "test", "MPa", "f Hz", "u cm", "v cm/s", "Kₑ MN/m", "used"
+    );
+    for (t, input) in id.tests.iter().zip(inputs) {
+        if t.kind != TestKind::Triangle {
+            continue;
+        }
+        let _ = writeln!(
+            s,
+            "  {:<w$} {:>5} {:>7.3} {:>8.2} {:>8.2}  {:>20} {:>5}  {}",
+            input.label,
+            pressure_text(t.pressure_pa),
+            t.cycle.frequency_hz,
+            100.0 * t.cycle.amplitude_m,
+            100.0 * t.peak_velocity_m_s,
+            pm(t.stiffness.as_ref(), 1e6, 4),
+            if t.used_for_stiffness { "yes" } else { "no" },
+            flag_codes(&t.flags)
+        );
+    }
+    let _ = writeln!(s, "\nEffective mass from sine tests (Eq. 18/19, Table II)");
+    let _ = writeln!(
+        s,
+        "  {:<w$} {:>5} {:>7} {:>8} {:>8} {:>7}  {:>16} {:>5}  flags",
+        "test", "MPa", "f Hz", "u cm", "v cm/s", "a g", "Mₑ t", "used"
+    );
+    for (t, input) in id.tests.iter().zip(inputs) {
+        if t.kind != TestKind::Sine {
+            continue;
+        }
+        let _ = writeln!(
+            s,
+            "  {:<w$} {:>5} {:>7.3} {:>8.2} {:>8.2} {:>7.3}  {:>16} {:>5}  {}",
+            input.label,
+            pressure_text(t.pressure_pa),
+            t.cycle.frequency_hz,
+            100.0 * t.cycle.amplitude_m,
+            100.0 * t.peak_velocity_m_s,
+            t.peak_acceleration_m_s2 / platen_model::STANDARD_GRAVITY_M_S2,
+            pm(t.effective_mass.as_ref(), 1e3, 2),
+            if t.used_for_mass { "yes" } else { "no" },
+            flag_codes(&t.flags)
+        );
+    }
+    let _ = writeln!(s, "\nDissipative force at peak velocity (Eq. 20, Fig. 7)");
+    let _ = writeln!(
+        s,
+        "  {:<w$} {:>8} {:>5} {:>10} {:>10}",
+        "test", "kind", "MPa", "v m/s", "F_D kN"
+    );
+    for (t, input) in id.tests.iter().zip(inputs) {
+        if let Some(p) = t.peak_dissipative {
+            let _ = writeln!(
+                s,
+                "  {:<w$} {:>8} {:>5} {:>10.4} {:>10.2}",
+                input.label,
+                t.kind.name(),
+                pressure_text(t.pressure_pa),
+                p.velocity_m_s,
+                p.force_n / 1e3
+            );
+        }
+    }
+    let _ = writeln!(s, "\nPer hold-down pressure");
+    let _ = writeln!(
+        s,
+        "  {:>5} {:>10} {:>22} {:>18} {:>14} {:>14}",
+        "MPa", "F_z MN", "Kₑ MN/m", "F_μ kN", "F_μ S (Eq.21)", "F_μ T (Eq.21)"
+    );
+    for g in &id.pressures {
+        let _ = writeln!(
+            s,
+            "  {:>5} {:>10} {:>22} {:>18} {:>14} {:>14}",
+            pressure_text(g.pressure_pa),
+            g.vertical_force_n
+                .map_or("—".to_owned(), |f| format!("{:.3}", f / 1e6)),
+            pm(g.stiffness.as_ref(), 1e6, 4),
+            pm(g.coulomb_force.as_ref(), 1e3, 2),
+            g.paper_coulomb_force_sine
+                .map_or("—".to_owned(), |e| format!("{:.2}", e.value / 1e3)),
+            g.paper_coulomb_force_triangle
+                .map_or("—".to_owned(), |e| format!("{:.2}", e.value / 1e3)),
+        );
+    }
+    if let Some(p) = &id.paper_fit {
+        let _ = writeln!(
+            s,
+            "\nEq. 21 as the paper fitted it ({} peak points{}): F_μ = {} kN, Cₑ = {} kN/(m/s)^0.5{}",
+            p.points,
+            if p.sine_only { ", sine tests" } else { ", all tests" },
+            pm(Some(&p.coulomb_force), 1e3, 2),
+            pm(Some(&p.viscous_coefficient), 1e3, 2),
+            p.friction_coefficient
+                .as_ref()
+                .map_or(String::new(), |mu| format!(
+                    ", μₑ = {} %",
+                    pm(Some(mu), 0.01, 4)
+                ))
+        );
+    }
+    if let Some(l) = &id.law {
+        let _ = writeln!(
+            s,
+            "Dissipative law fitted to {} points over {:.3}–{:.3} m/s: RMS residual {:.0} N",
+            l.points, l.speed_range_m_s[0], l.speed_range_m_s[1], l.rms_n
+        );
+    }
+    if let Some(g) = &id.global {
+        let _ = writeln!(
+            s,
+            "\nGlobal fit of Eq. 23 over every test ({} samples, RMS residual {:.0} N{}):",
+            g.points,
+            g.rms_residual_n,
+            if g.converged { "" } else { ", NOT converged" }
+        );
+        for (((name, p), (unit, scale, digits)), own) in platen_ident::PARAMETER_NAMES
+            .iter()
+            .zip(&g.parameters)
+            .zip(units)
+            .zip(&id.parameters)
+        {
+            let diff = match (p.value(), own.value()) {
+                (Some(a), Some(b)) if b != 0.0 => {
+                    format!("  ({:+.2} %)", 100.0 * (a - b) / b.abs())
+                }
+                _ => String::new(),
+            };
+            let text = match p {
+                Parameter::Estimated(e) => pm(Some(e), scale, digits),
+                Parameter::Fixed { value, .. } => {
+                    format!("{:.d$} (held)", value / scale, d = digits)
+                }
+                Parameter::NotIdentifiable { .. } => "not identifiable".to_owned(),
+            };
+            let _ = writeln!(s, "  {name:<28} {text} {unit}{diff}");
+        }
+    }
+    if !id.warnings.is_empty() {
+        let _ = writeln!(s, "\nWarnings");
+        for w in &id.warnings {
+            let _ = writeln!(s, "  - {w}");
+        }
+    }
+    s
+}

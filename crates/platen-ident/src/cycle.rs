@@ -1,0 +1,591 @@
+//! Cycle handling (paper §3): the period, the waveform, the steady-state cycle, its alignment
+//! (u > 0 on the first half) and the two low-passed versions of every channel.
+
+use std::f64::consts::PI;
+
+use platen_signal::{
+    differentiate, ButterworthLowpass, CrossoverVelocity, FirLowpass, SampleRate, Window,
+    ZeroPhaseFilter,
+};
+
+use crate::error::{IdentError, Result};
+use crate::record::{TestKind, TestRecord};
+use crate::settings::Settings;
+
+/// Hysteresis of the zero-crossing detector, as a fraction of the displacement amplitude: the
+/// displacement must swing past ±25 % of its amplitude between two crossings, so transducer
+/// noise (20 µm on the paper's smallest 1.6 cm amplitude) can never count as a crossing.
+const CROSSING_HYSTERESIS: f64 = 0.25;
+
+/// Largest spread of the intervals between same-direction zero crossings, as a fraction of
+/// the period, for a record to count as periodic. Steady periodic tests repeat to far better
+/// than 1 %; 10 % still accepts a ramped start, and rejects earthquake or white-noise records.
+const PERIOD_REGULARITY: f64 = 0.10;
+
+/// Velocity tolerance of a constant-velocity ("plateau") sample, relative to the plateau
+/// velocity. The rounded reversals of a triangle change the velocity linearly, so 3 % keeps
+/// 1.5 % of each arc's duration (their small inertial force is subtracted anyway, see
+/// `identify`), and the velocity noise of the paper's slowest test (≈ 1·10⁻⁴ m/s on 1 cm/s
+/// after the 8 Hz filter) stays well inside it.
+pub const PLATEAU_TOLERANCE: f64 = 0.03;
+
+/// A test whose velocity stays within [`PLATEAU_TOLERANCE`] of its median speed for at least
+/// this fraction of a cycle is a triangle test. A sine spends 4 %–20 % of its cycle within
+/// 3 %–5 % of any speed level; the paper's triangles spend 70 %–90 % at their plateau
+/// (T12, the fastest, 82 %). 40 % sits in the middle of that gap.
+pub const TRIANGLE_PLATEAU_FRACTION: f64 = 0.40;
+
+/// Step-response tolerance that sets the reversal window of the dissipative filter: within
+/// this window of a velocity reversal the low-passed force is still more than 5 % of the way
+/// through the friction jump `2·F_s` (82 ms for the paper's filter), so it says more about
+/// how the jump was filtered than about the force at that velocity, and the samples are not
+/// used. Outside it the jump's remaining ripple (the Hamming sinc's tail takes 0.33 s to fall
+/// below 0.5 %) is removed with the fitted law (see `identify`).
+const SETTLE_TOLERANCE: f64 = 0.05;
+
+/// What was found about a test's cycles.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CycleInfo {
+    /// Period, s (from a least-squares fit to every zero crossing of the low-passed
+    /// displacement).
+    pub period_s: f64,
+    /// Fundamental frequency `1/T`, Hz.
+    pub frequency_hz: f64,
+    /// Number of full cycles in the record.
+    pub full_cycles: usize,
+    /// Which full cycle was analysed, 1-based (the second-to-last when there are two or more).
+    pub cycle_used: usize,
+    /// Start of the analysed cycle, s: the upward zero crossing of the displacement about its
+    /// offset, so that `u > 0` over the cycle's first half.
+    pub cycle_start_s: f64,
+    /// Displacement amplitude about the offset, m.
+    pub amplitude_m: f64,
+    /// Displacement offset (mid-range), m.
+    pub offset_m: f64,
+    /// Fraction of the cycle at constant velocity (within 3 % of the plateau speed).
+    pub plateau_fraction: f64,
+    /// Total harmonic distortion of the displacement over the cycle (harmonics 2–7 against
+    /// the fundamental): 0 for a pure sine, ≈ 0.12 for a sharp triangle.
+    pub harmonic_distortion: f64,
+    /// The waveform recognised from the data.
+    pub detected_kind: TestKind,
+    /// Cut-off of the zero-phase Butterworth used for inertial and elastic forces, Hz
+    /// (4× the fundamental).
+    pub inertial_cutoff_hz: f64,
+    /// Cut-off of the FIR used for dissipative forces, Hz (8 Hz).
+    pub dissipative_cutoff_hz: f64,
+    /// Half-width of the window about each velocity reversal in which the dissipative filter
+    /// still smears the friction jump, s.
+    pub reversal_window_s: f64,
+}
+
+/// Plans shared by every record of one sample rate.
+#[derive(Debug, Clone)]
+pub(crate) struct RatePlan {
+    pub rate_hz: f64,
+    pub fir: FirLowpass,
+    pub settle_s: f64,
+    pub crossover: CrossoverVelocity,
+}
+
+impl RatePlan {
+    pub(crate) fn new(rate_hz: f64, settings: &Settings, test: &str) -> Result<Self> {
+        let signal = |source| IdentError::Signal {
+            test: test.to_owned(),
+            source,
+        };
+        let half = (0.5 * settings.dissipative_filter_length_s * rate_hz).round() as usize;
+        let order = 2 * half.max(8);
+        let fir = FirLowpass::new(
+            order,
+            settings.dissipative_cutoff_hz,
+            rate_hz,
+            Window::Hamming,
+        )
+        .map_err(signal)?;
+        let settle_s = settle_time_samples(fir.taps(), SETTLE_TOLERANCE) as f64 / rate_hz;
+        let crossover =
+            CrossoverVelocity::butterworth(2, settings.crossover_hz, rate_hz).map_err(signal)?;
+        Ok(Self {
+            rate_hz,
+            fir,
+            settle_s,
+            crossover,
+        })
+    }
+}
+
+/// Samples after (and before) a unit step beyond which the filtered step stays within
+/// [`SETTLE_TOLERANCE`] of its final (initial) value.
+fn settle_time_samples(taps: &[f64], tolerance: f64) -> usize {
+    let m = taps.len() - 1;
+    let half = m / 2;
+    // Unit step at sample 0 (x = 1 for i ≥ 0). Output at offset d: Σ_{k ≥ half − d} h_k.
+    let mut tail = vec![0.0; m + 2];
+    for k in (0..=m).rev() {
+        tail[k] = tail[k + 1] + taps[k];
+    }
+    let mut last_bad = 0usize;
+    for d in -(half as isize)..=(half as isize) {
+        let k = (half as isize - d) as usize;
+        let y = tail[k];
+        let target = if d >= 0 { 1.0 } else { 0.0 };
+        if (y - target).abs() > tolerance {
+            last_bad = last_bad.max(if d >= 0 {
+                d as usize + 1
+            } else {
+                (-d) as usize
+            });
+        }
+    }
+    last_bad
+}
+
+/// A test analysed: the aligned steady-state cycle on a grid, and whole-record channels.
+#[derive(Debug, Clone)]
+pub(crate) struct Analysed {
+    pub info: CycleInfo,
+    /// Grid points over the cycle (a multiple of 4); grid point `j` is at
+    /// `cycle_start + j·T/n`, so the mirror times of Eq. 10–20 fall on grid points.
+    pub n: usize,
+    /// First grid point and grid step, in samples of the record.
+    pub grid_start: f64,
+    pub grid_step: f64,
+    /// The dissipative FIR (to filter model forces the same way as the data).
+    pub fir: FirLowpass,
+    /// The dissipative filter's 0.5 % settling time, s.
+    pub arc_reach_s: f64,
+    /// Channels low-passed at 4× the fundamental, on the grid (the acceleration: see
+    /// `analyse`).
+    pub u4: Vec<f64>,
+    pub a4: Vec<f64>,
+    /// Signed unit impulses at the velocity reversals through the same low-pass, per N·s.
+    pub g4: Vec<f64>,
+    pub f4: Vec<f64>,
+    /// The force itself on the grid (for the plateaus of triangle tests).
+    pub f: Vec<f64>,
+    /// Channels low-passed by the dissipative FIR, on the grid: the velocity channel, the
+    /// force, and the velocity of the filtered displacement (for the plateaus).
+    pub v8: Vec<f64>,
+    pub f8: Vec<f64>,
+    pub vu8: Vec<f64>,
+    /// Plateau speed: median of |vu8| over the cycle, m/s.
+    pub plateau_speed: f64,
+    /// Whole record through the dissipative FIR: displacement, velocity, force, and the
+    /// acceleration as the second derivative of the filtered displacement.
+    pub rec_u8: Vec<f64>,
+    pub rec_v8: Vec<f64>,
+    /// The velocity channel itself (given, or the crossover estimate), unfiltered.
+    pub rec_v: Vec<f64>,
+    pub rec_f8: Vec<f64>,
+    pub rec_a8: Vec<f64>,
+    /// Samples of the whole record usable for instantaneous fits (away from the edges and
+    /// from velocity reversals).
+    pub rec_usable: Vec<bool>,
+}
+
+/// Zero crossings of `x` (already centred) with hysteresis `threshold`, as fractional sample
+/// indices with their direction (true = upward).
+fn crossings(x: &[f64], threshold: f64) -> Vec<(f64, bool)> {
+    let mut out = Vec::new();
+    let mut state = 0i8;
+    for i in 0..x.len() {
+        let up = x[i] > threshold;
+        let down = x[i] < -threshold;
+        if (up && state == 1) || (down && state == -1) || !(up || down) {
+            continue;
+        }
+        if state != 0 {
+            // The last sign change before i: walk back over samples of the new sign.
+            let positive = up;
+            let mut k = i;
+            while k > 0 && (x[k - 1] > 0.0) == positive && x[k - 1] != 0.0 {
+                k -= 1;
+            }
+            if k > 0 {
+                let (a, b) = (x[k - 1], x[k]);
+                let frac = if b != a { -a / (b - a) } else { 0.0 };
+                out.push(((k - 1) as f64 + frac.clamp(0.0, 1.0), positive));
+            }
+        }
+        state = if up { 1 } else { -1 };
+    }
+    out
+}
+
+fn min_max(x: &[f64]) -> (f64, f64) {
+    x.iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        })
+}
+
+/// Catmull–Rom interpolation of `x` at fractional index `s` (clamped to the record); exact
+/// for quadratics.
+pub(crate) fn interp(x: &[f64], s: f64) -> f64 {
+    let n = x.len();
+    let s = s.clamp(0.0, (n - 1) as f64);
+    let i = (s.floor() as usize).min(n - 2);
+    let f = s - i as f64;
+    let at = |k: isize| x[k.clamp(0, n as isize - 1) as usize];
+    let (p0, p1, p2, p3) = (
+        at(i as isize - 1),
+        at(i as isize),
+        at(i as isize + 1),
+        at(i as isize + 2),
+    );
+    p1 + 0.5
+        * f
+        * (p2 - p0 + f * (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3 + f * (3.0 * (p1 - p2) + p3 - p0)))
+}
+
+/// Least-squares fit of crossing times `t_k = c + k·T/2 + s_k·δ` (`s_k = ±1` for up/down):
+/// returns `(c, T, δ)` in sample units. The offset-free crossings are `c + k·T/2`.
+fn fit_crossings(cross: &[(f64, bool)]) -> Option<(f64, f64, f64)> {
+    let mut ata = nalgebra::Matrix3::<f64>::zeros();
+    let mut atb = nalgebra::Vector3::<f64>::zeros();
+    for (k, &(t, up)) in cross.iter().enumerate() {
+        let row = nalgebra::Vector3::new(1.0, 0.5 * k as f64, if up { 1.0 } else { -1.0 });
+        ata += row * row.transpose();
+        atb += row * t;
+    }
+    let sol = ata.lu().solve(&atb)?;
+    Some((sol[0], sol[1], sol[2]))
+}
+
+/// Analyses one record: period, waveform, steady-state cycle, filtered channels.
+pub(crate) fn analyse(rec: &TestRecord, plan: &RatePlan, settings: &Settings) -> Result<Analysed> {
+    let name = rec.name();
+    let rate = rec.sample_rate_hz();
+    let signal = |source| IdentError::Signal {
+        test: name.to_owned(),
+        source,
+    };
+    let not_periodic = |reason: String| IdentError::NotPeriodic {
+        test: name.to_owned(),
+        reason,
+    };
+    let n_rec = rec.len();
+    let u = rec.u_m();
+    let (lo, hi) = min_max(u);
+    let amp = 0.5 * (hi - lo);
+    if amp <= 0.0 {
+        return Err(not_periodic("the displacement is constant".into()));
+    }
+    let mid = 0.5 * (hi + lo);
+    let centred: Vec<f64> = u.iter().map(|x| x - mid).collect();
+    let rough = crossings(&centred, CROSSING_HYSTERESIS * amp);
+    if rough.len() < 3 {
+        return Err(not_periodic(format!(
+            "the displacement crosses its mid-range {} time(s); one full cycle needs at least 3",
+            rough.len()
+        )));
+    }
+    let rough_period = 2.0 * (rough[rough.len() - 1].0 - rough[0].0) / (rough.len() - 1) as f64;
+    // Same-direction intervals must all be close to the period.
+    for w in rough.windows(3) {
+        let interval = w[2].0 - w[0].0;
+        if (interval - rough_period).abs() > PERIOD_REGULARITY * rough_period {
+            return Err(not_periodic(format!(
+                "zero crossings are irregular (an interval of {:.4} s against a mean period of {:.4} s)",
+                interval / rate,
+                rough_period / rate
+            )));
+        }
+    }
+    let f0 = rate / rough_period;
+
+    // The inertial/elastic low-pass: 4× the fundamental (paper §3), zero phase.
+    let inertial_cutoff = settings.inertial_cutoff_factor * f0;
+    let butter = ButterworthLowpass::new(settings.butterworth_order, inertial_cutoff, rate)
+        .map_err(signal)?;
+    let v_raw: Vec<f64> = match rec.v_m_s() {
+        Some(v) => v.to_vec(),
+        None => plan.crossover.estimate(u, rec.a_m_s2()).map_err(signal)?,
+    };
+    // Acceleration for inertial work: the displacement's second derivative below the
+    // crossover frequency, the accelerometer above it (`a + L(ü − a)`), as the crossover
+    // velocity does one derivative lower. At the low frequencies of most tests the
+    // accelerometer's noise (0.005 g on the paper's records) would otherwise dominate small
+    // inertial forces: 1.5 % of S4's 0.026 g peak per sample after the 4f₀ low-pass, against
+    // < 0.1 % from 20 µm of displacement noise.
+    let sr = SampleRate::new(rate).map_err(signal)?;
+    let a_rec = rec.a_m_s2();
+    let udd = differentiate(&differentiate(u, sr), sr);
+    let gap: Vec<f64> = udd.iter().zip(a_rec).map(|(x, a)| x - a).collect();
+    let low = plan.crossover.low_pass().apply(&gap).map_err(signal)?;
+    let a_c: Vec<f64> = a_rec.iter().zip(&low).map(|(a, l)| a + l).collect();
+    let u4 = butter.apply(u).map_err(signal)?;
+    let f4 = butter.apply(rec.force_n()).map_err(signal)?;
+    // The dissipative FIR (order 512 at 8 Hz on 512 Hz data; never below 4× the fundamental).
+    let fir_owned;
+    let fir: &FirLowpass = if plan.fir.cutoff_hz() >= inertial_cutoff {
+        &plan.fir
+    } else {
+        let order = plan.fir.order();
+        fir_owned =
+            FirLowpass::new(order, inertial_cutoff, rate, Window::Hamming).map_err(signal)?;
+        &fir_owned
+    };
+    let settle_s = if std::ptr::eq(fir, &plan.fir) {
+        plan.settle_s
+    } else {
+        settle_time_samples(fir.taps(), SETTLE_TOLERANCE) as f64 / rate
+    };
+    let u8 = fir.apply(u).map_err(signal)?;
+    let v8 = fir.apply(&v_raw).map_err(signal)?;
+    let f8 = fir.apply(rec.force_n()).map_err(signal)?;
+    let vu8 = differentiate(&u8, sr);
+
+    // Refined crossings on the low-passed displacement.
+    let (lo4, hi4) = min_max(&u4);
+    let amp4 = 0.5 * (hi4 - lo4);
+    let mid4 = 0.5 * (hi4 + lo4);
+    let c4: Vec<f64> = u4.iter().map(|x| x - mid4).collect();
+    let fine = crossings(&c4, CROSSING_HYSTERESIS * amp4);
+    if fine.len() < 3 {
+        return Err(not_periodic(
+            "the low-passed displacement has fewer than 3 zero crossings".into(),
+        ));
+    }
+    let (c, period, _delta) = fit_crossings(&fine)
+        .ok_or_else(|| not_periodic("the zero crossings do not fit a period".into()))?;
+    if !(period.is_finite() && period > 4.0) {
+        return Err(not_periodic(format!(
+            "period of {period:.2} samples is too short for the sample rate"
+        )));
+    }
+    // Offset-free upward crossings: c + k·T/2 for the k of upward crossings.
+    let up_parity = fine
+        .iter()
+        .position(|&(_, up)| up)
+        .map(|k| k % 2)
+        .unwrap_or(0);
+    let first_up = c + up_parity as f64 * 0.5 * period;
+    // A cycle is full when every point of its grid (n points, spacing T/n ≤ 1 sample, the
+    // last one a step short of the next cycle) lies within the record, to half a sample.
+    let n = 4 * ((period / 4.0).ceil() as usize).max(4);
+    let step = period / n as f64;
+    let tol = 0.5;
+    let last = (n_rec - 1) as f64;
+    // Cycle starts τ_m = first_up + m·T with τ_m ≥ −tol and τ_m + T − step ≤ last + tol.
+    let m_lo = ((-tol - first_up) / period).ceil() as i64;
+    let m_hi = ((last + tol - (period - step) - first_up) / period).floor() as i64;
+    if m_hi < m_lo {
+        return Err(IdentError::NoFullCycle {
+            test: name.to_owned(),
+            period_s: period / rate,
+            span_s: last / rate,
+        });
+    }
+    let full_cycles = (m_hi - m_lo + 1) as usize;
+    let (m_used, cycle_used) = if full_cycles >= 2 {
+        (m_hi - 1, full_cycles - 1)
+    } else {
+        (m_hi, 1)
+    };
+    let tau = first_up + m_used as f64 * period;
+
+    // Grid over the cycle.
+    let on_grid =
+        |x: &[f64]| -> Vec<f64> { (0..n).map(|j| interp(x, tau + j as f64 * step)).collect() };
+    let g_u4 = on_grid(&u4);
+    let g_f4 = on_grid(&f4);
+    let g_f = on_grid(rec.force_n());
+    let g_v8 = on_grid(&v8);
+    let g_f8 = on_grid(&f8);
+    let g_vu8 = on_grid(&vu8);
+
+    // Waveform: time at the plateau speed.
+    let mut speeds: Vec<f64> = g_vu8.iter().map(|v| v.abs()).collect();
+    speeds.sort_by(f64::total_cmp);
+    let plateau_speed = speeds[n / 2];
+    let plateau_fraction = g_vu8
+        .iter()
+        .filter(|v| (v.abs() - plateau_speed).abs() <= PLATEAU_TOLERANCE * plateau_speed)
+        .count() as f64
+        / n as f64;
+    let detected_kind = if plateau_fraction >= TRIANGLE_PLATEAU_FRACTION {
+        TestKind::Triangle
+    } else {
+        TestKind::Sine
+    };
+    let kind = rec.kind().unwrap_or(detected_kind);
+    // The acceleration of the inertial force: on sines the crossover above; on triangles the
+    // accelerometer itself. A triangle's acceleration jumps at the ends of its reversal arcs
+    // (0 to ±A_r), and sampled displacement cannot place a jump within a sample interval: the
+    // displacement-derived acceleration then carries a spurious impulse of up to A_r·Δt/2 per
+    // jump (on T12, 144 t × 24 m/s² × 1 ms ≈ 3.4 kN·s), which the low-pass turns into kilonewtons
+    // of force. The accelerometer's noise matters less there: the reversal arcs are large.
+    let a4 = match kind {
+        TestKind::Sine => butter.apply(&a_c),
+        TestKind::Triangle => butter.apply(a_rec),
+    }
+    .map_err(signal)?;
+    let g_a4 = on_grid(&a4);
+    // Unit impulses at the velocity reversals, signed as the new motion, through the same
+    // low-pass: the shape of a force impulse at each reversal (see `identify`).
+    let vu4 = differentiate(&u4, sr);
+    let mut impulses = vec![0.0; n_rec];
+    for i in 1..n_rec {
+        let (a, b) = (vu4[i - 1], vu4[i]);
+        if (a > 0.0) != (b > 0.0) && a != b {
+            let frac = (a / (a - b)).clamp(0.0, 1.0);
+            let sign = if b > 0.0 { 1.0 } else { -1.0 };
+            // Area 1 N·s split between the two neighbouring samples.
+            impulses[i - 1] += sign * (1.0 - frac) * rate;
+            impulses[i] += sign * frac * rate;
+        }
+    }
+    let g4 = butter.apply(&impulses).map_err(signal)?;
+    let g_g4 = on_grid(&g4);
+    // Harmonics of the displacement over the cycle.
+    let mean_u = g_u4.iter().sum::<f64>() / n as f64;
+    let harmonic = |k: usize| -> f64 {
+        let (mut re, mut im) = (0.0, 0.0);
+        for (j, x) in g_u4.iter().enumerate() {
+            let ph = 2.0 * PI * (k * j) as f64 / n as f64;
+            re += (x - mean_u) * ph.cos();
+            im -= (x - mean_u) * ph.sin();
+        }
+        2.0 * (re * re + im * im).sqrt() / n as f64
+    };
+    let h1 = harmonic(1);
+    let thd =
+        ((2..=7).map(|k| harmonic(k).powi(2)).sum::<f64>()).sqrt() / h1.max(f64::MIN_POSITIVE);
+
+    // Whole-record channels for the instantaneous (global) fit.
+    // For the instantaneous (global) fit, the second derivative of the low-passed
+    // displacement: zero phase, unlike the accelerometer's conditioner (see `global`).
+    let rec_a8 = differentiate(&vu8, sr);
+    let settle = (settle_s * rate).ceil() as usize;
+    let edge = fir.order() / 2;
+    let mut rec_usable = vec![true; n_rec];
+    for flag in rec_usable.iter_mut().take(edge.min(n_rec)) {
+        *flag = false;
+    }
+    for flag in rec_usable.iter_mut().skip(n_rec.saturating_sub(edge)) {
+        *flag = false;
+    }
+    for i in 1..n_rec {
+        if (v8[i - 1] > 0.0) != (v8[i] > 0.0) {
+            let lo = i.saturating_sub(settle);
+            let hi = (i + settle).min(n_rec);
+            for flag in &mut rec_usable[lo..hi] {
+                *flag = false;
+            }
+        }
+    }
+
+    // The filter's 0.5 % settling time: how far the arcs' inertial transients (M·A_r, up to
+    // MN) leak into a triangle's plateau through the filter's tail.
+    let reach = settle_time_samples(fir.taps(), 0.005);
+    if kind == TestKind::Triangle {
+        // Only the plateaus, away from the reversal arcs by that time.
+        let off: Vec<bool> = vu8
+            .iter()
+            .map(|v| (v.abs() - plateau_speed).abs() > PLATEAU_TOLERANCE * plateau_speed)
+            .collect();
+        let mut last_off: Option<usize> = None;
+        for i in 0..n_rec {
+            if off[i] {
+                last_off = Some(i);
+            }
+            if last_off.is_some_and(|k| i - k <= reach) {
+                rec_usable[i] = false;
+            }
+        }
+        let mut next_off: Option<usize> = None;
+        for i in (0..n_rec).rev() {
+            if off[i] {
+                next_off = Some(i);
+            }
+            if next_off.is_some_and(|k| k - i <= reach) {
+                rec_usable[i] = false;
+            }
+        }
+    }
+
+    let info = CycleInfo {
+        period_s: period / rate,
+        frequency_hz: rate / period,
+        full_cycles,
+        cycle_used,
+        cycle_start_s: rec.start_s() + tau / rate,
+        amplitude_m: amp4,
+        offset_m: mid4,
+        plateau_fraction,
+        harmonic_distortion: thd,
+        detected_kind,
+        inertial_cutoff_hz: inertial_cutoff,
+        dissipative_cutoff_hz: fir.cutoff_hz(),
+        reversal_window_s: settle_s,
+    };
+    Ok(Analysed {
+        info,
+        n,
+        grid_start: tau,
+        grid_step: step,
+        fir: fir.clone(),
+        arc_reach_s: reach as f64 / rate,
+        u4: g_u4,
+        a4: g_a4,
+        g4: g_g4,
+        f4: g_f4,
+        f: g_f,
+        v8: g_v8,
+        f8: g_f8,
+        vu8: g_vu8,
+        plateau_speed,
+        rec_u8: u8,
+        rec_v8: v8,
+        rec_v: v_raw,
+        rec_f8: f8,
+        rec_a8,
+        rec_usable,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn catmull_rom_is_exact_for_quadratics() {
+        let x: Vec<f64> = (0..10)
+            .map(|i| 0.5 * (i * i) as f64 - 3.0 * i as f64 + 1.0)
+            .collect();
+        for s in [1.25, 3.5, 6.9] {
+            let want = 0.5 * s * s - 3.0 * s + 1.0;
+            assert!((interp(&x, s) - want).abs() < 1e-12, "{s}");
+        }
+    }
+
+    #[test]
+    fn crossings_of_a_sine_are_found_with_direction_and_sub_sample_accuracy() {
+        let period = 100.0;
+        let x: Vec<f64> = (0..1000)
+            .map(|i| (2.0 * PI * (i as f64 - 10.3) / period).sin())
+            .collect();
+        let c = crossings(&x, 0.25);
+        // Upward crossings at 10.3 + 100k, downward at 60.3 + 100k, up to 960.3.
+        assert_eq!(c.len(), 20);
+        assert!(c[0].1 && !c[1].1);
+        assert!((c[0].0 - 10.3).abs() < 2e-3, "{:?}", c[0]);
+        assert!((c[1].0 - 60.3).abs() < 2e-3, "{:?}", c[1]);
+        let (c0, t, delta) = fit_crossings(&c).unwrap();
+        assert!((t - period).abs() < 1e-4, "{t}");
+        assert!((c0 - 10.3).abs() < 2e-3, "{c0}");
+        assert!(delta.abs() < 1e-3, "{delta}");
+    }
+
+    #[test]
+    fn the_order_512_fir_at_8_hz_settles_to_5_percent_in_82_ms_and_to_half_a_percent_in_a_third_of_a_second(
+    ) {
+        let fir = FirLowpass::new(512, 8.0, 512.0, Window::Hamming).unwrap();
+        // 5 %: 82 ms; 0.5 %: 0.33 s (the Hamming sinc's slow tail).
+        let s = settle_time_samples(fir.taps(), 0.05);
+        assert_eq!(s, 42);
+        assert_eq!(settle_time_samples(fir.taps(), 0.005), 170);
+    }
+}

@@ -1,0 +1,409 @@
+//! The dissipative law `F_D = [F_μ + Cₑ|v|^α + a·e^(−b|v|)]·sign(v)` (Eq. 21/22) and its
+//! weighted least-squares fit to `(|v|, F_D)` points.
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::lm::{self, covariance, LmSettings, Problem};
+
+/// The dissipative law of Eq. 22 (Eq. 21 is the case `a = 0`, `α = 0.5`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DissipativeLaw {
+    /// Coulomb force `F_μ`, N.
+    pub coulomb_force_n: f64,
+    /// Viscous coefficient `Cₑ`, N/(m/s)^α.
+    pub viscous_coefficient: f64,
+    /// Viscous exponent `α`.
+    pub viscous_exponent: f64,
+    /// Low-velocity force `a`, N.
+    pub low_velocity_force_n: f64,
+    /// Low-velocity decay `b`, s/m.
+    pub low_velocity_decay_s_per_m: f64,
+}
+
+impl DissipativeLaw {
+    /// The magnitude `F_μ + Cₑ·w^α + a·e^(−b·w)` at speed `w ≥ 0`, N.
+    pub fn magnitude_n(&self, speed_m_s: f64) -> f64 {
+        self.coulomb_force_n
+            + self.viscous_coefficient * pow(speed_m_s, self.viscous_exponent)
+            + self.low_velocity_force_n * (-self.low_velocity_decay_s_per_m * speed_m_s).exp()
+    }
+
+    pub(crate) fn from_array(p: [f64; 5]) -> Self {
+        Self {
+            coulomb_force_n: p[0],
+            viscous_coefficient: p[1],
+            viscous_exponent: p[2],
+            low_velocity_force_n: p[3],
+            low_velocity_decay_s_per_m: p[4],
+        }
+    }
+
+    pub(crate) fn to_array(self) -> [f64; 5] {
+        [
+            self.coulomb_force_n,
+            self.viscous_coefficient,
+            self.viscous_exponent,
+            self.low_velocity_force_n,
+            self.low_velocity_decay_s_per_m,
+        ]
+    }
+}
+
+/// `w^α` with `0^α = 0` for `α > 0` and `w^0 = 1`.
+fn pow(w: f64, alpha: f64) -> f64 {
+    if alpha == 0.0 {
+        1.0
+    } else if w <= 0.0 {
+        0.0
+    } else {
+        (alpha * w.ln()).exp()
+    }
+}
+
+/// Index of each law parameter in the arrays of this module.
+pub(crate) const COULOMB: usize = 0;
+pub(crate) const VISCOUS: usize = 1;
+pub(crate) const EXPONENT: usize = 2;
+pub(crate) const LOW_FORCE: usize = 3;
+pub(crate) const LOW_DECAY: usize = 4;
+
+/// Bounds of each parameter: forces and coefficients non-negative, `α ∈ [0, 1]` (the model's
+/// range), `b ≤ 10⁴ s/m` (a term that dies within 0.1 mm/s is indistinguishable from friction).
+const LOWER: [f64; 5] = [0.0, 0.0, 0.0, 0.0, 0.0];
+const UPPER: [f64; 5] = [f64::INFINITY, f64::INFINITY, 1.0, f64::INFINITY, 1e4];
+
+/// Points `(|v|, |F_D|)` with weights.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct LawPoints {
+    pub speed: Vec<f64>,
+    pub force: Vec<f64>,
+    pub weight: Vec<f64>,
+}
+
+impl LawPoints {
+    pub fn push(&mut self, speed: f64, force: f64, weight: f64) {
+        if speed > 0.0 && speed.is_finite() && force.is_finite() && weight > 0.0 {
+            self.speed.push(speed);
+            self.force.push(force);
+            self.weight.push(weight);
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.speed.len()
+    }
+
+    pub fn extend(&mut self, other: &LawPoints) {
+        self.speed.extend_from_slice(&other.speed);
+        self.force.extend_from_slice(&other.force);
+        self.weight.extend_from_slice(&other.weight);
+    }
+
+    /// Weighted quantile of the speeds (`q` in [0, 1]).
+    pub fn speed_quantile(&self, q: f64) -> f64 {
+        let mut idx: Vec<usize> = (0..self.len()).collect();
+        idx.sort_by(|&a, &b| self.speed[a].total_cmp(&self.speed[b]));
+        let total: f64 = self.weight.iter().sum();
+        let mut acc = 0.0;
+        for &i in &idx {
+            acc += self.weight[i];
+            if acc >= q * total {
+                return self.speed[i];
+            }
+        }
+        idx.last().map_or(0.0, |&i| self.speed[i])
+    }
+
+    /// Weighted fraction of the points below `speed`.
+    pub fn weight_below(&self, speed: f64) -> f64 {
+        let total: f64 = self.weight.iter().sum();
+        let below: f64 = self
+            .speed
+            .iter()
+            .zip(&self.weight)
+            .filter(|(s, _)| **s < speed)
+            .map(|(_, w)| w)
+            .sum();
+        below / total.max(f64::MIN_POSITIVE)
+    }
+}
+
+/// Result of a law fit.
+#[derive(Debug, Clone)]
+pub(crate) struct LawFit {
+    pub law: DissipativeLaw,
+    /// Standard errors (NaN for parameters held fixed, ∞ for singular ones).
+    pub std_errors: [f64; 5],
+    /// Parameters the data cannot tell apart (singular `JᵀJ` direction).
+    pub singular: [bool; 5],
+    pub free: [bool; 5],
+    pub dof: f64,
+    /// Condition number of the scaled `JᵀJ` at the optimum.
+    pub condition: f64,
+    /// Weighted RMS residual, N.
+    pub rms_n: f64,
+    pub points: usize,
+}
+
+struct LawProblem<'a> {
+    pts: &'a LawPoints,
+    sqrt_w: Vec<f64>,
+    ln_v: Vec<f64>,
+    free: Vec<usize>,
+    base: [f64; 5],
+}
+
+impl LawProblem<'_> {
+    fn full(&self, p: &[f64]) -> [f64; 5] {
+        let mut q = self.base;
+        for (k, &i) in self.free.iter().enumerate() {
+            q[i] = p[k];
+        }
+        q
+    }
+}
+
+impl Problem for LawProblem<'_> {
+    fn residual_count(&self) -> usize {
+        self.pts.len()
+    }
+    fn parameter_count(&self) -> usize {
+        self.free.len()
+    }
+    fn residuals(&self, p: &[f64], r: &mut [f64]) {
+        let q = self.full(p);
+        for (i, r) in r.iter_mut().enumerate() {
+            let v = self.pts.speed[i];
+            let va = if q[EXPONENT] == 0.0 {
+                1.0
+            } else {
+                (q[EXPONENT] * self.ln_v[i]).exp()
+            };
+            let d = q[COULOMB] + q[VISCOUS] * va + q[LOW_FORCE] * (-q[LOW_DECAY] * v).exp();
+            *r = self.sqrt_w[i] * (d - self.pts.force[i]);
+        }
+    }
+    fn jacobian(&self, p: &[f64], j: &mut DMatrix<f64>) {
+        let q = self.full(p);
+        for i in 0..self.pts.len() {
+            let v = self.pts.speed[i];
+            let va = (q[EXPONENT] * self.ln_v[i]).exp();
+            let e = (-q[LOW_DECAY] * v).exp();
+            let sw = self.sqrt_w[i];
+            for (k, &which) in self.free.iter().enumerate() {
+                j[(i, k)] = sw
+                    * match which {
+                        COULOMB => 1.0,
+                        VISCOUS => va,
+                        EXPONENT => q[VISCOUS] * va * self.ln_v[i],
+                        LOW_FORCE => e,
+                        _ => -q[LOW_FORCE] * v * e,
+                    };
+            }
+        }
+    }
+}
+
+/// Weighted linear least squares of `force` on the columns `[1, w^α, e^(−b·w)]` restricted to
+/// the free linear parameters, for a start point. Returns the full parameter array and SSR.
+fn linear_start(
+    pts: &LawPoints,
+    ln_v: &[f64],
+    free: &[bool; 5],
+    base: [f64; 5],
+    alpha: f64,
+    b: f64,
+) -> Option<([f64; 5], f64)> {
+    let lin: Vec<usize> = [COULOMB, VISCOUS, LOW_FORCE]
+        .into_iter()
+        .filter(|&i| free[i])
+        .collect();
+    let k = lin.len();
+    let mut q = base;
+    q[EXPONENT] = alpha;
+    q[LOW_DECAY] = b;
+    let column = |which: usize, i: usize| match which {
+        COULOMB => 1.0,
+        VISCOUS => (alpha * ln_v[i]).exp(),
+        _ => (-b * pts.speed[i]).exp(),
+    };
+    let fixed_part = |i: usize| -> f64 {
+        [COULOMB, VISCOUS, LOW_FORCE]
+            .into_iter()
+            .filter(|&w| !free[w])
+            .map(|w| q[w] * column(w, i))
+            .sum()
+    };
+    if k > 0 {
+        let mut ata = DMatrix::<f64>::zeros(k, k);
+        let mut aty = DVector::<f64>::zeros(k);
+        let mut row = vec![0.0; k];
+        for i in 0..pts.len() {
+            let w = pts.weight[i];
+            let y = pts.force[i] - fixed_part(i);
+            for (c, &which) in lin.iter().enumerate() {
+                row[c] = column(which, i);
+            }
+            for a in 0..k {
+                aty[a] += w * row[a] * y;
+                for b2 in 0..k {
+                    ata[(a, b2)] += w * row[a] * row[b2];
+                }
+            }
+        }
+        // A whisker of ridge keeps collinear columns (one speed level) solvable; the
+        // covariance of the final fit then reports them as singular.
+        let ridge = 1e-12 * ata.trace().max(f64::MIN_POSITIVE);
+        for i in 0..k {
+            ata[(i, i)] += ridge;
+        }
+        let sol = ata.cholesky()?.solve(&aty);
+        for (c, &which) in lin.iter().enumerate() {
+            q[which] = sol[c].max(0.0);
+        }
+    }
+    let ssr = (0..pts.len())
+        .map(|i| {
+            let d = q[COULOMB]
+                + q[VISCOUS] * (alpha * ln_v[i]).exp()
+                + q[LOW_FORCE] * (-b * pts.speed[i]).exp();
+            pts.weight[i] * (d - pts.force[i]).powi(2)
+        })
+        .sum();
+    Some((q, ssr))
+}
+
+/// Fits the law to `pts` with the parameters marked `free` (the others held at `base`).
+/// Starts from the best of a grid over `α` and `b` (linear parameters solved exactly at each
+/// node), then refines all free parameters by Levenberg–Marquardt.
+///
+/// `correlation_samples`: see [`lm::covariance`].
+pub(crate) fn fit(
+    pts: &LawPoints,
+    free: [bool; 5],
+    base: [f64; 5],
+    correlation_samples: f64,
+) -> Option<LawFit> {
+    let n = pts.len();
+    let n_free = free.iter().filter(|f| **f).count();
+    if n <= n_free || n_free == 0 {
+        return None;
+    }
+    // Weights normalised to mean 1, so the residual variance is per unit weight.
+    let mean_w = pts.weight.iter().sum::<f64>() / n as f64;
+    let sqrt_w: Vec<f64> = pts.weight.iter().map(|w| (w / mean_w).sqrt()).collect();
+    let ln_v: Vec<f64> = pts.speed.iter().map(|v| v.ln()).collect();
+    let alphas: Vec<f64> = if free[EXPONENT] {
+        (1..=10).map(|k| 0.1 * k as f64).collect()
+    } else {
+        vec![base[EXPONENT]]
+    };
+    let decays: Vec<f64> = if free[LOW_DECAY] {
+        (0..12).map(|k| 5.0 * 2f64.powi(k) / 2.0).collect()
+    } else {
+        vec![base[LOW_DECAY]]
+    };
+    let mut best: Option<([f64; 5], f64)> = None;
+    for &alpha in &alphas {
+        for &b in &decays {
+            if let Some((q, ssr)) = linear_start(pts, &ln_v, &free, base, alpha, b) {
+                if best.as_ref().is_none_or(|(_, s)| ssr < *s) {
+                    best = Some((q, ssr));
+                }
+            }
+        }
+    }
+    let (start_full, _) = best?;
+    let free_idx: Vec<usize> = (0..5).filter(|&i| free[i]).collect();
+    let problem = LawProblem {
+        pts,
+        sqrt_w,
+        ln_v,
+        free: free_idx.clone(),
+        base: start_full,
+    };
+    let start: Vec<f64> = free_idx.iter().map(|&i| start_full[i]).collect();
+    let lower: Vec<f64> = free_idx.iter().map(|&i| LOWER[i]).collect();
+    let upper: Vec<f64> = free_idx.iter().map(|&i| UPPER[i]).collect();
+    let res = lm::minimize(&problem, &start, &lower, &upper, LmSettings::default());
+    let cov = covariance(&res.jacobian, res.ssr, correlation_samples);
+    let full = problem.full(&res.params);
+    let mut std_errors = [f64::NAN; 5];
+    let mut singular = [false; 5];
+    for (k, &i) in free_idx.iter().enumerate() {
+        std_errors[i] = cov.std_errors[k];
+        singular[i] = cov.singular[k];
+    }
+    Some(LawFit {
+        law: DissipativeLaw::from_array(full),
+        std_errors,
+        singular,
+        free,
+        dof: cov.dof,
+        condition: cov.condition,
+        rms_n: (res.ssr / n as f64).sqrt(),
+        points: n,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn paper() -> DissipativeLaw {
+        DissipativeLaw {
+            coulomb_force_n: 25.445e3,
+            viscous_coefficient: 44.58e3,
+            viscous_exponent: 0.5,
+            low_velocity_force_n: 12.04e3,
+            low_velocity_decay_s_per_m: 78.5,
+        }
+    }
+
+    #[test]
+    fn eq_22_at_one_metre_per_second_is_70_kn() {
+        assert!((paper().magnitude_n(1.0) - 70.025e3).abs() < 1.0);
+        assert!((paper().magnitude_n(0.0) - 37.485e3).abs() < 1.0);
+    }
+
+    #[test]
+    fn the_full_law_is_recovered_from_exact_points_over_the_papers_velocity_range() {
+        let law = paper();
+        let mut pts = LawPoints::default();
+        for k in 0..400 {
+            let v = 0.002 * 1.02f64.powi(k);
+            if v > 1.8 {
+                break;
+            }
+            pts.push(v, law.magnitude_n(v), 1.0);
+        }
+        let fit = fit(&pts, [true; 5], [0.0; 5], 1.0).unwrap();
+        let got = fit.law.to_array();
+        let want = law.to_array();
+        for i in 0..5 {
+            assert!(
+                (got[i] / want[i] - 1.0).abs() < 1e-6,
+                "parameter {i}: {} vs {}",
+                got[i],
+                want[i]
+            );
+        }
+    }
+
+    #[test]
+    fn one_speed_level_leaves_the_viscous_law_singular() {
+        let law = paper();
+        let mut pts = LawPoints::default();
+        for k in 0..100 {
+            pts.push(0.25, law.magnitude_n(0.25) + (k % 3) as f64, 1.0);
+        }
+        let fit = fit(
+            &pts,
+            [true, true, false, false, false],
+            [0.0, 0.0, 0.5, 0.0, 0.0],
+            1.0,
+        )
+        .unwrap();
+        assert!(fit.singular[COULOMB] && fit.singular[VISCOUS]);
+    }
+}

@@ -1,0 +1,141 @@
+//! Identification of a shake-table platen's parameters from periodic tests: the
+//! hysteresis-loop method of Ozcelik, Luco, Conte, Trombetti and Restrepo (2008, §3), the
+//! least-squares fits behind their Eq. 21/22 and Fig. 8, and a global fit of Eq. 23 as a
+//! cross-check.
+//!
+//! ```
+//! use platen_ident::{identify, Settings, TestRecord};
+//! use platen_integrate::{inverse, Motion, Trajectory};
+//! use platen_model::preset;
+//! use platen_scenario::generate::{sine_motion, triangle_motion};
+//!
+//! // Exact data of the identified LHPOST model at 13.8 MPa, sampled at 512 Hz.
+//! let model = preset::lhpost_2008_identified(13.8e6).build().unwrap();
+//! let record = |name: &str, motion: Motion| {
+//!     let mut out = Trajectory::with_capacity(motion.len());
+//!     inverse(&model, &motion, &mut out);
+//!     TestRecord::from_rate(name, 512.0, out.u_m, out.a_m_s2, out.force_n)
+//!         .unwrap()
+//!         .with_velocity(out.v_m_s)
+//!         .unwrap()
+//!         .with_pressure_pa(13.8e6)
+//!         .unwrap()
+//! };
+//! let tests = vec![
+//!     record("S5", sine_motion(0.04, 1.0, 512.0, 4.0).unwrap()),
+//!     record("S9", sine_motion(0.2, 0.6, 512.0, 5.0).unwrap()),
+//!     record("S11", sine_motion(0.2, 1.2, 512.0, 3.0).unwrap()),
+//!     record("T7", triangle_motion(0.375, 0.25, 0.8333, 512.0, 19.8).unwrap()),
+//!     record("T9", triangle_motion(0.4688, 0.75, 6.0, 512.0, 8.25).unwrap()),
+//! ];
+//! let id = identify(&tests, &Settings::default()).unwrap();
+//! let p = id.params().unwrap();
+//! assert!((p.effective_mass_kg / 144e3 - 1.0).abs() < 0.005);
+//! assert!((p.stiffness_n_per_m / 1.266e6 - 1.0).abs() < 0.005);
+//! // Every test is recognised from its data: names play no part.
+//! assert_eq!(id.tests[0].kind, platen_ident::TestKind::Sine);
+//! assert_eq!(id.tests[3].kind, platen_ident::TestKind::Triangle);
+//! ```
+//!
+//! # The method
+//!
+//! 1. **Cycles** ([`CycleInfo`]). The period comes from a least-squares fit to every zero
+//!    crossing of the low-passed displacement (`t_k = c + k·T/2 ± δ`, which also absorbs a
+//!    displacement offset). The waveform is recognised from the time spent at constant
+//!    velocity (a triangle ≥ 40 % of its cycle, a sine ≈ 5 %), unless given. Of the full
+//!    cycles in the record the second-to-last is analysed (paper §3), starting at the
+//!    offset-free upward zero crossing so that `u > 0` on its first half, and resampled on a
+//!    grid of `n` points (`n` a multiple of 4) so that the mirror times `T/2 − t`, `T − t`,
+//!    `3T/2 − t` of Eq. 10–20 fall on grid points.
+//! 2. **Filters.** Inertial and elastic work uses a zero-phase Butterworth at 4× the
+//!    fundamental; dissipative work the windowed-sinc FIR of order 512 at 8 Hz on 512 Hz data
+//!    (1 s long at any rate), which keeps the friction jump at reversals and removes the
+//!    10.66 Hz oil-column ringing. Every channel of a test goes through the same filter, so
+//!    the symmetry identities hold for the filtered data exactly.
+//! 3. **Stiffness** (Eq. 16/17, Table I): on the constant-velocity portions of each triangle
+//!    test, `½[F(t) + F(T/2 − t)] − Mₑā = Kₑū + βḡ + c`. The paper takes `ā = 0` there; the
+//!    small acceleration the low-pass leaves near the rounded reversals is subtracted with the
+//!    mass found from the sine tests (stiffness and mass are alternated until they agree).
+//!    `βḡ` is the net impulse of the oil-column transient at each reversal (see below). The
+//!    stiffness at a pressure is the mean over its triangle tests.
+//! 4. **Mass** (Eq. 18/19, Table II): for each sine test,
+//!    `½[F(t) + F(T/2 − t)] − Kₑū = Mₑā + βḡ + c` with the stiffness of its pressure. Tests
+//!    whose inertial force is small against their dissipative force (paper: S1–S3) or whose
+//!    displacement is distorted (S12) are flagged and not averaged in ([`Flag`]). The
+//!    acceleration of sine tests is the displacement's second derivative below the crossover
+//!    frequency and the accelerometer above it (at the paper's low frequencies the
+//!    accelerometer's noise would dominate S4's 0.026 g); triangle tests use the
+//!    accelerometer, which alone resolves the jumps at the ends of their reversal arcs.
+//! 5. **Dissipative force** (Eq. 20): `¼[F(t) + F(T − t) − F(T/2 − t) − F(T/2 + t)]` against
+//!    the same combination of velocities, which cancels inertial and elastic forces and any
+//!    force offset. On sine tests the FIR-filtered points outside a window about each
+//!    reversal are used, with the filter's smearing of the friction jump (its tail reaches
+//!    0.3 s) removed as the fitted law predicts it, fit and correction alternating. On
+//!    triangle tests, the constant-velocity portions: their unfiltered mean for the value at
+//!    peak velocity, and for the law fit the filtered force where the plateau lies farther
+//!    from the reversal arcs than the filter's reach. The value at peak velocity per test is
+//!    the paper's Fig. 7.
+//! 6. **Fits**: Eq. 21 as the paper did ([`PaperFit`]); the full law
+//!    `F_μ + Cₑ|v|^α + a·e^(−b|v|)` (α free or held) by Levenberg–Marquardt on the
+//!    instantaneous points of every test at the reference pressure, each test weighted
+//!    equally; `F_μ` at every pressure with the rest of the law held; and `μₑ` as the slope of
+//!    `F_μ` against the vertical load `F_z` ([`VerticalLoad`]). A parameter the tests cannot
+//!    determine is reported as [`Parameter::NotIdentifiable`] with the reason (or, for the
+//!    low-velocity term, left out as [`Parameter::Fixed`] at zero with the reason).
+//! 7. **Global fit** ([`GlobalFit`]): every parameter at once from the instantaneous residual
+//!    of Eq. 23 (plus the low-velocity term) over every test, started from the above; the
+//!    two are compared and disagreements reported.
+//!
+//! **The oil-column impulse.** The recorded force rings at the oil-column frequency after
+//! every reversal (§1.5). A low-pass removes the ringing but not its area, a net impulse of
+//! `≈ A/ω` that lands where the acceleration and the displacement peak; on the paper's
+//! records (ringing ≈ 30 % of the friction jump) it would add 1.5 % to S4's mass and 0.4 % to
+//! T12's stiffness. It is fitted as a nuisance term: a signed unit impulse at every velocity
+//! reversal through the same filter and mirror average (`ḡ`), with its size `β` free. The
+//! dissipative combination of Eq. 20 cancels it by symmetry.
+//!
+//! # Conventions
+//!
+//! * SI units throughout; the unit is part of every public name (`sample_rate_hz`,
+//!   `pressure_pa`, `force_n`). Forces are the total actuator force `F_A` and its parts, N;
+//!   `u`, `v`, `a` are positive along `F_A`.
+//! * Records are uniformly sampled; every filter is zero-phase (non-causal), applied to whole
+//!   records before the cycle is cut out, so the analysed cycle is far from the record edges.
+//! * **Uncertainties.** Standard errors come from the Jacobian at the optimum,
+//!   `s²·(JᵀJ)⁻¹`, inflated by the number of consecutive samples that carry one independent
+//!   observation (`f_s/(2f_c)` for data low-passed at `f_c`: residuals of filtered records are
+//!   correlated, and counting every sample would understate the errors). Intervals are 95 %
+//!   with Student's t for the independent degrees of freedom. Means over tests carry the
+//!   standard error of the mean. They measure the scatter of the data about the model, not
+//!   the model's own error.
+//! * The final estimate ([`Identification::parameters`]) belongs to the *reference*
+//!   pressure: the highest among the tests unless [`Settings::reference_pressure_pa`] says
+//!   otherwise. The mass is averaged over every pressure.
+
+#![warn(missing_docs)]
+
+mod cycle;
+mod error;
+mod estimate;
+mod global;
+mod identify;
+mod law;
+mod lm;
+mod record;
+mod result;
+mod settings;
+
+pub use cycle::{CycleInfo, PLATEAU_TOLERANCE, TRIANGLE_PLATEAU_FRACTION};
+pub use error::{IdentError, Result};
+pub use estimate::{student_t_975, Estimate, Parameter};
+pub use identify::{
+    identify, LOW_SPEED_M_S, MAX_MASS_RELATIVE_STD_ERROR, MAX_SINE_DISTORTION,
+    MIN_INERTIAL_TO_DISSIPATIVE, MIN_PLATEAU_FRACTION, MIN_SPEED_SPREAD,
+};
+pub use law::DissipativeLaw;
+pub use record::{TestKind, TestRecord, MIN_SAMPLES};
+pub use result::{
+    Flag, GlobalFit, Identification, LawReport, PaperFit, PeakForce, PressureGroup, TestResult,
+    PARAMETER_NAMES,
+};
+pub use settings::{Settings, VerticalLoad};

@@ -1,0 +1,225 @@
+//! One periodic test's recorded channels, with what is known about the test.
+
+use crate::error::{IdentError, Result};
+
+/// The waveform of a periodic test.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum TestKind {
+    /// A sine test (paper: S1–S12): used for the effective mass (Eq. 18/19).
+    Sine,
+    /// A triangle test with rounded reversals (paper: T1–T12): used for the stiffness
+    /// (Eq. 16/17) over its constant-velocity portions.
+    Triangle,
+}
+
+impl TestKind {
+    /// `"sine"` or `"triangle"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            TestKind::Sine => "sine",
+            TestKind::Triangle => "triangle",
+        }
+    }
+}
+
+/// The recorded channels of one periodic test, uniformly sampled.
+///
+/// Displacement `u_m`, acceleration `a_m_s2` and the total actuator force `force_n` are
+/// required; the velocity `v_m_s` is optional (without it the crossover estimate of
+/// [`platen_signal::CrossoverVelocity`] is made from `u` and `a`, as the paper's data system
+/// did). The hold-down pressure and the waveform may be given; the waveform is otherwise
+/// recognised from the data, and a test without a pressure is grouped with the other tests
+/// without one.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TestRecord {
+    name: String,
+    sample_rate_hz: f64,
+    start_s: f64,
+    u_m: Vec<f64>,
+    v_m_s: Option<Vec<f64>>,
+    a_m_s2: Vec<f64>,
+    force_n: Vec<f64>,
+    pressure_pa: Option<f64>,
+    kind: Option<TestKind>,
+}
+
+/// Fewest samples a record may have: far below any real test (a cycle of the paper's
+/// fastest test holds 358 samples at 512 Hz); this only rejects degenerate input.
+pub const MIN_SAMPLES: usize = 64;
+
+impl TestRecord {
+    /// A record sampled at the times `t_s` (uniform to within
+    /// [`platen_integrate::UNIFORM_RELATIVE_TOLERANCE`]).
+    ///
+    /// # Errors
+    /// [`IdentError::InvalidRecord`] naming `name` if the channels differ in length, hold
+    /// fewer than [`MIN_SAMPLES`] samples or a non-finite value, or the times are not uniform.
+    pub fn new(
+        name: impl Into<String>,
+        t_s: &[f64],
+        u_m: Vec<f64>,
+        a_m_s2: Vec<f64>,
+        force_n: Vec<f64>,
+    ) -> Result<Self> {
+        let name = name.into();
+        let dt =
+            platen_integrate::uniform_interval_s(t_s).map_err(|e| IdentError::InvalidRecord {
+                test: name.clone(),
+                message: format!("time column: {e}"),
+            })?;
+        let mut rec = Self::from_rate(name, 1.0 / dt, u_m, a_m_s2, force_n)?;
+        rec.start_s = t_s[0];
+        Ok(rec)
+    }
+
+    /// A record sampled at `sample_rate_hz` from time 0.
+    ///
+    /// # Errors
+    /// As [`TestRecord::new`], and for a rate that is not finite and positive.
+    pub fn from_rate(
+        name: impl Into<String>,
+        sample_rate_hz: f64,
+        u_m: Vec<f64>,
+        a_m_s2: Vec<f64>,
+        force_n: Vec<f64>,
+    ) -> Result<Self> {
+        let name = name.into();
+        let invalid = |message: String| IdentError::InvalidRecord {
+            test: name.clone(),
+            message,
+        };
+        if !(sample_rate_hz.is_finite() && sample_rate_hz > 0.0) {
+            return Err(invalid(format!(
+                "sample rate {sample_rate_hz} Hz: expected a finite rate > 0"
+            )));
+        }
+        let n = u_m.len();
+        if n < MIN_SAMPLES {
+            return Err(invalid(format!(
+                "{n} samples: expected at least {MIN_SAMPLES}"
+            )));
+        }
+        for (what, col) in [("a_m_s2", &a_m_s2), ("force_n", &force_n)] {
+            if col.len() != n {
+                return Err(invalid(format!(
+                    "`{what}` has {} samples, `u_m` has {n}",
+                    col.len()
+                )));
+            }
+        }
+        for (what, col) in [("u_m", &u_m), ("a_m_s2", &a_m_s2), ("force_n", &force_n)] {
+            if let Some(i) = col.iter().position(|x| !x.is_finite()) {
+                return Err(invalid(format!(
+                    "`{what}` sample {i} is {}: expected a finite number",
+                    col[i]
+                )));
+            }
+        }
+        Ok(Self {
+            name,
+            sample_rate_hz,
+            start_s: 0.0,
+            u_m,
+            v_m_s: None,
+            a_m_s2,
+            force_n,
+            pressure_pa: None,
+            kind: None,
+        })
+    }
+
+    /// Adds the recorded (or estimated) velocity channel.
+    ///
+    /// # Errors
+    /// [`IdentError::InvalidRecord`] if its length differs from the other channels' or a
+    /// value is not finite.
+    pub fn with_velocity(mut self, v_m_s: Vec<f64>) -> Result<Self> {
+        if v_m_s.len() != self.u_m.len() {
+            return Err(IdentError::InvalidRecord {
+                test: self.name.clone(),
+                message: format!(
+                    "`v_m_s` has {} samples, `u_m` has {}",
+                    v_m_s.len(),
+                    self.u_m.len()
+                ),
+            });
+        }
+        if let Some(i) = v_m_s.iter().position(|x| !x.is_finite()) {
+            return Err(IdentError::InvalidRecord {
+                test: self.name.clone(),
+                message: format!(
+                    "`v_m_s` sample {i} is {}: expected a finite number",
+                    v_m_s[i]
+                ),
+            });
+        }
+        self.v_m_s = Some(v_m_s);
+        Ok(self)
+    }
+
+    /// Sets the hold-down nitrogen pressure of the test, Pa.
+    ///
+    /// # Errors
+    /// [`IdentError::InvalidRecord`] for a negative or non-finite pressure.
+    pub fn with_pressure_pa(mut self, pressure_pa: f64) -> Result<Self> {
+        if !(pressure_pa.is_finite() && pressure_pa >= 0.0) {
+            return Err(IdentError::InvalidRecord {
+                test: self.name.clone(),
+                message: format!("hold-down pressure {pressure_pa} Pa: expected a pressure >= 0"),
+            });
+        }
+        self.pressure_pa = Some(pressure_pa);
+        Ok(self)
+    }
+
+    /// Declares the waveform (otherwise recognised from the data).
+    pub fn with_kind(mut self, kind: TestKind) -> Self {
+        self.kind = Some(kind);
+        self
+    }
+
+    /// The test's name (used in messages and tables).
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+    /// Sample rate, Hz.
+    pub fn sample_rate_hz(&self) -> f64 {
+        self.sample_rate_hz
+    }
+    /// Time of the first sample, s.
+    pub fn start_s(&self) -> f64 {
+        self.start_s
+    }
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.u_m.len()
+    }
+    /// Always false: a record has at least [`MIN_SAMPLES`] samples.
+    pub fn is_empty(&self) -> bool {
+        self.u_m.is_empty()
+    }
+    /// Displacement, m.
+    pub fn u_m(&self) -> &[f64] {
+        &self.u_m
+    }
+    /// Velocity, m/s, if given.
+    pub fn v_m_s(&self) -> Option<&[f64]> {
+        self.v_m_s.as_deref()
+    }
+    /// Acceleration, m/s².
+    pub fn a_m_s2(&self) -> &[f64] {
+        &self.a_m_s2
+    }
+    /// Total actuator force, N.
+    pub fn force_n(&self) -> &[f64] {
+        &self.force_n
+    }
+    /// Hold-down pressure, Pa, if given.
+    pub fn pressure_pa(&self) -> Option<f64> {
+        self.pressure_pa
+    }
+    /// Declared waveform, if given.
+    pub fn kind(&self) -> Option<TestKind> {
+        self.kind
+    }
+}
