@@ -5,10 +5,9 @@
 //! one-hour 1024 Hz run holds no trajectory in memory. The bytes are those that
 //! [`platen_scenario::csv_io::write_csv_atomic`] writes for the same columns.
 
-use std::fs::{self, File, OpenOptions};
+use std::fs::{self, File};
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use anyhow::{Context, Result};
 use serde_json::{json, Map, Value};
@@ -17,6 +16,7 @@ use platen_integrate::{
     forward_dopri5, forward_rk4, inverse, Peaks, RunStats, Sample, SampleSink, Trajectory,
 };
 use platen_model::{PlatenModel, STANDARD_GRAVITY_M_S2};
+use platen_scenario::csv_io::{create_temp_next_to, write_number};
 use platen_scenario::{Integrator, Model, Run, Scenario, ScenarioError};
 
 pub fn run(path: &Path, out: Option<&Path>, json_out: bool) -> Result<()> {
@@ -105,9 +105,6 @@ impl SampleSink for NoOutput {
     fn accept(&mut self, _: &Sample) {}
 }
 
-/// Counter making temporary file names unique within the process.
-static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);
-
 /// Capacity of the write buffer, bytes.
 const BUFFER_BYTES: usize = 1 << 16;
 
@@ -117,7 +114,7 @@ const BUFFER_BYTES: usize = 1 << 16;
 /// Rows go to a temporary file next to the destination (`.NAME.PID.sN.tmp`);
 /// [`CsvStream::finish`] flushes, syncs and renames it over the destination. Dropping the
 /// stream without finishing it (a failed run) removes the temporary file and leaves an
-/// existing destination untouched. Numbers are formatted by [`write_number`], exactly as
+/// existing destination untouched. Numbers are formatted by `write_number`, exactly as
 /// `write_csv_atomic` formats them, so the file has the same bytes; a non-finite value is an
 /// error naming the line it would have had, as there.
 pub struct CsvStream {
@@ -135,27 +132,7 @@ impl CsvStream {
     /// # Errors
     /// [`ScenarioError::Io`] if the temporary file cannot be created or written.
     pub fn create(path: &Path, header: &'static [&'static str]) -> Result<Self, ScenarioError> {
-        let Some(file_name) = path.file_name() else {
-            return Err(write_error(
-                path,
-                io::Error::new(io::ErrorKind::InvalidInput, "the path names no file"),
-            ));
-        };
-        let temp = directory_of(path).join(format!(
-            ".{}.{}.s{}.tmp",
-            file_name.to_string_lossy(),
-            std::process::id(),
-            TEMP_COUNTER.fetch_add(1, Ordering::Relaxed)
-        ));
-        let file = OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&temp)
-            .map_err(|source| ScenarioError::Io {
-                path: path.to_path_buf(),
-                action: "creating a temporary file next to",
-                source,
-            })?;
+        let (temp, file) = create_temp_next_to(path)?;
         let mut stream = Self {
             path: path.to_path_buf(),
             temp,
@@ -260,19 +237,6 @@ impl SampleSink for CsvStream {
             s.terms.elastic_n,
             s.terms.dissipative_n,
         ]);
-    }
-}
-
-/// Writes a finite `value` as the shortest text that parses back to it: `{}` formatting, or
-/// `{:e}` when the magnitude is below 1e-5 or at least 1e16. The same rule as
-/// `platen_scenario::csv_io`'s writer, so streamed and in-memory outputs have the same bytes.
-#[inline]
-pub fn write_number<W: Write>(out: &mut W, value: f64) -> io::Result<()> {
-    let magnitude = value.abs();
-    if magnitude == 0.0 || (1e-5..1e16).contains(&magnitude) {
-        write!(out, "{value}")
-    } else {
-        write!(out, "{value:e}")
     }
 }
 

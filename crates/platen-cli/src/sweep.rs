@@ -31,7 +31,7 @@ use platen_model::{IdentifiedParams, PhysicalParams, PlatenModel, Preset};
 use platen_scenario::csv_io::write_bytes_atomic;
 use platen_scenario::{Integrator, Model, Run, Scenario};
 
-use crate::simulate::write_number;
+use platen_scenario::csv_io::write_number;
 
 /// Keys of the identified model that `--set identified.KEY=…` accepts.
 pub const IDENTIFIED_KEYS: [&str; 7] = [

@@ -454,9 +454,11 @@ pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     })
 }
 
-/// Writes a finite `value` as the shortest text that parses back to it (see the module docs).
+/// Writes a finite `value` as the shortest text that parses back to it (see the module docs):
+/// `{}` formatting, or `{:e}` when the magnitude is below 1e-5 or at least 1e16. Every platen
+/// CSV writer formats numbers with it, so streamed and in-memory outputs have the same bytes.
 #[inline]
-fn write_number<W: Write>(out: &mut W, value: f64) -> io::Result<()> {
+pub fn write_number<W: Write>(out: &mut W, value: f64) -> io::Result<()> {
     let magnitude = value.abs();
     if magnitude == 0.0 || (1e-5..1e16).contains(&magnitude) {
         write!(out, "{value}")
@@ -473,12 +475,12 @@ fn write_error(path: &Path, source: io::Error) -> ScenarioError {
     }
 }
 
-/// Runs `fill` on a buffered temporary file next to `path`, then syncs it and renames it over
-/// `path`. Removes the temporary file on any error.
-fn write_atomic<F>(path: &Path, fill: F) -> Result<()>
-where
-    F: FnOnce(&mut BufWriter<File>) -> Result<()>,
-{
+/// Creates a new, uniquely named temporary file in the folder of `path` (`.NAME.PID.N.tmp`),
+/// to be renamed over `path` when its content is complete.
+///
+/// # Errors
+/// [`ScenarioError::Io`] if `path` names no file or the file cannot be created.
+pub fn create_temp_next_to(path: &Path) -> Result<(PathBuf, File)> {
     let Some(file_name) = path.file_name() else {
         return Err(write_error(
             path,
@@ -504,6 +506,16 @@ where
             action: "creating a temporary file next to",
             source,
         })?;
+    Ok((temp, file))
+}
+
+/// Runs `fill` on a buffered temporary file next to `path`, then syncs it and renames it over
+/// `path`. Removes the temporary file on any error.
+fn write_atomic<F>(path: &Path, fill: F) -> Result<()>
+where
+    F: FnOnce(&mut BufWriter<File>) -> Result<()>,
+{
+    let (temp, file) = create_temp_next_to(path)?;
 
     let result = (|| {
         let mut out = BufWriter::with_capacity(BUFFER_BYTES, file);
@@ -523,7 +535,7 @@ where
 
     match result {
         Ok(()) => {
-            sync_directory(dir);
+            sync_directory(temp.parent().unwrap_or(Path::new(".")));
             Ok(())
         }
         Err(error) => {
