@@ -343,6 +343,18 @@ fn summary_json(
         .map(|e| json!({"quantity": e.quantity, "peak": e.peak, "limit": e.limit, "t_s": e.t_s}))
         .collect();
     m.insert("limit_exceedances".into(), Value::Array(exceed));
+    // Every limit with the run's peak against it, so a report can say which ones it respects.
+    let l = &s.limits;
+    let check = |peak: f64, limit: f64| json!({"limit": limit, "peak": peak, "respected": peak.abs() <= limit});
+    m.insert(
+        "limits".into(),
+        json!({
+            "stroke_m": check(peaks.u_m.value, l.stroke_m),
+            "velocity_m_s": check(peaks.v_m_s.value, l.velocity_m_s),
+            "acceleration_m_s2": check(peaks.a_m_s2.value, l.acceleration_m_s2),
+            "force_n": check(peaks.force_n.value, l.force_n),
+        }),
+    );
     m.insert("out".into(), json!(out.map(|p| p.display().to_string())));
     Value::Object(m)
 }
@@ -407,7 +419,14 @@ fn print_summary(s: &Scenario, peaks: &Peaks, stats: Option<&RunStats>, out: Opt
     }
     let ex = peaks.exceedances(&s.limits);
     if ex.is_empty() {
-        println!("  within the table's limits");
+        let l = &s.limits;
+        println!(
+            "  within the table's limits (stroke ±{} m, {} m/s, {:.1} g, {:.1} MN)",
+            l.stroke_m,
+            l.velocity_m_s,
+            l.acceleration_m_s2 / STANDARD_GRAVITY_M_S2,
+            l.force_n / 1e6
+        );
     }
     for e in ex {
         println!(

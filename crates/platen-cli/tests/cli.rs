@@ -537,6 +537,9 @@ fn the_tarzana_scenario_runs_from_the_real_record_within_the_table_limits() {
     let f = s["peak_force_n"].as_f64().unwrap();
     assert!((2.3e6..2.8e6).contains(&f.abs()), "{f}");
     assert_eq!(s["limit_exceedances"].as_array().unwrap().len(), 0);
+    for key in ["stroke_m", "velocity_m_s", "acceleration_m_s2", "force_n"] {
+        assert_eq!(s["limits"][key]["respected"], true, "{key}: {s}");
+    }
 }
 
 /// A lab's export: its own headers and units (time in ms, displacement in mm, acceleration in
