@@ -28,7 +28,7 @@ use platen_model::PlatenModel;
 use crate::error::{IntegrateError, Result};
 use crate::output::SampleSink;
 use crate::record::ForceRecord;
-use crate::rk4::{mode_at_rest, sample_at, EnergyBalance, Kin, Mode, RunStats, State};
+use crate::rk4::{check_run, mode_at_rest, sample_at, EnergyBalance, Kin, Mode, RunStats, State};
 
 /// Settings of the adaptive integrator.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -112,18 +112,7 @@ pub fn forward_dopri5<M: PlatenModel, S: SampleSink>(
     samples: usize,
     sink: &mut S,
 ) -> Result<RunStats> {
-    if samples > record.len() {
-        return Err(IntegrateError::RecordTooShort {
-            requested: samples,
-            available: record.len(),
-        });
-    }
-    if !(initial.u_m.is_finite() && initial.v_m_s.is_finite()) {
-        return Err(IntegrateError::InvalidInitialState {
-            u_m: initial.u_m,
-            v_m_s: initial.v_m_s,
-        });
-    }
+    check_run(record, initial, samples)?;
     let force = record.force_n();
     let times = record.t_s();
     let dt = record.dt_s();

@@ -325,18 +325,7 @@ pub fn forward_rk4<M: PlatenModel, S: SampleSink>(
     samples: usize,
     sink: &mut S,
 ) -> Result<RunStats> {
-    if samples > record.len() {
-        return Err(IntegrateError::RecordTooShort {
-            requested: samples,
-            available: record.len(),
-        });
-    }
-    if !(initial.u_m.is_finite() && initial.v_m_s.is_finite()) {
-        return Err(IntegrateError::InvalidInitialState {
-            u_m: initial.u_m,
-            v_m_s: initial.v_m_s,
-        });
-    }
+    check_run(record, initial, samples)?;
     let k = u64::from(rk4.steps_per_sample);
     let grid = Grid {
         force: record.force_n(),
@@ -359,6 +348,24 @@ pub fn forward_rk4<M: PlatenModel, S: SampleSink>(
         sink.accept(&stepper.sample(j + 1, times[j + 1]));
     }
     Ok(stepper.finish())
+}
+
+/// The checks every forward run makes before it starts: the record holds the samples asked
+/// for, and the initial state is finite.
+pub(crate) fn check_run(record: &ForceRecord, initial: State, samples: usize) -> Result<()> {
+    if samples > record.len() {
+        return Err(IntegrateError::RecordTooShort {
+            requested: samples,
+            available: record.len(),
+        });
+    }
+    if !(initial.u_m.is_finite() && initial.v_m_s.is_finite()) {
+        return Err(IntegrateError::InvalidInitialState {
+            u_m: initial.u_m,
+            v_m_s: initial.v_m_s,
+        });
+    }
+    Ok(())
 }
 
 /// How a slip interval that touches `v = 0` is split into RK4 sub-steps.
