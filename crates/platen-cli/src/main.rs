@@ -6,9 +6,12 @@
 #![recursion_limit = "256"]
 
 mod bench;
+mod compare;
 mod generate;
 mod identify;
 mod model;
+mod plot;
+mod report;
 mod schema;
 mod simulate;
 mod sweep;
@@ -45,6 +48,35 @@ enum Command {
         /// Print a machine-readable summary on stdout.
         #[arg(long)]
         json: bool,
+    },
+    /// Run a scenario and compare it with a recorded test: forward scenarios compare the
+    /// displacement u_m and velocity v_m_s, inverse scenarios the actuator force force_n, on
+    /// the recorded time base. Per channel: RMS error, NRMSE (normalised by the recorded RMS),
+    /// signed peaks and their ratio, correlation and lag by cross-correlation.
+    Compare {
+        /// Scenario JSON file.
+        scenario: PathBuf,
+        /// Recorded CSV file (t_s and u_m, v_m_s for a forward run, force_n for an inverse
+        /// one; a_m_s2 and the other columns are used by the figures where present). It must
+        /// be uniformly sampled and cover the scenario's time span.
+        #[arg(long, value_name = "REC.csv")]
+        recorded: PathBuf,
+        /// Print the metrics as JSON (one object per channel: u_m, v_m_s or force_n).
+        #[arg(long)]
+        json: bool,
+        /// Write the figures to this folder as SVG and PNG (time histories with a zoom, residuals,
+        /// hysteresis loops, dissipative force against velocity with the model's law).
+        #[arg(long, value_name = "DIR")]
+        plot: Option<PathBuf>,
+        /// Compute the metrics over this time window only, s (also the zoomed interval).
+        #[arg(long, value_name = "T0,T1", allow_hyphen_values = true, value_parser = compare::parse_window)]
+        window: Option<compare::Window>,
+        /// Write a self-contained HTML report (metrics table and figures) to this file.
+        #[arg(long, value_name = "FILE.html")]
+        report: Option<PathBuf>,
+        /// Largest lag searched by cross-correlation, either way, s.
+        #[arg(long, value_name = "S", default_value_t = 0.25, value_parser = compare::parse_max_lag)]
+        max_lag: f64,
     },
     /// Print a preset's parameters and derived quantities.
     Model {
@@ -177,6 +209,23 @@ fn main() -> ExitCode {
             out,
             json,
         } => simulate::run(&scenario, out.as_deref(), json),
+        Command::Compare {
+            scenario,
+            recorded,
+            json,
+            plot,
+            window,
+            report,
+            max_lag,
+        } => compare::run(&compare::Options {
+            scenario: &scenario,
+            recorded: &recorded,
+            json,
+            plot: plot.as_deref(),
+            window,
+            report: report.as_deref(),
+            max_lag_s: max_lag,
+        }),
         Command::Model {
             preset,
             pressure_mpa,

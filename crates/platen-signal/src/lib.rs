@@ -80,6 +80,7 @@ mod crossover;
 mod error;
 mod extend;
 mod fir;
+pub mod metrics;
 mod resample;
 mod spectral;
 mod welch;
