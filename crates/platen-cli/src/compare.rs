@@ -13,7 +13,6 @@
 //! * Metrics are those of [`platen_signal::metrics`], over the whole compared span or the
 //!   `--window`.
 
-use std::fs;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
@@ -22,7 +21,7 @@ use serde_json::{json, Map, Value};
 use platen_integrate::Trajectory;
 use platen_model::{force_terms, PlatenModel};
 use platen_scenario::csv_io::{read_table, uniform_step_s, write_bytes_atomic, Table};
-use platen_scenario::{Model, Run, Scenario, ScenarioError};
+use platen_scenario::{Model, Run, Scenario};
 use platen_signal::metrics::{interpolate_linear, ChannelMetrics, Comparator};
 use platen_signal::{differentiate, SampleRate};
 
@@ -262,22 +261,10 @@ pub fn run(options: &Options<'_>) -> Result<()> {
         Vec::new()
     };
     let rendered = plot::render_all(&figures)?;
-    let mut written = Vec::new();
-    if let Some(dir) = options.plot {
-        fs::create_dir_all(dir).map_err(|source| ScenarioError::Io {
-            path: dir.to_path_buf(),
-            action: "creating the figure folder",
-            source,
-        })?;
-        for (file, svg) in &rendered {
-            let path = dir.join(file);
-            write_bytes_atomic(&path, svg.as_bytes())?;
-            written.push(path);
-            let png = dir.join(Path::new(file).with_extension("png"));
-            write_bytes_atomic(&png, &plot::svg_to_png(svg)?)?;
-            written.push(png);
-        }
-    }
+    let written = match options.plot {
+        Some(dir) => plot::write_figures(dir, &rendered)?,
+        None => Vec::new(),
+    };
     if let Some(path) = options.report {
         let html = report::html(&comparison, &figures, &rendered);
         write_bytes_atomic(path, html.as_bytes())?;

@@ -21,7 +21,9 @@ use serde_json::{json, Map, Value};
 use platen_ident::{
     identify, Estimate, Flag, Identification, Parameter, Settings, TestKind, TestRecord, TestResult,
 };
-use platen_scenario::csv_io::{read_table, uniform_step_s};
+use platen_scenario::csv_io::{read_table, uniform_step_s, write_bytes_atomic};
+
+use crate::{identify_plot, plot};
 
 /// Options of `platen identify`.
 pub struct Options<'a> {
@@ -31,6 +33,10 @@ pub struct Options<'a> {
     pub viscous_exponent: Option<f64>,
     pub no_low_velocity_term: bool,
     pub json: bool,
+    /// Folder for the figures (SVG and PNG).
+    pub plot: Option<&'a Path>,
+    /// Self-contained HTML report.
+    pub report: Option<&'a Path>,
 }
 
 /// The manifest file.
@@ -109,12 +115,138 @@ pub fn run(opts: &Options) -> Result<()> {
         ..Settings::default()
     };
     let id = identify(&records, &settings).context("identification failed")?;
-    if opts.json {
-        println!("{}", serde_json::to_string_pretty(&to_json(&id, &inputs))?);
+    let figures = if opts.plot.is_some() || opts.report.is_some() {
+        identify_plot::figures(&id)
     } else {
-        print!("{}", report(&id, &inputs));
+        Vec::new()
+    };
+    let rendered = plot::render_all(&figures)?;
+    let written = match opts.plot {
+        Some(dir) => plot::write_figures(dir, &rendered)?,
+        None => Vec::new(),
+    };
+    let text = report(&id, &inputs);
+    if let Some(path) = opts.report {
+        let html = html_report(&id, &inputs, &text, &figures, &rendered);
+        write_bytes_atomic(path, html.as_bytes())?;
+    }
+    if opts.json {
+        let mut summary = to_json(&id, &inputs);
+        if let Some(fields) = summary.as_object_mut() {
+            if opts.plot.is_some() {
+                fields.insert(
+                    "figures".into(),
+                    json!(written
+                        .iter()
+                        .map(|p| p.display().to_string())
+                        .collect::<Vec<_>>()),
+                );
+            }
+            if let Some(path) = opts.report {
+                fields.insert("report".into(), json!(path.display().to_string()));
+            }
+        }
+        println!("{}", serde_json::to_string_pretty(&summary)?);
+    } else {
+        print!("{text}");
+        if !written.is_empty() {
+            println!("\nWrote {} figure files (SVG and PNG):", written.len());
+            for path in &written {
+                println!("  {}", path.display());
+            }
+        }
+        if let Some(path) = opts.report {
+            println!("Wrote report {}", path.display());
+        }
     }
     Ok(())
+}
+
+/// The HTML report: the parameter table, the text report's per-test tables, the figures
+/// and the JSON summary.
+fn html_report(
+    id: &Identification,
+    inputs: &[Input],
+    text: &str,
+    figures: &[plot::Figure],
+    rendered: &[(String, String)],
+) -> String {
+    let items = vec![
+        (
+            "tests".to_owned(),
+            format!(
+                "{} ({} sine, {} triangle)",
+                id.tests.len(),
+                id.tests.iter().filter(|t| t.kind == TestKind::Sine).count(),
+                id.tests
+                    .iter()
+                    .filter(|t| t.kind == TestKind::Triangle)
+                    .count()
+            ),
+        ),
+        (
+            "files".to_owned(),
+            inputs
+                .iter()
+                .map(|i| i.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+        ),
+        (
+            "reference pressure".to_owned(),
+            id.reference_pressure_pa
+                .map_or("not given".to_owned(), |p| format!("{} MPa", p / 1e6)),
+        ),
+    ];
+    let units = ["kg", "N/m", "N", "N/(m/s)^α", "", "N", "s/m"];
+    let rows: Vec<Vec<String>> = id
+        .parameters()
+        .iter()
+        .zip(units)
+        .map(|((name, p), unit)| {
+            let (value, se, ci, status) = match p {
+                Parameter::Estimated(e) => (
+                    format!("{:.6e}", e.value),
+                    format!("{:.2e}", e.std_error),
+                    format!("{:.6e} – {:.6e}", e.ci95_low, e.ci95_high),
+                    "estimated".to_owned(),
+                ),
+                Parameter::Fixed { value, reason } => (
+                    format!("{value:.6e}"),
+                    "—".into(),
+                    "—".into(),
+                    format!("fixed: {reason}"),
+                ),
+                Parameter::NotIdentifiable { reason } => (
+                    "—".into(),
+                    "—".into(),
+                    "—".into(),
+                    format!("not identifiable: {reason}"),
+                ),
+            };
+            vec![(*name).to_owned(), value, unit.to_owned(), se, ci, status]
+        })
+        .collect();
+    let mut sections = vec![crate::report::heading("Identified parameters")];
+    sections.push(crate::report::table(
+        &["key", "value", "unit", "std. error", "95 % CI", "status"],
+        &rows,
+        true,
+    ));
+    for w in &id.warnings {
+        sections.push(crate::report::paragraph(w, Some("note")));
+    }
+    sections.push(crate::report::heading("Report"));
+    sections.push(crate::report::preformatted(text));
+    crate::report::page(&crate::report::Page {
+        title: "platen identify".into(),
+        heading: "Identification from periodic tests (hysteresis-loop method)".into(),
+        items,
+        sections,
+        figures,
+        rendered,
+        summary: to_json(id, inputs),
+    })
 }
 
 /// The files to read: the command line's, then the manifest's not already given, with

@@ -9,6 +9,7 @@ mod bench;
 mod compare;
 mod generate;
 mod identify;
+mod identify_plot;
 mod model;
 mod plot;
 mod report;
@@ -190,6 +191,16 @@ enum Command {
         /// JSON on stdout.
         #[arg(long)]
         json: bool,
+        /// Write the identification figures to this folder as SVG and PNG: per-test Kₑ and
+        /// Mₑ with confidence intervals (Tables I, II), elastic force against displacement,
+        /// inertial force against acceleration, dissipative force against velocity with the
+        /// fitted law (Fig. 7), Coulomb force against vertical load (Fig. 8).
+        #[arg(long, value_name = "DIR")]
+        plot: Option<PathBuf>,
+        /// Write a self-contained HTML report (parameters, per-test tables, figures) to this
+        /// file.
+        #[arg(long, value_name = "FILE.html")]
+        report: Option<PathBuf>,
     },
 }
 
@@ -260,6 +271,8 @@ fn main() -> ExitCode {
             viscous_exponent,
             no_low_velocity_term,
             json,
+            plot,
+            report,
         } => identify::run(&identify::Options {
             files: &files,
             pressure_mpa: &pressure_mpa,
@@ -267,6 +280,8 @@ fn main() -> ExitCode {
             viscous_exponent,
             no_low_velocity_term,
             json,
+            plot: plot.as_deref(),
+            report: report.as_deref(),
         }),
     };
     match result {

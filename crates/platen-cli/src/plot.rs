@@ -1,5 +1,6 @@
 //! SVG figures with plotters' SVG backend: a small layout layer (panels of line and point
-//! series with labelled axes and legends) and the figures of `platen compare`.
+//! series with labelled axes and legends) and the figures of `platen compare`; those of
+//! `platen identify` are in [`crate::identify_plot`].
 //!
 //! Only the SVG backend is used, with plotters' built-in text-size estimate, so no font file,
 //! font library or C library is needed: text is written as SVG `<text>` in the `sans-serif`
@@ -14,7 +15,12 @@
 //! colour, and its legend entry repeats that colour once, so a figure's series can be counted
 //! from the file.
 
+use std::fs;
+use std::path::{Path, PathBuf};
+
 use anyhow::{anyhow, Result};
+use platen_scenario::csv_io::write_bytes_atomic;
+use platen_scenario::ScenarioError;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -39,9 +45,13 @@ const AXIS_DESC_SIZE: f64 = 21.0;
 const TICK_SIZE: f64 = 19.0;
 const LEGEND_SIZE: f64 = 19.0;
 const FONT: &str = "sans-serif";
+/// Most tick labels on a horizontal axis.
+const X_LABELS_MAX: usize = 14;
+/// Most tick labels on a vertical axis.
+const Y_LABELS_MAX: usize = 12;
 
 /// Most points drawn for a scatter series (evenly spaced samples beyond that).
-const MAX_SCATTER_POINTS: usize = 4000;
+pub const MAX_SCATTER_POINTS: usize = 4000;
 /// Most points drawn for a loop (hysteresis) line (evenly spaced samples beyond that).
 const MAX_LOOP_POINTS: usize = 20_000;
 
@@ -52,6 +62,9 @@ pub enum Style {
     Line { color: RGBColor, width: u32 },
     /// Filled circles of radius `radius` px.
     Points { color: RGBColor, radius: i32 },
+    /// Separate straight segments between consecutive pairs of points (error bars); one
+    /// `<polyline>` per segment.
+    Segments { color: RGBColor, width: u32 },
 }
 
 /// One data series of a panel.
@@ -157,13 +170,50 @@ fn padded_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
-/// Decimals that tell ticks about `span / 6` apart from each other.
-fn tick_decimals(span: f64) -> usize {
-    let step = span / 6.0;
-    if !(step.is_finite() && step > 0.0) {
-        return 2;
+/// The spacing plotters gives at most `max_points` ticks over `range`: the finest of
+/// 1, 2 or 5 × 10^k that keeps the count (the same search as plotters' float key points).
+fn tick_step(range: (f64, f64), max_points: usize) -> f64 {
+    let span = range.1 - range.0;
+    if !(span.is_finite() && span > 0.0) || max_points == 0 {
+        return 1.0;
     }
-    (-(step.log10().floor()) as i64).clamp(0, 8) as usize
+    let rem = |a: f64, b: f64| a - (a / b).floor() * b;
+    let count = |step: f64| {
+        let mut left = range.0 - rem(range.0, step);
+        if left < range.0 {
+            left += step;
+        }
+        let right = range.1 - rem(range.1, step);
+        (1.0 + (right - left) / step).round() as usize
+    };
+    let mut scale = 10f64.powf(span.log10().floor());
+    if 1 + (span / scale).floor() as usize > max_points {
+        scale *= 10.0;
+    }
+    loop {
+        let old = scale;
+        for next in [2.0, 5.0, 10.0] {
+            if count(old / next) > max_points {
+                return scale;
+            }
+            scale = old / next;
+        }
+        scale = old / 10.0;
+        if scale < span * 1e-12 {
+            return scale;
+        }
+    }
+}
+
+/// Decimals that tell the ticks of `range` apart when at most `max_points` are drawn.
+fn tick_decimals(range: (f64, f64), max_points: usize) -> usize {
+    let step = tick_step(range, max_points);
+    (-((step.log10() + 1e-9).floor()) as i64).clamp(0, 8) as usize
+}
+
+/// Most tick labels along an axis of `px` pixels, `px_per_label` apart.
+fn label_count(px: f64, px_per_label: f64, max: usize) -> usize {
+    ((px / px_per_label) as usize).clamp(4, max)
 }
 
 fn format_tick(value: f64, decimals: usize) -> String {
@@ -199,7 +249,8 @@ fn ranges(panel: &Panel) -> ((f64, f64), (f64, f64)) {
 /// Width of the y label area that fits the widest tick label of `y` and the axis
 /// description, px (about 0.6 em per character).
 fn y_label_area(y: (f64, f64)) -> u32 {
-    let decimals = tick_decimals(y.1 - y.0);
+    // The most labels an axis gets (see `draw_panel`): the widest text.
+    let decimals = tick_decimals(y, Y_LABELS_MAX);
     let widest = [y.0, y.1, 0.5 * (y.0 + y.1)]
         .iter()
         .map(|v| format_tick(*v, decimals).chars().count())
@@ -285,7 +336,9 @@ fn draw_panel(panel: &Panel, area: &DrawingArea<SVGBackend<'_>, Shift>, y_area: 
         (f64::from(h) - f64::from(x_area + margin_top + margin_bottom) - caption_px).max(50.0),
     );
     let (legend_position, y) = place_legend(panel, x, y_data, plot_px);
-    let (x_dec, y_dec) = (tick_decimals(x.1 - x.0), tick_decimals(y.1 - y.0));
+    let x_labels = label_count(plot_px.0, 55.0, X_LABELS_MAX);
+    let y_labels = label_count(plot_px.1, 40.0, Y_LABELS_MAX);
+    let (x_dec, y_dec) = (tick_decimals(x, x_labels), tick_decimals(y, y_labels));
 
     let mut builder = ChartBuilder::on(area);
     if !panel.title.is_empty() {
@@ -306,8 +359,8 @@ fn draw_panel(panel: &Panel, area: &DrawingArea<SVGBackend<'_>, Shift>, y_area: 
         .configure_mesh()
         .x_desc(panel.x_label.as_str())
         .y_desc(panel.y_label.as_str())
-        .x_labels(((plot_px.0 / 55.0) as usize).clamp(4, 14))
-        .y_labels(((plot_px.1 / 40.0) as usize).clamp(4, 12))
+        .x_labels(x_labels)
+        .y_labels(y_labels)
         .x_label_formatter(&x_fmt)
         .y_label_formatter(&y_fmt)
         .label_style((FONT, TICK_SIZE))
@@ -354,6 +407,22 @@ fn draw_panel(panel: &Panel, area: &DrawingArea<SVGBackend<'_>, Shift>, y_area: 
                     drawn
                         .label(label)
                         .legend(move |(lx, ly)| Circle::new((lx + 14, ly), 5, color.filled()));
+                }
+            }
+            Style::Segments { color, width } => {
+                let style = color.stroke_width(width);
+                let drawn = chart
+                    .draw_series(
+                        series
+                            .points
+                            .chunks_exact(2)
+                            .map(move |pair| PathElement::new(vec![pair[0], pair[1]], style)),
+                    )
+                    .map_err(plot_error)?;
+                if !label.is_empty() {
+                    drawn.label(label).legend(move |(lx, ly)| {
+                        PathElement::new(vec![(lx + 14, ly - 8), (lx + 14, ly + 8)], style)
+                    });
                 }
             }
         }
@@ -423,11 +492,18 @@ pub fn thinned(x: &[f64], y: &[f64], max: usize) -> (Vec<(f64, f64)>, usize) {
     )
 }
 
-fn scaled(values: &[f64], scale: f64) -> Vec<f64> {
+/// `values` times `scale` (unit conversion for display).
+pub fn scaled(values: &[f64], scale: f64) -> Vec<f64> {
     values.iter().map(|v| v * scale).collect()
 }
 
-fn line(label: impl Into<String>, points: Vec<(f64, f64)>, color: RGBColor, width: u32) -> Series {
+/// A line series.
+pub fn line(
+    label: impl Into<String>,
+    points: Vec<(f64, f64)>,
+    color: RGBColor,
+    width: u32,
+) -> Series {
     Series {
         label: label.into(),
         points,
@@ -592,6 +668,10 @@ pub fn figures(c: &Comparison) -> Vec<Figure> {
     let f_sim = scaled(&c.simulated.force_n, 1e-3);
     let mut loops = Vec::new();
     let mut stride = 1;
+    // A forward run's "simulated" force is the one that drove the model (after any
+    // low-pass), not an output of it: the caption says so, the legend stays short enough for
+    // a third of the figure's width.
+    let sim_label = "simulated";
     for (quantity, symbol, unit, rec_x, sim_x) in [
         ("displacement", "u", "m", &c.recorded.u_m, &c.simulated.u_m),
         (
@@ -618,7 +698,7 @@ pub fn figures(c: &Comparison) -> Vec<Figure> {
             y_label: "actuator force F_A (kN)".into(),
             series: vec![
                 line("recorded", rec_points, RECORDED, 1),
-                line("simulated", sim_points, SIMULATED, 2),
+                line(sim_label, sim_points, SIMULATED, 2),
             ],
             x_range: None,
             shade_x: None,
@@ -693,7 +773,7 @@ pub fn figures(c: &Comparison) -> Vec<Figure> {
 }
 
 /// "every 3rd sample", "every 12th sample", …
-fn every(k: usize) -> String {
+pub fn every(k: usize) -> String {
     let suffix = match (k % 10, k % 100) {
         (_, 11..=13) => "th",
         (1, _) => "st",
@@ -718,6 +798,31 @@ pub fn render_all(figures: &[Figure]) -> Result<Vec<(String, String)>> {
         .iter()
         .map(|f| Ok((format!("{}.svg", f.name), f.to_svg()?)))
         .collect()
+}
+
+/// Writes every figure to `dir` (created if missing) as SVG and PNG, and returns the paths
+/// written. Every PNG is rendered before the first file is written, so a rendering failure
+/// leaves the folder as it was; each file is written atomically.
+pub fn write_figures(dir: &Path, rendered: &[(String, String)]) -> Result<Vec<PathBuf>> {
+    let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::with_capacity(2 * rendered.len());
+    for (file, svg) in rendered {
+        files.push((dir.join(file), svg.as_bytes().to_vec()));
+        files.push((
+            dir.join(Path::new(file).with_extension("png")),
+            svg_to_png(svg)?,
+        ));
+    }
+    fs::create_dir_all(dir).map_err(|source| ScenarioError::Io {
+        path: dir.to_path_buf(),
+        action: "creating the figure folder",
+        source,
+    })?;
+    let mut written = Vec::with_capacity(files.len());
+    for (path, bytes) in files {
+        write_bytes_atomic(&path, &bytes)?;
+        written.push(path);
+    }
+    Ok(written)
 }
 
 /// Renders an SVG document (as written by [`Figure::to_svg`]) to PNG at its own pixel size,

@@ -1,9 +1,11 @@
-//! `platen compare --report FILE.html`: one self-contained HTML page with what was compared,
-//! the metrics table and every figure inlined as SVG (no external file, script or font), the
-//! `--json` summary at the end. The page is a pure function of the comparison, so the same
-//! input gives the same bytes.
+//! Self-contained HTML reports: `platen compare --report FILE.html` and `platen identify
+//! --report FILE.html`. One page with what was run, the tables, every figure inlined as SVG
+//! (no external file, script or font) and the `--json` summary at the end. A page is a pure
+//! function of its inputs, so the same input gives the same bytes.
 
 use std::fmt::Write as _;
+
+use serde_json::Value;
 
 use crate::compare::{display_row, summary_json, Comparison, Direction, DISPLAY_HEADINGS};
 use crate::plot::Figure;
@@ -38,88 +40,47 @@ fn escape(text: &str) -> String {
     out
 }
 
-/// The report page; `rendered[i]` is the SVG of `figures[i]`.
-pub fn html(c: &Comparison, figures: &[Figure], rendered: &[(String, String)]) -> String {
+/// What a report page holds, top to bottom.
+pub struct Page<'a> {
+    /// Document title (browser tab).
+    pub title: String,
+    /// Heading at the top.
+    pub heading: String,
+    /// What was run: (term, value) pairs.
+    pub items: Vec<(String, String)>,
+    /// Sections of ready-made HTML (tables, notes), in order.
+    pub sections: Vec<String>,
+    /// The figures and their SVG (`rendered[i]` is the SVG of `figures[i]`).
+    pub figures: &'a [Figure],
+    /// `(file name, svg)` of each figure.
+    pub rendered: &'a [(String, String)],
+    /// The machine-readable summary shown at the end.
+    pub summary: Value,
+}
+
+/// The page as one HTML document.
+pub fn page(p: &Page<'_>) -> String {
     let mut h = String::new();
-    let title = format!("platen compare: {}", c.name);
     let _ = write!(
         h,
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
          <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
          <title>{}</title>\n<style>{STYLE}</style>\n</head>\n<body>\n<h1>{}</h1>\n",
-        escape(&title),
-        escape(&c.name)
+        escape(&p.title),
+        escape(&p.heading)
     );
-    let direction = match c.direction {
-        Direction::Forward => {
-            "forward: the force drives the model; displacement and velocity compared"
-        }
-        Direction::Inverse => "inverse: the motion drives the model; actuator force compared",
-    };
     let _ = writeln!(h, "<dl>");
-    let mut item = |term: &str, value: String| {
-        let _ = writeln!(h, "<dt>{}</dt><dd>{}</dd>", escape(term), escape(&value));
-    };
-    item("scenario", c.scenario_path.display().to_string());
-    item("recorded", c.recorded_path.display().to_string());
-    item("run", direction.to_string());
-    item("model", format!("{} form", c.model_form));
-    item(
-        "compared",
-        format!(
-            "{} recorded samples at {} Hz, {:.3}–{:.3} s (simulated {:.3}–{:.3} s, record {:.3}–{:.3} s)",
-            c.t_s.len(),
-            c.sample_rate_hz,
-            c.t_s[0],
-            c.t_s[c.t_s.len() - 1],
-            c.simulated_span_s.0,
-            c.simulated_span_s.1,
-            c.recorded_span_s.0,
-            c.recorded_span_s.1
-        ),
-    );
-    item(
-        "metrics window",
-        match c.window_s {
-            Some([a, b]) => format!("{a}–{b} s"),
-            None => "the whole compared span".into(),
-        },
-    );
-    item("lag search", format!("±{} s", c.max_lag_s));
+    for (term, value) in &p.items {
+        let _ = writeln!(h, "<dt>{}</dt><dd>{}</dd>", escape(term), escape(value));
+    }
     let _ = writeln!(h, "</dl>");
-
-    let _ = writeln!(
-        h,
-        "<h2>Metrics</h2>\n<div class=\"scroll\">\n<table>\n<tr><th>channel</th>"
-    );
-    for heading in DISPLAY_HEADINGS {
-        let _ = write!(h, "<th>{}</th>", escape(heading));
+    for section in &p.sections {
+        h.push_str(section);
     }
-    let _ = writeln!(h, "</tr>");
-    for ch in &c.channels {
-        let _ = write!(
-            h,
-            "<tr><td><code>{}</code> ({})</td>",
-            escape(ch.spec.key),
-            escape(ch.spec.quantity)
-        );
-        for cell in display_row(ch) {
-            let _ = write!(h, "<td>{}</td>", escape(&cell));
-        }
-        let _ = writeln!(h, "</tr>");
+    if !p.figures.is_empty() {
+        let _ = writeln!(h, "<h2>Figures</h2>");
     }
-    let _ = writeln!(
-        h,
-        "</table>\n</div>\n<p>Error = simulated − recorded on the recorded time base; NRMSE = RMS error / \
-         RMS of the recorded channel; peak ratio = |peak simulated| / |peak recorded|; correlation \
-         is Pearson's at zero lag; a positive lag means the simulation is late.</p>"
-    );
-    for note in &c.recorded.sources.notes {
-        let _ = writeln!(h, "<p class=\"note\">{}</p>", escape(note));
-    }
-
-    let _ = writeln!(h, "<h2>Figures</h2>");
-    for (figure, (file, svg)) in figures.iter().zip(rendered) {
+    for (figure, (file, svg)) in p.figures.iter().zip(p.rendered) {
         let _ = writeln!(
             h,
             "<figure id=\"{}\">\n{}\n<figcaption><b>{}</b> ({}). {}</figcaption>\n</figure>",
@@ -130,6 +91,121 @@ pub fn html(c: &Comparison, figures: &[Figure], rendered: &[(String, String)]) -
             escape(&figure.caption)
         );
     }
+    let _ = writeln!(
+        h,
+        "<h2>Summary (JSON)</h2>\n<pre>{}</pre>\n<p>Written by platen {}.</p>\n</body>\n</html>",
+        escape(&serde_json::to_string_pretty(&p.summary).unwrap_or_default()),
+        env!("CARGO_PKG_VERSION")
+    );
+    h
+}
+
+/// An HTML table: a heading row and body rows, every cell escaped; `code_first` sets the
+/// first word of the first column in `<code>` (a key, then its description).
+pub fn table(headings: &[&str], rows: &[Vec<String>], code_first: bool) -> String {
+    let mut h = String::from("<div class=\"scroll\">\n<table>\n<tr>");
+    for heading in headings {
+        let _ = write!(h, "<th>{}</th>", escape(heading));
+    }
+    let _ = writeln!(h, "</tr>");
+    for row in rows {
+        h.push_str("<tr>");
+        for (i, cell) in row.iter().enumerate() {
+            if i == 0 && code_first {
+                let (key, rest) = cell.split_once(' ').unwrap_or((cell, ""));
+                let rest = if rest.is_empty() {
+                    String::new()
+                } else {
+                    format!(" {}", escape(rest))
+                };
+                let _ = write!(h, "<td><code>{}</code>{rest}</td>", escape(key));
+            } else {
+                let _ = write!(h, "<td>{}</td>", escape(cell));
+            }
+        }
+        let _ = writeln!(h, "</tr>");
+    }
+    h.push_str("</table>\n</div>\n");
+    h
+}
+
+/// A paragraph of escaped text, with an optional class.
+pub fn paragraph(text: &str, class: Option<&str>) -> String {
+    match class {
+        Some(c) => format!("<p class=\"{}\">{}</p>\n", escape(c), escape(text)),
+        None => format!("<p>{}</p>\n", escape(text)),
+    }
+}
+
+/// A section heading.
+pub fn heading(text: &str) -> String {
+    format!("<h2>{}</h2>\n", escape(text))
+}
+
+/// Preformatted text.
+pub fn preformatted(text: &str) -> String {
+    format!("<pre>{}</pre>\n", escape(text))
+}
+
+/// The `platen compare` report page; `rendered[i]` is the SVG of `figures[i]`.
+pub fn html(c: &Comparison, figures: &[Figure], rendered: &[(String, String)]) -> String {
+    let direction = match c.direction {
+        Direction::Forward => {
+            "forward: the force drives the model; displacement and velocity compared"
+        }
+        Direction::Inverse => "inverse: the motion drives the model; actuator force compared",
+    };
+    let items = vec![
+        ("scenario".into(), c.scenario_path.display().to_string()),
+        ("recorded".into(), c.recorded_path.display().to_string()),
+        ("run".into(), direction.to_string()),
+        ("model".into(), format!("{} form", c.model_form)),
+        (
+            "compared".into(),
+            format!(
+                "{} recorded samples at {} Hz, {:.3}–{:.3} s (simulated {:.3}–{:.3} s, record {:.3}–{:.3} s)",
+                c.t_s.len(),
+                c.sample_rate_hz,
+                c.t_s[0],
+                c.t_s[c.t_s.len() - 1],
+                c.simulated_span_s.0,
+                c.simulated_span_s.1,
+                c.recorded_span_s.0,
+                c.recorded_span_s.1
+            ),
+        ),
+        (
+            "metrics window".into(),
+            match c.window_s {
+                Some([a, b]) => format!("{a}–{b} s"),
+                None => "the whole compared span".into(),
+            },
+        ),
+        ("lag search".into(), format!("±{} s", c.max_lag_s)),
+    ];
+
+    let mut headings = vec!["channel"];
+    headings.extend(DISPLAY_HEADINGS);
+    let rows: Vec<Vec<String>> = c
+        .channels
+        .iter()
+        .map(|ch| {
+            let mut row = vec![format!("{} ({})", ch.spec.key, ch.spec.quantity)];
+            row.extend(display_row(ch));
+            row
+        })
+        .collect();
+    let mut metrics = heading("Metrics");
+    metrics.push_str(&table(&headings, &rows, true));
+    metrics.push_str(&paragraph(
+        "Error = simulated − recorded on the recorded time base; NRMSE = RMS error / RMS of the \
+         recorded channel; peak ratio = |peak simulated| / |peak recorded|; correlation is \
+         Pearson's at zero lag; a positive lag means the simulation is late.",
+        None,
+    ));
+    for note in &c.recorded.sources.notes {
+        metrics.push_str(&paragraph(note, Some("note")));
+    }
 
     let mut summary = summary_json(c, &[], None);
     if let Some(fields) = summary.as_object_mut() {
@@ -137,11 +213,13 @@ pub fn html(c: &Comparison, figures: &[Figure], rendered: &[(String, String)]) -
         fields.remove("figures");
         fields.remove("report");
     }
-    let _ = writeln!(
-        h,
-        "<h2>Summary (JSON)</h2>\n<pre>{}</pre>\n<p>Written by platen {}.</p>\n</body>\n</html>",
-        escape(&serde_json::to_string_pretty(&summary).unwrap_or_default()),
-        env!("CARGO_PKG_VERSION")
-    );
-    h
+    page(&Page {
+        title: format!("platen compare: {}", c.name),
+        heading: c.name.clone(),
+        items,
+        sections: vec![metrics],
+        figures,
+        rendered,
+        summary,
+    })
 }

@@ -321,3 +321,187 @@ fn a_negative_pressure_is_a_usage_error() {
     assert!(stderr(&o).contains("pressure"));
     let _ = Path::new("x");
 }
+
+mod common;
+use common::{check_png, svg_content};
+
+/// Series colours of the identification figures (`identify_plot`): the first pressure group,
+/// flagged tests, the final fit, the paper's Eq. 21 fit.
+const GROUP: &str = "#1F77B4";
+const FLAGGED: &str = "#969696";
+const FIT: &str = "#000000";
+const EQ21: &str = "#B2182B";
+
+fn count(map: &std::collections::BTreeMap<String, usize>, colour: &str) -> usize {
+    map.get(colour).copied().unwrap_or(0)
+}
+
+/// `identify --plot` at one hold-down pressure: the five figures as valid SVG (and PNG) with
+/// the series the per-test tables of the JSON say they must have, the HTML report with every
+/// figure inlined, the same bytes on a second run.
+#[test]
+fn identify_plot_writes_every_figure_with_its_series_and_a_self_contained_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let plots = dir.path().join("figures");
+    let html = dir.path().join("identification.html");
+    let files = files();
+    let run = |plots: &Path, html: &Path| {
+        let mut args = vec![
+            "identify",
+            "--json",
+            "--pressure-mpa",
+            "13.8",
+            "--plot",
+            plots.to_str().unwrap(),
+            "--report",
+            html.to_str().unwrap(),
+        ];
+        args.extend(files.iter().map(String::as_str));
+        let o = platen(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        serde_json::from_slice::<Value>(&o.stdout).unwrap()
+    };
+    let id = run(&plots, &html);
+    let names = [
+        "estimates",
+        "elastic-force",
+        "inertial-force",
+        "dissipative-force",
+        "friction",
+    ];
+    let written: Vec<String> = id["figures"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p.as_str().unwrap().to_owned())
+        .collect();
+    assert_eq!(written.len(), 2 * names.len(), "{written:?}");
+
+    let tests = |kind: &str, used: bool| {
+        id[kind]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|t| t["used"] == used)
+            .count()
+    };
+    let (tri_used, tri_flagged) = (
+        tests("triangle_tests", true),
+        tests("triangle_tests", false),
+    );
+    let (sine_used, sine_flagged) = (tests("sine_tests", true), tests("sine_tests", false));
+    assert_eq!((tri_used, tri_flagged), (12, 0));
+    assert!(
+        sine_used >= 8 && sine_flagged >= 3,
+        "{sine_used} {sine_flagged}"
+    );
+
+    // Estimates: a confidence bar per test, a marker per test plus one per legend entry,
+    // the mass line and its legend entry.
+    let est = svg_content(&plots.join("estimates.svg"));
+    assert_eq!(
+        count(&est.polylines, GROUP),
+        tri_used + sine_used,
+        "{:?}",
+        est.polylines
+    );
+    assert_eq!(count(&est.polylines, FLAGGED), sine_flagged);
+    assert_eq!(count(&est.polylines, FIT), 2);
+    assert_eq!(count(&est.circles, GROUP), tri_used + 1 + sine_used + 1);
+    assert_eq!(count(&est.circles, FLAGGED), sine_flagged + 1);
+    for label in ["stiffness Kₑ (MN/m)", "effective mass Mₑ (t)", "13.8 MPa"] {
+        assert!(est.text.contains(label), "{label}");
+    }
+
+    // Elastic force: the stiffness line and its legend entry, data and residual points.
+    let el = svg_content(&plots.join("elastic-force.svg"));
+    assert_eq!(count(&el.polylines, GROUP), 2, "{:?}", el.polylines);
+    assert_eq!(el.circles.len(), 1, "{:?}", el.circles);
+    assert!(count(&el.circles, GROUP) > 1000);
+    assert!(el.text.contains("F_E − Kₑ·u (kN)"));
+
+    // Inertial force: the mass line, used and flagged points.
+    let inertial = svg_content(&plots.join("inertial-force.svg"));
+    assert_eq!(
+        count(&inertial.polylines, FIT),
+        2,
+        "{:?}",
+        inertial.polylines
+    );
+    assert!(count(&inertial.circles, GROUP) > 1000);
+    assert!(count(&inertial.circles, FLAGGED) > 100);
+    assert!(inertial.text.contains("inertial force F_I (kN)"));
+
+    // Dissipative force: data, the law and Eq. 21 with legend entries, one peak point per
+    // test plus its legend entry.
+    let fd = svg_content(&plots.join("dissipative-force.svg"));
+    assert_eq!(count(&fd.polylines, GROUP), 2, "{:?}", fd.polylines);
+    assert_eq!(count(&fd.polylines, EQ21), 2);
+    assert_eq!(count(&fd.circles, FIT), 24 + 1, "{:?}", fd.circles);
+    assert!(count(&fd.circles, GROUP) > 1000);
+    assert!(fd.text.contains("Eq. 21 fit"));
+
+    // Friction: one pressure (one bar, one point), the μₑ line.
+    let mu = svg_content(&plots.join("friction.svg"));
+    assert_eq!(count(&mu.polylines, GROUP), 1, "{:?}", mu.polylines);
+    assert_eq!(count(&mu.polylines, FIT), 2);
+    assert_eq!(count(&mu.circles, GROUP), 2);
+    assert!(mu.text.contains("vertical load F_z (MN)"));
+
+    for name in names {
+        let path = plots.join(format!("{name}.svg"));
+        check_png(&path, &svg_content(&path));
+    }
+
+    // The report: every figure inlined, the parameters, nothing fetched from elsewhere.
+    let page = std::fs::read_to_string(&html).unwrap();
+    assert_eq!(page.matches("<svg").count(), names.len());
+    for key in [
+        "effective_mass_kg",
+        "stiffness_n_per_m",
+        "friction_coefficient",
+    ] {
+        assert!(page.contains(key), "{key}");
+    }
+    for external in ["src=", "href=", "<script", "<link", "@import", "url("] {
+        assert!(!page.contains(external), "{external}");
+    }
+
+    // Determinism: a second run writes the same bytes.
+    let plots2 = dir.path().join("again");
+    let html2 = dir.path().join("again.html");
+    run(&plots2, &html2);
+    for name in names {
+        for ext in ["svg", "png"] {
+            let file = format!("{name}.{ext}");
+            assert!(
+                std::fs::read(plots.join(&file)).unwrap()
+                    == std::fs::read(plots2.join(&file)).unwrap(),
+                "{file} differs between runs"
+            );
+        }
+    }
+    assert!(std::fs::read(&html).unwrap() == std::fs::read(&html2).unwrap());
+}
+
+/// A figure folder that cannot be made is an output error (exit 5) and writes no report.
+#[test]
+fn identify_plot_into_a_file_is_an_output_error_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let blocker = dir.path().join("a-file");
+    std::fs::write(&blocker, "not a folder").unwrap();
+    let html = dir.path().join("report.html");
+    let f = files();
+    let o = platen(&[
+        "identify",
+        &f[0],
+        &f[1],
+        "--plot",
+        blocker.join("figures").to_str().unwrap(),
+        "--report",
+        html.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(5), "{}", stderr(&o));
+    assert!(stderr(&o).contains("figure folder"), "{}", stderr(&o));
+    assert!(!html.exists());
+}

@@ -1,0 +1,76 @@
+//! Helpers shared by the CLI's figure tests: read an SVG as XML and tally its series.
+
+#![allow(dead_code)]
+
+use std::collections::BTreeMap;
+use std::fs;
+use std::path::Path;
+
+/// What one SVG holds: polylines by stroke colour, circles by fill colour, all text.
+pub struct SvgContent {
+    pub width: u32,
+    pub height: u32,
+    pub polylines: BTreeMap<String, usize>,
+    pub circles: BTreeMap<String, usize>,
+    pub text: String,
+}
+
+/// The stroke of axes and tick marks (not a data series).
+const AXIS_STROKE: &str = "#5A5A5A";
+
+/// Parses `path` as XML (it must be a well-formed SVG document) and tallies its elements.
+pub fn svg_content(path: &Path) -> SvgContent {
+    let text = fs::read_to_string(path).unwrap();
+    let doc = roxmltree::Document::parse(&text)
+        .unwrap_or_else(|e| panic!("{} is not well-formed XML: {e}", path.display()));
+    let root = doc.root_element();
+    assert_eq!(root.tag_name().name(), "svg", "{}", path.display());
+    assert_eq!(
+        root.tag_name().namespace(),
+        Some("http://www.w3.org/2000/svg")
+    );
+    assert!(root.attribute("viewBox").is_some());
+    let mut content = SvgContent {
+        width: root.attribute("width").unwrap().parse().unwrap(),
+        height: root.attribute("height").unwrap().parse().unwrap(),
+        polylines: BTreeMap::new(),
+        circles: BTreeMap::new(),
+        text: String::new(),
+    };
+    for node in root.descendants().filter(|n| n.is_element()) {
+        match node.tag_name().name() {
+            "polyline" => {
+                let stroke = node.attribute("stroke").unwrap_or("none").to_owned();
+                if stroke != AXIS_STROKE {
+                    *content.polylines.entry(stroke).or_default() += 1;
+                }
+            }
+            "circle" => {
+                let fill = node.attribute("fill").unwrap_or("none").to_owned();
+                *content.circles.entry(fill).or_default() += 1;
+            }
+            "text" => {
+                content
+                    .text
+                    .push_str(node.text().unwrap_or_default().trim());
+                content.text.push('\n');
+            }
+            _ => {}
+        }
+    }
+    content
+}
+
+/// The number of polylines of each series colour, in colour order.
+pub fn series_counts(c: &SvgContent) -> Vec<usize> {
+    c.polylines.values().copied().collect()
+}
+
+/// The PNG copy next to an SVG: a PNG of the SVG's pixel size.
+pub fn check_png(svg: &Path, content: &SvgContent) {
+    let png = fs::read(svg.with_extension("png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "{}", svg.display());
+    let width = u32::from_be_bytes(png[16..20].try_into().unwrap());
+    let height = u32::from_be_bytes(png[20..24].try_into().unwrap());
+    assert_eq!((width, height), (content.width, content.height));
+}
