@@ -20,7 +20,8 @@ use serde_json::{json, Map, Value};
 
 use platen_integrate::Trajectory;
 use platen_model::{force_terms, PlatenModel};
-use platen_scenario::csv_io::{read_table, uniform_step_s, write_bytes_atomic, Table};
+use platen_scenario::columns::ColumnMap;
+use platen_scenario::csv_io::{uniform_step_s, write_bytes_atomic, Table};
 use platen_scenario::{Model, Run, Scenario};
 use platen_signal::metrics::{interpolate_linear, ChannelMetrics, Comparator};
 use platen_signal::{differentiate, SampleRate};
@@ -80,6 +81,8 @@ pub struct Options<'a> {
     pub report: Option<&'a Path>,
     /// Lag search bound, s.
     pub max_lag_s: f64,
+    /// JSON file mapping the record's own channel names and units to platen's columns.
+    pub columns: Option<&'a Path>,
 }
 
 /// What a run is compared on.
@@ -290,7 +293,11 @@ pub fn compare(options: &Options<'_>) -> Result<Comparison> {
         Direction::Forward => (&["t_s", "u_m", "v_m_s"], &["a_m_s2", "force_n"]),
         Direction::Inverse => (&["t_s", "force_n"], &["u_m", "v_m_s", "a_m_s2"]),
     };
-    let mut table = read_table(options.recorded, required, optional)?;
+    let map = match options.columns {
+        Some(path) => ColumnMap::load(path)?,
+        None => ColumnMap::default(),
+    };
+    let mut table = map.read_table(options.recorded, required, optional)?;
     let rec_t = table.take_column("t_s").unwrap_or_default();
     let dt = uniform_step_s(options.recorded, &rec_t)?;
 

@@ -11,7 +11,13 @@
 //!
 //! (`file` relative to the manifest; `kind` `sine` or `triangle`; every key but `file`
 //! optional). Files listed only in the manifest are identified too.
+//!
+//! A data system's own channel names and units are mapped to platen's columns with the
+//! `columns` object of the scenario format ([`platen_scenario::columns`]): `--columns
+//! MAP.json` for every file, a manifest's top-level `columns` for the files it lists, or an
+//! entry's own `columns`, the most specific winning.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
@@ -21,7 +27,9 @@ use serde_json::{json, Map, Value};
 use platen_ident::{
     identify, Estimate, Flag, Identification, Parameter, Settings, TestKind, TestRecord, TestResult,
 };
-use platen_scenario::csv_io::{read_table, uniform_step_s, write_bytes_atomic};
+use platen_scenario::columns::{ColumnMap, ColumnSpec};
+use platen_scenario::csv_io::{uniform_step_s, write_bytes_atomic};
+use platen_scenario::scenario::parse_json;
 
 use crate::{identify_plot, plot};
 
@@ -37,6 +45,8 @@ pub struct Options<'a> {
     pub plot: Option<&'a Path>,
     /// Self-contained HTML report.
     pub report: Option<&'a Path>,
+    /// JSON file mapping the files' own channel names and units to platen's columns.
+    pub columns: Option<&'a Path>,
 }
 
 /// The manifest file.
@@ -44,6 +54,9 @@ pub struct Options<'a> {
 #[serde(deny_unknown_fields)]
 struct Manifest {
     tests: Vec<ManifestEntry>,
+    /// Channel names and units of every listed file (an entry's own `columns` wins).
+    #[serde(default)]
+    columns: Option<BTreeMap<String, ColumnSpec>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -56,6 +69,8 @@ struct ManifestEntry {
     pressure_mpa: Option<f64>,
     #[serde(default)]
     name: Option<String>,
+    #[serde(default)]
+    columns: Option<BTreeMap<String, ColumnSpec>>,
 }
 
 #[derive(Debug, Clone, Copy, Deserialize)]
@@ -74,6 +89,8 @@ struct Input {
     label: String,
     kind: Option<TestKind>,
     pressure_mpa: Option<f64>,
+    /// How the file's channels map to platen's columns.
+    columns: ColumnMap,
 }
 
 /// Checks a `--pressure-mpa` value: finite and ≥ 0.
@@ -262,6 +279,10 @@ fn inputs(opts: &Options) -> Result<Vec<Input>> {
             opts.files.len()
         );
     }
+    let default_columns = match opts.columns {
+        Some(path) => ColumnMap::load(path)?,
+        None => ColumnMap::default(),
+    };
     let mut inputs: Vec<Input> = opts
         .files
         .iter()
@@ -276,17 +297,29 @@ fn inputs(opts: &Options) -> Result<Vec<Input>> {
                 1 => Some(opts.pressure_mpa[0]),
                 _ => Some(opts.pressure_mpa[i]),
             },
+            columns: default_columns.clone(),
         })
         .collect();
     if let Some(mpath) = opts.manifest {
         let text = std::fs::read_to_string(mpath)
             .with_context(|| format!("`{}`: cannot read the manifest", mpath.display()))?;
-        let manifest: Manifest = serde_json::from_str(&text).map_err(|e| {
+        let manifest: Manifest = parse_json(mpath, &text).map_err(|e| {
             anyhow::anyhow!(
-                "`{}`: {e} (expected {{\"tests\": [{{\"file\": PATH, \"kind\": \"sine\"|\"triangle\", \"pressure_mpa\": P, \"name\": NAME}}]}}, with only `file` required)",
-                mpath.display()
+                "{e} (expected {{\"tests\": [{{\"file\": PATH, \"kind\": \"sine\"|\"triangle\", \"pressure_mpa\": P, \"name\": NAME, \"columns\": MAP}}], \"columns\": MAP}}, with only `file` required)"
             )
         })?;
+        let column_map = |spec: &BTreeMap<String, ColumnSpec>, at: &str| {
+            ColumnMap::new(spec, at).map_err(|(json_path, value, expected)| {
+                anyhow::anyhow!(
+                    "`{}`: {json_path} = {value}: expected {expected}",
+                    mpath.display()
+                )
+            })
+        };
+        let manifest_columns = match &manifest.columns {
+            Some(spec) => Some(column_map(spec, "columns")?),
+            None => None,
+        };
         let base = mpath.parent().unwrap_or(Path::new("."));
         for (k, entry) in manifest.tests.into_iter().enumerate() {
             if let Some(p) = entry.pressure_mpa {
@@ -301,6 +334,11 @@ fn inputs(opts: &Options) -> Result<Vec<Input>> {
                 entry.file.clone()
             } else {
                 base.join(&entry.file)
+            };
+            let columns = match (&entry.columns, &manifest_columns) {
+                (Some(spec), _) => column_map(spec, &format!("tests[{k}].columns"))?,
+                (None, Some(map)) => map.clone(),
+                (None, None) => default_columns.clone(),
             };
             let kind = entry.kind.map(|k| match k {
                 KindName::Sine => TestKind::Sine,
@@ -323,6 +361,7 @@ fn inputs(opts: &Options) -> Result<Vec<Input>> {
                     }
                     input.pressure_mpa = entry.pressure_mpa.or(input.pressure_mpa);
                     input.kind = kind;
+                    input.columns = columns;
                     if let Some(n) = entry.name {
                         input.label = n.clone();
                         input.name = n;
@@ -338,6 +377,7 @@ fn inputs(opts: &Options) -> Result<Vec<Input>> {
                         [p] => Some(*p),
                         _ => None,
                     }),
+                    columns,
                 }),
             }
         }
@@ -357,7 +397,10 @@ fn file_label(path: &Path) -> String {
 
 fn read_record(input: &Input) -> Result<TestRecord> {
     let path = &input.path;
-    let mut table = read_table(path, &["t_s", "u_m", "a_m_s2", "force_n"], &["v_m_s"])?;
+    let mut table =
+        input
+            .columns
+            .read_table(path, &["t_s", "u_m", "a_m_s2", "force_n"], &["v_m_s"])?;
     let t = table.take_column("t_s").expect("required column");
     let dt = uniform_step_s(path, &t)?;
     let take = |table: &mut platen_scenario::csv_io::Table, c: &str| {

@@ -75,6 +75,10 @@ enum Command {
         /// Write a self-contained HTML report (metrics table and figures) to this file.
         #[arg(long, value_name = "FILE.html")]
         report: Option<PathBuf>,
+        /// JSON file mapping the record's channel names and units to platen's columns, as a
+        /// scenario's excitation.columns: {"u_m": {"name": "Table disp", "unit": "mm"}, …}.
+        #[arg(long, value_name = "MAP.json")]
+        columns: Option<PathBuf>,
         /// Largest lag searched by cross-correlation, either way, s.
         #[arg(long, value_name = "S", default_value_t = 0.25, value_parser = compare::parse_max_lag)]
         max_lag: f64,
@@ -201,6 +205,11 @@ enum Command {
         /// file.
         #[arg(long, value_name = "FILE.html")]
         report: Option<PathBuf>,
+        /// JSON file mapping the files' channel names and units to platen's columns, as a
+        /// scenario's excitation.columns: {"u_m": {"name": "Table disp", "unit": "mm"}, …}
+        /// (a manifest's own `columns` win).
+        #[arg(long, value_name = "MAP.json")]
+        columns: Option<PathBuf>,
     },
 }
 
@@ -227,6 +236,7 @@ fn main() -> ExitCode {
             plot,
             window,
             report,
+            columns,
             max_lag,
         } => compare::run(&compare::Options {
             scenario: &scenario,
@@ -235,6 +245,7 @@ fn main() -> ExitCode {
             plot: plot.as_deref(),
             window,
             report: report.as_deref(),
+            columns: columns.as_deref(),
             max_lag_s: max_lag,
         }),
         Command::Model {
@@ -273,6 +284,7 @@ fn main() -> ExitCode {
             json,
             plot,
             report,
+            columns,
         } => identify::run(&identify::Options {
             files: &files,
             pressure_mpa: &pressure_mpa,
@@ -282,6 +294,7 @@ fn main() -> ExitCode {
             json,
             plot: plot.as_deref(),
             report: report.as_deref(),
+            columns: columns.as_deref(),
         }),
     };
     match result {

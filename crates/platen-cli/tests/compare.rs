@@ -552,3 +552,79 @@ fn a_figure_folder_that_cannot_be_created_is_an_output_error() {
     assert_eq!(o.status.code(), Some(5), "{}", stderr(&o));
     assert!(stderr(&o).contains("figure folder"), "{}", stderr(&o));
 }
+
+/// A record exported with a lab's own channel names and units (`Time` in ms, `Table disp` in
+/// mm, velocity in cm/s, acceleration in g, force in kN), read through `--columns`, gives the
+/// metrics of the record in platen's columns. The two files hold the same numbers up to the
+/// rounding of a unit conversion, so the metrics agree to 1e-9 relative.
+#[test]
+fn columns_map_a_labs_channel_names_and_units() {
+    let dir = tempfile::tempdir().unwrap();
+    let lab = dir.path().join("lab.csv");
+    common::relabel(Path::new(&sr9_recorded()), &lab, &common::LAB_CHANNELS);
+    let map = dir.path().join("columns.json");
+    fs::write(&map, common::LAB_COLUMNS_JSON).unwrap();
+
+    let plain = ok_json(&platen(&[
+        "compare",
+        &sr9_forward(),
+        "--recorded",
+        &sr9_recorded(),
+        "--json",
+    ]));
+    let mapped = ok_json(&platen(&[
+        "compare",
+        &sr9_forward(),
+        "--recorded",
+        lab.to_str().unwrap(),
+        "--columns",
+        map.to_str().unwrap(),
+        "--json",
+    ]));
+    for key in ["u_m", "v_m_s"] {
+        for metric in ["rms_error", "nrmse", "correlation", "peak_ratio"] {
+            let (a, b) = (
+                plain[key][metric].as_f64().unwrap(),
+                mapped[key][metric].as_f64().unwrap(),
+            );
+            assert!(
+                (a - b).abs() <= 1e-9 * a.abs(),
+                "{key}.{metric}: {a} vs {b}"
+            );
+        }
+    }
+
+    // Without the map the lab's headers are a missing column, named with what the file has.
+    let o = platen(&[
+        "compare",
+        &sr9_forward(),
+        "--recorded",
+        lab.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("missing required column `t_s`"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(stderr(&o).contains("Table disp"), "{}", stderr(&o));
+
+    // A map with an unknown unit names the map file, the JSON path and the unit.
+    fs::write(
+        &map,
+        r#"{"u_m": {"name": "Table disp", "unit": "furlong"}}"#,
+    )
+    .unwrap();
+    let o = platen(&[
+        "compare",
+        &sr9_forward(),
+        "--recorded",
+        lab.to_str().unwrap(),
+        "--columns",
+        map.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    for needle in ["columns.json", "columns.u_m.unit", "furlong"] {
+        assert!(stderr(&o).contains(needle), "`{needle}` in {}", stderr(&o));
+    }
+}

@@ -505,3 +505,66 @@ fn identify_plot_into_a_file_is_an_output_error_and_writes_nothing() {
     assert!(stderr(&o).contains("figure folder"), "{}", stderr(&o));
     assert!(!html.exists());
 }
+
+/// Files exported with a lab's channel names and units identify to the same parameters as
+/// the same data in platen's columns: through `--columns`, and through a manifest's
+/// `columns`: the files differ only by the rounding of a unit conversion (about 1e-16), which
+/// the fits carry through to well below 1e-9 relative (measured: below 1e-10).
+#[test]
+fn columns_map_a_labs_channel_names_and_units() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut lab_files = Vec::new();
+    for (i, g) in generated().1.iter().enumerate() {
+        let dst = dir.path().join(format!("lab-{i:02}.csv"));
+        common::relabel(&g.file, &dst, &common::LAB_CHANNELS);
+        lab_files.push(dst.display().to_string());
+    }
+    let map = dir.path().join("columns.json");
+    std::fs::write(&map, common::LAB_COLUMNS_JSON).unwrap();
+    let mut args = vec!["identify", "--json", "--columns", map.to_str().unwrap()];
+    args.extend(lab_files.iter().map(String::as_str));
+    let o = platen(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mapped: Value = serde_json::from_slice(&o.stdout).unwrap();
+
+    let tests: Vec<Value> = lab_files.iter().map(|f| json!({ "file": f })).collect();
+    let columns: Value = serde_json::from_str(common::LAB_COLUMNS_JSON).unwrap();
+    let manifest = dir.path().join("manifest.json");
+    std::fs::write(
+        &manifest,
+        serde_json::to_string(&json!({ "tests": tests, "columns": columns })).unwrap(),
+    )
+    .unwrap();
+    let o = platen(&[
+        "identify",
+        "--json",
+        "--manifest",
+        manifest.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let manifested: Value = serde_json::from_slice(&o.stdout).unwrap();
+
+    let plain = identify_json(&[]);
+    for (key, _) in TABLE {
+        let a = plain[key].as_f64().unwrap();
+        for other in [&mapped, &manifested] {
+            let b = other[key].as_f64().unwrap();
+            assert!((a - b).abs() <= 1e-9 * a.abs(), "{key}: {a} vs {b}");
+        }
+    }
+
+    // An entry's own map with a unit of the wrong kind names the manifest and the entry.
+    std::fs::write(
+        &manifest,
+        serde_json::to_string(&json!({ "tests": [{
+            "file": &lab_files[0],
+            "columns": { "u_m": { "name": "Table disp", "unit": "kN" } }
+        }] }))
+        .unwrap(),
+    )
+    .unwrap();
+    fails_with(
+        &["identify", "--manifest", manifest.to_str().unwrap()],
+        &["manifest.json", "tests[0].columns.u_m.unit", "kN"],
+    );
+}

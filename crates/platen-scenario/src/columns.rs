@@ -23,8 +23,13 @@
 //! `kN`, `MN`, `lbf`, `kip`; pressure (with `times_area_m2`) `Pa`, `kPa`, `MPa`, `bar`, `psi`.
 
 use std::collections::BTreeMap;
+use std::path::Path;
 
 use serde::Deserialize;
+
+use crate::csv_io::{read_table, Table};
+use crate::error::{Result, ScenarioError};
+use crate::scenario::parse_json;
 
 use platen_model::STANDARD_GRAVITY_M_S2;
 
@@ -148,6 +153,46 @@ impl ColumnMap {
             entries.insert(ours.clone(), (header, factor));
         }
         Ok(Self { entries })
+    }
+
+    /// Reads a column map from a JSON file whose top level is a `columns` object (the same
+    /// as a scenario's `excitation.columns`), for recorded files named on the command line.
+    ///
+    /// # Errors
+    /// [`ScenarioError::Io`] if the file cannot be read, [`ScenarioError::Json`] (with the
+    /// JSON path) if it is not such an object, [`ScenarioError::InvalidField`] for an unknown
+    /// column or unit.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
+            path: path.to_owned(),
+            action: "reading",
+            source,
+        })?;
+        let spec: BTreeMap<String, ColumnSpec> = parse_json(path, &text)?;
+        Self::new(&spec, "columns").map_err(|(json_path, value, expected)| {
+            ScenarioError::InvalidField {
+                path: path.to_owned(),
+                json_path,
+                value,
+                expected,
+            }
+        })
+    }
+
+    /// Reads platen's columns `required` and `optional` from the CSV file `path` through this
+    /// map: the table holds them under platen's names, in SI units. A missing required
+    /// column is reported under the file's header name.
+    ///
+    /// # Errors
+    /// Every error of [`read_table`].
+    pub fn read_table(&self, path: &Path, required: &[&str], optional: &[&str]) -> Result<Table> {
+        let req: Vec<&str> = required.iter().map(|c| self.header(c)).collect();
+        let opt: Vec<&str> = optional.iter().map(|c| self.header(c)).collect();
+        let mut table = read_table(path, &req, &opt)?;
+        for &ours in required.iter().chain(optional) {
+            table.rename_scaled(self.header(ours), ours, self.factor(ours));
+        }
+        Ok(table)
     }
 
     /// The header to read for platen's column `ours`.

@@ -93,6 +93,17 @@ impl Table {
         &self.path
     }
 
+    /// Renames column `from` to `to` and multiplies it by `factor` (a unit conversion);
+    /// nothing happens if there is no column `from`.
+    pub(crate) fn rename_scaled(&mut self, from: &str, to: &str, factor: f64) {
+        if let Some(i) = self.position(from) {
+            to.clone_into(&mut self.names[i]);
+            if factor != 1.0 {
+                self.columns[i].iter_mut().for_each(|x| *x *= factor);
+            }
+        }
+    }
+
     fn position(&self, name: &str) -> Option<usize> {
         self.names.iter().position(|n| n == name)
     }

@@ -42,7 +42,7 @@ use platen_model::{
 };
 
 use crate::columns::{ColumnMap, ColumnSpec};
-use crate::csv_io::{read_table, uniform_step_s};
+use crate::csv_io::uniform_step_s;
 use crate::error::{Result, ScenarioError};
 use crate::generate::{self, GenerateError};
 
@@ -485,6 +485,16 @@ impl Scenario {
 /// # Errors
 /// [`ScenarioError::Json`].
 pub fn parse(path: &Path, text: &str) -> Result<ScenarioFile> {
+    parse_json(path, text)
+}
+
+/// Parses JSON text read from `path` into `T`, reporting the JSON path (or line and
+/// column) of any error: for scenario files and the other JSON inputs of platen (column
+/// maps, identification manifests).
+///
+/// # Errors
+/// [`ScenarioError::Json`].
+pub fn parse_json<T: serde::de::DeserializeOwned>(path: &Path, text: &str) -> Result<T> {
     let de = &mut serde_json::Deserializer::from_str(text);
     serde_path_to_error::deserialize(de).map_err(|e| {
         let inner = e.inner();
@@ -812,16 +822,10 @@ fn read_mapped(
             .map_err(|(json_path, value, expected)| ctx.invalid(&json_path, value, expected))?,
         None => ColumnMap::default(),
     };
-    let req: Vec<&str> = required.iter().map(|c| map.header(c)).collect();
-    let opt: Vec<&str> = optional.iter().map(|c| map.header(c)).collect();
-    let mut table = read_table(path, &req, &opt)?;
+    let mut table = map.read_table(path, required, optional)?;
     let mut out = BTreeMap::new();
     for &ours in required.iter().chain(optional) {
-        if let Some(mut col) = table.take_column(map.header(ours)) {
-            let f = map.factor(ours);
-            if f != 1.0 {
-                col.iter_mut().for_each(|x| *x *= f);
-            }
+        if let Some(col) = table.take_column(ours) {
             out.insert(ours, col);
         }
     }

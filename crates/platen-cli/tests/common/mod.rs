@@ -74,3 +74,43 @@ pub fn check_png(svg: &Path, content: &SvgContent) {
     let height = u32::from_be_bytes(png[20..24].try_into().unwrap());
     assert_eq!((width, height), (content.width, content.height));
 }
+
+/// Rewrites a platen CSV as a data system would export it: each `(platen column, header,
+/// SI units per file unit)` becomes a column `header` holding the value in the file's unit.
+pub fn relabel(src: &Path, dst: &Path, channels: &[(&str, &str, f64)]) {
+    use platen_scenario::csv_io::{read_table, write_csv_atomic};
+    let names: Vec<&str> = channels.iter().map(|c| c.0).collect();
+    let table = read_table(src, &names, &[]).unwrap();
+    let columns: Vec<Vec<f64>> = channels
+        .iter()
+        .map(|(ours, _, si_per_unit)| {
+            table
+                .column(ours)
+                .unwrap()
+                .iter()
+                .map(|x| x / si_per_unit)
+                .collect()
+        })
+        .collect();
+    let headers: Vec<&str> = channels.iter().map(|c| c.1).collect();
+    let slices: Vec<&[f64]> = columns.iter().map(Vec::as_slice).collect();
+    write_csv_atomic(dst, &headers, &slices).unwrap();
+}
+
+/// The column map of [`LAB_CHANNELS`], as `--columns` takes it.
+pub const LAB_COLUMNS_JSON: &str = r#"{
+  "t_s": {"name": "Time", "unit": "ms"},
+  "u_m": {"name": "Table disp", "unit": "mm"},
+  "v_m_s": {"name": "Table vel", "unit": "cm/s"},
+  "a_m_s2": {"name": "Table acc", "unit": "g"},
+  "force_n": {"name": "Act force", "unit": "kN"}
+}"#;
+
+/// A lab's channel names and units for platen's five columns.
+pub const LAB_CHANNELS: [(&str, &str, f64); 5] = [
+    ("t_s", "Time", 1e-3),
+    ("u_m", "Table disp", 1e-3),
+    ("v_m_s", "Table vel", 1e-2),
+    ("a_m_s2", "Table acc", 9.80665),
+    ("force_n", "Act force", 1e3),
+];
