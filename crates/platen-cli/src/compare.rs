@@ -301,16 +301,8 @@ pub fn compare(options: &Options<'_>) -> Result<Comparison> {
     let rec_t = table.take_column("t_s").unwrap_or_default();
     let dt = uniform_step_s(options.recorded, &rec_t)?;
 
-    let mut sim = Trajectory::default();
-    execute_scenario(&scenario, &mut sim)?;
-    if sim.len() < 2 {
-        bail!(
-            "scenario `{}` produced {} sample(s): a comparison needs at least 2",
-            options.scenario.display(),
-            sim.len()
-        );
-    }
-    let sim_span = (sim.t_s[0], sim.t_s[sim.len() - 1]);
+    // The span the run will cover, checked against the record before any work.
+    let sim_span = scenario.run.time_span_s();
     let rec_span = (rec_t[0], rec_t[rec_t.len() - 1]);
     let tol = 0.5 * dt;
     if rec_span.0 > sim_span.0 + tol || rec_span.1 < sim_span.1 - tol {
@@ -343,6 +335,30 @@ pub fn compare(options: &Options<'_>) -> Result<Comparison> {
             sim_span.1
         );
     }
+    // The window must lie inside the compared span.
+    let compared_span = (rec_t[first], rec_t[end - 1]);
+    if let Some(Window([w0, w1])) = options.window {
+        if w0 < compared_span.0 - tol || w1 > compared_span.1 + tol {
+            bail!(
+                "--window {w0},{w1} s is not inside the compared span {} s to {} s (the recorded \
+                 samples of `{}` within the scenario's span)",
+                compared_span.0,
+                compared_span.1,
+                options.recorded.display()
+            );
+        }
+    }
+
+    let mut sim = Trajectory::default();
+    execute_scenario(&scenario, &mut sim)?;
+    if sim.len() < 2 {
+        bail!(
+            "scenario `{}` produced {} sample(s): a comparison needs at least 2",
+            options.scenario.display(),
+            sim.len()
+        );
+    }
+    debug_assert_eq!((sim.t_s[0], sim.t_s[sim.len() - 1]), sim_span);
     let t_s = rec_t[range.clone()].to_vec();
     let on_record = |y: &[f64]| -> Result<Vec<f64>> {
         interpolate_linear(&sim.t_s, y, &t_s).context("aligning the simulation on the record")
@@ -364,19 +380,8 @@ pub fn compare(options: &Options<'_>) -> Result<Comparison> {
         options.recorded,
     );
 
-    // Window and metrics.
-    let compared_span = (t_s[0], t_s[t_s.len() - 1]);
     let mut comparator = Comparator::new(rate.hz(), t_s[0], options.max_lag_s)?;
     if let Some(Window([w0, w1])) = options.window {
-        if w0 < compared_span.0 - tol || w1 > compared_span.1 + tol {
-            bail!(
-                "--window {w0},{w1} s is not inside the compared span {} s to {} s (the recorded \
-                 samples of `{}` within the scenario's span)",
-                compared_span.0,
-                compared_span.1,
-                options.recorded.display()
-            );
-        }
         comparator = comparator.with_window_s(w0, w1)?;
     }
     let specs: &[&'static ChannelSpec] = match direction {

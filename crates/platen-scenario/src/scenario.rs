@@ -407,6 +407,23 @@ pub enum Run {
     },
 }
 
+impl Run {
+    /// The times of the first and last output sample, s: known before the run, so that
+    /// inputs that must cover them (a recorded test to compare with) are checked first.
+    pub fn time_span_s(&self) -> (f64, f64) {
+        let (t, n) = match self {
+            Run::Forward {
+                record, samples, ..
+            } => (record.t_s(), *samples),
+            Run::Inverse { motion } => (motion.t_s(), motion.len()),
+        };
+        match n.checked_sub(1).and_then(|last| t.get(last)) {
+            Some(&end) => (t[0], end),
+            None => (f64::NAN, f64::NAN),
+        }
+    }
+}
+
 /// A validated scenario, ready to run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scenario {
