@@ -215,21 +215,20 @@ fn html_report(
                 .map_or("not given".to_owned(), |p| format!("{} MPa", p / 1e6)),
         ),
     ];
-    let units = ["kg", "N/m", "N", "N/(m/s)^α", "", "N", "s/m"];
     let rows: Vec<Vec<String>> = id
         .parameters()
         .iter()
-        .zip(units)
-        .map(|((name, p), unit)| {
+        .zip(DISPLAY_UNITS)
+        .map(|((name, p), (unit, scale, d))| {
             let (value, se, ci, status) = match p {
                 Parameter::Estimated(e) => (
-                    format!("{:.6e}", e.value),
-                    format!("{:.2e}", e.std_error),
-                    format!("{:.6e} – {:.6e}", e.ci95_low, e.ci95_high),
+                    format!("{:.d$}", e.value / scale),
+                    format!("{:.d$}", e.std_error / scale, d = d + 1),
+                    format!("{:.d$} – {:.d$}", e.ci95_low / scale, e.ci95_high / scale),
                     "estimated".to_owned(),
                 ),
                 Parameter::Fixed { value, reason } => (
-                    format!("{value:.6e}"),
+                    format!("{:.d$}", value / scale),
                     "—".into(),
                     "—".into(),
                     format!("fixed: {reason}"),
@@ -703,6 +702,17 @@ fn flag_codes(flags: &[Flag]) -> String {
     flags.iter().map(Flag::code).collect::<Vec<_>>().join(",")
 }
 
+/// How the seven parameters are shown to a reader: unit, SI units per shown unit, decimals.
+const DISPLAY_UNITS: [(&str, f64, usize); 7] = [
+    ("t", 1e3, 2),
+    ("MN/m", 1e6, 4),
+    ("kN", 1e3, 2),
+    ("kN/(m/s)^α", 1e3, 2),
+    ("", 1.0, 3),
+    ("kN", 1e3, 2),
+    ("s/m", 1.0, 1),
+];
+
 /// The human-readable report.
 fn report(id: &Identification, inputs: &[Input]) -> String {
     use std::fmt::Write;
@@ -722,15 +732,7 @@ fn report(id: &Identification, inputs: &[Input]) -> String {
         .max()
         .unwrap_or(4)
         .max(4);
-    let units = [
-        ("t", 1e3, 2),
-        ("MN/m", 1e6, 4),
-        ("kN", 1e3, 2),
-        ("kN/(m/s)^α", 1e3, 2),
-        ("", 1.0, 3),
-        ("kN", 1e3, 2),
-        ("s/m", 1.0, 1),
-    ];
+    let units = DISPLAY_UNITS;
     for ((name, p), (unit, scale, digits)) in id.parameters().iter().zip(units) {
         let text = match p {
             Parameter::Estimated(e) => format!(
