@@ -843,3 +843,49 @@ pub fn svg_to_png(svg: &str) -> Result<Vec<u8>> {
         .encode_png()
         .map_err(|e| anyhow!("encoding a figure as PNG failed: {e}"))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use plotters::coord::ranged1d::Ranged;
+    use plotters::coord::types::RangedCoordf64;
+
+    /// The tick spacing assumed for the labels' decimals is the one plotters draws, over
+    /// ranges of every magnitude and label counts from 4 to 14 (a label such as "0 0 1 2 2"
+    /// on a 0–6 axis with 0.5 steps was the bug this guards against).
+    #[test]
+    fn tick_step_is_the_spacing_plotters_draws() {
+        let mut checked = 0;
+        for &(lo, hi) in &[
+            (0.0, 6.8),
+            (-0.67, 0.67),
+            (-2500.0, 2500.0),
+            (134.2, 148.9),
+            (0.0, 1.8),
+            (-3.2e-4, 7.7e-4),
+            (16.0, 20.0),
+            (1.2654, 1.2668),
+            (-30.5, 28.1),
+        ] {
+            for max_points in 4..=14 {
+                let keys = RangedCoordf64::from(lo..hi).key_points(max_points);
+                if keys.len() < 2 {
+                    continue;
+                }
+                let drawn = keys[1] - keys[0];
+                let step = tick_step((lo, hi), max_points);
+                assert!(
+                    (drawn - step).abs() <= 1e-9 * step,
+                    "{lo}..{hi}, {max_points} labels: plotters {drawn}, assumed {step}"
+                );
+                let decimals = tick_decimals((lo, hi), max_points);
+                let labels: Vec<String> = keys.iter().map(|k| format_tick(*k, decimals)).collect();
+                let mut unique = labels.clone();
+                unique.dedup();
+                assert_eq!(unique.len(), labels.len(), "{labels:?}");
+                checked += 1;
+            }
+        }
+        assert!(checked > 80, "{checked}");
+    }
+}
