@@ -525,32 +525,35 @@ pub fn figures(c: &Comparison) -> Vec<Figure> {
     };
     let span = (c.t_s[0], c.t_s[c.t_s.len() - 1]);
     let rec_name = c.recorded_name();
+    // Two time-history panels: the whole record with the zoomed interval shaded, and the zoom.
+    let whole_and_zoom =
+        |y_label: String, series: [(&str, &[f64], RGBColor, u32); 2], note: &str| {
+            let panel = |title: String, range: (f64, f64), shade: Option<(f64, f64)>| Panel {
+                title,
+                x_label: "time t (s)".into(),
+                y_label: y_label.clone(),
+                series: series
+                    .iter()
+                    .map(|&(label, y, color, width)| {
+                        line(label, envelope(&c.t_s, y, range, BUCKETS), color, width)
+                    })
+                    .collect(),
+                x_range: Some(range),
+                shade_x: shade,
+            };
+            vec![
+                panel(
+                    format!("whole record, {:.1}–{:.1} s", span.0, span.1),
+                    span,
+                    Some((z0, z1)),
+                ),
+                panel(format!("zoom {z0:.2}–{z1:.2} s{note}"), (z0, z1), None),
+            ]
+        };
     for ch in &c.channels {
         let s = ch.spec;
         let rec = scaled(&ch.recorded, s.display_scale);
         let sim = scaled(&ch.simulated, s.display_scale);
-        let y_label = format!("{} {} ({})", s.quantity, s.symbol, s.display_unit);
-        let panel = |title: String, range: (f64, f64), shade: Option<(f64, f64)>| Panel {
-            title,
-            x_label: "time t (s)".into(),
-            y_label: y_label.clone(),
-            series: vec![
-                line(
-                    "recorded",
-                    envelope(&c.t_s, &rec, range, BUCKETS),
-                    RECORDED,
-                    4,
-                ),
-                line(
-                    "simulated",
-                    envelope(&c.t_s, &sim, range, BUCKETS),
-                    SIMULATED,
-                    2,
-                ),
-            ],
-            x_range: Some(range),
-            shade_x: shade,
-        };
         out.push(Figure {
             name: format!("time-history-{}", s.key),
             title: format!("Recorded and simulated {} ({})", s.quantity, s.symbol),
@@ -559,18 +562,14 @@ pub fn figures(c: &Comparison) -> Vec<Figure> {
                  whole record, and the shaded interval zoomed below ({zoom_note}).",
                 capitalised(s.quantity)
             ),
-            panels: vec![
-                panel(
-                    format!("whole record, {:.1}–{:.1} s", span.0, span.1),
-                    span,
-                    Some((z0, z1)),
-                ),
-                panel(
-                    format!("zoom {z0:.2}–{z1:.2} s ({zoom_note})"),
-                    (z0, z1),
-                    None,
-                ),
-            ],
+            panels: whole_and_zoom(
+                format!("{} {} ({})", s.quantity, s.symbol, s.display_unit),
+                [
+                    ("recorded", &rec, RECORDED, 4),
+                    ("simulated", &sim, SIMULATED, 2),
+                ],
+                &format!(" ({zoom_note})"),
+            ),
             columns: 1,
             size: (1200, 900),
         });
@@ -579,27 +578,6 @@ pub fn figures(c: &Comparison) -> Vec<Figure> {
     if let Some(input) = &c.input_force {
         let rec = scaled(&input.recorded_n, 1e-3);
         let drv = scaled(&c.simulated.force_n, 1e-3);
-        let panel = |title: String, range: (f64, f64), shade: Option<(f64, f64)>| Panel {
-            title,
-            x_label: "time t (s)".into(),
-            y_label: "actuator force F_A (kN)".into(),
-            series: vec![
-                line(
-                    "recorded",
-                    envelope(&c.t_s, &rec, range, BUCKETS),
-                    RECORDED,
-                    2,
-                ),
-                line(
-                    "driving the model (scenario excitation)",
-                    envelope(&c.t_s, &drv, range, BUCKETS),
-                    SIMULATED,
-                    2,
-                ),
-            ],
-            x_range: Some(range),
-            shade_x: shade,
-        };
         out.push(Figure {
             name: "input-force".into(),
             title: "Actuator force: recorded and as it drives the model".into(),
@@ -607,14 +585,19 @@ pub fn figures(c: &Comparison) -> Vec<Figure> {
                 "The force column of {rec_name} as recorded (blue) and the scenario's excitation \
                  that drove the forward run, after any low-pass the scenario sets (orange)."
             ),
-            panels: vec![
-                panel(
-                    format!("whole record, {:.1}–{:.1} s", span.0, span.1),
-                    span,
-                    Some((z0, z1)),
-                ),
-                panel(format!("zoom {z0:.2}–{z1:.2} s"), (z0, z1), None),
-            ],
+            panels: whole_and_zoom(
+                "actuator force F_A (kN)".into(),
+                [
+                    ("recorded", &rec, RECORDED, 2),
+                    (
+                        "driving the model (scenario excitation)",
+                        &drv,
+                        SIMULATED,
+                        2,
+                    ),
+                ],
+                "",
+            ),
             columns: 1,
             size: (1200, 900),
         });
