@@ -21,7 +21,7 @@ use serde_json::{json, Map, Value};
 use platen_integrate::Trajectory;
 use platen_model::{force_terms, PlatenModel};
 use platen_scenario::columns::ColumnMap;
-use platen_scenario::csv_io::{uniform_step_s, write_bytes_atomic, Table};
+use platen_scenario::csv_io::{uniform_step_s, Table};
 use platen_scenario::{Model, Run, Scenario};
 use platen_signal::metrics::{interpolate_linear, ChannelMetrics, Comparator};
 use platen_signal::{differentiate, SampleRate};
@@ -258,20 +258,12 @@ impl Comparison {
 /// Runs `platen compare`.
 pub fn run(options: &Options<'_>) -> Result<()> {
     let comparison = compare(options)?;
-    let figures = if options.plot.is_some() || options.report.is_some() {
-        plot::figures(&comparison)
-    } else {
-        Vec::new()
-    };
-    let rendered = plot::render_all(&figures)?;
-    let written = match options.plot {
-        Some(dir) => plot::write_figures(dir, &rendered)?,
-        None => Vec::new(),
-    };
-    if let Some(path) = options.report {
-        let html = report::html(&comparison, &figures, &rendered);
-        write_bytes_atomic(path, html.as_bytes())?;
-    }
+    let written = plot::write_outputs(
+        options.plot,
+        options.report,
+        || plot::figures(&comparison),
+        |figures, rendered| report::html(&comparison, figures, rendered),
+    )?;
     if options.json {
         let summary = summary_json(&comparison, &written, options.report);
         println!("{}", serde_json::to_string_pretty(&summary)?);

@@ -28,8 +28,8 @@ use platen_ident::{
     identify, Estimate, Flag, Identification, Parameter, Settings, TestKind, TestRecord, TestResult,
 };
 use platen_scenario::columns::{ColumnMap, ColumnSpec};
-use platen_scenario::csv_io::{uniform_step_s, write_bytes_atomic};
-use platen_scenario::scenario::parse_json;
+use platen_scenario::csv_io::uniform_step_s;
+use platen_scenario::scenario::parse_json_file;
 
 use crate::{identify_plot, plot};
 
@@ -132,21 +132,12 @@ pub fn run(opts: &Options) -> Result<()> {
         ..Settings::default()
     };
     let id = identify(&records, &settings).context("identification failed")?;
-    let figures = if opts.plot.is_some() || opts.report.is_some() {
-        identify_plot::figures(&id)
-    } else {
-        Vec::new()
-    };
-    let rendered = plot::render_all(&figures)?;
-    let written = match opts.plot {
-        Some(dir) => plot::write_figures(dir, &rendered)?,
-        None => Vec::new(),
-    };
-    let text = report(&id, &inputs);
-    if let Some(path) = opts.report {
-        let html = html_report(&id, &inputs, &text, &figures, &rendered);
-        write_bytes_atomic(path, html.as_bytes())?;
-    }
+    let written = plot::write_outputs(
+        opts.plot,
+        opts.report,
+        || identify_plot::figures(&id),
+        |figures, rendered| html_report(&id, &inputs, figures, rendered),
+    )?;
     if opts.json {
         let mut summary = to_json(&id, &inputs);
         if let Some(fields) = summary.as_object_mut() {
@@ -165,7 +156,7 @@ pub fn run(opts: &Options) -> Result<()> {
         }
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
-        print!("{text}");
+        print!("{}", report(&id, &inputs));
         if !written.is_empty() {
             println!("\nWrote {} figure files (SVG and PNG):", written.len());
             for path in &written {
@@ -184,7 +175,6 @@ pub fn run(opts: &Options) -> Result<()> {
 fn html_report(
     id: &Identification,
     inputs: &[Input],
-    text: &str,
     figures: &[plot::Figure],
     rendered: &[(String, String)],
 ) -> String {
@@ -253,7 +243,7 @@ fn html_report(
         sections.push(crate::report::paragraph(w, Some("note")));
     }
     sections.push(crate::report::heading("Report"));
-    sections.push(crate::report::preformatted(text));
+    sections.push(crate::report::preformatted(&report(id, inputs)));
     crate::report::page(&crate::report::Page {
         title: "platen identify".into(),
         heading: "Identification from periodic tests (hysteresis-loop method)".into(),
@@ -300,13 +290,9 @@ fn inputs(opts: &Options) -> Result<Vec<Input>> {
         })
         .collect();
     if let Some(mpath) = opts.manifest {
-        let text = std::fs::read_to_string(mpath)
-            .with_context(|| format!("`{}`: cannot read the manifest", mpath.display()))?;
-        let manifest: Manifest = parse_json(mpath, &text).map_err(|e| {
-            anyhow::anyhow!(
-                "{e} (expected {{\"tests\": [{{\"file\": PATH, \"kind\": \"sine\"|\"triangle\", \"pressure_mpa\": P, \"name\": NAME, \"columns\": MAP}}], \"columns\": MAP}}, with only `file` required)"
-            )
-        })?;
+        let manifest: Manifest = parse_json_file(mpath).context(
+            "reading the identification manifest (expected {\"tests\": [{\"file\": PATH, \"kind\": \"sine\"|\"triangle\", \"pressure_mpa\": P, \"name\": NAME, \"columns\": MAP}], \"columns\": MAP}, with only `file` required)",
+        )?;
         let column_map = |spec: &BTreeMap<String, ColumnSpec>, at: &str| {
             ColumnMap::new(spec, at).map_err(|(json_path, value, expected)| {
                 anyhow::anyhow!(

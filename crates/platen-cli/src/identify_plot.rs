@@ -92,12 +92,26 @@ fn speed_grid(max: f64) -> Vec<f64> {
         .collect()
 }
 
-/// Smallest and largest of `x`.
-fn range_of(x: &[f64]) -> (f64, f64) {
-    x.iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
-            (lo.min(v), hi.max(v))
-        })
+/// Smallest and largest of the values.
+fn range_of(x: impl Iterator<Item = f64>) -> (f64, f64) {
+    x.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+        (lo.min(v), hi.max(v))
+    })
+}
+
+/// Points `(x, y)` of a series, in display units.
+type Points = Vec<(f64, f64)>;
+
+/// A decomposed force curve `(x, F)` (F in N) as points in kN, and with a fitted slope
+/// `F ≈ slope·x` the residual `F − slope·x` in kN; both thinned to [`MAX_SCATTER_POINTS`].
+fn scatter_and_residual(curve: &[[f64; 2]], slope: Option<f64>) -> (Points, Option<Points>) {
+    let x: Vec<f64> = curve.iter().map(|p| p[0]).collect();
+    let f: Vec<f64> = curve.iter().map(|p| p[1] / 1e3).collect();
+    let residual = slope.map(|k| {
+        let r: Vec<f64> = curve.iter().map(|p| (p[1] - k * p[0]) / 1e3).collect();
+        thinned(&x, &r, MAX_SCATTER_POINTS).0
+    });
+    (thinned(&x, &f, MAX_SCATTER_POINTS).0, residual)
 }
 
 /// Per-test points and their 95 % confidence intervals as vertical bars.
@@ -197,14 +211,13 @@ pub fn figures(id: &Identification) -> Vec<Figure> {
         }
         // The band of every estimate and the used tests' intervals; the flagged tests'
         // intervals (S1–S3-like tests can span ±30 %) are cut at its edges.
-        let band = used
-            .points
-            .iter()
-            .chain(&unused.points)
-            .chain(&used.bars)
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-                (lo.min(p.1), hi.max(p.1))
-            });
+        let band = range_of(
+            used.points
+                .iter()
+                .chain(&unused.points)
+                .chain(&used.bars)
+                .map(|p| p.1),
+        );
         let pad = 0.25 * (band.1 - band.0).max(1e-3 * band.1.abs());
         unused.clip_bars(band.0 - pad, band.1 + pad);
         let mut series = used.into_series("used", GROUP_COLORS[0]);
@@ -260,32 +273,23 @@ pub fn figures(id: &Identification) -> Vec<Figure> {
                 continue;
             }
             let color = group_color(i);
-            let u: Vec<f64> = curve.iter().map(|p| p[0]).collect();
-            let f: Vec<f64> = curve.iter().map(|p| p[1] / 1e3).collect();
+            let stiffness = g.stiffness.as_ref().map(|k| k.value);
+            let (pts, residual) = scatter_and_residual(&curve, stiffness);
             data.push(points(
                 format!("{} (data)", group_name(g.pressure_pa)),
-                thinned(&u, &f, MAX_SCATTER_POINTS).0,
+                pts,
                 color,
                 2,
             ));
-            if let Some(k) = &g.stiffness {
-                let (lo, hi) = range_of(&u);
+            if let (Some(k), Some(residual)) = (stiffness, residual) {
+                let (lo, hi) = range_of(curve.iter().map(|p| p[0]));
                 lines.push(line(
-                    format!("Kₑ·u, Kₑ = {:.4} MN/m", k.value / 1e6),
-                    vec![(lo, k.value * lo / 1e3), (hi, k.value * hi / 1e3)],
+                    format!("Kₑ·u, Kₑ = {:.4} MN/m", k / 1e6),
+                    vec![(lo, k * lo / 1e3), (hi, k * hi / 1e3)],
                     color,
                     2,
                 ));
-                let r: Vec<f64> = curve
-                    .iter()
-                    .map(|p| (p[1] - k.value * p[0]) / 1e3)
-                    .collect();
-                residuals.push(points(
-                    group_name(g.pressure_pa),
-                    thinned(&u, &r, MAX_SCATTER_POINTS).0,
-                    color,
-                    2,
-                ));
+                residuals.push(points(group_name(g.pressure_pa), residual, color, 2));
             }
         }
         // The lines first, so that the data drawn over them stay visible.
@@ -354,22 +358,10 @@ pub fn figures(id: &Identification) -> Vec<Figure> {
             if curve.is_empty() {
                 continue;
             }
-            let a: Vec<f64> = curve.iter().map(|p| p[0]).collect();
-            let f: Vec<f64> = curve.iter().map(|p| p[1] / 1e3).collect();
-            series.push(points(
-                label,
-                thinned(&a, &f, MAX_SCATTER_POINTS).0,
-                color,
-                2,
-            ));
-            if let Some(m) = mass {
-                let r: Vec<f64> = curve.iter().map(|p| (p[1] - m * p[0]) / 1e3).collect();
-                residuals.push(points(
-                    label,
-                    thinned(&a, &r, MAX_SCATTER_POINTS).0,
-                    color,
-                    2,
-                ));
+            let (pts, residual) = scatter_and_residual(&curve, mass);
+            series.push(points(label, pts, color, 2));
+            if let Some(residual) = residual {
+                residuals.push(points(label, residual, color, 2));
             }
         }
         out.push(Figure {

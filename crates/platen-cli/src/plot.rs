@@ -783,6 +783,30 @@ pub fn render_all(figures: &[Figure]) -> Result<Vec<(String, String)>> {
         .collect()
 }
 
+/// Writes what a verb's `--plot DIR` and `--report FILE.html` ask for: the figures (SVG and
+/// PNG) to the folder and the page `html` makes of the figures and their SVG. The figures are
+/// built only if one of the two is asked for. Returns the figure files written.
+pub fn write_outputs(
+    plot_dir: Option<&Path>,
+    report: Option<&Path>,
+    figures: impl FnOnce() -> Vec<Figure>,
+    html: impl FnOnce(&[Figure], &[(String, String)]) -> String,
+) -> Result<Vec<PathBuf>> {
+    if plot_dir.is_none() && report.is_none() {
+        return Ok(Vec::new());
+    }
+    let figures = figures();
+    let rendered = render_all(&figures)?;
+    let written = match plot_dir {
+        Some(dir) => write_figures(dir, &rendered)?,
+        None => Vec::new(),
+    };
+    if let Some(path) = report {
+        write_bytes_atomic(path, html(&figures, &rendered).as_bytes())?;
+    }
+    Ok(written)
+}
+
 /// Writes every figure to `dir` (created if missing) as SVG and PNG, and returns the paths
 /// written. Every PNG is rendered before the first file is written, so a rendering failure
 /// leaves the folder as it was; each file is written atomically.

@@ -29,7 +29,7 @@ use serde::Deserialize;
 
 use crate::csv_io::{read_table, Table};
 use crate::error::{Result, ScenarioError};
-use crate::scenario::parse_json;
+use crate::scenario::parse_json_file;
 
 use platen_model::STANDARD_GRAVITY_M_S2;
 
@@ -163,12 +163,7 @@ impl ColumnMap {
     /// JSON path) if it is not such an object, [`ScenarioError::InvalidField`] for an unknown
     /// column or unit.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
-            path: path.to_owned(),
-            action: "reading",
-            source,
-        })?;
-        let spec: BTreeMap<String, ColumnSpec> = parse_json(path, &text)?;
+        let spec: BTreeMap<String, ColumnSpec> = parse_json_file(path)?;
         Self::new(&spec, "columns").map_err(|(json_path, value, expected)| {
             ScenarioError::InvalidField {
                 path: path.to_owned(),

@@ -450,13 +450,7 @@ impl Scenario {
     /// path), invalid values (with their JSON path and what was expected), and every error of
     /// the records it references (with file and line).
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
-            path: path.to_owned(),
-            action: "reading",
-            source,
-        })?;
-        let file = parse(path, &text)?;
-        Self::from_file(path, file)
+        Self::from_file(path, parse_json_file(path)?)
     }
 
     /// Validates a parsed scenario; relative paths are resolved against `path`'s folder.
@@ -503,6 +497,19 @@ impl Scenario {
 /// [`ScenarioError::Json`].
 pub fn parse(path: &Path, text: &str) -> Result<ScenarioFile> {
     parse_json(path, text)
+}
+
+/// Reads the JSON file `path` into `T`.
+///
+/// # Errors
+/// [`ScenarioError::Io`] if it cannot be read, else as [`parse_json`].
+pub fn parse_json_file<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
+    let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
+        path: path.to_owned(),
+        action: "reading",
+        source,
+    })?;
+    parse_json(path, &text)
 }
 
 /// Parses JSON text read from `path` into `T`, reporting the JSON path (or line and
