@@ -28,7 +28,6 @@ use platen_signal::{differentiate, SampleRate};
 
 use crate::plot;
 use crate::report;
-use crate::simulate::execute_scenario;
 
 /// A time window `[t0, t1]`, s, from `--window T0,T1`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -342,7 +341,7 @@ pub fn compare(options: &Options<'_>) -> Result<Comparison> {
     }
 
     let mut sim = Trajectory::default();
-    execute_scenario(&scenario, &mut sim)?;
+    scenario.run(&mut sim)?;
     if sim.len() < 2 {
         bail!(
             "scenario `{}` produced {} sample(s): a comparison needs at least 2",

@@ -310,19 +310,23 @@ fn main() -> ExitCode {
 fn exit_code(e: &anyhow::Error) -> u8 {
     for cause in e.chain() {
         if let Some(ie) = cause.downcast_ref::<IntegrateError>() {
-            return match ie {
-                IntegrateError::NonFiniteState { .. } | IntegrateError::EventLoopStalled { .. } => {
-                    4
-                }
-                _ => 3,
-            };
+            return integrate_exit_code(ie);
         }
         if let Some(se) = cause.downcast_ref::<ScenarioError>() {
             return match se {
+                ScenarioError::Run(ie) => integrate_exit_code(ie),
                 ScenarioError::Io { action, .. } if *action != "reading" => 5,
                 _ => 3,
             };
         }
     }
     3
+}
+
+/// 4 for a numerical failure, 3 for an input the integrator cannot use.
+fn integrate_exit_code(e: &IntegrateError) -> u8 {
+    match e {
+        IntegrateError::NonFiniteState { .. } | IntegrateError::EventLoopStalled { .. } => 4,
+        _ => 3,
+    }
 }

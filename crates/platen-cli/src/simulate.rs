@@ -9,15 +9,13 @@ use std::fs::{self, File};
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use serde_json::{json, Map, Value};
 
-use platen_integrate::{
-    forward_dopri5, forward_rk4, inverse, Peaks, RunStats, Sample, SampleSink, Trajectory,
-};
-use platen_model::{PlatenModel, STANDARD_GRAVITY_M_S2};
+use platen_integrate::{ForwardIntegrator, Peaks, RunStats, Sample, SampleSink, Trajectory};
+use platen_model::STANDARD_GRAVITY_M_S2;
 use platen_scenario::csv_io::{create_temp_next_to, write_number};
-use platen_scenario::{Integrator, Model, Run, Scenario, ScenarioError};
+use platen_scenario::{Run, RunOutput, Scenario, ScenarioError};
 
 pub fn run(path: &Path, out: Option<&Path>, json_out: bool) -> Result<()> {
     let scenario = Scenario::load(path)?;
@@ -25,9 +23,9 @@ pub fn run(path: &Path, out: Option<&Path>, json_out: bool) -> Result<()> {
     let mut stream = out
         .map(|p| CsvStream::create(p, &Trajectory::COLUMN_NAMES))
         .transpose()?;
-    let (peaks, stats) = match stream.as_mut() {
-        Some(sink) => execute_scenario(&scenario, sink)?,
-        None => execute_scenario(&scenario, &mut NoOutput)?,
+    let RunOutput { peaks, stats } = match stream.as_mut() {
+        Some(sink) => scenario.run(sink)?,
+        None => scenario.run(&mut NoOutput)?,
     };
     if let Some(stream) = stream {
         stream.finish()?;
@@ -39,62 +37,6 @@ pub fn run(path: &Path, out: Option<&Path>, json_out: bool) -> Result<()> {
         print_summary(&scenario, &peaks, stats.as_ref(), out);
     }
     Ok(())
-}
-
-/// Runs `scenario`, delivering every output sample to `sink`; returns the peaks and, for a
-/// forward run, the solver statistics.
-pub fn execute_scenario<S: SampleSink>(
-    scenario: &Scenario,
-    sink: &mut S,
-) -> Result<(Peaks, Option<RunStats>)> {
-    match &scenario.model {
-        Model::Identified(m) => execute_into(m, &scenario.run, sink),
-        Model::Full(m) => execute_into(&**m, &scenario.run, sink),
-    }
-}
-
-/// Runs `run` on `model`, delivering every output sample to `sink` (and to a [`Peaks`]).
-pub fn execute_into<M: PlatenModel, S: SampleSink>(
-    model: &M,
-    run: &Run,
-    sink: &mut S,
-) -> Result<(Peaks, Option<RunStats>)> {
-    match run {
-        Run::Forward {
-            record,
-            integrator,
-            initial,
-            samples,
-        } => {
-            let mut sink = (sink, Peaks::default());
-            let stats = match integrator {
-                Integrator::Rk4(rk4) => {
-                    forward_rk4(model, record, *rk4, *initial, *samples, &mut sink)
-                }
-                Integrator::Dopri5(settings) => {
-                    forward_dopri5(model, record, *settings, *initial, *samples, &mut sink)
-                }
-            }
-            .context("forward run failed; no output was written")?;
-            Ok((sink.1, Some(stats)))
-        }
-        Run::Inverse { motion } => {
-            let mut sink = (sink, Peaks::default());
-            inverse(model, motion, &mut sink);
-            Ok((sink.1, None))
-        }
-    }
-}
-
-/// Runs `run` on `model` keeping the whole time series in memory.
-#[cfg(test)]
-pub fn execute<M: PlatenModel>(
-    model: &M,
-    run: &Run,
-) -> Result<(Trajectory, Peaks, Option<RunStats>)> {
-    let mut trajectory = Trajectory::default();
-    let (peaks, stats) = execute_into(model, run, &mut trajectory)?;
-    Ok((trajectory, peaks, stats))
 }
 
 /// A sink that keeps nothing (the summary's [`Peaks`] are collected alongside).
@@ -476,24 +418,20 @@ mod tests {
             "s9-sine-motion.json",
         ] {
             let scenario = Scenario::load(&shipped(name)).unwrap();
-            let (trajectory, peaks, stats) = match &scenario.model {
-                Model::Identified(m) => execute(m, &scenario.run).unwrap(),
-                Model::Full(m) => execute(&**m, &scenario.run).unwrap(),
-            };
+            let mut trajectory = Trajectory::default();
+            let in_memory_output = scenario.run(&mut trajectory).unwrap();
             let in_memory = dir.path().join("memory.csv");
             write_csv_atomic(&in_memory, &Trajectory::COLUMN_NAMES, &trajectory.columns()).unwrap();
             let streamed = dir.path().join("streamed.csv");
             let mut stream = CsvStream::create(&streamed, &Trajectory::COLUMN_NAMES).unwrap();
-            let (streamed_peaks, streamed_stats) =
-                execute_scenario(&scenario, &mut stream).unwrap();
+            let streamed_output = scenario.run(&mut stream).unwrap();
             stream.finish().unwrap();
             assert_eq!(
                 fs::read(&streamed).unwrap(),
                 fs::read(&in_memory).unwrap(),
                 "{name}"
             );
-            assert_eq!(streamed_peaks, peaks, "{name}");
-            assert_eq!(streamed_stats, stats, "{name}");
+            assert_eq!(streamed_output, in_memory_output, "{name}");
         }
         let left: Vec<_> = fs::read_dir(dir.path()).unwrap().collect();
         assert_eq!(left.len(), 2, "no temporary file left behind");

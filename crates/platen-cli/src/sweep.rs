@@ -25,11 +25,11 @@ use rayon::prelude::*;
 use serde_json::{json, Map, Value};
 
 use platen_integrate::{
-    forward_dopri5, forward_rk4, inverse, ForceRecord, IntegrateError, Motion, Peaks, RunStats,
+    inverse, ForceRecord, ForwardIntegrator, IntegrateError, Motion, Peaks, RunStats,
 };
 use platen_model::{IdentifiedParams, PhysicalParams, PlatenModel, Preset};
 use platen_scenario::csv_io::write_bytes_atomic;
-use platen_scenario::{Integrator, Model, Run, Scenario};
+use platen_scenario::{Model, Run, Scenario};
 
 use platen_scenario::csv_io::write_number;
 
@@ -479,15 +479,9 @@ fn run_case_on<M: PlatenModel>(model: &M, run: &Run, scale: f64) -> Outcome {
                     Err(e) => return failed(e),
                 }
             };
-            match integrator {
-                Integrator::Rk4(rk4) => {
-                    forward_rk4(model, record, *rk4, *initial, *samples, &mut peaks)
-                }
-                Integrator::Dopri5(settings) => {
-                    forward_dopri5(model, record, *settings, *initial, *samples, &mut peaks)
-                }
-            }
-            .map(Some)
+            integrator
+                .forward(model, record, *initial, *samples, &mut peaks)
+                .map(Some)
         }
         Run::Inverse { motion } => {
             let scaled;

@@ -31,6 +31,7 @@ pub mod baseline;
 mod dopri5;
 mod error;
 mod inverse;
+mod method;
 mod output;
 mod record;
 mod rk4;
@@ -38,6 +39,7 @@ mod rk4;
 pub use dopri5::{forward_dopri5, Dopri5Settings};
 pub use error::{IntegrateError, Result};
 pub use inverse::inverse;
+pub use method::{ForwardIntegrator, Method};
 pub use output::{Exceedance, Peak, Peaks, Sample, SampleSink, Trajectory};
 pub use record::{
     derivative, second_derivative, uniform_interval_s, ForceRecord, Motion,

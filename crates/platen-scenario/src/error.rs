@@ -249,6 +249,11 @@ pub enum ScenarioError {
         /// What is wrong.
         message: String,
     },
+
+    /// A forward run failed numerically (or its record could not serve it); the error names
+    /// the time. Nothing was written.
+    #[error("forward run failed; no output was written")]
+    Run(#[source] platen_integrate::IntegrateError),
 }
 
 /// Formats header names as a comma-separated list of back-quoted names.

@@ -35,7 +35,7 @@ use std::path::{Path, PathBuf};
 use schemars::JsonSchema;
 use serde::Deserialize;
 
-use platen_integrate::{Dopri5Settings, ForceRecord, Motion, Rk4, State};
+use platen_integrate::{Dopri5Settings, ForceRecord, Method, Motion, Rk4, State};
 use platen_model::{
     FullModel, IdentifiedModel, IdentifiedParams, ModelError, PhysicalParams, Preset, TableLimits,
     STANDARD_GRAVITY_M_S2,
@@ -325,25 +325,6 @@ pub const DEFAULT_RTOL: f64 = 1e-8;
 /// Default absolute tolerance of `dopri5`.
 pub const DEFAULT_ATOL: f64 = 1e-11;
 
-/// The integrator of a forward run.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Integrator {
-    /// Fixed-step RK4.
-    Rk4(Rk4),
-    /// Adaptive Dopri5.
-    Dopri5(Dopri5Settings),
-}
-
-impl Integrator {
-    /// `"rk4"` or `"dopri5"`.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Integrator::Rk4(_) => "rk4",
-            Integrator::Dopri5(_) => "dopri5",
-        }
-    }
-}
-
 /// `{"method": "rk4", "step_s": …}`.
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -394,7 +375,7 @@ pub enum Run {
         /// The actuator force.
         record: ForceRecord,
         /// Integrator settings.
-        integrator: Integrator,
+        integrator: Method,
         /// State at the first sample.
         initial: State,
         /// Output samples (the first `samples` of the record).
@@ -1027,10 +1008,10 @@ fn forward_run(
     recorded_state: Option<(f64, f64)>,
 ) -> Result<Run> {
     let integrator = match &file.integrator {
-        None => Integrator::Rk4(Rk4::with_steps_per_sample(1).expect("k = 1 is valid")),
+        None => Method::Rk4(Rk4::with_steps_per_sample(1).expect("k = 1 is valid")),
         Some(IntegratorSpec::Rk4(Rk4Spec { step_s })) => {
             let step = step_s.unwrap_or(record.dt_s());
-            Integrator::Rk4(
+            Method::Rk4(
                 Rk4::from_step(step, record.dt_s())
                     .map_err(|e| ctx.invalid("integrator.step_s", step, e.to_string()))?,
             )
@@ -1046,7 +1027,7 @@ fn forward_run(
                 ),
                 other => ctx.invalid("integrator", "", other.to_string()),
             })?;
-            Integrator::Dopri5(settings)
+            Method::Dopri5(settings)
         }
     };
     let initial = file.initial.clone().unwrap_or_default();

@@ -1,0 +1,96 @@
+//! One entry point for forward runs, whatever the integrator: [`ForwardIntegrator`] and the
+//! [`Method`] a scenario selects.
+
+use platen_model::PlatenModel;
+
+use crate::{forward_dopri5, forward_rk4, Dopri5Settings, ForceRecord, Result, Rk4};
+use crate::{RunStats, SampleSink, State};
+
+/// A forward integrator with exact stick-slip: a recorded force → the motion it produces.
+///
+/// Every implementation delivers `samples` output samples, at the record's first `samples`
+/// sample times, to `sink`, and returns the run's statistics.
+pub trait ForwardIntegrator {
+    /// The integrator's name as the scenario format spells it (`"rk4"`, `"dopri5"`).
+    fn name(&self) -> &'static str;
+
+    /// Runs `model` forward under `record` from `initial`.
+    ///
+    /// # Errors
+    /// As [`forward_rk4`] and [`forward_dopri5`]: a record too short for `samples`, a
+    /// non-finite initial state, or a numerical failure with its time.
+    fn forward<M: PlatenModel, S: SampleSink>(
+        &self,
+        model: &M,
+        record: &ForceRecord,
+        initial: State,
+        samples: usize,
+        sink: &mut S,
+    ) -> Result<RunStats>;
+}
+
+impl ForwardIntegrator for Rk4 {
+    fn name(&self) -> &'static str {
+        "rk4"
+    }
+
+    fn forward<M: PlatenModel, S: SampleSink>(
+        &self,
+        model: &M,
+        record: &ForceRecord,
+        initial: State,
+        samples: usize,
+        sink: &mut S,
+    ) -> Result<RunStats> {
+        forward_rk4(model, record, *self, initial, samples, sink)
+    }
+}
+
+impl ForwardIntegrator for Dopri5Settings {
+    fn name(&self) -> &'static str {
+        "dopri5"
+    }
+
+    fn forward<M: PlatenModel, S: SampleSink>(
+        &self,
+        model: &M,
+        record: &ForceRecord,
+        initial: State,
+        samples: usize,
+        sink: &mut S,
+    ) -> Result<RunStats> {
+        forward_dopri5(model, record, *self, initial, samples, sink)
+    }
+}
+
+/// The integrator of a forward run, as a scenario selects it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Method {
+    /// Fixed-step RK4 ([`forward_rk4`]).
+    Rk4(Rk4),
+    /// Adaptive Dormand–Prince 5(4) ([`forward_dopri5`]).
+    Dopri5(Dopri5Settings),
+}
+
+impl ForwardIntegrator for Method {
+    fn name(&self) -> &'static str {
+        match self {
+            Method::Rk4(rk4) => rk4.name(),
+            Method::Dopri5(settings) => settings.name(),
+        }
+    }
+
+    fn forward<M: PlatenModel, S: SampleSink>(
+        &self,
+        model: &M,
+        record: &ForceRecord,
+        initial: State,
+        samples: usize,
+        sink: &mut S,
+    ) -> Result<RunStats> {
+        match self {
+            Method::Rk4(rk4) => rk4.forward(model, record, initial, samples, sink),
+            Method::Dopri5(settings) => settings.forward(model, record, initial, samples, sink),
+        }
+    }
+}
