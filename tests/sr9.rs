@@ -5,8 +5,8 @@ use std::path::Path;
 
 use platen::integrate::Method;
 use platen::integrate::{inverse, Peaks, Trajectory};
+use platen::io::csv::{read_table, write_csv_atomic};
 use platen::model::PlatenModel;
-use platen::scenario::csv_io::{read_table, write_csv_atomic};
 use platen::scenario::recorded::{recorded_like, ArtefactSettings, Recorded};
 use platen::scenario::{Model, Run, Scenario};
 

@@ -19,9 +19,10 @@ use anyhow::{bail, Context, Result};
 use serde_json::{json, Map, Value};
 
 use platen_integrate::Trajectory;
+use platen_io::columns::ColumnMap;
+use platen_io::csv::Table;
 use platen_model::{force_terms, PlatenModel};
-use platen_scenario::columns::ColumnMap;
-use platen_scenario::csv_io::{uniform_step_s, Table};
+use platen_scenario::sampling::uniform_step_s;
 use platen_scenario::{Model, Run, Scenario};
 use platen_signal::metrics::{interpolate_linear, ChannelMetrics, Comparator};
 use platen_signal::{differentiate, SampleRate};

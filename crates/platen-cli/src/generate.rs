@@ -7,8 +7,8 @@ use anyhow::{bail, Context, Result};
 use serde_json::json;
 
 use platen_integrate::{inverse, Peaks, Trajectory};
+use platen_io::csv::write_csv_atomic;
 use platen_model::PlatenModel;
-use platen_scenario::csv_io::write_csv_atomic;
 use platen_scenario::recorded::{recorded_like, ArtefactSettings, Recorded};
 use platen_scenario::{Model, Run, Scenario};
 

@@ -27,9 +27,9 @@ use serde_json::{json, Map, Value};
 use platen_ident::{
     identify, Estimate, Flag, Identification, Parameter, Settings, TestKind, TestRecord, TestResult,
 };
-use platen_scenario::columns::{ColumnMap, ColumnSpec};
-use platen_scenario::csv_io::uniform_step_s;
-use platen_scenario::scenario::parse_json_file;
+use platen_io::columns::{ColumnMap, ColumnSpec};
+use platen_io::json::parse_json_file;
+use platen_scenario::sampling::uniform_step_s;
 
 use crate::{identify_plot, plot};
 
@@ -388,9 +388,8 @@ fn read_record(input: &Input) -> Result<TestRecord> {
             .read_table(path, &["t_s", "u_m", "a_m_s2", "force_n"], &["v_m_s"])?;
     let t = table.take_column("t_s").expect("required column");
     let dt = uniform_step_s(path, &t)?;
-    let take = |table: &mut platen_scenario::csv_io::Table, c: &str| {
-        table.take_column(c).expect("required column")
-    };
+    let take =
+        |table: &mut platen_io::csv::Table, c: &str| table.take_column(c).expect("required column");
     let u = take(&mut table, "u_m");
     let a = take(&mut table, "a_m_s2");
     let f = take(&mut table, "force_n");

@@ -23,6 +23,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand, ValueEnum};
 
 use platen_integrate::IntegrateError;
+use platen_io::IoError;
 use platen_scenario::ScenarioError;
 
 #[derive(Parser)]
@@ -315,12 +316,24 @@ fn exit_code(e: &anyhow::Error) -> u8 {
         if let Some(se) = cause.downcast_ref::<ScenarioError>() {
             return match se {
                 ScenarioError::Run(ie) => integrate_exit_code(ie),
-                ScenarioError::Io { action, .. } if *action != "reading" => 5,
+                ScenarioError::Io(io) => io_exit_code(io),
                 _ => 3,
             };
         }
+        if let Some(io) = cause.downcast_ref::<IoError>() {
+            return io_exit_code(io);
+        }
     }
     3
+}
+
+/// 5 for an output that could not be written, 3 for an input that could not be read.
+fn io_exit_code(e: &IoError) -> u8 {
+    if e.is_output_failure() {
+        5
+    } else {
+        3
+    }
 }
 
 /// 4 for a numerical failure, 3 for an input the integrator cannot use.

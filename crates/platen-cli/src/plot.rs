@@ -19,8 +19,8 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, Result};
-use platen_scenario::csv_io::write_bytes_atomic;
-use platen_scenario::ScenarioError;
+use platen_io::write_bytes_atomic;
+use platen_io::{IoAction, IoError};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -819,9 +819,9 @@ pub fn write_figures(dir: &Path, rendered: &[(String, String)]) -> Result<Vec<Pa
             svg_to_png(svg)?,
         ));
     }
-    fs::create_dir_all(dir).map_err(|source| ScenarioError::Io {
+    fs::create_dir_all(dir).map_err(|source| IoError::Io {
         path: dir.to_path_buf(),
-        action: "creating the figure folder",
+        action: IoAction::CreatingFolder,
         source,
     })?;
     let mut written = Vec::with_capacity(files.len());

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use anyhow::Result;
-use platen_scenario::csv_io::write_bytes_atomic;
+use platen_io::write_bytes_atomic;
 
 /// Prints the schema, or writes it to `out`.
 pub fn run(out: Option<&Path>) -> Result<()> {

@@ -27,11 +27,11 @@ use serde_json::{json, Map, Value};
 use platen_integrate::{
     inverse, ForceRecord, ForwardIntegrator, IntegrateError, Motion, Peaks, RunStats,
 };
+use platen_io::write_bytes_atomic;
 use platen_model::{IdentifiedParams, PhysicalParams, PlatenModel, Preset};
-use platen_scenario::csv_io::write_bytes_atomic;
 use platen_scenario::{Model, Run, Scenario};
 
-use platen_scenario::csv_io::write_number;
+use platen_io::csv::write_number;
 
 /// Keys of the identified model that `--set identified.KEY=…` accepts.
 pub const IDENTIFIED_KEYS: [&str; 7] = [

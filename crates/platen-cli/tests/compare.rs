@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use platen_integrate::{inverse, Trajectory};
+use platen_io::csv::write_csv_atomic;
 use platen_model::PlatenModel;
-use platen_scenario::csv_io::write_csv_atomic;
 use platen_scenario::recorded::{recorded_like, ArtefactSettings, Recorded};
 use platen_scenario::{Model, Run, Scenario};
 use serde_json::Value;

@@ -11,222 +11,20 @@
 
 use std::path::PathBuf;
 
+use platen_integrate::IntegrateError;
+use platen_io::IoError;
+
 /// Result type of this crate, defaulting to [`ScenarioError`].
 pub type Result<T, E = ScenarioError> = std::result::Result<T, E>;
 
-/// Everything that can go wrong while reading or writing scenario inputs and outputs.
+/// Everything that can go wrong while loading or running a scenario.
 #[non_exhaustive]
 #[derive(Debug, thiserror::Error)]
 pub enum ScenarioError {
-    /// An operating-system I/O operation failed.
-    #[error("{action} `{}` failed", path.display())]
-    Io {
-        /// File (or, for temporary files, the destination file) concerned.
-        path: PathBuf,
-        /// What was being done, e.g. `"reading"` or `"writing"`.
-        action: &'static str,
-        /// The underlying I/O error.
-        #[source]
-        source: std::io::Error,
-    },
-
-    /// The CSV text itself is malformed (invalid UTF-8, misplaced blank line, …).
-    #[error("`{}`, line {line}: malformed CSV: {message}", path.display())]
-    CsvSyntax {
-        /// CSV file.
-        path: PathBuf,
-        /// 1-based line number (header is line 1).
-        line: u64,
-        /// Description of the problem.
-        message: String,
-    },
-
-    /// A required column is not in the header.
-    #[error(
-        "`{}`, line 1: missing required column `{column}` (the header has: {})",
-        path.display(),
-        format_names(available)
-    )]
-    MissingColumn {
-        /// CSV file.
-        path: PathBuf,
-        /// Name of the missing column.
-        column: String,
-        /// Column names found in the header (trimmed), in file order.
-        available: Vec<String>,
-    },
-
-    /// A selected column name appears more than once in the header.
-    #[error(
-        "`{}`, line 1: column `{column}` appears more than once in the header \
-         (expected each selected column exactly once)",
-        path.display()
-    )]
-    DuplicateColumn {
-        /// CSV file.
-        path: PathBuf,
-        /// The duplicated column name.
-        column: String,
-    },
-
-    /// A cell of a selected column is not a number.
-    #[error(
-        "`{}`, line {line}, column `{column}`: expected a number, found `{value}`",
-        path.display()
-    )]
-    NonNumeric {
-        /// CSV file.
-        path: PathBuf,
-        /// 1-based line number (header is line 1).
-        line: u64,
-        /// Column name.
-        column: String,
-        /// The offending cell text (trimmed).
-        value: String,
-    },
-
-    /// A cell parses as a number but is NaN or infinite (or overflows `f64`).
-    #[error(
-        "`{}`, line {line}, column `{column}`: expected a finite number, found `{value}`",
-        path.display()
-    )]
-    NonFinite {
-        /// CSV file.
-        path: PathBuf,
-        /// 1-based line number (header is line 1).
-        line: u64,
-        /// Column name.
-        column: String,
-        /// The offending cell text (trimmed) or value.
-        value: String,
-    },
-
-    /// The file has no data rows (or not even a header row).
-    #[error(
-        "`{}`: no data rows (expected a header row followed by at least one row of numbers)",
-        path.display()
-    )]
-    Empty {
-        /// CSV file.
-        path: PathBuf,
-    },
-
-    /// The time column `t_s` does not increase strictly.
-    #[error(
-        "`{}`, line {line}, column `t_s`: time must increase strictly, \
-         but {value_s} s follows {previous_s} s",
-        path.display()
-    )]
-    TimeNotIncreasing {
-        /// CSV file.
-        path: PathBuf,
-        /// 1-based line number of the offending row.
-        line: u64,
-        /// Time on the previous data row, s.
-        previous_s: f64,
-        /// Time on the offending row, s.
-        value_s: f64,
-    },
-
-    /// A row has a different number of fields than the header.
-    #[error(
-        "`{}`, line {line}: expected {expected} comma-separated fields (as in the header), found {found}",
-        path.display()
-    )]
-    RaggedRow {
-        /// CSV file.
-        path: PathBuf,
-        /// 1-based line number of the offending row.
-        line: u64,
-        /// Number of fields in the header.
-        expected: usize,
-        /// Number of fields in this row.
-        found: usize,
-    },
-
-    /// A time column is not uniformly sampled.
-    #[error(
-        "`{}`, line {line}, column `t_s`: expected a uniform time step of {expected_s} s, \
-         found an interval of {found_s} s",
-        path.display()
-    )]
-    NonUniform {
-        /// File the time column came from.
-        path: PathBuf,
-        /// 1-based line of the later sample of the offending interval, assuming the header
-        /// is line 1 and one sample per line (as written by this crate).
-        line: u64,
-        /// Mean time step (span / intervals), s.
-        expected_s: f64,
-        /// The offending interval, s.
-        found_s: f64,
-    },
-
-    /// A record has fewer samples than an operation needs.
-    #[error("`{}`: {rows} data row(s), expected at least {needed}", path.display())]
-    TooShort {
-        /// File the record came from.
-        path: PathBuf,
-        /// Number of data rows present.
-        rows: usize,
-        /// Number of data rows needed.
-        needed: usize,
-    },
-
-    /// A table to be written has a different number of column names than columns.
-    #[error(
-        "`{}`: cannot write {columns} column(s) under a header of {names} name(s)",
-        path.display()
-    )]
-    HeaderMismatch {
-        /// Destination file.
-        path: PathBuf,
-        /// Number of header names given.
-        names: usize,
-        /// Number of columns given.
-        columns: usize,
-    },
-
-    /// A column to be written is not as long as the first column.
-    #[error(
-        "`{}`, column `{column}`: expected {expected} values (as in the first column), found {found}",
-        path.display()
-    )]
-    ColumnLengthMismatch {
-        /// Destination file.
-        path: PathBuf,
-        /// Column name.
-        column: String,
-        /// Length of the first column.
-        expected: usize,
-        /// Length of this column.
-        found: usize,
-    },
-
-    /// A column name to be written is empty, padded with whitespace or contains a
-    /// character that would need CSV quoting (`,`, `"`, line break).
-    #[error(
-        "`{}`: invalid column name `{column}` (expected a non-empty name without commas, \
-         quotes, line breaks or surrounding whitespace)",
-        path.display()
-    )]
-    InvalidColumnName {
-        /// Destination file.
-        path: PathBuf,
-        /// The offending column name.
-        column: String,
-    },
-
-    /// A scenario file is not valid JSON or does not match the scenario format.
-    #[error("`{}`: {json_path}: {message}", path.display())]
-    Json {
-        /// Scenario file.
-        path: PathBuf,
-        /// Where in the document (`model.identified.effective_mass_kg`, or `line L column C`).
-        json_path: String,
-        /// What is wrong and what was expected.
-        message: String,
-    },
+    /// A file the scenario reads (the scenario itself, a record, a column map) cannot be read
+    /// or parsed, or an output cannot be written.
+    #[error(transparent)]
+    Io(#[from] IoError),
 
     /// A scenario field has a value that cannot be used.
     #[error("`{}`: {json_path} = {value}: expected {expected}", path.display())]
@@ -253,22 +51,5 @@ pub enum ScenarioError {
     /// A forward run failed numerically (or its record could not serve it); the error names
     /// the time. Nothing was written.
     #[error("forward run failed; no output was written")]
-    Run(#[source] platen_integrate::IntegrateError),
-}
-
-/// Formats header names as a comma-separated list of back-quoted names.
-fn format_names(names: &[String]) -> String {
-    if names.is_empty() {
-        return "no columns".to_owned();
-    }
-    let mut out = String::new();
-    for (i, name) in names.iter().enumerate() {
-        if i > 0 {
-            out.push_str(", ");
-        }
-        out.push('`');
-        out.push_str(name);
-        out.push('`');
-    }
-    out
+    Run(#[source] IntegrateError),
 }

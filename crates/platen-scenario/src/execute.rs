@@ -1,6 +1,12 @@
 //! The executor: [`Scenario::run`] runs a validated scenario into any [`SampleSink`].
 
-use platen_integrate::{inverse, ForwardIntegrator, Peaks, RunStats, SampleSink};
+use std::path::Path;
+
+use platen_integrate::{
+    inverse, ForwardIntegrator, Peaks, RunStats, Sample, SampleSink, Trajectory,
+};
+use platen_io::csv::CsvWriter;
+use platen_io::IoError;
 use platen_model::PlatenModel;
 
 use crate::error::{Result, ScenarioError};
@@ -58,4 +64,61 @@ fn run_model<M: PlatenModel, S: SampleSink>(
         peaks: sink.1,
         stats,
     })
+}
+
+/// A [`SampleSink`] that streams the contract's columns ([`Trajectory::COLUMN_NAMES`]) to a
+/// CSV file as the run produces them, atomically ([`CsvWriter`]): a one-hour 1024 Hz run
+/// holds no trajectory in memory, and a failed run leaves no partial file.
+#[derive(Debug)]
+pub struct CsvSink {
+    writer: CsvWriter<'static>,
+    error: Option<IoError>,
+}
+
+impl CsvSink {
+    /// Creates the output's temporary file and writes the header, so that an unwritable
+    /// destination fails before the run.
+    ///
+    /// # Errors
+    /// [`ScenarioError::Io`] if the temporary file cannot be created or written.
+    pub fn create(path: &Path) -> Result<Self> {
+        Ok(Self {
+            writer: CsvWriter::create(path, &Trajectory::COLUMN_NAMES)?,
+            error: None,
+        })
+    }
+
+    /// Renames the complete file over the destination.
+    ///
+    /// # Errors
+    /// The first error met while writing (a non-finite value, with its line and column, or
+    /// a failed write), or one of committing the file; nothing is left behind.
+    pub fn finish(self) -> Result<()> {
+        if let Some(error) = self.error {
+            return Err(error.into());
+        }
+        Ok(self.writer.finish()?)
+    }
+}
+
+impl SampleSink for CsvSink {
+    #[inline]
+    fn accept(&mut self, s: &Sample) {
+        if self.error.is_some() {
+            return;
+        }
+        let row = [
+            s.t_s,
+            s.u_m,
+            s.v_m_s,
+            s.a_m_s2,
+            s.terms.actuator_n,
+            s.terms.inertial_n,
+            s.terms.elastic_n,
+            s.terms.dissipative_n,
+        ];
+        if let Err(error) = self.writer.write_row(&row) {
+            self.error = Some(error);
+        }
+    }
 }

@@ -2,7 +2,6 @@
 //!
 //! * [`scenario`]: the scenario JSON format ([`Scenario::load`] validates a file and loads
 //!   its records before anything is simulated);
-//! * [`csv_io`]: time-series CSV by column name, written atomically;
 //! * [`Scenario::run`]: the executor every front end calls (CLI, sweep, bench, Python).
 //!
 //! # Conventions
@@ -13,15 +12,13 @@
 
 #![warn(missing_docs)]
 
-pub mod columns;
-pub mod csv_io;
 pub mod error;
 mod execute;
 pub mod generate;
-pub mod peer;
 pub mod recorded;
+pub mod sampling;
 pub mod scenario;
 
 pub use error::{Result, ScenarioError};
-pub use execute::RunOutput;
+pub use execute::{CsvSink, RunOutput};
 pub use scenario::{Model, Run, Scenario};

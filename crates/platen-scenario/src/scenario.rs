@@ -41,10 +41,12 @@ use platen_model::{
     STANDARD_GRAVITY_M_S2,
 };
 
-use crate::columns::{ColumnMap, ColumnSpec};
-use crate::csv_io::uniform_step_s;
 use crate::error::{Result, ScenarioError};
 use crate::generate::{self, GenerateError};
+use crate::sampling::uniform_step_s;
+use platen_io::columns::{ColumnMap, ColumnSpec};
+use platen_io::json::{parse_json, parse_json_file};
+use platen_io::IoError;
 
 /// The scenario file as written (after JSON parsing, before validation).
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
@@ -151,7 +153,7 @@ pub struct ExcitationSpec {
     /// The filter of `lowpass_hz` (default `brickwall`).
     pub lowpass_filter: Option<LowpassFilter>,
     /// A lab's own channel names and units for `force_csv` / `motion_csv`
-    /// (see [`crate::columns`]).
+    /// (see [`platen_io::columns`]).
     pub columns: Option<BTreeMap<String, ColumnSpec>>,
 }
 
@@ -475,55 +477,9 @@ impl Scenario {
 /// Parses scenario JSON, reporting the JSON path (or line and column) of any error.
 ///
 /// # Errors
-/// [`ScenarioError::Json`].
+/// [`ScenarioError::Io`] ([`platen_io::IoError::Json`]).
 pub fn parse(path: &Path, text: &str) -> Result<ScenarioFile> {
-    parse_json(path, text)
-}
-
-/// Reads the JSON file `path` into `T`.
-///
-/// # Errors
-/// [`ScenarioError::Io`] if it cannot be read, else as [`parse_json`].
-pub fn parse_json_file<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
-    let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
-        path: path.to_owned(),
-        action: "reading",
-        source,
-    })?;
-    parse_json(path, &text)
-}
-
-/// Parses JSON text read from `path` into `T`, reporting the JSON path (or line and
-/// column) of any error: for scenario files and the other JSON inputs of platen (column
-/// maps, identification manifests).
-///
-/// # Errors
-/// [`ScenarioError::Json`].
-pub fn parse_json<T: serde::de::DeserializeOwned>(path: &Path, text: &str) -> Result<T> {
-    let de = &mut serde_json::Deserializer::from_str(text);
-    serde_path_to_error::deserialize(de).map_err(|e| {
-        let inner = e.inner();
-        let json_path = e.path().to_string();
-        let json_path = if json_path == "." || json_path.is_empty() {
-            format!("line {} column {}", inner.line(), inner.column())
-        } else {
-            format!(
-                "{json_path} (line {} column {})",
-                inner.line(),
-                inner.column()
-            )
-        };
-        // serde_json appends " at line L column C"; the location is already in json_path.
-        let mut message = inner.to_string();
-        if let Some(pos) = message.rfind(" at line ") {
-            message.truncate(pos);
-        }
-        ScenarioError::Json {
-            path: path.to_owned(),
-            json_path,
-            message,
-        }
-    })
+    Ok(parse_json(path, text)?)
 }
 
 struct Ctx<'a> {
@@ -836,12 +792,13 @@ fn read_mapped(
     }
     if let Some(t) = out.get("t_s") {
         if let Some(i) = (1..t.len()).find(|&i| t[i] <= t[i - 1]) {
-            return Err(ScenarioError::TimeNotIncreasing {
+            return Err(IoError::TimeNotIncreasing {
                 path: path.to_owned(),
                 line: i as u64 + 2,
                 previous_s: t[i - 1],
                 value_s: t[i],
-            });
+            }
+            .into());
         }
     }
     Ok(out)
@@ -905,7 +862,7 @@ fn ground_motion(ctx: &Ctx, g: &GroundMotion, duration_s: Option<f64>) -> Result
     let here = "excitation.ground_motion";
     let scale = check_finite(ctx, &format!("{here}.scale"), g.scale)?;
     let rate = check_positive(ctx, &format!("{here}.sample_rate_hz"), g.sample_rate_hz)?;
-    let path = crate::peer::find_record(ctx.path.parent(), &g.record)?;
+    let path = platen_io::peer::find_record(ctx.path.parent(), &g.record)?;
     let is_csv = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
@@ -926,8 +883,8 @@ fn ground_motion(ctx: &Ctx, g: &GroundMotion, duration_s: Option<f64>) -> Result
                 "columns only for a record given as .csv",
             ));
         }
-        let rec = crate::peer::read_peer(&path)?;
-        if rec.quantity != crate::peer::Quantity::Acceleration {
+        let rec = platen_io::peer::read_peer(&path)?;
+        if rec.quantity != platen_io::peer::Quantity::Acceleration {
             return Err(ScenarioError::Record {
                 path,
                 message: "ground_motion needs an acceleration record (.AT2); this one holds velocity or displacement"

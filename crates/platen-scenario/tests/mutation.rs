@@ -5,8 +5,8 @@
 
 use std::path::Path;
 
-use platen_scenario::csv_io::read_table;
-use platen_scenario::peer::read_peer;
+use platen_io::csv::read_table;
+use platen_io::peer::read_peer;
 use platen_scenario::scenario::parse;
 use platen_scenario::Scenario;
 use proptest::prelude::*;

@@ -1,7 +1,7 @@
 //! The real PEER NGA records (not shipped: read from `PLATEN_RECORDS_DIR`, which `.ci/run`
 //! points at `../shared/data/records`). Each test says so and passes when they are missing.
 
-use platen_scenario::peer::{read_peer, records_dir, Quantity, RECORDS_DIR_VAR};
+use platen_io::peer::{read_peer, records_dir, Quantity, RECORDS_DIR_VAR};
 
 macro_rules! need_records {
     () => {

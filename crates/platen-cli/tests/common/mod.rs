@@ -78,7 +78,7 @@ pub fn check_png(svg: &Path, content: &SvgContent) {
 /// Rewrites a platen CSV as a data system would export it: each `(platen column, header,
 /// SI units per file unit)` becomes a column `header` holding the value in the file's unit.
 pub fn relabel(src: &Path, dst: &Path, channels: &[(&str, &str, f64)]) {
-    use platen_scenario::csv_io::{read_table, write_csv_atomic};
+    use platen_io::csv::{read_table, write_csv_atomic};
     let names: Vec<&str> = channels.iter().map(|c| c.0).collect();
     let table = read_table(src, &names, &[]).unwrap();
     let columns: Vec<Vec<f64>> = channels

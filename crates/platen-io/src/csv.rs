@@ -23,14 +23,14 @@
 //!   deterministic. Files are replaced atomically: written to a temporary file in the same
 //!   directory, synced, then renamed over the destination.
 
-use std::fs::{self, File, OpenOptions};
-use std::io::{self, BufWriter, Read, Seek, SeekFrom, Write};
+use std::fs::File;
+use std::io::{self, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use csv::{ReaderBuilder, StringRecord, Terminator};
 
-use crate::error::{Result, ScenarioError};
+use crate::atomic::{write_error, AtomicFile};
+use crate::error::{IoAction, IoError, Result};
 
 /// Name of the time column, s. Whenever it is selected it must increase strictly.
 pub const TIME_COLUMN: &str = "t_s";
@@ -112,21 +112,21 @@ impl Table {
 /// Reads the columns `required` and, where present, `optional` from the CSV file at `path`.
 ///
 /// See the [module documentation](self) for the format. Errors:
-/// [`Io`](ScenarioError::Io) if the file cannot be read,
-/// [`CsvSyntax`](ScenarioError::CsvSyntax) for malformed CSV (invalid UTF-8, a blank line before
-/// the header or inside the data), [`MissingColumn`](ScenarioError::MissingColumn) if a required
-/// column is not in the header, [`DuplicateColumn`](ScenarioError::DuplicateColumn) if a
-/// selected name appears twice in the header, [`RaggedRow`](ScenarioError::RaggedRow) if a row's
-/// field count differs from the header's, [`NonNumeric`](ScenarioError::NonNumeric) /
-/// [`NonFinite`](ScenarioError::NonFinite) for a bad cell in a selected column,
-/// [`TimeNotIncreasing`](ScenarioError::TimeNotIncreasing) if `t_s` is selected and does not
-/// increase strictly, and [`Empty`](ScenarioError::Empty) if there is no data row.
+/// [`Io`](IoError::Io) if the file cannot be read,
+/// [`CsvSyntax`](IoError::CsvSyntax) for malformed CSV (invalid UTF-8, a blank line before
+/// the header or inside the data), [`MissingColumn`](IoError::MissingColumn) if a required
+/// column is not in the header, [`DuplicateColumn`](IoError::DuplicateColumn) if a
+/// selected name appears twice in the header, [`RaggedRow`](IoError::RaggedRow) if a row's
+/// field count differs from the header's, [`NonNumeric`](IoError::NonNumeric) /
+/// [`NonFinite`](IoError::NonFinite) for a bad cell in a selected column,
+/// [`TimeNotIncreasing`](IoError::TimeNotIncreasing) if `t_s` is selected and does not
+/// increase strictly, and [`Empty`](IoError::Empty) if there is no data row.
 ///
 /// A name listed twice (or in both lists) is read once.
 pub fn read_table(path: &Path, required: &[&str], optional: &[&str]) -> Result<Table> {
-    let read_error = |source| ScenarioError::Io {
+    let read_error = |source| IoError::Io {
         path: path.to_path_buf(),
-        action: "reading",
+        action: IoAction::Reading,
         source,
     };
     let mut file = File::open(path).map_err(read_error)?;
@@ -146,7 +146,7 @@ pub fn read_table(path: &Path, required: &[&str], optional: &[&str]) -> Result<T
         .read_record(&mut record)
         .map_err(|e| csv_error(path, e, 1))?
     {
-        return Err(ScenarioError::Empty {
+        return Err(IoError::Empty {
             path: path.to_path_buf(),
         });
     }
@@ -203,7 +203,7 @@ pub fn read_table(path: &Path, required: &[&str], optional: &[&str]) -> Result<T
             ));
         }
         if record.len() != header.len() {
-            return Err(ScenarioError::RaggedRow {
+            return Err(IoError::RaggedRow {
                 path: path.to_path_buf(),
                 line,
                 expected: header.len(),
@@ -217,7 +217,7 @@ pub fn read_table(path: &Path, required: &[&str], optional: &[&str]) -> Result<T
         if let Some(slot) = time_slot {
             let t = columns[slot][rows];
             if t <= previous_t {
-                return Err(ScenarioError::TimeNotIncreasing {
+                return Err(IoError::TimeNotIncreasing {
                     path: path.to_path_buf(),
                     line,
                     previous_s: previous_t,
@@ -230,7 +230,7 @@ pub fn read_table(path: &Path, required: &[&str], optional: &[&str]) -> Result<T
     }
 
     if rows == 0 {
-        return Err(ScenarioError::Empty {
+        return Err(IoError::Empty {
             path: path.to_path_buf(),
         });
     }
@@ -265,13 +265,13 @@ fn select_columns(
         match (matches.next(), matches.next()) {
             (Some((index, _)), None) => selection.push((index, name.to_owned())),
             (Some(_), Some(_)) => {
-                return Err(ScenarioError::DuplicateColumn {
+                return Err(IoError::DuplicateColumn {
                     path: path.to_path_buf(),
                     column: name.to_owned(),
                 })
             }
             (None, _) if is_required => {
-                return Err(ScenarioError::MissingColumn {
+                return Err(IoError::MissingColumn {
                     path: path.to_path_buf(),
                     column: name.to_owned(),
                     available: header.to_vec(),
@@ -289,13 +289,13 @@ fn parse_cell(path: &Path, line: u64, column: &str, cell: &str) -> Result<f64> {
     let text = cell.trim();
     match text.parse::<f64>() {
         Ok(value) if value.is_finite() => Ok(value),
-        Ok(_) => Err(ScenarioError::NonFinite {
+        Ok(_) => Err(IoError::NonFinite {
             path: path.to_path_buf(),
             line,
             column: column.to_owned(),
             value: quote_cell(text),
         }),
-        Err(_) => Err(ScenarioError::NonNumeric {
+        Err(_) => Err(IoError::NonNumeric {
             path: path.to_path_buf(),
             line,
             column: column.to_owned(),
@@ -354,8 +354,8 @@ fn is_blank(record: &StringRecord) -> bool {
     record.len() == 1 && record[0].trim().is_empty()
 }
 
-fn syntax(path: &Path, line: u64, message: &str) -> ScenarioError {
-    ScenarioError::CsvSyntax {
+fn syntax(path: &Path, line: u64, message: &str) -> IoError {
+    IoError::CsvSyntax {
         path: path.to_path_buf(),
         line,
         message: message.to_owned(),
@@ -363,22 +363,22 @@ fn syntax(path: &Path, line: u64, message: &str) -> ScenarioError {
 }
 
 /// Converts an error of the `csv` crate; `line` is used when the error carries no position.
-fn csv_error(path: &Path, error: csv::Error, line: u64) -> ScenarioError {
+fn csv_error(path: &Path, error: csv::Error, line: u64) -> IoError {
     let position_line = error.position().map(csv::Position::line);
     match error.into_kind() {
-        csv::ErrorKind::Io(source) => ScenarioError::Io {
+        csv::ErrorKind::Io(source) => IoError::Io {
             path: path.to_path_buf(),
-            action: "reading",
+            action: IoAction::Reading,
             source,
         },
-        csv::ErrorKind::Utf8 { pos, err } => ScenarioError::CsvSyntax {
+        csv::ErrorKind::Utf8 { pos, err } => IoError::CsvSyntax {
             path: path.to_path_buf(),
             line: pos.map_or(line, |p| p.line()),
             message: format!("field {} is not valid UTF-8 text", err.field() + 1),
         },
         // Other kinds (unequal lengths, seek, serde) cannot occur when reading flexible
         // `StringRecord`s; report them anyway.
-        other => ScenarioError::CsvSyntax {
+        other => IoError::CsvSyntax {
             path: path.to_path_buf(),
             line: position_line.unwrap_or(line),
             message: format!("{other:?}"),
@@ -386,43 +386,37 @@ fn csv_error(path: &Path, error: csv::Error, line: u64) -> ScenarioError {
     }
 }
 
-/// Counter making temporary file names unique within the process.
-static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);
-
 /// Writes a time-series CSV file atomically: `header[j]` names `columns[j]`.
 ///
 /// Numbers are printed as the shortest text that parses back to the same `f64` (`{}`
 /// formatting, or `{:e}` for magnitudes below 1e-5 or from 1e16 on); lines end with `\n`. All columns must have the same length
-/// ([`ColumnLengthMismatch`](ScenarioError::ColumnLengthMismatch)), there must be one name per
-/// column ([`HeaderMismatch`](ScenarioError::HeaderMismatch)), names must be non-empty and need no
-/// CSV quoting ([`InvalidColumnName`](ScenarioError::InvalidColumnName)), and every value must
-/// be finite ([`NonFinite`](ScenarioError::NonFinite), naming the line the value would have had),
+/// ([`ColumnLengthMismatch`](IoError::ColumnLengthMismatch)), there must be one name per
+/// column ([`HeaderMismatch`](IoError::HeaderMismatch)), names must be non-empty and need no
+/// CSV quoting ([`InvalidColumnName`](IoError::InvalidColumnName)), and every value must
+/// be finite ([`NonFinite`](IoError::NonFinite), naming the line the value would have had),
 /// so that every file written can be read back by [`read_table`].
 ///
-/// The data go to a temporary file in the same directory (`.NAME.PID.N.tmp`), which is flushed,
+/// The data go to a temporary file in the same directory ([`AtomicFile`]), which is flushed,
 /// synced and renamed over `path`. On any error the temporary file is removed and an existing
 /// file at `path` is left untouched.
 pub fn write_csv_atomic(path: &Path, header: &[&str], columns: &[&[f64]]) -> Result<()> {
     if header.len() != columns.len() {
-        return Err(ScenarioError::HeaderMismatch {
+        return Err(IoError::HeaderMismatch {
             path: path.to_path_buf(),
             names: header.len(),
             columns: columns.len(),
         });
     }
-    for name in header {
-        let needs_quoting = name.contains([',', '"', '\n', '\r']);
-        if name.is_empty() || needs_quoting || name.trim() != *name {
-            return Err(ScenarioError::InvalidColumnName {
-                path: path.to_path_buf(),
-                column: (*name).to_owned(),
-            });
-        }
+    if let Some(name) = header.iter().find(|n| !valid_column_name(n)) {
+        return Err(IoError::InvalidColumnName {
+            path: path.to_path_buf(),
+            column: (*name).to_owned(),
+        });
     }
     let rows = columns.first().map_or(0, |c| c.len());
     for (name, column) in header.iter().zip(columns) {
         if column.len() != rows {
-            return Err(ScenarioError::ColumnLengthMismatch {
+            return Err(IoError::ColumnLengthMismatch {
                 path: path.to_path_buf(),
                 column: (*name).to_owned(),
                 expected: rows,
@@ -431,38 +425,96 @@ pub fn write_csv_atomic(path: &Path, header: &[&str], columns: &[&[f64]]) -> Res
         }
     }
 
-    write_atomic(path, |out| {
-        let io = |source| write_error(path, source);
-        out.write_all(header.join(",").as_bytes()).map_err(io)?;
-        out.write_all(b"\n").map_err(io)?;
-        for row in 0..rows {
-            for (j, (name, column)) in header.iter().zip(columns).enumerate() {
-                let value = column[row];
-                if !value.is_finite() {
-                    return Err(ScenarioError::NonFinite {
-                        path: path.to_path_buf(),
-                        line: row as u64 + 2,
-                        column: (*name).to_owned(),
-                        value: value.to_string(),
-                    });
-                }
-                if j > 0 {
-                    out.write_all(b",").map_err(io)?;
-                }
-                write_number(out, value).map_err(io)?;
-            }
-            out.write_all(b"\n").map_err(io)?;
+    let mut writer = CsvWriter::create(path, header)?;
+    let mut row = vec![0.0; columns.len()];
+    for i in 0..rows {
+        for (value, column) in row.iter_mut().zip(columns) {
+            *value = column[i];
         }
-        Ok(())
-    })
+        writer.write_row(&row)?;
+    }
+    writer.finish()
 }
 
-/// Writes `bytes` to `path` atomically, as [`write_csv_atomic`] does (for JSON outputs).
-pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    write_atomic(path, |out| {
-        out.write_all(bytes)
-            .map_err(|source| write_error(path, source))
-    })
+/// A time-series CSV written row by row as a run produces it, atomically (see
+/// [`AtomicFile`]): the header at creation, one [`CsvWriter::write_row`] per sample, then
+/// [`CsvWriter::finish`]. Numbers are formatted by [`write_number`], so the bytes are those
+/// [`write_csv_atomic`] writes for the same columns. Dropped unfinished, it removes its
+/// temporary file.
+#[derive(Debug)]
+pub struct CsvWriter<'h> {
+    file: AtomicFile,
+    header: &'h [&'h str],
+    rows: u64,
+}
+
+impl<'h> CsvWriter<'h> {
+    /// Creates the temporary file next to `path` and writes the header.
+    ///
+    /// # Errors
+    /// [`InvalidColumnName`](IoError::InvalidColumnName) for a name that is empty or needs
+    /// CSV quoting; [`IoError::Io`] if the temporary file cannot be created or written.
+    pub fn create(path: &Path, header: &'h [&'h str]) -> Result<Self> {
+        if let Some(name) = header.iter().find(|n| !valid_column_name(n)) {
+            return Err(IoError::InvalidColumnName {
+                path: path.to_path_buf(),
+                column: (*name).to_owned(),
+            });
+        }
+        let mut file = AtomicFile::create(path)?;
+        let out = file.writer();
+        out.write_all(header.join(",").as_bytes())
+            .and_then(|()| out.write_all(b"\n"))
+            .map_err(|source| write_error(path, source))?;
+        Ok(Self {
+            file,
+            header,
+            rows: 0,
+        })
+    }
+
+    /// Writes one row, `values[j]` under `header[j]`.
+    ///
+    /// # Errors
+    /// [`NonFinite`](IoError::NonFinite) naming the line the value would have had, or
+    /// [`IoError::Io`] for a failed write.
+    pub fn write_row(&mut self, values: &[f64]) -> Result<()> {
+        if let Some(j) = values.iter().position(|v| !v.is_finite()) {
+            return Err(IoError::NonFinite {
+                path: self.file.path().to_path_buf(),
+                line: self.rows + 2,
+                column: self.header[j].to_owned(),
+                value: values[j].to_string(),
+            });
+        }
+        let out = self.file.writer();
+        let written = (|| {
+            for (j, &value) in values.iter().enumerate() {
+                if j > 0 {
+                    out.write_all(b",")?;
+                }
+                write_number(out, value)?;
+            }
+            out.write_all(b"\n")
+        })();
+        written.map_err(|source| write_error(self.file.path(), source))?;
+        self.rows += 1;
+        Ok(())
+    }
+
+    /// Flushes and syncs the file and renames it over the destination.
+    ///
+    /// # Errors
+    /// As [`AtomicFile::commit`].
+    pub fn finish(self) -> Result<()> {
+        self.file.commit()
+    }
+}
+
+/// Whether `name` can be written as a header without CSV quoting and read back as itself.
+fn valid_column_name(name: &str) -> bool {
+    let needs_quoting = name.contains([',', '"', '\n', '\r']);
+    !(name.is_empty() || needs_quoting || name.trim() != name)
 }
 
 /// Writes a finite `value` as the shortest text that parses back to it (see the module docs):
@@ -478,140 +530,11 @@ pub fn write_number<W: Write>(out: &mut W, value: f64) -> io::Result<()> {
     }
 }
 
-fn write_error(path: &Path, source: io::Error) -> ScenarioError {
-    ScenarioError::Io {
-        path: path.to_path_buf(),
-        action: "writing",
-        source,
-    }
-}
-
-/// Creates a new, uniquely named temporary file in the folder of `path` (`.NAME.PID.N.tmp`),
-/// to be renamed over `path` when its content is complete.
-///
-/// # Errors
-/// [`ScenarioError::Io`] if `path` names no file or the file cannot be created.
-pub fn create_temp_next_to(path: &Path) -> Result<(PathBuf, File)> {
-    let Some(file_name) = path.file_name() else {
-        return Err(write_error(
-            path,
-            io::Error::new(io::ErrorKind::InvalidInput, "the path names no file"),
-        ));
-    };
-    let dir = match path.parent() {
-        Some(parent) if !parent.as_os_str().is_empty() => parent,
-        _ => Path::new("."),
-    };
-    let temp = dir.join(format!(
-        ".{}.{}.{}.tmp",
-        file_name.to_string_lossy(),
-        std::process::id(),
-        TEMP_COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    let file = OpenOptions::new()
-        .write(true)
-        .create_new(true)
-        .open(&temp)
-        .map_err(|source| ScenarioError::Io {
-            path: path.to_path_buf(),
-            action: "creating a temporary file next to",
-            source,
-        })?;
-    Ok((temp, file))
-}
-
-/// Runs `fill` on a buffered temporary file next to `path`, then syncs it and renames it over
-/// `path`. Removes the temporary file on any error.
-fn write_atomic<F>(path: &Path, fill: F) -> Result<()>
-where
-    F: FnOnce(&mut BufWriter<File>) -> Result<()>,
-{
-    let (temp, file) = create_temp_next_to(path)?;
-
-    let result = (|| {
-        let mut out = BufWriter::with_capacity(BUFFER_BYTES, file);
-        fill(&mut out)?;
-        let file = out
-            .into_inner()
-            .map_err(|e| write_error(path, e.into_error()))?;
-        file.sync_all()
-            .map_err(|source| write_error(path, source))?;
-        drop(file);
-        fs::rename(&temp, path).map_err(|source| ScenarioError::Io {
-            path: path.to_path_buf(),
-            action: "renaming the temporary file onto",
-            source,
-        })
-    })();
-
-    match result {
-        Ok(()) => {
-            sync_directory(temp.parent().unwrap_or(Path::new(".")));
-            Ok(())
-        }
-        Err(error) => {
-            // Best effort: the original error is the one worth reporting.
-            let _ = fs::remove_file(&temp);
-            Err(error)
-        }
-    }
-}
-
-/// Makes the rename durable where the platform allows it (best effort).
-fn sync_directory(dir: &Path) {
-    #[cfg(unix)]
-    if let Ok(handle) = File::open(dir) {
-        let _ = handle.sync_all();
-    }
-    #[cfg(not(unix))]
-    let _ = dir;
-}
-
-/// Sample interval of the uniformly sampled time column `t_s` read from `path`, s.
-///
-/// The interval is the mean one, `(t_last − t_first) / (n − 1)`. Every interval must match the
-/// median interval within [`platen_integrate::UNIFORM_RELATIVE_TOLERANCE`] (0.1 %), else
-/// [`NonUniform`](ScenarioError::NonUniform) names the line that ends the odd interval; intervals
-/// that are not positive give [`TimeNotIncreasing`](ScenarioError::TimeNotIncreasing). Fewer
-/// than 2 samples give [`TooShort`](ScenarioError::TooShort). `path` is used for messages only;
-/// line numbers assume the header on line 1 and one sample per line (sample `i`, 0-based, on
-/// line `i + 2`).
-pub fn uniform_step_s(path: &Path, t_s: &[f64]) -> Result<f64> {
-    use platen_integrate::IntegrateError;
-    platen_integrate::uniform_interval_s(t_s).map_err(|e| match e {
-        IntegrateError::TooShort { found, needed } => ScenarioError::TooShort {
-            path: path.to_path_buf(),
-            rows: found,
-            needed,
-        },
-        IntegrateError::NonUniform { index, found_s, .. } if found_s <= 0.0 => {
-            ScenarioError::TimeNotIncreasing {
-                path: path.to_path_buf(),
-                line: index as u64 + 2,
-                previous_s: t_s[index - 1],
-                value_s: t_s[index],
-            }
-        }
-        IntegrateError::NonUniform {
-            index,
-            expected_s,
-            found_s,
-        } => ScenarioError::NonUniform {
-            path: path.to_path_buf(),
-            line: index as u64 + 2,
-            expected_s,
-            found_s,
-        },
-        other => ScenarioError::Record {
-            path: path.to_path_buf(),
-            message: other.to_string(),
-        },
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::atomic::write_bytes_atomic;
+    use std::fs;
     use tempfile::TempDir;
 
     /// Writes `contents` to `name` in a fresh temporary directory.
@@ -628,7 +551,7 @@ mod tests {
         contents: &str,
         required: &[&str],
         optional: &[&str],
-    ) -> (ScenarioError, String) {
+    ) -> (IoError, String) {
         let (_dir, path) = file_with(name, contents.as_bytes());
         let error = read_table(&path, required, optional).unwrap_err();
         let message = error.to_string();
@@ -695,7 +618,7 @@ mod tests {
             &[],
         );
         assert!(
-            matches!(error, ScenarioError::NonNumeric { line: 3, .. }),
+            matches!(error, IoError::NonNumeric { line: 3, .. }),
             "{error:?}"
         );
         assert!(message.contains("line 3"), "{message}");
@@ -707,7 +630,7 @@ mod tests {
             &[],
         );
         assert!(
-            matches!(error, ScenarioError::NonNumeric { line: 4, .. }),
+            matches!(error, IoError::NonNumeric { line: 4, .. }),
             "{error:?}"
         );
     }
@@ -719,7 +642,7 @@ mod tests {
         let error = read_table(&path, &["t_s"], &[]).unwrap_err();
         let message = error.to_string();
         assert!(
-            matches!(error, ScenarioError::Io { action: "reading", ref source, .. }
+            matches!(error, IoError::Io { action: IoAction::Reading, ref source, .. }
                 if source.kind() == io::ErrorKind::NotFound),
             "{error:?}"
         );
@@ -735,7 +658,7 @@ mod tests {
         let error = read_table(&path, &["t_s", "u_m"], &[]).unwrap_err();
         let message = error.to_string();
         assert!(
-            matches!(error, ScenarioError::CsvSyntax { line: 3, .. }),
+            matches!(error, IoError::CsvSyntax { line: 3, .. }),
             "{error:?}"
         );
         assert!(
@@ -748,32 +671,32 @@ mod tests {
     fn a_blank_line_inside_the_data_is_a_syntax_error_with_its_line() {
         let (error, message) = error_for("gap.csv", "t_s,u_m\n0,0\n\n1,0\n", &["t_s"], &[]);
         assert!(
-            matches!(error, ScenarioError::CsvSyntax { line: 3, .. }),
+            matches!(error, IoError::CsvSyntax { line: 3, .. }),
             "{error:?}"
         );
         assert!(message.contains("line 3"), "{message}");
 
         let (error, _) = error_for("gap2.csv", "t_s,u_m\n0,0\n  \n1,0\n", &["t_s"], &[]);
         assert!(
-            matches!(error, ScenarioError::CsvSyntax { line: 3, .. }),
+            matches!(error, IoError::CsvSyntax { line: 3, .. }),
             "{error:?}"
         );
 
         let (error, _) = error_for("gap_last.csv", "t_s,u_m\n0,0\n\n1,0", &["t_s"], &[]);
         assert!(
-            matches!(error, ScenarioError::CsvSyntax { line: 3, .. }),
+            matches!(error, IoError::CsvSyntax { line: 3, .. }),
             "{error:?}"
         );
 
         let (error, _) = error_for("gap_crlf.csv", "t_s\r\n0\r\n\r\n1\r\n", &["t_s"], &[]);
         assert!(
-            matches!(error, ScenarioError::CsvSyntax { line: 3, .. }),
+            matches!(error, IoError::CsvSyntax { line: 3, .. }),
             "{error:?}"
         );
 
         let (error, _) = error_for("gap3.csv", "\nt_s,u_m\n0,0\n", &["t_s"], &[]);
         assert!(
-            matches!(error, ScenarioError::CsvSyntax { line: 1, .. }),
+            matches!(error, IoError::CsvSyntax { line: 1, .. }),
             "{error:?}"
         );
     }
@@ -783,7 +706,7 @@ mod tests {
         let (error, message) =
             error_for("force.csv", "time, force\n0,1\n", &["t_s", "force_n"], &[]);
         match &error {
-            ScenarioError::MissingColumn {
+            IoError::MissingColumn {
                 column, available, ..
             } => {
                 assert_eq!(column, "t_s");
@@ -808,7 +731,7 @@ mod tests {
     fn a_selected_column_appearing_twice_is_a_duplicate_column_error() {
         let (error, message) = error_for("dup.csv", "t_s,u_m,u_m\n0,1,2\n", &["t_s"], &["u_m"]);
         assert!(
-            matches!(error, ScenarioError::DuplicateColumn { ref column, .. } if column == "u_m"),
+            matches!(error, IoError::DuplicateColumn { ref column, .. } if column == "u_m"),
             "{error:?}"
         );
         assert!(
@@ -832,7 +755,7 @@ mod tests {
             &[],
         );
         assert!(
-            matches!(error, ScenarioError::NonNumeric { line: 3, ref column, ref value, .. }
+            matches!(error, IoError::NonNumeric { line: 3, ref column, ref value, .. }
                 if column == "u_m" && value == "1.2.3"),
             "{error:?}"
         );
@@ -843,7 +766,7 @@ mod tests {
 
         let (error, _) = error_for("empty_cell.csv", "t_s,u_m\n0, \n", &["t_s", "u_m"], &[]);
         assert!(
-            matches!(error, ScenarioError::NonNumeric { line: 2, .. }),
+            matches!(error, IoError::NonNumeric { line: 2, .. }),
             "{error:?}"
         );
     }
@@ -863,7 +786,7 @@ mod tests {
             let contents = format!("t_s,force_n\n0,1\n1,{text}\n");
             let (error, message) = error_for("force.csv", &contents, &["t_s", "force_n"], &[]);
             assert!(
-                matches!(error, ScenarioError::NonFinite { line: 3, ref column, ref value, .. }
+                matches!(error, IoError::NonFinite { line: 3, ref column, ref value, .. }
                     if column == "force_n" && value == text),
                 "{text}: {error:?}"
             );
@@ -880,7 +803,7 @@ mod tests {
     fn a_file_without_data_rows_is_empty() {
         for contents in ["", "t_s,u_m\n", "t_s,u_m\n\n \n"] {
             let (error, message) = error_for("nothing.csv", contents, &["t_s"], &[]);
-            assert!(matches!(error, ScenarioError::Empty { .. }), "{error:?}");
+            assert!(matches!(error, IoError::Empty { .. }), "{error:?}");
             assert!(message.contains("no data rows"), "{message}");
         }
     }
@@ -894,7 +817,7 @@ mod tests {
             &["t_s"],
         );
         assert!(
-            matches!(error, ScenarioError::TimeNotIncreasing { line: 4, previous_s, value_s, .. }
+            matches!(error, IoError::TimeNotIncreasing { line: 4, previous_s, value_s, .. }
                 if previous_s == 0.5 && value_s == 0.25),
             "{error:?}"
         );
@@ -908,7 +831,7 @@ mod tests {
 
         let (error, _) = error_for("repeat.csv", "t_s\n0\n1\n1\n", &["t_s"], &[]);
         assert!(
-            matches!(error, ScenarioError::TimeNotIncreasing { line: 4, .. }),
+            matches!(error, IoError::TimeNotIncreasing { line: 4, .. }),
             "{error:?}"
         );
     }
@@ -920,7 +843,7 @@ mod tests {
         assert!(
             matches!(
                 error,
-                ScenarioError::RaggedRow {
+                IoError::RaggedRow {
                     line: 3,
                     expected: 2,
                     found: 3,
@@ -935,7 +858,7 @@ mod tests {
         assert!(
             matches!(
                 error,
-                ScenarioError::RaggedRow {
+                IoError::RaggedRow {
                     line: 2,
                     expected: 3,
                     found: 2,
@@ -1001,7 +924,7 @@ mod tests {
         let target = dir.path().join("no_such_dir").join("out.csv");
         let error = write_csv_atomic(&target, &["t_s"], &[&[1.0]]).unwrap_err();
         let message = error.to_string();
-        assert!(matches!(error, ScenarioError::Io { .. }), "{error:?}");
+        assert!(matches!(error, IoError::Io { .. }), "{error:?}");
         assert!(
             message.contains("out.csv") && message.contains("temporary"),
             "{message}"
@@ -1025,7 +948,7 @@ mod tests {
         .unwrap_err();
         let message = error.to_string();
         assert!(
-            matches!(error, ScenarioError::NonFinite { line: 4, ref column, .. } if column == "u_m"),
+            matches!(error, IoError::NonFinite { line: 4, ref column, .. } if column == "u_m"),
             "{error:?}"
         );
         assert!(
@@ -1047,7 +970,7 @@ mod tests {
         assert!(
             matches!(
                 error,
-                ScenarioError::HeaderMismatch {
+                IoError::HeaderMismatch {
                     names: 2,
                     columns: 1,
                     ..
@@ -1059,7 +982,7 @@ mod tests {
 
         let error = write_csv_atomic(&path, &["t_s", "u_m"], &[&[0.0, 1.0], &[0.0]]).unwrap_err();
         assert!(
-            matches!(error, ScenarioError::ColumnLengthMismatch { ref column, expected: 2, found: 1, .. }
+            matches!(error, IoError::ColumnLengthMismatch { ref column, expected: 2, found: 1, .. }
                 if column == "u_m"),
             "{error:?}"
         );
@@ -1068,56 +991,10 @@ mod tests {
         for name in ["", "a,b", "q\"", " t_s", "x\ny"] {
             let error = write_csv_atomic(&path, &[name], &[&[0.0]]).unwrap_err();
             assert!(
-                matches!(error, ScenarioError::InvalidColumnName { .. }),
+                matches!(error, IoError::InvalidColumnName { .. }),
                 "{name:?}: {error:?}"
             );
         }
         assert!(fs::read_dir(dir.path()).unwrap().next().is_none());
-    }
-
-    #[test]
-    fn the_step_of_a_uniform_time_column_is_its_mean_interval() {
-        let t: Vec<f64> = (0..10_000).map(|i| i as f64 / 1024.0).collect();
-        let step = uniform_step_s(Path::new("rec.csv"), &t).unwrap();
-        assert_eq!(step, 1.0 / 1024.0);
-
-        let t: Vec<f64> = (0..3_600_000).map(|i| i as f64 * 0.001).collect();
-        let step = uniform_step_s(Path::new("rec.csv"), &t).unwrap();
-        assert!((step - 0.001).abs() < 1e-15);
-    }
-
-    #[test]
-    fn a_non_uniform_time_column_is_reported_with_the_line_of_the_odd_interval() {
-        let t = [0.0, 0.01, 0.02, 0.035, 0.04];
-        let error = uniform_step_s(Path::new("irregular.csv"), &t).unwrap_err();
-        let message = error.to_string();
-        assert!(
-            matches!(error, ScenarioError::NonUniform { line: 5, expected_s, found_s, .. }
-                if expected_s == 0.01 && (found_s - 0.015).abs() < 1e-15),
-            "{error:?}"
-        );
-        assert!(
-            message.contains("irregular.csv")
-                && message.contains("line 5")
-                && message.contains("`t_s`"),
-            "{message}"
-        );
-        let error = uniform_step_s(Path::new("back.csv"), &[0.0, 1.0, 1.0, 3.0]).unwrap_err();
-        assert!(
-            matches!(error, ScenarioError::TimeNotIncreasing { line: 4, .. }),
-            "{error:?}"
-        );
-    }
-
-    #[test]
-    fn a_time_column_with_fewer_than_two_samples_is_too_short() {
-        for t in [&[][..], &[0.0][..]] {
-            let error = uniform_step_s(Path::new("one.csv"), t).unwrap_err();
-            assert!(
-                matches!(error, ScenarioError::TooShort { rows, needed: 2, .. } if rows == t.len()),
-                "{error:?}"
-            );
-            assert!(error.to_string().contains("one.csv"));
-        }
     }
 }

@@ -21,9 +21,9 @@
 
 use std::path::{Path, PathBuf};
 
-use platen_model::STANDARD_GRAVITY_M_S2;
+use crate::STANDARD_GRAVITY_M_S2;
 
-use crate::error::{Result, ScenarioError};
+use crate::error::{IoAction, IoError, Result};
 
 /// The environment variable naming the folder that holds ground-motion records.
 pub const RECORDS_DIR_VAR: &str = "PLATEN_RECORDS_DIR";
@@ -68,8 +68,8 @@ impl PeerRecord {
     }
 }
 
-fn header_error(path: &Path, line: u64, message: impl Into<String>) -> ScenarioError {
-    ScenarioError::CsvSyntax {
+fn header_error(path: &Path, line: u64, message: impl Into<String>) -> IoError {
+    IoError::CsvSyntax {
         path: path.to_owned(),
         line,
         message: message.into(),
@@ -79,14 +79,14 @@ fn header_error(path: &Path, line: u64, message: impl Into<String>) -> ScenarioE
 /// Reads a PEER NGA `.AT2`, `.VT2` or `.DT2` file.
 ///
 /// # Errors
-/// [`ScenarioError::Io`] if it cannot be read; [`ScenarioError::CsvSyntax`] naming the line for a
+/// [`IoError::Io`] if it cannot be read; [`IoError::CsvSyntax`] naming the line for a
 /// header that is not a PEER header, an unknown quantity or unit, a missing or malformed
-/// `NPTS`/`DT`, or a value count that differs from `NPTS`; [`ScenarioError::NonNumeric`] or
-/// [`ScenarioError::NonFinite`] naming the line of a bad value.
+/// `NPTS`/`DT`, or a value count that differs from `NPTS`; [`IoError::NonNumeric`] or
+/// [`IoError::NonFinite`] naming the line of a bad value.
 pub fn read_peer(path: &Path) -> Result<PeerRecord> {
-    let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
+    let text = std::fs::read_to_string(path).map_err(|source| IoError::Io {
         path: path.to_owned(),
-        action: "reading",
+        action: IoAction::Reading,
         source,
     })?;
     let mut lines = text.lines();
@@ -129,14 +129,14 @@ pub fn read_peer(path: &Path) -> Result<PeerRecord> {
     for (i, line) in text.lines().enumerate().skip(4) {
         let line_no = i as u64 + 1;
         for token in line.split_whitespace() {
-            let v: f64 = parse_fortran(token).ok_or_else(|| ScenarioError::NonNumeric {
+            let v: f64 = parse_fortran(token).ok_or_else(|| IoError::NonNumeric {
                 path: path.to_owned(),
                 line: line_no,
                 column: "value".to_owned(),
                 value: token.to_owned(),
             })?;
             if !v.is_finite() {
-                return Err(ScenarioError::NonFinite {
+                return Err(IoError::NonFinite {
                     path: path.to_owned(),
                     line: line_no,
                     column: "value".to_owned(),
@@ -212,7 +212,7 @@ fn parse_fortran(token: &str) -> Option<f64> {
 /// exists there, else in the folder named by [`RECORDS_DIR_VAR`].
 ///
 /// # Errors
-/// [`ScenarioError::Record`] saying where it looked and how to get the records.
+/// [`IoError::Record`] saying where it looked and how to get the records.
 pub fn find_record(scenario_dir: Option<&Path>, name: &Path) -> Result<PathBuf> {
     if name.is_absolute() && name.is_file() {
         return Ok(name.to_owned());
@@ -235,7 +235,7 @@ pub fn find_record(scenario_dir: Option<&Path>, name: &Path) -> Result<PathBuf> 
         }
         None => looked.push(format!("${RECORDS_DIR_VAR} (not set)")),
     }
-    Err(ScenarioError::Record {
+    Err(IoError::Record {
         path: name.to_owned(),
         message: format!(
             "ground-motion record not found (looked in: {}). {RECORDS_HELP}",

@@ -27,11 +27,11 @@ use std::path::Path;
 
 use serde::Deserialize;
 
-use crate::csv_io::{read_table, Table};
-use crate::error::{Result, ScenarioError};
-use crate::scenario::parse_json_file;
+use crate::csv::{read_table, Table};
+use crate::error::{IoError, Result};
+use crate::json::parse_json_file;
 
-use platen_model::STANDARD_GRAVITY_M_S2;
+use crate::STANDARD_GRAVITY_M_S2;
 
 /// How one of platen's columns is found in a file.
 #[derive(Debug, Clone, Default, Deserialize, PartialEq, schemars::JsonSchema)]
@@ -159,18 +159,16 @@ impl ColumnMap {
     /// as a scenario's `excitation.columns`), for recorded files named on the command line.
     ///
     /// # Errors
-    /// [`ScenarioError::Io`] if the file cannot be read, [`ScenarioError::Json`] (with the
-    /// JSON path) if it is not such an object, [`ScenarioError::InvalidField`] for an unknown
+    /// [`IoError::Io`] if the file cannot be read, [`IoError::Json`] (with the
+    /// JSON path) if it is not such an object, [`IoError::InvalidField`] for an unknown
     /// column or unit.
     pub fn load(path: &Path) -> Result<Self> {
         let spec: BTreeMap<String, ColumnSpec> = parse_json_file(path)?;
-        Self::new(&spec, "columns").map_err(|(json_path, value, expected)| {
-            ScenarioError::InvalidField {
-                path: path.to_owned(),
-                json_path,
-                value,
-                expected,
-            }
+        Self::new(&spec, "columns").map_err(|(json_path, value, expected)| IoError::InvalidField {
+            path: path.to_owned(),
+            json_path,
+            value,
+            expected,
         })
     }
 

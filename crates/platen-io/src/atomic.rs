@@ -1,0 +1,127 @@
+//! Atomic output: every file platen writes goes to a temporary file in the destination's
+//! folder, which is flushed, synced and renamed over the destination only when complete.
+//! A failed or interrupted write removes the temporary file and leaves an existing
+//! destination untouched. This is the one implementation every writer uses (CSV, streamed
+//! CSV, JSON, SVG, PNG, HTML).
+
+use std::fs::File;
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use tempfile::NamedTempFile;
+
+use crate::error::{IoAction, IoError, Result};
+
+/// Capacity of the write buffer, bytes.
+const BUFFER_BYTES: usize = 1 << 16;
+
+/// An output being written: a buffered temporary file next to its destination.
+///
+/// Write through [`AtomicFile::writer`], then [`AtomicFile::commit`]. Dropping it without
+/// committing (an error on the way) removes the temporary file.
+#[derive(Debug)]
+pub struct AtomicFile {
+    path: PathBuf,
+    out: BufWriter<NamedTempFile>,
+}
+
+impl AtomicFile {
+    /// Creates the temporary file (`.NAME.XXXXXX.tmp`) in the folder of `path`.
+    ///
+    /// # Errors
+    /// [`IoError::Io`] ([`IoAction::CreatingTemporary`]) if `path` names no file or the
+    /// folder does not take a new file.
+    pub fn create(path: &Path) -> Result<Self> {
+        let Some(file_name) = path.file_name() else {
+            return Err(write_error(
+                path,
+                io::Error::new(io::ErrorKind::InvalidInput, "the path names no file"),
+            ));
+        };
+        let temp = tempfile::Builder::new()
+            .prefix(&format!(".{}.", file_name.to_string_lossy()))
+            .suffix(".tmp")
+            .tempfile_in(directory_of(path))
+            .map_err(|source| IoError::Io {
+                path: path.to_path_buf(),
+                action: IoAction::CreatingTemporary,
+                source,
+            })?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            out: BufWriter::with_capacity(BUFFER_BYTES, temp),
+        })
+    }
+
+    /// The destination.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The buffered writer of the temporary file.
+    pub fn writer(&mut self) -> &mut BufWriter<NamedTempFile> {
+        &mut self.out
+    }
+
+    /// Flushes and syncs the temporary file and renames it over the destination.
+    ///
+    /// # Errors
+    /// [`IoError::Io`] for a failed flush or sync ([`IoAction::Writing`]) or rename
+    /// ([`IoAction::Renaming`]); the temporary file is removed.
+    pub fn commit(self) -> Result<()> {
+        let path = self.path;
+        let temp = self
+            .out
+            .into_inner()
+            .map_err(|e| write_error(&path, e.into_error()))?;
+        temp.as_file()
+            .sync_all()
+            .map_err(|source| write_error(&path, source))?;
+        temp.persist(&path).map_err(|e| IoError::Io {
+            path: path.clone(),
+            action: IoAction::Renaming,
+            source: e.error,
+        })?;
+        sync_directory(directory_of(&path));
+        Ok(())
+    }
+}
+
+/// Writes `bytes` to `path` atomically (JSON, SVG, PNG and HTML outputs).
+///
+/// # Errors
+/// As [`AtomicFile::create`] and [`AtomicFile::commit`].
+pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let mut file = AtomicFile::create(path)?;
+    file.writer()
+        .write_all(bytes)
+        .map_err(|source| write_error(path, source))?;
+    file.commit()
+}
+
+/// The error of a failed write to (the temporary file of) `path`.
+pub(crate) fn write_error(path: &Path, source: io::Error) -> IoError {
+    IoError::Io {
+        path: path.to_path_buf(),
+        action: IoAction::Writing,
+        source,
+    }
+}
+
+/// The folder that holds `path` (`.` for a bare file name).
+fn directory_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
+        _ => Path::new("."),
+    }
+}
+
+/// Makes the rename durable where the platform allows it (best effort).
+fn sync_directory(dir: &Path) {
+    #[cfg(unix)]
+    if let Ok(handle) = File::open(dir) {
+        let _ = handle.sync_all();
+    }
+    #[cfg(not(unix))]
+    let _ = dir;
+}
