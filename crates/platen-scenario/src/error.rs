@@ -39,13 +39,33 @@ pub enum ScenarioError {
         expected: String,
     },
 
-    /// A record referenced by a scenario cannot serve it.
-    #[error("`{}`: {message}", path.display())]
-    Record {
-        /// The record file (or the scenario, for generated records).
+    /// A record is shorter than the scenario's `duration_s`.
+    #[error("`{}`: record spans {span_s} s{} but the scenario's duration_s is {duration_s} s", path.display(), samples.map_or(String::new(), |n| format!(" ({n} samples)")))]
+    RecordTooShort {
+        /// The record file.
         path: PathBuf,
-        /// What is wrong.
-        message: String,
+        /// The record's span, s.
+        span_s: f64,
+        /// The record's number of samples, where the message states it.
+        samples: Option<usize>,
+        /// The scenario's duration, s.
+        duration_s: f64,
+    },
+
+    /// A record cannot drive a run (the integrator's checks reject it).
+    #[error("`{}`: {cause}", path.display())]
+    RecordRejected {
+        /// The record file.
+        path: PathBuf,
+        /// Why the integrator rejects it.
+        cause: IntegrateError,
+    },
+
+    /// A `ground_motion` record holds velocity or displacement, not acceleration.
+    #[error("`{}`: ground_motion needs an acceleration record (.AT2); this one holds velocity or displacement", path.display())]
+    NotAcceleration {
+        /// The record file.
+        path: PathBuf,
     },
 
     /// A forward run failed numerically (or its record could not serve it); the error names

@@ -12,8 +12,11 @@
 
 #![warn(missing_docs)]
 
+mod ctx;
 pub mod error;
+mod excitation;
 mod execute;
+pub mod file;
 pub mod generate;
 pub mod recorded;
 pub mod sampling;
@@ -21,4 +24,6 @@ pub mod scenario;
 
 pub use error::{Result, ScenarioError};
 pub use execute::{CsvSink, RunOutput};
+/// Column maps are part of the scenario format (`excitation.columns`).
+pub use platen_io::columns;
 pub use scenario::{Model, Run, Scenario};

@@ -133,25 +133,7 @@ pub fn recorded_like(
 
     // Force: model force + ringing after reversals + valve tone + noise, then quantised.
     let mut force = truth.force_n.clone();
-    let w_oil = 2.0 * PI * settings.oil_column_hz;
-    let zeta = settings.oil_column_damping_ratio;
-    let wd = w_oil * (1.0 - zeta * zeta).sqrt();
-    let ring_amp = settings.oil_column_fraction * 2.0 * static_threshold_n;
-    let ring_len = ((8.0 / (zeta * w_oil)) * rate).ceil() as usize; // e^-8 of the start
-    for i in 1..n {
-        let (a, b) = (truth.v_m_s[i - 1], truth.v_m_s[i]);
-        if a != 0.0 && b != 0.0 && a.signum() != b.signum()
-            || (a != 0.0 && b == 0.0 && i + 1 < n && truth.v_m_s[i + 1].signum() == -a.signum())
-        {
-            // A reversal between samples i-1 and i: ring in the direction of the new motion.
-            let t_r = truth.t_s[i - 1] + dt * a.abs() / (a.abs() + b.abs()).max(f64::MIN_POSITIVE);
-            let sign = -a.signum();
-            for (j, f) in force.iter_mut().enumerate().skip(i).take(ring_len) {
-                let s = truth.t_s[j] - t_r;
-                *f += sign * ring_amp * (-zeta * w_oil * s).exp() * (wd * s).sin();
-            }
-        }
-    }
+    add_oil_column_ringing(&mut force, truth, settings, static_threshold_n, dt);
     let tone_phase = 2.0 * PI * rng.uniform();
     let step = settings.pressure_resolution_pa * settings.piston_area_m2;
     for (f, &t) in force.iter_mut().zip(&truth.t_s) {
@@ -201,6 +183,39 @@ pub fn recorded_like(
         a_m_s2: a,
         force_n: force,
     })
+}
+
+/// Adds the oil column's ringing at `settings.oil_column_hz` after every velocity reversal of
+/// `truth` to `force`, in the direction of the new motion, sized by the friction jump
+/// (twice the static threshold `static_threshold_n`).
+fn add_oil_column_ringing(
+    force: &mut [f64],
+    truth: &Trajectory,
+    settings: &ArtefactSettings,
+    static_threshold_n: f64,
+    dt: f64,
+) {
+    let n = truth.len();
+    let rate = 1.0 / dt;
+    let w_oil = 2.0 * PI * settings.oil_column_hz;
+    let zeta = settings.oil_column_damping_ratio;
+    let wd = w_oil * (1.0 - zeta * zeta).sqrt();
+    let ring_amp = settings.oil_column_fraction * 2.0 * static_threshold_n;
+    let ring_len = ((8.0 / (zeta * w_oil)) * rate).ceil() as usize; // e^-8 of the start
+    for i in 1..n {
+        let (a, b) = (truth.v_m_s[i - 1], truth.v_m_s[i]);
+        if a != 0.0 && b != 0.0 && a.signum() != b.signum()
+            || (a != 0.0 && b == 0.0 && i + 1 < n && truth.v_m_s[i + 1].signum() == -a.signum())
+        {
+            // A reversal between samples i-1 and i: ring in the direction of the new motion.
+            let t_r = truth.t_s[i - 1] + dt * a.abs() / (a.abs() + b.abs()).max(f64::MIN_POSITIVE);
+            let sign = -a.signum();
+            for (j, f) in force.iter_mut().enumerate().skip(i).take(ring_len) {
+                let s = truth.t_s[j] - t_r;
+                *f += sign * ring_amp * (-zeta * w_oil * s).exp() * (wd * s).sin();
+            }
+        }
+    }
 }
 
 /// A causal 2nd-order Butterworth low-pass (bilinear transform, prewarped), starting from the

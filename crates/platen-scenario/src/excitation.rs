@@ -1,0 +1,592 @@
+//! `excitation` → what a scenario runs ([`Run`]): the record or generated waveform, read,
+//! checked against the duration, low-passed (forces) or integrated (ground motions).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use platen_integrate::{Dopri5Settings, ForceRecord, Method, Motion, Rk4, State};
+use platen_io::columns::ColumnMap;
+use platen_io::IoError;
+use platen_model::STANDARD_GRAVITY_M_S2;
+
+use crate::ctx::{check_finite, check_positive, Ctx};
+use crate::error::{Result, ScenarioError};
+use crate::file::*;
+use crate::generate::{self, GenerateError};
+use crate::sampling::uniform_step_s;
+
+/// What a scenario runs.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Run {
+    /// Force-driven: the force record drives the model forward.
+    Forward {
+        /// The actuator force.
+        record: ForceRecord,
+        /// Integrator settings.
+        integrator: Method,
+        /// State at the first sample.
+        initial: State,
+        /// Output samples (the first `samples` of the record).
+        samples: usize,
+    },
+    /// Motion-driven: the force the motion needs.
+    Inverse {
+        /// The prescribed motion (already cut to the duration).
+        motion: Motion,
+    },
+}
+
+impl Run {
+    /// The times of the first and last output sample, s: known before the run, so that
+    /// inputs that must cover them (a recorded test to compare with) are checked first.
+    pub fn time_span_s(&self) -> (f64, f64) {
+        let (t, n) = match self {
+            Run::Forward {
+                record, samples, ..
+            } => (record.t_s(), *samples),
+            Run::Inverse { motion } => (motion.t_s(), motion.len()),
+        };
+        match n.checked_sub(1).and_then(|last| t.get(last)) {
+            Some(&end) => (t[0], end),
+            None => (f64::NAN, f64::NAN),
+        }
+    }
+}
+
+/// Number of samples of a record of `len` samples at interval `dt` that `duration_s` covers.
+fn samples_for(
+    ctx: &Ctx,
+    record_path: &Path,
+    duration_s: Option<f64>,
+    dt: f64,
+    len: usize,
+) -> Result<usize> {
+    let Some(d) = duration_s else { return Ok(len) };
+    check_positive(ctx, "duration_s", d)?;
+    // Tolerate rounding of the duration to about a millionth of a sample.
+    let n = (d / dt + 1e-6).floor() as usize + 1;
+    if n > len {
+        return Err(ScenarioError::RecordTooShort {
+            path: record_path.to_owned(),
+            span_s: (len - 1) as f64 * dt,
+            samples: Some(len),
+            duration_s: d,
+        });
+    }
+    Ok(n)
+}
+
+/// The one source of an `excitation`, validated: exactly one is present by construction.
+#[derive(Clone, Copy)]
+enum Source<'a> {
+    ForceCsv(&'a Path),
+    MotionCsv(&'a Path),
+    SineForce(&'a SineForce),
+    SineMotion(&'a SineMotion),
+    TriangleMotion(&'a TriangleMotion),
+    WhiteNoiseMotion(&'a WhiteNoiseMotion),
+    GroundMotion(&'a GroundMotion),
+}
+
+impl<'a> Source<'a> {
+    /// The one source of `ex`, or an error listing those given.
+    fn of(ctx: &Ctx, ex: &'a ExcitationSpec) -> Result<Self> {
+        let mut given: Vec<(&str, Source<'a>)> = Vec::new();
+        let mut add = |name, source: Option<Source<'a>>| given.extend(source.map(|s| (name, s)));
+        add("force_csv", ex.force_csv.as_deref().map(Source::ForceCsv));
+        add(
+            "motion_csv",
+            ex.motion_csv.as_deref().map(Source::MotionCsv),
+        );
+        add("sine_force", ex.sine_force.as_ref().map(Source::SineForce));
+        add(
+            "sine_motion",
+            ex.sine_motion.as_ref().map(Source::SineMotion),
+        );
+        add(
+            "triangle_motion",
+            ex.triangle_motion.as_ref().map(Source::TriangleMotion),
+        );
+        add(
+            "white_noise_motion",
+            ex.white_noise_motion.as_ref().map(Source::WhiteNoiseMotion),
+        );
+        add(
+            "ground_motion",
+            ex.ground_motion.as_ref().map(Source::GroundMotion),
+        );
+        match given.as_slice() {
+            [(_, source)] => Ok(*source),
+            _ => {
+                let names: Vec<&str> = given.iter().map(|(name, _)| *name).collect();
+                Err(ctx.invalid(
+                    "excitation",
+                    format!("{{{}}}", names.join(", ")),
+                    "exactly one of force_csv, motion_csv, sine_force, sine_motion, triangle_motion, white_noise_motion, ground_motion",
+                ))
+            }
+        }
+    }
+
+    /// The key of this source in `excitation`.
+    fn name(self) -> &'static str {
+        match self {
+            Source::ForceCsv(_) => "force_csv",
+            Source::MotionCsv(_) => "motion_csv",
+            Source::SineForce(_) => "sine_force",
+            Source::SineMotion(_) => "sine_motion",
+            Source::TriangleMotion(_) => "triangle_motion",
+            Source::WhiteNoiseMotion(_) => "white_noise_motion",
+            Source::GroundMotion(_) => "ground_motion",
+        }
+    }
+
+    /// Whether the source is a force (a forward run) rather than a motion (an inverse run).
+    fn is_force(self) -> bool {
+        matches!(self, Source::ForceCsv(_) | Source::SineForce(_))
+    }
+}
+
+/// What the scenario file's excitation, integrator, initial state and duration run.
+pub(crate) fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
+    let ex = &file.excitation;
+    let source = Source::of(ctx, ex)?;
+    check_direction_fields(ctx, file, source)?;
+    let gen = Generated { ctx, file, source };
+    match source {
+        Source::ForceCsv(rel) => force_csv_run(ctx, file, &ctx.resolve(rel)),
+        Source::SineForce(g) => {
+            let record = generate::sine_force(
+                g.amplitude_n,
+                g.frequency_hz,
+                g.ramp_s,
+                g.sample_rate_hz,
+                gen.duration()?,
+            )
+            .map_err(|e| gen.error(e))?;
+            let samples = record.len();
+            let record = lowpass(ctx, ex, record, samples)?;
+            forward_run(ctx, file, record, samples, None)
+        }
+        Source::MotionCsv(rel) => motion_csv(ctx, file, &ctx.resolve(rel)),
+        Source::SineMotion(g) => generate::sine_motion(
+            g.amplitude_m,
+            g.frequency_hz,
+            g.sample_rate_hz,
+            gen.duration()?,
+        )
+        .map_err(|e| gen.error(e))
+        .map(|motion| Run::Inverse { motion }),
+        Source::TriangleMotion(g) => generate::triangle_motion(
+            g.amplitude_m,
+            g.velocity_m_s,
+            g.reversal_acceleration_m_s2,
+            g.sample_rate_hz,
+            gen.duration()?,
+        )
+        .map_err(|e| gen.error(e))
+        .map(|motion| Run::Inverse { motion }),
+        Source::WhiteNoiseMotion(g) => white_noise(&gen, g),
+        Source::GroundMotion(g) => Ok(Run::Inverse {
+            motion: ground_motion(ctx, g, file.duration_s)?,
+        }),
+    }
+}
+
+/// Fields that only one direction takes: a low-pass (forces), an integrator and an initial
+/// state (forward runs).
+fn check_direction_fields(ctx: &Ctx, file: &ScenarioFile, source: Source) -> Result<()> {
+    let ex = &file.excitation;
+    if source.is_force() {
+        return Ok(());
+    }
+    if ex.lowpass_hz.is_some() || ex.lowpass_filter.is_some() {
+        return Err(ctx.invalid(
+            "excitation.lowpass_hz",
+            ex.lowpass_hz
+                .map_or("(filter only)".to_owned(), |f| f.to_string()),
+            "no low-pass on a motion: it applies to force excitations (force_csv, sine_force)",
+        ));
+    }
+    if file.integrator.is_some() {
+        return Err(ctx.invalid(
+            "integrator",
+            "{…}",
+            "no integrator: a motion-driven (inverse) run integrates nothing",
+        ));
+    }
+    if file.initial.is_some() {
+        return Err(ctx.invalid(
+            "initial",
+            "{…}",
+            "no initial state: a motion-driven (inverse) run starts from its motion",
+        ));
+    }
+    Ok(())
+}
+
+/// A generated excitation: it has no length of its own, and its generator's errors are
+/// reported under its own key.
+struct Generated<'a> {
+    ctx: &'a Ctx<'a>,
+    file: &'a ScenarioFile,
+    source: Source<'a>,
+}
+
+impl Generated<'_> {
+    /// The scenario's `duration_s`, which a generated excitation requires.
+    fn duration(&self) -> Result<f64> {
+        self.file.duration_s.ok_or_else(|| {
+            self.ctx.invalid(
+                "duration_s",
+                "(missing)",
+                format!(
+                    "a duration in s: excitation.{} has no length of its own",
+                    self.source.name()
+                ),
+            )
+        })
+    }
+
+    /// A generator's error, under the JSON path of the field it names.
+    fn error(&self, e: GenerateError) -> ScenarioError {
+        match e {
+            GenerateError::Invalid {
+                name: "duration_s",
+                value,
+                expected,
+            } => self.ctx.invalid("duration_s", value, expected),
+            GenerateError::Invalid {
+                name,
+                value,
+                expected,
+            } => self.ctx.invalid(
+                &format!("excitation.{}.{name}", self.source.name()),
+                value,
+                expected,
+            ),
+        }
+    }
+}
+
+/// `excitation.force_csv`: a recorded force, cut to the duration and low-passed.
+fn force_csv_run(ctx: &Ctx, file: &ScenarioFile, path: &Path) -> Result<Run> {
+    let ex = &file.excitation;
+    let mut cols = read_mapped(ctx, path, ex, &["t_s", "force_n"], &["u_m", "v_m_s"])?;
+    let t = cols.remove("t_s").unwrap_or_default();
+    let f = cols.remove("force_n").unwrap_or_default();
+    let recorded_state = match (cols.get("u_m"), cols.get("v_m_s")) {
+        (Some(u), Some(v)) => Some((u[0], v[0])),
+        _ => None,
+    };
+    let dt = uniform_step_s(path, &t)?;
+    let samples = samples_for(ctx, path, file.duration_s, dt, t.len())?;
+    let record = ForceRecord::new(t, f).map_err(|cause| rejected(path, cause))?;
+    let record = lowpass(ctx, ex, record, samples)?;
+    forward_run(ctx, file, record, samples, recorded_state)
+}
+
+/// `excitation.motion_csv`: a prescribed motion, cut to the duration; missing velocity and
+/// acceleration are derived from the displacement.
+fn motion_csv(ctx: &Ctx, file: &ScenarioFile, path: &Path) -> Result<Run> {
+    let ex = &file.excitation;
+    let mut cols = read_mapped(ctx, path, ex, &["t_s", "u_m"], &["v_m_s", "a_m_s2"])?;
+    let t = cols.remove("t_s").unwrap_or_default();
+    let u = cols.remove("u_m").unwrap_or_default();
+    let v = cols.remove("v_m_s");
+    let a = cols.remove("a_m_s2");
+    let samples = match file.duration_s {
+        None => t.len(),
+        Some(d) => {
+            check_positive(ctx, "duration_s", d)?;
+            let end = t[0] + d;
+            if t[t.len() - 1] < end - 1e-9 * d.abs() {
+                return Err(ScenarioError::RecordTooShort {
+                    path: path.to_owned(),
+                    span_s: t[t.len() - 1] - t[0],
+                    samples: None,
+                    duration_s: d,
+                });
+            }
+            t.partition_point(|&x| x <= end + 1e-9 * d.abs())
+        }
+    };
+    let cut = |c: Vec<f64>| c[..samples].to_vec();
+    let motion = match (v, a) {
+        (Some(v), Some(a)) => Motion::new(cut(t), cut(u), cut(v), cut(a)),
+        (Some(v), None) => Motion::from_displacement_velocity(cut(t), cut(u), cut(v)),
+        (None, Some(_)) | (None, None) => Motion::from_displacement(cut(t), cut(u)),
+    }
+    .map_err(|cause| rejected(path, cause))?;
+    Ok(Run::Inverse { motion })
+}
+
+/// `excitation.white_noise_motion`: band-limited white noise of the given RMS acceleration.
+fn white_noise(gen: &Generated, g: &WhiteNoiseMotion) -> Result<Run> {
+    let rms = check_positive(
+        gen.ctx,
+        "excitation.white_noise_motion.rms_acceleration_g",
+        g.rms_acceleration_g,
+    )?;
+    let motion = generate::white_noise_motion(
+        rms * STANDARD_GRAVITY_M_S2,
+        (g.band_hz[0], g.band_hz[1]),
+        g.seed,
+        g.sample_rate_hz,
+        gen.duration()?,
+    )
+    .map_err(|e| gen.error(e))?;
+    Ok(Run::Inverse { motion })
+}
+
+/// A record the integrator's checks reject.
+fn rejected(path: &Path, cause: platen_integrate::IntegrateError) -> ScenarioError {
+    ScenarioError::RecordRejected {
+        path: path.to_owned(),
+        cause,
+    }
+}
+
+/// Reads platen's columns `required` and `optional` from `path` through the excitation's
+/// `columns` mapping (file headers and units), in SI units. The time column must increase
+/// strictly; a violation names its line.
+fn read_mapped(
+    ctx: &Ctx,
+    path: &Path,
+    ex: &ExcitationSpec,
+    required: &[&'static str],
+    optional: &[&'static str],
+) -> Result<BTreeMap<&'static str, Vec<f64>>> {
+    let map = match &ex.columns {
+        Some(spec) => ColumnMap::new(spec, "excitation.columns")
+            .map_err(|(json_path, value, expected)| ctx.invalid(&json_path, value, expected))?,
+        None => ColumnMap::default(),
+    };
+    let mut table = map.read_table(path, required, optional)?;
+    let mut out = BTreeMap::new();
+    for &ours in required.iter().chain(optional) {
+        if let Some(col) = table.take_column(ours) {
+            out.insert(ours, col);
+        }
+    }
+    if let Some(t) = out.get("t_s") {
+        if let Some(i) = (1..t.len()).find(|&i| t[i] <= t[i - 1]) {
+            return Err(IoError::TimeNotIncreasing {
+                path: path.to_owned(),
+                line: i as u64 + 2,
+                previous_s: t[i - 1],
+                value_s: t[i],
+            }
+            .into());
+        }
+    }
+    Ok(out)
+}
+
+/// Applies `excitation.lowpass_hz` to the first `samples` samples of a force record (the part
+/// that runs), with the chosen zero-phase filter.
+fn lowpass(
+    ctx: &Ctx,
+    ex: &ExcitationSpec,
+    record: ForceRecord,
+    samples: usize,
+) -> Result<ForceRecord> {
+    let Some(cutoff) = ex.lowpass_hz else {
+        if ex.lowpass_filter.is_some() {
+            return Err(ctx.invalid(
+                "excitation.lowpass_filter",
+                "(set)",
+                "a lowpass_hz for the filter to use",
+            ));
+        }
+        return Ok(record);
+    };
+    let rate = 1.0 / record.dt_s();
+    if !(cutoff.is_finite() && cutoff > 0.0 && cutoff < 0.5 * rate) {
+        return Err(ctx.invalid(
+            "excitation.lowpass_hz",
+            cutoff,
+            format!(
+                "a cut-off between 0 and the record's Nyquist frequency {} Hz",
+                0.5 * rate
+            ),
+        ));
+    }
+    let input = &record.force_n()[..samples];
+    let signal =
+        |e: platen_signal::SignalError| ctx.invalid("excitation.lowpass_hz", cutoff, e.to_string());
+    use platen_signal::ZeroPhaseFilter;
+    let filtered = match ex.lowpass_filter.unwrap_or(LowpassFilter::Brickwall) {
+        LowpassFilter::Brickwall => platen_signal::SpectralLowpass::new(samples, cutoff, rate)
+            .map_err(signal)?
+            .apply(input)
+            .map_err(signal)?,
+        LowpassFilter::Fir => {
+            platen_signal::FirLowpass::new(1024, cutoff, rate, platen_signal::Window::Hamming)
+                .map_err(signal)?
+                .apply(input)
+                .map_err(signal)?
+        }
+        LowpassFilter::Butterworth => platen_signal::ButterworthLowpass::new(4, cutoff, rate)
+            .map_err(signal)?
+            .apply(input)
+            .map_err(signal)?,
+    };
+    ForceRecord::new(record.t_s()[..samples].to_vec(), filtered)
+        .map_err(|e| ctx.invalid("excitation.lowpass_hz", cutoff, e.to_string()))
+}
+
+/// The table motion of an `excitation.ground_motion`.
+fn ground_motion(ctx: &Ctx, g: &GroundMotion, duration_s: Option<f64>) -> Result<Motion> {
+    let here = "excitation.ground_motion";
+    let scale = check_finite(ctx, &format!("{here}.scale"), g.scale)?;
+    let rate = check_positive(ctx, &format!("{here}.sample_rate_hz"), g.sample_rate_hz)?;
+    let path = platen_io::peer::find_record(ctx.path.parent(), &g.record)?;
+    let (acc, dt_s) = read_ground_acceleration(ctx, g, &path)?;
+    let signal = |name: &str, e: platen_signal::SignalError| {
+        ctx.invalid(&format!("{here}.{name}"), "", e.to_string())
+    };
+    let a: Vec<f64> = acc.iter().map(|x| x * scale).collect();
+    let resampler =
+        platen_signal::Resampler::new(1.0 / dt_s, rate, platen_signal::Interpolation::default())
+            .map_err(|e| signal("sample_rate_hz", e))?;
+    if resampler.output_len(a.len()) > generate::MAX_GENERATED_SAMPLES {
+        return Err(ctx.invalid(
+            &format!("{here}.sample_rate_hz"),
+            rate,
+            format!(
+                "a rate giving at most {} samples for this record",
+                generate::MAX_GENERATED_SAMPLES
+            ),
+        ));
+    }
+    let mut a = resampler
+        .apply(&a)
+        .map_err(|e| signal("sample_rate_hz", e))?;
+    if let Some(d) = duration_s {
+        check_positive(ctx, "duration_s", d)?;
+        let n = (d * rate + 1e-6).floor() as usize + 1;
+        if n > a.len() {
+            return Err(ScenarioError::RecordTooShort {
+                path,
+                span_s: (a.len() - 1) as f64 / rate,
+                samples: None,
+                duration_s: d,
+            });
+        }
+        a.truncate(n);
+    }
+    let baseline = match g.baseline {
+        BaselineKind::None => platen_signal::Baseline::None,
+        BaselineKind::Acceleration => platen_signal::Baseline::Acceleration {
+            order: g.baseline_order,
+        },
+        BaselineKind::Velocity => platen_signal::Baseline::Velocity {
+            order: g.baseline_order,
+        },
+    };
+    let integrator = platen_signal::MotionIntegrator::new(rate, baseline)
+        .map_err(|e| signal("baseline_order", e))?;
+    if matches!(g.baseline, BaselineKind::Acceleration) {
+        platen_signal::remove_polynomial(&mut a, g.baseline_order);
+    }
+    let m = integrator.integrate(&a, platen_signal::InitialMotion::default());
+    let t = (0..a.len()).map(|j| j as f64 / rate).collect();
+    Motion::new(t, m.u_m, m.v_m_s, a).map_err(|cause| rejected(&path, cause))
+}
+
+/// The ground acceleration of a `ground_motion` record (m/s²) and its sample interval (s):
+/// a PEER `.AT2` file, or a CSV read through the record's `columns`.
+fn read_ground_acceleration(ctx: &Ctx, g: &GroundMotion, path: &Path) -> Result<(Vec<f64>, f64)> {
+    let here = "excitation.ground_motion";
+    let is_csv = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
+    Ok(if is_csv {
+        let ex = ExcitationSpec {
+            columns: g.columns.clone(),
+            ..ExcitationSpec::default()
+        };
+        let mut cols = read_mapped(ctx, path, &ex, &["t_s", "a_m_s2"], &[])?;
+        let t = cols.remove("t_s").unwrap_or_default();
+        let dt = uniform_step_s(path, &t)?;
+        (cols.remove("a_m_s2").unwrap_or_default(), dt)
+    } else {
+        if g.columns.is_some() {
+            return Err(ctx.invalid(
+                &format!("{here}.columns"),
+                "(set)",
+                "columns only for a record given as .csv",
+            ));
+        }
+        let rec = platen_io::peer::read_peer(path)?;
+        if rec.quantity != platen_io::peer::Quantity::Acceleration {
+            return Err(ScenarioError::NotAcceleration {
+                path: path.to_path_buf(),
+            });
+        }
+        (rec.values, rec.dt_s)
+    })
+}
+
+fn forward_run(
+    ctx: &Ctx,
+    file: &ScenarioFile,
+    record: ForceRecord,
+    samples: usize,
+    recorded_state: Option<(f64, f64)>,
+) -> Result<Run> {
+    let integrator = match &file.integrator {
+        None => Method::Rk4(Rk4::with_steps_per_sample(1).expect("k = 1 is valid")),
+        Some(IntegratorSpec::Rk4(Rk4Spec { step_s })) => {
+            let step = step_s.unwrap_or(record.dt_s());
+            Method::Rk4(
+                Rk4::from_step(step, record.dt_s())
+                    .map_err(|e| ctx.invalid("integrator.step_s", step, e.to_string()))?,
+            )
+        }
+        Some(IntegratorSpec::Dopri5(spec)) => {
+            let rtol = spec.rtol.unwrap_or(DEFAULT_RTOL);
+            let atol = spec.atol.unwrap_or(DEFAULT_ATOL);
+            let settings = Dopri5Settings::new(rtol, atol).map_err(|e| match e {
+                platen_integrate::IntegrateError::InvalidTolerance { name, value } => ctx.invalid(
+                    &format!("integrator.{name}"),
+                    value,
+                    "a finite number > 0 (rtol < 1)",
+                ),
+                other => ctx.invalid("integrator", "", other.to_string()),
+            })?;
+            Method::Dopri5(settings)
+        }
+    };
+    let initial = file.initial.clone().unwrap_or_default();
+    let (u0, v0) = if initial.from_record {
+        if initial.u_m.is_some() || initial.v_m_s.is_some() {
+            return Err(ctx.invalid(
+                "initial",
+                "{from_record, u_m/v_m_s}",
+                "either from_record or u_m/v_m_s, not both",
+            ));
+        }
+        match recorded_state {
+            Some(state) => state,
+            None => {
+                return Err(ctx.invalid(
+                    "initial.from_record",
+                    "true",
+                    "a force_csv with u_m and v_m_s columns to take the initial state from",
+                ))
+            }
+        }
+    } else {
+        (initial.u_m.unwrap_or(0.0), initial.v_m_s.unwrap_or(0.0))
+    };
+    let u_m = check_finite(ctx, "initial.u_m", u0)?;
+    let v_m_s = check_finite(ctx, "initial.v_m_s", v0)?;
+    Ok(Run::Forward {
+        record,
+        integrator,
+        initial: State { u_m, v_m_s },
+        samples,
+    })
+}

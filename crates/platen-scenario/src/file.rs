@@ -1,0 +1,339 @@
+//! The scenario file as written: serde types with `deny_unknown_fields`, before validation
+//! (see [`crate::scenario`] for the format and [`crate::Scenario`] for the validated type).
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use schemars::JsonSchema;
+use serde::Deserialize;
+
+use platen_io::columns::ColumnSpec;
+use platen_io::json::parse_json;
+
+use crate::error::Result;
+
+/// The scenario file as written (after JSON parsing, before validation).
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ScenarioFile {
+    /// The JSON Schema this file follows (ignored; lets editors find `platen schema`'s output).
+    #[serde(rename = "$schema")]
+    pub schema: Option<String>,
+    /// A short name for reports (default: the file stem).
+    pub name: Option<String>,
+    /// Free text.
+    pub description: Option<String>,
+    /// The model.
+    pub model: ModelSpec,
+    /// The excitation.
+    pub excitation: ExcitationSpec,
+    /// The integrator (forward runs).
+    pub integrator: Option<IntegratorSpec>,
+    /// The initial state (forward runs).
+    pub initial: Option<InitialSpec>,
+    /// Simulated duration, s (default: the record's span).
+    pub duration_s: Option<f64>,
+}
+
+/// `model`: a preset, its hold-down pressure, and the form with overrides.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ModelSpec {
+    /// Preset name (`lhpost-2008`).
+    pub preset: String,
+    /// Hold-down nitrogen pressure, MPa (default: the preset's nominal 13.8 MPa).
+    pub hold_down_pressure_mpa: Option<f64>,
+    /// Identified-model values laid over the preset's (Eq. 22/23).
+    pub identified: Option<IdentifiedOverrides>,
+    /// Selects the full Lagrangian model; physical values laid over the preset's.
+    pub full: Option<PhysicalOverrides>,
+}
+
+/// Overrides of the identified model; the contract's keys.
+#[derive(Debug, Clone, Default, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+#[allow(missing_docs)]
+pub struct IdentifiedOverrides {
+    pub effective_mass_kg: Option<f64>,
+    pub stiffness_n_per_m: Option<f64>,
+    pub coulomb_force_n: Option<f64>,
+    pub viscous_coefficient: Option<f64>,
+    pub viscous_exponent: Option<f64>,
+    pub low_velocity_force_n: Option<f64>,
+    pub low_velocity_decay_s_per_m: Option<f64>,
+}
+
+/// Overrides of the physical parameters of the full model (see
+/// [`platen_model::PhysicalParams`] for meanings and units). The hold-down pressure is set by
+/// `model.hold_down_pressure_mpa`.
+#[derive(Debug, Clone, Default, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+#[allow(missing_docs)]
+pub struct PhysicalOverrides {
+    pub platen_mass_kg: Option<f64>,
+    pub actuator_moving_mass_kg: Option<f64>,
+    pub strut_piston_mass_kg: Option<f64>,
+    pub strut_cylinder_mass_kg: Option<f64>,
+    pub strut_height_m: Option<f64>,
+    pub strut_piston_length_m: Option<f64>,
+    pub strut_area_m2: Option<f64>,
+    pub gas_heat_capacity_ratio: Option<f64>,
+    pub supported_weight_n: Option<f64>,
+    pub bearing_friction_coefficient: Option<f64>,
+    pub lateral_friction_coefficient: Option<f64>,
+    pub lateral_normal_force_n: Option<f64>,
+    pub hinge_swivel_friction_coefficient: Option<f64>,
+    pub hinge_radius_m: Option<f64>,
+    pub hinge_force_distribution_factor: Option<f64>,
+    pub viscous_coefficient: Option<f64>,
+    pub viscous_exponent: Option<f64>,
+    pub strut_viscous_coefficient: Option<f64>,
+    pub strut_viscous_exponent: Option<f64>,
+    pub low_velocity_force_n: Option<f64>,
+    pub low_velocity_decay_s_per_m: Option<f64>,
+}
+
+/// `excitation`: exactly one source.
+#[derive(Debug, Clone, Default, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ExcitationSpec {
+    /// Recorded actuator force (`t_s`, `force_n`): forward run.
+    pub force_csv: Option<PathBuf>,
+    /// Prescribed motion (`t_s`, `u_m`, optional `v_m_s`, `a_m_s2`): inverse run.
+    pub motion_csv: Option<PathBuf>,
+    /// Generated sine force: forward run.
+    pub sine_force: Option<SineForce>,
+    /// Generated sine displacement (the paper's S tests): inverse run.
+    pub sine_motion: Option<SineMotion>,
+    /// Generated triangle displacement with rounded reversals (the paper's T tests): inverse run.
+    pub triangle_motion: Option<TriangleMotion>,
+    /// Generated band-limited white-noise motion (the paper's WN tests): inverse run.
+    pub white_noise_motion: Option<WhiteNoiseMotion>,
+    /// Table motion from a ground-acceleration record (an earthquake test): inverse run.
+    pub ground_motion: Option<GroundMotion>,
+    /// Zero-phase low-pass of a force excitation before it drives the model, Hz (the paper
+    /// low-passed the SR9 force at 0.6 Hz). Forward runs only.
+    pub lowpass_hz: Option<f64>,
+    /// The filter of `lowpass_hz` (default `brickwall`).
+    pub lowpass_filter: Option<LowpassFilter>,
+    /// A lab's own channel names and units for `force_csv` / `motion_csv`
+    /// (see [`crate::columns`]).
+    pub columns: Option<BTreeMap<String, ColumnSpec>>,
+}
+
+/// Zero-phase low-pass filters for `lowpass_hz`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, JsonSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum LowpassFilter {
+    /// Frequency-domain brick wall: unit gain and zero phase below the cut-off, nothing above.
+    /// Exact for a record holding whole periods of a periodic test; on other records the
+    /// wrap-around from the last sample to the first leaks near the ends.
+    Brickwall,
+    /// Windowed-sinc FIR of order 1024 (Hamming), zero phase: gain 1 ± 0.5 % in the pass
+    /// band, 0.5 at the cut-off (the transition is about 3.3·fs/1024 wide).
+    Fir,
+    /// 4th-order Butterworth run forward and backward: gain |H(f)|², 0.5 at the cut-off (so
+    /// NOT unit gain near it: 0.81 at 5/6 of the cut-off).
+    Butterworth,
+}
+
+/// A table motion that reproduces a ground-acceleration record: the PEER `.AT2` record is
+/// scaled, resampled (not-a-knot cubic spline; anti-aliased when downsampling),
+/// baseline-corrected and integrated (trapezoidal) to table velocity and displacement, from
+/// rest at 0.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct GroundMotion {
+    /// The record's file name: looked up next to the scenario, then in the folder named by
+    /// `PLATEN_RECORDS_DIR`.
+    pub record: PathBuf,
+    /// Scale factor on the acceleration (default 1: "100 %").
+    #[serde(default = "default_scale")]
+    pub scale: f64,
+    /// Sample rate of the table motion, Hz (default 1024).
+    #[serde(default = "default_rate")]
+    pub sample_rate_hz: f64,
+    /// Baseline correction before integrating: `none`, `acceleration` (remove the
+    /// least-squares polynomial of `baseline_order` from the acceleration) or `velocity` (from
+    /// the velocity). Default `acceleration` of order 0: the mean acceleration is removed, so
+    /// the table ends at rest.
+    #[serde(default = "default_baseline")]
+    pub baseline: BaselineKind,
+    /// Polynomial order of the baseline correction (default 0, at most 8).
+    #[serde(default)]
+    pub baseline_order: usize,
+    /// For a record given as CSV (a `.csv` file): the time and acceleration columns' names and
+    /// units, e.g. `{"t_s": {"name": "time"}, "a_m_s2": {"name": "acc (g)", "unit": "g"}}`.
+    pub columns: Option<BTreeMap<String, ColumnSpec>>,
+}
+
+/// Baseline correction of a ground-motion record.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, JsonSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum BaselineKind {
+    /// None.
+    None,
+    /// Remove a polynomial from the acceleration.
+    Acceleration,
+    /// Remove a polynomial from the velocity.
+    Velocity,
+}
+
+fn default_scale() -> f64 {
+    1.0
+}
+
+fn default_baseline() -> BaselineKind {
+    BaselineKind::Acceleration
+}
+
+/// `F(t) = r(t)·amplitude_n·sin(2π·frequency_hz·t)`, with `r` a linear ramp from 0 to 1 over
+/// `ramp_s` (0: none), sampled at `sample_rate_hz` from `t = 0`.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SineForce {
+    /// Force amplitude, N.
+    pub amplitude_n: f64,
+    /// Frequency, Hz.
+    pub frequency_hz: f64,
+    /// Sample rate, Hz (default 1024, the LHPOST data acquisition rate).
+    #[serde(default = "default_rate")]
+    pub sample_rate_hz: f64,
+    /// Length of the initial amplitude ramp, s (default 0).
+    #[serde(default)]
+    pub ramp_s: f64,
+}
+
+/// `u(t) = amplitude_m·sin(2π·frequency_hz·t)` with its exact velocity and acceleration,
+/// sampled at `sample_rate_hz` from `t = 0` (the paper's S tests).
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SineMotion {
+    /// Displacement amplitude, m.
+    pub amplitude_m: f64,
+    /// Frequency, Hz.
+    pub frequency_hz: f64,
+    /// Sample rate, Hz (default 1024).
+    #[serde(default = "default_rate")]
+    pub sample_rate_hz: f64,
+}
+
+/// A triangle displacement wave with constant-acceleration rounded reversals
+/// ([`crate::generate::triangle_motion`]): peak `amplitude_m`, constant velocity
+/// `velocity_m_s`, reversal arcs at `reversal_acceleration_m_s2`; period
+/// `4U/V + 2V/A_r`.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct TriangleMotion {
+    /// Peak displacement, m.
+    pub amplitude_m: f64,
+    /// Constant velocity between reversals, m/s.
+    pub velocity_m_s: f64,
+    /// Acceleration of the rounded reversals, m/s².
+    pub reversal_acceleration_m_s2: f64,
+    /// Sample rate, Hz (default 1024).
+    #[serde(default = "default_rate")]
+    pub sample_rate_hz: f64,
+}
+
+/// Band-limited white-noise motion ([`crate::generate::white_noise_motion`]).
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct WhiteNoiseMotion {
+    /// RMS acceleration, in g (`0.1` for the paper's WN10%g).
+    pub rms_acceleration_g: f64,
+    /// Band of the flat acceleration spectrum, Hz (default `[0.5, 20]`: up to the table's
+    /// 20 Hz bandwidth; the lower edge keeps the displacement within the stroke).
+    #[serde(default = "default_band")]
+    pub band_hz: [f64; 2],
+    /// Seed of the random phases (default 1).
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    /// Sample rate, Hz (default 1024).
+    #[serde(default = "default_rate")]
+    pub sample_rate_hz: f64,
+}
+
+fn default_band() -> [f64; 2] {
+    [0.5, 20.0]
+}
+
+fn default_seed() -> u64 {
+    1
+}
+
+fn default_rate() -> f64 {
+    1024.0
+}
+
+/// `integrator`, selected by `method`.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(tag = "method", rename_all = "lowercase")]
+pub enum IntegratorSpec {
+    /// Fixed-step RK4 with exact stick-slip.
+    Rk4(Rk4Spec),
+    /// Adaptive Dormand–Prince 5(4) (ode_solvers' Dopri5) with exact stick-slip.
+    Dopri5(Dopri5Spec),
+}
+
+/// `{"method": "dopri5", "rtol": …, "atol": …}`.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Dopri5Spec {
+    /// Relative tolerance (default 1e-8).
+    pub rtol: Option<f64>,
+    /// Absolute tolerance, in the state's units (m, m/s) (default 1e-11).
+    pub atol: Option<f64>,
+}
+
+/// Default relative tolerance of `dopri5`.
+pub const DEFAULT_RTOL: f64 = 1e-8;
+/// Default absolute tolerance of `dopri5`.
+pub const DEFAULT_ATOL: f64 = 1e-11;
+
+/// `{"method": "rk4", "step_s": …}`.
+#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Rk4Spec {
+    /// Step, s; must divide the record's sample interval (default: the sample interval).
+    pub step_s: Option<f64>,
+}
+
+/// `initial`: the state at the record's first sample, given (`{"u_m": …, "v_m_s": …}`) or
+/// taken from the force record's own `u_m` and `v_m_s` columns (`{"from_record": true}`, for
+/// a recorded test that did not start at rest, like the paper's SR9).
+#[derive(Debug, Clone, Default, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct InitialSpec {
+    /// Displacement, m (default 0).
+    pub u_m: Option<f64>,
+    /// Velocity, m/s (default 0).
+    pub v_m_s: Option<f64>,
+    /// Take the state from the first row of the force CSV's `u_m` and `v_m_s` columns.
+    #[serde(default)]
+    pub from_record: bool,
+}
+
+/// Parses scenario JSON, reporting the JSON path (or line and column) of any error.
+///
+/// # Errors
+/// [`ScenarioError::Io`] ([`platen_io::IoError::Json`]).
+pub fn parse(path: &Path, text: &str) -> Result<ScenarioFile> {
+    Ok(parse_json(path, text)?)
+}
+
+/// The JSON Schema (draft 2020-12) of the scenario format, generated from the types above.
+/// `platen schema` prints it; point an editor's JSON-schema support at the printed file.
+pub fn json_schema() -> serde_json::Value {
+    let mut schema = serde_json::to_value(schemars::schema_for!(ScenarioFile)).unwrap_or_default();
+    if let Some(obj) = schema.as_object_mut() {
+        obj.insert("title".into(), "platen scenario".into());
+        obj.insert(
+            "description".into(),
+            "A platen scenario: model (preset, identified or full form), excitation, integrator, initial \
+             state and duration. SI units; the unit is in every key's name."
+                .into(),
+        );
+    }
+    schema
+}
