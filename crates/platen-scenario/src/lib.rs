@@ -21,9 +21,14 @@ pub mod generate;
 pub mod recorded;
 pub mod sampling;
 pub mod scenario;
+mod summary;
 
 pub use error::{Result, ScenarioError};
 pub use execute::{CsvSink, RunOutput};
 /// Column maps are part of the scenario format (`excitation.columns`).
 pub use platen_io::columns;
 pub use scenario::{Model, Run, Scenario};
+pub use summary::{
+    EnergySummary, ExceedanceSummary, ForwardSummary, LimitCheck, LimitsSummary, RunSummary,
+    SolverSummary,
+};

@@ -1,0 +1,255 @@
+//! The summary of a run ([`RunSummary`]): what `platen simulate --json` prints and a Python
+//! user's `run.summary` holds. A serde type, so every front end reports the same keys.
+
+use std::path::Path;
+
+use serde::Serialize;
+
+use platen_integrate::{Exceedance, ForwardIntegrator, Peaks, RunStats};
+use platen_model::TableLimits;
+
+use crate::scenario::{Run, Scenario};
+use crate::RunOutput;
+
+/// The summary of one run of a scenario. Serialise it through [`serde_json::to_value`] to
+/// get the keys in alphabetical order, as `platen simulate --json` prints them.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunSummary {
+    /// The scenario file.
+    pub scenario: String,
+    /// The scenario's name.
+    pub name: String,
+    /// `"forward"` (force → motion) or `"inverse"` (motion → force).
+    pub direction: &'static str,
+    /// `"identified"` or `"full"`.
+    pub model_form: &'static str,
+    /// The preset the model is based on.
+    pub preset: &'static str,
+    /// The hold-down pressure, MPa.
+    pub hold_down_pressure_mpa: f64,
+    /// Output samples.
+    pub samples: usize,
+    /// Time from the first to the last output sample, s.
+    pub duration_s: f64,
+    /// Signed peak displacement, m.
+    pub peak_u_m: f64,
+    /// When it occurred, s.
+    pub peak_u_m_t_s: f64,
+    /// Signed peak velocity, m/s.
+    pub peak_v_m_s: f64,
+    /// When it occurred, s.
+    pub peak_v_m_s_t_s: f64,
+    /// Signed peak acceleration, m/s².
+    pub peak_a_m_s2: f64,
+    /// When it occurred, s.
+    pub peak_a_m_s2_t_s: f64,
+    /// Signed peak actuator force, N.
+    pub peak_force_n: f64,
+    /// When it occurred, s.
+    pub peak_force_n_t_s: f64,
+    /// Stick-slip counts, solver statistics and energy balance (forward runs only).
+    #[serde(flatten)]
+    pub forward: Option<ForwardSummary>,
+    /// Every limit the run exceeds.
+    pub limit_exceedances: Vec<ExceedanceSummary>,
+    /// Every limit with the run's peak against it.
+    pub limits: LimitsSummary,
+    /// The CSV written, if any.
+    pub out: Option<String>,
+}
+
+/// What only a forward run reports.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ForwardSummary {
+    /// Time spent stuck, s.
+    pub stick_time_s: f64,
+    /// Times the platen came to rest and stuck.
+    pub stick_events: u64,
+    /// Breakaways from rest.
+    pub breakaways: u64,
+    /// Direct reversals of the velocity.
+    pub reversals: u64,
+    /// The integrator's statistics.
+    pub solver: SolverSummary,
+    /// The energy balance.
+    pub energy: EnergySummary,
+}
+
+/// The integrator's statistics.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SolverSummary {
+    /// `"rk4"` or `"dopri5"`.
+    pub method: &'static str,
+    /// Steps taken.
+    pub steps: u64,
+    /// Accepted steps.
+    pub accepted_steps: u64,
+    /// Rejected steps (adaptive integrators).
+    pub rejected_steps: u64,
+    /// Right-hand-side evaluations.
+    pub rhs_evaluations: u64,
+    /// Stick-slip events located (stops, breakaways, reversals).
+    pub events_located: u64,
+    /// Root-finding iterations spent locating them.
+    pub root_iterations: u64,
+}
+
+/// Actuator work = change of kinetic and elastic energy + energy dissipated, J.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EnergySummary {
+    /// Work done by the actuator force, J.
+    pub actuator_work_j: f64,
+    /// Kinetic energy at the start, J.
+    pub kinetic_start_j: f64,
+    /// Kinetic energy at the end, J.
+    pub kinetic_end_j: f64,
+    /// Elastic energy at the start, J.
+    pub elastic_start_j: f64,
+    /// Elastic energy at the end, J.
+    pub elastic_end_j: f64,
+    /// Energy dissipated, J.
+    pub dissipated_j: f64,
+    /// What the balance leaves, J: an accuracy indicator.
+    pub residual_j: f64,
+    /// The residual relative to the largest term.
+    pub relative_residual: f64,
+}
+
+/// A limit the run exceeds.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ExceedanceSummary {
+    /// `"stroke"`, `"velocity"`, `"acceleration"` or `"force"`.
+    pub quantity: &'static str,
+    /// The run's signed peak, SI units.
+    pub peak: f64,
+    /// The limit, SI units.
+    pub limit: f64,
+    /// When the peak occurred, s.
+    pub t_s: f64,
+}
+
+/// One limit against the run's peak.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LimitCheck {
+    /// The limit, SI units.
+    pub limit: f64,
+    /// The run's signed peak, SI units.
+    pub peak: f64,
+    /// Whether |peak| ≤ limit.
+    pub respected: bool,
+}
+
+/// Every table limit against the run's peaks.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LimitsSummary {
+    /// Stroke, m.
+    pub stroke_m: LimitCheck,
+    /// Velocity, m/s.
+    pub velocity_m_s: LimitCheck,
+    /// Acceleration, m/s².
+    pub acceleration_m_s2: LimitCheck,
+    /// Actuator force, N.
+    pub force_n: LimitCheck,
+}
+
+impl RunSummary {
+    /// The summary of `output`, a run of `scenario` (read from `path`) that wrote `out`.
+    pub fn new(path: &Path, scenario: &Scenario, output: &RunOutput, out: Option<&Path>) -> Self {
+        let peaks = &output.peaks;
+        Self {
+            scenario: path.display().to_string(),
+            name: scenario.name.clone(),
+            direction: if output.stats.is_some() {
+                "forward"
+            } else {
+                "inverse"
+            },
+            model_form: scenario.model.form(),
+            preset: scenario.preset.name(),
+            hold_down_pressure_mpa: scenario.hold_down_pressure_pa / 1e6,
+            samples: peaks.samples,
+            duration_s: peaks.span_s.1 - peaks.span_s.0,
+            peak_u_m: peaks.u_m.value,
+            peak_u_m_t_s: peaks.u_m.t_s,
+            peak_v_m_s: peaks.v_m_s.value,
+            peak_v_m_s_t_s: peaks.v_m_s.t_s,
+            peak_a_m_s2: peaks.a_m_s2.value,
+            peak_a_m_s2_t_s: peaks.a_m_s2.t_s,
+            peak_force_n: peaks.force_n.value,
+            peak_force_n_t_s: peaks.force_n.t_s,
+            forward: output
+                .stats
+                .as_ref()
+                .map(|st| ForwardSummary::new(st, &scenario.run)),
+            limit_exceedances: peaks
+                .exceedances(&scenario.limits)
+                .iter()
+                .map(ExceedanceSummary::from)
+                .collect(),
+            limits: LimitsSummary::new(peaks, &scenario.limits),
+            out: out.map(|p| p.display().to_string()),
+        }
+    }
+}
+
+impl ForwardSummary {
+    fn new(st: &RunStats, run: &Run) -> Self {
+        let method = match run {
+            Run::Forward { integrator, .. } => integrator.name(),
+            Run::Inverse { .. } => "none",
+        };
+        let e = &st.energy;
+        Self {
+            stick_time_s: st.stick_time_s,
+            stick_events: st.stick_events,
+            breakaways: st.breakaways,
+            reversals: st.reversals,
+            solver: SolverSummary {
+                method,
+                steps: st.steps,
+                accepted_steps: st.accepted_steps,
+                rejected_steps: st.rejected_steps,
+                rhs_evaluations: st.rhs_evaluations,
+                events_located: st.events(),
+                root_iterations: st.root_iterations,
+            },
+            energy: EnergySummary {
+                actuator_work_j: e.actuator_work_j,
+                kinetic_start_j: e.kinetic_start_j,
+                kinetic_end_j: e.kinetic_end_j,
+                elastic_start_j: e.elastic_start_j,
+                elastic_end_j: e.elastic_end_j,
+                dissipated_j: e.dissipated_j,
+                residual_j: e.residual_j(),
+                relative_residual: e.relative_residual(),
+            },
+        }
+    }
+}
+
+impl From<&Exceedance> for ExceedanceSummary {
+    fn from(e: &Exceedance) -> Self {
+        Self {
+            quantity: e.quantity,
+            peak: e.peak,
+            limit: e.limit,
+            t_s: e.t_s,
+        }
+    }
+}
+
+impl LimitsSummary {
+    fn new(peaks: &Peaks, l: &TableLimits) -> Self {
+        let check = |peak: f64, limit: f64| LimitCheck {
+            limit,
+            peak,
+            respected: peak.abs() <= limit,
+        };
+        Self {
+            stroke_m: check(peaks.u_m.value, l.stroke_m),
+            velocity_m_s: check(peaks.v_m_s.value, l.velocity_m_s),
+            acceleration_m_s2: check(peaks.a_m_s2.value, l.acceleration_m_s2),
+            force_n: check(peaks.force_n.value, l.force_n),
+        }
+    }
+}
