@@ -7,3 +7,10 @@ pub use platen_io as io;
 pub use platen_model as model;
 pub use platen_scenario as scenario;
 pub use platen_signal as signal;
+
+/// Loads and runs a scenario file, keeping every column in memory.
+pub use platen_scenario::simulate;
+/// A finished run in memory: columns by name and the summary ([`simulate`]).
+pub use platen_scenario::RunResult as Run;
+/// The validated scenario: [`Scenario::load`] then [`Scenario::run`] into any sink.
+pub use platen_scenario::Scenario;

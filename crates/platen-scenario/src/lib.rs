@@ -29,6 +29,6 @@ pub use execute::{CsvSink, RunOutput};
 pub use platen_io::columns;
 pub use scenario::{Model, Run, Scenario};
 pub use summary::{
-    EnergySummary, ExceedanceSummary, ForwardSummary, LimitCheck, LimitsSummary, RunSummary,
-    SolverSummary,
+    simulate, EnergySummary, ExceedanceSummary, ForwardSummary, LimitCheck, LimitsSummary,
+    RunResult, RunSummary, SolverSummary,
 };

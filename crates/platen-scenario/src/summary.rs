@@ -5,9 +5,10 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use platen_integrate::{Exceedance, ForwardIntegrator, Peaks, RunStats};
+use platen_integrate::{Exceedance, ForwardIntegrator, Peaks, RunStats, Trajectory};
 use platen_model::TableLimits;
 
+use crate::error::Result;
 use crate::scenario::{Run, Scenario};
 use crate::RunOutput;
 
@@ -252,4 +253,45 @@ impl LimitsSummary {
             force_n: check(peaks.force_n.value, l.force_n),
         }
     }
+}
+
+/// A finished run held in memory: every output column and the summary
+/// ([`simulate`] returns it).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunResult {
+    /// The time series: one value per output sample in each of the contract's columns.
+    pub trajectory: Trajectory,
+    /// The summary, as `platen simulate --json` prints it.
+    pub summary: RunSummary,
+}
+
+impl RunResult {
+    /// The names of the output columns, in CSV order (`t_s`, `u_m`, `v_m_s`, `a_m_s2`,
+    /// `force_n`, `inertial_force_n`, `elastic_force_n`, `dissipative_force_n`).
+    pub fn columns(&self) -> &'static [&'static str] {
+        &Trajectory::COLUMN_NAMES
+    }
+
+    /// The output column `name` (SI units), or `None` for a name that is not a column.
+    pub fn column(&self, name: &str) -> Option<&[f64]> {
+        let j = Trajectory::COLUMN_NAMES.iter().position(|c| *c == name)?;
+        Some(self.trajectory.columns()[j])
+    }
+}
+
+/// Loads the scenario at `path`, runs it keeping the whole time series in memory, and
+/// summarises it: `platen simulate` as one library call.
+///
+/// # Errors
+/// Every error of [`Scenario::load`] and [`Scenario::run`].
+pub fn simulate(path: impl AsRef<Path>) -> Result<RunResult> {
+    let path = path.as_ref();
+    let scenario = Scenario::load(path)?;
+    let mut trajectory = Trajectory::default();
+    let output = scenario.run(&mut trajectory)?;
+    let summary = RunSummary::new(path, &scenario, &output, None);
+    Ok(RunResult {
+        trajectory,
+        summary,
+    })
 }
