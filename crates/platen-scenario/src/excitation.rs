@@ -4,7 +4,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use platen_integrate::{Dopri5Settings, ForceRecord, Method, Motion, Rk4, State};
+use platen_integrate::{Dopri5Settings, ForceRecord, IntegrateError, Method, Motion, Rk4, State};
 use platen_io::columns::ColumnMap;
 use platen_io::IoError;
 use platen_model::STANDARD_GRAVITY_M_S2;
@@ -50,6 +50,40 @@ impl Run {
             Some(&end) => (t[0], end),
             None => (f64::NAN, f64::NAN),
         }
+    }
+
+    /// The same run with its excitation multiplied by `k`: the force record, or the
+    /// prescribed displacement, velocity and acceleration. `k = 1` gives an identical copy.
+    ///
+    /// # Errors
+    /// The record's checks ([`ForceRecord::new`], [`Motion::new`]) when a scaled value is
+    /// not finite.
+    pub fn scaled(&self, k: f64) -> std::result::Result<Run, IntegrateError> {
+        if k == 1.0 {
+            return Ok(self.clone());
+        }
+        let times = |c: &[f64]| c.iter().map(|x| x * k).collect();
+        Ok(match self {
+            Run::Forward {
+                record,
+                integrator,
+                initial,
+                samples,
+            } => Run::Forward {
+                record: ForceRecord::new(record.t_s().to_vec(), times(record.force_n()))?,
+                integrator: *integrator,
+                initial: *initial,
+                samples: *samples,
+            },
+            Run::Inverse { motion } => Run::Inverse {
+                motion: Motion::new(
+                    motion.t_s().to_vec(),
+                    times(motion.u_m()),
+                    times(motion.v_m_s()),
+                    times(motion.a_m_s2()),
+                )?,
+            },
+        })
     }
 }
 
@@ -340,7 +374,7 @@ fn white_noise(gen: &Generated, g: &WhiteNoiseMotion) -> Result<Run> {
 }
 
 /// A record the integrator's checks reject.
-fn rejected(path: &Path, cause: platen_integrate::IntegrateError) -> ScenarioError {
+fn rejected(path: &Path, cause: IntegrateError) -> ScenarioError {
     ScenarioError::RecordRejected {
         path: path.to_owned(),
         cause,

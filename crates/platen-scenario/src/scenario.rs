@@ -31,6 +31,7 @@
 
 use std::path::Path;
 
+use platen_integrate::IntegrateError;
 use platen_model::{
     FullModel, IdentifiedModel, IdentifiedParams, PhysicalParams, Preset, TableLimits,
 };
@@ -80,6 +81,21 @@ pub struct Scenario {
 }
 
 impl Scenario {
+    /// The same scenario with its excitation multiplied by `k` (see [`Run::scaled`]).
+    ///
+    /// # Errors
+    /// As [`Run::scaled`].
+    pub fn scaled(&self, k: f64) -> std::result::Result<Scenario, IntegrateError> {
+        Ok(Scenario {
+            name: self.name.clone(),
+            preset: self.preset,
+            hold_down_pressure_pa: self.hold_down_pressure_pa,
+            model: self.model.clone(),
+            limits: self.limits,
+            run: self.run.scaled(k)?,
+        })
+    }
+
     /// Reads, parses and validates the scenario at `path`, and loads every record it names.
     /// Nothing is simulated.
     ///
