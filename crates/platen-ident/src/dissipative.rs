@@ -17,17 +17,6 @@ pub const MIN_SPEED_SPREAD: f64 = 1.5;
 /// The low-velocity term acts below ≈ 3 cm/s ("negligibly small for velocities higher than
 /// 3 cm/s", §3.4); it is fitted only if at least 2 % of the points' weight lies below that.
 pub const LOW_SPEED_M_S: f64 = 0.03;
-const MIN_LOW_SPEED_WEIGHT: f64 = 0.02;
-
-/// The low-velocity term is kept only if `a` is at least 3 standard errors from zero and `b`
-/// is known within 50 %; otherwise it is set to zero and reported as not significant.
-const MIN_LOW_VELOCITY_SIGNIFICANCE: f64 = 3.0;
-const MAX_DECAY_RELATIVE_STD_ERROR: f64 = 0.5;
-
-/// The viscous law is reported as not identifiable if `Cₑ` has a relative standard error
-/// above 50 % or a free `α` a standard error above 0.25 (a quarter of its whole range).
-const MAX_VISCOUS_RELATIVE_STD_ERROR: f64 = 0.5;
-const MAX_EXPONENT_STD_ERROR: f64 = 0.25;
 
 /// Rounds of "fit the law, then remove from the data the part of the filtered friction jump
 /// the fitted law predicts". The correction changes by well under 1 % of itself from the
@@ -205,12 +194,7 @@ fn fit_law(
     let dof = fit.dof;
     let est = |i: usize| Estimate::new(law_values(&fit.law)[i], fit.std_errors[i], dof);
     let c = est(law::VISCOUS);
-    let viscous_bad = fit.singular[law::COULOMB]
-        || fit.singular[law::VISCOUS]
-        || (alpha_free && fit.singular[law::EXPONENT])
-        || c.relative_std_error() > MAX_VISCOUS_RELATIVE_STD_ERROR
-        || (alpha_free && fit.std_errors[law::EXPONENT] > MAX_EXPONENT_STD_ERROR);
-    if viscous_bad {
+    if viscous_bad(&fit, alpha_free) {
         let problem = ViscousLawProblem::NotSeparated {
             viscous_coefficient: c.value,
             viscous_coefficient_std_error: c.std_error,
@@ -247,6 +231,24 @@ fn fit_law(
     Some((estimates, fit))
 }
 
+/// Whether the fit leaves `F_μ`, `Cₑ` and a free `α` undetermined: singular, or `Cₑ` with a
+/// relative standard error above 50 %, or a free `α` with a standard error above 0.25 (a
+/// quarter of its whole range).
+fn viscous_bad(fit: &LawFit, alpha_free: bool) -> bool {
+    const MAX_VISCOUS_RELATIVE_STD_ERROR: f64 = 0.5;
+    const MAX_EXPONENT_STD_ERROR: f64 = 0.25;
+    let c = Estimate::new(
+        fit.law.viscous_coefficient,
+        fit.std_errors[law::VISCOUS],
+        fit.dof,
+    );
+    fit.singular[law::COULOMB]
+        || fit.singular[law::VISCOUS]
+        || (alpha_free && fit.singular[law::EXPONENT])
+        || c.relative_std_error() > MAX_VISCOUS_RELATIVE_STD_ERROR
+        || (alpha_free && fit.std_errors[law::EXPONENT] > MAX_EXPONENT_STD_ERROR)
+}
+
 /// The law with the low-velocity term, if the settings ask for it, the data reach low
 /// speeds, and the term comes out significant; else why it is left out.
 fn fit_low_velocity(
@@ -259,6 +261,8 @@ fn fit_low_velocity(
     if !settings.low_velocity_term {
         return (None, LowVelocityOmission::NoFit);
     }
+    // At least 2 % of the points' weight below LOW_SPEED_M_S.
+    const MIN_LOW_SPEED_WEIGHT: f64 = 0.02;
     if pts.weight_below(LOW_SPEED_M_S) < MIN_LOW_SPEED_WEIGHT {
         let omission = LowVelocityOmission::NoLowSpeedPoints {
             below_m_s: LOW_SPEED_M_S,
@@ -271,9 +275,13 @@ fn fit_low_velocity(
     let a = f.law.low_velocity_force_n;
     let b = f.law.low_velocity_decay_s_per_m;
     let (sa, sb) = (f.std_errors[law::LOW_FORCE], f.std_errors[law::LOW_DECAY]);
+    // Kept only if `a` is at least 3 standard errors from zero and `b` is known within 50 %;
+    // otherwise it is set to zero and reported as not significant.
+    const MIN_SIGNIFICANCE: f64 = 3.0;
+    const MAX_DECAY_RELATIVE_STD_ERROR: f64 = 0.5;
     let significant = !f.singular[law::LOW_FORCE]
         && !f.singular[law::LOW_DECAY]
-        && a > MIN_LOW_VELOCITY_SIGNIFICANCE * sa
+        && a > MIN_SIGNIFICANCE * sa
         && b > 0.0
         && sb <= MAX_DECAY_RELATIVE_STD_ERROR * b;
     if significant {

@@ -31,13 +31,7 @@ impl Work {
             var += (dk_dm * m.std_error).powi(2);
         }
         self.stiffness = Some(Estimate::new(k, var.sqrt(), reg.dof(l)));
-        let beta = reg.coef[1];
-        self.elastic_curve =
-            p.u.iter()
-                .zip(&y)
-                .zip(&p.g)
-                .map(|((u, y), g)| [*u, y - beta * g])
-                .collect();
+        self.elastic_curve = p.curve(&p.u, &y, reg.coef[1]);
         self.used_for_stiffness = !self
             .flags
             .iter()

@@ -164,13 +164,7 @@ impl Work {
         let var = var_fit + (dm_dk * k.std_error).powi(2);
         let est = Estimate::new(m, var.sqrt(), reg.dof(l));
         self.mass = Some(est);
-        let beta = reg.coef[1];
-        self.inertial_curve =
-            p.a.iter()
-                .zip(&y)
-                .zip(&p.g)
-                .map(|((a, y), g)| [*a, y - beta * g])
-                .collect();
+        self.inertial_curve = p.curve(&p.a, &y, reg.coef[1]);
         let inertial = est.value.abs() * self.peak_acceleration;
         if let Some(pk) = self.peak {
             let ratio = inertial / pk.force_n.abs().max(f64::MIN_POSITIVE);

@@ -302,14 +302,9 @@ pub(crate) fn fit(
 mod tests {
     use super::*;
 
+    /// Eq. 22 at 13.8 MPa.
     fn paper() -> DissipativeLaw {
-        DissipativeLaw {
-            coulomb_force_n: 25.445e3,
-            viscous_coefficient: 44.58e3,
-            exponent: Exponent::Half,
-            low_velocity_force_n: 12.04e3,
-            low_velocity_decay_s_per_m: 78.5,
-        }
+        platen_model::preset::lhpost_2008_identified(13.8e6).dissipative_law()
     }
 
     #[test]

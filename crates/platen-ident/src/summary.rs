@@ -213,6 +213,11 @@ pub struct TestSummary {
     pub velocity_at_peak_m_s: Option<f64>,
     /// Flags.
     pub flags: Vec<FlagSummary>,
+    /// Whether its estimate (stiffness or mass) enters the mean.
+    pub used: bool,
+    /// The dissipative force curve `(|v̄|, F_D)` of Eq. 20, m/s and N, decimated to
+    /// [`CURVE_POINTS`].
+    pub dissipative_curve: Vec<[f64; 2]>,
     /// What the test's waveform estimates.
     #[serde(flatten)]
     pub estimate: KindSummary,
@@ -241,6 +246,11 @@ impl TestSummary {
             dissipative_force_at_peak_n: t.peak_dissipative.map(|p| p.force_n),
             velocity_at_peak_m_s: t.peak_dissipative.map(|p| p.velocity_m_s),
             flags: t.flags.iter().map(flag_summary).collect(),
+            used: match t.kind {
+                TestKind::Triangle => t.used_for_stiffness,
+                TestKind::Sine => t.used_for_mass,
+            },
+            dissipative_curve: decimate(&t.dissipative_curve, CURVE_POINTS),
             estimate: KindSummary::new(t),
         }
     }
@@ -253,7 +263,7 @@ fn flag_summary(f: &Flag) -> FlagSummary {
     }
 }
 
-/// The estimate of a test's waveform: stiffness (triangle) or mass (sine), with its curves
+/// The estimate of a test's waveform: stiffness (triangle) or mass (sine), with its curve
 /// decimated to [`CURVE_POINTS`].
 #[derive(Debug, Clone, Serialize)]
 #[serde(untagged)]
@@ -264,12 +274,8 @@ pub enum KindSummary {
         stiffness_n_per_m: Option<f64>,
         /// Its standard error.
         stiffness_std_error: Option<f64>,
-        /// Whether it enters the mean.
-        used: bool,
-        /// `(ū, F_E)` points, m and N.
+        /// The elastic force curve `(ū, F_E)`, m and N.
         elastic_curve: Vec<[f64; 2]>,
-        /// `(|v̄|, F_D)` points, m/s and N.
-        dissipative_curve: Vec<[f64; 2]>,
     },
     /// A sine test.
     Sine {
@@ -277,32 +283,23 @@ pub enum KindSummary {
         effective_mass_kg: Option<f64>,
         /// Its standard error.
         effective_mass_std_error: Option<f64>,
-        /// Whether it enters the mean.
-        used: bool,
-        /// `(ā, Mₑā)` points, m/s² and N.
+        /// The inertial force curve `(ā, Mₑā)`, m/s² and N.
         inertial_curve: Vec<[f64; 2]>,
-        /// `(|v̄|, F_D)` points, m/s and N.
-        dissipative_curve: Vec<[f64; 2]>,
     },
 }
 
 impl KindSummary {
     fn new(t: &TestResult) -> Self {
-        let dissipative_curve = decimate(&t.dissipative_curve, CURVE_POINTS);
         match t.kind {
             TestKind::Triangle => KindSummary::Triangle {
                 stiffness_n_per_m: t.stiffness.map(|e| e.value),
                 stiffness_std_error: t.stiffness.map(|e| e.std_error),
-                used: t.used_for_stiffness,
                 elastic_curve: decimate(&t.elastic_curve, CURVE_POINTS),
-                dissipative_curve,
             },
             TestKind::Sine => KindSummary::Sine {
                 effective_mass_kg: t.effective_mass.map(|e| e.value),
                 effective_mass_std_error: t.effective_mass.map(|e| e.std_error),
-                used: t.used_for_mass,
                 inertial_curve: decimate(&t.inertial_curve, CURVE_POINTS),
-                dissipative_curve,
             },
         }
     }

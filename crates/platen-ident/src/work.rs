@@ -67,6 +67,18 @@ pub(crate) struct Pairs {
     pub(crate) g: Vec<f64>,
 }
 
+impl Pairs {
+    /// The points `(x, y − β·ḡ)`: a response `y` against `x` with the fitted reversal
+    /// impulses `β·ḡ` removed.
+    pub(crate) fn curve(&self, x: &[f64], y: &[f64], beta: f64) -> Vec<[f64; 2]> {
+        x.iter()
+            .zip(y)
+            .zip(&self.g)
+            .map(|((x, y), g)| [*x, y - beta * g])
+            .collect()
+    }
+}
+
 /// Mirror pairs of Eq. 16–19 on a grid of `n` points: `(t, T/2 − t)` for `0 < t ≤ T/4` and
 /// `(t, 3T/2 − t)` for `T/2 < t ≤ 3T/4`.
 pub(crate) fn mirror_pairs(n: usize) -> impl Iterator<Item = (usize, usize)> {

@@ -168,32 +168,18 @@ fn the_friction_coefficient_from_the_three_pressures_is_within_10_percent_of_0_4
 #[test]
 fn the_full_dissipative_law_is_close_to_eq_22() {
     let p = &program().parameters;
-    let rel = |k: IdentifiedKey, want: f64| (p[k].value().unwrap() / want - 1.0).abs();
-    assert!(
-        rel(IdentifiedKey::CoulombForce, 25.445e3) < 0.02,
-        "F_μ = {:?}",
-        p[IdentifiedKey::CoulombForce]
-    );
-    assert!(
-        rel(IdentifiedKey::ViscousCoefficient, 44.58e3) < 0.02,
-        "Cₑ = {:?}",
-        p[IdentifiedKey::ViscousCoefficient]
-    );
-    assert!(
-        (p[IdentifiedKey::ViscousExponent].value().unwrap() - 0.5).abs() < 0.01,
-        "α = {:?}",
-        p[IdentifiedKey::ViscousExponent]
-    );
-    assert!(
-        rel(IdentifiedKey::LowVelocityForce, 12.04e3) < 0.05,
-        "a = {:?}",
-        p[IdentifiedKey::LowVelocityForce]
-    );
-    assert!(
-        rel(IdentifiedKey::LowVelocityDecay, 78.5) < 0.05,
-        "b = {:?}",
-        p[IdentifiedKey::LowVelocityDecay]
-    );
+    // (parameter, Eq. 22's value, relative tolerance)
+    for (key, want, tol) in [
+        (IdentifiedKey::CoulombForce, 25.445e3, 0.02),
+        (IdentifiedKey::ViscousCoefficient, 44.58e3, 0.02),
+        (IdentifiedKey::LowVelocityForce, 12.04e3, 0.05),
+        (IdentifiedKey::LowVelocityDecay, 78.5, 0.05),
+    ] {
+        let got = p[key].value().unwrap();
+        assert!((got / want - 1.0).abs() < tol, "{key} = {:?}", p[key]);
+    }
+    let alpha = p[IdentifiedKey::ViscousExponent].value().unwrap();
+    assert!((alpha - 0.5).abs() < 0.01, "α = {alpha}");
 }
 
 /// The global fit of Eq. 23 agrees with the hysteresis-loop estimate.
