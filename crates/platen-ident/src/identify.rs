@@ -13,7 +13,6 @@ use crate::paper_fit::paper_fit;
 use crate::record::{TestKind, TestRecord};
 use crate::result::{Identification, ParameterEstimates, PressureGroup};
 use crate::settings::ValidSettings;
-use crate::warning::Warning;
 use crate::work::Work;
 
 /// Identifies the platen's parameters from periodic tests (see the crate docs).
@@ -56,14 +55,7 @@ pub fn identify(records: &[TestRecord], settings: &ValidSettings) -> Result<Iden
     let found = alternate(&mut work, groups.keys.len(), settings);
     let mass = mass_parameter(&work, &found, &mut warnings);
     let stiffness = stiffness_parameter(&work, &groups, &found.group_stiffness, &mut warnings);
-    for w in &work {
-        for f in &w.flags {
-            warnings.push(Warning::FlaggedTest {
-                test: w.name.clone(),
-                flag: f.clone(),
-            });
-        }
-    }
+    warnings.extend(work.iter().flat_map(Work::flag_warnings));
 
     let mut pressures = pressure_groups(
         &work,

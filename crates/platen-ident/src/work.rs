@@ -10,7 +10,7 @@ use crate::law::LawPoints;
 use crate::record::{TestKind, TestRecord};
 use crate::result::{PeakForce, TestResult};
 use crate::settings::ValidSettings;
-use crate::warning::Flag;
+use crate::warning::{Flag, Warning};
 
 /// A sine test whose displacement has more than 5 % harmonic distortion (harmonics 2–7 over
 /// the fundamental) is "distorted" (paper: S12) and not used for the mass. A controller
@@ -326,6 +326,14 @@ impl Work {
     /// `(n/T)/(2·f_c) = n/(2·factor)`.
     pub(crate) fn correlation(&self) -> f64 {
         self.an.n as f64 / (2.0 * self.cutoff_factor)
+    }
+
+    /// A warning for each of the test's flags.
+    pub(crate) fn flag_warnings(&self) -> impl Iterator<Item = Warning> + '_ {
+        self.flags.iter().map(|f| Warning::FlaggedTest {
+            test: self.name.clone(),
+            flag: f.clone(),
+        })
     }
 
     pub(crate) fn into_result(self) -> TestResult {

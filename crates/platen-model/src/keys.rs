@@ -137,3 +137,37 @@ impl IdentifiedParams {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_key_round_trips_through_its_name() {
+        for key in IdentifiedKey::ALL {
+            assert_eq!(key.name().parse::<IdentifiedKey>().unwrap(), key);
+        }
+        let names: Vec<&str> = IdentifiedKey::ALL.iter().map(|k| k.name()).collect();
+        assert_eq!(names.join(", "), IDENTIFIED_KEY_NAMES);
+    }
+
+    #[test]
+    fn an_unknown_name_lists_the_seven_in_the_wording_sweep_uses() {
+        let err = IdentifiedKey::from_name("mass_kg").unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "unknown identified parameter; expected one of effective_mass_kg, \
+             stiffness_n_per_m, coulomb_force_n, viscous_coefficient, viscous_exponent, \
+             low_velocity_force_n, low_velocity_decay_s_per_m"
+        );
+    }
+
+    #[test]
+    fn get_and_set_address_the_named_field() {
+        let mut p = IdentifiedParams::from_fn(|_| 0.0);
+        p.set(IdentifiedKey::LowVelocityDecay, 78.5);
+        assert_eq!(p.low_velocity_decay_s_per_m, 78.5);
+        assert_eq!(p.get(IdentifiedKey::LowVelocityDecay), 78.5);
+        assert_eq!(p.get(IdentifiedKey::EffectiveMass), 0.0);
+    }
+}
