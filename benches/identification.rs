@@ -74,7 +74,7 @@ fn program() -> Vec<TestRecord> {
 
 fn bench(c: &mut Criterion) {
     let tests = program();
-    let settings = Settings::default();
+    let settings = Settings::default().build().unwrap();
     let mut group = c.benchmark_group("identification");
     group.sample_size(10);
     group.bench_function("paper_s_t_program_24_tests", |b| {

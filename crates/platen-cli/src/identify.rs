@@ -18,14 +18,15 @@
 //! entry's own `columns`, the most specific winning.
 
 use std::collections::BTreeMap;
+use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use serde::Deserialize;
-use serde_json::{json, Map, Value};
+use serde::{Deserialize, Serialize};
 
 use platen_ident::{
-    identify, Estimate, Flag, Identification, Parameter, Settings, TestKind, TestRecord, TestResult,
+    identify, Estimate, Flag, Identification, IdentificationSummary, IdentifiedKey, Parameter,
+    Settings, TestKind, TestRecord,
 };
 use platen_io::columns::{ColumnMap, ColumnSpec};
 use platen_io::json::parse_json_file;
@@ -130,7 +131,9 @@ pub fn run(opts: &Options) -> Result<()> {
         viscous_exponent: opts.viscous_exponent,
         low_velocity_term: !opts.no_low_velocity_term,
         ..Settings::default()
-    };
+    }
+    .build()
+    .context("identification failed")?;
     let id = identify(&records, &settings).context("identification failed")?;
     let written = plot::write_outputs(
         opts.plot,
@@ -139,22 +142,16 @@ pub fn run(opts: &Options) -> Result<()> {
         |figures, rendered| html_report(&id, &inputs, figures, rendered),
     )?;
     if opts.json {
-        let mut summary = to_json(&id, &inputs);
-        if let Some(fields) = summary.as_object_mut() {
-            if opts.plot.is_some() {
-                fields.insert(
-                    "figures".into(),
-                    json!(written
-                        .iter()
-                        .map(|p| p.display().to_string())
-                        .collect::<Vec<_>>()),
-                );
-            }
-            if let Some(path) = opts.report {
-                fields.insert("report".into(), json!(path.display().to_string()));
-            }
-        }
-        println!("{}", serde_json::to_string_pretty(&summary)?);
+        let output = JsonOutput {
+            summary: summary(&id, &inputs),
+            figures: opts
+                .plot
+                .map(|_| written.iter().map(|p| p.display().to_string()).collect()),
+            report: opts.report.map(|path| path.display().to_string()),
+        };
+        // Through a `Value`, whose maps sort their keys at every level.
+        let value = serde_json::to_value(&output)?;
+        println!("{}", serde_json::to_string_pretty(&value)?);
     } else {
         print!("{}", report(&id, &inputs));
         if !written.is_empty() {
@@ -170,6 +167,26 @@ pub fn run(opts: &Options) -> Result<()> {
     Ok(())
 }
 
+/// What `--json` prints: the identification's summary, and the files written.
+#[derive(Serialize)]
+struct JsonOutput {
+    #[serde(flatten)]
+    summary: IdentificationSummary,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    figures: Option<Vec<String>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    report: Option<String>,
+}
+
+/// The summary of `id`, whose tests come from `inputs`.
+fn summary(id: &Identification, inputs: &[Input]) -> IdentificationSummary {
+    let files: Vec<String> = inputs
+        .iter()
+        .map(|i| i.path.display().to_string())
+        .collect();
+    IdentificationSummary::new(id, &files)
+}
+
 /// The HTML report: the parameter table, the text report's per-test tables, the figures
 /// and the JSON summary.
 fn html_report(
@@ -178,17 +195,40 @@ fn html_report(
     figures: &[plot::Figure],
     rendered: &[(String, String)],
 ) -> String {
-    let items = vec![
+    let mut sections = vec![crate::report::heading("Identified parameters")];
+    sections.push(crate::report::table(
+        &["key", "value", "unit", "std. error", "95 % CI", "status"],
+        &parameter_rows(id),
+        true,
+    ));
+    for w in &id.warnings {
+        sections.push(crate::report::paragraph(&w.to_string(), Some("note")));
+    }
+    sections.push(crate::report::heading("Report"));
+    sections.push(crate::report::preformatted(&report(id, inputs)));
+    crate::report::page(&crate::report::Page {
+        title: "platen identify".into(),
+        heading: "Identification from periodic tests (hysteresis-loop method)".into(),
+        items: html_items(id, inputs),
+        sections,
+        figures,
+        rendered,
+        summary: serde_json::to_value(summary(id, inputs))
+            .expect("a summary of numbers, strings and string-keyed maps serialises"),
+    })
+}
+
+/// The report's header items: the tests, the files, the reference pressure.
+fn html_items(id: &Identification, inputs: &[Input]) -> Vec<(String, String)> {
+    let count = |kind: TestKind| id.tests.iter().filter(|t| t.kind == kind).count();
+    vec![
         (
             "tests".to_owned(),
             format!(
                 "{} ({} sine, {} triangle)",
                 id.tests.len(),
-                id.tests.iter().filter(|t| t.kind == TestKind::Sine).count(),
-                id.tests
-                    .iter()
-                    .filter(|t| t.kind == TestKind::Triangle)
-                    .count()
+                count(TestKind::Sine),
+                count(TestKind::Triangle)
             ),
         ),
         (
@@ -204,12 +244,15 @@ fn html_report(
             id.reference_pressure_pa
                 .map_or("not given".to_owned(), |p| format!("{} MPa", p / 1e6)),
         ),
-    ];
-    let rows: Vec<Vec<String>> = id
-        .parameters()
+    ]
+}
+
+/// The HTML table's rows: key, value, unit, standard error, interval, status.
+fn parameter_rows(id: &Identification) -> Vec<Vec<String>> {
+    id.parameters
         .iter()
-        .zip(DISPLAY_UNITS)
-        .map(|((name, p), (unit, scale, d))| {
+        .map(|(key, p)| {
+            let (unit, scale, d) = display_unit(key);
             let (value, se, ci, status) = match p {
                 Parameter::Estimated(e) => (
                     format!("{:.d$}", e.value / scale),
@@ -230,29 +273,16 @@ fn html_report(
                     format!("not identifiable: {reason}"),
                 ),
             };
-            vec![(*name).to_owned(), value, unit.to_owned(), se, ci, status]
+            vec![
+                key.name().to_owned(),
+                value,
+                unit.to_owned(),
+                se,
+                ci,
+                status,
+            ]
         })
-        .collect();
-    let mut sections = vec![crate::report::heading("Identified parameters")];
-    sections.push(crate::report::table(
-        &["key", "value", "unit", "std. error", "95 % CI", "status"],
-        &rows,
-        true,
-    ));
-    for w in &id.warnings {
-        sections.push(crate::report::paragraph(w, Some("note")));
-    }
-    sections.push(crate::report::heading("Report"));
-    sections.push(crate::report::preformatted(&report(id, inputs)));
-    crate::report::page(&crate::report::Page {
-        title: "platen identify".into(),
-        heading: "Identification from periodic tests (hysteresis-loop method)".into(),
-        items,
-        sections,
-        figures,
-        rendered,
-        summary: to_json(id, inputs),
-    })
+        .collect()
 }
 
 /// The files to read: the command line's, then the manifest's not already given, with
@@ -290,87 +320,144 @@ fn inputs(opts: &Options) -> Result<Vec<Input>> {
         })
         .collect();
     if let Some(mpath) = opts.manifest {
-        let manifest: Manifest = parse_json_file(mpath).context(
-            "reading the identification manifest (expected {\"tests\": [{\"file\": PATH, \"kind\": \"sine\"|\"triangle\", \"pressure_mpa\": P, \"name\": NAME, \"columns\": MAP}], \"columns\": MAP}, with only `file` required)",
-        )?;
-        let column_map = |spec: &BTreeMap<String, ColumnSpec>, at: &str| {
-            ColumnMap::new(spec, at).map_err(|(json_path, value, expected)| {
-                anyhow::anyhow!(
-                    "`{}`: {json_path} = {value}: expected {expected}",
-                    mpath.display()
-                )
-            })
-        };
-        let manifest_columns = match &manifest.columns {
-            Some(spec) => Some(column_map(spec, "columns")?),
-            None => None,
-        };
-        let base = mpath.parent().unwrap_or(Path::new("."));
+        let manifest = ManifestReader::read(mpath, default_columns)?;
         for (k, entry) in manifest.tests.into_iter().enumerate() {
-            if let Some(p) = entry.pressure_mpa {
-                if !(p.is_finite() && p >= 0.0) {
-                    bail!(
-                        "`{}`, at `tests[{k}].pressure_mpa`: {p}: expected a pressure >= 0 MPa",
-                        mpath.display()
-                    );
-                }
-            }
-            let path = if entry.file.is_absolute() {
-                entry.file.clone()
-            } else {
-                base.join(&entry.file)
-            };
-            let columns = match (&entry.columns, &manifest_columns) {
-                (Some(spec), _) => column_map(spec, &format!("tests[{k}].columns"))?,
-                (None, Some(map)) => map.clone(),
-                (None, None) => default_columns.clone(),
-            };
-            let kind = entry.kind.map(|k| match k {
-                KindName::Sine => TestKind::Sine,
-                KindName::Triangle => TestKind::Triangle,
-            });
-            let canon = std::fs::canonicalize(&path).ok();
-            let existing = inputs
-                .iter_mut()
-                .find(|i| canon.is_some() && std::fs::canonicalize(&i.path).ok() == canon);
-            match existing {
-                Some(input) => {
-                    if let (Some(a), Some(b)) = (input.pressure_mpa, entry.pressure_mpa) {
-                        if a != b {
-                            bail!(
-                                "`{}`: hold-down pressure {a} MPa from --pressure-mpa but {b} MPa in the manifest `{}`",
-                                input.path.display(),
-                                mpath.display()
-                            );
-                        }
-                    }
-                    input.pressure_mpa = entry.pressure_mpa.or(input.pressure_mpa);
-                    input.kind = kind;
-                    input.columns = columns;
-                    if let Some(n) = entry.name {
-                        input.label = n.clone();
-                        input.name = n;
-                    }
-                }
-                None => inputs.push(Input {
-                    label: entry.name.clone().unwrap_or_else(|| file_label(&path)),
-                    name: entry.name.unwrap_or_else(|| path.display().to_string()),
-                    path,
-                    kind,
-                    // A single --pressure-mpa is the default for every file.
-                    pressure_mpa: entry.pressure_mpa.or(match opts.pressure_mpa {
-                        [p] => Some(*p),
-                        _ => None,
-                    }),
-                    columns,
-                }),
-            }
+            manifest
+                .reader
+                .add(&mut inputs, k, entry, opts.pressure_mpa)?;
         }
     }
     if inputs.is_empty() {
         bail!("no test files: give recorded CSV files, or a manifest that lists them");
     }
     Ok(inputs)
+}
+
+/// A manifest read, with what its entries need.
+struct ManifestTests<'a> {
+    tests: Vec<ManifestEntry>,
+    reader: ManifestReader<'a>,
+}
+
+/// Turns a manifest's entries into inputs.
+struct ManifestReader<'a> {
+    path: &'a Path,
+    /// The folder the entries' files are relative to.
+    base: &'a Path,
+    /// The manifest's own `columns`, if any.
+    columns: Option<ColumnMap>,
+    /// `--columns`, or platen's own names.
+    default_columns: ColumnMap,
+}
+
+impl<'a> ManifestReader<'a> {
+    fn read(path: &'a Path, default_columns: ColumnMap) -> Result<ManifestTests<'a>> {
+        let manifest: Manifest = parse_json_file(path).context(
+            "reading the identification manifest (expected {\"tests\": [{\"file\": PATH, \"kind\": \"sine\"|\"triangle\", \"pressure_mpa\": P, \"name\": NAME, \"columns\": MAP}], \"columns\": MAP}, with only `file` required)",
+        )?;
+        let mut reader = ManifestReader {
+            path,
+            base: path.parent().unwrap_or(Path::new(".")),
+            columns: None,
+            default_columns,
+        };
+        reader.columns = match &manifest.columns {
+            Some(spec) => Some(reader.column_map(spec, "columns")?),
+            None => None,
+        };
+        Ok(ManifestTests {
+            tests: manifest.tests,
+            reader,
+        })
+    }
+
+    fn column_map(&self, spec: &BTreeMap<String, ColumnSpec>, at: &str) -> Result<ColumnMap> {
+        ColumnMap::new(spec, at).map_err(|(json_path, value, expected)| {
+            anyhow::anyhow!(
+                "`{}`: {json_path} = {value}: expected {expected}",
+                self.path.display()
+            )
+        })
+    }
+
+    /// Adds entry `k`: to the input of the same file if there is one, else as a new input.
+    fn add(
+        &self,
+        inputs: &mut Vec<Input>,
+        k: usize,
+        entry: ManifestEntry,
+        pressure_mpa: &[f64],
+    ) -> Result<()> {
+        if let Some(p) = entry.pressure_mpa {
+            if !(p.is_finite() && p >= 0.0) {
+                bail!(
+                    "`{}`, at `tests[{k}].pressure_mpa`: {p}: expected a pressure >= 0 MPa",
+                    self.path.display()
+                );
+            }
+        }
+        let path = if entry.file.is_absolute() {
+            entry.file.clone()
+        } else {
+            self.base.join(&entry.file)
+        };
+        let columns = match (&entry.columns, &self.columns) {
+            (Some(spec), _) => self.column_map(spec, &format!("tests[{k}].columns"))?,
+            (None, Some(map)) => map.clone(),
+            (None, None) => self.default_columns.clone(),
+        };
+        let kind = entry.kind.map(|k| match k {
+            KindName::Sine => TestKind::Sine,
+            KindName::Triangle => TestKind::Triangle,
+        });
+        let canon = std::fs::canonicalize(&path).ok();
+        let existing = inputs
+            .iter_mut()
+            .find(|i| canon.is_some() && std::fs::canonicalize(&i.path).ok() == canon);
+        match existing {
+            Some(input) => self.merge(input, entry, kind, columns)?,
+            None => inputs.push(Input {
+                label: entry.name.clone().unwrap_or_else(|| file_label(&path)),
+                name: entry.name.unwrap_or_else(|| path.display().to_string()),
+                path,
+                kind,
+                // A single --pressure-mpa is the default for every file.
+                pressure_mpa: entry.pressure_mpa.or(match pressure_mpa {
+                    [p] => Some(*p),
+                    _ => None,
+                }),
+                columns,
+            }),
+        }
+        Ok(())
+    }
+
+    /// Lays an entry over the command line's input of the same file.
+    fn merge(
+        &self,
+        input: &mut Input,
+        entry: ManifestEntry,
+        kind: Option<TestKind>,
+        columns: ColumnMap,
+    ) -> Result<()> {
+        if let (Some(a), Some(b)) = (input.pressure_mpa, entry.pressure_mpa) {
+            if a != b {
+                bail!(
+                    "`{}`: hold-down pressure {a} MPa from --pressure-mpa but {b} MPa in the manifest `{}`",
+                    input.path.display(),
+                    self.path.display()
+                );
+            }
+        }
+        input.pressure_mpa = entry.pressure_mpa.or(input.pressure_mpa);
+        input.kind = kind;
+        input.columns = columns;
+        if let Some(n) = entry.name {
+            input.label = n.clone();
+            input.name = n;
+        }
+        Ok(())
+    }
 }
 
 fn file_label(path: &Path) -> String {
@@ -409,262 +496,6 @@ fn read_record(input: &Input) -> Result<TestRecord> {
     Ok(rec)
 }
 
-/// A finite number, or null.
-fn num(x: f64) -> Value {
-    if x.is_finite() {
-        json!(x)
-    } else {
-        Value::Null
-    }
-}
-
-fn estimate_json(e: &Estimate) -> Value {
-    json!({
-        "value": num(e.value),
-        "std_error": num(e.std_error),
-        "ci95": [num(e.ci95_low), num(e.ci95_high)],
-        "dof": num(e.dof),
-    })
-}
-
-fn parameter_json(p: &Parameter) -> Value {
-    match p {
-        Parameter::Estimated(e) => json!({
-            "status": "estimated",
-            "std_error": num(e.std_error),
-            "ci95": [num(e.ci95_low), num(e.ci95_high)],
-            "dof": num(e.dof),
-        }),
-        Parameter::Fixed { value, reason } => json!({
-            "status": "fixed",
-            "value": num(*value),
-            "reason": reason,
-        }),
-        Parameter::NotIdentifiable { reason } => json!({
-            "status": "not_identifiable",
-            "reason": reason,
-        }),
-    }
-}
-
-/// Up to `max` evenly spaced points of a curve, as `[x, y]` pairs.
-fn decimate(curve: &[[f64; 2]], max: usize) -> Value {
-    if curve.is_empty() {
-        return json!([]);
-    }
-    let step = curve.len().div_ceil(max).max(1);
-    Value::Array(
-        curve
-            .iter()
-            .step_by(step)
-            .map(|[x, y]| json!([num(*x), num(*y)]))
-            .collect(),
-    )
-}
-
-fn flags_json(flags: &[Flag]) -> Value {
-    Value::Array(
-        flags
-            .iter()
-            .map(|f| json!({"code": f.code(), "message": f.message()}))
-            .collect(),
-    )
-}
-
-/// Points per curve in the JSON output.
-const CURVE_POINTS: usize = 40;
-
-fn test_json(t: &TestResult, input: &Input) -> Map<String, Value> {
-    let c = &t.cycle;
-    let mut m = Map::new();
-    m.insert("file".into(), json!(input.path.display().to_string()));
-    m.insert("name".into(), json!(t.name));
-    m.insert("kind".into(), json!(t.kind.name()));
-    m.insert(
-        "kind_source".into(),
-        json!(if t.kind_given { "manifest" } else { "data" }),
-    );
-    m.insert(
-        "pressure_mpa".into(),
-        t.pressure_pa.map_or(Value::Null, |p| num(p / 1e6)),
-    );
-    m.insert("frequency_hz".into(), num(c.frequency_hz));
-    m.insert("period_s".into(), num(c.period_s));
-    m.insert("full_cycles".into(), json!(c.full_cycles));
-    m.insert("cycle_used".into(), json!(c.cycle_used));
-    m.insert("cycle_start_s".into(), num(c.cycle_start_s));
-    m.insert("amplitude_m".into(), num(c.amplitude_m));
-    m.insert("peak_velocity_m_s".into(), num(t.peak_velocity_m_s));
-    m.insert(
-        "peak_acceleration_m_s2".into(),
-        num(t.peak_acceleration_m_s2),
-    );
-    m.insert("plateau_fraction".into(), num(c.plateau_fraction));
-    m.insert("harmonic_distortion".into(), num(c.harmonic_distortion));
-    m.insert(
-        "dissipative_force_at_peak_n".into(),
-        t.peak_dissipative.map_or(Value::Null, |p| num(p.force_n)),
-    );
-    m.insert(
-        "velocity_at_peak_m_s".into(),
-        t.peak_dissipative
-            .map_or(Value::Null, |p| num(p.velocity_m_s)),
-    );
-    m.insert("flags".into(), flags_json(&t.flags));
-    m
-}
-
-fn to_json(id: &Identification, inputs: &[Input]) -> Value {
-    let mut top = Map::new();
-    let mut unc = Map::new();
-    for (name, p) in id.parameters() {
-        top.insert(name.into(), p.value().map_or(Value::Null, num));
-        unc.insert(name.into(), parameter_json(p));
-    }
-    top.insert(
-        "reference_pressure_mpa".into(),
-        id.reference_pressure_pa
-            .map_or(Value::Null, |p| num(p / 1e6)),
-    );
-    top.insert("uncertainty".into(), Value::Object(unc));
-    top.insert(
-        "friction_coefficient".into(),
-        id.friction_coefficient
-            .as_ref()
-            .map_or(Value::Null, estimate_json),
-    );
-    let mut triangles = Vec::new();
-    let mut sines = Vec::new();
-    for (t, input) in id.tests.iter().zip(inputs) {
-        let mut m = test_json(t, input);
-        match t.kind {
-            TestKind::Triangle => {
-                m.insert(
-                    "stiffness_n_per_m".into(),
-                    t.stiffness.map_or(Value::Null, |e| num(e.value)),
-                );
-                m.insert(
-                    "stiffness_std_error".into(),
-                    t.stiffness.map_or(Value::Null, |e| num(e.std_error)),
-                );
-                m.insert("used".into(), json!(t.used_for_stiffness));
-                m.insert(
-                    "elastic_curve".into(),
-                    decimate(&t.elastic_curve, CURVE_POINTS),
-                );
-                m.insert(
-                    "dissipative_curve".into(),
-                    decimate(&t.dissipative_curve, CURVE_POINTS),
-                );
-                triangles.push(Value::Object(m));
-            }
-            TestKind::Sine => {
-                m.insert(
-                    "effective_mass_kg".into(),
-                    t.effective_mass.map_or(Value::Null, |e| num(e.value)),
-                );
-                m.insert(
-                    "effective_mass_std_error".into(),
-                    t.effective_mass.map_or(Value::Null, |e| num(e.std_error)),
-                );
-                m.insert("used".into(), json!(t.used_for_mass));
-                m.insert(
-                    "inertial_curve".into(),
-                    decimate(&t.inertial_curve, CURVE_POINTS),
-                );
-                m.insert(
-                    "dissipative_curve".into(),
-                    decimate(&t.dissipative_curve, CURVE_POINTS),
-                );
-                sines.push(Value::Object(m));
-            }
-        }
-    }
-    top.insert("triangle_tests".into(), Value::Array(triangles));
-    top.insert("sine_tests".into(), Value::Array(sines));
-    let opt = |e: &Option<Estimate>| e.as_ref().map_or(Value::Null, estimate_json);
-    top.insert(
-        "pressures".into(),
-        Value::Array(
-            id.pressures
-                .iter()
-                .map(|g| {
-                    json!({
-                        "pressure_mpa": g.pressure_pa.map_or(Value::Null, |p| num(p / 1e6)),
-                        "vertical_force_n": g.vertical_force_n.map_or(Value::Null, num),
-                        "sine_tests": g.sine_tests,
-                        "triangle_tests": g.triangle_tests,
-                        "stiffness_n_per_m": opt(&g.stiffness),
-                        "stiffness_source": g.stiffness_source,
-                        "coulomb_force_n": opt(&g.coulomb_force),
-                        "paper_coulomb_force_sine_n": opt(&g.paper_coulomb_force_sine),
-                        "paper_coulomb_force_triangle_n": opt(&g.paper_coulomb_force_triangle),
-                    })
-                })
-                .collect(),
-        ),
-    );
-    top.insert(
-        "paper_eq21".into(),
-        id.paper_fit.as_ref().map_or(Value::Null, |p| {
-            json!({
-                "coulomb_force_n": estimate_json(&p.coulomb_force),
-                "viscous_coefficient": estimate_json(&p.viscous_coefficient),
-                "viscous_exponent": 0.5,
-                "points": p.points,
-                "sine_tests_only": p.sine_only,
-                "friction_coefficient": p.friction_coefficient.as_ref().map_or(Value::Null, estimate_json),
-            })
-        }),
-    );
-    top.insert(
-        "dissipative_fit".into(),
-        id.law.as_ref().map_or(Value::Null, |l| {
-            json!({
-                "points": l.points,
-                "rms_n": num(l.rms_n),
-                "condition_number": num(l.condition_number),
-                "speed_range_m_s": [num(l.speed_range_m_s[0]), num(l.speed_range_m_s[1])],
-            })
-        }),
-    );
-    top.insert(
-        "global_fit".into(),
-        id.global.as_ref().map_or(Value::Null, |g| {
-            let mut m = Map::new();
-            let mut u = Map::new();
-            for (k, p) in platen_ident::PARAMETER_NAMES.iter().zip(&g.parameters) {
-                m.insert((*k).into(), p.value().map_or(Value::Null, num));
-                u.insert((*k).into(), parameter_json(p));
-            }
-            m.insert("uncertainty".into(), Value::Object(u));
-            m.insert(
-                "pressures".into(),
-                Value::Array(
-                    g.groups
-                        .iter()
-                        .map(|(p, k, f)| {
-                            json!({
-                                "pressure_mpa": p.map_or(Value::Null, |p| num(p / 1e6)),
-                                "stiffness_n_per_m": estimate_json(k),
-                                "coulomb_force_n": estimate_json(f),
-                            })
-                        })
-                        .collect(),
-                ),
-            );
-            m.insert("rms_residual_n".into(), num(g.rms_residual_n));
-            m.insert("points".into(), json!(g.points));
-            m.insert("converged".into(), json!(g.converged));
-            m.insert("iterations".into(), json!(g.iterations));
-            m.insert("condition_number".into(), num(g.condition_number));
-            Value::Object(m)
-        }),
-    );
-    top.insert("warnings".into(), json!(id.warnings));
-    Value::Object(top)
-}
-
 /// `value ± se` in a unit with `digits` decimals.
 fn pm(e: Option<&Estimate>, scale: f64, digits: usize) -> String {
     match e {
@@ -687,21 +518,40 @@ fn flag_codes(flags: &[Flag]) -> String {
     flags.iter().map(Flag::code).collect::<Vec<_>>().join(",")
 }
 
-/// How the seven parameters are shown to a reader: unit, SI units per shown unit, decimals.
-const DISPLAY_UNITS: [(&str, f64, usize); 7] = [
-    ("t", 1e3, 2),
-    ("MN/m", 1e6, 4),
-    ("kN", 1e3, 2),
-    ("kN/(m/s)^α", 1e3, 2),
-    ("", 1.0, 3),
-    ("kN", 1e3, 2),
-    ("s/m", 1.0, 1),
-];
+/// How a parameter is shown to a reader: unit, SI units per shown unit, decimals.
+fn display_unit(key: IdentifiedKey) -> (&'static str, f64, usize) {
+    match key {
+        IdentifiedKey::EffectiveMass => ("t", 1e3, 2),
+        IdentifiedKey::Stiffness => ("MN/m", 1e6, 4),
+        IdentifiedKey::CoulombForce | IdentifiedKey::LowVelocityForce => ("kN", 1e3, 2),
+        IdentifiedKey::ViscousCoefficient => ("kN/(m/s)^α", 1e3, 2),
+        IdentifiedKey::ViscousExponent => ("", 1.0, 3),
+        IdentifiedKey::LowVelocityDecay => ("s/m", 1.0, 1),
+    }
+}
 
 /// The human-readable report.
 fn report(id: &Identification, inputs: &[Input]) -> String {
-    use std::fmt::Write;
     let mut s = String::new();
+    let w = inputs
+        .iter()
+        .map(|i| i.label.chars().count())
+        .max()
+        .unwrap_or(4)
+        .max(4);
+    report_parameters(&mut s, id);
+    report_triangle_tests(&mut s, id, inputs, w);
+    report_sine_tests(&mut s, id, inputs, w);
+    report_peaks(&mut s, id, inputs, w);
+    report_pressures(&mut s, id);
+    report_fits(&mut s, id);
+    report_global(&mut s, id);
+    report_warnings(&mut s, id);
+    s
+}
+
+/// The seven parameters and μₑ.
+fn report_parameters(s: &mut String, id: &Identification) {
     let _ = writeln!(
         s,
         "Identified parameters ({} tests; {})",
@@ -711,14 +561,8 @@ fn report(id: &Identification, inputs: &[Input]) -> String {
             None => "hold-down pressure not given".to_owned(),
         }
     );
-    let w = inputs
-        .iter()
-        .map(|i| i.label.chars().count())
-        .max()
-        .unwrap_or(4)
-        .max(4);
-    let units = DISPLAY_UNITS;
-    for ((name, p), (unit, scale, digits)) in id.parameters().iter().zip(units) {
+    for (key, p) in id.parameters.iter() {
+        let (name, (unit, scale, digits)) = (key.name(), display_unit(key));
         let text = match p {
             Parameter::Estimated(e) => format!(
                 "{} {unit}   (95 % CI {:.d$} – {:.d$})",
@@ -746,7 +590,10 @@ fn report(id: &Identification, inputs: &[Input]) -> String {
             pm(Some(mu), 0.01, 4)
         );
     }
+}
 
+/// The stiffness table (Table I).
+fn report_triangle_tests(s: &mut String, id: &Identification, inputs: &[Input], w: usize) {
     let _ = writeln!(s, "\nStiffness from triangle tests (Eq. 16/17, Table I)");
     let _ = writeln!(
         s,
@@ -770,6 +617,10 @@ fn report(id: &Identification, inputs: &[Input]) -> String {
             flag_codes(&t.flags)
         );
     }
+}
+
+/// The mass table (Table II).
+fn report_sine_tests(s: &mut String, id: &Identification, inputs: &[Input], w: usize) {
     let _ = writeln!(s, "\nEffective mass from sine tests (Eq. 18/19, Table II)");
     let _ = writeln!(
         s,
@@ -794,6 +645,10 @@ fn report(id: &Identification, inputs: &[Input]) -> String {
             flag_codes(&t.flags)
         );
     }
+}
+
+/// The dissipative force at peak velocity per test (Fig. 7).
+fn report_peaks(s: &mut String, id: &Identification, inputs: &[Input], w: usize) {
     let _ = writeln!(s, "\nDissipative force at peak velocity (Eq. 20, Fig. 7)");
     let _ = writeln!(
         s,
@@ -813,6 +668,10 @@ fn report(id: &Identification, inputs: &[Input]) -> String {
             );
         }
     }
+}
+
+/// The per-pressure table.
+fn report_pressures(s: &mut String, id: &Identification) {
     let _ = writeln!(s, "\nPer hold-down pressure");
     let _ = writeln!(
         s,
@@ -834,6 +693,10 @@ fn report(id: &Identification, inputs: &[Input]) -> String {
                 .map_or("—".to_owned(), |e| format!("{:.2}", e.value / 1e3)),
         );
     }
+}
+
+/// Eq. 21 as the paper fitted it, and the law fit.
+fn report_fits(s: &mut String, id: &Identification) {
     if let Some(p) = &id.paper_fit {
         let _ = writeln!(
             s,
@@ -857,6 +720,10 @@ fn report(id: &Identification, inputs: &[Input]) -> String {
             l.points, l.speed_range_m_s[0], l.speed_range_m_s[1], l.rms_n
         );
     }
+}
+
+/// The global fit against the hysteresis-loop estimate.
+fn report_global(s: &mut String, id: &Identification) {
     if let Some(g) = &id.global {
         let _ = writeln!(
             s,
@@ -865,12 +732,9 @@ fn report(id: &Identification, inputs: &[Input]) -> String {
             g.rms_residual_n,
             if g.converged { "" } else { ", NOT converged" }
         );
-        for (((name, p), (unit, scale, digits)), own) in platen_ident::PARAMETER_NAMES
-            .iter()
-            .zip(&g.parameters)
-            .zip(units)
-            .zip(&id.parameters)
-        {
+        for (key, p) in g.parameters.iter() {
+            let (name, (unit, scale, digits)) = (key.name(), display_unit(key));
+            let own = id.parameters.get(key);
             let diff = match (p.value(), own.value()) {
                 (Some(a), Some(b)) if b != 0.0 => {
                     format!("  ({:+.2} %)", 100.0 * (a - b) / b.abs())
@@ -887,11 +751,14 @@ fn report(id: &Identification, inputs: &[Input]) -> String {
             let _ = writeln!(s, "  {name:<28} {text} {unit}{diff}");
         }
     }
+}
+
+/// The warnings.
+fn report_warnings(s: &mut String, id: &Identification) {
     if !id.warnings.is_empty() {
         let _ = writeln!(s, "\nWarnings");
         for w in &id.warnings {
             let _ = writeln!(s, "  - {w}");
         }
     }
-    s
 }

@@ -71,14 +71,7 @@ fn segments(points: Vec<(f64, f64)>, color: RGBColor) -> Series {
 /// The final dissipative law (`F_μ`, `Cₑ`, `α`, `a`, `b` of the identification), if every one
 /// of its parameters has a value.
 fn final_law(id: &Identification) -> Option<DissipativeLaw> {
-    let v = |i: usize| id.parameters[i].value();
-    Some(DissipativeLaw {
-        coulomb_force_n: v(2)?,
-        viscous_coefficient: v(3)?,
-        viscous_exponent: v(4)?,
-        low_velocity_force_n: v(5)?,
-        low_velocity_decay_s_per_m: v(6)?,
-    })
+    id.parameters.law()
 }
 
 /// Speeds from 0 to `max`, dense near 0 where the low-velocity term and `|v|^α` bend.
@@ -222,7 +215,7 @@ pub fn figures(id: &Identification) -> Vec<Figure> {
         unused.clip_bars(band.0 - pad, band.1 + pad);
         let mut series = used.into_series("used", GROUP_COLORS[0]);
         series.extend(unused.into_series("not used (flagged)", UNUSED));
-        if let Some(m) = id.parameters[0].value() {
+        if let Some(m) = id.parameters.effective_mass_kg.value() {
             let x_max = id
                 .tests
                 .iter()
@@ -326,7 +319,7 @@ pub fn figures(id: &Identification) -> Vec<Figure> {
 
     // Inertial force against acceleration, with Mₑ·a and what Mₑ·a leaves.
     if sines {
-        let mass = id.parameters[0].value();
+        let mass = id.parameters.effective_mass_kg.value();
         let (mut series, mut residuals) = (Vec::new(), Vec::new());
         if let Some(m) = mass {
             let a_max = id
@@ -428,7 +421,7 @@ pub fn figures(id: &Identification) -> Vec<Figure> {
                 format!("law, F_μ = {:.2} kN", fmu.value / 1e3),
                 speed_grid(v_max)
                     .into_iter()
-                    .map(|w| (w, law.magnitude_n(w) / 1e3))
+                    .map(|w| (w, law.smooth_magnitude_n(w) / 1e3))
                     .collect(),
                 color,
                 3,

@@ -10,7 +10,7 @@ use platen_signal::{
 
 use crate::error::{IdentError, Result};
 use crate::record::{TestKind, TestRecord};
-use crate::settings::Settings;
+use crate::settings::ValidSettings;
 
 /// Hysteresis of the zero-crossing detector, as a fraction of the displacement amplitude: the
 /// displacement must swing past ±25 % of its amplitude between two crossings, so transducer
@@ -89,7 +89,7 @@ pub(crate) struct RatePlan {
 }
 
 impl RatePlan {
-    pub(crate) fn new(rate_hz: f64, settings: &Settings, test: &str) -> Result<Self> {
+    pub(crate) fn new(rate_hz: f64, settings: &ValidSettings, test: &str) -> Result<Self> {
         let signal = |source| IdentError::Signal {
             test: test.to_owned(),
             source,
@@ -253,30 +253,40 @@ fn fit_crossings(cross: &[(f64, bool)]) -> Option<(f64, f64, f64)> {
     Some((sol[0], sol[1], sol[2]))
 }
 
-/// Analyses one record: period, waveform, steady-state cycle, filtered channels.
-pub(crate) fn analyse(rec: &TestRecord, plan: &RatePlan, settings: &Settings) -> Result<Analysed> {
-    let name = rec.name();
-    let rate = rec.sample_rate_hz();
-    let signal = |source| IdentError::Signal {
-        test: name.to_owned(),
-        source,
-    };
-    let not_periodic = |reason: String| IdentError::NotPeriodic {
-        test: name.to_owned(),
-        reason,
-    };
-    let n_rec = rec.len();
-    let u = rec.u_m();
+/// The errors of one record, naming it.
+struct Errors<'a> {
+    test: &'a str,
+}
+
+impl Errors<'_> {
+    fn signal(&self, source: platen_signal::SignalError) -> IdentError {
+        IdentError::Signal {
+            test: self.test.to_owned(),
+            source,
+        }
+    }
+
+    fn not_periodic(&self, reason: String) -> IdentError {
+        IdentError::NotPeriodic {
+            test: self.test.to_owned(),
+            reason,
+        }
+    }
+}
+
+/// The fundamental frequency from the zero crossings of the raw displacement about its
+/// mid-range, Hz, after checking that they are regular.
+fn fundamental_hz(u: &[f64], rate: f64, errors: &Errors) -> Result<f64> {
     let (lo, hi) = min_max(u);
     let amp = 0.5 * (hi - lo);
     if amp <= 0.0 {
-        return Err(not_periodic("the displacement is constant".into()));
+        return Err(errors.not_periodic("the displacement is constant".into()));
     }
     let mid = 0.5 * (hi + lo);
     let centred: Vec<f64> = u.iter().map(|x| x - mid).collect();
     let rough = crossings(&centred, CROSSING_HYSTERESIS * amp);
     if rough.len() < 3 {
-        return Err(not_periodic(format!(
+        return Err(errors.not_periodic(format!(
             "the displacement crosses its mid-range {} time(s); one full cycle needs at least 3",
             rough.len()
         )));
@@ -286,15 +296,46 @@ pub(crate) fn analyse(rec: &TestRecord, plan: &RatePlan, settings: &Settings) ->
     for w in rough.windows(3) {
         let interval = w[2].0 - w[0].0;
         if (interval - rough_period).abs() > PERIOD_REGULARITY * rough_period {
-            return Err(not_periodic(format!(
+            return Err(errors.not_periodic(format!(
                 "zero crossings are irregular (an interval of {:.4} s against a mean period of {:.4} s)",
                 interval / rate,
                 rough_period / rate
             )));
         }
     }
-    let f0 = rate / rough_period;
+    Ok(rate / rough_period)
+}
 
+/// Every channel of a record through the two low-passes.
+struct Filtered {
+    sr: SampleRate,
+    butter: ButterworthLowpass,
+    inertial_cutoff_hz: f64,
+    /// The velocity channel (given, or the crossover estimate).
+    v_raw: Vec<f64>,
+    /// The acceleration of sine tests' inertial force (see [`filter`]).
+    a_c: Vec<f64>,
+    u4: Vec<f64>,
+    f4: Vec<f64>,
+    fir: FirLowpass,
+    settle_s: f64,
+    u8: Vec<f64>,
+    v8: Vec<f64>,
+    f8: Vec<f64>,
+    vu8: Vec<f64>,
+}
+
+/// Low-passes the channels of `rec`: at `factor × f0` (Butterworth, zero phase) for inertial
+/// and elastic work, and through the dissipative FIR.
+fn filter(
+    rec: &TestRecord,
+    plan: &RatePlan,
+    settings: &ValidSettings,
+    f0: f64,
+    errors: &Errors,
+) -> Result<Filtered> {
+    let (rate, u) = (rec.sample_rate_hz(), rec.u_m());
+    let signal = |e| errors.signal(e);
     // The inertial/elastic low-pass: 4× the fundamental (paper §3), zero phase.
     let inertial_cutoff = settings.inertial_cutoff_factor * f0;
     let butter = ButterworthLowpass::new(settings.butterworth_order, inertial_cutoff, rate)
@@ -318,40 +359,65 @@ pub(crate) fn analyse(rec: &TestRecord, plan: &RatePlan, settings: &Settings) ->
     let u4 = butter.apply(u).map_err(signal)?;
     let f4 = butter.apply(rec.force_n()).map_err(signal)?;
     // The dissipative FIR (order 512 at 8 Hz on 512 Hz data; never below 4× the fundamental).
-    let fir_owned;
-    let fir: &FirLowpass = if plan.fir.cutoff_hz() >= inertial_cutoff {
-        &plan.fir
+    let (fir, settle_s) = if plan.fir.cutoff_hz() >= inertial_cutoff {
+        (plan.fir.clone(), plan.settle_s)
     } else {
         let order = plan.fir.order();
-        fir_owned =
-            FirLowpass::new(order, inertial_cutoff, rate, Window::Hamming).map_err(signal)?;
-        &fir_owned
-    };
-    let settle_s = if std::ptr::eq(fir, &plan.fir) {
-        plan.settle_s
-    } else {
-        settle_time_samples(fir.taps(), SETTLE_TOLERANCE) as f64 / rate
+        let fir = FirLowpass::new(order, inertial_cutoff, rate, Window::Hamming).map_err(signal)?;
+        let settle_s = settle_time_samples(fir.taps(), SETTLE_TOLERANCE) as f64 / rate;
+        (fir, settle_s)
     };
     let u8 = fir.apply(u).map_err(signal)?;
     let v8 = fir.apply(&v_raw).map_err(signal)?;
     let f8 = fir.apply(rec.force_n()).map_err(signal)?;
     let vu8 = differentiate(&u8, sr);
+    Ok(Filtered {
+        sr,
+        butter,
+        inertial_cutoff_hz: inertial_cutoff,
+        v_raw,
+        a_c,
+        u4,
+        f4,
+        fir,
+        settle_s,
+        u8,
+        v8,
+        f8,
+        vu8,
+    })
+}
 
-    // Refined crossings on the low-passed displacement.
-    let (lo4, hi4) = min_max(&u4);
+/// The cycle analysed and its grid, in samples of the record.
+struct CycleChoice {
+    period: f64,
+    amplitude: f64,
+    offset: f64,
+    full_cycles: usize,
+    cycle_used: usize,
+    /// Start of the cycle (first grid point).
+    tau: f64,
+    /// Grid points over the cycle, and their spacing.
+    n: usize,
+    step: f64,
+}
+
+/// Fits the period to the crossings of the low-passed displacement `u4` and chooses the
+/// cycle: the second-to-last full one, from its offset-free upward zero crossing.
+fn choose_cycle(u4: &[f64], rate: f64, errors: &Errors) -> Result<CycleChoice> {
+    let (lo4, hi4) = min_max(u4);
     let amp4 = 0.5 * (hi4 - lo4);
     let mid4 = 0.5 * (hi4 + lo4);
     let c4: Vec<f64> = u4.iter().map(|x| x - mid4).collect();
     let fine = crossings(&c4, CROSSING_HYSTERESIS * amp4);
     if fine.len() < 3 {
-        return Err(not_periodic(
-            "the low-passed displacement has fewer than 3 zero crossings".into(),
-        ));
+        return Err(errors
+            .not_periodic("the low-passed displacement has fewer than 3 zero crossings".into()));
     }
     let (c, period, _delta) = fit_crossings(&fine)
-        .ok_or_else(|| not_periodic("the zero crossings do not fit a period".into()))?;
+        .ok_or_else(|| errors.not_periodic("the zero crossings do not fit a period".into()))?;
     if !(period.is_finite() && period > 4.0) {
-        return Err(not_periodic(format!(
+        return Err(errors.not_periodic(format!(
             "period of {period:.2} samples is too short for the sample rate"
         )));
     }
@@ -367,13 +433,13 @@ pub(crate) fn analyse(rec: &TestRecord, plan: &RatePlan, settings: &Settings) ->
     let n = 4 * ((period / 4.0).ceil() as usize).max(4);
     let step = period / n as f64;
     let tol = 0.5;
-    let last = (n_rec - 1) as f64;
+    let last = (u4.len() - 1) as f64;
     // Cycle starts τ_m = first_up + m·T with τ_m ≥ −tol and τ_m + T − step ≤ last + tol.
     let m_lo = ((-tol - first_up) / period).ceil() as i64;
     let m_hi = ((last + tol - (period - step) - first_up) / period).floor() as i64;
     if m_hi < m_lo {
         return Err(IdentError::NoFullCycle {
-            test: name.to_owned(),
+            test: errors.test.to_owned(),
             period_s: period / rate,
             span_s: last / rate,
         });
@@ -384,19 +450,31 @@ pub(crate) fn analyse(rec: &TestRecord, plan: &RatePlan, settings: &Settings) ->
     } else {
         (m_hi, 1)
     };
-    let tau = first_up + m_used as f64 * period;
+    Ok(CycleChoice {
+        period,
+        amplitude: amp4,
+        offset: mid4,
+        full_cycles,
+        cycle_used,
+        tau: first_up + m_used as f64 * period,
+        n,
+        step,
+    })
+}
 
-    // Grid over the cycle.
-    let on_grid =
-        |x: &[f64]| -> Vec<f64> { (0..n).map(|j| interp(x, tau + j as f64 * step)).collect() };
-    let g_u4 = on_grid(&u4);
-    let g_f4 = on_grid(&f4);
-    let g_f = on_grid(rec.force_n());
-    let g_v8 = on_grid(&v8);
-    let g_f8 = on_grid(&f8);
-    let g_vu8 = on_grid(&vu8);
+impl CycleChoice {
+    /// `x` interpolated on the cycle's grid.
+    fn on_grid(&self, x: &[f64]) -> Vec<f64> {
+        (0..self.n)
+            .map(|j| interp(x, self.tau + j as f64 * self.step))
+            .collect()
+    }
+}
 
-    // Waveform: time at the plateau speed.
+/// The plateau speed (median of `|v|` over the cycle), the fraction of the cycle within
+/// [`PLATEAU_TOLERANCE`] of it, and the waveform that fraction says.
+fn waveform(g_vu8: &[f64]) -> (f64, f64, TestKind) {
+    let n = g_vu8.len();
     let mut speeds: Vec<f64> = g_vu8.iter().map(|v| v.abs()).collect();
     speeds.sort_by(f64::total_cmp);
     let plateau_speed = speeds[n / 2];
@@ -410,36 +488,29 @@ pub(crate) fn analyse(rec: &TestRecord, plan: &RatePlan, settings: &Settings) ->
     } else {
         TestKind::Sine
     };
-    let kind = rec.kind().unwrap_or(detected_kind);
-    // The acceleration of the inertial force: on sines the crossover above; on triangles the
-    // accelerometer itself. A triangle's acceleration jumps at the ends of its reversal arcs
-    // (0 to ±A_r), and sampled displacement cannot place a jump within a sample interval: the
-    // displacement-derived acceleration then carries a spurious impulse of up to A_r·Δt/2 per
-    // jump (on T12, 144 t × 24 m/s² × 1 ms ≈ 3.4 kN·s), which the low-pass turns into kilonewtons
-    // of force. The accelerometer's noise matters less there: the reversal arcs are large.
-    let a4 = match kind {
-        TestKind::Sine => butter.apply(&a_c),
-        TestKind::Triangle => butter.apply(a_rec),
-    }
-    .map_err(signal)?;
-    let g_a4 = on_grid(&a4);
-    // Unit impulses at the velocity reversals, signed as the new motion, through the same
-    // low-pass: the shape of a force impulse at each reversal (see `identify`).
-    let vu4 = differentiate(&u4, sr);
+    (plateau_speed, plateau_fraction, detected_kind)
+}
+
+/// Unit impulses at the velocity reversals of `vu4`, signed as the new motion, each of area
+/// 1 N·s split between the two neighbouring samples.
+fn reversal_impulses(vu4: &[f64], rate: f64) -> Vec<f64> {
+    let n_rec = vu4.len();
     let mut impulses = vec![0.0; n_rec];
     for i in 1..n_rec {
         let (a, b) = (vu4[i - 1], vu4[i]);
         if (a > 0.0) != (b > 0.0) && a != b {
             let frac = (a / (a - b)).clamp(0.0, 1.0);
             let sign = if b > 0.0 { 1.0 } else { -1.0 };
-            // Area 1 N·s split between the two neighbouring samples.
             impulses[i - 1] += sign * (1.0 - frac) * rate;
             impulses[i] += sign * frac * rate;
         }
     }
-    let g4 = butter.apply(&impulses).map_err(signal)?;
-    let g_g4 = on_grid(&g4);
-    // Harmonics of the displacement over the cycle.
+    impulses
+}
+
+/// Total harmonic distortion (harmonics 2–7 over the fundamental) of one cycle on a grid.
+fn harmonic_distortion(g_u4: &[f64]) -> f64 {
+    let n = g_u4.len();
     let mean_u = g_u4.iter().sum::<f64>() / n as f64;
     let harmonic = |k: usize| -> f64 {
         let (mut re, mut im) = (0.0, 0.0);
@@ -451,15 +522,15 @@ pub(crate) fn analyse(rec: &TestRecord, plan: &RatePlan, settings: &Settings) ->
         2.0 * (re * re + im * im).sqrt() / n as f64
     };
     let h1 = harmonic(1);
-    let thd =
-        ((2..=7).map(|k| harmonic(k).powi(2)).sum::<f64>()).sqrt() / h1.max(f64::MIN_POSITIVE);
+    ((2..=7).map(|k| harmonic(k).powi(2)).sum::<f64>()).sqrt() / h1.max(f64::MIN_POSITIVE)
+}
 
-    // Whole-record channels for the instantaneous (global) fit.
-    // For the instantaneous (global) fit, the second derivative of the low-passed
-    // displacement: zero phase, unlike the accelerometer's conditioner (see `global`).
-    let rec_a8 = differentiate(&vu8, sr);
-    let settle = (settle_s * rate).ceil() as usize;
-    let edge = fir.order() / 2;
+/// Samples of the whole record usable for instantaneous fits: away from the filter's edges
+/// and from the velocity reversals by the reversal window.
+fn usable_samples(filtered: &Filtered, rate: f64) -> Vec<bool> {
+    let (v8, n_rec) = (&filtered.v8, filtered.v8.len());
+    let settle = (filtered.settle_s * rate).ceil() as usize;
+    let edge = filtered.fir.order() / 2;
     let mut rec_usable = vec![true; n_rec];
     for flag in rec_usable.iter_mut().take(edge.min(n_rec)) {
         *flag = false;
@@ -476,73 +547,132 @@ pub(crate) fn analyse(rec: &TestRecord, plan: &RatePlan, settings: &Settings) ->
             }
         }
     }
+    rec_usable
+}
 
-    // The filter's 0.5 % settling time: how far the arcs' inertial transients (M·A_r, up to
-    // MN) leak into a triangle's plateau through the filter's tail.
-    let reach = settle_time_samples(fir.taps(), 0.005);
-    if kind == TestKind::Triangle {
-        // Only the plateaus, away from the reversal arcs by that time.
-        let off: Vec<bool> = vu8
-            .iter()
-            .map(|v| (v.abs() - plateau_speed).abs() > PLATEAU_TOLERANCE * plateau_speed)
-            .collect();
-        let mut last_off: Option<usize> = None;
-        for i in 0..n_rec {
-            if off[i] {
-                last_off = Some(i);
-            }
-            if last_off.is_some_and(|k| i - k <= reach) {
-                rec_usable[i] = false;
-            }
+/// Marks unusable the samples of a triangle test off its plateaus or within `reach`
+/// samples of them: how far the arcs' inertial transients (M·A_r, up to MN) leak into a
+/// plateau through the filter's tail.
+fn keep_plateaus_only(rec_usable: &mut [bool], vu8: &[f64], plateau_speed: f64, reach: usize) {
+    let n_rec = vu8.len();
+    let off: Vec<bool> = vu8
+        .iter()
+        .map(|v| (v.abs() - plateau_speed).abs() > PLATEAU_TOLERANCE * plateau_speed)
+        .collect();
+    let mut last_off: Option<usize> = None;
+    for i in 0..n_rec {
+        if off[i] {
+            last_off = Some(i);
         }
-        let mut next_off: Option<usize> = None;
-        for i in (0..n_rec).rev() {
-            if off[i] {
-                next_off = Some(i);
-            }
-            if next_off.is_some_and(|k| k - i <= reach) {
-                rec_usable[i] = false;
-            }
+        if last_off.is_some_and(|k| i - k <= reach) {
+            rec_usable[i] = false;
         }
     }
+    let mut next_off: Option<usize> = None;
+    for i in (0..n_rec).rev() {
+        if off[i] {
+            next_off = Some(i);
+        }
+        if next_off.is_some_and(|k| k - i <= reach) {
+            rec_usable[i] = false;
+        }
+    }
+}
 
+/// The acceleration of the inertial force and the reversal impulses, through the 4×
+/// fundamental low-pass.
+fn inertial_channels(
+    rec: &TestRecord,
+    filtered: &Filtered,
+    kind: TestKind,
+    errors: &Errors,
+) -> Result<(Vec<f64>, Vec<f64>)> {
+    // The acceleration of the inertial force: on sines the crossover above; on triangles the
+    // accelerometer itself. A triangle's acceleration jumps at the ends of its reversal arcs
+    // (0 to ±A_r), and sampled displacement cannot place a jump within a sample interval: the
+    // displacement-derived acceleration then carries a spurious impulse of up to A_r·Δt/2 per
+    // jump (on T12, 144 t × 24 m/s² × 1 ms ≈ 3.4 kN·s), which the low-pass turns into kilonewtons
+    // of force. The accelerometer's noise matters less there: the reversal arcs are large.
+    let errs = |e| errors.signal(e);
+    let a4 = match kind {
+        TestKind::Sine => filtered.butter.apply(&filtered.a_c),
+        TestKind::Triangle => filtered.butter.apply(rec.a_m_s2()),
+    }
+    .map_err(errs)?;
+    // Unit impulses at the velocity reversals, signed as the new motion, through the same
+    // low-pass: the shape of a force impulse at each reversal (see `identify`).
+    let vu4 = differentiate(&filtered.u4, filtered.sr);
+    let g4 = filtered
+        .butter
+        .apply(&reversal_impulses(&vu4, rec.sample_rate_hz()))
+        .map_err(errs)?;
+    Ok((a4, g4))
+}
+
+/// Analyses one record: period, waveform, steady-state cycle, filtered channels.
+pub(crate) fn analyse(
+    rec: &TestRecord,
+    plan: &RatePlan,
+    settings: &ValidSettings,
+) -> Result<Analysed> {
+    let rate = rec.sample_rate_hz();
+    let errors = Errors { test: rec.name() };
+    let f0 = fundamental_hz(rec.u_m(), rate, &errors)?;
+    let filtered = filter(rec, plan, settings, f0, &errors)?;
+    let cycle = choose_cycle(&filtered.u4, rate, &errors)?;
+    let g_vu8 = cycle.on_grid(&filtered.vu8);
+    let (plateau_speed, plateau_fraction, detected_kind) = waveform(&g_vu8);
+    let kind = rec.kind().unwrap_or(detected_kind);
+    let (a4, g4) = inertial_channels(rec, &filtered, kind, &errors)?;
+    let g_u4 = cycle.on_grid(&filtered.u4);
+    let thd = harmonic_distortion(&g_u4);
+    let mut rec_usable = usable_samples(&filtered, rate);
+    // The filter's 0.5 % settling time: how far the arcs' inertial transients reach.
+    let reach = settle_time_samples(filtered.fir.taps(), 0.005);
+    if kind == TestKind::Triangle {
+        // Only the plateaus, away from the reversal arcs by that time.
+        keep_plateaus_only(&mut rec_usable, &filtered.vu8, plateau_speed, reach);
+    }
     let info = CycleInfo {
-        period_s: period / rate,
-        frequency_hz: rate / period,
-        full_cycles,
-        cycle_used,
-        cycle_start_s: rec.start_s() + tau / rate,
-        amplitude_m: amp4,
-        offset_m: mid4,
+        period_s: cycle.period / rate,
+        frequency_hz: rate / cycle.period,
+        full_cycles: cycle.full_cycles,
+        cycle_used: cycle.cycle_used,
+        cycle_start_s: rec.start_s() + cycle.tau / rate,
+        amplitude_m: cycle.amplitude,
+        offset_m: cycle.offset,
         plateau_fraction,
         harmonic_distortion: thd,
         detected_kind,
-        inertial_cutoff_hz: inertial_cutoff,
-        dissipative_cutoff_hz: fir.cutoff_hz(),
-        reversal_window_s: settle_s,
+        inertial_cutoff_hz: filtered.inertial_cutoff_hz,
+        dissipative_cutoff_hz: filtered.fir.cutoff_hz(),
+        reversal_window_s: filtered.settle_s,
     };
+    // For the instantaneous (global) fit, the second derivative of the low-passed
+    // displacement: zero phase, unlike the accelerometer's conditioner (see `global`).
+    let rec_a8 = differentiate(&filtered.vu8, filtered.sr);
     Ok(Analysed {
         info,
-        n,
-        grid_start: tau,
-        grid_step: step,
-        fir: fir.clone(),
+        n: cycle.n,
+        grid_start: cycle.tau,
+        grid_step: cycle.step,
         arc_reach_s: reach as f64 / rate,
         u4: g_u4,
-        a4: g_a4,
-        g4: g_g4,
-        f4: g_f4,
-        f: g_f,
-        v8: g_v8,
-        f8: g_f8,
+        a4: cycle.on_grid(&a4),
+        g4: cycle.on_grid(&g4),
+        f4: cycle.on_grid(&filtered.f4),
+        f: cycle.on_grid(rec.force_n()),
+        v8: cycle.on_grid(&filtered.v8),
+        f8: cycle.on_grid(&filtered.f8),
         vu8: g_vu8,
         plateau_speed,
-        rec_u8: u8,
-        rec_v8: v8,
-        rec_v: v_raw,
-        rec_f8: f8,
+        rec_u8: filtered.u8,
+        rec_v8: filtered.v8,
+        rec_v: filtered.v_raw,
+        rec_f8: filtered.f8,
         rec_a8,
         rec_usable,
+        fir: filtered.fir,
     })
 }
 

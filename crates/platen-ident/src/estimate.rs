@@ -53,6 +53,15 @@ impl Estimate {
         let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (nf - 1.0);
         Some(Self::new(mean, (var / nf).sqrt(), nf - 1.0))
     }
+
+    /// Estimates pooled: none, the one, or the mean of their values ([`Estimate::mean_of`]).
+    pub(crate) fn pooled(estimates: &[Estimate]) -> Option<Self> {
+        match estimates {
+            [] => None,
+            [one] => Some(*one),
+            _ => Self::mean_of(&estimates.iter().map(|e| e.value).collect::<Vec<_>>()),
+        }
+    }
 }
 
 /// The status of one identified parameter in the final estimate.

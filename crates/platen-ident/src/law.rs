@@ -2,62 +2,30 @@
 //! weighted least-squares fit to `(|v|, F_D)` points.
 
 use nalgebra::{DMatrix, DVector};
+use platen_model::{DissipativeLaw, Exponent};
 
 use crate::lm::{self, covariance, LmSettings, Problem};
 
-/// The dissipative law of Eq. 22 (Eq. 21 is the case `a = 0`, `α = 0.5`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct DissipativeLaw {
-    /// Coulomb force `F_μ`, N.
-    pub coulomb_force_n: f64,
-    /// Viscous coefficient `Cₑ`, N/(m/s)^α.
-    pub viscous_coefficient: f64,
-    /// Viscous exponent `α`.
-    pub viscous_exponent: f64,
-    /// Low-velocity force `a`, N.
-    pub low_velocity_force_n: f64,
-    /// Low-velocity decay `b`, s/m.
-    pub low_velocity_decay_s_per_m: f64,
-}
-
-impl DissipativeLaw {
-    /// The magnitude `F_μ + Cₑ·w^α + a·e^(−b·w)` at speed `w ≥ 0`, N.
-    pub fn magnitude_n(&self, speed_m_s: f64) -> f64 {
-        self.coulomb_force_n
-            + self.viscous_coefficient * pow(speed_m_s, self.viscous_exponent)
-            + self.low_velocity_force_n * (-self.low_velocity_decay_s_per_m * speed_m_s).exp()
-    }
-
-    pub(crate) fn from_array(p: [f64; 5]) -> Self {
-        Self {
-            coulomb_force_n: p[0],
-            viscous_coefficient: p[1],
-            viscous_exponent: p[2],
-            low_velocity_force_n: p[3],
-            low_velocity_decay_s_per_m: p[4],
-        }
-    }
-
-    pub(crate) fn to_array(self) -> [f64; 5] {
-        [
-            self.coulomb_force_n,
-            self.viscous_coefficient,
-            self.viscous_exponent,
-            self.low_velocity_force_n,
-            self.low_velocity_decay_s_per_m,
-        ]
+/// The law from its parameters in the order of the index constants below.
+pub(crate) fn law_from(p: [f64; 5]) -> DissipativeLaw {
+    DissipativeLaw {
+        coulomb_force_n: p[COULOMB],
+        viscous_coefficient: p[VISCOUS],
+        exponent: Exponent::new(p[EXPONENT]),
+        low_velocity_force_n: p[LOW_FORCE],
+        low_velocity_decay_s_per_m: p[LOW_DECAY],
     }
 }
 
-/// `w^α` with `0^α = 0` for `α > 0` and `w^0 = 1`.
-fn pow(w: f64, alpha: f64) -> f64 {
-    if alpha == 0.0 {
-        1.0
-    } else if w <= 0.0 {
-        0.0
-    } else {
-        (alpha * w.ln()).exp()
-    }
+/// The law's parameters in the order of the index constants below.
+pub(crate) fn law_values(law: &DissipativeLaw) -> [f64; 5] {
+    let mut p = [0.0; 5];
+    p[COULOMB] = law.coulomb_force_n;
+    p[VISCOUS] = law.viscous_coefficient;
+    p[EXPONENT] = law.exponent.value();
+    p[LOW_FORCE] = law.low_velocity_force_n;
+    p[LOW_DECAY] = law.low_velocity_decay_s_per_m;
+    p
 }
 
 /// Index of each law parameter in the arrays of this module.
@@ -171,34 +139,19 @@ impl Problem for LawProblem<'_> {
         self.free.len()
     }
     fn residuals(&self, p: &[f64], r: &mut [f64]) {
-        let q = self.full(p);
+        let law = law_from(self.full(p));
         for (i, r) in r.iter_mut().enumerate() {
-            let v = self.pts.speed[i];
-            let va = if q[EXPONENT] == 0.0 {
-                1.0
-            } else {
-                (q[EXPONENT] * self.ln_v[i]).exp()
-            };
-            let d = q[COULOMB] + q[VISCOUS] * va + q[LOW_FORCE] * (-q[LOW_DECAY] * v).exp();
+            let d = law.magnitude_from_ln_n(self.pts.speed[i], self.ln_v[i]);
             *r = self.sqrt_w[i] * (d - self.pts.force[i]);
         }
     }
     fn jacobian(&self, p: &[f64], j: &mut DMatrix<f64>) {
-        let q = self.full(p);
+        let law = law_from(self.full(p));
         for i in 0..self.pts.len() {
-            let v = self.pts.speed[i];
-            let va = (q[EXPONENT] * self.ln_v[i]).exp();
-            let e = (-q[LOW_DECAY] * v).exp();
+            let grad = law.gradient(self.pts.speed[i], self.ln_v[i]);
             let sw = self.sqrt_w[i];
             for (k, &which) in self.free.iter().enumerate() {
-                j[(i, k)] = sw
-                    * match which {
-                        COULOMB => 1.0,
-                        VISCOUS => va,
-                        EXPONENT => q[VISCOUS] * va * self.ln_v[i],
-                        LOW_FORCE => e,
-                        _ => -q[LOW_FORCE] * v * e,
-                    };
+                j[(i, k)] = sw * grad[which];
             }
         }
     }
@@ -262,11 +215,10 @@ fn linear_start(
             q[which] = sol[c].max(0.0);
         }
     }
+    let law = law_from(q);
     let ssr = (0..pts.len())
         .map(|i| {
-            let d = q[COULOMB]
-                + q[VISCOUS] * (alpha * ln_v[i]).exp()
-                + q[LOW_FORCE] * (-b * pts.speed[i]).exp();
+            let d = law.magnitude_from_ln_n(pts.speed[i], ln_v[i]);
             pts.weight[i] * (d - pts.force[i]).powi(2)
         })
         .sum();
@@ -335,7 +287,7 @@ pub(crate) fn fit(
         singular[i] = cov.singular[k];
     }
     Some(LawFit {
-        law: DissipativeLaw::from_array(full),
+        law: law_from(full),
         std_errors,
         singular,
         free,
@@ -350,20 +302,9 @@ pub(crate) fn fit(
 mod tests {
     use super::*;
 
+    /// Eq. 22 at 13.8 MPa.
     fn paper() -> DissipativeLaw {
-        DissipativeLaw {
-            coulomb_force_n: 25.445e3,
-            viscous_coefficient: 44.58e3,
-            viscous_exponent: 0.5,
-            low_velocity_force_n: 12.04e3,
-            low_velocity_decay_s_per_m: 78.5,
-        }
-    }
-
-    #[test]
-    fn eq_22_at_one_metre_per_second_is_70_kn() {
-        assert!((paper().magnitude_n(1.0) - 70.025e3).abs() < 1.0);
-        assert!((paper().magnitude_n(0.0) - 37.485e3).abs() < 1.0);
+        platen_model::preset::lhpost_2008_identified(13.8e6).dissipative_law()
     }
 
     #[test]
@@ -375,11 +316,11 @@ mod tests {
             if v > 1.8 {
                 break;
             }
-            pts.push(v, law.magnitude_n(v), 1.0);
+            pts.push(v, law.smooth_magnitude_n(v), 1.0);
         }
         let fit = fit(&pts, [true; 5], [0.0; 5], 1.0).unwrap();
-        let got = fit.law.to_array();
-        let want = law.to_array();
+        let got = law_values(&fit.law);
+        let want = law_values(&law);
         for i in 0..5 {
             assert!(
                 (got[i] / want[i] - 1.0).abs() < 1e-6,
@@ -395,7 +336,7 @@ mod tests {
         let law = paper();
         let mut pts = LawPoints::default();
         for k in 0..100 {
-            pts.push(0.25, law.magnitude_n(0.25) + (k % 3) as f64, 1.0);
+            pts.push(0.25, law.smooth_magnitude_n(0.25) + (k % 3) as f64, 1.0);
         }
         let fit = fit(
             &pts,

@@ -28,7 +28,7 @@
 //!     record("T7", triangle_motion(0.375, 0.25, 0.8333, 512.0, 19.8).unwrap()),
 //!     record("T9", triangle_motion(0.4688, 0.75, 6.0, 512.0, 8.25).unwrap()),
 //! ];
-//! let id = identify(&tests, &Settings::default()).unwrap();
+//! let id = identify(&tests, &Settings::default().build().unwrap()).unwrap();
 //! let p = id.params().unwrap();
 //! assert!((p.effective_mass_kg / 144e3 - 1.0).abs() < 0.005);
 //! assert!((p.stiffness_n_per_m / 1.266e6 - 1.0).abs() < 0.005);
@@ -115,27 +115,38 @@
 #![warn(missing_docs)]
 
 mod cycle;
+mod dissipative;
+mod elastic;
 mod error;
 mod estimate;
 mod global;
+mod groups;
 mod identify;
+mod inertial;
 mod law;
 mod lm;
+mod paper_fit;
 mod record;
+mod regression;
 mod result;
 mod settings;
+pub mod summary;
+mod warning;
+mod work;
 
 pub use cycle::{CycleInfo, PLATEAU_TOLERANCE, TRIANGLE_PLATEAU_FRACTION};
+pub use dissipative::{LOW_SPEED_M_S, MIN_SPEED_SPREAD};
 pub use error::{IdentError, Result};
 pub use estimate::{student_t_975, Estimate, Parameter};
-pub use identify::{
-    identify, LOW_SPEED_M_S, MAX_MASS_RELATIVE_STD_ERROR, MAX_SINE_DISTORTION,
-    MIN_INERTIAL_TO_DISSIPATIVE, MIN_PLATEAU_FRACTION, MIN_SPEED_SPREAD,
-};
-pub use law::DissipativeLaw;
+pub use identify::identify;
+pub use inertial::{MAX_MASS_RELATIVE_STD_ERROR, MIN_INERTIAL_TO_DISSIPATIVE};
+pub use platen_model::{DissipativeLaw, IdentifiedKey};
 pub use record::{TestKind, TestRecord, MIN_SAMPLES};
 pub use result::{
-    Flag, GlobalFit, Identification, LawReport, PaperFit, PeakForce, PressureGroup, TestResult,
-    PARAMETER_NAMES,
+    GlobalFit, Identification, LawReport, PaperFit, ParameterEstimates, PeakForce, PressureGroup,
+    TestResult,
 };
-pub use settings::{Settings, VerticalLoad};
+pub use settings::{Settings, ValidSettings, VerticalLoad};
+pub use summary::IdentificationSummary;
+pub use warning::{Flag, LowVelocityOmission, StiffnessSource, ViscousLawProblem, Warning};
+pub use work::{MAX_SINE_DISTORTION, MIN_PLATEAU_FRACTION};

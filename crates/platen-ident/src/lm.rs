@@ -61,6 +61,86 @@ fn sum_sq(r: &[f64]) -> f64 {
     r.iter().map(|x| x * x).sum()
 }
 
+/// Projects `p` onto the box `lower ≤ p ≤ upper`.
+fn project(p: &mut [f64], lower: &[f64], upper: &[f64]) {
+    for ((x, lo), hi) in p.iter_mut().zip(lower).zip(upper) {
+        *x = x.clamp(*lo, *hi);
+    }
+}
+
+/// The state of a minimisation between iterations.
+struct Search<'a> {
+    p: Vec<f64>,
+    r: Vec<f64>,
+    trial: Vec<f64>,
+    trial_r: Vec<f64>,
+    cost: f64,
+    lambda: f64,
+    lower: &'a [f64],
+    upper: &'a [f64],
+}
+
+impl Search<'_> {
+    /// One outer iteration at the Jacobian `jac`: raises the damping until a step lowers the
+    /// cost, and takes it. Returns true when a stopping rule says the minimum is reached.
+    fn iterate<P: Problem>(
+        &mut self,
+        problem: &P,
+        jac: &DMatrix<f64>,
+        settings: &LmSettings,
+    ) -> bool {
+        let m = self.p.len();
+        let jtj = jac.tr_mul(jac);
+        let g = jac.tr_mul(&DVector::from_column_slice(&self.r));
+        let diag: Vec<f64> = (0..m)
+            .map(|i| jtj[(i, i)].max(1e-300 + 1e-12 * jtj.diagonal().max()))
+            .collect();
+        loop {
+            let mut a = jtj.clone();
+            for (i, d) in diag.iter().enumerate() {
+                a[(i, i)] += self.lambda * d;
+            }
+            let Some(chol) = a.cholesky() else {
+                self.lambda *= 10.0;
+                if self.lambda > 1e20 {
+                    return true;
+                }
+                continue;
+            };
+            let step = chol.solve(&(-&g));
+            for i in 0..m {
+                self.trial[i] = self.p[i] + step[i];
+            }
+            project(&mut self.trial, self.lower, self.upper);
+            problem.residuals(&self.trial, &mut self.trial_r);
+            let trial_cost = sum_sq(&self.trial_r);
+            if trial_cost.is_finite() && trial_cost <= self.cost {
+                return self.accept(trial_cost, &diag, settings);
+            }
+            self.lambda *= 10.0;
+            if self.lambda > 1e20 {
+                // No descent direction left: a (possibly constrained) minimum.
+                return true;
+            }
+        }
+    }
+
+    /// Takes the trial point; true if the step or the gain was below tolerance.
+    fn accept(&mut self, trial_cost: f64, diag: &[f64], settings: &LmSettings) -> bool {
+        let (p, trial) = (&self.p, &self.trial);
+        let small_step = (0..p.len()).all(|i| {
+            let scale = p[i].abs().max(1.0 / diag[i].sqrt().max(1e-300));
+            (trial[i] - p[i]).abs() <= settings.step_tolerance * scale
+        });
+        let small_gain = self.cost - trial_cost <= settings.cost_tolerance * self.cost;
+        std::mem::swap(&mut self.p, &mut self.trial);
+        std::mem::swap(&mut self.r, &mut self.trial_r);
+        self.cost = trial_cost;
+        self.lambda = (self.lambda * 0.1).max(1e-15);
+        small_step || small_gain || self.cost == 0.0
+    }
+}
+
 /// Minimises `problem` from `start`, keeping `lower ≤ p ≤ upper` by projecting every trial
 /// point onto the box.
 pub(crate) fn minimize<P: Problem>(
@@ -73,78 +153,35 @@ pub(crate) fn minimize<P: Problem>(
     let n = problem.residual_count();
     let m = problem.parameter_count();
     debug_assert_eq!(start.len(), m);
-    let project = |p: &mut [f64]| {
-        for ((x, lo), hi) in p.iter_mut().zip(lower).zip(upper) {
-            *x = x.clamp(*lo, *hi);
-        }
-    };
     let mut p = start.to_vec();
-    project(&mut p);
+    project(&mut p, lower, upper);
     let mut r = vec![0.0; n];
-    let mut trial_r = vec![0.0; n];
     problem.residuals(&p, &mut r);
-    let mut cost = sum_sq(&r);
+    let mut search = Search {
+        cost: sum_sq(&r),
+        p,
+        r,
+        trial: vec![0.0; m],
+        trial_r: vec![0.0; n],
+        lambda: 1e-3,
+        lower,
+        upper,
+    };
     let mut jac = DMatrix::zeros(n, m);
-    let mut lambda = 1e-3;
     let mut iterations = 0;
     let mut converged = false;
-    let mut trial = vec![0.0; m];
-    'outer: while iterations < settings.max_iterations {
+    while iterations < settings.max_iterations {
         iterations += 1;
-        problem.jacobian(&p, &mut jac);
-        let jtj = jac.tr_mul(&jac);
-        let g = jac.tr_mul(&DVector::from_column_slice(&r));
-        let diag: Vec<f64> = (0..m)
-            .map(|i| jtj[(i, i)].max(1e-300 + 1e-12 * jtj.diagonal().max()))
-            .collect();
-        loop {
-            let mut a = jtj.clone();
-            for (i, d) in diag.iter().enumerate() {
-                a[(i, i)] += lambda * d;
-            }
-            let Some(chol) = a.cholesky() else {
-                lambda *= 10.0;
-                if lambda > 1e20 {
-                    converged = true;
-                    break 'outer;
-                }
-                continue;
-            };
-            let step = chol.solve(&(-&g));
-            for i in 0..m {
-                trial[i] = p[i] + step[i];
-            }
-            project(&mut trial);
-            problem.residuals(&trial, &mut trial_r);
-            let trial_cost = sum_sq(&trial_r);
-            if trial_cost.is_finite() && trial_cost <= cost {
-                let small_step = (0..m).all(|i| {
-                    let scale = p[i].abs().max(1.0 / diag[i].sqrt().max(1e-300));
-                    (trial[i] - p[i]).abs() <= settings.step_tolerance * scale
-                });
-                let small_gain = cost - trial_cost <= settings.cost_tolerance * cost;
-                std::mem::swap(&mut p, &mut trial);
-                std::mem::swap(&mut r, &mut trial_r);
-                cost = trial_cost;
-                lambda = (lambda * 0.1).max(1e-15);
-                if small_step || small_gain || cost == 0.0 {
-                    converged = true;
-                    break 'outer;
-                }
-                break;
-            }
-            lambda *= 10.0;
-            if lambda > 1e20 {
-                // No descent direction left: a (possibly constrained) minimum.
-                converged = true;
-                break 'outer;
-            }
+        problem.jacobian(&search.p, &mut jac);
+        if search.iterate(problem, &jac, &settings) {
+            converged = true;
+            break;
         }
     }
-    problem.jacobian(&p, &mut jac);
+    problem.jacobian(&search.p, &mut jac);
     LmResult {
-        params: p,
-        ssr: cost,
+        params: search.p,
+        ssr: search.cost,
         jacobian: jac,
         iterations,
         converged,

@@ -1,95 +1,14 @@
 //! What identification returns: the final estimate, the per-test tables, the fits behind
 //! them, and the warnings.
 
-use platen_model::IdentifiedParams;
+use std::ops::Index;
+
+use platen_model::{DissipativeLaw, Exponent, IdentifiedKey, IdentifiedParams};
 
 use crate::cycle::CycleInfo;
 use crate::estimate::{Estimate, Parameter};
 use crate::record::TestKind;
-
-/// Why a test does not support an estimate, or what to know about it.
-#[derive(Debug, Clone, PartialEq)]
-#[non_exhaustive]
-pub enum Flag {
-    /// Sine test whose inertial force amplitude `Mₑ·max|ā|` is below a quarter of its
-    /// dissipative force (paper: S1–S3, "extremely small accelerations … not reliable"): not
-    /// used for the mass.
-    SmallInertialForce {
-        /// Inertial force amplitude over the dissipative force at peak velocity.
-        ratio: f64,
-    },
-    /// Sine test whose displacement is not sinusoidal (harmonic distortion above 5 %; paper:
-    /// S12, "the sinusoidal pulses are distorted"): not used for the mass.
-    Distorted {
-        /// Harmonic distortion of the displacement (harmonics 2–7 over the fundamental).
-        harmonic_distortion: f64,
-    },
-    /// Sine test whose mass estimate has a relative standard error above 10 %: not used.
-    ImpreciseMass {
-        /// Relative standard error.
-        relative_std_error: f64,
-    },
-    /// Triangle test with constant velocity over less than a quarter of its cycle (severely
-    /// rounded or distorted reversals): not used for the stiffness.
-    ShortPlateau {
-        /// Fraction of the cycle at constant velocity.
-        fraction: f64,
-    },
-    /// Only one full cycle in the record: the cycle analysed may not be in steady state.
-    SingleCycle,
-    /// The waveform given (manifest) differs from the one recognised from the data; the given
-    /// one is used.
-    KindMismatch {
-        /// The waveform the data look like.
-        detected: TestKind,
-    },
-}
-
-impl Flag {
-    /// A short machine-readable code (`small_inertial_force`, `distorted`, …).
-    pub fn code(&self) -> &'static str {
-        match self {
-            Flag::SmallInertialForce { .. } => "small_inertial_force",
-            Flag::Distorted { .. } => "distorted",
-            Flag::ImpreciseMass { .. } => "imprecise_mass",
-            Flag::ShortPlateau { .. } => "short_plateau",
-            Flag::SingleCycle => "single_cycle",
-            Flag::KindMismatch { .. } => "kind_mismatch",
-        }
-    }
-
-    /// A sentence saying what the flag means for this test.
-    pub fn message(&self) -> String {
-        match self {
-            Flag::SmallInertialForce { ratio } => format!(
-                "inertial force only {:.0} % of the dissipative force: mass not reliable, not used",
-                100.0 * ratio
-            ),
-            Flag::Distorted {
-                harmonic_distortion,
-            } => format!(
-                "displacement distorted ({:.1} % harmonics): mass not used",
-                100.0 * harmonic_distortion
-            ),
-            Flag::ImpreciseMass { relative_std_error } => format!(
-                "mass standard error {:.1} %: not used",
-                100.0 * relative_std_error
-            ),
-            Flag::ShortPlateau { fraction } => format!(
-                "constant velocity over only {:.0} % of the cycle: stiffness not used",
-                100.0 * fraction
-            ),
-            Flag::SingleCycle => {
-                "only one full cycle: steady state not verified (the paper uses the second-to-last)"
-                    .to_owned()
-            }
-            Flag::KindMismatch { detected } => format!(
-                "the data look like a {} test; the given waveform is used",
-                detected.name()
-            ),
-        }
-    }
-}
+use crate::warning::{Flag, StiffnessSource, Warning};
 
 /// The dissipative force at the peak velocity of a test (one point of the paper's Fig. 7).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -153,7 +72,7 @@ pub struct PressureGroup {
     /// sine tests at two or more frequencies when there is no triangle test.
     pub stiffness: Option<Estimate>,
     /// Where the stiffness comes from.
-    pub stiffness_source: &'static str,
+    pub stiffness_source: StiffnessSource,
     /// `F_μ` at this pressure with the rest of the dissipative law held at the reference
     /// pressure's (the instantaneous points of every test at this pressure).
     pub coulomb_force: Option<Estimate>,
@@ -201,9 +120,8 @@ pub struct LawReport {
 /// reversals), with `Kₑ` and `F_μ` per pressure.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GlobalFit {
-    /// The seven parameters at the reference pressure, in the order of
-    /// [`Identification::parameters`].
-    pub parameters: [Parameter; 7],
+    /// The seven parameters at the reference pressure.
+    pub parameters: ParameterEstimates,
     /// `(pressure, Kₑ, F_μ)` per pressure group.
     pub groups: Vec<(Option<f64>, Estimate, Estimate)>,
     /// RMS of the force residual, N.
@@ -218,27 +136,83 @@ pub struct GlobalFit {
     pub condition_number: f64,
 }
 
-/// The names of the seven identified parameters, as in the contract.
-pub const PARAMETER_NAMES: [&str; 7] = [
-    "effective_mass_kg",
-    "stiffness_n_per_m",
-    "coulomb_force_n",
-    "viscous_coefficient",
-    "viscous_exponent",
-    "low_velocity_force_n",
-    "low_velocity_decay_s_per_m",
-];
+/// The seven identified parameters by name, each with its status.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParameterEstimates {
+    /// `Mₑ`, kg.
+    pub effective_mass_kg: Parameter,
+    /// `Kₑ`, N/m.
+    pub stiffness_n_per_m: Parameter,
+    /// `F_μ`, N.
+    pub coulomb_force_n: Parameter,
+    /// `Cₑ`, N/(m/s)^α.
+    pub viscous_coefficient: Parameter,
+    /// `α`.
+    pub viscous_exponent: Parameter,
+    /// `a`, N.
+    pub low_velocity_force_n: Parameter,
+    /// `b`, s/m.
+    pub low_velocity_decay_s_per_m: Parameter,
+}
+
+impl ParameterEstimates {
+    /// The parameter of `key`.
+    pub fn get(&self, key: IdentifiedKey) -> &Parameter {
+        match key {
+            IdentifiedKey::EffectiveMass => &self.effective_mass_kg,
+            IdentifiedKey::Stiffness => &self.stiffness_n_per_m,
+            IdentifiedKey::CoulombForce => &self.coulomb_force_n,
+            IdentifiedKey::ViscousCoefficient => &self.viscous_coefficient,
+            IdentifiedKey::ViscousExponent => &self.viscous_exponent,
+            IdentifiedKey::LowVelocityForce => &self.low_velocity_force_n,
+            IdentifiedKey::LowVelocityDecay => &self.low_velocity_decay_s_per_m,
+        }
+    }
+
+    /// The seven `(key, parameter)` pairs in the contract's order.
+    pub fn iter(&self) -> impl Iterator<Item = (IdentifiedKey, &Parameter)> + '_ {
+        IdentifiedKey::ALL.into_iter().map(|k| (k, self.get(k)))
+    }
+
+    /// The identified model's parameters, if all seven have a value.
+    pub fn values(&self) -> Option<IdentifiedParams> {
+        let mut params = IdentifiedParams::from_fn(|_| 0.0);
+        for (key, p) in self.iter() {
+            params.set(key, p.value()?);
+        }
+        Some(params)
+    }
+
+    /// The dissipative law (`F_μ`, `Cₑ`, `α`, `a`, `b`), if each of its parameters has a
+    /// value.
+    pub fn law(&self) -> Option<DissipativeLaw> {
+        Some(DissipativeLaw {
+            coulomb_force_n: self.coulomb_force_n.value()?,
+            viscous_coefficient: self.viscous_coefficient.value()?,
+            exponent: Exponent::new(self.viscous_exponent.value()?),
+            low_velocity_force_n: self.low_velocity_force_n.value()?,
+            low_velocity_decay_s_per_m: self.low_velocity_decay_s_per_m.value()?,
+        })
+    }
+}
+
+impl Index<IdentifiedKey> for ParameterEstimates {
+    type Output = Parameter;
+
+    fn index(&self, key: IdentifiedKey) -> &Parameter {
+        self.get(key)
+    }
+}
 
 /// The result of [`crate::identify`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Identification {
     /// The hold-down pressure the final stiffness and Coulomb force belong to, Pa.
     pub reference_pressure_pa: Option<f64>,
-    /// The seven parameters (the final estimate), in the order of [`PARAMETER_NAMES`]:
-    /// `Mₑ` (mean of the reliable sine tests), `Kₑ` (mean of the triangle tests at the
-    /// reference pressure), and `F_μ`, `Cₑ`, `α`, `a`, `b` (the law fitted to the Eq. 20
-    /// points at the reference pressure).
-    pub parameters: [Parameter; 7],
+    /// The seven parameters (the final estimate): `Mₑ` (mean of the reliable sine tests),
+    /// `Kₑ` (mean of the triangle tests at the reference pressure), and `F_μ`, `Cₑ`, `α`,
+    /// `a`, `b` (the law fitted to the Eq. 20 points at the reference pressure).
+    pub parameters: ParameterEstimates,
     /// `μₑ = F_μ/F_z`: slope through the origin of the per-pressure `F_μ` against `F_z`
     /// (needs tests at known pressures).
     pub friction_coefficient: Option<Estimate>,
@@ -254,30 +228,12 @@ pub struct Identification {
     pub global: Option<GlobalFit>,
     /// Everything the user should know: parameters not identifiable, flagged tests, fits
     /// that disagree.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<Warning>,
 }
 
 impl Identification {
-    /// The seven parameters with their contract names.
-    pub fn parameters(&self) -> [(&'static str, &Parameter); 7] {
-        std::array::from_fn(|i| (PARAMETER_NAMES[i], &self.parameters[i]))
-    }
-
     /// The identified model's parameters, if all seven have a value.
     pub fn params(&self) -> Option<IdentifiedParams> {
-        let v: Vec<f64> = self
-            .parameters
-            .iter()
-            .filter_map(Parameter::value)
-            .collect();
-        (v.len() == 7).then(|| IdentifiedParams {
-            effective_mass_kg: v[0],
-            stiffness_n_per_m: v[1],
-            coulomb_force_n: v[2],
-            viscous_coefficient: v[3],
-            viscous_exponent: v[4],
-            low_velocity_force_n: v[5],
-            low_velocity_decay_s_per_m: v[6],
-        })
+        self.parameters.values()
     }
 }

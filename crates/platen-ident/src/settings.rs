@@ -1,5 +1,11 @@
 //! Settings of the identification, with the paper's choices as defaults.
 
+use std::ops::Deref;
+
+use platen_model::{
+    LHPOST_HOLD_DOWN_FORCE_AT_NOMINAL_N, LHPOST_NOMINAL_PRESSURE_PA, LHPOST_SUPPORTED_WEIGHT_N,
+};
+
 use crate::error::{IdentError, Result};
 
 /// The vertical force `F_z` on the bearings as a function of the hold-down pressure `p`:
@@ -18,12 +24,12 @@ pub struct VerticalLoad {
 impl VerticalLoad {
     /// The LHPOST (paper §1.4, §3.2, §3.4): `W = 1.613 MN`, `F_hd = 2 × 2085 kN` at
     /// 13.8 MPa, so `F_z` = 1.613, 3.698 and 5.783 MN at 0, 6.9 and 13.8 MPa, as in the
-    /// `lhpost-2008` preset of `platen-model`.
+    /// `lhpost-2008` preset of `platen-model`, whose constants these are.
     pub fn lhpost_2008() -> Self {
         Self {
-            supported_weight_n: 1.613e6,
-            hold_down_force_n: 2.0 * 2085e3,
-            nominal_pressure_pa: 13.8e6,
+            supported_weight_n: LHPOST_SUPPORTED_WEIGHT_N,
+            hold_down_force_n: LHPOST_HOLD_DOWN_FORCE_AT_NOMINAL_N,
+            nominal_pressure_pa: LHPOST_NOMINAL_PRESSURE_PA,
         }
     }
 
@@ -87,19 +93,55 @@ impl Default for Settings {
     }
 }
 
+/// Settings that have been checked ([`Settings::build`]): what [`crate::identify`] takes, so
+/// the physics never re-checks them. Read them through `Deref`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ValidSettings(Settings);
+
+impl Deref for ValidSettings {
+    type Target = Settings;
+
+    fn deref(&self) -> &Settings {
+        &self.0
+    }
+}
+
+impl Default for ValidSettings {
+    /// The paper's method ([`Settings::default`]), which is valid.
+    fn default() -> Self {
+        Self(Settings::default())
+    }
+}
+
+impl TryFrom<Settings> for ValidSettings {
+    type Error = IdentError;
+
+    fn try_from(settings: Settings) -> Result<Self> {
+        settings.check_filters()?;
+        settings.check_model()?;
+        Ok(Self(settings))
+    }
+}
+
+fn bad(name: &'static str, value: f64, expected: &'static str) -> Result<()> {
+    Err(IdentError::InvalidSetting {
+        name,
+        value,
+        expected,
+    })
+}
+
 impl Settings {
-    /// Checks every setting.
+    /// Checks every setting and returns them validated.
     ///
     /// # Errors
     /// [`IdentError::InvalidSetting`] naming the first bad one.
-    pub fn validate(&self) -> Result<()> {
-        let bad = |name, value, expected| {
-            Err(IdentError::InvalidSetting {
-                name,
-                value,
-                expected,
-            })
-        };
+    pub fn build(&self) -> Result<ValidSettings> {
+        ValidSettings::try_from(self.clone())
+    }
+
+    /// The filter and cycle settings.
+    fn check_filters(&self) -> Result<()> {
         if !(self.inertial_cutoff_factor.is_finite() && self.inertial_cutoff_factor >= 2.0) {
             return bad(
                 "inertial_cutoff_factor",
@@ -132,6 +174,11 @@ impl Settings {
         if !(self.crossover_hz.is_finite() && self.crossover_hz > 0.0) {
             return bad("crossover_hz", self.crossover_hz, "a frequency > 0 Hz");
         }
+        Ok(())
+    }
+
+    /// The settings of the model and its reference.
+    fn check_model(&self) -> Result<()> {
         if let Some(alpha) = self.viscous_exponent {
             if !(alpha.is_finite() && (0.0..=1.0).contains(&alpha)) {
                 return bad("viscous_exponent", alpha, "an exponent in [0, 1]");

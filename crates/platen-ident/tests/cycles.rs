@@ -5,7 +5,7 @@ mod common;
 
 use std::f64::consts::PI;
 
-use platen_ident::{identify, Flag, IdentError, Settings, TestKind, TestRecord};
+use platen_ident::{identify, Flag, IdentError, Settings, TestKind, TestRecord, ValidSettings};
 use platen_integrate::Motion;
 
 fn nominal() -> platen_model::IdentifiedParams {
@@ -41,7 +41,11 @@ fn the_period_and_the_aligned_second_to_last_cycle_are_found_in_any_sine() {
     let motion = sine(0.1, 0.013, 0.7, 1.1, 0.0, 512.0, 9.3);
     let rec = common::record_of_motion("s", &motion, &nominal(), 13.8e6, &Default::default(), 2);
     let tri = common::nominal_records(&["T7", "T8"], &Default::default(), 4);
-    let id = identify(&[rec, tri[0].clone(), tri[1].clone()], &Settings::default()).unwrap();
+    let id = identify(
+        &[rec, tri[0].clone(), tri[1].clone()],
+        &ValidSettings::default(),
+    )
+    .unwrap();
     let c = &id.tests[0].cycle;
     assert!((c.period_s * 0.7 - 1.0).abs() < 1e-4, "{}", c.period_s);
     assert!((c.offset_m - 0.013).abs() < 1e-4, "{}", c.offset_m);
@@ -68,7 +72,7 @@ fn a_distorted_sine_is_flagged_and_left_out_of_the_mass() {
     let bad = common::record_of_motion("bad", &motion, &nominal(), 13.8e6, &Default::default(), 2);
     let mut records = common::nominal_records(&["S7", "S9", "T7", "T8"], &Default::default(), 8);
     records.push(bad);
-    let id = identify(&records, &Settings::default()).unwrap();
+    let id = identify(&records, &ValidSettings::default()).unwrap();
     let t = id.tests.iter().find(|t| t.name == "bad").unwrap();
     assert!(
         t.flags.iter().any(
@@ -85,7 +89,7 @@ fn a_distorted_sine_is_flagged_and_left_out_of_the_mass() {
 fn a_given_waveform_that_disagrees_with_the_data_is_flagged() {
     let mut records = common::nominal_records(&["S7", "S9", "T7", "T8"], &Default::default(), 8);
     records[3] = records[3].clone().with_kind(TestKind::Sine);
-    let id = identify(&records, &Settings::default()).unwrap();
+    let id = identify(&records, &ValidSettings::default()).unwrap();
     assert_eq!(id.tests[3].kind, TestKind::Sine);
     assert!(id.tests[3].kind_given);
     assert!(id.tests[3].flags.contains(&Flag::KindMismatch {
@@ -124,7 +128,7 @@ fn records_at_1024_hz_and_records_without_velocity_give_the_same_parameters() {
         );
     }
     for records in [fast, no_v] {
-        let id = identify(&records, &Settings::default()).unwrap();
+        let id = identify(&records, &ValidSettings::default()).unwrap();
         let p = id.params().unwrap();
         assert!((p.effective_mass_kg / 144e3 - 1.0).abs() < 0.01, "{p:?}");
         assert!((p.stiffness_n_per_m / 1.266e6 - 1.0).abs() < 0.01, "{p:?}");
@@ -142,7 +146,7 @@ fn a_record_that_is_not_periodic_is_rejected_by_name() {
     // A ramp: the displacement never comes back.
     let u: Vec<f64> = (0..n).map(|i| i as f64 * 1e-4).collect();
     let rec = TestRecord::from_rate("ramp.csv", 512.0, u, vec![0.0; n], vec![0.0; n]).unwrap();
-    let err = identify(&[rec], &Settings::default()).unwrap_err();
+    let err = identify(&[rec], &ValidSettings::default()).unwrap_err();
     assert!(
         matches!(err, IdentError::NotPeriodic { ref test, .. } if test == "ramp.csv"),
         "{err}"
@@ -157,7 +161,7 @@ fn a_record_that_is_not_periodic_is_rejected_by_name() {
         })
         .collect();
     let rec = TestRecord::from_rate("chirp.csv", 512.0, u, vec![0.0; n], vec![0.0; n]).unwrap();
-    let err = identify(&[rec], &Settings::default()).unwrap_err();
+    let err = identify(&[rec], &ValidSettings::default()).unwrap_err();
     assert!(err.to_string().contains("irregular"), "{err}");
 }
 
@@ -166,7 +170,7 @@ fn a_record_shorter_than_its_period_has_no_full_cycle() {
     let motion = sine(0.05, 0.0, 0.5, 0.3, 0.0, 512.0, 1.9);
     let rec =
         common::record_of_motion("short", &motion, &nominal(), 13.8e6, &Default::default(), 1);
-    let err = identify(&[rec], &Settings::default()).unwrap_err();
+    let err = identify(&[rec], &ValidSettings::default()).unwrap_err();
     assert!(
         matches!(
             err,
@@ -191,7 +195,7 @@ fn bad_records_and_settings_are_rejected_with_what_is_wrong() {
     let err = TestRecord::new("x", &t, vec![0.0; 100], vec![0.0; 100], vec![0.0; 100]).unwrap_err();
     assert!(err.to_string().contains("time column"), "{err}");
     assert_eq!(
-        identify(&[], &Settings::default()).unwrap_err(),
+        identify(&[], &ValidSettings::default()).unwrap_err(),
         IdentError::NoTests
     );
     let bad = Settings {
@@ -199,7 +203,7 @@ fn bad_records_and_settings_are_rejected_with_what_is_wrong() {
         ..Settings::default()
     };
     assert!(matches!(
-        bad.validate(),
+        bad.build(),
         Err(IdentError::InvalidSetting {
             name: "viscous_exponent",
             ..

@@ -16,7 +16,7 @@ mod common;
 
 use std::sync::OnceLock;
 
-use platen_ident::{identify, Flag, Identification, Settings, TestKind};
+use platen_ident::{identify, Flag, Identification, IdentifiedKey, TestKind, ValidSettings};
 
 /// The whole program at the three pressures, identified once for every test of this file.
 fn program() -> &'static Identification {
@@ -30,7 +30,7 @@ fn program() -> &'static Identification {
                 1000 * k as u64 + 17,
             ));
         }
-        identify(&records, &Settings::default()).unwrap()
+        identify(&records, &ValidSettings::default()).unwrap()
     })
 }
 
@@ -74,7 +74,7 @@ fn stiffness_per_triangle_test_lies_within_table_i_and_the_mean_within_1_percent
     assert_eq!(ks.len(), 12);
     let mean = ks.iter().sum::<f64>() / 12.0;
     assert!((mean / 1.266e6 - 1.0).abs() < 0.01, "mean Kₑ = {mean}");
-    let k = id.parameters[1].value().unwrap();
+    let k = id.parameters[IdentifiedKey::Stiffness].value().unwrap();
     assert!((k / 1.266e6 - 1.0).abs() < 0.01, "final Kₑ = {k}");
     assert_eq!(id.reference_pressure_pa, Some(13.8e6));
 }
@@ -118,7 +118,9 @@ fn mass_per_sine_test_is_within_2_percent_of_144_t_and_s1_to_s3_are_flagged() {
             );
         }
     }
-    let m = id.parameters[0].estimate().unwrap();
+    let m = id.parameters[IdentifiedKey::EffectiveMass]
+        .estimate()
+        .unwrap();
     assert!(
         (m.value / 144e3 - 1.0).abs() < 0.01,
         "final Mₑ = {}",
@@ -166,12 +168,18 @@ fn the_friction_coefficient_from_the_three_pressures_is_within_10_percent_of_0_4
 #[test]
 fn the_full_dissipative_law_is_close_to_eq_22() {
     let p = &program().parameters;
-    let rel = |i: usize, want: f64| (p[i].value().unwrap() / want - 1.0).abs();
-    assert!(rel(2, 25.445e3) < 0.02, "F_μ = {:?}", p[2]);
-    assert!(rel(3, 44.58e3) < 0.02, "Cₑ = {:?}", p[3]);
-    assert!((p[4].value().unwrap() - 0.5).abs() < 0.01, "α = {:?}", p[4]);
-    assert!(rel(5, 12.04e3) < 0.05, "a = {:?}", p[5]);
-    assert!(rel(6, 78.5) < 0.05, "b = {:?}", p[6]);
+    // (parameter, Eq. 22's value, relative tolerance)
+    for (key, want, tol) in [
+        (IdentifiedKey::CoulombForce, 25.445e3, 0.02),
+        (IdentifiedKey::ViscousCoefficient, 44.58e3, 0.02),
+        (IdentifiedKey::LowVelocityForce, 12.04e3, 0.05),
+        (IdentifiedKey::LowVelocityDecay, 78.5, 0.05),
+    ] {
+        let got = p[key].value().unwrap();
+        assert!((got / want - 1.0).abs() < tol, "{key} = {:?}", p[key]);
+    }
+    let alpha = p[IdentifiedKey::ViscousExponent].value().unwrap();
+    assert!((alpha - 0.5).abs() < 0.01, "α = {alpha}");
 }
 
 /// The global fit of Eq. 23 agrees with the hysteresis-loop estimate.
@@ -180,11 +188,13 @@ fn the_global_fit_agrees_with_the_hysteresis_loop_estimate() {
     let id = program();
     let g = id.global.as_ref().expect("global fit");
     assert!(g.converged);
-    let m = g.parameters[0].value().unwrap();
-    let k = g.parameters[1].value().unwrap();
+    let m = g.parameters[IdentifiedKey::EffectiveMass].value().unwrap();
+    let k = g.parameters[IdentifiedKey::Stiffness].value().unwrap();
     assert!((m / 144e3 - 1.0).abs() < 0.01, "{m}");
     assert!((k / 1.266e6 - 1.0).abs() < 0.01, "{k}");
-    let c = g.parameters[3].value().unwrap();
+    let c = g.parameters[IdentifiedKey::ViscousCoefficient]
+        .value()
+        .unwrap();
     assert!((c / 44.58e3 - 1.0).abs() < 0.05, "{c}");
     assert_eq!(g.groups.len(), 3);
 }

@@ -18,7 +18,7 @@
 //! Do not use it to simulate anything: with `sign(v)` friction it is off by ~4e-4 m on the
 //! paper's reference record and never sits still (see the crate's stick-slip tests).
 
-use platen_model::IdentifiedParams;
+use platen_model::{DissipativeLaw, Exponent, IdentifiedParams};
 
 use crate::rk4::State;
 
@@ -36,15 +36,15 @@ pub fn baseline_rk4(
     initial: State,
 ) -> State {
     let k = params.stiffness_n_per_m;
-    let fmu = params.coulomb_force_n;
-    let c = params.viscous_coefficient;
-    let a = params.low_velocity_force_n;
-    let b = params.low_velocity_decay_s_per_m;
+    let law = DissipativeLaw {
+        exponent: Exponent::Half,
+        ..params.dissipative_law()
+    };
     let inv_m = 1.0 / params.effective_mass_kg;
     let h = dt_s;
     let acc = |f: f64, u: f64, v: f64| {
         let w = v.abs();
-        (f - k * u - (fmu + c * w.sqrt() + a * (-b * w).exp()).copysign(v)) * inv_m
+        (f - k * u - law.magnitude_n(w).copysign(v)) * inv_m
     };
     let (mut u, mut v) = (initial.u_m, initial.v_m_s);
     for pair in force_n.windows(2) {

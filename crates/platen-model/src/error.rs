@@ -22,6 +22,16 @@ pub enum ModelError {
         /// The preset names that exist, comma separated.
         known: &'static str,
     },
+    /// A parameter name that the form does not have.
+    #[error("unknown {form} parameter; expected one of {known}")]
+    UnknownParameter {
+        /// The form of the model (`"identified"` or `"full"`).
+        form: &'static str,
+        /// The name that was asked for.
+        name: String,
+        /// The names that exist, comma separated.
+        known: String,
+    },
 }
 
 /// Result alias of this crate.

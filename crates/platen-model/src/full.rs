@@ -1,7 +1,7 @@
 //! The full Lagrangian model of the paper (Eq. 1–8), built from physical parameters.
 
 use crate::error::{finite, non_negative, positive, unit_exponent, ModelError, Result};
-use crate::{Exponent, PlatenModel};
+use crate::{DissipativeLaw, Exponent, PlatenModel};
 
 /// Physical parameters of a platen with two inclined nitrogen hold-down struts (paper §2).
 ///
@@ -206,7 +206,7 @@ pub struct FullModel {
     derived: DerivedQuantities,
     inv_h: f64,
     two_mp: f64,
-    alpha: Exponent,
+    law: DissipativeLaw,
     beta: Exponent,
     two_c_beta: f64,
     hinge_force_n: f64,
@@ -225,7 +225,13 @@ impl FullModel {
             derived,
             inv_h: 1.0 / params.strut_height_m,
             two_mp: 2.0 * derived.strut_rotational_mass_kg,
-            alpha: Exponent::new(params.viscous_exponent),
+            law: DissipativeLaw {
+                coulomb_force_n: derived.coulomb_force_n,
+                viscous_coefficient: params.viscous_coefficient,
+                exponent: Exponent::new(params.viscous_exponent),
+                low_velocity_force_n: params.low_velocity_force_n,
+                low_velocity_decay_s_per_m: params.low_velocity_decay_s_per_m,
+            },
             beta: Exponent::new(params.strut_viscous_exponent),
             two_c_beta: 2.0 * params.strut_viscous_coefficient,
             hinge_force_n: derived.hinge_friction_coefficient * derived.hold_down_force_n,
@@ -240,6 +246,12 @@ impl FullModel {
     /// The derived quantities of Eq. 5–8.
     pub fn derived(&self) -> &DerivedQuantities {
         &self.derived
+    }
+
+    /// The dissipative law `F_μ + Cₑ|v|^α + a·e^(−b|v|)` of Eq. 4 (without the strut terms),
+    /// with `F_μ` from Eq. 7a.
+    pub fn law(&self) -> &DissipativeLaw {
+        &self.law
     }
 }
 
@@ -273,14 +285,10 @@ impl PlatenModel for FullModel {
 
     #[inline(always)]
     fn dissipative_magnitude_n(&self, u_m: f64, speed_m_s: f64) -> f64 {
-        let p = &self.params;
         let r = (u_m * self.inv_h).abs();
         // |u/h|^(1+β)·|v|^β = |u/h|·(|u/h|·|v|)^β: one power instead of two.
         let strut = self.two_c_beta * r * self.beta.pow(r * speed_m_s);
-        self.derived.coulomb_force_n
-            + p.viscous_coefficient * self.alpha.pow(speed_m_s)
-            + p.low_velocity_force_n * (-p.low_velocity_decay_s_per_m * speed_m_s).exp()
-            + strut
-            + self.hinge_force_n * r * r
+        // (F_μ + Cₑw^α + a·e^(−bw)) + strut + hinge, in this order.
+        self.law.magnitude_n(speed_m_s) + strut + self.hinge_force_n * r * r
     }
 }

@@ -1,7 +1,7 @@
 //! The identified model of the paper (Eq. 22/23).
 
 use crate::error::{non_negative, positive, unit_exponent, Result};
-use crate::{Exponent, PlatenModel, SlipRates};
+use crate::{DissipativeLaw, Exponent, PlatenModel, SlipRates};
 
 /// The seven parameters of the identified model (Eq. 22/23), named as in the contract.
 ///
@@ -34,6 +34,18 @@ impl IdentifiedParams {
     pub fn build(&self) -> Result<IdentifiedModel> {
         IdentifiedModel::new(*self)
     }
+
+    /// The dissipative law `F_μ + Cₑ|v|^α + a·e^(−b|v|)` of these parameters (the exponent
+    /// is not validated here: [`IdentifiedParams::build`] does that).
+    pub fn dissipative_law(&self) -> DissipativeLaw {
+        DissipativeLaw {
+            coulomb_force_n: self.coulomb_force_n,
+            viscous_coefficient: self.viscous_coefficient,
+            exponent: Exponent::new(self.viscous_exponent),
+            low_velocity_force_n: self.low_velocity_force_n,
+            low_velocity_decay_s_per_m: self.low_velocity_decay_s_per_m,
+        }
+    }
 }
 
 /// The identified model of Eq. 22/23, validated and ready to evaluate.
@@ -41,7 +53,7 @@ impl IdentifiedParams {
 pub struct IdentifiedModel {
     params: IdentifiedParams,
     inv_mass: f64,
-    exponent: Exponent,
+    law: DissipativeLaw,
 }
 
 impl IdentifiedModel {
@@ -64,13 +76,18 @@ impl IdentifiedModel {
         Ok(Self {
             params,
             inv_mass: 1.0 / params.effective_mass_kg,
-            exponent: Exponent::new(params.viscous_exponent),
+            law: params.dissipative_law(),
         })
     }
 
     /// The parameters this model was built from.
     pub fn params(&self) -> &IdentifiedParams {
         &self.params
+    }
+
+    /// The model's dissipative law.
+    pub fn law(&self) -> &DissipativeLaw {
+        &self.law
     }
 }
 
@@ -92,10 +109,7 @@ impl PlatenModel for IdentifiedModel {
 
     #[inline(always)]
     fn dissipative_magnitude_n(&self, _u_m: f64, speed_m_s: f64) -> f64 {
-        let p = &self.params;
-        p.coulomb_force_n
-            + p.viscous_coefficient * self.exponent.pow(speed_m_s)
-            + p.low_velocity_force_n * (-p.low_velocity_decay_s_per_m * speed_m_s).exp()
+        self.law.magnitude_n(speed_m_s)
     }
 
     #[inline(always)]

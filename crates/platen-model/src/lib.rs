@@ -40,14 +40,21 @@
 mod error;
 mod full;
 mod identified;
+mod keys;
+mod law;
 mod power;
 pub mod preset;
 
 pub use error::{ModelError, Result};
 pub use full::{DerivedQuantities, FullModel, PhysicalParams};
 pub use identified::{IdentifiedModel, IdentifiedParams};
+pub use keys::{IdentifiedKey, IDENTIFIED_KEY_NAMES};
+pub use law::DissipativeLaw;
 pub use power::Exponent;
-pub use preset::{Preset, TableLimits};
+pub use preset::{
+    Preset, TableLimits, LHPOST_HOLD_DOWN_FORCE_AT_NOMINAL_N, LHPOST_NOMINAL_PRESSURE_PA,
+    LHPOST_SUPPORTED_WEIGHT_N,
+};
 
 /// Standard gravity, m/s² (used only to express accelerations in g).
 pub const STANDARD_GRAVITY_M_S2: f64 = 9.806_65;

@@ -51,4 +51,31 @@ impl Exponent {
             Exponent::General(a) => w.powf(a),
         }
     }
+
+    /// `w^α` for `w ≥ 0` evaluated as `e^(α·ln w)` whatever `α` is (`w^0 = 1`, `0^α = 0`
+    /// for `α > 0`): smooth in `α`, for fitting the exponent. Agrees with
+    /// [`Exponent::pow`] to rounding.
+    #[inline]
+    pub fn pow_smooth(self, w: f64) -> f64 {
+        let alpha = self.value();
+        if alpha == 0.0 {
+            1.0
+        } else if w <= 0.0 {
+            0.0
+        } else {
+            (alpha * w.ln()).exp()
+        }
+    }
+
+    /// `w^α` for `w > 0` given `ln w`, as `e^(α·ln w)` (`w^0 = 1`): see
+    /// [`Exponent::pow_smooth`].
+    #[inline]
+    pub fn pow_from_ln(self, ln_w: f64) -> f64 {
+        let alpha = self.value();
+        if alpha == 0.0 {
+            1.0
+        } else {
+            (alpha * ln_w).exp()
+        }
+    }
 }

@@ -52,10 +52,14 @@ use crate::{IdentifiedParams, PhysicalParams, STANDARD_GRAVITY_M_S2};
 pub const LHPOST_NOMINAL_PRESSURE_PA: f64 = 13.8e6;
 
 /// Measured hold-down force per strut at the nominal pressure, N (paper §1.4).
-const LHPOST_STRUT_FORCE_AT_NOMINAL_N: f64 = 2085e3;
+pub const LHPOST_STRUT_FORCE_AT_NOMINAL_N: f64 = 2085e3;
+
+/// Total measured hold-down force of the two struts at the nominal pressure, N
+/// (`2 × 2085 kN`, paper §1.4).
+pub const LHPOST_HOLD_DOWN_FORCE_AT_NOMINAL_N: f64 = 2.0 * LHPOST_STRUT_FORCE_AT_NOMINAL_N;
 
 /// Weight carried by the vertical bearings with unpressurised struts, N (paper §3.2).
-const LHPOST_SUPPORTED_WEIGHT_N: f64 = 1.613e6;
+pub const LHPOST_SUPPORTED_WEIGHT_N: f64 = 1.613e6;
 
 /// Operational limits of a table, used to flag exceedances.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -157,8 +161,7 @@ pub fn lhpost_2008_limits() -> TableLimits {
 /// The pressure is not validated here; use [`Preset::identified`] for that.
 pub fn lhpost_2008_identified(pressure_pa: f64) -> IdentifiedParams {
     let scale = pressure_pa / LHPOST_NOMINAL_PRESSURE_PA;
-    let vertical_force_n =
-        LHPOST_SUPPORTED_WEIGHT_N + 2.0 * LHPOST_STRUT_FORCE_AT_NOMINAL_N * scale;
+    let vertical_force_n = LHPOST_SUPPORTED_WEIGHT_N + LHPOST_HOLD_DOWN_FORCE_AT_NOMINAL_N * scale;
     IdentifiedParams {
         effective_mass_kg: 144e3,
         stiffness_n_per_m: 1.266e6 * scale,
