@@ -20,7 +20,7 @@
 
 use platen_model::IdentifiedParams;
 
-use crate::rk4::State;
+use crate::run::State;
 
 /// Runs the plain RK4 loop on the identified model with parameters `params` (the exponent
 /// is taken as `α = 0.5` whatever `params.viscous_exponent` says: the loop is written for the
