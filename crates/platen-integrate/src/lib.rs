@@ -38,7 +38,6 @@
 
 #![warn(missing_docs)]
 
-pub mod baseline;
 mod dopri5;
 mod error;
 mod event;
