@@ -128,12 +128,7 @@ pub fn forward_dopri5<M: PlatenModel, S: SampleSink>(
         model,
         settings,
         e0,
-        y: Kin {
-            u: initial.u_m,
-            v: initial.v_m_s,
-            work: 0.0,
-            dissipated: 0.0,
-        },
+        y: Kin::start(initial),
         mode: Mode::Stick,
         h: 0.0,
         stats: RunStats::default(),

@@ -297,12 +297,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
         let mut s = Self {
             model,
             grid,
-            y: Kin {
-                u: initial.u_m,
-                v: initial.v_m_s,
-                work: 0.0,
-                dissipated: 0.0,
-            },
+            y: Kin::start(initial),
             mode: Mode::Stick,
             rates: AT_REST,
             stats: RunStats::default(),

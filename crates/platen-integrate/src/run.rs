@@ -157,6 +157,18 @@ pub(crate) struct Kin {
     pub dissipated: f64,
 }
 
+impl Kin {
+    /// The state at the start of a run: `initial`, nothing integrated yet.
+    pub(crate) fn start(initial: State) -> Self {
+        Self {
+            u: initial.u_m,
+            v: initial.v_m_s,
+            work: 0.0,
+            dissipated: 0.0,
+        }
+    }
+}
+
 /// The checks every forward run makes before it starts: the record holds the samples asked
 /// for, and the initial state is finite.
 pub(crate) fn check_run(record: &ForceRecord, initial: State, samples: usize) -> Result<()> {
