@@ -4,14 +4,22 @@ use platen_integrate::{
     forward_dopri5, forward_rk4, AdaptiveFailure, Dopri5Settings, Failure, ForceRecord,
     IntegrateError, Peaks, Rk4, State, StopReason,
 };
-use platen_model::preset;
+use platen_model::{preset, IdentifiedModel};
+
+/// The `lhpost-2008` identified model at 13.8 MPa, one RK4 step per sample and an empty sink.
+fn setup() -> (IdentifiedModel, Rk4, Peaks) {
+    let model = preset::lhpost_2008_identified(13.8e6).build().unwrap();
+    (
+        model,
+        Rk4::with_steps_per_sample(1).unwrap(),
+        Peaks::default(),
+    )
+}
 
 #[test]
 fn a_finished_run_says_so_with_the_time_of_its_last_sample() {
-    let model = preset::lhpost_2008_identified(13.8e6).build().unwrap();
+    let (model, rk4, mut peaks) = setup();
     let record = ForceRecord::from_rate(1024.0, vec![100e3; 1025]).unwrap();
-    let rk4 = Rk4::with_steps_per_sample(1).unwrap();
-    let mut peaks = Peaks::default();
     let stats = forward_rk4(&model, &record, rk4, State::default(), 513, &mut peaks).unwrap();
     assert_eq!(stats.stop, StopReason::Finished { t_s: 0.5 });
     let settings = Dopri5Settings::new(1e-6, 1e-9).unwrap();
@@ -30,10 +38,8 @@ fn a_finished_run_says_so_with_the_time_of_its_last_sample() {
 /// run fails with a non-finite state, and the error tells when.
 #[test]
 fn a_run_that_blows_up_reports_a_typed_non_finite_failure_with_its_time() {
-    let model = preset::lhpost_2008_identified(13.8e6).build().unwrap();
+    let (model, rk4, mut peaks) = setup();
     let record = ForceRecord::from_rate(1024.0, vec![1e308; 4097]).unwrap();
-    let rk4 = Rk4::with_steps_per_sample(1).unwrap();
-    let mut peaks = Peaks::default();
     let e = forward_rk4(&model, &record, rk4, State::default(), 4097, &mut peaks).unwrap_err();
     let Some(StopReason::Failed { t_s, cause }) = e.stop_reason() else {
         panic!("not a run failure: {e:?}");
