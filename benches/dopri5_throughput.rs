@@ -18,10 +18,10 @@ mod common;
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use platen::integrate::baseline::baseline_rk4;
 use platen::integrate::{forward_dopri5, Dopri5Settings, ForceRecord, Peaks, State};
 use platen::model::preset;
 
+use common::baseline::baseline_rk4;
 use common::{report_ratios, sine_force, timed, PRESSURE_PA, RATE_HZ};
 
 const SAMPLE_SIZE: usize = 10;

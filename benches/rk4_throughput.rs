@@ -1,6 +1,6 @@
 //! Step throughput of the forward RK4 with exact stick-slip, against the plain-loop baseline
-//! ([`platen::integrate::baseline::baseline_rk4`]) measured in the same run, and the ratio of
-//! the two medians.
+//! (`baseline_rk4` of `benches/common/baseline.rs`) measured in the same run, and the ratio
+//! of the two medians.
 //!
 //! Two records, each at 60 s and 600 s (`BenchmarkId` over the record length), sampled at
 //! 1024 Hz and stepped at 1/1024 s on the `lhpost-2008` preset at 13.8 MPa, from rest:
@@ -24,10 +24,10 @@ mod common;
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use platen::integrate::baseline::baseline_rk4;
 use platen::integrate::{forward_rk4, ForceRecord, Peaks, Rk4, State};
 use platen::model::preset;
 
+use common::baseline::baseline_rk4;
 use common::{report_ratios, sine_force, timed, PRESSURE_PA, RATE_HZ};
 
 const SAMPLE_SIZE: usize = 20;

@@ -9,6 +9,8 @@
 
 #![allow(dead_code)]
 
+pub mod baseline;
+
 use std::collections::BTreeMap;
 use std::hint::black_box;
 use std::sync::Mutex;

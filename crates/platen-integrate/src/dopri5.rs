@@ -17,6 +17,9 @@
 //! * in **stick**, the breakaway time is solved in closed form (the force is linear within
 //!   the segment), exactly as in the fixed-step RK4.
 //!
+//! The modes, the root finder, the stick decision and the breakaway are those of
+//! [`crate::event`], shared with the RK4.
+//!
 //! The state handed to Dopri5 is `(u, v, W/E₀, E_D/E₀)`: the actuator work and the dissipated
 //! energy ride along, scaled by `E₀ = M(0)·(1 m/s)²` so that their error weights match the
 //! motion's, which gives the energy balance of the run.
@@ -26,9 +29,13 @@ use ode_solvers::{Dopri5, Vector4};
 use platen_model::PlatenModel;
 
 use crate::error::{IntegrateError, Result};
+use crate::event::{
+    arrive_at_rest, breakaway, locate_zero_velocity, EventKind, Mode, StepStop, MAX_EVENTS_PER_STEP,
+};
 use crate::output::SampleSink;
 use crate::record::ForceRecord;
-use crate::rk4::{check_run, mode_at_rest, sample_at, EnergyBalance, Kin, Mode, RunStats, State};
+use crate::run::{check_run, sample_at, EnergyBalance, Kin, RunStats, State};
+use crate::stop::{AdaptiveFailure, Failure, StopReason};
 
 /// Settings of the adaptive integrator.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -121,25 +128,15 @@ pub fn forward_dopri5<M: PlatenModel, S: SampleSink>(
         model,
         settings,
         e0,
-        y: Kin {
-            u: initial.u_m,
-            v: initial.v_m_s,
-            work: 0.0,
-            dissipated: 0.0,
-        },
+        y: Kin::start(initial),
         mode: Mode::Stick,
         h: 0.0,
         stats: RunStats::default(),
     };
-    run.mode = if initial.v_m_s > 0.0 {
-        Mode::Slip(1.0)
-    } else if initial.v_m_s < 0.0 {
-        Mode::Slip(-1.0)
-    } else {
-        mode_at_rest(model, initial.u_m, force[0])
-    };
+    run.mode = Mode::initial(model, initial.u_m, initial.v_m_s, force[0]);
     run.stats.energy = EnergyBalance::start(model, initial.u_m, initial.v_m_s);
     if samples == 0 {
+        run.stats.stop = StopReason::Finished { t_s: times[0] };
         return Ok(run.stats);
     }
     sink.accept(&sample_at(
@@ -168,6 +165,9 @@ pub fn forward_dopri5<M: PlatenModel, S: SampleSink>(
         .energy
         .close(model, run.y.u, run.y.v, run.y.work, run.y.dissipated);
     run.stats.steps = run.stats.accepted_steps + run.stats.rejected_steps;
+    run.stats.stop = StopReason::Finished {
+        t_s: times[samples - 1],
+    };
     Ok(run.stats)
 }
 
@@ -182,9 +182,6 @@ struct AdaptiveRun<'a, M> {
     stats: RunStats,
 }
 
-/// Largest number of events tolerated within one sample interval.
-const MAX_EVENTS_PER_SEGMENT: u32 = 64;
-
 impl<M: PlatenModel> AdaptiveRun<'_, M> {
     fn acceleration(&mut self, f: f64) -> f64 {
         match self.mode {
@@ -192,7 +189,7 @@ impl<M: PlatenModel> AdaptiveRun<'_, M> {
             Mode::Slip(dir) => {
                 self.stats.rhs_evaluations += 1;
                 self.model
-                    .slip_acceleration_m_s2(f, self.y.u, self.y.v, dir)
+                    .slip_acceleration_m_s2(f, self.y.u, self.y.v, dir.sign())
             }
         }
     }
@@ -205,68 +202,85 @@ impl<M: PlatenModel> AdaptiveRun<'_, M> {
         let mut events = 0u32;
         while x < dt {
             events += 1;
-            if events > MAX_EVENTS_PER_SEGMENT {
-                return Err(IntegrateError::EventLoopStalled {
-                    t_s: t0 + x,
-                    events,
-                });
+            if events > MAX_EVENTS_PER_STEP {
+                let stalled = Failure::EventLoopStalled { events };
+                return Err(IntegrateError::failed(t0 + x, stalled));
             }
-            match self.mode {
-                Mode::Stick => {
-                    let elastic = self.model.elastic_force_n(self.y.u);
-                    let threshold = self.model.static_threshold_n(self.y.u);
-                    let net_end = f1 - elastic;
-                    if net_end.abs() <= threshold {
-                        self.stats.stick_time_s += dt - x;
-                        return Ok(());
-                    }
-                    let net_start = f0 + slope * x - elastic;
-                    let target = threshold.copysign(net_end);
-                    let frac = ((target - net_start) / (net_end - net_start)).clamp(0.0, 1.0);
-                    let xb = x + frac * (dt - x);
-                    self.stats.stick_time_s += xb - x;
-                    self.stats.breakaways += 1;
-                    x = xb;
-                    self.mode = Mode::Slip(1.0f64.copysign(net_end));
-                }
-                Mode::Slip(dir) => {
-                    let sys = SlipSystem {
-                        model: self.model,
-                        dir,
-                        f0,
-                        slope,
-                        inv_e0: 1.0 / self.e0,
-                        stop_on_crossing: true,
-                    };
-                    let (xs, ys, crossed) = self.integrate(sys, x, dt, self.h, t0)?;
-                    let n = xs.len();
-                    if !crossed {
-                        self.y = self.unpack(ys[n - 1]);
-                        self.check_finite(t0 + dt)?;
-                        return Ok(());
-                    }
-                    // The last accepted step [xs[n-2], xs[n-1]] crosses v = 0.
-                    let (xa, ya) = (xs[n - 2], ys[n - 2]);
-                    let (xb, yb) = (xs[n - 1], ys[n - 1]);
-                    let (xe, ye) = self.locate(dir, f0, slope, xa, ya, xb, yb, t0)?;
-                    x = xe;
-                    self.y = Kin {
-                        v: 0.0,
-                        ..self.unpack(ye)
-                    };
-                    self.check_finite(t0 + x)?;
-                    self.mode = mode_at_rest(self.model, self.y.u, f0 + slope * x);
-                    match self.mode {
-                        Mode::Stick => self.stats.stick_events += 1,
-                        Mode::Slip(_) => self.stats.reversals += 1,
-                    }
-                    if dt - x < 1e-12 * dt {
+            let stop = match self.mode {
+                Mode::Stick => self.stick(x, dt, f0, f1, slope),
+                Mode::Slip(direction) => self.slip(direction.sign(), x, dt, f0, slope, t0)?,
+            };
+            match stop {
+                StepStop::Step => return Ok(()),
+                StepStop::Event { at, kind } => {
+                    x = at;
+                    // A stop or reversal within rounding of the end ends the segment.
+                    if kind != EventKind::Breakaway && dt - x < 1e-12 * dt {
                         return Ok(());
                     }
                 }
             }
         }
         Ok(())
+    }
+
+    /// The stick part of [`AdaptiveRun::segment`] from local time `x`: friction holds to the
+    /// end of the segment, or the platen breaks away ([`breakaway`]) and slips.
+    fn stick(&mut self, x: f64, dt: f64, f0: f64, f1: f64, slope: f64) -> StepStop {
+        let Some(b) = breakaway(self.model, self.y.u, f0 + slope * x, f1) else {
+            self.stats.stick_time_s += dt - x;
+            return StepStop::Step;
+        };
+        let xb = x + b.fraction * (dt - x);
+        self.stats.stick_time_s += xb - x;
+        self.stats.record(EventKind::Breakaway);
+        self.mode = Mode::Slip(b.direction);
+        StepStop::Event {
+            at: xb,
+            kind: EventKind::Breakaway,
+        }
+    }
+
+    /// The slip part of [`AdaptiveRun::segment`] from local time `x`: Dopri5 to the end of the
+    /// segment, or to the located `v = 0` crossing, where the reset is applied.
+    /// `dir` is the direction of slip, `±1.0`.
+    fn slip(
+        &mut self,
+        dir: f64,
+        x: f64,
+        dt: f64,
+        f0: f64,
+        slope: f64,
+        t0: f64,
+    ) -> Result<StepStop> {
+        let sys = SlipSystem {
+            model: self.model,
+            dir,
+            f0,
+            slope,
+            inv_e0: 1.0 / self.e0,
+            stop_on_crossing: true,
+        };
+        let (xs, ys, crossed) = self.integrate(sys, x, dt, self.h, t0)?;
+        let n = xs.len();
+        if !crossed {
+            self.y = self.unpack(ys[n - 1]);
+            self.check_finite(t0 + dt)?;
+            return Ok(StepStop::Step);
+        }
+        // The last accepted step [xs[n-2], xs[n-1]] crosses v = 0.
+        let (xa, ya) = (xs[n - 2], ys[n - 2]);
+        let (xb, yb) = (xs[n - 1], ys[n - 1]);
+        let (xe, ye) = self.locate(dir, f0, slope, xa, ya, xb, yb, t0)?;
+        self.y = Kin {
+            v: 0.0,
+            ..self.unpack(ye)
+        };
+        self.check_finite(t0 + xe)?;
+        let kind;
+        (self.mode, kind) = arrive_at_rest(self.model, self.y.u, f0 + slope * xe);
+        self.stats.record(kind);
+        Ok(StepStop::Event { at: xe, kind })
     }
 
     fn unpack(&self, y: Vector4<f64>) -> Kin {
@@ -286,11 +300,11 @@ impl<M: PlatenModel> AdaptiveRun<'_, M> {
         if self.y.u.is_finite() && self.y.v.is_finite() {
             Ok(())
         } else {
-            Err(IntegrateError::NonFiniteState {
-                t_s,
+            let cause = Failure::NonFiniteState {
                 u_m: self.y.u,
                 v_m_s: self.y.v,
-            })
+            };
+            Err(IntegrateError::failed(t_s, cause))
         }
     }
 
@@ -345,15 +359,16 @@ impl<M: PlatenModel> AdaptiveRun<'_, M> {
         let stats = solver.integrate().map_err(|e| {
             let (x, reason) = match e {
                 IntegrationError::MaxNumStepReached { x, n_step } => {
-                    (x, format!("more than {n_step} steps needed"))
+                    (x, AdaptiveFailure::TooManySteps { steps: n_step })
                 }
-                IntegrationError::StepSizeUnderflow { x } => (x, "step size underflow".to_owned()),
-                IntegrationError::StiffnessDetected { x } => (x, "stiffness detected".to_owned()),
+                IntegrationError::StepSizeUnderflow { x } => {
+                    (x, AdaptiveFailure::StepSizeUnderflow)
+                }
+                IntegrationError::StiffnessDetected { x } => {
+                    (x, AdaptiveFailure::StiffnessDetected)
+                }
             };
-            IntegrateError::AdaptiveFailed {
-                t_s: t0 + x,
-                reason,
-            }
+            IntegrateError::failed(t0 + x, Failure::AdaptiveFailed(reason))
         })?;
         self.stats.rhs_evaluations += u64::from(stats.num_eval);
         self.stats.accepted_steps += u64::from(stats.accepted_steps);
@@ -377,8 +392,10 @@ impl<M: PlatenModel> AdaptiveRun<'_, M> {
         Ok((xs, ys, crossed))
     }
 
-    /// Locates the zero of `dir·v` inside the accepted step `[xa, xb]` by Illinois root
-    /// finding on the length of a Dopri5 integration from `(xa, ya)`.
+    /// Locates the zero of `dir·v` inside the accepted step `[xa, xb]` by
+    /// [`locate_zero_velocity`] on the length of a Dopri5 integration from `(xa, ya)`, with the
+    /// run's tolerances. Returns `(xa, ya)` if the platen started at rest and cannot move in
+    /// `dir` at all: it stays where it is.
     #[allow(clippy::too_many_arguments)]
     fn locate(
         &mut self,
@@ -392,64 +409,22 @@ impl<M: PlatenModel> AdaptiveRun<'_, M> {
         t0: f64,
     ) -> Result<(f64, Vector4<f64>)> {
         let inv_e0 = 1.0 / self.e0;
-        let trial = |run: &mut Self, len: f64| -> Result<Vector4<f64>> {
-            run.stats.root_iterations += 1;
+        let span = xb - xa;
+        let tolerance = 4.0 * f64::EPSILON * span.max(xb.abs());
+        let found = locate_zero_velocity(span, dir * ya[1], (yb, dir * yb[1]), tolerance, |len| {
+            self.stats.root_iterations += 1;
             let sys = SlipSystem {
-                model: run.model,
+                model: self.model,
                 dir,
                 f0,
                 slope,
                 inv_e0,
                 stop_on_crossing: false,
             };
-            let (_, ys, _) = run.integrate_from(sys, xa, ya, xa + len, len, t0)?;
-            Ok(ys[ys.len() - 1])
-        };
-        let span = xb - xa;
-        let (mut lo, mut g_lo) = (0.0, dir * ya[1]);
-        let (mut hi, mut y_hi, mut g_hi) = (span, yb, dir * yb[1]);
-        if g_lo <= 0.0 {
-            // The step started at rest: find a length at which the platen moves.
-            let mut len = 0.5 * span;
-            loop {
-                let y = trial(self, len)?;
-                if dir * y[1] > 0.0 {
-                    (lo, g_lo) = (len, dir * y[1]);
-                    break;
-                }
-                (hi, y_hi, g_hi) = (len, y, dir * y[1]);
-                len *= 0.5;
-                if len < 1e-15 * span {
-                    // It cannot move in `dir` at all: it stays where it is.
-                    return Ok((xa, ya));
-                }
-            }
-        }
-        let mut side = 0i8;
-        for _ in 0..100 {
-            if g_hi == 0.0 || hi - lo <= 4.0 * f64::EPSILON * span.max(xb.abs()) {
-                break;
-            }
-            let mut len = (lo * g_hi - hi * g_lo) / (g_hi - g_lo);
-            if !(len > lo && len < hi) {
-                len = 0.5 * (lo + hi);
-            }
-            let y = trial(self, len)?;
-            let g = dir * y[1];
-            if g > 0.0 {
-                (lo, g_lo) = (len, g);
-                if side == 1 {
-                    g_hi *= 0.5;
-                }
-                side = 1;
-            } else {
-                (hi, y_hi, g_hi) = (len, y, g);
-                if side == -1 {
-                    g_lo *= 0.5;
-                }
-                side = -1;
-            }
-        }
-        Ok((xa + hi, y_hi))
+            let (_, ys, _) = self.integrate_from(sys, xa, ya, xa + len, len, t0)?;
+            let y = ys[ys.len() - 1];
+            Ok((y, dir * y[1]))
+        })?;
+        Ok(found.map_or((xa, ya), |(len, y)| (xa + len, y)))
     }
 }

@@ -1,5 +1,7 @@
 //! Errors of the integrators.
 
+use crate::stop::{AdaptiveFailure, Failure, StopReason};
+
 /// Why a run could not be set up or did not finish.
 #[non_exhaustive]
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -114,7 +116,7 @@ pub enum IntegrateError {
         /// Time of the failure, s.
         t_s: f64,
         /// What ode_solvers reported.
-        reason: String,
+        reason: AdaptiveFailure,
     },
     /// The stick-slip event loop stopped advancing inside one step.
     #[error("numerical failure at t = {t_s} s: {events} stick-slip events inside one step; the event loop does not advance")]
@@ -124,6 +126,40 @@ pub enum IntegrateError {
         /// Events handled inside the step.
         events: u32,
     },
+}
+
+impl IntegrateError {
+    /// The error of a run stopped at `t_s` by a numerical failure `cause`.
+    pub fn failed(t_s: f64, cause: Failure) -> Self {
+        match cause {
+            Failure::NonFiniteState { u_m, v_m_s } => {
+                IntegrateError::NonFiniteState { t_s, u_m, v_m_s }
+            }
+            Failure::EventLoopStalled { events } => {
+                IntegrateError::EventLoopStalled { t_s, events }
+            }
+            Failure::AdaptiveFailed(reason) => IntegrateError::AdaptiveFailed { t_s, reason },
+        }
+    }
+
+    /// Why the run stopped, for an error that stopped a run under way
+    /// ([`StopReason::Failed`] with the time and the typed cause of the numerical failure);
+    /// `None` for an error that prevented a run from starting (a bad record or setting).
+    pub fn stop_reason(&self) -> Option<StopReason> {
+        let (t_s, cause) = match *self {
+            IntegrateError::NonFiniteState { t_s, u_m, v_m_s } => {
+                (t_s, Failure::NonFiniteState { u_m, v_m_s })
+            }
+            IntegrateError::EventLoopStalled { t_s, events } => {
+                (t_s, Failure::EventLoopStalled { events })
+            }
+            IntegrateError::AdaptiveFailed { t_s, reason } => {
+                (t_s, Failure::AdaptiveFailed(reason))
+            }
+            _ => return None,
+        };
+        Some(StopReason::Failed { t_s, cause })
+    }
 }
 
 /// Result alias of this crate.

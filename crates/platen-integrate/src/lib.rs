@@ -3,7 +3,15 @@
 //! * [`forward_rk4`]: a recorded or generated actuator force → displacement, velocity,
 //!   acceleration and the force decomposition, with fixed-step RK4 and exact stick-slip
 //!   (modes slip+, slip−, stick; `v = 0` located inside the step; breakaway solved exactly).
+//! * [`forward_dopri5`]: the same with the adaptive Dormand–Prince 5(4) of `ode_solvers`.
+//! * [`ForwardIntegrator`] and [`Method`]: one entry point for both, as a scenario selects it.
 //! * [`inverse`]: a prescribed motion → the actuator force it needs and its decomposition.
+//!
+//! Both forward integrators share one event module (the friction modes, the `v = 0` root
+//! finder, the stick decision and the exact breakaway; the [`EventKind`]s it counts in
+//! [`RunStats`]), and say why a run stopped with a [`StopReason`]: `Finished` in the
+//! [`RunStats`] of a run that returns, `Failed` with the time and the typed [`Failure`] from
+//! [`IntegrateError::stop_reason`] of one that does not.
 //!
 //! ```
 //! use platen_integrate::{forward_rk4, ForceRecord, Rk4, State, Trajectory};
@@ -23,21 +31,27 @@
 //! SI units; `u`, `v`, `a` positive along the actuator force. Output is delivered at the
 //! input record's own sample times, one sample per input sample. The force of a record is
 //! linear between samples. Friction at `v = 0` is set-valued and resolved exactly, never
-//! regularised.
+//! regularised. Time inside a fixed-step run comes from an integer step counter,
+//! `t = t₀ + n·h`, never from accumulated floats. A run never allocates per step; it
+//! allocates only what its [`SampleSink`] stores. Samples before a failure have already been
+//! delivered to the sink when the error returns.
 
 #![warn(missing_docs)]
 
-pub mod baseline;
 mod dopri5;
 mod error;
+mod event;
 mod inverse;
 mod method;
 mod output;
 mod record;
 mod rk4;
+mod run;
+mod stop;
 
 pub use dopri5::{forward_dopri5, Dopri5Settings};
 pub use error::{IntegrateError, Result};
+pub use event::EventKind;
 pub use inverse::inverse;
 pub use method::{ForwardIntegrator, Method};
 pub use output::{Exceedance, Peak, Peaks, Sample, SampleSink, Trajectory};
@@ -45,4 +59,6 @@ pub use record::{
     derivative, second_derivative, uniform_interval_s, ForceRecord, Motion,
     UNIFORM_RELATIVE_TOLERANCE,
 };
-pub use rk4::{forward_rk4, EnergyBalance, Rk4, RunStats, State};
+pub use rk4::{forward_rk4, Rk4};
+pub use run::{EnergyBalance, RunStats, State};
+pub use stop::{AdaptiveFailure, Failure, StopReason};

@@ -3,8 +3,12 @@
 
 use platen_model::PlatenModel;
 
-use crate::{forward_dopri5, forward_rk4, Dopri5Settings, ForceRecord, Result, Rk4};
-use crate::{RunStats, SampleSink, State};
+use crate::dopri5::{forward_dopri5, Dopri5Settings};
+use crate::error::Result;
+use crate::output::SampleSink;
+use crate::record::ForceRecord;
+use crate::rk4::{forward_rk4, Rk4};
+use crate::run::{RunStats, State};
 
 /// A forward integrator with exact stick-slip: a recorded force → the motion it produces.
 ///

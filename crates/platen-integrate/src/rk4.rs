@@ -7,7 +7,8 @@
 //! current step already done. The force is linear between samples, so it is linear inside
 //! every step and is evaluated from the two samples that bracket it, never from a float time.
 //!
-//! The platen is in one of three modes:
+//! The platen is in one of three modes (the events between them, and how they are located
+//! and decided, are those of [`crate::event`], shared with Dopri5):
 //!
 //! * **slip±**: the smooth right-hand side with the friction direction fixed is stepped with
 //!   RK4. If the step ends with the velocity on the other side of zero, the crossing is
@@ -21,19 +22,19 @@
 //!
 //! No allocation happens per step; a run allocates only what its [`SampleSink`] stores.
 
-use platen_model::{ForceTerms, PlatenModel, SlipRates};
+use std::convert::Infallible;
+
+use platen_model::{PlatenModel, SlipRates};
 
 use crate::error::{IntegrateError, Result};
+use crate::event::{
+    arrive_at_rest, breakaway, locate_zero_velocity, Direction, EventKind, Mode, StepStop,
+    MAX_EVENTS_PER_STEP,
+};
 use crate::output::{Sample, SampleSink};
 use crate::record::ForceRecord;
-
-/// Largest number of stick-slip events tolerated inside one step before the run is declared
-/// stalled. Physical events are separated by many steps; dozens in one step means the event
-/// loop is not advancing.
-const MAX_EVENTS_PER_STEP: u32 = 64;
-
-/// Iteration cap of the event root-finder (it converges in about ten).
-const MAX_ROOT_ITERATIONS: u32 = 100;
+use crate::run::{check_run, sample_at, EnergyBalance, Kin, RunStats, State};
+use crate::stop::{Failure, StopReason};
 
 /// Fixed-step RK4 settings: `k` steps per sample interval of the force record.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -87,126 +88,6 @@ impl Rk4 {
     }
 }
 
-/// The state of the platen.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct State {
-    /// Displacement, m.
-    pub u_m: f64,
-    /// Velocity, m/s.
-    pub v_m_s: f64,
-}
-
-/// Counters of a forward run.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct RunStats {
-    /// Integration steps attempted: grid steps of length `h` for the RK4, accepted plus
-    /// rejected steps for Dopri5 (root-finding trials are counted in `root_iterations`).
-    pub steps: u64,
-    /// Evaluations of the right-hand side.
-    pub rhs_evaluations: u64,
-    /// Slip → stick transitions (the platen came to rest and friction held it).
-    pub stick_events: u64,
-    /// Stick → slip transitions (breakaways).
-    pub breakaways: u64,
-    /// Direct reversals (velocity crossed zero and the net force exceeded the threshold).
-    pub reversals: u64,
-    /// Iterations spent locating `v = 0` crossings.
-    pub root_iterations: u64,
-    /// Total time spent stuck, s.
-    pub stick_time_s: f64,
-    /// Accepted steps of an adaptive integrator (equal to `steps` for the fixed-step RK4).
-    pub accepted_steps: u64,
-    /// Rejected steps of an adaptive integrator (0 for the fixed-step RK4).
-    pub rejected_steps: u64,
-    /// The energy balance of the run.
-    pub energy: EnergyBalance,
-}
-
-/// Energy balance of a forward run: the work done by the actuator equals the change of
-/// kinetic and elastic energy plus the energy dissipated. The work and the dissipated energy
-/// are integrated by the same stages as the motion, so the residual measures the integration
-/// error (it is not forced to zero by construction).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct EnergyBalance {
-    /// Work done by the actuator force, `∫F_A·v dt`, J.
-    pub actuator_work_j: f64,
-    /// Kinetic energy at the start, J.
-    pub kinetic_start_j: f64,
-    /// Kinetic energy at the end, `½M(u)v²`, J.
-    pub kinetic_end_j: f64,
-    /// Elastic energy at the start, J.
-    pub elastic_start_j: f64,
-    /// Elastic energy at the end, J.
-    pub elastic_end_j: f64,
-    /// Energy dissipated, `∫D·|v| dt`, J.
-    pub dissipated_j: f64,
-}
-
-impl EnergyBalance {
-    pub(crate) fn start<M: PlatenModel>(model: &M, u: f64, v: f64) -> Self {
-        let kinetic = model.kinetic_energy_j(u, v);
-        let elastic = model.elastic_energy_j(u);
-        Self {
-            kinetic_start_j: kinetic,
-            kinetic_end_j: kinetic,
-            elastic_start_j: elastic,
-            elastic_end_j: elastic,
-            ..Self::default()
-        }
-    }
-
-    pub(crate) fn close<M: PlatenModel>(
-        &mut self,
-        model: &M,
-        u: f64,
-        v: f64,
-        work: f64,
-        dissipated: f64,
-    ) {
-        self.actuator_work_j = work;
-        self.dissipated_j = dissipated;
-        self.kinetic_end_j = model.kinetic_energy_j(u, v);
-        self.elastic_end_j = model.elastic_energy_j(u);
-    }
-
-    /// `W − ΔE_kin − ΔE_el − E_diss`, J: zero for an exact solution.
-    pub fn residual_j(&self) -> f64 {
-        self.actuator_work_j
-            - (self.kinetic_end_j - self.kinetic_start_j)
-            - (self.elastic_end_j - self.elastic_start_j)
-            - self.dissipated_j
-    }
-
-    /// The residual relative to the largest energy flow of the run (actuator work or
-    /// dissipated energy), or 0 for a run in which nothing moved.
-    pub fn relative_residual(&self) -> f64 {
-        let scale = self
-            .actuator_work_j
-            .abs()
-            .max(self.dissipated_j)
-            .max(self.kinetic_start_j + self.elastic_start_j);
-        if scale > 0.0 {
-            self.residual_j() / scale
-        } else {
-            0.0
-        }
-    }
-}
-
-impl RunStats {
-    /// All located events: stops, breakaways and reversals.
-    pub fn events(&self) -> u64 {
-        self.stick_events + self.breakaways + self.reversals
-    }
-}
-
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum Mode {
-    Stick,
-    /// Slip with friction direction `+1.0` or `−1.0`.
-    Slip(f64),
-}
-
 /// Grid step `n` (from `t₀`), which is sub-step `i` of the sample interval that starts at
 /// sample `j` (`n = j·k + i`). Carried together so that the hot loop never divides.
 #[derive(Debug, Clone, Copy)]
@@ -243,19 +124,6 @@ impl Grid<'_> {
     fn time_s(&self, n: GridStep, tau: f64) -> f64 {
         self.t0 + (n.n as f64 + tau) * self.h
     }
-}
-
-/// The integrated state of a slipping platen: displacement, velocity, and the two energy
-/// integrals carried along with them (same RK4 stages, so the energy balance measures the
-/// integration error).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub(crate) struct Kin {
-    pub u: f64,
-    pub v: f64,
-    /// Work done by the actuator force, `∫F_A·v dt`, J.
-    pub work: f64,
-    /// Energy dissipated, `∫D·|v| dt`, J.
-    pub dissipated: f64,
 }
 
 /// The friction direction of slip as a number: `+1.0` for `POSITIVE`, `−1.0` otherwise.
@@ -336,7 +204,7 @@ pub fn forward_rk4<M: PlatenModel, S: SampleSink>(
     let mut stepper = Stepper::new(model, grid, initial);
     let times = record.t_s();
     if samples == 0 {
-        return Ok(stepper.finish());
+        return Ok(stepper.finish(times[0]));
     }
     sink.accept(&stepper.sample(0, times[0]));
     let mut n = 0u64;
@@ -347,25 +215,7 @@ pub fn forward_rk4<M: PlatenModel, S: SampleSink>(
         }
         sink.accept(&stepper.sample(j + 1, times[j + 1]));
     }
-    Ok(stepper.finish())
-}
-
-/// The checks every forward run makes before it starts: the record holds the samples asked
-/// for, and the initial state is finite.
-pub(crate) fn check_run(record: &ForceRecord, initial: State, samples: usize) -> Result<()> {
-    if samples > record.len() {
-        return Err(IntegrateError::RecordTooShort {
-            requested: samples,
-            available: record.len(),
-        });
-    }
-    if !(initial.u_m.is_finite() && initial.v_m_s.is_finite()) {
-        return Err(IntegrateError::InvalidInitialState {
-            u_m: initial.u_m,
-            v_m_s: initial.v_m_s,
-        });
-    }
-    Ok(())
+    Ok(stepper.finish(times[samples - 1]))
 }
 
 /// How a slip interval that touches `v = 0` is split into RK4 sub-steps.
@@ -447,24 +297,13 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
         let mut s = Self {
             model,
             grid,
-            y: Kin {
-                u: initial.u_m,
-                v: initial.v_m_s,
-                work: 0.0,
-                dissipated: 0.0,
-            },
+            y: Kin::start(initial),
             mode: Mode::Stick,
             rates: AT_REST,
             stats: RunStats::default(),
         };
         let f0 = s.grid.force[0];
-        s.mode = if s.y.v > 0.0 {
-            Mode::Slip(1.0)
-        } else if s.y.v < 0.0 {
-            Mode::Slip(-1.0)
-        } else {
-            mode_at_rest(model, s.y.u, f0)
-        };
+        s.mode = Mode::initial(model, s.y.u, s.y.v, f0);
         s.refresh_rates(f0);
         s.stats.energy = EnergyBalance::start(model, s.y.u, s.y.v);
         s
@@ -476,7 +315,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
             Mode::Stick => AT_REST,
             Mode::Slip(dir) => {
                 self.stats.rhs_evaluations += 1;
-                self.model.slip_rates(f, self.y.u, self.y.v, dir)
+                self.model.slip_rates(f, self.y.u, self.y.v, dir.sign())
             }
         };
     }
@@ -498,72 +337,68 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
     #[inline]
     fn step(&mut self, n: GridStep) -> Result<()> {
         self.stats.steps += 1;
-        let h = self.grid.h;
         let mut tau = 0.0;
         let mut events = 0u32;
         loop {
-            match self.mode {
-                Mode::Slip(dir) => {
-                    let committed = if dir > 0.0 {
-                        self.slip::<true>(n, &mut tau)?
-                    } else {
-                        self.slip::<false>(n, &mut tau)?
-                    };
-                    if committed {
-                        return Ok(());
-                    }
-                }
-                Mode::Stick => {
-                    let model = self.model;
-                    let elastic = model.elastic_force_n(self.y.u);
-                    let threshold = model.static_threshold_n(self.y.u);
-                    let net_end = self.grid.force(n, 1.0) - elastic;
-                    if net_end.abs() <= threshold {
-                        self.stats.stick_time_s += (1.0 - tau) * h;
-                        return Ok(());
-                    }
-                    // |net| is linear in τ: it crosses the threshold once inside [τ, 1].
-                    let net_start = self.grid.force(n, tau) - elastic;
-                    let target = threshold.copysign(net_end);
-                    let x = ((target - net_start) / (net_end - net_start)).clamp(0.0, 1.0);
-                    let tau_b = tau + x * (1.0 - tau);
-                    self.stats.stick_time_s += (tau_b - tau) * h;
-                    self.stats.breakaways += 1;
-                    tau = tau_b;
-                    self.mode = Mode::Slip(1.0f64.copysign(net_end));
-                    let f = self.grid.force(n, tau);
-                    self.refresh_rates(f);
-                }
+            let stop = match self.mode {
+                Mode::Slip(Direction::Positive) => self.slip::<true>(n, tau)?,
+                Mode::Slip(Direction::Negative) => self.slip::<false>(n, tau)?,
+                Mode::Stick => self.stick(n, tau),
+            };
+            match stop {
+                StepStop::Step => return Ok(()),
+                StepStop::Event { at, .. } => tau = at,
             }
             events += 1;
             if tau >= 1.0 {
                 return Ok(());
             }
             if events > MAX_EVENTS_PER_STEP {
-                return Err(IntegrateError::EventLoopStalled {
-                    t_s: self.grid.time_s(n, tau),
-                    events,
-                });
+                let stalled = Failure::EventLoopStalled { events };
+                return Err(IntegrateError::failed(self.grid.time_s(n, tau), stalled));
             }
         }
     }
 
+    /// The stick part of [`Stepper::step`], from fraction `tau` of step `n`: either friction
+    /// holds the platen to the end of the step, or it breaks away ([`breakaway`]) and the
+    /// mode becomes slip.
+    #[inline]
+    fn stick(&mut self, n: GridStep, tau: f64) -> StepStop {
+        let h = self.grid.h;
+        let (f_start, f_end) = (self.grid.force(n, tau), self.grid.force(n, 1.0));
+        let Some(b) = breakaway(self.model, self.y.u, f_start, f_end) else {
+            self.stats.stick_time_s += (1.0 - tau) * h;
+            return StepStop::Step;
+        };
+        let tau_b = tau + b.fraction * (1.0 - tau);
+        self.stats.stick_time_s += (tau_b - tau) * h;
+        self.stats.record(EventKind::Breakaway);
+        self.mode = Mode::Slip(b.direction);
+        let f = self.grid.force(n, tau_b);
+        self.refresh_rates(f);
+        StepStop::Event {
+            at: tau_b,
+            kind: EventKind::Breakaway,
+        }
+    }
+
     /// The slip part of [`Stepper::step`] in direction `direction::<POSITIVE>()`, from
-    /// fraction `tau` of step `n`: either completes the step (`Ok(true)`) or stops at the
-    /// located `v = 0` event with `tau` and the mode updated (`Ok(false)`).
+    /// fraction `tau` of step `n`: either completes the step ([`StepStop::Step`]) or stops at
+    /// the located `v = 0` event with the reset applied ([`StepStop::Event`] at the new `τ`).
     #[inline(always)]
-    fn slip<const POSITIVE: bool>(&mut self, n: GridStep, tau: &mut f64) -> Result<bool> {
+    fn slip<const POSITIVE: bool>(&mut self, n: GridStep, tau: f64) -> Result<StepStop> {
         let dir = direction::<POSITIVE>();
         let h = self.grid.h;
-        let rem = 1.0 - *tau;
+        let rem = 1.0 - tau;
         // Leaving v = 0 (after a breakaway or reversal) the √|v| law is singular:
         // grade the sub-steps towards the start.
         let from_rest = self.y.v == 0.0;
         let y1 = if from_rest {
-            self.advance::<POSITIVE>(n, *tau, rem, Grading::Start)
+            self.advance::<POSITIVE>(n, tau, rem, Grading::Start)
         } else {
-            let f_start = self.grid.force(n, *tau);
-            let f_mid = self.grid.force(n, *tau + 0.5 * rem);
+            let f_start = self.grid.force(n, tau);
+            let f_mid = self.grid.force(n, tau + 0.5 * rem);
             let f_end = self.grid.force(n, 1.0);
             self.stats.rhs_evaluations += 3;
             rk4_slip::<M, POSITIVE>(
@@ -577,11 +412,11 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
             )
         };
         if !(y1.u.is_finite() && y1.v.is_finite()) {
-            return Err(self.non_finite(n, *tau));
+            return Err(self.non_finite(n, tau));
         }
         if dir * y1.v > 0.0 {
             self.commit::<POSITIVE>(n, y1)?;
-            return Ok(true);
+            return Ok(StepStop::Step);
         }
         // v reaches zero inside the step. Arriving at v = 0 is singular too:
         // redo the remainder graded towards the end, then locate the crossing on
@@ -591,36 +426,34 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
         } else {
             Grading::End
         };
-        let y2 = self.advance::<POSITIVE>(n, *tau, rem, grading);
+        let y2 = self.advance::<POSITIVE>(n, tau, rem, grading);
         if dir * y2.v > 0.0 {
             self.commit::<POSITIVE>(n, y2)?;
-            return Ok(true);
+            return Ok(StepStop::Step);
         }
-        match self.locate_zero_velocity::<POSITIVE>(n, *tau, rem, y2, grading) {
-            Some((x, y_event)) => {
-                *tau += x;
-                if 1.0 - *tau < 1e-12 {
-                    *tau = 1.0;
-                }
-                self.y = Kin { v: 0.0, ..y_event };
-                let f = self.grid.force(n, *tau);
-                self.mode = mode_at_rest(self.model, self.y.u, f);
-                match self.mode {
-                    Mode::Stick => self.stats.stick_events += 1,
-                    Mode::Slip(_) => self.stats.reversals += 1,
-                }
-                self.refresh_rates(f);
-            }
-            None => {
-                // Started at v = 0 and no step length moves the platen in `dir`:
-                // friction holds it.
-                self.y.v = 0.0;
-                self.mode = Mode::Stick;
-                self.stats.stick_events += 1;
-                self.rates = AT_REST;
-            }
+        let Some((x, y_event)) = self.locate::<POSITIVE>(n, tau, rem, y2, grading) else {
+            // Started at v = 0 and no step length moves the platen in `dir`:
+            // friction holds it.
+            self.y.v = 0.0;
+            self.mode = Mode::Stick;
+            self.stats.record(EventKind::Stop);
+            self.rates = AT_REST;
+            return Ok(StepStop::Event {
+                at: tau,
+                kind: EventKind::Stop,
+            });
+        };
+        let mut at = tau + x;
+        if 1.0 - at < 1e-12 {
+            at = 1.0;
         }
-        Ok(false)
+        self.y = Kin { v: 0.0, ..y_event };
+        let f = self.grid.force(n, at);
+        let kind;
+        (self.mode, kind) = arrive_at_rest(self.model, self.y.u, f);
+        self.stats.record(kind);
+        self.refresh_rates(f);
+        Ok(StepStop::Event { at, kind })
     }
 
     /// Accepts the state at the end of step `n`.
@@ -667,19 +500,21 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
         y
     }
 
+    /// The error of a state found non-finite at fraction `tau` of step `n`.
     fn non_finite(&self, n: GridStep, tau: f64) -> IntegrateError {
-        IntegrateError::NonFiniteState {
-            t_s: self.grid.time_s(n, tau),
+        let cause = Failure::NonFiniteState {
             u_m: self.y.u,
             v_m_s: self.y.v,
-        }
+        };
+        IntegrateError::failed(self.grid.time_s(n, tau), cause)
     }
 
     /// Finds the step length `x ∈ (0, rem]` (fraction of `h`) at which the graded RK4
     /// velocity from the current state reaches zero, given that the full remainder ends at
-    /// `y_rem` with `dir·v ≤ 0`. Returns `x` and the state there (velocity not yet zeroed),
-    /// or `None` if the platen starts at rest and does not move in `dir` for any step length.
-    fn locate_zero_velocity<const POSITIVE: bool>(
+    /// `y_rem` with `dir·v ≤ 0` ([`locate_zero_velocity`] on the graded RK4 map). Returns `x`
+    /// and the state there (velocity not yet zeroed), or `None` if the platen starts at rest
+    /// and does not move in `dir` for any step length.
+    fn locate<const POSITIVE: bool>(
         &mut self,
         n: GridStep,
         tau: f64,
@@ -688,64 +523,20 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
         grading: Grading,
     ) -> Option<(f64, Kin)> {
         let dir = direction::<POSITIVE>();
-        let trial = |s: &mut Self, x: f64| {
-            s.stats.root_iterations += 1;
-            s.advance::<POSITIVE>(n, tau, x, grading)
-        };
         // g(x) = dir·v(x): positive before the crossing, ≤ 0 after it.
-        let (mut hi, mut y_hi) = (rem, y_rem);
-        let mut g_hi = dir * y_rem.v;
-        let mut lo = 0.0;
-        let mut g_lo = dir * self.y.v;
-        if g_lo <= 0.0 {
-            // Starting at rest (after a breakaway or reversal): find a length that moves.
-            let mut x = 0.5 * rem;
-            loop {
-                let y = trial(self, x);
-                if dir * y.v > 0.0 {
-                    lo = x;
-                    g_lo = dir * y.v;
-                    break;
-                }
-                (hi, y_hi, g_hi) = (x, y, dir * y.v);
-                x *= 0.5;
-                if x < 1e-15 * rem {
-                    return None;
-                }
-            }
-        }
-        // Illinois variant of regula falsi: bracketing, superlinear.
-        let mut side = 0i8;
-        for _ in 0..MAX_ROOT_ITERATIONS {
-            if g_hi == 0.0 || hi - lo <= 4.0 * f64::EPSILON * rem {
-                break;
-            }
-            let mut x = (lo * g_hi - hi * g_lo) / (g_hi - g_lo);
-            if !(x > lo && x < hi) {
-                x = 0.5 * (lo + hi);
-            }
-            let y = trial(self, x);
-            let g = dir * y.v;
-            if g > 0.0 {
-                lo = x;
-                g_lo = g;
-                if side == 1 {
-                    g_hi *= 0.5;
-                }
-                side = 1;
-            } else {
-                (hi, y_hi, g_hi) = (x, y, g);
-                if side == -1 {
-                    g_lo *= 0.5;
-                }
-                side = -1;
-            }
-        }
-        Some((hi, y_hi))
+        let g_start = dir * self.y.v;
+        let end = (y_rem, dir * y_rem.v);
+        let tolerance = 4.0 * f64::EPSILON * rem;
+        let Ok(found) = locate_zero_velocity(rem, g_start, end, tolerance, |x| {
+            self.stats.root_iterations += 1;
+            let y = self.advance::<POSITIVE>(n, tau, x, grading);
+            Ok::<_, Infallible>((y, dir * y.v))
+        });
+        found
     }
 
-    /// Closes the energy balance at the current state.
-    fn finish(&mut self) -> RunStats {
+    /// Closes the energy balance at the current state, the run having finished at `t_s`.
+    fn finish(&mut self, t_s: f64) -> RunStats {
         self.stats.energy.close(
             self.model,
             self.y.u,
@@ -754,48 +545,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
             self.y.dissipated,
         );
         self.stats.accepted_steps = self.stats.steps;
+        self.stats.stop = StopReason::Finished { t_s };
         self.stats
-    }
-}
-
-/// Mode of a platen at rest at `u` under actuator force `f`: stick inside the friction cone,
-/// otherwise slip towards the net force.
-#[inline]
-pub(crate) fn mode_at_rest<M: PlatenModel>(model: &M, u: f64, f: f64) -> Mode {
-    let net = f - model.elastic_force_n(u);
-    if net.abs() <= model.static_threshold_n(u) {
-        Mode::Stick
-    } else {
-        Mode::Slip(1.0f64.copysign(net))
-    }
-}
-
-/// An output sample from a state; F_D is the remainder of Eq. 1: the dissipative force in slip
-/// (to rounding), the static friction reaction in stick.
-#[inline]
-pub(crate) fn sample_at<M: PlatenModel>(
-    model: &M,
-    index: usize,
-    t_s: f64,
-    f: f64,
-    y: Kin,
-    a: f64,
-    stuck: bool,
-) -> Sample {
-    let inertial_n = model.mass_kg(y.u) * a + model.velocity_inertial_force_n(y.u, y.v);
-    let elastic_n = model.elastic_force_n(y.u);
-    Sample {
-        index,
-        t_s,
-        u_m: y.u,
-        v_m_s: y.v,
-        a_m_s2: a,
-        terms: ForceTerms {
-            inertial_n,
-            elastic_n,
-            dissipative_n: f - inertial_n - elastic_n,
-            actuator_n: f,
-        },
-        stuck,
     }
 }

@@ -1,5 +1,5 @@
-//! A plain-loop RK4 used as a **measuring stick** for the speed of [`crate::forward_rk4`]:
-//! not a physics integrator.
+//! A plain-loop RK4 used as a **measuring stick** for the speed of
+//! [`platen_integrate::forward_rk4`]: not a physics integrator, and not part of any library.
 //!
 //! [`baseline_rk4`] is the loop one would write for the purpose of timing the arithmetic of
 //! the identified model (Eq. 22/23) and nothing else: classical RK4 at the force record's
@@ -11,16 +11,19 @@
 //! latency of that chain on the machine, the limit that an integrator of the same model with
 //! exact stick-slip can approach but not beat.
 //!
-//! The criterion bench `benches/rk4_throughput.rs` and `platen bench` both time it in the same
-//! run as the real integrators and report their ratio to it; `benches/c/rk4_baseline.c` is the
-//! same loop in C.
+//! The criterion benches (`benches/rk4_throughput.rs`, `benches/dopri5_throughput.rs`, through
+//! `benches/common/mod.rs`) and `platen bench` (`crates/platen-cli/src/bench.rs`, through
+//! `#[path]`) all compile this one file, time it in the same run as the real integrators and
+//! report their ratio to it; `benches/c/rk4_baseline.c` is the same loop in C.
+//!
+//! Its test (that it computes the model it claims to) is in `crates/platen-cli/src/bench.rs`,
+//! where it runs as a unit test of the `platen` binary.
 //!
 //! Do not use it to simulate anything: with `sign(v)` friction it is off by ~4e-4 m on the
 //! paper's reference record and never sits still (see the crate's stick-slip tests).
 
+use platen_integrate::State;
 use platen_model::{DissipativeLaw, Exponent, IdentifiedParams};
-
-use crate::rk4::State;
 
 /// Runs the plain RK4 loop on the identified model with parameters `params` (the exponent
 /// is taken as `α = 0.5` whatever `params.viscous_exponent` says: the loop is written for the
@@ -61,39 +64,4 @@ pub fn baseline_rk4(
         v += h / 6.0 * (a1 + 2.0 * (a2 + a3) + a4);
     }
     State { u_m: u, v_m_s: v }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use platen_model::preset;
-
-    /// Under a force well above the friction threshold the platen slips in one direction
-    /// from the first step, so the plain loop (no stick logic) and the exact integrator take
-    /// the same path: the baseline computes the model it claims to.
-    #[test]
-    fn the_baseline_matches_the_exact_integrator_while_the_platen_slips_one_way() {
-        let params = preset::lhpost_2008_identified(13.8e6);
-        let force: Vec<f64> = vec![200e3; 257];
-        let end = baseline_rk4(&params, &force, 1.0 / 1024.0, State::default());
-        let model = params.build().unwrap();
-        let record = crate::ForceRecord::from_rate(1024.0, force).unwrap();
-        let mut out = crate::Trajectory::with_capacity(record.len());
-        let rk4 = crate::Rk4::with_steps_per_sample(1).unwrap();
-        crate::forward_rk4(
-            &model,
-            &record,
-            rk4,
-            State::default(),
-            record.len(),
-            &mut out,
-        )
-        .unwrap();
-        let (u, v) = (out.u_m[256], out.v_m_s[256]);
-        assert!(end.v_m_s > 0.2, "{end:?}");
-        // Only the first step differs: the exact run grades it towards the √|v| singularity
-        // at rest, the plain loop does not (an O(h^1.5) error of ~2e-7 m/s, measured).
-        assert!((end.u_m - u).abs() < 1e-6, "{} vs {u}", end.u_m);
-        assert!((end.v_m_s - v).abs() < 1e-6, "{} vs {v}", end.v_m_s);
-    }
 }
