@@ -31,7 +31,7 @@ use platen_scenario::columns::{ColumnMap, ColumnSpec};
 use platen_scenario::csv_io::uniform_step_s;
 use platen_scenario::scenario::parse_json_file;
 
-use crate::{identify_plot, plot};
+use platen_report::{html, identify_figures, Figure};
 
 /// Options of `platen identify`.
 pub struct Options<'a> {
@@ -132,10 +132,10 @@ pub fn run(opts: &Options) -> Result<()> {
         ..Settings::default()
     };
     let id = identify(&records, &settings).context("identification failed")?;
-    let written = plot::write_outputs(
+    let written = platen_report::write_outputs(
         opts.plot,
         opts.report,
-        || identify_plot::figures(&id),
+        || identify_figures::figures(&id),
         |figures, rendered| html_report(&id, &inputs, figures, rendered),
     )?;
     if opts.json {
@@ -175,7 +175,7 @@ pub fn run(opts: &Options) -> Result<()> {
 fn html_report(
     id: &Identification,
     inputs: &[Input],
-    figures: &[plot::Figure],
+    figures: &[Figure],
     rendered: &[(String, String)],
 ) -> String {
     let items = vec![
@@ -233,18 +233,18 @@ fn html_report(
             vec![(*name).to_owned(), value, unit.to_owned(), se, ci, status]
         })
         .collect();
-    let mut sections = vec![crate::report::heading("Identified parameters")];
-    sections.push(crate::report::table(
+    let mut sections = vec![html::heading("Identified parameters")];
+    sections.push(html::table(
         &["key", "value", "unit", "std. error", "95 % CI", "status"],
         &rows,
         true,
     ));
     for w in &id.warnings {
-        sections.push(crate::report::paragraph(w, Some("note")));
+        sections.push(html::paragraph(w, Some("note")));
     }
-    sections.push(crate::report::heading("Report"));
-    sections.push(crate::report::preformatted(&report(id, inputs)));
-    crate::report::page(&crate::report::Page {
+    sections.push(html::heading("Report"));
+    sections.push(html::preformatted(&report(id, inputs)));
+    html::page(&html::Page {
         title: "platen identify".into(),
         heading: "Identification from periodic tests (hysteresis-loop method)".into(),
         items,

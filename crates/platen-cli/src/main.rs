@@ -9,10 +9,7 @@ mod bench;
 mod compare;
 mod generate;
 mod identify;
-mod identify_plot;
 mod model;
-mod plot;
-mod report;
 mod schema;
 mod simulate;
 mod sweep;
@@ -22,7 +19,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
+use platen_compare::CompareError;
 use platen_integrate::IntegrateError;
+use platen_report::ReportError;
 use platen_scenario::ScenarioError;
 
 #[derive(Parser)]
@@ -312,7 +311,16 @@ fn exit_code(e: &anyhow::Error) -> u8 {
         if let Some(ie) = cause.downcast_ref::<IntegrateError>() {
             return integrate_exit_code(ie);
         }
-        if let Some(se) = cause.downcast_ref::<ScenarioError>() {
+        // The comparison's and the report's errors carry a scenario error transparently
+        // (its message, not wrapped): the same codes as that error.
+        let wrapped = match (
+            cause.downcast_ref::<CompareError>(),
+            cause.downcast_ref::<ReportError>(),
+        ) {
+            (Some(CompareError::Scenario(se)), _) | (_, Some(ReportError::Write(se))) => Some(se),
+            _ => None,
+        };
+        if let Some(se) = cause.downcast_ref::<ScenarioError>().or(wrapped) {
             return match se {
                 ScenarioError::Run(ie) => integrate_exit_code(ie),
                 ScenarioError::Io { action, .. } if *action != "reading" => 5,
