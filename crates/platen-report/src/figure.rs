@@ -1,5 +1,5 @@
 //! What a figure is made of: a title over a grid of panels, each a set of axes holding line,
-//! point or segment series. Drawing is in [`crate::svg`], rendering and writing in
+//! point or segment series. Drawing is [`Figure::to_svg`], rendering and writing in
 //! [`crate::render`].
 
 use plotters::style::RGBColor;
