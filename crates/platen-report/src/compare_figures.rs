@@ -8,8 +8,10 @@ use plotters::style::RGBColor;
 use platen_compare::{ComparedChannel, Comparison, Direction};
 use platen_signal::metrics::signed_peak;
 
-use crate::figure::{Figure, Panel, Series, Style, MODEL, RECORDED, RESIDUAL, SIMULATED};
-use crate::series::{envelope, every, line, scaled, thinned, MAX_LOOP_POINTS, MAX_SCATTER_POINTS};
+use crate::figure::{Figure, Panel, MODEL, RECORDED, RESIDUAL, SIMULATED};
+use crate::series::{
+    envelope, every, line, points, scaled, thinned, MAX_LOOP_POINTS, MAX_SCATTER_POINTS,
+};
 use crate::text::{display_units, significant};
 
 /// Horizontal pixels of a full-width panel, the number of envelope buckets.
@@ -229,17 +231,15 @@ fn hysteresis(c: &Comparison) -> Figure {
         let (rec_points, k) = thinned(rec_x, &f_rec, MAX_LOOP_POINTS);
         let (sim_points, _) = thinned(sim_x, &f_sim, MAX_LOOP_POINTS);
         stride = k;
-        loops.push(Panel {
-            title: format!("Actuator force against {quantity}"),
-            x_label: format!("{quantity} {symbol} ({unit})"),
-            y_label: "actuator force F_A (kN)".into(),
-            series: vec![
+        loops.push(Panel::new(
+            format!("Actuator force against {quantity}"),
+            format!("{quantity} {symbol} ({unit})"),
+            "actuator force F_A (kN)",
+            vec![
                 line("recorded", rec_points, RECORDED, 1),
                 line(sim_label, sim_points, SIMULATED, 2),
             ],
-            x_range: None,
-            shade_x: None,
-        });
+        ));
     }
     let thinning = if stride > 1 {
         format!(" ({} drawn)", every(stride))
@@ -267,7 +267,7 @@ fn hysteresis(c: &Comparison) -> Figure {
 
 /// The recorded dissipative force against velocity, with the model's law.
 fn dissipative_force(c: &Comparison) -> Figure {
-    let (points, k) = thinned(
+    let (recorded, k) = thinned(
         &c.recorded.v_m_s,
         &scaled(&c.recorded_dissipative_n, 1e-3),
         MAX_SCATTER_POINTS,
@@ -287,24 +287,15 @@ fn dissipative_force(c: &Comparison) -> Figure {
             },
             c.law_label
         ),
-        panels: vec![Panel {
-            title: String::new(),
-            x_label: "velocity v (m/s)".into(),
-            y_label: "dissipative force F_D (kN)".into(),
-            series: vec![
-                Series {
-                    label: "recorded: F_A − M·a − F_E".into(),
-                    points,
-                    style: Style::Points {
-                        color: RECORDED,
-                        radius: 2,
-                    },
-                },
+        panels: vec![Panel::new(
+            "",
+            "velocity v (m/s)",
+            "dissipative force F_D (kN)",
+            vec![
+                points("recorded: F_A − M·a − F_E", recorded, RECORDED, 2),
                 line(format!("model law {}", c.law_label), law, MODEL, 3),
             ],
-            x_range: None,
-            shade_x: None,
-        }],
+        )],
         columns: 1,
         size: (1200, 800),
     }

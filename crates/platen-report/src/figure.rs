@@ -82,6 +82,24 @@ pub struct Panel {
     pub shade_x: Option<(f64, f64)>,
 }
 
+impl Panel {
+    /// A panel with a caption, axis descriptions and series, over the data's ranges.
+    pub fn new(
+        title: impl Into<String>,
+        x_label: impl Into<String>,
+        y_label: impl Into<String>,
+        series: Vec<Series>,
+    ) -> Self {
+        Self {
+            title: title.into(),
+            x_label: x_label.into(),
+            y_label: y_label.into(),
+            series,
+            ..Self::default()
+        }
+    }
+}
+
 /// A figure: a title over a grid of panels.
 #[derive(Debug, Clone)]
 pub struct Figure {

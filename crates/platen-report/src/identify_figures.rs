@@ -16,7 +16,7 @@ use plotters::style::RGBColor;
 use platen_ident::{DissipativeLaw, Estimate, Identification, PressureGroup, TestKind, TestResult};
 
 use crate::figure::{Figure, Panel, Series, MODEL};
-use crate::series::{line, points, segments, thinned, MAX_SCATTER_POINTS};
+use crate::series::{line, points, segments, thinned, Points, MAX_SCATTER_POINTS};
 
 /// Colours of the pressure groups, by increasing pressure (repeated beyond four groups).
 pub const GROUP_COLORS: [RGBColor; 4] = [
@@ -88,9 +88,6 @@ fn range_of(x: impl Iterator<Item = f64>) -> (f64, f64) {
     })
 }
 
-/// Points `(x, y)` of a series, in display units.
-type Points = Vec<(f64, f64)>;
-
 /// A decomposed force curve `(x, F)` (F in N) as points in kN, and with a fitted slope
 /// `F ≈ slope·x` the residual `F − slope·x` in kN; both thinned to [`MAX_SCATTER_POINTS`].
 fn scatter_and_residual(curve: &[[f64; 2]], slope: Option<f64>) -> (Points, Option<Points>) {
@@ -140,6 +137,19 @@ impl Estimates {
             segments(self.bars, color),
             points(label, self.points, color, 5),
         ]
+    }
+}
+
+/// `used` if `is_used`, else `unused`.
+fn pick<'a>(
+    is_used: bool,
+    used: &'a mut Estimates,
+    unused: &'a mut Estimates,
+) -> &'a mut Estimates {
+    if is_used {
+        used
+    } else {
+        unused
     }
 }
 
@@ -195,12 +205,11 @@ fn stiffness_panel(id: &Identification) -> Panel {
         let mut used = Estimates::new();
         for t in in_group(id, g) {
             if let Some(k) = &t.stiffness {
-                let target = if t.used_for_stiffness {
-                    &mut used
-                } else {
-                    &mut unused
-                };
-                target.push(t.peak_velocity_m_s, k, 1e6);
+                pick(t.used_for_stiffness, &mut used, &mut unused).push(
+                    t.peak_velocity_m_s,
+                    k,
+                    1e6,
+                );
             }
         }
         let label = match &g.stiffness {
@@ -214,13 +223,12 @@ fn stiffness_panel(id: &Identification) -> Panel {
         series.extend(used.into_series(label, group_color(i)));
     }
     series.extend(unused.into_series("not used (flagged)", UNUSED));
-    Panel {
-        title: "Kₑ per triangle test (Eq. 16/17, Table I)".into(),
-        x_label: "plateau velocity v (m/s)".into(),
-        y_label: "stiffness Kₑ (MN/m)".into(),
+    Panel::new(
+        "Kₑ per triangle test (Eq. 16/17, Table I)",
+        "plateau velocity v (m/s)",
+        "stiffness Kₑ (MN/m)",
         series,
-        ..Panel::default()
-    }
+    )
 }
 
 /// Mₑ of each sine test against its peak acceleration, with the mean of the used tests.
@@ -229,12 +237,7 @@ fn mass_panel(id: &Identification) -> Panel {
     let mut unused = Estimates::new();
     for t in &id.tests {
         if let Some(m) = &t.effective_mass {
-            let target = if t.used_for_mass {
-                &mut used
-            } else {
-                &mut unused
-            };
-            target.push(t.peak_acceleration_m_s2, m, 1e3);
+            pick(t.used_for_mass, &mut used, &mut unused).push(t.peak_acceleration_m_s2, m, 1e3);
         }
     }
     // The band of every estimate and the used tests' intervals; the flagged tests'
@@ -264,13 +267,12 @@ fn mass_panel(id: &Identification) -> Panel {
             2,
         ));
     }
-    Panel {
-        title: "Mₑ per sine test (Eq. 18/19, Table II)".into(),
-        x_label: "peak acceleration a (m/s²)".into(),
-        y_label: "effective mass Mₑ (t)".into(),
+    Panel::new(
+        "Mₑ per sine test (Eq. 18/19, Table II)",
+        "peak acceleration a (m/s²)",
+        "effective mass Mₑ (t)",
         series,
-        ..Panel::default()
-    }
+    )
 }
 
 /// Elastic force against displacement, per pressure, with Kₑ·u and what Kₑ·u leaves.
@@ -392,19 +394,8 @@ fn fit_figure(
         title: title.into(),
         caption: caption.into(),
         panels: vec![
-            Panel {
-                x_label: x_label.into(),
-                y_label: y_label.into(),
-                series,
-                ..Panel::default()
-            },
-            Panel {
-                title: residual_title.into(),
-                x_label: x_label.into(),
-                y_label: residual_label.into(),
-                series: residuals,
-                ..Panel::default()
-            },
+            Panel::new("", x_label, y_label, series),
+            Panel::new(residual_title, x_label, residual_label, residuals),
         ],
         columns: 1,
         size: (1200, 1200),
@@ -451,12 +442,12 @@ fn dissipative_force(id: &Identification) -> Option<Figure> {
                   at each pressure's F_μ, the paper's Eq. 21 fit to the peak points, and \
                   the force at each test's peak velocity."
             .into(),
-        panels: vec![Panel {
-            x_label: "velocity |v| (m/s)".into(),
-            y_label: "dissipative force F_D (kN)".into(),
+        panels: vec![Panel::new(
+            "",
+            "velocity |v| (m/s)",
+            "dissipative force F_D (kN)",
             series,
-            ..Panel::default()
-        }],
+        )],
         columns: 1,
         size: (1200, 800),
     })
@@ -529,12 +520,12 @@ fn friction(id: &Identification) -> Option<Figure> {
                   load F_z at that pressure, with 95 % confidence intervals and the line \
                   through the origin whose slope is the friction coefficient μₑ."
             .into(),
-        panels: vec![Panel {
-            x_label: "vertical load F_z (MN)".into(),
-            y_label: "Coulomb force F_μ (kN)".into(),
+        panels: vec![Panel::new(
+            "",
+            "vertical load F_z (MN)",
+            "Coulomb force F_μ (kN)",
             series,
-            ..Panel::default()
-        }],
+        )],
         columns: 1,
         size: (1000, 700),
     })

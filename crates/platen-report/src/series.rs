@@ -5,6 +5,9 @@ use plotters::style::RGBColor;
 
 use crate::figure::{Series, Style};
 
+/// Points `(x, y)` of a series, in the panel's units.
+pub type Points = Vec<(f64, f64)>;
+
 /// Most points drawn for a scatter series (evenly spaced samples beyond that).
 pub const MAX_SCATTER_POINTS: usize = 4000;
 /// Most points drawn for a loop (hysteresis) line (evenly spaced samples beyond that).
@@ -65,41 +68,28 @@ pub fn scaled(values: &[f64], scale: f64) -> Vec<f64> {
     values.iter().map(|v| v * scale).collect()
 }
 
-/// A line series.
-pub fn line(
-    label: impl Into<String>,
-    points: Vec<(f64, f64)>,
-    color: RGBColor,
-    width: u32,
-) -> Series {
+/// A series drawn in `style`.
+pub fn series(label: impl Into<String>, points: Vec<(f64, f64)>, style: Style) -> Series {
     Series {
         label: label.into(),
         points,
-        style: Style::Line { color, width },
+        style,
     }
 }
 
+/// A line series.
+pub fn line(label: impl Into<String>, points: Points, color: RGBColor, width: u32) -> Series {
+    series(label, points, Style::Line { color, width })
+}
+
 /// A point series: filled circles of `radius` px.
-pub fn points(
-    label: impl Into<String>,
-    points: Vec<(f64, f64)>,
-    color: RGBColor,
-    radius: i32,
-) -> Series {
-    Series {
-        label: label.into(),
-        points,
-        style: Style::Points { color, radius },
-    }
+pub fn points(label: impl Into<String>, points: Points, color: RGBColor, radius: i32) -> Series {
+    series(label, points, Style::Points { color, radius })
 }
 
 /// Error bars: one segment, 2 px wide, per consecutive pair of `points`, without a legend.
 pub fn segments(points: Vec<(f64, f64)>, color: RGBColor) -> Series {
-    Series {
-        label: String::new(),
-        points,
-        style: Style::Segments { color, width: 2 },
-    }
+    series("", points, Style::Segments { color, width: 2 })
 }
 
 /// "every 3rd sample", "every 12th sample", …
