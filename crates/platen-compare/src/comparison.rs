@@ -13,34 +13,7 @@ use platen_signal::metrics::{interpolate_linear, ChannelMetrics, Comparator};
 use platen_signal::{differentiate, SampleRate};
 
 use crate::error::{CompareError, Result};
-use crate::{Channel, Direction, Recording};
-
-/// A time window `[start_s, end_s]`, s.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Window {
-    /// Start, s.
-    pub start_s: f64,
-    /// End, s (after the start).
-    pub end_s: f64,
-}
-
-/// How a comparison is made.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Settings {
-    /// Compute the metrics over this window only (default: the whole compared span).
-    pub window: Option<Window>,
-    /// Largest lag searched by cross-correlation, either way, s (default: `0.25`).
-    pub max_lag_s: f64,
-}
-
-impl Default for Settings {
-    fn default() -> Self {
-        Self {
-            window: None,
-            max_lag_s: 0.25,
-        }
-    }
-}
+use crate::{Channel, Direction, Recording, Settings, Window};
 
 /// One compared channel on the recorded time base.
 #[derive(Debug)]

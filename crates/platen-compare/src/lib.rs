@@ -53,10 +53,12 @@ mod channel;
 mod comparison;
 mod error;
 mod recording;
+mod settings;
 mod summary;
 
 pub use channel::{Channel, Direction};
-pub use comparison::{ComparedChannel, Comparison, Quantities, Settings, Sources, Window};
+pub use comparison::{ComparedChannel, Comparison, Quantities, Sources};
 pub use error::{CompareError, Result};
 pub use recording::Recording;
+pub use settings::{Settings, Window};
 pub use summary::{ChannelSummary, Summary};
