@@ -32,7 +32,7 @@ use platen_io::columns::{ColumnMap, ColumnSpec};
 use platen_io::json::parse_json_file;
 use platen_scenario::sampling::uniform_step_s;
 
-use crate::{identify_plot, plot};
+use platen_report::{html, identify_figures, Figure};
 
 /// Options of `platen identify`.
 pub struct Options<'a> {
@@ -135,10 +135,10 @@ pub fn run(opts: &Options) -> Result<()> {
     .build()
     .context("identification failed")?;
     let id = identify(&records, &settings).context("identification failed")?;
-    let written = plot::write_outputs(
+    let written = platen_report::write_outputs(
         opts.plot,
         opts.report,
-        || identify_plot::figures(&id),
+        || identify_figures::figures(&id),
         |figures, rendered| html_report(&id, &inputs, figures, rendered),
     )?;
     if opts.json {
@@ -192,21 +192,21 @@ fn summary(id: &Identification, inputs: &[Input]) -> IdentificationSummary {
 fn html_report(
     id: &Identification,
     inputs: &[Input],
-    figures: &[plot::Figure],
+    figures: &[Figure],
     rendered: &[(String, String)],
 ) -> String {
-    let mut sections = vec![crate::report::heading("Identified parameters")];
-    sections.push(crate::report::table(
+    let mut sections = vec![html::heading("Identified parameters")];
+    sections.push(html::table(
         &["key", "value", "unit", "std. error", "95 % CI", "status"],
         &parameter_rows(id),
         true,
     ));
     for w in &id.warnings {
-        sections.push(crate::report::paragraph(&w.to_string(), Some("note")));
+        sections.push(html::paragraph(&w.to_string(), Some("note")));
     }
-    sections.push(crate::report::heading("Report"));
-    sections.push(crate::report::preformatted(&report(id, inputs)));
-    crate::report::page(&crate::report::Page {
+    sections.push(html::heading("Report"));
+    sections.push(html::preformatted(&report(id, inputs)));
+    html::page(&html::Page {
         title: "platen identify".into(),
         heading: "Identification from periodic tests (hysteresis-loop method)".into(),
         items: html_items(id, inputs),

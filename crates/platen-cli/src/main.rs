@@ -9,10 +9,7 @@ mod bench;
 mod compare;
 mod generate;
 mod identify;
-mod identify_plot;
 mod model;
-mod plot;
-mod report;
 mod schema;
 mod simulate;
 mod sweep;
@@ -22,8 +19,10 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
+use platen_compare::CompareError;
 use platen_integrate::IntegrateError;
 use platen_io::IoError;
+use platen_report::ReportError;
 use platen_scenario::ScenarioError;
 
 #[derive(Parser)]
@@ -307,20 +306,32 @@ fn main() -> ExitCode {
     }
 }
 
-/// Maps an error chain to the documented exit codes.
+/// Maps an error chain to the documented exit codes. Transparent wrappers (a comparison's
+/// scenario error, a report's write error) hide the inner error from `chain()`, so they are
+/// unwrapped here.
 fn exit_code(e: &anyhow::Error) -> u8 {
     for cause in e.chain() {
         if let Some(ie) = cause.downcast_ref::<IntegrateError>() {
             return integrate_exit_code(ie);
         }
-        if let Some(se) = cause.downcast_ref::<ScenarioError>() {
-            return match se {
-                ScenarioError::Run(ie) => integrate_exit_code(ie),
-                ScenarioError::Io(io) => io_exit_code(io),
-                _ => 3,
-            };
+        let scenario = match cause.downcast_ref::<CompareError>() {
+            Some(CompareError::Scenario(se)) => Some(se),
+            _ => cause.downcast_ref::<ScenarioError>(),
+        };
+        match scenario {
+            Some(ScenarioError::Run(ie)) => return integrate_exit_code(ie),
+            Some(ScenarioError::Io(io)) => return io_exit_code(io),
+            Some(_) => return 3,
+            None => {}
         }
-        if let Some(io) = cause.downcast_ref::<IoError>() {
+        let io = match (
+            cause.downcast_ref::<ReportError>(),
+            cause.downcast_ref::<CompareError>(),
+        ) {
+            (Some(ReportError::Write(io)), _) | (_, Some(CompareError::Io(io))) => Some(io),
+            _ => cause.downcast_ref::<IoError>(),
+        };
+        if let Some(io) = io {
             return io_exit_code(io);
         }
     }

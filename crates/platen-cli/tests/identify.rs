@@ -325,8 +325,8 @@ fn a_negative_pressure_is_a_usage_error() {
 mod common;
 use common::{check_png, svg_content};
 
-/// Series colours of the identification figures (`identify_plot`): the first pressure group,
-/// flagged tests, the final fit, the paper's Eq. 21 fit.
+/// Series colours of the identification figures (`platen_report::identify_figures`): the
+/// first pressure group, flagged tests, the final fit, the paper's Eq. 21 fit.
 const GROUP: &str = "#1F77B4";
 const FLAGGED: &str = "#969696";
 const FIT: &str = "#000000";

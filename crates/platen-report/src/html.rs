@@ -1,14 +1,17 @@
-//! Self-contained HTML reports: `platen compare --report FILE.html` and `platen identify
-//! --report FILE.html`. One page with what was run, the tables, every figure inlined as SVG
-//! (no external file, script or font) and the `--json` summary at the end. A page is a pure
-//! function of its inputs, so the same input gives the same bytes.
+//! Self-contained HTML reports (`platen compare --report FILE.html`, `platen identify
+//! --report FILE.html`): one page with what was run, the tables, every figure inlined as SVG
+//! (no external file, script or font) and the `--json` summary at the end; and the pieces
+//! (tables, paragraphs, headings) a verb builds its sections from. A page is a pure function
+//! of its inputs, so the same input gives the same bytes.
 
 use std::fmt::Write as _;
 
 use serde_json::Value;
 
-use crate::compare::{display_row, summary_json, Comparison, Direction, DISPLAY_HEADINGS};
-use crate::plot::Figure;
+use platen_compare::{Comparison, Direction};
+
+use crate::figure::Figure;
+use crate::text::{display_row, DISPLAY_HEADINGS};
 
 const STYLE: &str = "\
 body{font-family:system-ui,-apple-system,'Segoe UI',Roboto,Helvetica,Arial,sans-serif;\
@@ -148,14 +151,34 @@ pub fn preformatted(text: &str) -> String {
 }
 
 /// The `platen compare` report page; `rendered[i]` is the SVG of `figures[i]`.
-pub fn html(c: &Comparison, figures: &[Figure], rendered: &[(String, String)]) -> String {
+pub fn compare_page(c: &Comparison, figures: &[Figure], rendered: &[(String, String)]) -> String {
+    let mut summary = serde_json::to_value(c.summary(&[], None)).unwrap_or_default();
+    if let Some(fields) = summary.as_object_mut() {
+        // What this run wrote is not part of the comparison.
+        fields.remove("figures");
+        fields.remove("report");
+    }
+    page(&Page {
+        title: format!("platen compare: {}", c.name),
+        heading: c.name.clone(),
+        items: compare_items(c),
+        sections: vec![metrics_section(c)],
+        figures,
+        rendered,
+        summary,
+    })
+}
+
+/// What was compared: files, direction, model, samples, window, lag search.
+fn compare_items(c: &Comparison) -> Vec<(String, String)> {
     let direction = match c.direction {
         Direction::Forward => {
             "forward: the force drives the model; displacement and velocity compared"
         }
         Direction::Inverse => "inverse: the motion drives the model; actuator force compared",
     };
-    let items = vec![
+    let (first, last) = c.compared_span_s();
+    vec![
         ("scenario".into(), c.scenario_path.display().to_string()),
         ("recorded".into(), c.recorded_path.display().to_string()),
         ("run".into(), direction.to_string()),
@@ -163,11 +186,9 @@ pub fn html(c: &Comparison, figures: &[Figure], rendered: &[(String, String)]) -
         (
             "compared".into(),
             format!(
-                "{} recorded samples at {} Hz, {:.3}–{:.3} s (simulated {:.3}–{:.3} s, record {:.3}–{:.3} s)",
+                "{} recorded samples at {} Hz, {first:.3}–{last:.3} s (simulated {:.3}–{:.3} s, record {:.3}–{:.3} s)",
                 c.t_s.len(),
                 c.sample_rate_hz,
-                c.t_s[0],
-                c.t_s[c.t_s.len() - 1],
                 c.simulated_span_s.0,
                 c.simulated_span_s.1,
                 c.recorded_span_s.0,
@@ -176,21 +197,24 @@ pub fn html(c: &Comparison, figures: &[Figure], rendered: &[(String, String)]) -
         ),
         (
             "metrics window".into(),
-            match c.window_s {
-                Some([a, b]) => format!("{a}–{b} s"),
+            match c.window {
+                Some(w) => format!("{}–{} s", w.start_s, w.end_s),
                 None => "the whole compared span".into(),
             },
         ),
         ("lag search".into(), format!("±{} s", c.max_lag_s)),
-    ];
+    ]
+}
 
+/// The metrics table, how to read it, and the notes on substituted columns.
+fn metrics_section(c: &Comparison) -> String {
     let mut headings = vec!["channel"];
     headings.extend(DISPLAY_HEADINGS);
     let rows: Vec<Vec<String>> = c
         .channels
         .iter()
         .map(|ch| {
-            let mut row = vec![format!("{} ({})", ch.spec.key, ch.spec.quantity)];
+            let mut row = vec![format!("{} ({})", ch.channel.name(), ch.channel.quantity())];
             row.extend(display_row(ch));
             row
         })
@@ -206,20 +230,5 @@ pub fn html(c: &Comparison, figures: &[Figure], rendered: &[(String, String)]) -
     for note in &c.recorded.sources.notes {
         metrics.push_str(&paragraph(note, Some("note")));
     }
-
-    let mut summary = summary_json(c, &[], None);
-    if let Some(fields) = summary.as_object_mut() {
-        // What this run wrote is not part of the comparison.
-        fields.remove("figures");
-        fields.remove("report");
-    }
-    page(&Page {
-        title: format!("platen compare: {}", c.name),
-        heading: c.name.clone(),
-        items,
-        sections: vec![metrics],
-        figures,
-        rendered,
-        summary,
-    })
+    metrics
 }

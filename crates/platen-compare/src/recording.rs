@@ -1,0 +1,103 @@
+//! The recorded test: its columns, time base and sample interval, read and checked before
+//! anything is simulated.
+
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use platen_io::columns::ColumnMap;
+use platen_io::csv::Table;
+use platen_scenario::sampling::uniform_step_s;
+
+use crate::error::{CompareError, Result};
+use crate::{Direction, Window};
+
+/// A recorded test read for a comparison: uniformly sampled, with the columns its direction
+/// needs (see [`Direction::record_columns`]) in SI units.
+#[derive(Debug)]
+pub struct Recording {
+    /// The file it was read from.
+    pub path: PathBuf,
+    /// Recorded times, s.
+    pub t_s: Vec<f64>,
+    /// The sample interval, s.
+    pub step_s: f64,
+    /// Every other column read, under platen's names, in SI units.
+    pub table: Table,
+}
+
+impl Recording {
+    /// Reads the record at `path` through the column map `columns` (use
+    /// `ColumnMap::default()` for a file with platen's own column names), with the columns a
+    /// comparison in `direction` needs, and checks that it is uniformly sampled.
+    ///
+    /// # Errors
+    /// [`CompareError::Scenario`] for an unreadable or malformed file, a missing column or a
+    /// non-uniform time base.
+    pub fn read(path: &Path, direction: Direction, columns: &ColumnMap) -> Result<Self> {
+        let (required, optional) = direction.record_columns();
+        let mut table = columns.read_table(path, required, optional)?;
+        let t_s = table.take_column("t_s").unwrap_or_default();
+        let step_s = uniform_step_s(path, &t_s)?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            t_s,
+            step_s,
+            table,
+        })
+    }
+
+    /// The first and last recorded time, s.
+    pub fn span_s(&self) -> (f64, f64) {
+        (self.t_s[0], self.t_s[self.t_s.len() - 1])
+    }
+
+    /// The indices of the recorded samples inside `simulated_span_s` (within half a sample
+    /// interval), checked to cover that span and to hold `window`.
+    ///
+    /// # Errors
+    /// [`CompareError::RecordTooShort`], [`CompareError::TooFewRecordedSamples`],
+    /// [`CompareError::WindowOutside`].
+    pub(crate) fn compared_range(
+        &self,
+        scenario_path: &Path,
+        simulated_span_s: (f64, f64),
+        window: Option<Window>,
+    ) -> Result<Range<usize>> {
+        let (rec_span, sim_span) = (self.span_s(), simulated_span_s);
+        let tol = 0.5 * self.step_s;
+        if rec_span.0 > sim_span.0 + tol || rec_span.1 < sim_span.1 - tol {
+            return Err(CompareError::RecordTooShort {
+                recorded: self.path.clone(),
+                scenario: scenario_path.to_path_buf(),
+                recorded_span_s: rec_span,
+                simulated_span_s: sim_span,
+                tolerance_s: tol,
+            });
+        }
+        let first = self.t_s.partition_point(|&t| t < sim_span.0 - tol);
+        let end = self.t_s.partition_point(|&t| t <= sim_span.1 + tol);
+        if end.saturating_sub(first) < 2 {
+            return Err(CompareError::TooFewRecordedSamples {
+                recorded: self.path.clone(),
+                samples: end.saturating_sub(first),
+                simulated_span_s: sim_span,
+            });
+        }
+        let compared_span = (self.t_s[first], self.t_s[end - 1]);
+        if let Some(w) = window {
+            if w.start_s < compared_span.0 - tol || w.end_s > compared_span.1 + tol {
+                return Err(CompareError::WindowOutside {
+                    window_s: [w.start_s, w.end_s],
+                    compared_span_s: compared_span,
+                    recorded: self.path.clone(),
+                });
+            }
+        }
+        Ok(first..end)
+    }
+
+    /// The column `key` on `range`, if the record has it.
+    pub(crate) fn column(&self, key: &str, range: &Range<usize>) -> Option<Vec<f64>> {
+        self.table.column(key).map(|c| c[range.clone()].to_vec())
+    }
+}

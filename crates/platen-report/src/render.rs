@@ -1,0 +1,114 @@
+//! From figures to files: the SVG of every figure, PNG copies rendered from it, and the
+//! figure folder and HTML page written through one atomic writer.
+//!
+//! PNG copies are rendered from the SVG by `resvg` (pure Rust, tiny-skia) with the text set in
+//! Noto Sans, which is embedded in the binary (the `ttf-noto-sans` crate, Apache-2.0): no
+//! system font is read, so the pixels are the same on every machine.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use platen_io::{write_bytes_atomic, IoAction, IoError};
+
+use crate::error::{ReportError, Result};
+use crate::figure::Figure;
+
+/// The SVG of every figure, `(file name, svg)`.
+///
+/// # Errors
+/// [`ReportError::Draw`] if a figure cannot be drawn.
+pub fn render_all(figures: &[Figure]) -> Result<Vec<(String, String)>> {
+    figures
+        .iter()
+        .map(|f| Ok((format!("{}.svg", f.name), f.to_svg()?)))
+        .collect()
+}
+
+/// Writes what a verb's `--plot DIR` and `--report FILE.html` ask for: the figures (SVG and
+/// PNG) to the folder and the page `html` makes of the figures and their SVG. The figures are
+/// built only if one of the two is asked for. Returns the figure files written.
+///
+/// # Errors
+/// Those of [`render_all`] and [`write_figures`]; [`ReportError::Write`] if the page cannot
+/// be written.
+pub fn write_outputs(
+    plot_dir: Option<&Path>,
+    report: Option<&Path>,
+    figures: impl FnOnce() -> Vec<Figure>,
+    html: impl FnOnce(&[Figure], &[(String, String)]) -> String,
+) -> Result<Vec<PathBuf>> {
+    if plot_dir.is_none() && report.is_none() {
+        return Ok(Vec::new());
+    }
+    let figures = figures();
+    let rendered = render_all(&figures)?;
+    let written = match plot_dir {
+        Some(dir) => write_figures(dir, &rendered)?,
+        None => Vec::new(),
+    };
+    if let Some(path) = report {
+        write_file(path, html(&figures, &rendered).as_bytes())?;
+    }
+    Ok(written)
+}
+
+/// Writes every figure to `dir` (created if missing) as SVG and PNG, and returns the paths
+/// written. Every PNG is rendered before the first file is written, so a rendering failure
+/// leaves the folder as it was; each file is written atomically.
+///
+/// # Errors
+/// Those of [`svg_to_png`]; [`ReportError::Write`] if the folder cannot be made or a file
+/// written.
+pub fn write_figures(dir: &Path, rendered: &[(String, String)]) -> Result<Vec<PathBuf>> {
+    let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::with_capacity(2 * rendered.len());
+    for (file, svg) in rendered {
+        files.push((dir.join(file), svg.as_bytes().to_vec()));
+        files.push((
+            dir.join(Path::new(file).with_extension("png")),
+            svg_to_png(svg)?,
+        ));
+    }
+    fs::create_dir_all(dir).map_err(|source| IoError::Io {
+        path: dir.to_path_buf(),
+        action: IoAction::CreatingFolder,
+        source,
+    })?;
+    let mut written = Vec::with_capacity(files.len());
+    for (path, bytes) in files {
+        write_file(&path, &bytes)?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+/// Renders an SVG document (as written by [`Figure::to_svg`]) to PNG at its own pixel size,
+/// with `sans-serif` text set in the embedded Noto Sans.
+///
+/// # Errors
+/// [`ReportError::SvgParse`], [`ReportError::PixmapSize`], [`ReportError::PngEncode`].
+pub fn svg_to_png(svg: &str) -> Result<Vec<u8>> {
+    use resvg::{tiny_skia, usvg};
+    let mut options = usvg::Options::default();
+    let fonts = options.fontdb_mut();
+    fonts.load_font_data(ttf_noto_sans::REGULAR.to_vec());
+    fonts.set_sans_serif_family("Noto Sans");
+    let tree =
+        usvg::Tree::from_str(svg, &options).map_err(|e| ReportError::SvgParse(e.to_string()))?;
+    let size = tree.size().to_int_size();
+    let mut pixmap =
+        tiny_skia::Pixmap::new(size.width(), size.height()).ok_or(ReportError::PixmapSize {
+            width: size.width(),
+            height: size.height(),
+        })?;
+    resvg::render(&tree, tiny_skia::Transform::default(), &mut pixmap.as_mut());
+    pixmap
+        .encode_png()
+        .map_err(|e| ReportError::PngEncode(e.to_string()))
+}
+
+/// Every file this crate writes goes through here: written to a temporary file next to
+/// `path`, then renamed onto it, so a failure leaves no partial file.
+fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_bytes_atomic(path, bytes)?;
+    Ok(())
+}

@@ -1,0 +1,172 @@
+//! Numbers and channels as text: significant digits, each channel's display units, the metric
+//! rows shared by the terminal summary and the HTML report, and the terminal summary of a
+//! comparison.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use platen_compare::{Channel, ComparedChannel, Comparison, Direction};
+
+/// How a channel is shown: its unit in figures and tables, and that of its residual.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DisplayUnits {
+    /// Factor from the SI unit to the display unit.
+    pub scale: f64,
+    /// Unit of figures and of the terminal table.
+    pub unit: &'static str,
+    /// Factor from the SI unit to the residual's display unit.
+    pub residual_scale: f64,
+    /// Unit of the residual figure.
+    pub residual_unit: &'static str,
+}
+
+/// The display units of `channel`: m and mm, m/s and mm/s, kN and kN.
+pub fn display_units(channel: Channel) -> DisplayUnits {
+    match channel {
+        Channel::Displacement => DisplayUnits {
+            scale: 1.0,
+            unit: "m",
+            residual_scale: 1e3,
+            residual_unit: "mm",
+        },
+        Channel::Velocity => DisplayUnits {
+            scale: 1.0,
+            unit: "m/s",
+            residual_scale: 1e3,
+            residual_unit: "mm/s",
+        },
+        Channel::Force => DisplayUnits {
+            scale: 1e-3,
+            unit: "kN",
+            residual_scale: 1e-3,
+            residual_unit: "kN",
+        },
+    }
+}
+
+/// `x` with `digits` significant digits, in plain notation between 1e-3 and 1e6.
+pub fn significant(x: f64, digits: usize) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let magnitude = x.abs().log10().floor() as i64;
+    if (-3..6).contains(&magnitude) {
+        let decimals = (digits as i64 - 1 - magnitude).max(0) as usize;
+        format!("{x:.decimals$}")
+    } else {
+        format!("{x:.prec$e}", prec = digits.saturating_sub(1))
+    }
+}
+
+/// `text` with an explicit sign.
+fn signed(text: String) -> String {
+    if text.starts_with('-') {
+        text.replacen('-', "−", 1)
+    } else {
+        format!("+{text}")
+    }
+}
+
+/// Column headings of [`display_row`].
+pub const DISPLAY_HEADINGS: [&str; 7] = [
+    "RMS error",
+    "NRMSE",
+    "peak recorded",
+    "peak simulated",
+    "peak ratio",
+    "correlation",
+    "lag",
+];
+
+/// The metrics of a channel as display strings: RMS error, NRMSE, peaks, ratio, correlation,
+/// lag.
+pub fn display_row(ch: &ComparedChannel) -> [String; 7] {
+    let m = &ch.metrics;
+    let units = display_units(ch.channel);
+    let unit = units.unit;
+    let value = |x: f64| significant(x * units.scale, 4);
+    let opt = |x: Option<f64>, f: &dyn Fn(f64) -> String| x.map_or_else(|| "–".into(), f);
+    [
+        format!("{} {unit}", value(m.rms_error)),
+        opt(m.nrmse, &|x| format!("{:.3} %", 100.0 * x)),
+        format!(
+            "{} {unit} at {:.3} s",
+            signed(value(m.peak_recorded.value)),
+            m.peak_recorded.t_s
+        ),
+        format!(
+            "{} {unit} at {:.3} s",
+            signed(value(m.peak_simulated.value)),
+            m.peak_simulated.t_s
+        ),
+        opt(m.peak_ratio, &|x| format!("{x:.4}")),
+        opt(m.correlation, &|x| format!("{x:.5}")),
+        m.lag.map_or_else(
+            || "–".into(),
+            |l| {
+                format!(
+                    "{:+.2} ms{}",
+                    1e3 * l.lag_s,
+                    if l.at_search_limit {
+                        " (at the search limit)"
+                    } else {
+                        ""
+                    }
+                )
+            },
+        ),
+    ]
+}
+
+/// The terminal summary of a comparison (what `platen compare` prints without `--json`),
+/// listing the figure files and the report written; every line ends with a newline.
+pub fn compare_summary(c: &Comparison, figures: &[PathBuf], report: Option<&Path>) -> String {
+    let mut s = String::new();
+    let dir = match c.direction {
+        Direction::Forward => "forward (force → motion)",
+        Direction::Inverse => "inverse (motion → force)",
+    };
+    let (first, last) = c.compared_span_s();
+    let _ = writeln!(s, "{}: {dir}, {} model", c.name, c.model_form);
+    let _ = writeln!(
+        s,
+        "  compared with {}: {} samples at {} Hz over {first:.3}–{last:.3} s",
+        c.recorded_path.display(),
+        c.t_s.len(),
+        c.sample_rate_hz,
+    );
+    if let Some(w) = c.window {
+        let _ = writeln!(s, "  metrics over the window {}–{} s", w.start_s, w.end_s);
+    }
+    for ch in &c.channels {
+        let row = display_row(ch);
+        let _ = writeln!(
+            s,
+            "  {} ({}, {}):",
+            ch.channel.name(),
+            ch.channel.quantity(),
+            display_units(ch.channel).unit
+        );
+        for (heading, value) in DISPLAY_HEADINGS.iter().zip(&row) {
+            let _ = writeln!(s, "    {heading:<24}{value}");
+        }
+    }
+    let _ = writeln!(
+        s,
+        "  (error = simulated − recorded; NRMSE = RMS error / recorded RMS; lag > 0: the \
+         simulation is late)"
+    );
+    for note in &c.recorded.sources.notes {
+        let _ = writeln!(s, "  note: {note}");
+    }
+    if !figures.is_empty() {
+        let _ = writeln!(s, "  wrote {} figure files (SVG and PNG):", figures.len());
+        for f in figures {
+            let _ = writeln!(s, "    {}", f.display());
+        }
+    }
+    if let Some(r) = report {
+        let _ = writeln!(s, "  wrote report {}", r.display());
+    }
+    s
+}
