@@ -317,7 +317,7 @@ pub struct InitialSpec {
 /// Parses scenario JSON, reporting the JSON path (or line and column) of any error.
 ///
 /// # Errors
-/// [`ScenarioError::Io`] ([`platen_io::IoError::Json`]).
+/// [`crate::ScenarioError::Io`] ([`platen_io::IoError::Json`]).
 pub fn parse(path: &Path, text: &str) -> Result<ScenarioFile> {
     Ok(parse_json(path, text)?)
 }

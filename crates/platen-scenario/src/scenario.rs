@@ -100,7 +100,7 @@ impl Scenario {
     /// Nothing is simulated.
     ///
     /// # Errors
-    /// Any [`ScenarioError`]: unreadable file, malformed JSON or unknown key (with its JSON
+    /// Any [`crate::ScenarioError`]: unreadable file, malformed JSON or unknown key (with its JSON
     /// path), invalid values (with their JSON path and what was expected), and every error of
     /// the records it references (with file and line).
     pub fn load(path: &Path) -> Result<Self> {
