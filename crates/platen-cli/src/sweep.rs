@@ -24,51 +24,12 @@ use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde_json::{json, Map, Value};
 
-use platen_integrate::{
-    inverse, ForceRecord, ForwardIntegrator, IntegrateError, Motion, Peaks, RunStats,
-};
+use platen_integrate::{IntegrateError, Peaks, RunStats};
 use platen_io::write_bytes_atomic;
-use platen_model::{IdentifiedParams, PhysicalParams, PlatenModel, Preset};
-use platen_scenario::{Model, Run, Scenario};
+use platen_model::{IdentifiedKey, PhysicalKey};
+use platen_scenario::{Model, ModelKey, Run, Scenario};
 
 use platen_io::csv::write_number;
-
-/// Keys of the identified model that `--set identified.KEY=…` accepts.
-pub const IDENTIFIED_KEYS: [&str; 7] = [
-    "effective_mass_kg",
-    "stiffness_n_per_m",
-    "coulomb_force_n",
-    "viscous_coefficient",
-    "viscous_exponent",
-    "low_velocity_force_n",
-    "low_velocity_decay_s_per_m",
-];
-
-/// Physical parameters of the full model that `--set full.KEY=…` accepts (the hold-down
-/// pressure has its own axis, `--pressure-mpa`).
-pub const FULL_KEYS: [&str; 21] = [
-    "platen_mass_kg",
-    "actuator_moving_mass_kg",
-    "strut_piston_mass_kg",
-    "strut_cylinder_mass_kg",
-    "strut_height_m",
-    "strut_piston_length_m",
-    "strut_area_m2",
-    "gas_heat_capacity_ratio",
-    "supported_weight_n",
-    "bearing_friction_coefficient",
-    "lateral_friction_coefficient",
-    "lateral_normal_force_n",
-    "hinge_swivel_friction_coefficient",
-    "hinge_radius_m",
-    "hinge_force_distribution_factor",
-    "viscous_coefficient",
-    "viscous_exponent",
-    "strut_viscous_coefficient",
-    "strut_viscous_exponent",
-    "low_velocity_force_n",
-    "low_velocity_decay_s_per_m",
-];
 
 /// Which form of the model a parameter belongs to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -90,14 +51,14 @@ impl Form {
 #[derive(Debug, Clone, PartialEq)]
 pub struct SetAxis {
     pub form: Form,
-    pub key: &'static str,
+    pub key: ModelKey,
     pub values: Vec<f64>,
 }
 
 impl SetAxis {
     /// `FORM.KEY`, the column name of the axis.
     fn name(&self) -> String {
-        format!("{}.{}", self.form.name(), self.key)
+        format!("{}.{}", self.form.name(), self.key.name())
     }
 }
 
@@ -140,138 +101,26 @@ pub fn parse_set(s: &str) -> std::result::Result<SetAxis, String> {
             ))
         }
     };
-    let known: &[&'static str] = match form {
-        Form::Identified => &IDENTIFIED_KEYS,
-        Form::Full => &FULL_KEYS,
-    };
-    let Some(&key) = known.iter().find(|k| **k == key) else {
-        return Err(format!(
-            "`{name}`: unknown {} parameter; expected one of {}{}",
-            form.name(),
-            known.join(", "),
+    let key = match form {
+        Form::Identified => IdentifiedKey::from_name(key).map(ModelKey::Identified),
+        Form::Full => PhysicalKey::from_name(key).map(ModelKey::Full),
+    }
+    .map_err(|e| {
+        format!(
+            "`{name}`: {e}{}",
             if key == "hold_down_pressure_pa" || key == "hold_down_pressure_mpa" {
                 " (the pressure has its own axis: --pressure-mpa)"
             } else {
                 ""
             }
-        ));
-    };
+        )
+    })?;
     let values = values
         .split(',')
         .map(parse_number)
         .collect::<std::result::Result<Vec<f64>, String>>()
         .map_err(|e| format!("`{name}`: {e}"))?;
     Ok(SetAxis { form, key, values })
-}
-
-/// Lays `value` on the identified parameter `key`; false for an unknown key.
-fn set_identified(p: &mut IdentifiedParams, key: &str, value: f64) -> bool {
-    let slot = match key {
-        "effective_mass_kg" => &mut p.effective_mass_kg,
-        "stiffness_n_per_m" => &mut p.stiffness_n_per_m,
-        "coulomb_force_n" => &mut p.coulomb_force_n,
-        "viscous_coefficient" => &mut p.viscous_coefficient,
-        "viscous_exponent" => &mut p.viscous_exponent,
-        "low_velocity_force_n" => &mut p.low_velocity_force_n,
-        "low_velocity_decay_s_per_m" => &mut p.low_velocity_decay_s_per_m,
-        _ => return false,
-    };
-    *slot = value;
-    true
-}
-
-/// Lays `value` on the physical parameter `key`; false for an unknown key.
-fn set_physical(p: &mut PhysicalParams, key: &str, value: f64) -> bool {
-    let slot = match key {
-        "platen_mass_kg" => &mut p.platen_mass_kg,
-        "actuator_moving_mass_kg" => &mut p.actuator_moving_mass_kg,
-        "strut_piston_mass_kg" => &mut p.strut_piston_mass_kg,
-        "strut_cylinder_mass_kg" => &mut p.strut_cylinder_mass_kg,
-        "strut_height_m" => &mut p.strut_height_m,
-        "strut_piston_length_m" => &mut p.strut_piston_length_m,
-        "strut_area_m2" => &mut p.strut_area_m2,
-        "gas_heat_capacity_ratio" => &mut p.gas_heat_capacity_ratio,
-        "supported_weight_n" => &mut p.supported_weight_n,
-        "bearing_friction_coefficient" => &mut p.bearing_friction_coefficient,
-        "lateral_friction_coefficient" => &mut p.lateral_friction_coefficient,
-        "lateral_normal_force_n" => &mut p.lateral_normal_force_n,
-        "hinge_swivel_friction_coefficient" => &mut p.hinge_swivel_friction_coefficient,
-        "hinge_radius_m" => &mut p.hinge_radius_m,
-        "hinge_force_distribution_factor" => &mut p.hinge_force_distribution_factor,
-        "viscous_coefficient" => &mut p.viscous_coefficient,
-        "viscous_exponent" => &mut p.viscous_exponent,
-        "strut_viscous_coefficient" => &mut p.strut_viscous_coefficient,
-        "strut_viscous_exponent" => &mut p.strut_viscous_exponent,
-        "low_velocity_force_n" => &mut p.low_velocity_force_n,
-        "low_velocity_decay_s_per_m" => &mut p.low_velocity_decay_s_per_m,
-        _ => return false,
-    };
-    *slot = value;
-    true
-}
-
-/// Builds models of the scenario's form at any pressure with any overrides.
-struct ModelBuilder {
-    preset: Preset,
-    form: Form,
-    /// The scenario file's own `identified` or `full` overrides, in file order.
-    scenario_overrides: Vec<(String, f64)>,
-}
-
-impl ModelBuilder {
-    fn new(path: &Path, scenario: &Scenario) -> Result<Self> {
-        let form = match scenario.model {
-            Model::Identified(_) => Form::Identified,
-            Model::Full(_) => Form::Full,
-        };
-        // The file has been validated by `Scenario::load`: only its override values are read.
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("reading `{}`", path.display()))?;
-        let raw: Value =
-            serde_json::from_str(&text).with_context(|| format!("parsing `{}`", path.display()))?;
-        let scenario_overrides = raw["model"][form.name()]
-            .as_object()
-            .map(|o| {
-                o.iter()
-                    .filter_map(|(k, v)| v.as_f64().map(|v| (k.clone(), v)))
-                    .collect()
-            })
-            .unwrap_or_default();
-        Ok(Self {
-            preset: scenario.preset,
-            form,
-            scenario_overrides,
-        })
-    }
-
-    /// The model at `pressure_pa` with `sets` (key, value) laid over the scenario's overrides.
-    fn build(&self, pressure_pa: f64, sets: &[(&str, f64)]) -> Result<Model> {
-        let overrides = self
-            .scenario_overrides
-            .iter()
-            .map(|(k, v)| (k.as_str(), *v))
-            .chain(sets.iter().copied());
-        match self.form {
-            Form::Identified => {
-                let mut p = self.preset.identified(pressure_pa)?;
-                for (key, value) in overrides {
-                    if !set_identified(&mut p, key, value) {
-                        return Err(anyhow!("unknown identified parameter `{key}`"));
-                    }
-                }
-                Ok(Model::Identified(p.build()?))
-            }
-            Form::Full => {
-                let mut p = self.preset.physical(pressure_pa)?;
-                for (key, value) in overrides {
-                    if !set_physical(&mut p, key, value) {
-                        return Err(anyhow!("unknown physical parameter `{key}`"));
-                    }
-                }
-                Ok(Model::Full(Box::new(p.build()?)))
-            }
-        }
-    }
 }
 
 /// One case of the grid.
@@ -300,16 +149,19 @@ pub fn run(
     json_out: bool,
 ) -> Result<()> {
     let scenario = Scenario::load(path)?;
-    let builder = ModelBuilder::new(path, &scenario)?;
+    let form = match scenario.model {
+        Model::Identified(_) => Form::Identified,
+        Model::Full(_) => Form::Full,
+    };
     for (i, axis) in sets.iter().enumerate() {
-        if axis.form != builder.form {
+        if axis.form != form {
             usage_error(format!(
                 "--set {}: the scenario `{}` runs the {} model; set {}.NAME parameters instead \
                  (a `full` object in the scenario's model selects the full model)",
                 axis.name(),
                 path.display(),
-                builder.form.name(),
-                builder.form.name(),
+                form.name(),
+                form.name(),
             ));
         }
         if sets[..i].iter().any(|other| other.key == axis.key) {
@@ -319,7 +171,7 @@ pub fn run(
 
     // The base case must reproduce the scenario's own model exactly.
     let base_pressure_mpa = scenario.hold_down_pressure_pa / 1e6;
-    let base = builder.build(scenario.hold_down_pressure_pa, &[])?;
+    let base = scenario.model_at(scenario.hold_down_pressure_pa, &[])?;
     if base != scenario.model {
         return Err(anyhow!(
             "internal error: the sweep's model differs from the scenario's ({})",
@@ -341,12 +193,12 @@ pub fn run(
     for &scale in scales {
         for &(pressure_mpa, pressure_pa) in &pressures {
             for combo in product(sets) {
-                let named: Vec<(&str, f64)> = sets
+                let named: Vec<(ModelKey, f64)> = sets
                     .iter()
                     .zip(&combo)
                     .map(|(axis, &v)| (axis.key, v))
                     .collect();
-                let model = builder.build(pressure_pa, &named).with_context(|| {
+                let model = scenario.model_at(pressure_pa, &named).with_context(|| {
                     format!(
                         "case {} ({}): the model cannot be built; nothing was run",
                         cases.len(),
@@ -368,7 +220,7 @@ pub fn run(
     let outcomes: Vec<Outcome> = cases
         .par_iter()
         .map(|case| {
-            let outcome = run_case(&case.model, &scenario.run, case.scale);
+            let outcome = run_case(case, &scenario.run);
             progress.inc(1);
             outcome
         })
@@ -449,74 +301,21 @@ fn progress_bar(cases: usize) -> ProgressBar {
     bar
 }
 
-/// Runs one case with the excitation multiplied by `scale`, keeping only its peaks.
-fn run_case(model: &Model, run: &Run, scale: f64) -> Outcome {
-    match model {
-        Model::Identified(m) => run_case_on(m, run, scale),
-        Model::Full(m) => run_case_on(&**m, run, scale),
-    }
-}
-
-fn run_case_on<M: PlatenModel>(model: &M, run: &Run, scale: f64) -> Outcome {
-    let mut peaks = Peaks::default();
-    let result = match run {
-        Run::Forward {
-            record,
-            integrator,
-            initial,
-            samples,
-        } => {
-            let scaled;
-            let record = if scale == 1.0 {
-                record
-            } else {
-                let force = record.force_n().iter().map(|f| f * scale).collect();
-                match ForceRecord::new(record.t_s().to_vec(), force) {
-                    Ok(r) => {
-                        scaled = r;
-                        &scaled
-                    }
-                    Err(e) => return failed(e),
-                }
-            };
-            integrator
-                .forward(model, record, *initial, *samples, &mut peaks)
-                .map(Some)
-        }
-        Run::Inverse { motion } => {
-            let scaled;
-            let motion = if scale == 1.0 {
-                motion
-            } else {
-                let times = |c: &[f64]| c.iter().map(|x| x * scale).collect();
-                match Motion::new(
-                    motion.t_s().to_vec(),
-                    times(motion.u_m()),
-                    times(motion.v_m_s()),
-                    times(motion.a_m_s2()),
-                ) {
-                    Ok(m) => {
-                        scaled = m;
-                        &scaled
-                    }
-                    Err(e) => return failed(e),
-                }
-            };
-            inverse(model, motion, &mut peaks);
-            Ok(None)
-        }
+/// Runs one case: its model under the scenario's excitation multiplied by its scale,
+/// keeping only the peaks.
+fn run_case(case: &Case, run: &Run) -> Outcome {
+    let run = match run.scaled(case.scale) {
+        Ok(run) => run,
+        Err(e) => return failed(e),
     };
-    match result {
-        Ok(stats) => Outcome {
+    let mut peaks = Peaks::default();
+    match case.model.run(&run, &mut peaks) {
+        Ok(output) => Outcome {
             peaks,
-            stats,
+            stats: output.stats,
             error: None,
         },
-        Err(e) => Outcome {
-            peaks,
-            stats: None,
-            error: Some(e),
-        },
+        Err(e) => failed(e),
     }
 }
 

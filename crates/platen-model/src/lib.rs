@@ -42,6 +42,7 @@ mod full;
 mod identified;
 mod keys;
 mod law;
+mod physical_keys;
 mod power;
 pub mod preset;
 
@@ -50,6 +51,7 @@ pub use full::{DerivedQuantities, FullModel, PhysicalParams};
 pub use identified::{IdentifiedModel, IdentifiedParams};
 pub use keys::{IdentifiedKey, IDENTIFIED_KEY_NAMES};
 pub use law::DissipativeLaw;
+pub use physical_keys::PhysicalKey;
 pub use power::Exponent;
 pub use preset::{
     Preset, TableLimits, LHPOST_HOLD_DOWN_FORCE_AT_NOMINAL_N, LHPOST_NOMINAL_PRESSURE_PA,

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use platen_integrate::{
-    inverse, ForwardIntegrator, Peaks, RunStats, Sample, SampleSink, Trajectory,
+    inverse, ForwardIntegrator, IntegrateError, Peaks, RunStats, Sample, SampleSink, Trajectory,
 };
 use platen_io::csv::CsvWriter;
 use platen_io::IoError;
@@ -30,9 +30,24 @@ impl Scenario {
     /// [`ScenarioError::Run`] when a forward run fails numerically (the cause names the
     /// time); samples before the failure have been delivered to `sink`.
     pub fn run<S: SampleSink>(&self, sink: &mut S) -> Result<RunOutput> {
-        match &self.model {
-            Model::Identified(m) => run_model(m, &self.run, sink),
-            Model::Full(m) => run_model(&**m, &self.run, sink),
+        self.model.run(&self.run, sink).map_err(ScenarioError::Run)
+    }
+}
+
+impl Model {
+    /// Runs `run` on this model (a sweep's case: another model or a scaled excitation),
+    /// delivering every output sample to `sink`.
+    ///
+    /// # Errors
+    /// The integrator's error when a forward run fails numerically, with its time.
+    pub fn run<S: SampleSink>(
+        &self,
+        run: &Run,
+        sink: &mut S,
+    ) -> std::result::Result<RunOutput, IntegrateError> {
+        match self {
+            Model::Identified(m) => run_model(m, run, sink),
+            Model::Full(m) => run_model(&**m, run, sink),
         }
     }
 }
@@ -42,7 +57,7 @@ fn run_model<M: PlatenModel, S: SampleSink>(
     model: &M,
     run: &Run,
     sink: &mut S,
-) -> Result<RunOutput> {
+) -> std::result::Result<RunOutput, IntegrateError> {
     let mut sink = (sink, Peaks::default());
     let stats = match run {
         Run::Forward {
@@ -50,11 +65,7 @@ fn run_model<M: PlatenModel, S: SampleSink>(
             integrator,
             initial,
             samples,
-        } => Some(
-            integrator
-                .forward(model, record, *initial, *samples, &mut sink)
-                .map_err(ScenarioError::Run)?,
-        ),
+        } => Some(integrator.forward(model, record, *initial, *samples, &mut sink)?),
         Run::Inverse { motion } => {
             inverse(model, motion, &mut sink);
             None

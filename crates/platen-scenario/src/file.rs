@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use schemars::JsonSchema;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use platen_io::columns::ColumnSpec;
 use platen_io::json::parse_json;
@@ -50,7 +50,7 @@ pub struct ModelSpec {
 }
 
 /// Overrides of the identified model; the contract's keys.
-#[derive(Debug, Clone, Default, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, Default, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 #[allow(missing_docs)]
 pub struct IdentifiedOverrides {
@@ -66,7 +66,7 @@ pub struct IdentifiedOverrides {
 /// Overrides of the physical parameters of the full model (see
 /// [`platen_model::PhysicalParams`] for meanings and units). The hold-down pressure is set by
 /// `model.hold_down_pressure_mpa`.
-#[derive(Debug, Clone, Default, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, Default, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 #[allow(missing_docs)]
 pub struct PhysicalOverrides {
@@ -336,4 +336,16 @@ pub fn json_schema() -> serde_json::Value {
         );
     }
     schema
+}
+
+/// The `(name, value)` pairs an overrides object sets (absent fields are not listed), in
+/// alphabetical order of the names.
+pub(crate) fn given_values<T: Serialize>(overrides: &T) -> Vec<(String, f64)> {
+    match serde_json::to_value(overrides) {
+        Ok(serde_json::Value::Object(map)) => map
+            .into_iter()
+            .filter_map(|(k, v)| v.as_f64().map(|v| (k, v)))
+            .collect(),
+        _ => Vec::new(),
+    }
 }

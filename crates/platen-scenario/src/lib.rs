@@ -27,7 +27,7 @@ pub use error::{Result, ScenarioError};
 pub use execute::{CsvSink, RunOutput};
 /// Column maps are part of the scenario format (`excitation.columns`).
 pub use platen_io::columns;
-pub use scenario::{Model, Run, Scenario};
+pub use scenario::{Model, ModelKey, ModelOverrides, Run, Scenario};
 pub use summary::{
     simulate, EnergySummary, ExceedanceSummary, ForwardSummary, LimitCheck, LimitsSummary,
     RunResult, RunSummary, SolverSummary,

@@ -33,12 +33,13 @@ use std::path::Path;
 
 use platen_integrate::IntegrateError;
 use platen_model::{
-    FullModel, IdentifiedModel, IdentifiedParams, PhysicalParams, Preset, TableLimits,
+    FullModel, IdentifiedKey, IdentifiedModel, ModelError, PhysicalKey, Preset, TableLimits,
 };
 
 use crate::ctx::Ctx;
 use crate::error::Result;
 use crate::excitation::build_run;
+use crate::file::given_values;
 use platen_io::json::parse_json_file;
 
 pub use crate::excitation::Run;
@@ -74,6 +75,9 @@ pub struct Scenario {
     pub hold_down_pressure_pa: f64,
     /// The model.
     pub model: Model,
+    /// The form and the values laid over the preset: what rebuilds the model at another
+    /// pressure or with other parameter values ([`Scenario::model_at`]).
+    pub overrides: ModelOverrides,
     /// The table's limits.
     pub limits: TableLimits,
     /// What to run.
@@ -91,9 +95,23 @@ impl Scenario {
             preset: self.preset,
             hold_down_pressure_pa: self.hold_down_pressure_pa,
             model: self.model.clone(),
+            overrides: self.overrides.clone(),
             limits: self.limits,
             run: self.run.scaled(k)?,
         })
+    }
+
+    /// The scenario's model rebuilt from its preset at `pressure_pa`, with the scenario's own
+    /// overrides and then `extra` laid over it (what a sweep varies).
+    ///
+    /// # Errors
+    /// As [`ModelOverrides::build`].
+    pub fn model_at(
+        &self,
+        pressure_pa: f64,
+        extra: &[(ModelKey, f64)],
+    ) -> std::result::Result<Model, ModelError> {
+        self.overrides.build(self.preset, pressure_pa, extra)
     }
 
     /// Reads, parses and validates the scenario at `path`, and loads every record it names.
@@ -127,7 +145,8 @@ impl Scenario {
             Some(p) => p * 1e6,
             None => preset.nominal_pressure_pa(),
         };
-        let model = build_model(&ctx, preset, pressure_pa, &file.model)?;
+        let overrides = model_overrides(&ctx, &file.model)?;
+        let model = build_model(&ctx, preset, pressure_pa, &overrides)?;
         let run = build_run(&ctx, &file)?;
         let name = file.name.clone().unwrap_or_else(|| {
             path.file_stem()
@@ -139,48 +158,140 @@ impl Scenario {
             preset,
             hold_down_pressure_pa: pressure_pa,
             model,
+            overrides,
             limits: preset.limits(),
             run,
         })
     }
 }
 
-macro_rules! lay_over {
-    ($target:expr, $over:expr, [$($field:ident),* $(,)?]) => {
-        $( if let Some(v) = $over.$field { $target.$field = v; } )*
-    };
+/// A model parameter of either form, by its contract name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ModelKey {
+    /// One of the identified model's seven keys.
+    Identified(IdentifiedKey),
+    /// A physical parameter of the full model.
+    Full(PhysicalKey),
 }
 
-fn build_model(ctx: &Ctx, preset: Preset, pressure_pa: f64, spec: &ModelSpec) -> Result<Model> {
-    match (&spec.identified, &spec.full) {
-        (Some(_), Some(_)) => Err(ctx.invalid(
+impl ModelKey {
+    /// `"identified"` or `"full"`: the form the key belongs to.
+    pub fn form(self) -> &'static str {
+        match self {
+            ModelKey::Identified(_) => "identified",
+            ModelKey::Full(_) => "full",
+        }
+    }
+
+    /// The key's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelKey::Identified(k) => k.name(),
+            ModelKey::Full(k) => k.name(),
+        }
+    }
+}
+
+/// The values a scenario lays over its preset: the model form and its overrides.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelOverrides {
+    full: bool,
+    values: Vec<(ModelKey, f64)>,
+}
+
+impl ModelOverrides {
+    /// `"identified"` or `"full"`.
+    pub fn form(&self) -> &'static str {
+        if self.full {
+            "full"
+        } else {
+            "identified"
+        }
+    }
+
+    /// The model of `preset` at `pressure_pa` with these overrides and then `extra` laid
+    /// over it.
+    ///
+    /// # Errors
+    /// [`ModelError::InvalidParameter`] for a value the model rejects, or
+    /// [`ModelError::UnknownParameter`] for a key of the other form.
+    pub fn build(
+        &self,
+        preset: Preset,
+        pressure_pa: f64,
+        extra: &[(ModelKey, f64)],
+    ) -> std::result::Result<Model, ModelError> {
+        let values = self.values.iter().chain(extra);
+        if self.full {
+            let mut p = preset.physical(pressure_pa)?;
+            for &(key, value) in values {
+                match key {
+                    ModelKey::Full(k) => p.set(k, value),
+                    other => return Err(wrong_form("full", other)),
+                }
+            }
+            Ok(Model::Full(Box::new(p.build()?)))
+        } else {
+            let mut p = preset.identified(pressure_pa)?;
+            for &(key, value) in values {
+                match key {
+                    ModelKey::Identified(k) => p.set(k, value),
+                    other => return Err(wrong_form("identified", other)),
+                }
+            }
+            Ok(Model::Identified(p.build()?))
+        }
+    }
+}
+
+/// A key of the other form, reported as an unknown parameter of `form`.
+fn wrong_form(form: &'static str, key: ModelKey) -> ModelError {
+    ModelError::UnknownParameter {
+        form,
+        name: key.name().to_owned(),
+        known: format!("the parameters of the {form} model"),
+    }
+}
+
+/// The scenario's model form and overrides, validated by name.
+fn model_overrides(ctx: &Ctx, spec: &ModelSpec) -> Result<ModelOverrides> {
+    let (full, given, section) = match (&spec.identified, &spec.full) {
+        (Some(_), Some(_)) => return Err(ctx.invalid(
             "model",
             "{identified, full}",
             "either an `identified` object (identified model) or a `full` object (full Lagrangian model), not both",
         )),
-        (_, Some(over)) => {
-            let mut p: PhysicalParams = preset.physical(pressure_pa).map_err(|e| ctx.model_error("model.full", e))?;
-            lay_over!(p, over, [
-                platen_mass_kg, actuator_moving_mass_kg, strut_piston_mass_kg, strut_cylinder_mass_kg,
-                strut_height_m, strut_piston_length_m, strut_area_m2, gas_heat_capacity_ratio,
-                supported_weight_n, bearing_friction_coefficient, lateral_friction_coefficient,
-                lateral_normal_force_n, hinge_swivel_friction_coefficient, hinge_radius_m,
-                hinge_force_distribution_factor, viscous_coefficient, viscous_exponent,
-                strut_viscous_coefficient, strut_viscous_exponent, low_velocity_force_n,
-                low_velocity_decay_s_per_m,
-            ]);
-            p.build().map(|m| Model::Full(Box::new(m))).map_err(|e| ctx.model_error("model.full", e))
-        }
-        (over, None) => {
-            let mut p: IdentifiedParams =
-                preset.identified(pressure_pa).map_err(|e| ctx.model_error("model.identified", e))?;
-            if let Some(over) = over {
-                lay_over!(p, over, [
-                    effective_mass_kg, stiffness_n_per_m, coulomb_force_n, viscous_coefficient,
-                    viscous_exponent, low_velocity_force_n, low_velocity_decay_s_per_m,
-                ]);
-            }
-            p.build().map(Model::Identified).map_err(|e| ctx.model_error("model.identified", e))
-        }
-    }
+        (_, Some(over)) => (true, given_values(over), "model.full"),
+        (Some(over), None) => (false, given_values(over), "model.identified"),
+        (None, None) => (false, Vec::new(), "model.identified"),
+    };
+    let values = given
+        .into_iter()
+        .map(|(name, value)| {
+            let key = if full {
+                PhysicalKey::from_name(&name).map(ModelKey::Full)
+            } else {
+                IdentifiedKey::from_name(&name).map(ModelKey::Identified)
+            };
+            key.map(|k| (k, value))
+                .map_err(|e| ctx.model_error(section, e))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok(ModelOverrides { full, values })
+}
+
+fn build_model(
+    ctx: &Ctx,
+    preset: Preset,
+    pressure_pa: f64,
+    overrides: &ModelOverrides,
+) -> Result<Model> {
+    let section = if overrides.full {
+        "model.full"
+    } else {
+        "model.identified"
+    };
+    overrides
+        .build(preset, pressure_pa, &[])
+        .map_err(|e| ctx.model_error(section, e))
 }
