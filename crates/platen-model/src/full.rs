@@ -1,7 +1,7 @@
 //! The full Lagrangian model of the paper (Eq. 1–8), built from physical parameters.
 
 use crate::error::{finite, non_negative, positive, unit_exponent, ModelError, Result};
-use crate::{DissipativeLaw, Exponent, PlatenModel};
+use crate::{DissipativeLaw, Exponent, IdentifiedParams, PlatenModel};
 
 /// Physical parameters of a platen with two inclined nitrogen hold-down struts (paper §2).
 ///
@@ -246,6 +246,22 @@ impl FullModel {
     /// The derived quantities of Eq. 5–8.
     pub fn derived(&self) -> &DerivedQuantities {
         &self.derived
+    }
+
+    /// The seven identified parameters this model reduces to for small strokes (the terms in
+    /// `u/h` dropped): `Mₑ`, `Kₑ`, `F_μ` of Eq. 5–8 and the actuator's viscous and
+    /// low-velocity terms.
+    pub fn identified_equivalent(&self) -> IdentifiedParams {
+        let (p, d) = (self.params(), self.derived());
+        IdentifiedParams {
+            effective_mass_kg: d.effective_mass_kg,
+            stiffness_n_per_m: d.stiffness_n_per_m,
+            coulomb_force_n: d.coulomb_force_n,
+            viscous_coefficient: p.viscous_coefficient,
+            viscous_exponent: p.viscous_exponent,
+            low_velocity_force_n: p.low_velocity_force_n,
+            low_velocity_decay_s_per_m: p.low_velocity_decay_s_per_m,
+        }
     }
 
     /// The dissipative law `F_μ + Cₑ|v|^α + a·e^(−b|v|)` of Eq. 4 (without the strut terms),
