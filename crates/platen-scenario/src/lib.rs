@@ -22,6 +22,7 @@ pub mod recorded;
 pub mod sampling;
 pub mod scenario;
 mod summary;
+pub mod sweep;
 
 pub use error::{Result, ScenarioError};
 pub use execute::{CsvSink, RunOutput};

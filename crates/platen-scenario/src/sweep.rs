@@ -1,0 +1,376 @@
+//! Batch sweeps: the Cartesian product of excitation scales, hold-down pressures and model
+//! parameter values over one scenario, run in parallel on every core (rayon), one row of
+//! peaks and counters per case. The rows are in case order, so the output has the same bytes
+//! whatever the number of threads.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use rayon::prelude::*;
+use serde_json::{json, Map, Value};
+
+use platen_integrate::{IntegrateError, Peaks, RunStats};
+use platen_io::csv::write_number;
+use platen_model::ModelError;
+
+use crate::scenario::{Model, ModelKey, Run, Scenario};
+
+/// One parameter axis: `FORM.KEY` and its values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SetAxis {
+    /// `identified.KEY` or `full.KEY`, the column name of the axis.
+    pub name: String,
+    /// The parameter.
+    pub key: ModelKey,
+    /// Its values, in order.
+    pub values: Vec<f64>,
+}
+
+/// A case whose model cannot be built: nothing runs.
+#[derive(Debug, thiserror::Error)]
+#[error("case {case} ({description}): the model cannot be built; nothing was run")]
+pub struct CaseError {
+    /// The case's index.
+    pub case: usize,
+    /// Its scale, pressure and parameter values.
+    pub description: String,
+    /// Why the model is rejected.
+    #[source]
+    pub source: ModelError,
+}
+
+/// The grid of a sweep: every case's model, built (and so validated) before anything runs.
+#[derive(Debug, Clone)]
+pub struct Sweep {
+    /// The cases in order: scale varies slowest, then pressure, then each axis in order.
+    pub cases: Vec<Case>,
+    /// The column names of the parameter axes.
+    pub set_names: Vec<String>,
+}
+
+impl Sweep {
+    /// The grid over `scenario`: an empty `scales` or `pressures_mpa` holds the scenario's
+    /// own value.
+    ///
+    /// # Errors
+    /// [`CaseError`] for the first case whose model cannot be built.
+    pub fn new(
+        scenario: &Scenario,
+        scales: &[f64],
+        pressures_mpa: &[f64],
+        sets: &[SetAxis],
+    ) -> Result<Self, CaseError> {
+        let scales = if scales.is_empty() {
+            &[1.0][..]
+        } else {
+            scales
+        };
+        let pressures: Vec<(f64, f64)> = if pressures_mpa.is_empty() {
+            vec![(
+                scenario.hold_down_pressure_pa / 1e6,
+                scenario.hold_down_pressure_pa,
+            )]
+        } else {
+            pressures_mpa.iter().map(|&p| (p, p * 1e6)).collect()
+        };
+        let mut cases = Vec::new();
+        for &scale in scales {
+            for &(pressure_mpa, pressure_pa) in &pressures {
+                for combo in product(sets) {
+                    let named: Vec<(ModelKey, f64)> = sets
+                        .iter()
+                        .zip(&combo)
+                        .map(|(axis, &v)| (axis.key, v))
+                        .collect();
+                    let model =
+                        scenario
+                            .model_at(pressure_pa, &named)
+                            .map_err(|source| CaseError {
+                                case: cases.len(),
+                                description: describe(scale, pressure_mpa, sets, &combo),
+                                source,
+                            })?;
+                    cases.push(Case {
+                        scale,
+                        pressure_mpa,
+                        sets: combo,
+                        model,
+                    });
+                }
+            }
+        }
+        Ok(Self {
+            cases,
+            set_names: sets.iter().map(|a| a.name.clone()).collect(),
+        })
+    }
+
+    /// Runs every case in parallel under `run` (the scenario's excitation), calling
+    /// `progress` after each; the outcomes are in case order.
+    pub fn run(&self, run: &Run, progress: impl Fn() + Sync) -> Vec<Outcome> {
+        self.cases
+            .par_iter()
+            .map(|case| {
+                let outcome = run_case(case, run);
+                progress();
+                outcome
+            })
+            .collect()
+    }
+}
+
+/// One case of the grid.
+#[derive(Debug, Clone)]
+pub struct Case {
+    /// The factor on the excitation.
+    pub scale: f64,
+    /// The hold-down pressure, MPa.
+    pub pressure_mpa: f64,
+    /// One value per `--set` axis.
+    pub sets: Vec<f64>,
+    /// The case's model.
+    pub model: Model,
+}
+
+/// What a case produced.
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    /// The peaks of the run.
+    pub peaks: Peaks,
+    /// Solver statistics of a forward run.
+    pub stats: Option<RunStats>,
+    /// The numerical failure, if the case failed.
+    pub error: Option<IntegrateError>,
+}
+
+/// Every combination of the `--set` axes' values, the last axis varying fastest.
+fn product(sets: &[SetAxis]) -> Vec<Vec<f64>> {
+    let mut combos = vec![Vec::new()];
+    for axis in sets {
+        combos = combos
+            .into_iter()
+            .flat_map(|prefix| {
+                axis.values.iter().map(move |&v| {
+                    let mut c = prefix.clone();
+                    c.push(v);
+                    c
+                })
+            })
+            .collect();
+    }
+    combos
+}
+
+fn describe(scale: f64, pressure_mpa: f64, sets: &[SetAxis], values: &[f64]) -> String {
+    let mut s = format!("scale {scale}, {pressure_mpa} MPa");
+    for (axis, v) in sets.iter().zip(values) {
+        let _ = write!(s, ", {} = {v}", axis.name);
+    }
+    s
+}
+
+/// Runs one case: its model under the scenario's excitation multiplied by its scale,
+/// keeping only the peaks.
+fn run_case(case: &Case, run: &Run) -> Outcome {
+    let run = match run.scaled(case.scale) {
+        Ok(run) => run,
+        Err(e) => return failed(e),
+    };
+    let mut peaks = Peaks::default();
+    match case.model.run(&run, &mut peaks) {
+        Ok(output) => Outcome {
+            peaks,
+            stats: output.stats,
+            error: None,
+        },
+        Err(e) => failed(e),
+    }
+}
+
+fn failed(e: IntegrateError) -> Outcome {
+    Outcome {
+        peaks: Peaks::default(),
+        stats: None,
+        error: Some(e),
+    }
+}
+
+/// The limits a case's peaks exceed: `"stroke;velocity"`, or `"none"`.
+pub fn exceeded(scenario: &Scenario, peaks: &Peaks) -> String {
+    let names: Vec<&str> = peaks
+        .exceedances(&scenario.limits)
+        .iter()
+        .map(|e| e.quantity)
+        .collect();
+    if names.is_empty() {
+        "none".to_owned()
+    } else {
+        names.join(";")
+    }
+}
+
+/// `ok`, or `failed: …` with the case's error.
+pub fn status(outcome: &Outcome) -> String {
+    match &outcome.error {
+        None => "ok".to_owned(),
+        Some(e) => format!("failed: {e}"),
+    }
+}
+
+/// A CSV field holding free text, quoted when it needs to be.
+fn text_field(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_owned()
+    }
+}
+
+/// Column names of the sweep CSV.
+fn header(set_names: &[String]) -> Vec<String> {
+    let mut h = vec![
+        "case".to_owned(),
+        "scale".to_owned(),
+        "hold_down_pressure_mpa".to_owned(),
+    ];
+    h.extend(set_names.iter().cloned());
+    h.extend(
+        [
+            "peak_u_m",
+            "peak_v_m_s",
+            "peak_a_m_s2",
+            "peak_force_n",
+            "stick_time_s",
+            "events",
+            "limits_exceeded",
+            "status",
+        ]
+        .map(str::to_owned),
+    );
+    h
+}
+
+/// The sweep CSV: one row per case in case order. Numbers in the shortest round-trip form of
+/// the time-series CSVs; `stick_time_s` and `events` are empty for inverse runs, and every
+/// result column but `status` is empty for a case that failed.
+pub fn csv_text(
+    scenario: &Scenario,
+    set_names: &[String],
+    cases: &[Case],
+    outs: &[Outcome],
+) -> String {
+    let mut text = header(set_names).join(",");
+    text.push('\n');
+    let mut buf = Vec::new();
+    let mut number = |text: &mut String, v: f64| {
+        buf.clear();
+        // Writing to a Vec cannot fail.
+        let _ = write_number(&mut buf, v);
+        text.push_str(std::str::from_utf8(&buf).unwrap_or_default());
+        text.push(',');
+    };
+    for (i, (case, o)) in cases.iter().zip(outs).enumerate() {
+        let _ = write!(text, "{i},");
+        number(&mut text, case.scale);
+        number(&mut text, case.pressure_mpa);
+        for &v in &case.sets {
+            number(&mut text, v);
+        }
+        if o.error.is_some() {
+            // Peaks up to a numerical failure mean nothing: leave them out.
+            let _ = writeln!(text, ",,,,,,,{}", text_field(&status(o)));
+            continue;
+        }
+        for v in [
+            o.peaks.u_m.value,
+            o.peaks.v_m_s.value,
+            o.peaks.a_m_s2.value,
+            o.peaks.force_n.value,
+        ] {
+            number(&mut text, v);
+        }
+        match &o.stats {
+            Some(st) => {
+                number(&mut text, st.stick_time_s);
+                let _ = write!(text, "{},", st.events());
+            }
+            None => text.push_str(",,"),
+        }
+        let _ = writeln!(
+            text,
+            "{},{}",
+            exceeded(scenario, &o.peaks),
+            text_field(&status(o))
+        );
+    }
+    text
+}
+
+/// The `--json` summary of a sweep: the scenario, counts, and one object per case.
+pub fn json_summary(
+    path: &Path,
+    scenario: &Scenario,
+    set_names: &[String],
+    cases: &[Case],
+    outs: &[Outcome],
+    out: Option<&Path>,
+) -> Value {
+    let rows: Vec<Value> = cases
+        .iter()
+        .zip(outs)
+        .enumerate()
+        .map(|(i, (case, o))| {
+            let mut m = Map::new();
+            m.insert("case".into(), json!(i));
+            m.insert("scale".into(), json!(case.scale));
+            m.insert("hold_down_pressure_mpa".into(), json!(case.pressure_mpa));
+            let set: Map<String, Value> = set_names
+                .iter()
+                .zip(&case.sets)
+                .map(|(n, v)| (n.clone(), json!(v)))
+                .collect();
+            m.insert("set".into(), Value::Object(set));
+            m.insert("status".into(), json!(status(o)));
+            if o.error.is_some() {
+                return Value::Object(m);
+            }
+            for (key, peak) in [
+                ("peak_u_m", o.peaks.u_m),
+                ("peak_v_m_s", o.peaks.v_m_s),
+                ("peak_a_m_s2", o.peaks.a_m_s2),
+                ("peak_force_n", o.peaks.force_n),
+            ] {
+                m.insert(key.into(), json!(peak.value));
+                m.insert(format!("{key}_t_s"), json!(peak.t_s));
+            }
+            m.insert(
+                "stick_time_s".into(),
+                json!(o.stats.map(|s| s.stick_time_s)),
+            );
+            m.insert("events".into(), json!(o.stats.map(|s| s.events())));
+            let exceed: Vec<Value> = o
+                .peaks
+                .exceedances(&scenario.limits)
+                .iter()
+                .map(|e| json!({"quantity": e.quantity, "peak": e.peak, "limit": e.limit, "t_s": e.t_s}))
+                .collect();
+            m.insert("limit_exceedances".into(), Value::Array(exceed));
+            Value::Object(m)
+        })
+        .collect();
+    json!({
+        "scenario": path.display().to_string(),
+        "name": scenario.name,
+        "direction": match scenario.run { Run::Forward { .. } => "forward", Run::Inverse { .. } => "inverse" },
+        "model_form": scenario.model.form(),
+        "preset": scenario.preset.name(),
+        "cases": cases.len(),
+        "failed": outs.iter().filter(|o| o.error.is_some()).count(),
+        "exceeding_a_limit": outs
+            .iter()
+            .filter(|o| o.error.is_none() && !o.peaks.exceedances(&scenario.limits).is_empty())
+            .count(),
+        "out": out.map(|p| p.display().to_string()),
+        "results": rows,
+    })
+}
