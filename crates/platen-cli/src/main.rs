@@ -222,8 +222,18 @@ pub(crate) enum Form {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
-    let result = match cli.command {
+    match run(Cli::parse().command) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(exit_code(&e))
+        }
+    }
+}
+
+/// Runs one verb.
+fn run(command: Command) -> anyhow::Result<()> {
+    match command {
         Command::Simulate {
             scenario,
             out,
@@ -296,13 +306,6 @@ fn main() -> ExitCode {
             report: report.as_deref(),
             columns: columns.as_deref(),
         }),
-    };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::from(exit_code(&e))
-        }
     }
 }
 
