@@ -141,35 +141,7 @@ pub fn read_table(path: &Path, required: &[&str], optional: &[&str]) -> Result<T
         .from_reader(file);
     let mut record = StringRecord::new();
 
-    // Header row.
-    if !reader
-        .read_record(&mut record)
-        .map_err(|e| csv_error(path, e, 1))?
-    {
-        return Err(IoError::Empty {
-            path: path.to_path_buf(),
-        });
-    }
-    let (_, skipped) = locate(&record, reader.position(), unterminated_end);
-    if skipped > 0 {
-        return Err(syntax(
-            path,
-            1,
-            "expected the header row on line 1, found a blank line",
-        ));
-    }
-    let header: Vec<String> = record
-        .iter()
-        .enumerate()
-        .map(|(i, name)| {
-            let name = if i == 0 {
-                name.trim_start_matches('\u{feff}')
-            } else {
-                name
-            };
-            name.trim().to_owned()
-        })
-        .collect();
+    let header = read_header(path, &mut reader, &mut record, unterminated_end)?;
     let selection = select_columns(path, &header, required, optional)?;
     let time_slot = selection.iter().position(|(_, name)| name == TIME_COLUMN);
 
@@ -202,18 +174,7 @@ pub fn read_table(path: &Path, required: &[&str], optional: &[&str]) -> Result<T
                 "blank line inside the data (only trailing blank lines are allowed)",
             ));
         }
-        if record.len() != header.len() {
-            return Err(IoError::RaggedRow {
-                path: path.to_path_buf(),
-                line,
-                expected: header.len(),
-                found: record.len(),
-            });
-        }
-        for ((index, name), column) in selection.iter().zip(columns.iter_mut()) {
-            let cell = record.get(*index).unwrap_or_default();
-            column.push(parse_cell(path, line, name, cell)?);
-        }
+        push_row(path, line, &record, header.len(), &selection, &mut columns)?;
         if let Some(slot) = time_slot {
             let t = columns[slot][rows];
             if t <= previous_t {
@@ -240,6 +201,67 @@ pub fn read_table(path: &Path, required: &[&str], optional: &[&str]) -> Result<T
         columns,
         rows,
     })
+}
+
+/// Reads the header row (line 1): names trimmed, a UTF-8 byte-order mark dropped.
+fn read_header(
+    path: &Path,
+    reader: &mut csv::Reader<File>,
+    record: &mut StringRecord,
+    unterminated_end: Option<u64>,
+) -> Result<Vec<String>> {
+    if !reader
+        .read_record(record)
+        .map_err(|e| csv_error(path, e, 1))?
+    {
+        return Err(IoError::Empty {
+            path: path.to_path_buf(),
+        });
+    }
+    let (_, skipped) = locate(record, reader.position(), unterminated_end);
+    if skipped > 0 {
+        return Err(syntax(
+            path,
+            1,
+            "expected the header row on line 1, found a blank line",
+        ));
+    }
+    Ok(record
+        .iter()
+        .enumerate()
+        .map(|(i, name)| {
+            let name = if i == 0 {
+                name.trim_start_matches('\u{feff}')
+            } else {
+                name
+            };
+            name.trim().to_owned()
+        })
+        .collect())
+}
+
+/// Appends the selected cells of the data row `record` (on `line`) to `columns`.
+fn push_row(
+    path: &Path,
+    line: u64,
+    record: &StringRecord,
+    fields: usize,
+    selection: &[(usize, String)],
+    columns: &mut [Vec<f64>],
+) -> Result<()> {
+    if record.len() != fields {
+        return Err(IoError::RaggedRow {
+            path: path.to_path_buf(),
+            line,
+            expected: fields,
+            found: record.len(),
+        });
+    }
+    for ((index, name), column) in selection.iter().zip(columns.iter_mut()) {
+        let cell = record.get(*index).unwrap_or_default();
+        column.push(parse_cell(path, line, name, cell)?);
+    }
+    Ok(())
 }
 
 /// Resolves the requested names to header indices: `(index in the header, name)`.

@@ -104,47 +104,14 @@ pub fn read_peer(path: &Path) -> Result<PeerRecord> {
         ));
     }
     let description = next(2)?.trim().to_owned();
-    let l3 = next(3)?.to_ascii_uppercase();
-    let (quantity, scale) = if l3.contains("ACCELERATION") && l3.contains("UNITS OF G") {
-        (Quantity::Acceleration, STANDARD_GRAVITY_M_S2)
-    } else if l3.contains("VELOCITY") && l3.contains("CM/S") {
-        (Quantity::Velocity, 0.01)
-    } else if l3.contains("DISPLACEMENT") && l3.contains("CM") {
-        (Quantity::Displacement, 0.01)
-    } else {
-        return Err(header_error(
-            path,
-            3,
-            format!(
-                "expected `ACCELERATION … IN UNITS OF G`, `VELOCITY … CM/S` or `DISPLACEMENT … CM`, found {:?}",
-                l3.trim()
-            ),
-        ));
-    };
+    let (quantity, scale) = quantity_of(path, next(3)?)?;
     let l4 = next(4)?;
     let (npts, dt_s) = parse_npts_dt(l4).map_err(|m| header_error(path, 4, m))?;
     // NPTS comes from the file: never trust it for an allocation (a value needs at least two
     // bytes of text, so the text bounds the count).
     let mut values = Vec::with_capacity(npts.min(text.len() / 2));
     for (i, line) in text.lines().enumerate().skip(4) {
-        let line_no = i as u64 + 1;
-        for token in line.split_whitespace() {
-            let v: f64 = parse_fortran(token).ok_or_else(|| IoError::NonNumeric {
-                path: path.to_owned(),
-                line: line_no,
-                column: "value".to_owned(),
-                value: token.to_owned(),
-            })?;
-            if !v.is_finite() {
-                return Err(IoError::NonFinite {
-                    path: path.to_owned(),
-                    line: line_no,
-                    column: "value".to_owned(),
-                    value: token.to_owned(),
-                });
-            }
-            values.push(v * scale);
-        }
+        parse_values(path, i as u64 + 1, line, scale, &mut values)?;
     }
     if values.len() != npts {
         return Err(header_error(
@@ -170,6 +137,55 @@ pub fn read_peer(path: &Path) -> Result<PeerRecord> {
         dt_s,
         values,
     })
+}
+
+/// The quantity of header line 3 and the factor from the file's unit to SI.
+fn quantity_of(path: &Path, line: &str) -> Result<(Quantity, f64)> {
+    let l3 = line.to_ascii_uppercase();
+    if l3.contains("ACCELERATION") && l3.contains("UNITS OF G") {
+        Ok((Quantity::Acceleration, STANDARD_GRAVITY_M_S2))
+    } else if l3.contains("VELOCITY") && l3.contains("CM/S") {
+        Ok((Quantity::Velocity, 0.01))
+    } else if l3.contains("DISPLACEMENT") && l3.contains("CM") {
+        Ok((Quantity::Displacement, 0.01))
+    } else {
+        Err(header_error(
+            path,
+            3,
+            format!(
+                "expected `ACCELERATION … IN UNITS OF G`, `VELOCITY … CM/S` or `DISPLACEMENT … CM`, found {:?}",
+                l3.trim()
+            ),
+        ))
+    }
+}
+
+/// Parses the values of data line `line_no`, in SI units, onto `values`.
+fn parse_values(
+    path: &Path,
+    line_no: u64,
+    line: &str,
+    scale: f64,
+    values: &mut Vec<f64>,
+) -> Result<()> {
+    for token in line.split_whitespace() {
+        let v: f64 = parse_fortran(token).ok_or_else(|| IoError::NonNumeric {
+            path: path.to_owned(),
+            line: line_no,
+            column: "value".to_owned(),
+            value: token.to_owned(),
+        })?;
+        if !v.is_finite() {
+            return Err(IoError::NonFinite {
+                path: path.to_owned(),
+                line: line_no,
+                column: "value".to_owned(),
+                value: token.to_owned(),
+            });
+        }
+        values.push(v * scale);
+    }
+    Ok(())
 }
 
 /// Parses `NPTS=   2000, DT=   .0200 SEC` and its variants.
