@@ -33,40 +33,6 @@ pub trait ForwardIntegrator {
     ) -> Result<RunStats>;
 }
 
-impl ForwardIntegrator for Rk4 {
-    fn name(&self) -> &'static str {
-        "rk4"
-    }
-
-    fn forward<M: PlatenModel, S: SampleSink>(
-        &self,
-        model: &M,
-        record: &ForceRecord,
-        initial: State,
-        samples: usize,
-        sink: &mut S,
-    ) -> Result<RunStats> {
-        forward_rk4(model, record, *self, initial, samples, sink)
-    }
-}
-
-impl ForwardIntegrator for Dopri5Settings {
-    fn name(&self) -> &'static str {
-        "dopri5"
-    }
-
-    fn forward<M: PlatenModel, S: SampleSink>(
-        &self,
-        model: &M,
-        record: &ForceRecord,
-        initial: State,
-        samples: usize,
-        sink: &mut S,
-    ) -> Result<RunStats> {
-        forward_dopri5(model, record, *self, initial, samples, sink)
-    }
-}
-
 /// The integrator of a forward run, as a scenario selects it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Method {
@@ -79,8 +45,8 @@ pub enum Method {
 impl ForwardIntegrator for Method {
     fn name(&self) -> &'static str {
         match self {
-            Method::Rk4(rk4) => rk4.name(),
-            Method::Dopri5(settings) => settings.name(),
+            Method::Rk4(_) => "rk4",
+            Method::Dopri5(_) => "dopri5",
         }
     }
 
@@ -93,8 +59,10 @@ impl ForwardIntegrator for Method {
         sink: &mut S,
     ) -> Result<RunStats> {
         match self {
-            Method::Rk4(rk4) => rk4.forward(model, record, initial, samples, sink),
-            Method::Dopri5(settings) => settings.forward(model, record, initial, samples, sink),
+            Method::Rk4(rk4) => forward_rk4(model, record, *rk4, initial, samples, sink),
+            Method::Dopri5(settings) => {
+                forward_dopri5(model, record, *settings, initial, samples, sink)
+            }
         }
     }
 }

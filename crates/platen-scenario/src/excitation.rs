@@ -125,34 +125,22 @@ enum Source<'a> {
 impl<'a> Source<'a> {
     /// The one source of `ex`, or an error listing those given.
     fn of(ctx: &Ctx, ex: &'a ExcitationSpec) -> Result<Self> {
-        let mut given: Vec<(&str, Source<'a>)> = Vec::new();
-        let mut add = |name, source: Option<Source<'a>>| given.extend(source.map(|s| (name, s)));
-        add("force_csv", ex.force_csv.as_deref().map(Source::ForceCsv));
-        add(
-            "motion_csv",
+        let given: Vec<Source<'a>> = [
+            ex.force_csv.as_deref().map(Source::ForceCsv),
             ex.motion_csv.as_deref().map(Source::MotionCsv),
-        );
-        add("sine_force", ex.sine_force.as_ref().map(Source::SineForce));
-        add(
-            "sine_motion",
+            ex.sine_force.as_ref().map(Source::SineForce),
             ex.sine_motion.as_ref().map(Source::SineMotion),
-        );
-        add(
-            "triangle_motion",
             ex.triangle_motion.as_ref().map(Source::TriangleMotion),
-        );
-        add(
-            "white_noise_motion",
             ex.white_noise_motion.as_ref().map(Source::WhiteNoiseMotion),
-        );
-        add(
-            "ground_motion",
             ex.ground_motion.as_ref().map(Source::GroundMotion),
-        );
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
         match given.as_slice() {
-            [(_, source)] => Ok(*source),
+            [source] => Ok(*source),
             _ => {
-                let names: Vec<&str> = given.iter().map(|(name, _)| *name).collect();
+                let names: Vec<&str> = given.iter().map(|source| source.name()).collect();
                 Err(ctx.invalid(
                     "excitation",
                     format!("{{{}}}", names.join(", ")),
