@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+use platen_io::IoError;
 use platen_model::ModelError;
 
 use crate::error::{Result, ScenarioError};
@@ -19,12 +20,12 @@ impl Ctx<'_> {
         value: impl ToString,
         expected: impl Into<String>,
     ) -> ScenarioError {
-        ScenarioError::InvalidField {
+        ScenarioError::Io(IoError::InvalidField {
             path: self.path.to_owned(),
             json_path: json_path.to_owned(),
             value: value.to_string(),
             expected: expected.into(),
-        }
+        })
     }
 
     pub(crate) fn resolve(&self, relative: &Path) -> PathBuf {

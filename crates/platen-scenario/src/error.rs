@@ -22,22 +22,10 @@ pub type Result<T, E = ScenarioError> = std::result::Result<T, E>;
 #[derive(Debug, thiserror::Error)]
 pub enum ScenarioError {
     /// A file the scenario reads (the scenario itself, a record, a column map) cannot be read
-    /// or parsed, or an output cannot be written.
+    /// or parsed, a scenario field has a value that cannot be used
+    /// ([`IoError::InvalidField`], with its JSON path), or an output cannot be written.
     #[error(transparent)]
     Io(#[from] IoError),
-
-    /// A scenario field has a value that cannot be used.
-    #[error("`{}`: {json_path} = {value}: expected {expected}", path.display())]
-    InvalidField {
-        /// Scenario file.
-        path: PathBuf,
-        /// JSON path of the field.
-        json_path: String,
-        /// The offending value, as written.
-        value: String,
-        /// What a valid value looks like.
-        expected: String,
-    },
 
     /// A record is shorter than the scenario's `duration_s`.
     #[error("`{}`: record spans {span_s} s{} but the scenario's duration_s is {duration_s} s", path.display(), samples.map_or(String::new(), |n| format!(" ({n} samples)")))]
