@@ -26,38 +26,9 @@ use platen_integrate::IntegrateError;
 use platen_io::write_bytes_atomic;
 use platen_model::{IdentifiedKey, PhysicalKey};
 use platen_scenario::sweep::{self, Case, Outcome, Sweep};
-use platen_scenario::{Model, ModelKey, Scenario};
+use platen_scenario::{ModelKey, Scenario};
 
-/// Which form of the model a parameter belongs to.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Form {
-    Identified,
-    Full,
-}
-
-impl Form {
-    fn name(self) -> &'static str {
-        match self {
-            Form::Identified => "identified",
-            Form::Full => "full",
-        }
-    }
-}
-
-/// One `--set FORM.KEY=V1,V2,…` axis.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SetAxis {
-    pub form: Form,
-    pub key: ModelKey,
-    pub values: Vec<f64>,
-}
-
-impl SetAxis {
-    /// `FORM.KEY`, the column name of the axis.
-    fn name(&self) -> String {
-        format!("{}.{}", self.form.name(), self.key.name())
-    }
-}
+pub use platen_scenario::sweep::SetAxis;
 
 fn parse_number(s: &str) -> std::result::Result<f64, String> {
     match s.trim().parse::<f64>() {
@@ -89,18 +60,19 @@ pub fn parse_set(s: &str) -> std::result::Result<SetAxis, String> {
         ));
     };
     let name = name.trim();
-    let (form, key) = match name.split_once('.') {
-        Some(("identified", key)) => (Form::Identified, key),
-        Some(("full", key)) => (Form::Full, key),
+    let (full, key) = match name.split_once('.') {
+        Some(("identified", key)) => (false, key),
+        Some(("full", key)) => (true, key),
         _ => {
             return Err(format!(
                 "`{name}`: expected identified.NAME or full.NAME (e.g. identified.coulomb_force_n)"
             ))
         }
     };
-    let key = match form {
-        Form::Identified => IdentifiedKey::from_name(key).map(ModelKey::Identified),
-        Form::Full => PhysicalKey::from_name(key).map(ModelKey::Full),
+    let key = if full {
+        PhysicalKey::from_name(key).map(ModelKey::Full)
+    } else {
+        IdentifiedKey::from_name(key).map(ModelKey::Identified)
     }
     .map_err(|e| {
         format!(
@@ -117,7 +89,11 @@ pub fn parse_set(s: &str) -> std::result::Result<SetAxis, String> {
         .map(parse_number)
         .collect::<std::result::Result<Vec<f64>, String>>()
         .map_err(|e| format!("`{name}`: {e}"))?;
-    Ok(SetAxis { form, key, values })
+    Ok(SetAxis {
+        name: name.to_owned(),
+        key,
+        values,
+    })
 }
 
 /// Runs every case of the grid over the scenario at `path` and reports one row per case.
@@ -139,15 +115,7 @@ pub fn run(
             path.display()
         ));
     }
-    let axes: Vec<sweep::SetAxis> = sets
-        .iter()
-        .map(|a| sweep::SetAxis {
-            name: a.name(),
-            key: a.key,
-            values: a.values.clone(),
-        })
-        .collect();
-    let grid = Sweep::new(&scenario, scales, pressures_mpa, &axes)?;
+    let grid = Sweep::new(&scenario, scales, pressures_mpa, sets)?;
     let progress = progress_bar(grid.cases.len());
     let start = Instant::now();
     let outcomes = grid.run(&scenario.run, || progress.inc(1));
@@ -170,23 +138,20 @@ pub fn run(
 
 /// A form mismatch or an axis given twice is a usage error (exit code 2).
 fn check_axes(path: &Path, scenario: &Scenario, sets: &[SetAxis]) {
-    let form = match scenario.model {
-        Model::Identified(_) => Form::Identified,
-        Model::Full(_) => Form::Full,
-    };
+    let form = scenario.overrides.form();
     for (i, axis) in sets.iter().enumerate() {
-        if axis.form != form {
+        if axis.key.form() != form {
             usage_error(format!(
                 "--set {}: the scenario `{}` runs the {} model; set {}.NAME parameters instead \
                  (a `full` object in the scenario's model selects the full model)",
-                axis.name(),
+                axis.name,
                 path.display(),
-                form.name(),
-                form.name(),
+                form,
+                form,
             ));
         }
         if sets[..i].iter().any(|other| other.key == axis.key) {
-            usage_error(format!("--set {} is given twice", axis.name()));
+            usage_error(format!("--set {} is given twice", axis.name));
         }
     }
 }

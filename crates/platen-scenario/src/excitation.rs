@@ -1,6 +1,7 @@
 //! `excitation` → what a scenario runs ([`Run`]): the record or generated waveform, read,
 //! checked against the duration, low-passed (forces) or integrated (ground motions).
 
+use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -53,17 +54,18 @@ impl Run {
     }
 
     /// The same run with its excitation multiplied by `k`: the force record, or the
-    /// prescribed displacement, velocity and acceleration. `k = 1` gives an identical copy.
+    /// prescribed displacement, velocity and acceleration. `k = 1` borrows this run, so a
+    /// sweep's unscaled cases copy no record.
     ///
     /// # Errors
     /// The record's checks ([`ForceRecord::new`], [`Motion::new`]) when a scaled value is
     /// not finite.
-    pub fn scaled(&self, k: f64) -> std::result::Result<Run, IntegrateError> {
+    pub fn scaled(&self, k: f64) -> std::result::Result<Cow<'_, Run>, IntegrateError> {
         if k == 1.0 {
-            return Ok(self.clone());
+            return Ok(Cow::Borrowed(self));
         }
         let times = |c: &[f64]| c.iter().map(|x| x * k).collect();
-        Ok(match self {
+        Ok(Cow::Owned(match self {
             Run::Forward {
                 record,
                 integrator,
@@ -83,7 +85,7 @@ impl Run {
                     times(motion.a_m_s2()),
                 )?,
             },
-        })
+        }))
     }
 }
 

@@ -97,7 +97,7 @@ impl Scenario {
             model: self.model.clone(),
             overrides: self.overrides.clone(),
             limits: self.limits,
-            run: self.run.scaled(k)?,
+            run: self.run.scaled(k)?.into_owned(),
         })
     }
 
