@@ -307,4 +307,13 @@ impl PlatenModel for FullModel {
         // (F_μ + Cₑw^α + a·e^(−bw)) + strut + hinge, in this order.
         self.law.magnitude_n(speed_m_s) + strut + self.hinge_force_n * r * r
     }
+
+    #[inline]
+    fn dissipative_excess_n(&self, u_m: f64, speed_m_s: f64) -> f64 {
+        let r = (u_m * self.inv_h).abs();
+        // The strut term's own excess over its value at rest (zero there for β > 0); the
+        // hinge term does not depend on the speed.
+        let strut = self.two_c_beta * r * (self.beta.pow(r * speed_m_s) - self.beta.pow(0.0));
+        self.law.excess_n(speed_m_s) + strut
+    }
 }

@@ -112,6 +112,11 @@ impl PlatenModel for IdentifiedModel {
         self.law.magnitude_n(speed_m_s)
     }
 
+    #[inline]
+    fn dissipative_excess_n(&self, _u_m: f64, speed_m_s: f64) -> f64 {
+        self.law.excess_n(speed_m_s)
+    }
+
     #[inline(always)]
     fn elastic_energy_j(&self, u_m: f64) -> f64 {
         0.5 * self.params.stiffness_n_per_m * u_m * u_m

@@ -33,6 +33,16 @@ impl DissipativeLaw {
             + self.low_velocity_force_n * (-self.low_velocity_decay_s_per_m * speed_m_s).exp()
     }
 
+    /// The excess `D(w) − D(0⁺) = Cₑ·(w^α − 0^α) + a·(e^(−b·w) − 1)` at speed `w ≥ 0`, N,
+    /// computed without forming the difference (`e^x − 1` by `exp_m1`), so it keeps full
+    /// relative precision where it is far smaller than `F_μ + a` (a platen barely above its
+    /// static threshold creeps at a speed set by this excess alone).
+    #[inline]
+    pub fn excess_n(&self, speed_m_s: f64) -> f64 {
+        self.viscous_coefficient * (self.exponent.pow(speed_m_s) - self.exponent.pow(0.0))
+            + self.low_velocity_force_n * (-self.low_velocity_decay_s_per_m * speed_m_s).exp_m1()
+    }
+
     /// The magnitude at speed `w > 0` given `ln w`, with `w^α` evaluated as `e^(α·ln w)`
     /// whatever `α` is ([`Exponent::pow_from_ln`]): the form that is smooth in `α`, as a fit
     /// of the law needs. Agrees with [`DissipativeLaw::magnitude_n`] to rounding.
