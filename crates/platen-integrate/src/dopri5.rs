@@ -11,11 +11,16 @@
 //!   reject steps at a kink; the step size carries over from one segment to the next;
 //! * in **slip**, the smooth right-hand side with the friction direction fixed is integrated
 //!   with `solout` stopping after the first accepted step that ends with the velocity on the
-//!   other side of zero. The crossing is then located by a bracketing root-finder (Illinois)
-//!   on the length of a Dopri5 integration from the start of that step, with the same
-//!   tolerances; there `v` is set to exactly zero and the net force decides stick or reverse;
+//!   other side of zero, or whose cubic Hermite interpolant (the states and accelerations at
+//!   both ends) dips to zero inside it. A dip is checked by integrating to it: if the platen is
+//!   across zero there, the first crossing lies before it; otherwise the run resumes after the
+//!   step. The crossing is located by a bracketing root-finder (Illinois) on the length of a
+//!   Dopri5 integration from the start of that step, with the same tolerances; there `v` is set
+//!   to exactly zero and the net force decides stick, reverse or creep on;
 //! * in **stick**, the breakaway time is solved in closed form (the force is linear within
-//!   the segment), exactly as in the fixed-step RK4.
+//!   the segment), exactly as in the fixed-step RK4;
+//! * in **creep**, the quasi-static creep of [`crate::creep`], with the stiff speed of a step
+//!   of one sample interval.
 //!
 //! The modes, the root finder, the stick decision and the breakaway are those of
 //! [`crate::event`], shared with the RK4.
@@ -28,9 +33,13 @@ use ode_solvers::dop_shared::{IntegrationError, OutputType, System};
 use ode_solvers::{Dopri5, Vector4};
 use platen_model::PlatenModel;
 
+use std::cell::Cell;
+
+use crate::creep::{creep, creep_speed_m_s, stiff_speed_m_s, CreepEnd};
 use crate::error::{IntegrateError, Result};
 use crate::event::{
-    arrive_at_rest, breakaway, locate_zero_velocity, EventKind, Mode, StepStop, MAX_EVENTS_PER_STEP,
+    arrive_at_rest, breakaway, dip_to_zero, just_past, locate_zero_velocity, Direction, EventKind,
+    Mode, StepStop, MAX_EVENTS_PER_STEP,
 };
 use crate::output::SampleSink;
 use crate::record::ForceRecord;
@@ -77,6 +86,16 @@ impl Dopri5Settings {
     }
 }
 
+/// Why an integration in slip stopped before the end of its span: the last accepted step
+/// ended across `v = 0`, or its cubic Hermite interpolant (from the states and accelerations
+/// at both ends) dips to zero at the fraction `θ` of the step ([`dip_to_zero`]): two
+/// crossings may lie inside it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Trigger {
+    Crossed,
+    Dip(f64),
+}
+
 /// Slip dynamics on one segment: local time `x` (s) from the segment's sample, force
 /// `f0 + slope·x`.
 struct SlipSystem<'a, M> {
@@ -85,8 +104,11 @@ struct SlipSystem<'a, M> {
     f0: f64,
     slope: f64,
     inv_e0: f64,
-    /// Stop after an accepted step that crosses v = 0 (not while locating the crossing).
-    stop_on_crossing: bool,
+    /// Stop after an accepted step that crosses or may cross v = 0 (not while locating the
+    /// crossing), and say why here.
+    watch: Option<&'a Cell<Option<Trigger>>>,
+    /// Time, speed `dir·v` and its rate `dir·a` at the end of the last accepted step.
+    last: (f64, f64, f64),
 }
 
 impl<M: PlatenModel> System<f64, Vector4<f64>> for SlipSystem<'_, M> {
@@ -100,8 +122,21 @@ impl<M: PlatenModel> System<f64, Vector4<f64>> for SlipSystem<'_, M> {
         dy[3] = r.dissipated_power_w * self.inv_e0;
     }
 
-    fn solout(&mut self, _x: f64, y: &Vector4<f64>, _dy: &Vector4<f64>) -> bool {
-        self.stop_on_crossing && self.dir * y[1] <= 0.0
+    fn solout(&mut self, x: f64, y: &Vector4<f64>, dy: &Vector4<f64>) -> bool {
+        let Some(watch) = self.watch else {
+            return false;
+        };
+        let (x0, w0, r0) = self.last;
+        let (w1, r1) = (self.dir * y[1], self.dir * dy[1]);
+        self.last = (x, w1, r1);
+        let h = x - x0;
+        let trigger = if w1 <= 0.0 {
+            Some(Trigger::Crossed)
+        } else {
+            dip_to_zero(w0, w1, r0 * h, r1 * h).map(Trigger::Dip)
+        };
+        watch.set(trigger);
+        trigger.is_some()
     }
 }
 
@@ -131,6 +166,7 @@ pub fn forward_dopri5<M: PlatenModel, S: SampleSink>(
         y: Kin::start(initial),
         mode: Mode::Stick,
         h: 0.0,
+        w_stiff: 0.0,
         stats: RunStats::default(),
     };
     run.mode = Mode::initial(model, initial.u_m, initial.v_m_s, force[0]);
@@ -179,13 +215,15 @@ struct AdaptiveRun<'a, M> {
     mode: Mode,
     /// Step size carried from one segment to the next (0: let Dopri5 choose).
     h: f64,
+    /// The stiff speed of the current creep phase (see [`crate::creep`]), m/s.
+    w_stiff: f64,
     stats: RunStats,
 }
 
 impl<M: PlatenModel> AdaptiveRun<'_, M> {
     fn acceleration(&mut self, f: f64) -> f64 {
         match self.mode {
-            Mode::Stick => 0.0,
+            Mode::Stick | Mode::Creep(_) => 0.0,
             Mode::Slip(dir) => {
                 self.stats.rhs_evaluations += 1;
                 self.model
@@ -208,10 +246,12 @@ impl<M: PlatenModel> AdaptiveRun<'_, M> {
             }
             let stop = match self.mode {
                 Mode::Stick => self.stick(x, dt, f0, f1, slope),
-                Mode::Slip(direction) => self.slip(direction.sign(), x, dt, f0, slope, t0)?,
+                Mode::Slip(direction) => self.slip(direction, x, dt, f0, slope, t0)?,
+                Mode::Creep(direction) => self.creep(direction, x, dt, f0, f1, slope, t0)?,
             };
             match stop {
                 StepStop::Step => return Ok(()),
+                StepStop::Moved { at } => x = at,
                 StepStop::Event { at, kind } => {
                     x = at;
                     // A stop or reversal within rounding of the end ends the segment.
@@ -224,14 +264,28 @@ impl<M: PlatenModel> AdaptiveRun<'_, M> {
         Ok(())
     }
 
+    /// Switches to `mode` at the current state: a creep phase gets its stiff speed for steps
+    /// of one sample interval `dt`.
+    fn enter(&mut self, mode: Mode, dt: f64) {
+        self.mode = mode;
+        if let Mode::Creep(_) = mode {
+            self.w_stiff = stiff_speed_m_s(self.model, self.y.u, dt);
+        }
+    }
+
     /// The stick part of [`AdaptiveRun::segment`] from local time `x`: friction holds to the
-    /// end of the segment, or the platen breaks away ([`breakaway`]) and slips.
+    /// end of the segment, or the platen breaks away ([`breakaway`]) and slips, from a point
+    /// where `|N|` is above the threshold.
     fn stick(&mut self, x: f64, dt: f64, f0: f64, f1: f64, slope: f64) -> StepStop {
         let Some(b) = breakaway(self.model, self.y.u, f0 + slope * x, f1) else {
             self.stats.stick_time_s += dt - x;
             return StepStop::Step;
         };
-        let xb = x + b.fraction * (dt - x);
+        let elastic = self.model.elastic_force_n(self.y.u);
+        let threshold = self.model.static_threshold_n(self.y.u);
+        let xb = just_past(x + b.fraction * (dt - x), dt, |t| {
+            (f0 + slope * t - elastic).abs() > threshold
+        });
         self.stats.stick_time_s += xb - x;
         self.stats.record(EventKind::Breakaway);
         self.mode = Mode::Slip(b.direction);
@@ -241,46 +295,134 @@ impl<M: PlatenModel> AdaptiveRun<'_, M> {
         }
     }
 
+    /// The creep part of [`AdaptiveRun::segment`] from local time `x` ([`crate::creep`]).
+    #[allow(clippy::too_many_arguments)]
+    fn creep(
+        &mut self,
+        dir: Direction,
+        x: f64,
+        dt: f64,
+        f0: f64,
+        f1: f64,
+        slope: f64,
+        t0: f64,
+    ) -> Result<StepStop> {
+        let span_s = dt - x;
+        let run = creep(
+            self.model,
+            dir,
+            self.y,
+            f0 + slope * x,
+            f1,
+            span_s,
+            self.w_stiff,
+        );
+        self.stats.rhs_evaluations += run.evaluations;
+        self.y = run.y;
+        let at = if run.at_s >= span_s {
+            dt
+        } else {
+            (x + run.at_s).min(dt)
+        };
+        self.check_finite(t0 + at)?;
+        Ok(match run.end {
+            CreepEnd::Continues if at >= dt => StepStop::Step,
+            CreepEnd::Continues => StepStop::Moved { at },
+            CreepEnd::Stops => {
+                self.stats.record(EventKind::Stop);
+                self.mode = Mode::Stick;
+                StepStop::Event {
+                    at,
+                    kind: EventKind::Stop,
+                }
+            }
+            CreepEnd::Slips => {
+                self.mode = Mode::Slip(dir);
+                StepStop::Moved { at }
+            }
+        })
+    }
+
     /// The slip part of [`AdaptiveRun::segment`] from local time `x`: Dopri5 to the end of the
-    /// segment, or to the located `v = 0` crossing, where the reset is applied.
-    /// `dir` is the direction of slip, `±1.0`.
+    /// segment, or to the located `v = 0` crossing, where the reset is applied. A step whose
+    /// Hermite interpolant dips to zero is checked at the dip: if the platen is across zero
+    /// there, the first crossing is located inside it; otherwise the run resumes after it.
     fn slip(
         &mut self,
-        dir: f64,
+        direction: Direction,
         x: f64,
         dt: f64,
         f0: f64,
         slope: f64,
         t0: f64,
     ) -> Result<StepStop> {
+        let dir = direction.sign();
+        if self.y.v == 0.0 {
+            // Leaving rest: if the creep speed stays below the stiff speed to the end of the
+            // segment (the force is linear: its ends bound it), the explicit steps would only
+            // overshoot; creep instead.
+            let w_stiff = stiff_speed_m_s(self.model, self.y.u, dt);
+            let creeps = [f0 + slope * x, f0 + slope * dt]
+                .iter()
+                .all(|&f| creep_speed_m_s(self.model, direction, self.y.u, f, w_stiff).is_some());
+            if creeps {
+                self.enter(Mode::Creep(direction), dt);
+                return Ok(StepStop::Moved { at: x });
+            }
+        }
+        let watch = Cell::new(None);
+        let a0 = self.acceleration(f0 + slope * x);
         let sys = SlipSystem {
             model: self.model,
             dir,
             f0,
             slope,
             inv_e0: 1.0 / self.e0,
-            stop_on_crossing: true,
+            watch: Some(&watch),
+            last: (x, dir * self.y.v, dir * a0),
         };
-        let (xs, ys, crossed) = self.integrate(sys, x, dt, self.h, t0)?;
+        let (xs, ys) = self.integrate(sys, x, dt, self.h, t0)?;
         let n = xs.len();
-        if !crossed {
-            self.y = self.unpack(ys[n - 1]);
-            self.check_finite(t0 + dt)?;
-            return Ok(StepStop::Step);
-        }
-        // The last accepted step [xs[n-2], xs[n-1]] crosses v = 0.
         let (xa, ya) = (xs[n - 2], ys[n - 2]);
         let (xb, yb) = (xs[n - 1], ys[n - 1]);
-        let (xe, ye) = self.locate(dir, f0, slope, xa, ya, xb, yb, t0)?;
+        let end = match watch.get() {
+            None => {
+                self.y = self.unpack(yb);
+                self.check_finite(t0 + dt)?;
+                return Ok(StepStop::Step);
+            }
+            Some(Trigger::Crossed) => (xb, yb),
+            Some(Trigger::Dip(theta)) => {
+                let xm = xa + theta * (xb - xa);
+                let ym = self.integrate_plain(dir, f0, slope, xa, ya, xm, t0)?;
+                if dir * ym[1] > 0.0 {
+                    // No crossing at the dip: resume after the step.
+                    self.y = self.unpack(yb);
+                    self.check_finite(t0 + xb)?;
+                    return Ok(if xb >= dt {
+                        StepStop::Step
+                    } else {
+                        StepStop::Moved { at: xb }
+                    });
+                }
+                (xm, ym)
+            }
+        };
+        let (xe, ye) = self.locate(dir, f0, slope, (xa, ya), end, t0)?;
         self.y = Kin {
             v: 0.0,
             ..self.unpack(ye)
         };
         self.check_finite(t0 + xe)?;
-        let kind;
-        (self.mode, kind) = arrive_at_rest(self.model, self.y.u, f0 + slope * xe);
-        self.stats.record(kind);
-        Ok(StepStop::Event { at: xe, kind })
+        let (mode, kind) = arrive_at_rest(self.model, self.y.u, f0 + slope * xe, direction);
+        self.enter(mode, dt);
+        Ok(match kind {
+            Some(kind) => {
+                self.stats.record(kind);
+                StepStop::Event { at: xe, kind }
+            }
+            None => StepStop::Moved { at: xe },
+        })
     }
 
     fn unpack(&self, y: Vector4<f64>) -> Kin {
@@ -317,7 +459,7 @@ impl<M: PlatenModel> AdaptiveRun<'_, M> {
         x1: f64,
         h0: f64,
         t0: f64,
-    ) -> Result<(Vec<f64>, Vec<Vector4<f64>>, bool)> {
+    ) -> Result<(Vec<f64>, Vec<Vector4<f64>>)> {
         let y0 = self.pack(self.y);
         self.integrate_from(sys, x0, y0, x1, h0, t0)
     }
@@ -331,9 +473,8 @@ impl<M: PlatenModel> AdaptiveRun<'_, M> {
         x1: f64,
         h0: f64,
         t0: f64,
-    ) -> Result<(Vec<f64>, Vec<Vector4<f64>>, bool)> {
+    ) -> Result<(Vec<f64>, Vec<Vector4<f64>>)> {
         let span = x1 - x0;
-        let dir = sys.dir;
         let h = if h0 > 0.0 { h0.min(span) } else { 0.0 };
         debug_assert!(h.is_finite());
         let mut solver = Dopri5::from_param(
@@ -388,16 +529,13 @@ impl<M: PlatenModel> AdaptiveRun<'_, M> {
                 xs[1] - xs[0]
             };
         }
-        let crossed = n >= 2 && dir * ys[n - 1][1] <= 0.0 && xs[n - 1] <= x1;
-        Ok((xs, ys, crossed))
+        Ok((xs, ys))
     }
 
-    /// Locates the zero of `dir·v` inside the accepted step `[xa, xb]` by
-    /// [`locate_zero_velocity`] on the length of a Dopri5 integration from `(xa, ya)`, with the
-    /// run's tolerances. Returns `(xa, ya)` if the platen started at rest and cannot move in
-    /// `dir` at all: it stays where it is.
+    /// The state after a Dopri5 integration in slip `dir` from `(xa, ya)` to `xb`, with the
+    /// run's tolerances and no stop on crossings.
     #[allow(clippy::too_many_arguments)]
-    fn locate(
+    fn integrate_plain(
         &mut self,
         dir: f64,
         f0: f64,
@@ -405,24 +543,39 @@ impl<M: PlatenModel> AdaptiveRun<'_, M> {
         xa: f64,
         ya: Vector4<f64>,
         xb: f64,
-        yb: Vector4<f64>,
+        t0: f64,
+    ) -> Result<Vector4<f64>> {
+        let sys = SlipSystem {
+            model: self.model,
+            dir,
+            f0,
+            slope,
+            inv_e0: 1.0 / self.e0,
+            watch: None,
+            last: (xa, 0.0, 0.0),
+        };
+        let (_, ys) = self.integrate_from(sys, xa, ya, xb, xb - xa, t0)?;
+        Ok(ys[ys.len() - 1])
+    }
+
+    /// Locates the zero of `dir·v` between `a = (xa, ya)`, where the platen slips in `dir`,
+    /// and `b = (xb, yb)`, where it is across zero, by [`locate_zero_velocity`] on the length
+    /// of a Dopri5 integration from `a`, with the run's tolerances. Returns `a` if the platen
+    /// started at rest and cannot move in `dir` at all: it stays where it is.
+    fn locate(
+        &mut self,
+        dir: f64,
+        f0: f64,
+        slope: f64,
+        (xa, ya): (f64, Vector4<f64>),
+        (xb, yb): (f64, Vector4<f64>),
         t0: f64,
     ) -> Result<(f64, Vector4<f64>)> {
-        let inv_e0 = 1.0 / self.e0;
         let span = xb - xa;
         let tolerance = 4.0 * f64::EPSILON * span.max(xb.abs());
         let found = locate_zero_velocity(span, dir * ya[1], (yb, dir * yb[1]), tolerance, |len| {
             self.stats.root_iterations += 1;
-            let sys = SlipSystem {
-                model: self.model,
-                dir,
-                f0,
-                slope,
-                inv_e0,
-                stop_on_crossing: false,
-            };
-            let (_, ys, _) = self.integrate_from(sys, xa, ya, xa + len, len, t0)?;
-            let y = ys[ys.len() - 1];
+            let y = self.integrate_plain(dir, f0, slope, xa, ya, xa + len, t0)?;
             Ok((y, dir * y[1]))
         })?;
         Ok(found.map_or((xa, ya), |(len, y)| (xa + len, y)))

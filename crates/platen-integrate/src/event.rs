@@ -3,35 +3,51 @@
 //!
 //! # Model
 //!
-//! At `v = 0` the friction is set-valued, so the platen is in one of three [`Mode`]s:
-//! slip+ and slip− (the smooth right-hand side with the friction direction fixed) and stick
-//! (`u` fixed, `v = a = 0`). The mode changes only at an event ([`EventKind`]):
+//! At `v = 0` the friction is set-valued, so the platen is in one of four [`Mode`]s: slip+ and
+//! slip− (the smooth right-hand side with the friction direction fixed), stick (`u` fixed,
+//! `v = a = 0`), and creep± (slip so slow that the law is too stiff for an explicit step: the
+//! quasi-static limit of [`crate::creep`]). The stick-slip mode changes only at an event
+//! ([`EventKind`]):
 //!
-//! * **stop** or **reversal**: in slip, the velocity reaches zero. The integrator steps past
-//!   the crossing, then [`locate_zero_velocity`] finds it (Illinois root finding on the length
-//!   of the integrator's own step from a point before the crossing, so the state there is one
-//!   the integrator produced); the integrator sets `v` to exactly zero and applies the reset
+//! * **stop** or **reversal**: in slip, the velocity reaches zero. Every crossing inside a
+//!   step is found: a step is accepted only if the speed is positive at each of its stages, at
+//!   its end, and on its cubic Hermite interpolant ([`dip_to_zero`]), otherwise it is halved
+//!   until a piece is safe or ends across zero (so two reversals inside one step are both
+//!   located). [`locate_zero_velocity`] then finds the crossing (Illinois root finding on the
+//!   length of the integrator's own step from a point before it, so the state there is one the
+//!   integrator produced); the integrator sets `v` to exactly zero and applies the reset
 //!   [`arrive_at_rest`]: the net force `N = F_A − F_E(u)` decides stick if `|N| ≤ F_s(u)`,
-//!   otherwise slip in the direction of `N`;
+//!   slip the other way if it is beyond the threshold against the motion, and creep on if it
+//!   is beyond the threshold along the motion (the exact solution cannot reach rest there; the
+//!   step was too long for the stiff law, and this is not counted as an event);
 //! * **breakaway**: in stick, [`breakaway`] solves the time at which `|N|` reaches `F_s(u)`
-//!   exactly, since `F_A` is linear between the force record's samples.
+//!   exactly, since `F_A` is linear between the force record's samples; [`just_past`] moves it
+//!   past rounding so that slip starts where `|N| > F_s` holds.
+//!
+//! A platen that leaves rest with a creep speed below the stiff speed for the rest of the step
+//! creeps from the start; creep ends in a stop (where `|N|` falls to `F_s`, checked) or in
+//! slip (where the creep speed reaches the stiff speed). A stick decision is only ever taken
+//! where `|N| ≤ F_s(u)` holds at the state reached.
 //!
 //! # Interface
 //!
 //! An integrator advances inside one step (RK4: a grid step, Dopri5: a sample interval) in
 //! the current mode until it reports a [`StepStop`]: [`StepStop::Step`] (the end of the step
-//! was reached) or [`StepStop::Event`] (an event was located and its reset applied), and
-//! gives up after [`MAX_EVENTS_PER_STEP`] events in one step. The integrators measure time
-//! inside a step in their own units (RK4: the fraction `τ` of the grid step; Dopri5: seconds
-//! from the segment's start); every function here works on the fraction or length it is
-//! given and returns one in the same units.
+//! was reached), [`StepStop::Event`] (an event was located and its reset applied) or
+//! [`StepStop::Moved`] (part of the step was done without an event), and gives up after
+//! [`MAX_EVENTS_PER_STEP`] of those in one step (a guard against a defect: every one of them
+//! moves time forward or changes the mode in a way that cannot repeat in place). The
+//! integrators measure time inside a step in their own units (RK4: the fraction `τ` of the grid
+//! step; Dopri5: seconds from the segment's start); every function here works on the fraction
+//! or length it is given and returns one in the same units.
 
 use platen_model::PlatenModel;
 
-/// Largest number of stick-slip events tolerated inside one step before the run is declared
-/// stalled. Physical events are separated by many steps; dozens in one step means the event
-/// loop is not advancing.
-pub(crate) const MAX_EVENTS_PER_STEP: u32 = 64;
+/// Largest number of stick-slip events and partial advances tolerated inside one step before
+/// the run is declared stalled. Every event and advance moves time forward or changes the mode
+/// in a way that cannot repeat without time moving (see [`arrive_at_rest`] and [`just_past`]),
+/// so this is a guard against a defect, not a limit a run is expected to reach.
+pub(crate) const MAX_EVENTS_PER_STEP: u32 = 4096;
 
 /// Iteration cap of the event root-finder (it converges in about ten).
 const MAX_ROOT_ITERATIONS: u32 = 100;
@@ -86,6 +102,9 @@ pub(crate) enum Mode {
     Stick,
     /// Slipping in a direction.
     Slip(Direction),
+    /// Creeping in a direction: slip at speeds where the law is too stiff for an explicit
+    /// step, with the velocity slaved to the force (see [`crate::creep`]).
+    Creep(Direction),
 }
 
 impl Mode {
@@ -115,17 +134,91 @@ pub(crate) fn mode_at_rest<M: PlatenModel>(model: &M, u: f64, f: f64) -> Mode {
     }
 }
 
-/// The reset at a located `v = 0` (the caller sets the velocity to exactly zero): the mode
-/// that follows, by [`mode_at_rest`] at `u` under `f`, and the kind of the event (a stop if
-/// friction holds, a reversal otherwise).
+/// The reset at a located `v = 0` reached in slip in direction `from` (the caller sets the
+/// velocity to exactly zero): the mode that follows and the event, if one happened.
+///
+/// * `|N| ≤ F_s(u)`: stick, a [`EventKind::Stop`];
+/// * `N` beyond the threshold against `from`: slip the other way, a [`EventKind::Reversal`];
+/// * `N` beyond the threshold along `from`: no event. The exact solution cannot reach `v = 0`
+///   there (the net force still drives the platen on, so it settles at its creep speed); the
+///   step that crossed zero was too long for the stiff law at that speed. The platen creeps on
+///   in its direction ([`Mode::Creep`]).
 #[inline]
-pub(crate) fn arrive_at_rest<M: PlatenModel>(model: &M, u: f64, f: f64) -> (Mode, EventKind) {
-    let mode = mode_at_rest(model, u, f);
-    let kind = match mode {
-        Mode::Stick => EventKind::Stop,
-        Mode::Slip(_) => EventKind::Reversal,
-    };
-    (mode, kind)
+pub(crate) fn arrive_at_rest<M: PlatenModel>(
+    model: &M,
+    u: f64,
+    f: f64,
+    from: Direction,
+) -> (Mode, Option<EventKind>) {
+    match mode_at_rest(model, u, f) {
+        Mode::Stick => (Mode::Stick, Some(EventKind::Stop)),
+        Mode::Slip(d) if d == from => (Mode::Creep(from), None),
+        other => (other, Some(EventKind::Reversal)),
+    }
+}
+
+/// The first of `at, at + ε, at + 2ε, at + 4ε, …` (capped at `end`) where `holds` is true,
+/// `ε` a few ulps of 1. Used to step an event time that rounding left on the wrong side of its
+/// condition (a breakaway where `|N|` is not yet above `F_s`) just past it, so the next mode's
+/// precondition holds at the state it starts from. `holds(end)` must be true.
+#[inline]
+pub(crate) fn just_past(at: f64, end: f64, holds: impl Fn(f64) -> bool) -> f64 {
+    let mut x = at;
+    let mut eps = 4.0 * f64::EPSILON * end.abs().max(1.0);
+    for _ in 0..64 {
+        if x >= end || holds(x) {
+            return x.min(end);
+        }
+        x = (at + eps).min(end);
+        eps *= 2.0;
+    }
+    end
+}
+
+/// Whether the velocity may touch zero inside a step whose speed goes from `w0 ≥ 0` to
+/// `w1 > 0` with slopes `d0`, `d1` (the speed's derivative times the step length, i.e. in
+/// units of the step fraction `θ`): the cubic Hermite interpolant of the speed on `θ ∈ [0,
+/// 1]` has an interior minimum at or below zero. Returns that `θ`, if any.
+///
+/// The interpolant is accurate to `O(h⁴)` on a smooth step, so a dip below zero that it does
+/// not show is smaller than the step's own error. A cheap bound is tried first (the cubic
+/// lies above `min(w0, w1) − ¼·max|dᵢ − Δ|`), so a step far from rest costs a few flops.
+#[inline]
+pub(crate) fn dip_to_zero(w0: f64, w1: f64, d0: f64, d1: f64) -> Option<f64> {
+    let delta = w1 - w0;
+    let bound = 0.25 * (d0 - delta).abs().max((d1 - delta).abs());
+    if w0.min(w1) > bound {
+        return None;
+    }
+    dip_to_zero_exact(w0, w1, d0, d1)
+}
+
+#[cold]
+fn dip_to_zero_exact(w0: f64, w1: f64, d0: f64, d1: f64) -> Option<f64> {
+    // p(θ) = w0 + d0·θ + c2·θ² + c3·θ³
+    let delta = w1 - w0;
+    let c2 = 3.0 * delta - 2.0 * d0 - d1;
+    let c3 = d0 + d1 - 2.0 * delta;
+    let p = |t: f64| w0 + t * (d0 + t * (c2 + t * c3));
+    // p′(θ) = d0 + 2c2·θ + 3c3·θ²: its roots in (0, 1).
+    let (qa, qb, qc) = (3.0 * c3, 2.0 * c2, d0);
+    let mut roots = [f64::NAN; 2];
+    if qa.abs() <= 1e-12 * (qb.abs() + qc.abs()) {
+        if qb != 0.0 {
+            roots[0] = -qc / qb;
+        }
+    } else {
+        let disc = qb * qb - 4.0 * qa * qc;
+        if disc >= 0.0 {
+            let q = -0.5 * (qb + disc.sqrt().copysign(qb));
+            roots = [q / qa, if q != 0.0 { qc / q } else { f64::NAN }];
+        }
+    }
+    roots
+        .into_iter()
+        .filter(|t| *t > 0.0 && *t < 1.0)
+        .filter(|&t| p(t) <= 0.0)
+        .reduce(f64::min)
 }
 
 /// Why an advance inside one step stopped: the stepper's stop reason.
@@ -140,6 +233,12 @@ pub(crate) enum StepStop {
         at: f64,
         /// What happened.
         kind: EventKind,
+    },
+    /// The state advanced to `at` without a stick-slip event: the mode changed between slip
+    /// and creep, or part of the step was committed on the way to a possible crossing.
+    Moved {
+        /// Where the advance stopped, in the integrator's units of time inside the step.
+        at: f64,
     },
 }
 

@@ -38,6 +38,7 @@
 
 #![warn(missing_docs)]
 
+mod creep;
 mod dopri5;
 mod error;
 mod event;

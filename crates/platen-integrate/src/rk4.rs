@@ -7,18 +7,22 @@
 //! current step already done. The force is linear between samples, so it is linear inside
 //! every step and is evaluated from the two samples that bracket it, never from a float time.
 //!
-//! The platen is in one of three modes (the events between them, and how they are located
-//! and decided, are those of [`crate::event`], shared with Dopri5):
+//! The platen is in one of the modes of [`crate::event`] (the events between them, and how
+//! they are located and decided, are shared with Dopri5):
 //!
 //! * **slip±**: the smooth right-hand side with the friction direction fixed is stepped with
-//!   RK4. If the step ends with the velocity on the other side of zero, the crossing is
-//!   located by root-finding (Illinois) on the *length* of the RK4 step taken from the step's
-//!   start, so the state at the event is an RK4 step that ends at `v = 0`. There `v` is set to
+//!   RK4. A step is accepted as it is when the speed stays positive at every stage, at its end
+//!   and on its cubic Hermite interpolant; otherwise the rest of the step is halved until a
+//!   piece is safe (committed) or ends across `v = 0`, where the crossing is located by
+//!   root-finding (Illinois) on the *length* of an RK4 step graded towards the singular end,
+//!   so the state at the event is an RK4 step that ends at `v = 0`. There `v` is set to
 //!   exactly zero and the net force `N = F_A − F_E(u)` decides: stick if `|N| ≤ F_s(u)`,
-//!   otherwise slip in the direction of `N`.
+//!   reversal if it is beyond the threshold against the motion, creep if along it.
 //! * **stick**: `u` is fixed and `v = a = 0`. Because `F_A` is linear within a step, the
 //!   breakaway time, at which `|N|` reaches `F_s(u)`, is solved exactly; the rest of the
-//!   step is then stepped in slip.
+//!   step is then stepped in slip (or creep, if the creep speed stays below the stiff speed).
+//! * **creep±**: the quasi-static creep of [`crate::creep`], with the stiff speed of the grid
+//!   step `h`.
 //!
 //! No allocation happens per step; a run allocates only what its [`SampleSink`] stores.
 
@@ -26,10 +30,11 @@ use std::convert::Infallible;
 
 use platen_model::{PlatenModel, SlipRates};
 
+use crate::creep::{creep, creep_speed_m_s, stiff_speed_m_s, CreepEnd};
 use crate::error::{IntegrateError, Result};
 use crate::event::{
-    arrive_at_rest, breakaway, locate_zero_velocity, Direction, EventKind, Mode, StepStop,
-    MAX_EVENTS_PER_STEP,
+    arrive_at_rest, breakaway, dip_to_zero, just_past, locate_zero_velocity, Direction, EventKind,
+    Mode, StepStop, MAX_EVENTS_PER_STEP,
 };
 use crate::output::{Sample, SampleSink};
 use crate::record::ForceRecord;
@@ -143,7 +148,8 @@ const fn direction<const POSITIVE: bool>() -> f64 {
 
 /// One classical RK4 step of length `h` in slip with direction `direction::<POSITIVE>()`
 /// from `y`, given the rates at the start `r0` (so the caller can reuse them) and the forces
-/// at the start, middle and end of the step.
+/// at the start, middle and end of the step. Also returns the smallest speed `direction·v`
+/// of the three later stages (a stage at or below zero means the step may cross `v = 0`).
 #[inline(always)]
 fn rk4_slip<M: PlatenModel, const POSITIVE: bool>(
     m: &M,
@@ -153,7 +159,7 @@ fn rk4_slip<M: PlatenModel, const POSITIVE: bool>(
     f_start: f64,
     f_mid: f64,
     f_end: f64,
-) -> Kin {
+) -> (Kin, f64) {
     let dir = direction::<POSITIVE>();
     let (u, v) = (y.u, y.v);
     let hh = 0.5 * h;
@@ -164,7 +170,8 @@ fn rk4_slip<M: PlatenModel, const POSITIVE: bool>(
     let v4 = v + h * r3.a_m_s2;
     let r4 = m.slip_rates(f_end, u + h * v3, v4, dir);
     let h6 = h / 6.0;
-    Kin {
+    let stage_min = (dir * v2).min(dir * v3).min(dir * v4);
+    let y1 = Kin {
         u: u + h6 * (v + 2.0 * (v2 + v3) + v4),
         v: v + h6 * (r0.a_m_s2 + 2.0 * (r2.a_m_s2 + r3.a_m_s2) + r4.a_m_s2),
         work: y.work + h6 * (f_start * v + 2.0 * f_mid * (v2 + v3) + f_end * v4),
@@ -172,7 +179,8 @@ fn rk4_slip<M: PlatenModel, const POSITIVE: bool>(
             + h6 * (r0.dissipated_power_w
                 + 2.0 * (r2.dissipated_power_w + r3.dissipated_power_w)
                 + r4.dissipated_power_w),
-    }
+    };
+    (y1, stage_min)
 }
 
 /// Runs the model forward under the recorded force `record` from `initial`, with fixed-step
@@ -218,7 +226,7 @@ pub fn forward_rk4<M: PlatenModel, S: SampleSink>(
     Ok(stepper.finish(times[samples - 1]))
 }
 
-/// How a slip interval that touches `v = 0` is split into RK4 sub-steps.
+/// How a slip interval is split into RK4 sub-steps.
 ///
 /// Near `v = 0` the `|v|^α` law (α < 1) makes the right-hand side singular like `√(t − t*)`,
 /// which cuts a single RK4 step's accuracy to `O(h^1.5)` (about 1e-7 m/s per event at
@@ -227,6 +235,8 @@ pub fn forward_rk4<M: PlatenModel, S: SampleSink>(
 /// 1e-10 m level, at the cost of a few extra stages per event only.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Grading {
+    /// One plain RK4 step.
+    Single,
     /// Singular at the start (leaving rest).
     Start,
     /// Singular at the end (arriving at rest).
@@ -269,6 +279,7 @@ const GRADED_BOTH: [f64; 12] = [
 impl Grading {
     fn pieces(self) -> &'static [f64] {
         match self {
+            Grading::Single => &[1.0],
             Grading::Start => &GRADED_START,
             Grading::End => &GRADED_END,
             Grading::Both => &GRADED_BOTH,
@@ -276,14 +287,20 @@ impl Grading {
     }
 }
 
+/// Halvings of a careful piece before its start is taken as a state at rest (2⁻⁶⁰ of a step:
+/// the speed there is below what a piece that short can resolve).
+const MAX_HALVINGS: u32 = 60;
+
 /// The mutable state of a forward RK4 run.
 struct Stepper<'a, M> {
     model: &'a M,
     grid: Grid<'a>,
     y: Kin,
     mode: Mode,
-    /// Rates at the current state in the current mode (zero in stick).
+    /// Rates at the current state in the current mode (zero in stick and creep).
     rates: SlipRates,
+    /// The stiff speed of the current creep phase (see [`crate::creep`]), m/s.
+    w_stiff: f64,
     stats: RunStats,
 }
 
@@ -300,19 +317,29 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
             y: Kin::start(initial),
             mode: Mode::Stick,
             rates: AT_REST,
+            w_stiff: 0.0,
             stats: RunStats::default(),
         };
         let f0 = s.grid.force[0];
-        s.mode = Mode::initial(model, s.y.u, s.y.v, f0);
-        s.refresh_rates(f0);
+        s.enter(Mode::initial(model, s.y.u, s.y.v, f0), f0);
         s.stats.energy = EnergyBalance::start(model, s.y.u, s.y.v);
         s
+    }
+
+    /// Switches to `mode` at the current state under force `f`: the rates of slip, or the
+    /// stiff speed of a creep phase.
+    fn enter(&mut self, mode: Mode, f: f64) {
+        self.mode = mode;
+        if let Mode::Creep(_) = mode {
+            self.w_stiff = stiff_speed_m_s(self.model, self.y.u, self.grid.h);
+        }
+        self.refresh_rates(f);
     }
 
     #[inline(always)]
     fn refresh_rates(&mut self, f: f64) {
         self.rates = match self.mode {
-            Mode::Stick => AT_REST,
+            Mode::Stick | Mode::Creep(_) => AT_REST,
             Mode::Slip(dir) => {
                 self.stats.rhs_evaluations += 1;
                 self.model.slip_rates(f, self.y.u, self.y.v, dir.sign())
@@ -344,10 +371,11 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
                 Mode::Slip(Direction::Positive) => self.slip::<true>(n, tau)?,
                 Mode::Slip(Direction::Negative) => self.slip::<false>(n, tau)?,
                 Mode::Stick => self.stick(n, tau),
+                Mode::Creep(dir) => self.creep(n, tau, dir)?,
             };
             match stop {
                 StepStop::Step => return Ok(()),
-                StepStop::Event { at, .. } => tau = at,
+                StepStop::Event { at, .. } | StepStop::Moved { at } => tau = at,
             }
             events += 1;
             if tau >= 1.0 {
@@ -362,7 +390,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
 
     /// The stick part of [`Stepper::step`], from fraction `tau` of step `n`: either friction
     /// holds the platen to the end of the step, or it breaks away ([`breakaway`]) and the
-    /// mode becomes slip.
+    /// mode becomes slip, from a point where `|N|` is above the threshold.
     #[inline]
     fn stick(&mut self, n: GridStep, tau: f64) -> StepStop {
         let h = self.grid.h;
@@ -371,118 +399,222 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
             self.stats.stick_time_s += (1.0 - tau) * h;
             return StepStop::Step;
         };
-        let tau_b = tau + b.fraction * (1.0 - tau);
+        let (elastic, threshold) = (
+            self.model.elastic_force_n(self.y.u),
+            self.model.static_threshold_n(self.y.u),
+        );
+        let tau_b = just_past(tau + b.fraction * (1.0 - tau), 1.0, |t| {
+            (self.grid.force(n, t) - elastic).abs() > threshold
+        });
         self.stats.stick_time_s += (tau_b - tau) * h;
         self.stats.record(EventKind::Breakaway);
-        self.mode = Mode::Slip(b.direction);
         let f = self.grid.force(n, tau_b);
-        self.refresh_rates(f);
+        self.enter(Mode::Slip(b.direction), f);
         StepStop::Event {
             at: tau_b,
             kind: EventKind::Breakaway,
         }
     }
 
-    /// The slip part of [`Stepper::step`] in direction `direction::<POSITIVE>()`, from
-    /// fraction `tau` of step `n`: either completes the step ([`StepStop::Step`]) or stops at
-    /// the located `v = 0` event with the reset applied ([`StepStop::Event`] at the new `τ`).
-    #[inline(always)]
-    fn slip<const POSITIVE: bool>(&mut self, n: GridStep, tau: f64) -> Result<StepStop> {
-        let dir = direction::<POSITIVE>();
+    /// The creep part of [`Stepper::step`] in direction `dir`, from fraction `tau` of step
+    /// `n`: the quasi-static creep of [`crate::creep`] to the end of the step, a stop, or the
+    /// return to slip.
+    fn creep(&mut self, n: GridStep, tau: f64, dir: Direction) -> Result<StepStop> {
         let h = self.grid.h;
-        let rem = 1.0 - tau;
-        // Leaving v = 0 (after a breakaway or reversal) the √|v| law is singular:
-        // grade the sub-steps towards the start.
-        let from_rest = self.y.v == 0.0;
-        let y1 = if from_rest {
-            self.advance::<POSITIVE>(n, tau, rem, Grading::Start)
+        let span_s = (1.0 - tau) * h;
+        let (f_start, f_end) = (self.grid.force(n, tau), self.grid.force(n, 1.0));
+        let run = creep(
+            self.model,
+            dir,
+            self.y,
+            f_start,
+            f_end,
+            span_s,
+            self.w_stiff,
+        );
+        self.stats.rhs_evaluations += run.evaluations;
+        self.y = run.y;
+        let at = if run.at_s >= span_s {
+            1.0
         } else {
-            let f_start = self.grid.force(n, tau);
-            let f_mid = self.grid.force(n, tau + 0.5 * rem);
-            let f_end = self.grid.force(n, 1.0);
-            self.stats.rhs_evaluations += 3;
-            rk4_slip::<M, POSITIVE>(
-                self.model,
-                self.y,
-                self.rates,
-                rem * h,
-                f_start,
-                f_mid,
-                f_end,
-            )
+            (tau + run.at_s / h).min(1.0)
         };
-        if !(y1.u.is_finite() && y1.v.is_finite()) {
-            return Err(self.non_finite(n, tau));
+        if !(self.y.u.is_finite() && self.y.v.is_finite()) {
+            return Err(self.non_finite(n, at));
         }
-        if dir * y1.v > 0.0 {
-            self.commit::<POSITIVE>(n, y1)?;
-            return Ok(StepStop::Step);
-        }
-        // v reaches zero inside the step. Arriving at v = 0 is singular too:
-        // redo the remainder graded towards the end, then locate the crossing on
-        // that graded map.
-        let grading = if from_rest {
-            Grading::Both
-        } else {
-            Grading::End
-        };
-        let y2 = self.advance::<POSITIVE>(n, tau, rem, grading);
-        if dir * y2.v > 0.0 {
-            self.commit::<POSITIVE>(n, y2)?;
-            return Ok(StepStop::Step);
-        }
-        let Some((x, y_event)) = self.locate::<POSITIVE>(n, tau, rem, y2, grading) else {
-            // Started at v = 0 and no step length moves the platen in `dir`:
-            // friction holds it.
-            self.y.v = 0.0;
-            self.mode = Mode::Stick;
-            self.stats.record(EventKind::Stop);
-            self.rates = AT_REST;
-            return Ok(StepStop::Event {
-                at: tau,
-                kind: EventKind::Stop,
-            });
-        };
-        let mut at = tau + x;
-        if 1.0 - at < 1e-12 {
-            at = 1.0;
-        }
-        self.y = Kin { v: 0.0, ..y_event };
-        let f = self.grid.force(n, at);
-        let kind;
-        (self.mode, kind) = arrive_at_rest(self.model, self.y.u, f);
-        self.stats.record(kind);
-        self.refresh_rates(f);
-        Ok(StepStop::Event { at, kind })
+        Ok(match run.end {
+            CreepEnd::Continues if at >= 1.0 => StepStop::Step,
+            CreepEnd::Continues => StepStop::Moved { at },
+            CreepEnd::Stops => {
+                self.stats.record(EventKind::Stop);
+                self.enter(Mode::Stick, 0.0);
+                StepStop::Event {
+                    at,
+                    kind: EventKind::Stop,
+                }
+            }
+            CreepEnd::Slips => {
+                let f = self.grid.force(n, at);
+                self.enter(Mode::Slip(dir), f);
+                StepStop::Moved { at }
+            }
+        })
     }
 
-    /// Accepts the state at the end of step `n`.
+    /// The slip part of [`Stepper::step`] in direction `direction::<POSITIVE>()`, from
+    /// fraction `tau` of step `n`.
+    ///
+    /// The fast path is one RK4 step to the end of the grid step, accepted when the speed
+    /// stays positive at every stage and end and its cubic Hermite interpolant does not dip to
+    /// zero inside the step ([`dip_to_zero`]). Otherwise [`Stepper::careful`] takes over.
     #[inline(always)]
-    fn commit<const POSITIVE: bool>(&mut self, n: GridStep, y: Kin) -> Result<()> {
-        self.y = y;
-        // The mode is slip in this direction: refresh_rates with the direction known.
-        let f = self.grid.force(n, 1.0);
-        self.stats.rhs_evaluations += 1;
-        self.rates = self
-            .model
-            .slip_rates(f, self.y.u, self.y.v, direction::<POSITIVE>());
-        if !self.rates.a_m_s2.is_finite() {
-            return Err(self.non_finite(n, 1.0));
+    fn slip<const POSITIVE: bool>(&mut self, n: GridStep, tau: f64) -> Result<StepStop> {
+        if self.y.v != 0.0 {
+            let dir = direction::<POSITIVE>();
+            let span = (1.0 - tau) * self.grid.h;
+            let f_start = self.grid.force(n, tau);
+            let f_mid = self.grid.force(n, 0.5 * (1.0 + tau));
+            let f_end = self.grid.force(n, 1.0);
+            self.stats.rhs_evaluations += 3;
+            let (y1, stage_min) = rk4_slip::<M, POSITIVE>(
+                self.model, self.y, self.rates, span, f_start, f_mid, f_end,
+            );
+            if dir * y1.v > 0.0 && stage_min > 0.0 {
+                self.stats.rhs_evaluations += 1;
+                let r1 = self.model.slip_rates(f_end, y1.u, y1.v, dir);
+                let (d0, d1) = (dir * self.rates.a_m_s2 * span, dir * r1.a_m_s2 * span);
+                if dip_to_zero(dir * self.y.v, dir * y1.v, d0, d1).is_none() {
+                    if !(y1.u.is_finite() && r1.a_m_s2.is_finite()) {
+                        return Err(self.non_finite(n, 1.0));
+                    }
+                    self.y = y1;
+                    self.rates = r1;
+                    return Ok(StepStop::Step);
+                }
+            }
+            if !(y1.u.is_finite() && y1.v.is_finite()) {
+                return Err(self.non_finite(n, tau));
+            }
         }
-        Ok(())
+        self.careful::<POSITIVE>(n, tau)
+    }
+
+    /// Slip near `v = 0` from fraction `tau` of step `n`: the rest of the step is tried, and
+    /// halved until the piece either is safe (speed positive at every stage, at its end and
+    /// on its Hermite interpolant: it is committed, [`StepStop::Moved`] or
+    /// [`StepStop::Step`]) or ends across `v = 0` (the crossing is located on the graded map
+    /// and the reset of [`arrive_at_rest`] applied: [`StepStop::Event`], or
+    /// [`StepStop::Moved`] into creep). Every crossing inside the step is found this way, two
+    /// reversals in one step included.
+    fn careful<const POSITIVE: bool>(&mut self, n: GridStep, tau: f64) -> Result<StepStop> {
+        let dir = direction::<POSITIVE>();
+        let from = Direction::of_sign(dir);
+        let from_rest = self.y.v == 0.0;
+        if from_rest
+            && self.creeps_from_rest(from, self.grid.force(n, tau), self.grid.force(n, 1.0))
+        {
+            self.enter(Mode::Creep(from), 0.0);
+            return Ok(StepStop::Moved { at: tau });
+        }
+        let mut len = 1.0 - tau;
+        for _ in 0..=MAX_HALVINGS {
+            let grading = if from_rest {
+                Grading::Start
+            } else {
+                Grading::Single
+            };
+            let (y1, stage_min) = self.advance::<POSITIVE>(n, tau, len, grading);
+            if !(y1.u.is_finite() && y1.v.is_finite()) {
+                return Err(self.non_finite(n, tau));
+            }
+            if dir * y1.v > 0.0 && stage_min > 0.0 {
+                let f1 = self.grid.force(n, tau + len);
+                self.stats.rhs_evaluations += 1;
+                let r1 = self.model.slip_rates(f1, y1.u, y1.v, dir);
+                let span = len * self.grid.h;
+                let (d0, d1) = (dir * self.rates.a_m_s2 * span, dir * r1.a_m_s2 * span);
+                if dip_to_zero(dir * self.y.v, dir * y1.v, d0, d1).is_none() {
+                    if !r1.a_m_s2.is_finite() {
+                        return Err(self.non_finite(n, tau + len));
+                    }
+                    self.y = y1;
+                    self.rates = r1;
+                    let at = tau + len;
+                    return Ok(if at >= 1.0 {
+                        StepStop::Step
+                    } else {
+                        StepStop::Moved { at }
+                    });
+                }
+            } else if dir * y1.v <= 0.0 {
+                // The piece ends across v = 0. Arriving at rest is singular: redo it graded
+                // towards the end, then locate the crossing on that graded map.
+                let grading = if from_rest {
+                    Grading::Both
+                } else {
+                    Grading::End
+                };
+                let (y2, _) = self.advance::<POSITIVE>(n, tau, len, grading);
+                if dir * y2.v <= 0.0 {
+                    let (x, y_event) = self
+                        .locate::<POSITIVE>(n, tau, len, y2, grading)
+                        .unwrap_or((0.0, self.y));
+                    let mut at = tau + x;
+                    if 1.0 - at < 1e-12 {
+                        at = 1.0;
+                    }
+                    self.y = Kin { v: 0.0, ..y_event };
+                    return Ok(self.arrive(n, at, from));
+                }
+            }
+            // Not safe and not (yet) across: the crossing or dip, if any, is in the first
+            // part of the piece.
+            len *= 0.5;
+        }
+        // A piece of 2⁻⁶⁰ of the step still not safe: the platen is at rest to within what
+        // such a piece resolves.
+        self.y.v = 0.0;
+        Ok(self.arrive(n, tau, from))
+    }
+
+    /// Whether a platen leaving rest in `from` is in the creep regime for the rest of the
+    /// step: its creep speed under the force at both ends (`f_start`, `f_end`; the force is
+    /// linear in between) is below the stiff speed, so an explicit step would only overshoot
+    /// (see [`crate::creep`]).
+    fn creeps_from_rest(&mut self, from: Direction, f_start: f64, f_end: f64) -> bool {
+        let w_stiff = stiff_speed_m_s(self.model, self.y.u, self.grid.h);
+        [f_start, f_end]
+            .iter()
+            .all(|&f| creep_speed_m_s(self.model, from, self.y.u, f, w_stiff).is_some())
+    }
+
+    /// The reset at `v = 0` reached at fraction `at` of step `n` in slip `from`
+    /// ([`arrive_at_rest`]): stick, reversal, or creep on.
+    fn arrive(&mut self, n: GridStep, at: f64, from: Direction) -> StepStop {
+        let f = self.grid.force(n, at);
+        let (mode, kind) = arrive_at_rest(self.model, self.y.u, f, from);
+        self.enter(mode, f);
+        match kind {
+            Some(kind) => {
+                self.stats.record(kind);
+                StepStop::Event { at, kind }
+            }
+            None => StepStop::Moved { at },
+        }
     }
 
     /// RK4 in slip from the current state at fraction `tau` of step `n` over a length `x·h`,
-    /// split into the sub-steps of `grading`.
+    /// split into the sub-steps of `grading`; with the smallest stage speed of all sub-steps.
     fn advance<const POSITIVE: bool>(
         &mut self,
         n: GridStep,
         tau: f64,
         x: f64,
         grading: Grading,
-    ) -> Kin {
+    ) -> (Kin, f64) {
         let dir = direction::<POSITIVE>();
         let (mut y, mut r) = (self.y, self.rates);
+        let mut stage_min = f64::INFINITY;
         let mut s = tau;
         for (i, &p) in grading.pieces().iter().enumerate() {
             let len = p * x;
@@ -493,11 +625,14 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
             }
             let f_mid = self.grid.force(n, s + 0.5 * len);
             let f_end = self.grid.force(n, s + len);
-            y = rk4_slip::<M, POSITIVE>(self.model, y, r, len * self.grid.h, f_start, f_mid, f_end);
+            let (y1, m) =
+                rk4_slip::<M, POSITIVE>(self.model, y, r, len * self.grid.h, f_start, f_mid, f_end);
+            y = y1;
+            stage_min = stage_min.min(m);
             self.stats.rhs_evaluations += 3;
             s += len;
         }
-        y
+        (y, stage_min)
     }
 
     /// The error of a state found non-finite at fraction `tau` of step `n`.
@@ -510,7 +645,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
     }
 
     /// Finds the step length `x ∈ (0, rem]` (fraction of `h`) at which the graded RK4
-    /// velocity from the current state reaches zero, given that the full remainder ends at
+    /// velocity from the current state reaches zero, given that the length `rem` ends at
     /// `y_rem` with `dir·v ≤ 0` ([`locate_zero_velocity`] on the graded RK4 map). Returns `x`
     /// and the state there (velocity not yet zeroed), or `None` if the platen starts at rest
     /// and does not move in `dir` for any step length.
@@ -529,7 +664,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
         let tolerance = 4.0 * f64::EPSILON * rem;
         let Ok(found) = locate_zero_velocity(rem, g_start, end, tolerance, |x| {
             self.stats.root_iterations += 1;
-            let y = self.advance::<POSITIVE>(n, tau, x, grading);
+            let (y, _) = self.advance::<POSITIVE>(n, tau, x, grading);
             Ok::<_, Infallible>((y, dir * y.v))
         });
         found
