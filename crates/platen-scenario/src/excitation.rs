@@ -14,7 +14,7 @@ use crate::ctx::{check_finite, check_positive, Ctx};
 use crate::error::{Result, ScenarioError};
 use crate::file::*;
 use crate::generate::{self, GenerateError};
-use crate::sampling::uniform_step_s;
+use crate::sampling::{sampling_grid, uniform_step_s};
 
 /// What a scenario runs.
 #[derive(Debug, Clone, PartialEq)]
@@ -336,10 +336,24 @@ fn motion_csv(ctx: &Ctx, file: &ScenarioFile, path: &Path) -> Result<Run> {
         }
     };
     let cut = |c: Vec<f64>| c[..samples].to_vec();
+    // Derived channels are differentiated on the grid fitted to the stamps (rounded stamps
+    // would put their rounding into every finite difference); the output keeps the stamps.
+    let grid = sampling_grid(path, &t[..samples])?;
+    let on_grid: Vec<f64> = (0..samples)
+        .map(|i| grid.start_s + i as f64 * grid.interval_s)
+        .collect();
+    let at_stamps = |m: Motion| {
+        let (u, v, a) = (m.u_m().to_vec(), m.v_m_s().to_vec(), m.a_m_s2().to_vec());
+        Motion::new(cut(t.clone()), u, v, a)
+    };
     let motion = match (v, a) {
-        (Some(v), Some(a)) => Motion::new(cut(t), cut(u), cut(v), cut(a)),
-        (Some(v), None) => Motion::from_displacement_velocity(cut(t), cut(u), cut(v)),
-        (None, Some(_)) | (None, None) => Motion::from_displacement(cut(t), cut(u)),
+        (Some(v), Some(a)) => Motion::new(cut(t.clone()), cut(u), cut(v), cut(a)),
+        (Some(v), None) => {
+            Motion::from_displacement_velocity(on_grid, cut(u), cut(v)).and_then(at_stamps)
+        }
+        (None, Some(_)) | (None, None) => {
+            Motion::from_displacement(on_grid, cut(u)).and_then(at_stamps)
+        }
     }
     .map_err(|cause| rejected(path, cause))?;
     Ok(Run::Inverse { motion })
@@ -564,8 +578,13 @@ fn forward_run(
         None => Method::Rk4(Rk4::with_steps_per_sample(1).expect("k = 1 is valid")),
         Some(IntegratorSpec::Rk4(Rk4Spec { step_s })) => {
             let step = step_s.unwrap_or(record.dt_s());
+            // The step must divide the interval fitted over the record (not one measured
+            // between two rounded stamps); the integrator then steps at that interval / k.
+            let k = platen_integrate::sampling_grid(record.t_s())
+                .and_then(|grid| grid.steps_per_interval(step))
+                .map_err(|e| ctx.invalid("integrator.step_s", step, e.to_string()))?;
             Method::Rk4(
-                Rk4::from_step(step, record.dt_s())
+                Rk4::with_steps_per_sample(k)
                     .map_err(|e| ctx.invalid("integrator.step_s", step, e.to_string()))?,
             )
         }
