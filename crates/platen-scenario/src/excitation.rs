@@ -474,7 +474,9 @@ fn lowpass(
         .map_err(|e| ctx.invalid("excitation.lowpass_hz", cutoff, e.to_string()))
 }
 
-/// The table motion of an `excitation.ground_motion`.
+/// The table motion of an `excitation.ground_motion`: the record scaled, cut to the
+/// duration, baseline-corrected and integrated as PEER integrates it
+/// ([`platen_signal::AccelerogramMotion`]: straight lines between samples, exact integrals).
 fn ground_motion(ctx: &Ctx, g: &GroundMotion, duration_s: Option<f64>) -> Result<Motion> {
     let here = "excitation.ground_motion";
     let scale = check_finite(ctx, &format!("{here}.scale"), g.scale)?;
@@ -484,36 +486,6 @@ fn ground_motion(ctx: &Ctx, g: &GroundMotion, duration_s: Option<f64>) -> Result
     let signal = |name: &str, e: platen_signal::SignalError| {
         ctx.invalid(&format!("{here}.{name}"), "", e.to_string())
     };
-    let a: Vec<f64> = acc.iter().map(|x| x * scale).collect();
-    let resampler =
-        platen_signal::Resampler::new(1.0 / dt_s, rate, platen_signal::Interpolation::default())
-            .map_err(|e| signal("sample_rate_hz", e))?;
-    if resampler.output_len(a.len()) > generate::MAX_GENERATED_SAMPLES {
-        return Err(ctx.invalid(
-            &format!("{here}.sample_rate_hz"),
-            rate,
-            format!(
-                "a rate giving at most {} samples for this record",
-                generate::MAX_GENERATED_SAMPLES
-            ),
-        ));
-    }
-    let mut a = resampler
-        .apply(&a)
-        .map_err(|e| signal("sample_rate_hz", e))?;
-    if let Some(d) = duration_s {
-        check_positive(ctx, "duration_s", d)?;
-        let n = (d * rate + 1e-6).floor() as usize + 1;
-        if n > a.len() {
-            return Err(ScenarioError::RecordTooShort {
-                path,
-                span_s: (a.len() - 1) as f64 / rate,
-                samples: None,
-                duration_s: d,
-            });
-        }
-        a.truncate(n);
-    }
     let baseline = match g.baseline {
         BaselineKind::None => platen_signal::Baseline::None,
         BaselineKind::Acceleration => platen_signal::Baseline::Acceleration {
@@ -523,14 +495,50 @@ fn ground_motion(ctx: &Ctx, g: &GroundMotion, duration_s: Option<f64>) -> Result
             order: g.baseline_order,
         },
     };
-    let integrator = platen_signal::MotionIntegrator::new(rate, baseline)
-        .map_err(|e| signal("baseline_order", e))?;
-    if matches!(g.baseline, BaselineKind::Acceleration) {
-        platen_signal::remove_polynomial(&mut a, g.baseline_order);
+    let plan =
+        platen_signal::AccelerogramMotion::new(1.0 / dt_s, rate, baseline).map_err(
+            |e| match e {
+                platen_signal::SignalError::InvalidCount { .. } => signal("baseline_order", e),
+                other => signal("sample_rate_hz", other),
+            },
+        )?;
+    let available = plan.output_len(acc.len());
+    if available > generate::MAX_GENERATED_SAMPLES {
+        return Err(ctx.invalid(
+            &format!("{here}.sample_rate_hz"),
+            rate,
+            format!(
+                "a rate giving at most {} samples for this record",
+                generate::MAX_GENERATED_SAMPLES
+            ),
+        ));
     }
-    let m = integrator.integrate(&a, platen_signal::InitialMotion::default());
-    let t = (0..a.len()).map(|j| j as f64 / rate).collect();
-    Motion::new(t, m.u_m, m.v_m_s, a).map_err(|cause| rejected(&path, cause))
+    // The table samples that run, and the record samples that cover them (the baseline is
+    // fitted over what runs).
+    let (samples, record_samples) = match duration_s {
+        None => (available, acc.len()),
+        Some(d) => {
+            check_positive(ctx, "duration_s", d)?;
+            let n = (d * rate + 1e-6).floor() as usize + 1;
+            if n > available {
+                return Err(ScenarioError::RecordTooShort {
+                    path,
+                    span_s: (available - 1) as f64 / rate,
+                    samples: None,
+                    duration_s: d,
+                });
+            }
+            let last = ((n - 1) as f64 / rate / dt_s - 1e-9).ceil() as usize;
+            (n, (last + 1).clamp(2, acc.len()))
+        }
+    };
+    let a: Vec<f64> = acc[..record_samples].iter().map(|x| x * scale).collect();
+    let mut m = plan.process(&a).map_err(|e| signal("record", e))?;
+    for column in [&mut m.a_m_s2, &mut m.v_m_s, &mut m.u_m] {
+        column.truncate(samples);
+    }
+    let t = (0..m.a_m_s2.len()).map(|j| j as f64 / rate).collect();
+    Motion::new(t, m.u_m, m.v_m_s, m.a_m_s2).map_err(|cause| rejected(&path, cause))
 }
 
 /// The ground acceleration of a `ground_motion` record (m/s²) and its sample interval (s):

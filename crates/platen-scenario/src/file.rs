@@ -137,10 +137,12 @@ pub enum LowpassFilter {
     Butterworth,
 }
 
-/// A table motion that reproduces a ground-acceleration record: the PEER `.AT2` record is
-/// scaled, resampled (not-a-knot cubic spline; anti-aliased when downsampling),
-/// baseline-corrected and integrated (trapezoidal) to table velocity and displacement, from
-/// rest at 0.
+/// A table motion that reproduces a ground-acceleration record as PEER integrates it: the
+/// PEER `.AT2` record (or a CSV) is scaled, taken as straight lines between its samples (which
+/// cannot overshoot them), baseline-corrected if asked, and integrated exactly to the table
+/// velocity and displacement from rest, sampled at `sample_rate_hz`
+/// ([`platen_signal::AccelerogramMotion`]). With the default `baseline` (`none`) the velocity
+/// and displacement at the record's own sample times are PEER's `.VT2` and `.DT2`.
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GroundMotion {
@@ -153,10 +155,12 @@ pub struct GroundMotion {
     /// Sample rate of the table motion, Hz (default 1024).
     #[serde(default = "default_rate")]
     pub sample_rate_hz: f64,
-    /// Baseline correction before integrating: `none`, `acceleration` (remove the
-    /// least-squares polynomial of `baseline_order` from the acceleration) or `velocity` (from
-    /// the velocity). Default `acceleration` of order 0: the mean acceleration is removed, so
-    /// the table ends at rest.
+    /// Baseline correction before integrating: `none` (default: a PEER-processed record is
+    /// already corrected, and integrating it as it is reproduces its `.VT2`/`.DT2`),
+    /// `acceleration` (remove the least-squares polynomial of `baseline_order` from the
+    /// acceleration: order 0 removes a bias, for a raw record) or `velocity` (remove it from
+    /// the velocity, its derivative from the acceleration and its integral from the
+    /// displacement).
     #[serde(default = "default_baseline")]
     pub baseline: BaselineKind,
     /// Polynomial order of the baseline correction (default 0, at most 8).
@@ -184,7 +188,7 @@ fn default_scale() -> f64 {
 }
 
 fn default_baseline() -> BaselineKind {
-    BaselineKind::Acceleration
+    BaselineKind::None
 }
 
 /// `F(t) = r(t)·amplitude_n·sin(2π·frequency_hz·t)`, with `r` a linear ramp from 0 to 1 over
