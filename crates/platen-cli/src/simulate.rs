@@ -62,6 +62,9 @@ fn print_summary(s: &Scenario, peaks: &Peaks, stats: Option<&RunStats>, out: Opt
         peaks.samples,
         peaks.span_s.1 - peaks.span_s.0
     );
+    for (channel, how) in &s.derived {
+        println!("  derived {channel}: {how}");
+    }
     println!(
         "  peak displacement {:>+10.4} m     at {:.3} s",
         peaks.u_m.value, peaks.u_m.t_s

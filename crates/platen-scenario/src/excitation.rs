@@ -171,14 +171,16 @@ impl<'a> Source<'a> {
     }
 }
 
-/// What the scenario file's excitation, integrator, initial state and duration run.
-pub(crate) fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
+/// What the scenario file's excitation, integrator, initial state and duration run, and
+/// which channels of the excitation were derived (not given by the file or generator).
+pub(crate) fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<(Run, Derived)> {
     let ex = &file.excitation;
     let source = Source::of(ctx, ex)?;
     check_direction_fields(ctx, file, source)?;
     let gen = Generated { ctx, file, source };
+    let nothing = |run: Run| (run, Derived::new());
     match source {
-        Source::ForceCsv(rel) => force_csv_run(ctx, file, &ctx.resolve(rel)),
+        Source::ForceCsv(rel) => force_csv_run(ctx, file, &ctx.resolve(rel)).map(nothing),
         Source::SineForce(g) => {
             let record = generate::sine_force(
                 g.amplitude_n,
@@ -190,7 +192,7 @@ pub(crate) fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
             .map_err(|e| gen.error(e))?;
             let samples = record.len();
             let record = lowpass(ctx, ex, record, samples)?;
-            forward_run(ctx, file, record, samples, None)
+            forward_run(ctx, file, record, samples, None).map(nothing)
         }
         Source::MotionCsv(rel) => motion_csv(ctx, file, &ctx.resolve(rel)),
         Source::SineMotion(g) => generate::sine_motion(
@@ -200,7 +202,7 @@ pub(crate) fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
             gen.duration()?,
         )
         .map_err(|e| gen.error(e))
-        .map(|motion| Run::Inverse { motion }),
+        .map(|motion| nothing(Run::Inverse { motion })),
         Source::TriangleMotion(g) => generate::triangle_motion(
             g.amplitude_m,
             g.velocity_m_s,
@@ -209,11 +211,17 @@ pub(crate) fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
             gen.duration()?,
         )
         .map_err(|e| gen.error(e))
-        .map(|motion| Run::Inverse { motion }),
-        Source::WhiteNoiseMotion(g) => white_noise(&gen, g),
-        Source::GroundMotion(g) => Ok(Run::Inverse {
-            motion: ground_motion(ctx, g, file.duration_s)?,
-        }),
+        .map(|motion| nothing(Run::Inverse { motion })),
+        Source::WhiteNoiseMotion(g) => white_noise(&gen, g).map(nothing),
+        Source::GroundMotion(g) => {
+            let motion = ground_motion(ctx, g, file.duration_s)?;
+            let integral = "exact integral of a_m_s2 (straight lines between the record's samples)";
+            let derived = Derived::from([
+                ("v_m_s", integral.to_owned()),
+                ("u_m", format!("{integral}, twice")),
+            ]);
+            Ok((Run::Inverse { motion }, derived))
+        }
     }
 }
 
@@ -310,9 +318,11 @@ fn force_csv_run(ctx: &Ctx, file: &ScenarioFile, path: &Path) -> Result<Run> {
     forward_run(ctx, file, record, samples, recorded_state)
 }
 
-/// `excitation.motion_csv`: a prescribed motion, cut to the duration; missing velocity and
-/// acceleration are derived from the displacement.
-fn motion_csv(ctx: &Ctx, file: &ScenarioFile, path: &Path) -> Result<Run> {
+/// `excitation.motion_csv`: a prescribed motion, cut to the duration. Every channel given is
+/// kept; a missing velocity is the crossover estimate from `u_m` and `a_m_s2` when the
+/// acceleration is given, else the derivative of `u_m`; a missing acceleration is the
+/// derivative of `v_m_s` (or the second derivative of `u_m`).
+fn motion_csv(ctx: &Ctx, file: &ScenarioFile, path: &Path) -> Result<(Run, Derived)> {
     let ex = &file.excitation;
     let mut cols = read_mapped(ctx, path, ex, &["t_s", "u_m"], &["v_m_s", "a_m_s2"])?;
     let t = cols.remove("t_s").unwrap_or_default();
@@ -336,27 +346,71 @@ fn motion_csv(ctx: &Ctx, file: &ScenarioFile, path: &Path) -> Result<Run> {
         }
     };
     let cut = |c: Vec<f64>| c[..samples].to_vec();
-    // Derived channels are differentiated on the grid fitted to the stamps (rounded stamps
-    // would put their rounding into every finite difference); the output keeps the stamps.
+    // Derived channels are computed on the grid fitted to the stamps (rounded stamps would put
+    // their rounding into every finite difference); the output keeps the stamps.
     let grid = sampling_grid(path, &t[..samples])?;
     let on_grid: Vec<f64> = (0..samples)
         .map(|i| grid.start_s + i as f64 * grid.interval_s)
         .collect();
-    let at_stamps = |m: Motion| {
-        let (u, v, a) = (m.u_m().to_vec(), m.v_m_s().to_vec(), m.a_m_s2().to_vec());
-        Motion::new(cut(t.clone()), u, v, a)
-    };
+    let stamps = cut(t);
+    let mut derived = Derived::new();
     let motion = match (v, a) {
-        (Some(v), Some(a)) => Motion::new(cut(t.clone()), cut(u), cut(v), cut(a)),
+        (Some(v), Some(a)) => Motion::new(stamps, cut(u), cut(v), cut(a)),
         (Some(v), None) => {
-            Motion::from_displacement_velocity(on_grid, cut(u), cut(v)).and_then(at_stamps)
+            derived.insert("a_m_s2", DERIVATIVE_OF_V.to_owned());
+            Motion::from_displacement_velocity(on_grid, cut(u), cut(v))
+                .and_then(|m| restamp(stamps, &m))
         }
-        (None, Some(_)) | (None, None) => {
-            Motion::from_displacement(on_grid, cut(u)).and_then(at_stamps)
+        (None, Some(a)) => {
+            // Keep the recorded acceleration; the velocity is the crossover estimate, as a
+            // table's data system makes it (differentiated displacement below the crossover,
+            // integrated acceleration above).
+            let (u, a) = (cut(u), cut(a));
+            let v = platen_signal::CrossoverVelocity::standard(1.0 / grid.interval_s)
+                .and_then(|c| c.estimate(&u, &a))
+                .map_err(|e| {
+                    ScenarioError::Io(IoError::Record {
+                        path: path.to_owned(),
+                        message: format!("velocity from u_m and a_m_s2: {e}"),
+                    })
+                })?;
+            derived.insert("v_m_s", crossover_note());
+            Motion::new(stamps, u, v, a)
+        }
+        (None, None) => {
+            derived.insert("v_m_s", DERIVATIVE_OF_U.to_owned());
+            derived.insert("a_m_s2", SECOND_DERIVATIVE_OF_U.to_owned());
+            Motion::from_displacement(on_grid, cut(u)).and_then(|m| restamp(stamps, &m))
         }
     }
     .map_err(|cause| rejected(path, cause))?;
-    Ok(Run::Inverse { motion })
+    Ok((Run::Inverse { motion }, derived))
+}
+
+/// The channels of an excitation that platen derived, by name, with how (what a summary
+/// reports under `derived`).
+pub type Derived = BTreeMap<&'static str, String>;
+
+const DERIVATIVE_OF_V: &str = "derivative of v_m_s (second-order finite differences)";
+const DERIVATIVE_OF_U: &str = "derivative of u_m (second-order finite differences)";
+const SECOND_DERIVATIVE_OF_U: &str = "second derivative of u_m (second-order finite differences)";
+
+/// How the crossover velocity is made ([`platen_signal::CrossoverVelocity::standard`]).
+fn crossover_note() -> String {
+    format!(
+        "crossover of u_m (differentiated, below {} Hz) and a_m_s2 (integrated, above)",
+        platen_signal::DEFAULT_CROSSOVER_HZ
+    )
+}
+
+/// `m` at the time stamps `t_s` (same length) instead of its own times.
+fn restamp(t_s: Vec<f64>, m: &Motion) -> std::result::Result<Motion, IntegrateError> {
+    Motion::new(
+        t_s,
+        m.u_m().to_vec(),
+        m.v_m_s().to_vec(),
+        m.a_m_s2().to_vec(),
+    )
 }
 
 /// `excitation.white_noise_motion`: band-limited white noise of the given RMS acceleration.

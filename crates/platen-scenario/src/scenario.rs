@@ -42,7 +42,7 @@ use crate::excitation::build_run;
 use crate::file::given_values;
 use platen_io::json::parse_json_file;
 
-pub use crate::excitation::Run;
+pub use crate::excitation::{Derived, Run};
 pub use crate::file::*;
 
 /// A validated model in one of its two forms.
@@ -82,6 +82,9 @@ pub struct Scenario {
     pub limits: TableLimits,
     /// What to run.
     pub run: Run,
+    /// The excitation's channels that platen derived (not given by the file or generator), by
+    /// name, with how: what the summary reports under `derived`.
+    pub derived: Derived,
 }
 
 impl Scenario {
@@ -98,6 +101,7 @@ impl Scenario {
             overrides: self.overrides.clone(),
             limits: self.limits,
             run: self.run.scaled(k)?.into_owned(),
+            derived: self.derived.clone(),
         })
     }
 
@@ -147,7 +151,7 @@ impl Scenario {
         };
         let overrides = model_overrides(&ctx, &file.model)?;
         let model = build_model(&ctx, preset, pressure_pa, &overrides)?;
-        let run = build_run(&ctx, &file)?;
+        let (run, derived) = build_run(&ctx, &file)?;
         let name = file.name.clone().unwrap_or_else(|| {
             path.file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
@@ -161,6 +165,7 @@ impl Scenario {
             overrides,
             limits: preset.limits(),
             run,
+            derived,
         })
     }
 }

@@ -9,7 +9,7 @@ use platen_integrate::{Exceedance, ForwardIntegrator, Peaks, RunStats, Trajector
 use platen_model::TableLimits;
 
 use crate::error::Result;
-use crate::scenario::{Run, Scenario};
+use crate::scenario::{Derived, Run, Scenario};
 use crate::RunOutput;
 
 /// The summary of one run of a scenario. Serialise it through [`serde_json::to_value`] to
@@ -55,6 +55,10 @@ pub struct RunSummary {
     pub limit_exceedances: Vec<ExceedanceSummary>,
     /// Every limit with the run's peak against it.
     pub limits: LimitsSummary,
+    /// The excitation's channels that platen derived, with how (absent when the file or
+    /// generator gave every channel).
+    #[serde(skip_serializing_if = "Derived::is_empty")]
+    pub derived: Derived,
     /// The CSV written, if any.
     pub out: Option<String>,
 }
@@ -188,6 +192,7 @@ impl RunSummary {
                 .map(ExceedanceSummary::from)
                 .collect(),
             limits: LimitsSummary::new(peaks, &scenario.limits),
+            derived: scenario.derived.clone(),
             out: out.map(|p| p.display().to_string()),
         }
     }

@@ -95,7 +95,7 @@ pub use calculus::{
     cumulative_trapezoid, differentiate, remove_polynomial, Baseline, InitialMotion, Motion,
     MotionIntegrator, MAX_BASELINE_ORDER,
 };
-pub use crossover::CrossoverVelocity;
+pub use crossover::{CrossoverVelocity, DEFAULT_CROSSOVER_HZ};
 pub use error::{Result, SignalError};
 pub use fir::{FirLowpass, MAX_FIR_ORDER};
 pub use resample::{Interpolation, Resampler};
