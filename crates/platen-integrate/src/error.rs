@@ -86,6 +86,12 @@ pub enum IntegrateError {
         /// The record's sample interval, s.
         sample_interval_s: f64,
     },
+    /// A velocity dead band that is not a finite positive number.
+    #[error("rest_velocity_m_s = {value} is invalid: expected a finite velocity > 0 m/s")]
+    InvalidRestVelocity {
+        /// The value given, m/s.
+        value: f64,
+    },
     /// A step size that is not a finite positive number.
     #[error("step_s = {step_s} is invalid: expected a finite number > 0")]
     InvalidStep {

@@ -251,13 +251,16 @@ impl ForceRecord {
     }
 }
 
-/// A prescribed platen motion: displacement, velocity and acceleration at each sample time.
+/// A prescribed platen motion: displacement, velocity and acceleration at each sample time,
+/// and optionally the velocity below which the platen counts as at rest
+/// ([`Motion::with_rest_velocity`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Motion {
     t_s: Vec<f64>,
     u_m: Vec<f64>,
     v_m_s: Vec<f64>,
     a_m_s2: Vec<f64>,
+    rest_velocity_m_s: Option<f64>,
 }
 
 impl Motion {
@@ -276,6 +279,7 @@ impl Motion {
             u_m,
             v_m_s,
             a_m_s2,
+            rest_velocity_m_s: None,
         })
     }
 
@@ -294,6 +298,7 @@ impl Motion {
             u_m,
             v_m_s,
             a_m_s2,
+            rest_velocity_m_s: None,
         })
     }
 
@@ -316,7 +321,31 @@ impl Motion {
             u_m,
             v_m_s,
             a_m_s2,
+            rest_velocity_m_s: None,
         })
+    }
+
+    /// The same motion with a velocity dead band: where `|v| ≤ rest_velocity_m_s` the
+    /// platen counts as at rest, and an inverse run ([`crate::inverse`]) takes the friction
+    /// as the static reaction that balances the other forces within `±F_s` instead of
+    /// `sign(v)·D` (which flips by `2F_s` on a noisy measured velocity while the table stands
+    /// still). Without it (the default) only `v = 0` exactly is at rest.
+    ///
+    /// # Errors
+    /// [`IntegrateError::InvalidRestVelocity`] unless `rest_velocity_m_s` is finite and > 0.
+    pub fn with_rest_velocity(mut self, rest_velocity_m_s: f64) -> Result<Self> {
+        if !(rest_velocity_m_s.is_finite() && rest_velocity_m_s > 0.0) {
+            return Err(IntegrateError::InvalidRestVelocity {
+                value: rest_velocity_m_s,
+            });
+        }
+        self.rest_velocity_m_s = Some(rest_velocity_m_s);
+        Ok(self)
+    }
+
+    /// The velocity dead band, m/s ([`Motion::with_rest_velocity`]); `None` by default.
+    pub fn rest_velocity_m_s(&self) -> Option<f64> {
+        self.rest_velocity_m_s
     }
 
     /// Sample times, s.

@@ -77,14 +77,21 @@ impl Run {
                 initial: *initial,
                 samples: *samples,
             },
-            Run::Inverse { motion } => Run::Inverse {
-                motion: Motion::new(
+            Run::Inverse { motion } => {
+                let scaled = Motion::new(
                     motion.t_s().to_vec(),
                     times(motion.u_m()),
                     times(motion.v_m_s()),
                     times(motion.a_m_s2()),
-                )?,
-            },
+                )?;
+                // The dead band is the velocity measurement's resolution: not scaled.
+                Run::Inverse {
+                    motion: match motion.rest_velocity_m_s() {
+                        Some(band) => scaled.with_rest_velocity(band)?,
+                        None => scaled,
+                    },
+                }
+            }
         }))
     }
 }
@@ -177,6 +184,25 @@ pub(crate) fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<(Run, Derived)
     let ex = &file.excitation;
     let source = Source::of(ctx, ex)?;
     check_direction_fields(ctx, file, source)?;
+    let here = "excitation.rest_velocity_m_s";
+    let band = (ex.rest_velocity_m_s)
+        .map(|b| check_positive(ctx, here, b))
+        .transpose()?;
+    let (run, derived) = build_source(ctx, file, source)?;
+    let run = match (run, band) {
+        (Run::Inverse { motion }, Some(band)) => Run::Inverse {
+            motion: motion
+                .with_rest_velocity(band)
+                .map_err(|e| ctx.invalid(here, band, e.to_string()))?,
+        },
+        (run, _) => run,
+    };
+    Ok((run, derived))
+}
+
+/// The run of the excitation's one source.
+fn build_source(ctx: &Ctx, file: &ScenarioFile, source: Source) -> Result<(Run, Derived)> {
+    let ex = &file.excitation;
     let gen = Generated { ctx, file, source };
     let nothing = |run: Run| (run, Derived::new());
     match source {
@@ -230,6 +256,13 @@ pub(crate) fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<(Run, Derived)
 fn check_direction_fields(ctx: &Ctx, file: &ScenarioFile, source: Source) -> Result<()> {
     let ex = &file.excitation;
     if source.is_force() {
+        if let Some(band) = ex.rest_velocity_m_s {
+            return Err(ctx.invalid(
+                "excitation.rest_velocity_m_s",
+                band,
+                "no velocity dead band on a force: it applies to motion excitations (inverse runs)",
+            ));
+        }
         return Ok(());
     }
     if ex.lowpass_hz.is_some() || ex.lowpass_filter.is_some() {

@@ -33,6 +33,24 @@ pub struct ScenarioFile {
     pub initial: Option<InitialSpec>,
     /// Simulated duration, s (default: the record's span).
     pub duration_s: Option<f64>,
+    /// The table's limits, laid over the preset's (default: the preset's; the LHPOST's are
+    /// ±0.75 m, 1.8 m/s, 4.2 g, 6.8 MN).
+    pub limits: Option<LimitsSpec>,
+}
+
+/// `limits`: any of the table's four limits, each a number > 0 in SI units; a limit not given
+/// is the preset's.
+#[derive(Debug, Clone, Default, Deserialize, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct LimitsSpec {
+    /// Displacement stroke, ±m.
+    pub stroke_m: Option<f64>,
+    /// Peak velocity, m/s.
+    pub velocity_m_s: Option<f64>,
+    /// Peak acceleration, m/s².
+    pub acceleration_m_s2: Option<f64>,
+    /// Horizontal actuator force capacity, N.
+    pub force_n: Option<f64>,
 }
 
 /// `model`: a preset, its hold-down pressure, and the form with overrides.
@@ -116,6 +134,12 @@ pub struct ExcitationSpec {
     pub lowpass_hz: Option<f64>,
     /// The filter of `lowpass_hz` (default `brickwall`).
     pub lowpass_filter: Option<LowpassFilter>,
+    /// Velocity dead band of an inverse run, m/s (default: none, only `v = 0` is at rest):
+    /// where `|v|` is at most this the platen counts as at rest, and the friction is the
+    /// static reaction that balances the inertial and elastic forces within `±F_s` instead of
+    /// flipping with the sign of a noisy measured velocity
+    /// ([`platen_integrate::inverse`]). Motion excitations only.
+    pub rest_velocity_m_s: Option<f64>,
     /// A lab's own channel names and units for `force_csv` / `motion_csv`
     /// (see [`crate::columns`]).
     pub columns: Option<BTreeMap<String, ColumnSpec>>,

@@ -1,6 +1,7 @@
 //! The summary of a run ([`RunSummary`]): what `platen simulate --json` prints and a Python
 //! user's `run.summary` holds. A serde type, so every front end reports the same keys.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use serde::Serialize;
@@ -26,6 +27,10 @@ pub struct RunSummary {
     pub model_form: &'static str,
     /// The preset the model is based on.
     pub preset: &'static str,
+    /// The values the scenario lays over the preset's, by name (absent when the preset's own
+    /// values run): the model is the preset's only where this does not name a parameter.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub model_overrides: BTreeMap<&'static str, f64>,
     /// The hold-down pressure, MPa.
     pub hold_down_pressure_mpa: f64,
     /// Output samples.
@@ -144,7 +149,8 @@ pub struct LimitCheck {
     pub respected: bool,
 }
 
-/// Every table limit against the run's peaks.
+/// Every table limit (the preset's, with the scenario's `limits` laid over them) against the
+/// run's peaks.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LimitsSummary {
     /// Stroke, m.
@@ -171,6 +177,12 @@ impl RunSummary {
             },
             model_form: scenario.model.form(),
             preset: scenario.preset.name(),
+            model_overrides: scenario
+                .overrides
+                .values()
+                .iter()
+                .map(|(key, value)| (key.name(), *value))
+                .collect(),
             hold_down_pressure_mpa: scenario.hold_down_pressure_pa / 1e6,
             samples: peaks.samples,
             duration_s: peaks.span_s.1 - peaks.span_s.0,

@@ -123,3 +123,64 @@ fn a_motion_with_every_channel_derives_nothing() {
     let json = serde_json::to_value(&run.summary).unwrap();
     assert!(json.get("derived").is_none(), "{json}");
 }
+
+/// `excitation.rest_velocity_m_s` reaches the inverse run (a constant position with a velocity
+/// jittering by ±0.5 mm/s: the friction is the static reaction, without sign flips), and a
+/// force excitation or a band that is not a positive velocity is refused with its JSON path.
+#[test]
+fn the_scenarios_dead_band_reaches_the_inverse_run_and_is_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let n = 2048;
+    let u = vec![0.05; n];
+    let v = (0..n)
+        .map(|i| if i % 2 == 0 { 5e-4 } else { -5e-4 })
+        .collect();
+    let a = vec![0.0; n];
+    let path = scenario(
+        dir.path(),
+        "still",
+        &[("u_m", u), ("v_m_s", v), ("a_m_s2", a)],
+    );
+    let flips = |run: &RunResult| {
+        column(run, "dissipative_force_n")
+            .windows(2)
+            .filter(|w| w[0] * w[1] < 0.0)
+            .count()
+    };
+    assert_eq!(flips(&simulate(&path).unwrap()), n - 1);
+    let text = std::fs::read_to_string(&path).unwrap().replace(
+        r#""motion_csv": "still.csv""#,
+        r#""motion_csv": "still.csv", "rest_velocity_m_s": 0.001"#,
+    );
+    std::fs::write(&path, &text).unwrap();
+    let run = simulate(&path).unwrap();
+    assert_eq!(flips(&run), 0);
+    // Kₑu = 63.3 kN against F_s = 37.485 kN: the actuator holds the difference.
+    let f = column(&run, "force_n");
+    assert!(
+        f.iter()
+            .all(|&f| (f - (1.266e6 * 0.05 - 37_485.2)).abs() < 1.0),
+        "{}",
+        f[0]
+    );
+
+    for (bad, needle) in [
+        (text.replace("0.001", "0"), "excitation.rest_velocity_m_s"),
+        (text.replace("0.001", "-1"), "excitation.rest_velocity_m_s"),
+    ] {
+        std::fs::write(&path, bad).unwrap();
+        let e = simulate(&path).unwrap_err().to_string();
+        assert!(e.contains(needle), "{e}");
+    }
+    let force = dir.path().join("force.json");
+    std::fs::write(
+        &force,
+        r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"sine_force": {"amplitude_n": 1e5, "frequency_hz": 0.5}, "rest_velocity_m_s": 0.001}, "duration_s": 2}"#,
+    )
+    .unwrap();
+    let e = simulate(&force).unwrap_err().to_string();
+    assert!(
+        e.contains("excitation.rest_velocity_m_s") && e.contains("motion"),
+        "{e}"
+    );
+}
