@@ -591,11 +591,15 @@ fn a_lab_export_with_its_own_channel_names_and_units_is_mapped() {
     let (a, b) = (run("lab"), run("si"));
     assert_eq!(a.len(), b.len());
     // Unit conversions round in the last bits: compare each column to 1e-9 of its own scale.
+    // Where the velocity (the crossover estimate from u and a) is zero to rounding, 1e-15 m/s,
+    // the √|v| law turns that rounding into Cₑ·√(1e-14 m/s) = 44.58 kN × 1e-7 ≈ 5 mN of force
+    // (columns force_n and dissipative_force_n): allowed on top.
     for c in 0..b[0].len() {
         let scale = b.iter().map(|r| r[c].abs()).fold(0.0, f64::max).max(1e-12);
+        let sqrt_law = if c == 4 || c == 7 { 5e-3 } else { 0.0 };
         for (x, y) in a.iter().zip(&b) {
             assert!(
-                (x[c] - y[c]).abs() <= 1e-9 * scale,
+                (x[c] - y[c]).abs() <= 1e-9 * scale + sqrt_law,
                 "column {c}: {x:?} vs {y:?}"
             );
         }
