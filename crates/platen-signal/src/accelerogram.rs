@@ -1,26 +1,5 @@
-//! The table motion of a ground-acceleration record, processed as PEER processes it.
-//!
-//! PEER's NGA `.VT2` and `.DT2` files are the trapezoidal integrals of the `.AT2`
-//! acceleration from rest, at the record's own interval. The trapezoid is the *exact*
-//! integral of the acceleration taken as straight lines between its samples, so that is the
-//! motion PEER's velocity and displacement describe. [`AccelerogramMotion`] builds it at any
-//! table rate: the acceleration is interpolated linearly (it cannot overshoot its samples),
-//! and the velocity and displacement are its exact integrals (a quadratic and a cubic between
-//! samples), so at the record's own sample times they are PEER's `.VT2` and (to
-//! `Δt²·Δa/12`) `.DT2`, and at every table sample the three channels are one consistent
-//! motion.
-//!
-//! Why not a smoother interpolation: a not-a-knot cubic spline through the 50 Hz Tarzana record
-//! overshoots the 1.78 g pulse (2.27 m/s² above the straight line at 8.35 s) and leaves a
-//! lasting velocity offset (1.45 % NRMSE against `.VT2`); a band-limited (FFT) interpolation
-//! overshoots the record's peak too (17.71 m/s² against 17.45) and puts the peak velocity
-//! 5.6 % above `.VT2`'s. The straight line is the one interpolant whose integrals are PEER's.
-//!
-//! **The peak between samples.** Where the acceleration changes sign between two samples the
-//! velocity peaks between them, above both samples. In TAR090 the acceleration goes from
-//! −7.96 to +6.98 m/s² across the 50 Hz interval before PEER's peak velocity sample
-//! (−109.65 cm/s), so the motion's velocity reaches −112.9 cm/s in between (+3.0 %): a table
-//! rate shows that peak, the 50 Hz `.VT2` cannot.
+//! The table motion of a ground-acceleration record, processed as PEER processes it
+//! ([`AccelerogramMotion`]).
 
 use crate::calculus::{remove_polynomial, Baseline, MAX_BASELINE_ORDER};
 use crate::error::{Result, SignalError};
@@ -44,7 +23,8 @@ pub struct Kinematics {
 ///
 /// * The acceleration is the straight line between the record's samples, after the
 ///   [`Baseline`] correction; the velocity and displacement are its exact integrals from rest
-///   (see the [module docs](self) for why this reproduces PEER's `.VT2` and `.DT2`).
+///   (they are exactly what PEER's `.VT2` and `.DT2` integrate: the trapezoid is the exact
+///   integral of straight lines between samples).
 /// * [`Baseline::None`] integrates the record as it is: PEER's processed records are already
 ///   baseline-corrected and filtered, and this reproduces their `.VT2`/`.DT2`.
 ///   [`Baseline::Acceleration`] removes the least-squares polynomial of the acceleration
@@ -55,6 +35,28 @@ pub struct Kinematics {
 /// * Downsampling (`to_hz < from_hz`) first low-passes the record with the [`Resampler`]'s
 ///   anti-alias filter (zero-phase windowed sinc, cut-off at 0.4·`to_hz`); only then can the
 ///   straight lines ring (the filter's ripple, ≤ 0.5 %).
+///
+/// PEER's NGA `.VT2` and `.DT2` files are the trapezoidal integrals of the `.AT2`
+/// acceleration from rest, at the record's own interval. The trapezoid is the *exact*
+/// integral of the acceleration taken as straight lines between its samples, so that is the
+/// motion PEER's velocity and displacement describe. [`AccelerogramMotion`] builds it at any
+/// table rate: the acceleration is interpolated linearly (it cannot overshoot its samples),
+/// and the velocity and displacement are its exact integrals (a quadratic and a cubic between
+/// samples), so at the record's own sample times they are PEER's `.VT2` and (to
+/// `Δt²·Δa/12`) `.DT2`, and at every table sample the three channels are one consistent
+/// motion.
+///
+/// Why not a smoother interpolation: a not-a-knot cubic spline through the 50 Hz Tarzana record
+/// overshoots the 1.78 g pulse (2.27 m/s² above the straight line at 8.35 s) and leaves a
+/// lasting velocity offset (1.45 % NRMSE against `.VT2`); a band-limited (FFT) interpolation
+/// overshoots the record's peak too (17.71 m/s² against 17.45) and puts the peak velocity
+/// 5.6 % above `.VT2`'s. The straight line is the one interpolant whose integrals are PEER's.
+///
+/// **The peak between samples.** Where the acceleration changes sign between two samples the
+/// velocity peaks between them, above both samples. In TAR090 the acceleration goes from
+/// −7.96 to +6.98 m/s² across the 50 Hz interval before PEER's peak velocity sample
+/// (−109.65 cm/s), so the motion's velocity reaches −112.9 cm/s in between (+3.0 %): a table
+/// rate shows that peak, the 50 Hz `.VT2` cannot.
 #[derive(Debug, Clone)]
 pub struct AccelerogramMotion {
     from: SampleRate,
