@@ -36,6 +36,25 @@ pub fn run(path: &Path, out: Option<&Path>, json_out: bool) -> Result<()> {
     Ok(())
 }
 
+/// `", overridden: name = value, …"` when the scenario lays values over its preset's.
+fn overridden(s: &Scenario) -> String {
+    let values = s.overrides.values();
+    if values.is_empty() {
+        return String::new();
+    }
+    let listed: Vec<String> = values
+        .iter()
+        .map(|(key, value)| format!("{} = {value}", key.name()))
+        .collect();
+    format!(", overridden: {}", listed.join(", "))
+}
+
+/// `x` to 3 decimals without trailing zeros (4.2 g, 6.8 MN, 2.25 g).
+fn trimmed(x: f64) -> String {
+    let s = format!("{x:.3}");
+    s.trim_end_matches('0').trim_end_matches('.').to_owned()
+}
+
 /// A sink that keeps nothing (the summary's [`Peaks`] are collected alongside).
 struct NoOutput;
 
@@ -51,17 +70,21 @@ fn print_summary(s: &Scenario, peaks: &Peaks, stats: Option<&RunStats>, out: Opt
         "inverse (motion → force)"
     };
     println!(
-        "{}: {dir}, {} model, {} at {:.2} MPa",
+        "{}: {dir}, {} model, {} at {:.2} MPa{}",
         s.name,
         s.model.form(),
         s.preset.name(),
-        s.hold_down_pressure_pa / 1e6
+        s.hold_down_pressure_pa / 1e6,
+        overridden(s)
     );
     println!(
         "  {} samples over {:.3} s",
         peaks.samples,
         peaks.span_s.1 - peaks.span_s.0
     );
+    for (channel, how) in &s.derived {
+        println!("  derived {channel}: {how}");
+    }
     println!(
         "  peak displacement {:>+10.4} m     at {:.3} s",
         peaks.u_m.value, peaks.u_m.t_s
@@ -106,11 +129,11 @@ fn print_summary(s: &Scenario, peaks: &Peaks, stats: Option<&RunStats>, out: Opt
     if ex.is_empty() {
         let l = &s.limits;
         println!(
-            "  within the table's limits (stroke ±{} m, {} m/s, {:.1} g, {:.1} MN)",
+            "  within the table's limits (stroke ±{} m, {} m/s, {} g, {} MN)",
             l.stroke_m,
             l.velocity_m_s,
-            l.acceleration_m_s2 / STANDARD_GRAVITY_M_S2,
-            l.force_n / 1e6
+            trimmed(l.acceleration_m_s2 / STANDARD_GRAVITY_M_S2),
+            trimmed(l.force_n / 1e6)
         );
     }
     for e in ex {

@@ -510,8 +510,11 @@ fn bad_dopri5_tolerances_name_their_json_path() {
 }
 
 /// The paper's earthquake test: Northridge 1994 Tarzana at 100 % from the real record. The
-/// table respects all four limits: PGD 0.32 m < 0.75 m, PGV 1.15 m/s < 1.8 m/s,
-/// PGA 1.78 g < 4.2 g, and the force 144 t × 17.4 m/s² ≈ 2.5 MN < 6.8 MN.
+/// table respects all four limits: PGD 0.32 m < 0.75 m, PGV 1.13 m/s < 1.8 m/s,
+/// PGA 1.78 g < 4.2 g, and the force 144 t × 17.4 m/s² ≈ 2.5 MN < 6.8 MN. The 1024 Hz samples
+/// of the straight lines between the 50 Hz record's samples fall 0.36/1024 s after its
+/// 1.7794 g peak sample, where the line has dropped by 291 m/s³ × 0.35 ms = 0.1 m/s²
+/// (0.0104 g): the peak acceleration is checked to 0.015 g.
 #[test]
 fn the_tarzana_scenario_runs_from_the_real_record_within_the_table_limits() {
     if std::env::var_os("PLATEN_RECORDS_DIR").is_none() {
@@ -527,7 +530,7 @@ fn the_tarzana_scenario_runs_from_the_real_record_within_the_table_limits() {
     let s: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let g = 9.80665;
     assert!(
-        (s["peak_a_m_s2"].as_f64().unwrap() / g - 1.7794).abs() < 0.01,
+        (s["peak_a_m_s2"].as_f64().unwrap() / g - 1.7794).abs() < 0.015,
         "{s}"
     );
     assert!(
@@ -588,11 +591,15 @@ fn a_lab_export_with_its_own_channel_names_and_units_is_mapped() {
     let (a, b) = (run("lab"), run("si"));
     assert_eq!(a.len(), b.len());
     // Unit conversions round in the last bits: compare each column to 1e-9 of its own scale.
+    // Where the velocity (the crossover estimate from u and a) is zero to rounding, 1e-15 m/s,
+    // the √|v| law turns that rounding into Cₑ·√(1e-14 m/s) = 44.58 kN × 1e-7 ≈ 5 mN of force
+    // (columns force_n and dissipative_force_n): allowed on top.
     for c in 0..b[0].len() {
         let scale = b.iter().map(|r| r[c].abs()).fold(0.0, f64::max).max(1e-12);
+        let sqrt_law = if c == 4 || c == 7 { 5e-3 } else { 0.0 };
         for (x, y) in a.iter().zip(&b) {
             assert!(
-                (x[c] - y[c]).abs() <= 1e-9 * scale,
+                (x[c] - y[c]).abs() <= 1e-9 * scale + sqrt_law,
                 "column {c}: {x:?} vs {y:?}"
             );
         }

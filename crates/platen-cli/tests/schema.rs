@@ -68,6 +68,34 @@ fn the_schema_rejects_unknown_keys_and_wrong_types() {
     }
 }
 
+/// The keys added for issue 16 are in the schema, and unknown keys inside them stay errors.
+#[test]
+fn the_schema_has_limits_column_offsets_and_the_inverse_dead_band() {
+    let (schemas, index) = compile(schema());
+    for good in [
+        r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"sine_motion": {"amplitude_m": 0.1, "frequency_hz": 1}},
+            "duration_s": 2, "limits": {"stroke_m": 0.15, "velocity_m_s": 0.5, "acceleration_m_s2": 20, "force_n": 1e6}}"#,
+        r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"motion_csv": "m.csv",
+            "columns": {"u_m": {"name": "disp", "unit": "mm", "offset": 0.3, "zero_at_start": true},
+                        "a_m_s2": {"name": "acc", "unit": "g", "remove_mean": true}}}}"#,
+        r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"motion_csv": "m.csv", "rest_velocity_m_s": 0.002}}"#,
+    ] {
+        let doc: serde_json::Value = serde_json::from_str(good).unwrap();
+        assert!(schemas.validate(&doc, index).is_ok(), "rejected {good}");
+    }
+    for bad in [
+        r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"force_csv": "f.csv"}, "limits": {"stroke": 1}}"#,
+        r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"force_csv": "f.csv"}, "limits": {"stroke_m": "far"}}"#,
+        r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"force_csv": "f.csv",
+            "columns": {"force_n": {"offset_mpa": 1}}}}"#,
+        r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"force_csv": "f.csv",
+            "columns": {"force_n": {"remove_mean": "yes"}}}}"#,
+    ] {
+        let doc: serde_json::Value = serde_json::from_str(bad).unwrap();
+        assert!(schemas.validate(&doc, index).is_err(), "accepted {bad}");
+    }
+}
+
 #[test]
 fn schema_out_writes_the_same_schema_to_a_file() {
     let dir = tempfile::tempdir().unwrap();

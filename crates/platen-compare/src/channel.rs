@@ -41,7 +41,7 @@ impl Direction {
     /// where present.
     pub fn record_columns(self) -> (&'static [&'static str], &'static [&'static str]) {
         match self {
-            Direction::Forward => (&["t_s", "u_m", "v_m_s"], &["a_m_s2", "force_n"]),
+            Direction::Forward => (&["t_s", "u_m"], &["v_m_s", "a_m_s2", "force_n"]),
             Direction::Inverse => (&["t_s", "force_n"], &["u_m", "v_m_s", "a_m_s2"]),
         }
     }

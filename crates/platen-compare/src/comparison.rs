@@ -10,7 +10,7 @@ use platen_io::columns::ColumnMap;
 use platen_model::{force_terms, PlatenModel};
 use platen_scenario::{Model, Scenario};
 use platen_signal::metrics::{interpolate_linear, ChannelMetrics, Comparator};
-use platen_signal::{differentiate, SampleRate};
+use platen_signal::{differentiate, CrossoverVelocity, SampleRate, DEFAULT_CROSSOVER_HZ};
 
 use crate::error::{CompareError, Result};
 use crate::{Channel, Direction, Recording, Settings, Window};
@@ -154,7 +154,7 @@ impl Comparison {
         let t_s = recording.t_s[range.clone()].to_vec();
         let simulated = aligned(&sim, &t_s)?;
         let rate = SampleRate::new(1.0 / recording.step_s).map_err(CompareError::SampleRate)?;
-        let mut recorded = recorded_quantities(&recording, &range, direction, &simulated, rate);
+        let mut recorded = recorded_quantities(&recording, &range, direction, &simulated, rate)?;
         let channels = compare_channels(direction, &recorded, &simulated, rate, &t_s, settings)?;
         let (recorded_dissipative_n, law, law_label) = match &scenario.model {
             Model::Identified(m) => dissipative(m, &recorded, "(Eq. 22)"),
@@ -268,6 +268,37 @@ fn compare_channels(
     Ok(channels)
 }
 
+/// The velocity of a recording without one, over the whole recording, and how it was made:
+/// the crossover estimate from `u_m` and `a_m_s2`
+/// ([`platen_signal::CrossoverVelocity::standard`]), or the derivative of `u_m` when there is
+/// no acceleration either.
+fn recorded_velocity(recording: &Recording, rate: SampleRate) -> Result<(Vec<f64>, String)> {
+    let u = recording.table.column("u_m").unwrap_or_default();
+    match recording.table.column("a_m_s2") {
+        Some(a) => {
+            let v = CrossoverVelocity::standard(rate.hz())
+                .and_then(|c| c.estimate(u, a))
+                .map_err(|e| CompareError::Derived {
+                    recorded: recording.path.clone(),
+                    channel: Channel::Velocity,
+                    source: e,
+                })?;
+            Ok((
+                v,
+                format!(
+                    "the recorded velocity is the crossover estimate from its u_m \
+                     (differentiated, below {} Hz) and a_m_s2 (integrated, above)",
+                    DEFAULT_CROSSOVER_HZ
+                ),
+            ))
+        }
+        None => Ok((
+            differentiate(u, rate),
+            "nor an a_m_s2 column: the recorded velocity is the derivative of its u_m".into(),
+        )),
+    }
+}
+
 /// The recorded quantities on `range`, with substitutes for the columns the file lacks.
 fn recorded_quantities(
     recording: &Recording,
@@ -275,7 +306,7 @@ fn recorded_quantities(
     direction: Direction,
     simulated: &Quantities,
     rate: SampleRate,
-) -> Quantities {
+) -> Result<Quantities> {
     let name = recording.path.display();
     let take = |key: &str| recording.column(key, range);
     let mut notes = Vec::new();
@@ -283,9 +314,17 @@ fn recorded_quantities(
     let (u_m, v_m_s, a_m_s2, force_n, loops, dissipative);
     match direction {
         Direction::Forward => {
-            // u and v are required for a forward comparison.
+            // u is required for a forward comparison; a missing velocity is estimated as a
+            // table's data system does, over the whole recording (then cut to the range).
             u_m = u.unwrap_or_default();
-            v_m_s = v.unwrap_or_default();
+            v_m_s = match v {
+                Some(v) => v,
+                None => {
+                    let (velocity, how) = recorded_velocity(recording, rate)?;
+                    notes.push(format!("`{name}` has no v_m_s column: {how}."));
+                    velocity[range.clone()].to_vec()
+                }
+            };
             a_m_s2 = a.unwrap_or_else(|| {
                 notes.push(format!(
                     "`{name}` has no a_m_s2 column: the recorded acceleration is the derivative \
@@ -311,7 +350,7 @@ fn recorded_quantities(
             dissipative = "recorded force and motion, unfiltered";
         }
     }
-    Quantities {
+    Ok(Quantities {
         u_m,
         v_m_s,
         a_m_s2,
@@ -321,7 +360,7 @@ fn recorded_quantities(
             dissipative: dissipative.into(),
             notes,
         },
-    }
+    })
 }
 
 /// `F_A − F_I − F_E` of the recorded data, and the model's law `sign(v)·D(0, |v|)` over the

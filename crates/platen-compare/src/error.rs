@@ -106,6 +106,18 @@ pub enum CompareError {
     #[error(transparent)]
     Settings(SignalError),
 
+    /// A channel the recording lacks could not be derived from the ones it has.
+    #[error("`{}`: deriving the recorded {channel}", recorded.display())]
+    Derived {
+        /// The recorded file.
+        recorded: PathBuf,
+        /// The channel.
+        channel: Channel,
+        /// Why.
+        #[source]
+        source: SignalError,
+    },
+
     /// The metrics of a channel could not be computed.
     #[error("comparing {channel}")]
     Metrics {

@@ -44,18 +44,36 @@ pub enum IntegrateError {
         /// The offending time, s.
         value_s: f64,
     },
-    /// A force record for the fixed-step integrator must be uniformly sampled.
+    /// A record is not uniformly sampled: one interval (a dropped sample, a jump) differs
+    /// from the typical one by more than twice [`crate::UNIFORM_RELATIVE_TOLERANCE`].
     #[error(
-        "force record is not uniformly sampled: interval before sample {index} is {found_s} s, \
-         expected {expected_s} s (within 0.1 %)"
+        "record is not uniformly sampled: the interval before sample {index} is {found_s} s, \
+         expected {expected_s} s (within 20 %: a gap or a jump in time)"
     )]
     NonUniform {
         /// Zero-based sample index.
         index: usize,
-        /// The mean interval, s.
+        /// The typical (median) interval, s.
         expected_s: f64,
         /// The offending interval, s.
         found_s: f64,
+    },
+    /// A time stamp is further from the record's fitted sampling grid than
+    /// [`crate::UNIFORM_RELATIVE_TOLERANCE`] of the interval (jitter, or a change of rate).
+    #[error(
+        "record is not uniformly sampled: sample {index} is stamped {found_s} s, but the grid \
+         fitted over the record puts it at {grid_s} s (interval {interval_s} s; stamps may be off \
+         it by up to 10 % of the interval)"
+    )]
+    OffGrid {
+        /// Zero-based sample index.
+        index: usize,
+        /// Where the fitted grid puts the sample, s.
+        grid_s: f64,
+        /// Its stamp, s.
+        found_s: f64,
+        /// The fitted interval, s.
+        interval_s: f64,
     },
     /// The integration step does not divide the sample interval.
     #[error(
@@ -67,6 +85,12 @@ pub enum IntegrateError {
         step_s: f64,
         /// The record's sample interval, s.
         sample_interval_s: f64,
+    },
+    /// A velocity dead band that is not a finite positive number.
+    #[error("rest_velocity_m_s = {value} is invalid: expected a finite velocity > 0 m/s")]
+    InvalidRestVelocity {
+        /// The value given, m/s.
+        value: f64,
     },
     /// A step size that is not a finite positive number.
     #[error("step_s = {step_s} is invalid: expected a finite number > 0")]

@@ -57,8 +57,8 @@ pub use inverse::inverse;
 pub use method::{ForwardIntegrator, Method};
 pub use output::{Exceedance, Peak, Peaks, Sample, SampleSink, Trajectory};
 pub use record::{
-    derivative, second_derivative, uniform_interval_s, ForceRecord, Motion,
-    UNIFORM_RELATIVE_TOLERANCE,
+    derivative, sampling_grid, second_derivative, uniform_interval_s, ForceRecord, Motion,
+    SamplingGrid, UNIFORM_RELATIVE_TOLERANCE,
 };
 pub use rk4::{forward_rk4, Rk4};
 pub use run::{EnergyBalance, RunStats, State};

@@ -18,6 +18,11 @@
 //! A force can come from a pressure: `"force_n": {"name": "dP", "unit": "MPa",
 //! "times_area_m2": 0.33}`. Columns not mapped are read under platen's own name in SI units.
 //!
+//! A channel's zero: `"offset": -0.13` subtracts a transducer's offset (in the file's unit,
+//! before the conversion: `SI = (value − offset)·factor`); `"remove_mean": true` subtracts the
+//! channel's mean over the file, `"zero_at_start": true` its first value (one or the other;
+//! the time column takes `offset` and `zero_at_start` only).
+//!
 //! Units: time `s`, `ms`; displacement `m`, `mm`, `cm`, `in`; velocity `m/s`, `mm/s`, `cm/s`,
 //! `in/s`; acceleration `m/s2`, `mm/s2`, `cm/s2` (`gal`), `in/s2`, `g` (9.80665 m/s²); force `N`,
 //! `kN`, `MN`, `lbf`, `kip`; pressure (with `times_area_m2`) `Pa`, `kPa`, `MPa`, `bar`, `psi`.
@@ -43,6 +48,55 @@ pub struct ColumnSpec {
     pub unit: Option<String>,
     /// For a force given as a pressure: the area it acts on, m².
     pub times_area_m2: Option<f64>,
+    /// A constant subtracted from every value, in the file's unit (before the conversion to
+    /// SI; default 0): a transducer's offset, e.g. `-0.13` for a pressure read in MPa.
+    pub offset: Option<f64>,
+    /// Subtract the channel's mean over the file (after the offset; default false). Not for
+    /// `t_s`.
+    #[serde(default)]
+    pub remove_mean: bool,
+    /// Subtract the channel's first value, so it starts at zero (default false); not with
+    /// `remove_mean`.
+    #[serde(default)]
+    pub zero_at_start: bool,
+}
+
+/// How a channel is read: its header, the factor from the file's unit to SI, the offset
+/// subtracted first (file unit), and how its zero is set.
+#[derive(Debug, Clone, PartialEq)]
+struct Mapping {
+    header: String,
+    factor: f64,
+    offset: f64,
+    zero: Zero,
+}
+
+/// Where a channel's zero is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Zero {
+    /// As recorded (less the offset).
+    AsRecorded,
+    /// At the channel's mean.
+    Mean,
+    /// At the channel's first value.
+    Start,
+}
+
+impl Mapping {
+    /// The channel in SI units: `(x − offset)·factor`, then its zero set.
+    fn apply(&self, column: &mut [f64]) {
+        if self.offset != 0.0 || self.factor != 1.0 {
+            for x in column.iter_mut() {
+                *x = (*x - self.offset) * self.factor;
+            }
+        }
+        let zero = match self.zero {
+            Zero::AsRecorded => return,
+            Zero::Mean => column.iter().sum::<f64>() / column.len().max(1) as f64,
+            Zero::Start => column.first().copied().unwrap_or(0.0),
+        };
+        column.iter_mut().for_each(|x| *x -= zero);
+    }
 }
 
 /// platen's column names and the kind of quantity each holds.
@@ -63,10 +117,11 @@ enum Kind {
     Force,
 }
 
-/// A validated mapping: for each platen column, the header to read and the factor to SI.
+/// A validated mapping: for each platen column, the header to read, the factor to SI, the
+/// offset and the zero.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ColumnMap {
-    entries: BTreeMap<String, (String, f64)>,
+    entries: BTreeMap<String, Mapping>,
 }
 
 impl ColumnMap {
@@ -150,7 +205,43 @@ impl ColumnMap {
                 }
             };
             let header = s.name.clone().unwrap_or_else(|| ours.clone());
-            entries.insert(ours.clone(), (header, factor));
+            let offset = s.offset.unwrap_or(0.0);
+            if !offset.is_finite() {
+                return Err((
+                    format!("{here}.offset"),
+                    offset.to_string(),
+                    "a finite number in the file's unit".into(),
+                ));
+            }
+            let zero = match (s.remove_mean, s.zero_at_start) {
+                (true, true) => {
+                    return Err((
+                        format!("{here}.remove_mean"),
+                        "true".into(),
+                        "either remove_mean or zero_at_start, not both".into(),
+                    ))
+                }
+                (true, false) if kind == Kind::Time => {
+                    return Err((
+                        format!("{here}.remove_mean"),
+                        "true".into(),
+                        "no mean removal on the time column (zero_at_start or offset shift it)"
+                            .into(),
+                    ))
+                }
+                (true, false) => Zero::Mean,
+                (false, true) => Zero::Start,
+                (false, false) => Zero::AsRecorded,
+            };
+            entries.insert(
+                ours.clone(),
+                Mapping {
+                    header,
+                    factor,
+                    offset,
+                    zero,
+                },
+            );
         }
         Ok(Self { entries })
     }
@@ -183,19 +274,28 @@ impl ColumnMap {
         let opt: Vec<&str> = optional.iter().map(|c| self.header(c)).collect();
         let mut table = read_table(path, &req, &opt)?;
         for &ours in required.iter().chain(optional) {
-            table.rename_scaled(self.header(ours), ours, self.factor(ours));
+            match self.entries.get(ours) {
+                Some(m) => table.rename_with(&m.header, ours, |c| m.apply(c)),
+                None => table.rename_with(ours, ours, |_| ()),
+            }
         }
         Ok(table)
     }
 
     /// The header to read for platen's column `ours`.
     pub fn header<'a>(&'a self, ours: &'a str) -> &'a str {
-        self.entries.get(ours).map_or(ours, |(h, _)| h.as_str())
+        self.entries.get(ours).map_or(ours, |m| m.header.as_str())
     }
 
     /// The factor from the file's unit to SI for platen's column `ours`.
     pub fn factor(&self, ours: &str) -> f64 {
-        self.entries.get(ours).map_or(1.0, |(_, f)| *f)
+        self.entries.get(ours).map_or(1.0, |m| m.factor)
+    }
+
+    /// The offset subtracted from platen's column `ours` before the conversion, in the file's
+    /// unit (0 when none is given).
+    pub fn offset(&self, ours: &str) -> f64 {
+        self.entries.get(ours).map_or(0.0, |m| m.offset)
     }
 }
 
@@ -296,5 +396,62 @@ mod tests {
             let e = map(json).unwrap_err();
             assert_eq!(e.0, path, "{json}: {e:?}");
         }
+    }
+
+    /// A pressure transducer reading −0.13 MPa at zero load: the offset is subtracted in the
+    /// file's unit before the area multiplies it, so 0.87 MPa on 0.33 m² is 1.0 MPa·0.33 m².
+    #[test]
+    fn an_offset_is_subtracted_in_the_files_unit_and_the_zero_can_be_set() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("lab.csv");
+        std::fs::write(&path, "time,dP,disp\n1,-0.13,5\n2,0.87,7\n3,0.37,12\n").unwrap();
+        let m = map(r#"{"t_s": {"name": "time", "zero_at_start": true},
+                        "force_n": {"name": "dP", "unit": "MPa", "times_area_m2": 0.33, "offset": -0.13},
+                        "u_m": {"name": "disp", "unit": "mm", "remove_mean": true}}"#)
+        .unwrap();
+        assert_eq!(m.offset("force_n"), -0.13);
+        let mut t = m
+            .read_table(&path, &["t_s", "force_n", "u_m"], &[])
+            .unwrap();
+        assert_eq!(t.take_column("t_s").unwrap(), vec![0.0, 1.0, 2.0]);
+        let f = t.take_column("force_n").unwrap();
+        for (got, want) in f.iter().zip([0.0, 0.33e6, 0.165e6]) {
+            assert!((got - want).abs() < 1e-6, "{f:?}");
+        }
+        // (5, 7, 12) mm less their mean 8 mm.
+        let u = t.take_column("u_m").unwrap();
+        for (got, want) in u.iter().zip([-3e-3, -1e-3, 4e-3]) {
+            assert!((got - want).abs() < 1e-15, "{u:?}");
+        }
+        let m = map(r#"{"u_m": {"name": "disp", "zero_at_start": true, "offset": 1}}"#).unwrap();
+        let mut t = m.read_table(&path, &["u_m"], &[]).unwrap();
+        assert_eq!(t.take_column("u_m").unwrap(), vec![0.0, 2.0, 7.0]);
+    }
+
+    #[test]
+    fn zero_options_that_contradict_or_make_no_sense_name_their_json_path() {
+        for (json, path) in [
+            (
+                r#"{"u_m": {"remove_mean": true, "zero_at_start": true}}"#,
+                "excitation.columns.u_m.remove_mean",
+            ),
+            (
+                r#"{"t_s": {"remove_mean": true}}"#,
+                "excitation.columns.t_s.remove_mean",
+            ),
+        ] {
+            let e = map(json).unwrap_err();
+            assert_eq!(e.0, path, "{json}: {e:?}");
+        }
+        // A non-finite offset cannot be written in JSON; one given programmatically is refused.
+        let spec = BTreeMap::from([(
+            "u_m".to_owned(),
+            ColumnSpec {
+                offset: Some(f64::NAN),
+                ..ColumnSpec::default()
+            },
+        )]);
+        let e = ColumnMap::new(&spec, "columns").unwrap_err();
+        assert_eq!(e.0, "columns.u_m.offset");
     }
 }

@@ -93,14 +93,12 @@ impl Table {
         &self.path
     }
 
-    /// Renames column `from` to `to` and multiplies it by `factor` (a unit conversion);
-    /// nothing happens if there is no column `from`.
-    pub(crate) fn rename_scaled(&mut self, from: &str, to: &str, factor: f64) {
+    /// Renames column `from` to `to` and transforms its values with `f` (a unit conversion,
+    /// an offset); nothing happens if there is no column `from`.
+    pub(crate) fn rename_with(&mut self, from: &str, to: &str, f: impl FnOnce(&mut [f64])) {
         if let Some(i) = self.position(from) {
             to.clone_into(&mut self.names[i]);
-            if factor != 1.0 {
-                self.columns[i].iter_mut().for_each(|x| *x *= factor);
-            }
+            f(&mut self.columns[i]);
         }
     }
 

@@ -144,10 +144,12 @@ pub enum IoError {
         found: usize,
     },
 
-    /// A time column is not uniformly sampled.
+    /// A time column is not uniformly sampled: one interval (a dropped sample, a jump) is
+    /// off the typical one by more than 20 %.
     #[error(
         "`{}`, line {line}, column `t_s`: expected a uniform time step of {expected_s} s, \
-         found an interval of {found_s} s",
+         found an interval of {found_s} s (intervals may differ by up to 20 %: a gap or a \
+         jump in time)",
         path.display()
     )]
     NonUniform {
@@ -156,10 +158,31 @@ pub enum IoError {
         /// 1-based line of the later sample of the offending interval, assuming the header
         /// is line 1 and one sample per line (as written by this crate).
         line: u64,
-        /// Mean time step (span / intervals), s.
+        /// The typical (median) time step, s.
         expected_s: f64,
         /// The offending interval, s.
         found_s: f64,
+    },
+
+    /// A time stamp is off the sampling grid fitted over the whole record by more than 10 %
+    /// of the interval (jitter, or a change of rate).
+    #[error(
+        "`{}`, line {line}, column `t_s`: the stamp {found_s} s is off the uniform grid \
+         fitted over the record, which puts this sample at {grid_s} s (interval {interval_s} s; \
+         stamps may be off it by up to 10 % of the interval)",
+        path.display()
+    )]
+    OffGrid {
+        /// File the time column came from.
+        path: PathBuf,
+        /// 1-based line of the sample (header on line 1, one sample per line).
+        line: u64,
+        /// Where the fitted grid puts the sample, s.
+        grid_s: f64,
+        /// Its stamp, s.
+        found_s: f64,
+        /// The fitted interval, s.
+        interval_s: f64,
     },
 
     /// A record has fewer samples than an operation needs.

@@ -36,14 +36,27 @@
 //! * `M_act = 2590 kg`: then `Mₑ = M_pl + 2M_act + 2M̄ₑ = 144.0 t`, the identified mass.
 //! * `μ″ₑ = 0.413 %`, hinge `μ_hg = 0.52 %`, `κ = 4/π`, `a = 0.10 m` (so
 //!   `2μ_hgκa/h = 0.040 %`), lateral `μ‴ₑ = 0.44 %` with `F_l = 0` (§3.4: lateral friction
-//!   negligible): `F_μ = 25.42 kN` at 13.8 MPa (paper: 0.44 % × 5783 kN = 25.44 kN;
-//!   Eq. 21 fit 26.0 kN) and 16.1 kN at 6.9 MPa (paper mean 16.2 kN).
-//! * `c_β = 150 kN/(m/s)^0.5`, `β = 0.5`: the strut viscous term is negligible for
-//!   `|u| < 0.3 m` and reaches ≈ 33 kN at 0.75 m and 1 m/s, in the 20–70 kN range of the
-//!   additional dissipative force the paper observes in T8/T10 for `u > 50 cm`,
-//!   `v > 75 cm/s` (§3.5).
-//! * Eq. 6a uses the nominal `A = 0.15 m²`, so `Kₑ = 2p₀A/h = 1.2545 MN/m` and
-//!   `F_hd = 4.14 MN` at 13.8 MPa (the measured 2 × 2085 kN implies 0.1511 m²).
+//!   negligible): `F_μ = 25.56 kN` at 13.8 MPa (paper: 0.44 % × 5783 kN = 25.445 kN, measured
+//!   mean 25.87 kN, Eq. 21 fit 26.0 kN), 16.1 kN at 6.9 MPa (paper mean 16.2 kN) and 6.66 kN
+//!   at 0 MPa (7.66 kN).
+//! * `A = 2085 kN / 13.8 MPa = 0.151087 m²` (the paper's "0.15 m²", to the measured strut
+//!   force, §1.4): `F_hd = 2p₀A = 2 × 2085 kN = 4.17 MN` at 13.8 MPa, the same hold-down force
+//!   as the identified form's `F_z = 1.613 MN + F_hd` at every pressure, and
+//!   `Kₑ = 2p₀A/h = 1.2636 MN/m` (the paper's "1.26 MN/m"; identified 1.266 MN/m).
+//! * **Strut damping** `2c_β|u/h|^(1+β)|v|^β` with `β = 1`, `c_β = 290 kN/(m/s)`. §3.5: the
+//!   additional dissipative force "appears to be significant only when the platen displacement
+//!   exceeds 50 cm and the platen velocity exceeds 75 cm/s", reaching 20–70 kN in T8/T10.
+//!   "Significant" is taken as visible above the ±20 kN scatter of the paper's `F_D` data
+//!   (Fig. 10), so the term must stay within half of it, 10 kN, for `|u| ≤ 50 cm` and
+//!   `|v| ≤ 75 cm/s`: its largest value there is at the corner,
+//!   `2c_β(0.5/3.3)²·0.75 = 0.03444·c_β`, which gives `c_β = 290 kN/(m/s)` (9.99 kN).
+//!   `β = 1` is the most velocity-selective exponent the paper allows (`0 ≤ β ≤ 1`). Then, at
+//!   the peak displacement and plateau velocity of the paper's triangle tests: T4 (50 cm,
+//!   10 cm/s) 1.3 kN and T6 (62.5 cm, 25 cm/s) 5.2 kN (with `c_β = 150 kN/(m/s)^0.5`,
+//!   `β = 0.5` before: 5.6 and 12.4 kN), T9 (46.9 cm, 75 cm/s) 8.8 kN; T10 (62.5 cm, 1 m/s)
+//!   20.8 kN, T11 and T12 44–45 kN, within the paper's 20–70 kN. The form cannot do both
+//!   everywhere: T8 (75 cm, but 50 cm/s) gets 15 kN, where the paper shows extra force
+//!   although its velocity is below 75 cm/s.
 
 use crate::error::{non_negative, ModelError, Result};
 use crate::{IdentifiedParams, PhysicalParams, STANDARD_GRAVITY_M_S2};
@@ -57,6 +70,11 @@ pub const LHPOST_STRUT_FORCE_AT_NOMINAL_N: f64 = 2085e3;
 /// Total measured hold-down force of the two struts at the nominal pressure, N
 /// (`2 × 2085 kN`, paper §1.4).
 pub const LHPOST_HOLD_DOWN_FORCE_AT_NOMINAL_N: f64 = 2.0 * LHPOST_STRUT_FORCE_AT_NOMINAL_N;
+
+/// Effective nitrogen-chamber area of one hold-down strut, m²: the measured strut force at
+/// the nominal pressure over that pressure (2085 kN / 13.8 MPa = 0.151087 m², the paper's
+/// "0.15 m²"), so that the full form's `F_hd = 2p₀A` is the identified form's hold-down force.
+pub const LHPOST_STRUT_AREA_M2: f64 = LHPOST_STRUT_FORCE_AT_NOMINAL_N / LHPOST_NOMINAL_PRESSURE_PA;
 
 /// Weight carried by the vertical bearings with unpressurised struts, N (paper §3.2).
 pub const LHPOST_SUPPORTED_WEIGHT_N: f64 = 1.613e6;
@@ -187,7 +205,7 @@ pub fn lhpost_2008_physical(pressure_pa: f64) -> PhysicalParams {
         strut_height_m: 3.3,
         strut_piston_length_m: 2.1,
         hold_down_pressure_pa: pressure_pa,
-        strut_area_m2: 0.15,
+        strut_area_m2: LHPOST_STRUT_AREA_M2,
         gas_heat_capacity_ratio: 1.44,
         supported_weight_n: LHPOST_SUPPORTED_WEIGHT_N,
         bearing_friction_coefficient: 0.00413,
@@ -198,8 +216,8 @@ pub fn lhpost_2008_physical(pressure_pa: f64) -> PhysicalParams {
         hinge_force_distribution_factor: 4.0 / std::f64::consts::PI,
         viscous_coefficient: 44.58e3,
         viscous_exponent: 0.5,
-        strut_viscous_coefficient: 150e3,
-        strut_viscous_exponent: 0.5,
+        strut_viscous_coefficient: 290e3,
+        strut_viscous_exponent: 1.0,
         low_velocity_force_n: 12.04e3,
         low_velocity_decay_s_per_m: 78.5,
     }

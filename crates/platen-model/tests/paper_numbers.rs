@@ -5,17 +5,82 @@ use platen_model::{force_terms, ModelError, PlatenModel};
 
 const P_NOMINAL_PA: f64 = 13.8e6;
 
-/// Eq. 6a: Kₑ = 2p₀A/h = 2 × 13.8 MPa × 0.15 m² / 3.3 m = 1.254545… MN/m.
+/// Eq. 6a: Kₑ = 2p₀A/h with A = 2085 kN / 13.8 MPa (the measured strut force, §1.4; the
+/// paper's "0.15 m²"): 2 × 2085 kN / 3.3 m = 1.263636… MN/m.
 #[test]
 fn strut_stiffness_is_two_p0_a_over_h() {
     let d = lhpost_2008_physical(P_NOMINAL_PA).derived();
     assert!(
-        (d.stiffness_n_per_m - 1.254_545_454_5e6).abs() < 1e-3,
+        (d.stiffness_n_per_m - 1.263_636_363_6e6).abs() < 1e-3,
         "{}",
         d.stiffness_n_per_m
     );
-    // "takes the value Kₑ = 1.26 MN/m" (§3.1), and the identified 1.266 MN/m is within 1 %.
-    assert!((d.stiffness_n_per_m / 1.266e6 - 1.0).abs() < 0.01);
+    // "takes the value Kₑ = 1.26 MN/m" (§3.1), and the identified 1.266 MN/m is within 0.2 %.
+    assert!((d.stiffness_n_per_m - 1.26e6).abs() < 5e3);
+    assert!((d.stiffness_n_per_m / 1.266e6 - 1.0).abs() < 0.002);
+}
+
+/// The hold-down force is one number in both forms: the full form's `F_hd = 2p₀A` is the
+/// identified form's `F_z − F_pl+act` (2 × 2085 kN × p₀/13.8 MPa, §1.4 and §3.4) at every
+/// pressure, to rounding.
+#[test]
+fn the_hold_down_force_is_the_same_in_both_forms() {
+    for p_mpa in [0.0, 3.0, 6.9, 13.8, 20.0] {
+        let p = p_mpa * 1e6;
+        let full = lhpost_2008_physical(p).derived().hold_down_force_n;
+        let identified = lhpost_2008_identified(p).coulomb_force_n / 0.0044 - 1.613e6;
+        assert!(
+            (full - identified).abs() <= 1e-9 * 4.17e6,
+            "{p_mpa} MPa: full {full} N, identified {identified} N"
+        );
+    }
+    let at_nominal = lhpost_2008_physical(P_NOMINAL_PA)
+        .derived()
+        .hold_down_force_n;
+    assert!((at_nominal - 2.0 * 2085e3).abs() < 1e-6, "{at_nominal}");
+}
+
+/// §3.5: the additional dissipative force "appears to be significant only when the platen
+/// displacement exceeds 50 cm and the platen velocity exceeds 75 cm/s", and reaches 20–70 kN.
+/// The preset's strut damping (the only term of the full model that grows with both) is
+/// isolated as the full model's dissipative force less that of the same model without it.
+///
+/// * Below both thresholds (`|u| ≤ 0.5 m`, `|v| ≤ 0.75 m/s`, on a 51 × 76 grid) it stays within
+///   10 kN: half the ±20 kN scatter of the paper's `F_D` data (Fig. 10), so it could not
+///   have been seen there.
+/// * At the paper's triangle tests below the thresholds (peak displacement with the plateau
+///   velocity, Table I: T4 50 cm at 10 cm/s, T6 62.5 cm at 25 cm/s, T9 46.9 cm at 75 cm/s) it
+///   is 1.3, 5.2 and 8.8 kN (the issue measured 5.6 and 12.4 kN at T4/T6 before).
+/// * Beyond both (T10 62.5 cm at 1 m/s, T11 75 cm at 1.5 m/s, T12 67.5 cm at 1.8 m/s) it is
+///   within the paper's 20–70 kN.
+#[test]
+fn strut_damping_is_negligible_below_50_cm_and_75_cm_per_s_and_significant_beyond() {
+    let with = lhpost_2008_physical(P_NOMINAL_PA).build().unwrap();
+    let mut q = lhpost_2008_physical(P_NOMINAL_PA);
+    q.strut_viscous_coefficient = 0.0;
+    let without = q.build().unwrap();
+    let strut =
+        |u: f64, v: f64| with.dissipative_magnitude_n(u, v) - without.dissipative_magnitude_n(u, v);
+    let mut worst: f64 = 0.0;
+    for i in 0..=50 {
+        for j in 0..=75 {
+            worst = worst.max(strut(0.01 * i as f64, 0.01 * j as f64));
+        }
+    }
+    assert!(worst <= 10e3, "{worst} N below the thresholds");
+    assert!(worst > 9.9e3, "{worst} N: the bound is the corner's");
+    for (test, u, v, bound) in [
+        ("T4", 0.5, 0.1, 1.4e3),
+        ("T6", 0.625, 0.25, 5.3e3),
+        ("T9", 0.4688, 0.75, 9e3),
+    ] {
+        let f = strut(u, v);
+        assert!(f <= bound, "{test}: {f} N");
+    }
+    for (test, u, v) in [("T10", 0.625, 1.0), ("T11", 0.75, 1.5), ("T12", 0.675, 1.8)] {
+        let f = strut(u, v);
+        assert!((20e3..=70e3).contains(&f), "{test}: {f} N");
+    }
 }
 
 /// §2: "the ratio K′ₑ(u/h)²/Kₑ amounts to less than 3.3 %" for u ≤ 0.75 m, and "the elastic

@@ -14,7 +14,7 @@ use crate::ctx::{check_finite, check_positive, Ctx};
 use crate::error::{Result, ScenarioError};
 use crate::file::*;
 use crate::generate::{self, GenerateError};
-use crate::sampling::uniform_step_s;
+use crate::sampling::{sampling_grid, uniform_step_s};
 
 /// What a scenario runs.
 #[derive(Debug, Clone, PartialEq)]
@@ -77,14 +77,21 @@ impl Run {
                 initial: *initial,
                 samples: *samples,
             },
-            Run::Inverse { motion } => Run::Inverse {
-                motion: Motion::new(
+            Run::Inverse { motion } => {
+                let scaled = Motion::new(
                     motion.t_s().to_vec(),
                     times(motion.u_m()),
                     times(motion.v_m_s()),
                     times(motion.a_m_s2()),
-                )?,
-            },
+                )?;
+                // The dead band is the velocity measurement's resolution: not scaled.
+                Run::Inverse {
+                    motion: match motion.rest_velocity_m_s() {
+                        Some(band) => scaled.with_rest_velocity(band)?,
+                        None => scaled,
+                    },
+                }
+            }
         }))
     }
 }
@@ -171,14 +178,35 @@ impl<'a> Source<'a> {
     }
 }
 
-/// What the scenario file's excitation, integrator, initial state and duration run.
-pub(crate) fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
+/// What the scenario file's excitation, integrator, initial state and duration run, and
+/// which channels of the excitation were derived (not given by the file or generator).
+pub(crate) fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<(Run, Derived)> {
     let ex = &file.excitation;
     let source = Source::of(ctx, ex)?;
     check_direction_fields(ctx, file, source)?;
+    let here = "excitation.rest_velocity_m_s";
+    let band = (ex.rest_velocity_m_s)
+        .map(|b| check_positive(ctx, here, b))
+        .transpose()?;
+    let (run, derived) = build_source(ctx, file, source)?;
+    let run = match (run, band) {
+        (Run::Inverse { motion }, Some(band)) => Run::Inverse {
+            motion: motion
+                .with_rest_velocity(band)
+                .map_err(|e| ctx.invalid(here, band, e.to_string()))?,
+        },
+        (run, _) => run,
+    };
+    Ok((run, derived))
+}
+
+/// The run of the excitation's one source.
+fn build_source(ctx: &Ctx, file: &ScenarioFile, source: Source) -> Result<(Run, Derived)> {
+    let ex = &file.excitation;
     let gen = Generated { ctx, file, source };
+    let nothing = |run: Run| (run, Derived::new());
     match source {
-        Source::ForceCsv(rel) => force_csv_run(ctx, file, &ctx.resolve(rel)),
+        Source::ForceCsv(rel) => force_csv_run(ctx, file, &ctx.resolve(rel)).map(nothing),
         Source::SineForce(g) => {
             let record = generate::sine_force(
                 g.amplitude_n,
@@ -190,7 +218,7 @@ pub(crate) fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
             .map_err(|e| gen.error(e))?;
             let samples = record.len();
             let record = lowpass(ctx, ex, record, samples)?;
-            forward_run(ctx, file, record, samples, None)
+            forward_run(ctx, file, record, samples, None).map(nothing)
         }
         Source::MotionCsv(rel) => motion_csv(ctx, file, &ctx.resolve(rel)),
         Source::SineMotion(g) => generate::sine_motion(
@@ -200,7 +228,7 @@ pub(crate) fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
             gen.duration()?,
         )
         .map_err(|e| gen.error(e))
-        .map(|motion| Run::Inverse { motion }),
+        .map(|motion| nothing(Run::Inverse { motion })),
         Source::TriangleMotion(g) => generate::triangle_motion(
             g.amplitude_m,
             g.velocity_m_s,
@@ -209,11 +237,17 @@ pub(crate) fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
             gen.duration()?,
         )
         .map_err(|e| gen.error(e))
-        .map(|motion| Run::Inverse { motion }),
-        Source::WhiteNoiseMotion(g) => white_noise(&gen, g),
-        Source::GroundMotion(g) => Ok(Run::Inverse {
-            motion: ground_motion(ctx, g, file.duration_s)?,
-        }),
+        .map(|motion| nothing(Run::Inverse { motion })),
+        Source::WhiteNoiseMotion(g) => white_noise(&gen, g).map(nothing),
+        Source::GroundMotion(g) => {
+            let motion = ground_motion(ctx, g, file.duration_s)?;
+            let integral = "exact integral of a_m_s2 (straight lines between the record's samples)";
+            let derived = Derived::from([
+                ("v_m_s", integral.to_owned()),
+                ("u_m", format!("{integral}, twice")),
+            ]);
+            Ok((Run::Inverse { motion }, derived))
+        }
     }
 }
 
@@ -222,6 +256,13 @@ pub(crate) fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<Run> {
 fn check_direction_fields(ctx: &Ctx, file: &ScenarioFile, source: Source) -> Result<()> {
     let ex = &file.excitation;
     if source.is_force() {
+        if let Some(band) = ex.rest_velocity_m_s {
+            return Err(ctx.invalid(
+                "excitation.rest_velocity_m_s",
+                band,
+                "no velocity dead band on a force: it applies to motion excitations (inverse runs)",
+            ));
+        }
         return Ok(());
     }
     if ex.lowpass_hz.is_some() || ex.lowpass_filter.is_some() {
@@ -310,9 +351,11 @@ fn force_csv_run(ctx: &Ctx, file: &ScenarioFile, path: &Path) -> Result<Run> {
     forward_run(ctx, file, record, samples, recorded_state)
 }
 
-/// `excitation.motion_csv`: a prescribed motion, cut to the duration; missing velocity and
-/// acceleration are derived from the displacement.
-fn motion_csv(ctx: &Ctx, file: &ScenarioFile, path: &Path) -> Result<Run> {
+/// `excitation.motion_csv`: a prescribed motion, cut to the duration. Every channel given is
+/// kept; a missing velocity is the crossover estimate from `u_m` and `a_m_s2` when the
+/// acceleration is given, else the derivative of `u_m`; a missing acceleration is the
+/// derivative of `v_m_s` (or the second derivative of `u_m`).
+fn motion_csv(ctx: &Ctx, file: &ScenarioFile, path: &Path) -> Result<(Run, Derived)> {
     let ex = &file.excitation;
     let mut cols = read_mapped(ctx, path, ex, &["t_s", "u_m"], &["v_m_s", "a_m_s2"])?;
     let t = cols.remove("t_s").unwrap_or_default();
@@ -336,13 +379,71 @@ fn motion_csv(ctx: &Ctx, file: &ScenarioFile, path: &Path) -> Result<Run> {
         }
     };
     let cut = |c: Vec<f64>| c[..samples].to_vec();
+    // Derived channels are computed on the grid fitted to the stamps (rounded stamps would put
+    // their rounding into every finite difference); the output keeps the stamps.
+    let grid = sampling_grid(path, &t[..samples])?;
+    let on_grid: Vec<f64> = (0..samples)
+        .map(|i| grid.start_s + i as f64 * grid.interval_s)
+        .collect();
+    let stamps = cut(t);
+    let mut derived = Derived::new();
     let motion = match (v, a) {
-        (Some(v), Some(a)) => Motion::new(cut(t), cut(u), cut(v), cut(a)),
-        (Some(v), None) => Motion::from_displacement_velocity(cut(t), cut(u), cut(v)),
-        (None, Some(_)) | (None, None) => Motion::from_displacement(cut(t), cut(u)),
+        (Some(v), Some(a)) => Motion::new(stamps, cut(u), cut(v), cut(a)),
+        (Some(v), None) => {
+            derived.insert("a_m_s2", DERIVATIVE_OF_V.to_owned());
+            Motion::from_displacement_velocity(on_grid, cut(u), cut(v))
+                .and_then(|m| restamp(stamps, &m))
+        }
+        (None, Some(a)) => {
+            // Keep the recorded acceleration; the velocity is the crossover estimate, as a
+            // table's data system makes it (differentiated displacement below the crossover,
+            // integrated acceleration above).
+            let (u, a) = (cut(u), cut(a));
+            let v = platen_signal::CrossoverVelocity::standard(1.0 / grid.interval_s)
+                .and_then(|c| c.estimate(&u, &a))
+                .map_err(|e| {
+                    ScenarioError::Io(IoError::Record {
+                        path: path.to_owned(),
+                        message: format!("velocity from u_m and a_m_s2: {e}"),
+                    })
+                })?;
+            derived.insert("v_m_s", crossover_note());
+            Motion::new(stamps, u, v, a)
+        }
+        (None, None) => {
+            derived.insert("v_m_s", DERIVATIVE_OF_U.to_owned());
+            derived.insert("a_m_s2", SECOND_DERIVATIVE_OF_U.to_owned());
+            Motion::from_displacement(on_grid, cut(u)).and_then(|m| restamp(stamps, &m))
+        }
     }
     .map_err(|cause| rejected(path, cause))?;
-    Ok(Run::Inverse { motion })
+    Ok((Run::Inverse { motion }, derived))
+}
+
+/// The channels of an excitation that platen derived, by name, with how (what a summary
+/// reports under `derived`).
+pub type Derived = BTreeMap<&'static str, String>;
+
+const DERIVATIVE_OF_V: &str = "derivative of v_m_s (second-order finite differences)";
+const DERIVATIVE_OF_U: &str = "derivative of u_m (second-order finite differences)";
+const SECOND_DERIVATIVE_OF_U: &str = "second derivative of u_m (second-order finite differences)";
+
+/// How the crossover velocity is made ([`platen_signal::CrossoverVelocity::standard`]).
+fn crossover_note() -> String {
+    format!(
+        "crossover of u_m (differentiated, below {} Hz) and a_m_s2 (integrated, above)",
+        platen_signal::DEFAULT_CROSSOVER_HZ
+    )
+}
+
+/// `m` at the time stamps `t_s` (same length) instead of its own times.
+fn restamp(t_s: Vec<f64>, m: &Motion) -> std::result::Result<Motion, IntegrateError> {
+    Motion::new(
+        t_s,
+        m.u_m().to_vec(),
+        m.v_m_s().to_vec(),
+        m.a_m_s2().to_vec(),
+    )
 }
 
 /// `excitation.white_noise_motion`: band-limited white noise of the given RMS acceleration.
@@ -460,7 +561,9 @@ fn lowpass(
         .map_err(|e| ctx.invalid("excitation.lowpass_hz", cutoff, e.to_string()))
 }
 
-/// The table motion of an `excitation.ground_motion`.
+/// The table motion of an `excitation.ground_motion`: the record scaled, cut to the
+/// duration, baseline-corrected and integrated as PEER integrates it
+/// ([`platen_signal::AccelerogramMotion`]: straight lines between samples, exact integrals).
 fn ground_motion(ctx: &Ctx, g: &GroundMotion, duration_s: Option<f64>) -> Result<Motion> {
     let here = "excitation.ground_motion";
     let scale = check_finite(ctx, &format!("{here}.scale"), g.scale)?;
@@ -470,36 +573,6 @@ fn ground_motion(ctx: &Ctx, g: &GroundMotion, duration_s: Option<f64>) -> Result
     let signal = |name: &str, e: platen_signal::SignalError| {
         ctx.invalid(&format!("{here}.{name}"), "", e.to_string())
     };
-    let a: Vec<f64> = acc.iter().map(|x| x * scale).collect();
-    let resampler =
-        platen_signal::Resampler::new(1.0 / dt_s, rate, platen_signal::Interpolation::default())
-            .map_err(|e| signal("sample_rate_hz", e))?;
-    if resampler.output_len(a.len()) > generate::MAX_GENERATED_SAMPLES {
-        return Err(ctx.invalid(
-            &format!("{here}.sample_rate_hz"),
-            rate,
-            format!(
-                "a rate giving at most {} samples for this record",
-                generate::MAX_GENERATED_SAMPLES
-            ),
-        ));
-    }
-    let mut a = resampler
-        .apply(&a)
-        .map_err(|e| signal("sample_rate_hz", e))?;
-    if let Some(d) = duration_s {
-        check_positive(ctx, "duration_s", d)?;
-        let n = (d * rate + 1e-6).floor() as usize + 1;
-        if n > a.len() {
-            return Err(ScenarioError::RecordTooShort {
-                path,
-                span_s: (a.len() - 1) as f64 / rate,
-                samples: None,
-                duration_s: d,
-            });
-        }
-        a.truncate(n);
-    }
     let baseline = match g.baseline {
         BaselineKind::None => platen_signal::Baseline::None,
         BaselineKind::Acceleration => platen_signal::Baseline::Acceleration {
@@ -509,14 +582,50 @@ fn ground_motion(ctx: &Ctx, g: &GroundMotion, duration_s: Option<f64>) -> Result
             order: g.baseline_order,
         },
     };
-    let integrator = platen_signal::MotionIntegrator::new(rate, baseline)
-        .map_err(|e| signal("baseline_order", e))?;
-    if matches!(g.baseline, BaselineKind::Acceleration) {
-        platen_signal::remove_polynomial(&mut a, g.baseline_order);
+    let plan =
+        platen_signal::AccelerogramMotion::new(1.0 / dt_s, rate, baseline).map_err(
+            |e| match e {
+                platen_signal::SignalError::InvalidCount { .. } => signal("baseline_order", e),
+                other => signal("sample_rate_hz", other),
+            },
+        )?;
+    let available = plan.output_len(acc.len());
+    if available > generate::MAX_GENERATED_SAMPLES {
+        return Err(ctx.invalid(
+            &format!("{here}.sample_rate_hz"),
+            rate,
+            format!(
+                "a rate giving at most {} samples for this record",
+                generate::MAX_GENERATED_SAMPLES
+            ),
+        ));
     }
-    let m = integrator.integrate(&a, platen_signal::InitialMotion::default());
-    let t = (0..a.len()).map(|j| j as f64 / rate).collect();
-    Motion::new(t, m.u_m, m.v_m_s, a).map_err(|cause| rejected(&path, cause))
+    // The table samples that run, and the record samples that cover them (the baseline is
+    // fitted over what runs).
+    let (samples, record_samples) = match duration_s {
+        None => (available, acc.len()),
+        Some(d) => {
+            check_positive(ctx, "duration_s", d)?;
+            let n = (d * rate + 1e-6).floor() as usize + 1;
+            if n > available {
+                return Err(ScenarioError::RecordTooShort {
+                    path,
+                    span_s: (available - 1) as f64 / rate,
+                    samples: None,
+                    duration_s: d,
+                });
+            }
+            let last = ((n - 1) as f64 / rate / dt_s - 1e-9).ceil() as usize;
+            (n, (last + 1).clamp(2, acc.len()))
+        }
+    };
+    let a: Vec<f64> = acc[..record_samples].iter().map(|x| x * scale).collect();
+    let mut m = plan.process(&a).map_err(|e| signal("record", e))?;
+    for column in [&mut m.a_m_s2, &mut m.v_m_s, &mut m.u_m] {
+        column.truncate(samples);
+    }
+    let t = (0..m.a_m_s2.len()).map(|j| j as f64 / rate).collect();
+    Motion::new(t, m.u_m, m.v_m_s, m.a_m_s2).map_err(|cause| rejected(&path, cause))
 }
 
 /// The ground acceleration of a `ground_motion` record (m/s²) and its sample interval (s):
@@ -564,8 +673,13 @@ fn forward_run(
         None => Method::Rk4(Rk4::with_steps_per_sample(1).expect("k = 1 is valid")),
         Some(IntegratorSpec::Rk4(Rk4Spec { step_s })) => {
             let step = step_s.unwrap_or(record.dt_s());
+            // The step must divide the interval fitted over the record (not one measured
+            // between two rounded stamps); the integrator then steps at that interval / k.
+            let k = platen_integrate::sampling_grid(record.t_s())
+                .and_then(|grid| grid.steps_per_interval(step))
+                .map_err(|e| ctx.invalid("integrator.step_s", step, e.to_string()))?;
             Method::Rk4(
-                Rk4::from_step(step, record.dt_s())
+                Rk4::with_steps_per_sample(k)
                     .map_err(|e| ctx.invalid("integrator.step_s", step, e.to_string()))?,
             )
         }

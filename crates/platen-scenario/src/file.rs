@@ -33,6 +33,24 @@ pub struct ScenarioFile {
     pub initial: Option<InitialSpec>,
     /// Simulated duration, s (default: the record's span).
     pub duration_s: Option<f64>,
+    /// The table's limits, laid over the preset's (default: the preset's; the LHPOST's are
+    /// ±0.75 m, 1.8 m/s, 4.2 g, 6.8 MN).
+    pub limits: Option<LimitsSpec>,
+}
+
+/// `limits`: any of the table's four limits, each a number > 0 in SI units; a limit not given
+/// is the preset's.
+#[derive(Debug, Clone, Default, Deserialize, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct LimitsSpec {
+    /// Displacement stroke, ±m.
+    pub stroke_m: Option<f64>,
+    /// Peak velocity, m/s.
+    pub velocity_m_s: Option<f64>,
+    /// Peak acceleration, m/s².
+    pub acceleration_m_s2: Option<f64>,
+    /// Horizontal actuator force capacity, N.
+    pub force_n: Option<f64>,
 }
 
 /// `model`: a preset, its hold-down pressure, and the form with overrides.
@@ -116,6 +134,12 @@ pub struct ExcitationSpec {
     pub lowpass_hz: Option<f64>,
     /// The filter of `lowpass_hz` (default `brickwall`).
     pub lowpass_filter: Option<LowpassFilter>,
+    /// Velocity dead band of an inverse run, m/s (default: none, only `v = 0` is at rest):
+    /// where `|v|` is at most this the platen counts as at rest, and the friction is the
+    /// static reaction that balances the inertial and elastic forces within `±F_s` instead of
+    /// flipping with the sign of a noisy measured velocity
+    /// ([`platen_integrate::inverse`]). Motion excitations only.
+    pub rest_velocity_m_s: Option<f64>,
     /// A lab's own channel names and units for `force_csv` / `motion_csv`
     /// (see [`crate::columns`]).
     pub columns: Option<BTreeMap<String, ColumnSpec>>,
@@ -137,10 +161,12 @@ pub enum LowpassFilter {
     Butterworth,
 }
 
-/// A table motion that reproduces a ground-acceleration record: the PEER `.AT2` record is
-/// scaled, resampled (not-a-knot cubic spline; anti-aliased when downsampling),
-/// baseline-corrected and integrated (trapezoidal) to table velocity and displacement, from
-/// rest at 0.
+/// A table motion that reproduces a ground-acceleration record as PEER integrates it: the
+/// PEER `.AT2` record (or a CSV) is scaled, taken as straight lines between its samples (which
+/// cannot overshoot them), baseline-corrected if asked, and integrated exactly to the table
+/// velocity and displacement from rest, sampled at `sample_rate_hz`
+/// ([`platen_signal::AccelerogramMotion`]). With the default `baseline` (`none`) the velocity
+/// and displacement at the record's own sample times are PEER's `.VT2` and `.DT2`.
 #[derive(Debug, Clone, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GroundMotion {
@@ -153,10 +179,12 @@ pub struct GroundMotion {
     /// Sample rate of the table motion, Hz (default 1024).
     #[serde(default = "default_rate")]
     pub sample_rate_hz: f64,
-    /// Baseline correction before integrating: `none`, `acceleration` (remove the
-    /// least-squares polynomial of `baseline_order` from the acceleration) or `velocity` (from
-    /// the velocity). Default `acceleration` of order 0: the mean acceleration is removed, so
-    /// the table ends at rest.
+    /// Baseline correction before integrating: `none` (default: a PEER-processed record is
+    /// already corrected, and integrating it as it is reproduces its `.VT2`/`.DT2`),
+    /// `acceleration` (remove the least-squares polynomial of `baseline_order` from the
+    /// acceleration: order 0 removes a bias, for a raw record) or `velocity` (remove it from
+    /// the velocity, its derivative from the acceleration and its integral from the
+    /// displacement).
     #[serde(default = "default_baseline")]
     pub baseline: BaselineKind,
     /// Polynomial order of the baseline correction (default 0, at most 8).
@@ -184,7 +212,7 @@ fn default_scale() -> f64 {
 }
 
 fn default_baseline() -> BaselineKind {
-    BaselineKind::Acceleration
+    BaselineKind::None
 }
 
 /// `F(t) = r(t)·amplitude_n·sin(2π·frequency_hz·t)`, with `r` a linear ramp from 0 to 1 over

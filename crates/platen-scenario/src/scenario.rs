@@ -26,6 +26,8 @@
 //!   `{"method": "rk4", "step_s": Δt/k}` or `{"method": "dopri5", "rtol": 1e-8, "atol": 1e-11}`.
 //! * `initial` (forward runs only; default at rest at 0).
 //! * `duration_s` defaults to the record's span; required for generated excitations.
+//! * `limits` (optional): any of `stroke_m`, `velocity_m_s`, `acceleration_m_s2`, `force_n`,
+//!   laid over the preset's table limits; the summary checks the run's peaks against them.
 //!
 //! Unknown keys are errors, reported with their JSON path.
 
@@ -36,13 +38,13 @@ use platen_model::{
     FullModel, IdentifiedKey, IdentifiedModel, ModelError, PhysicalKey, Preset, TableLimits,
 };
 
-use crate::ctx::Ctx;
+use crate::ctx::{check_positive, Ctx};
 use crate::error::Result;
 use crate::excitation::build_run;
 use crate::file::given_values;
 use platen_io::json::parse_json_file;
 
-pub use crate::excitation::Run;
+pub use crate::excitation::{Derived, Run};
 pub use crate::file::*;
 
 /// A validated model in one of its two forms.
@@ -82,6 +84,9 @@ pub struct Scenario {
     pub limits: TableLimits,
     /// What to run.
     pub run: Run,
+    /// The excitation's channels that platen derived (not given by the file or generator), by
+    /// name, with how: what the summary reports under `derived`.
+    pub derived: Derived,
 }
 
 impl Scenario {
@@ -98,6 +103,7 @@ impl Scenario {
             overrides: self.overrides.clone(),
             limits: self.limits,
             run: self.run.scaled(k)?.into_owned(),
+            derived: self.derived.clone(),
         })
     }
 
@@ -147,7 +153,8 @@ impl Scenario {
         };
         let overrides = model_overrides(&ctx, &file.model)?;
         let model = build_model(&ctx, preset, pressure_pa, &overrides)?;
-        let run = build_run(&ctx, &file)?;
+        let limits = table_limits(&ctx, preset, file.limits.as_ref())?;
+        let (run, derived) = build_run(&ctx, &file)?;
         let name = file.name.clone().unwrap_or_else(|| {
             path.file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
@@ -159,10 +166,34 @@ impl Scenario {
             hold_down_pressure_pa: pressure_pa,
             model,
             overrides,
-            limits: preset.limits(),
+            limits,
             run,
+            derived,
         })
     }
+}
+
+/// The preset's table limits with the scenario's `limits` laid over them.
+fn table_limits(ctx: &Ctx, preset: Preset, given: Option<&LimitsSpec>) -> Result<TableLimits> {
+    let mut limits = preset.limits();
+    let Some(given) = given else {
+        return Ok(limits);
+    };
+    for (name, value, slot) in [
+        ("stroke_m", given.stroke_m, &mut limits.stroke_m),
+        ("velocity_m_s", given.velocity_m_s, &mut limits.velocity_m_s),
+        (
+            "acceleration_m_s2",
+            given.acceleration_m_s2,
+            &mut limits.acceleration_m_s2,
+        ),
+        ("force_n", given.force_n, &mut limits.force_n),
+    ] {
+        if let Some(v) = value {
+            *slot = check_positive(ctx, &format!("limits.{name}"), v)?;
+        }
+    }
+    Ok(limits)
 }
 
 /// A model parameter of either form, by its contract name.
@@ -200,6 +231,12 @@ pub struct ModelOverrides {
 }
 
 impl ModelOverrides {
+    /// The values laid over the preset, by key, in the order given (alphabetical for a
+    /// scenario file); empty when the preset's own values run.
+    pub fn values(&self) -> &[(ModelKey, f64)] {
+        &self.values
+    }
+
     /// `"identified"` or `"full"`.
     pub fn form(&self) -> &'static str {
         if self.full {

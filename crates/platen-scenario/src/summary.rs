@@ -1,6 +1,7 @@
 //! The summary of a run ([`RunSummary`]): what `platen simulate --json` prints and a Python
 //! user's `run.summary` holds. A serde type, so every front end reports the same keys.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use serde::Serialize;
@@ -9,7 +10,7 @@ use platen_integrate::{Exceedance, ForwardIntegrator, Peaks, RunStats, Trajector
 use platen_model::TableLimits;
 
 use crate::error::Result;
-use crate::scenario::{Run, Scenario};
+use crate::scenario::{Derived, Run, Scenario};
 use crate::RunOutput;
 
 /// The summary of one run of a scenario. Serialise it through [`serde_json::to_value`] to
@@ -26,6 +27,10 @@ pub struct RunSummary {
     pub model_form: &'static str,
     /// The preset the model is based on.
     pub preset: &'static str,
+    /// The values the scenario lays over the preset's, by name (absent when the preset's own
+    /// values run): the model is the preset's only where this does not name a parameter.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub model_overrides: BTreeMap<&'static str, f64>,
     /// The hold-down pressure, MPa.
     pub hold_down_pressure_mpa: f64,
     /// Output samples.
@@ -55,6 +60,10 @@ pub struct RunSummary {
     pub limit_exceedances: Vec<ExceedanceSummary>,
     /// Every limit with the run's peak against it.
     pub limits: LimitsSummary,
+    /// The excitation's channels that platen derived, with how (absent when the file or
+    /// generator gave every channel).
+    #[serde(skip_serializing_if = "Derived::is_empty")]
+    pub derived: Derived,
     /// The CSV written, if any.
     pub out: Option<String>,
 }
@@ -140,7 +149,8 @@ pub struct LimitCheck {
     pub respected: bool,
 }
 
-/// Every table limit against the run's peaks.
+/// Every table limit (the preset's, with the scenario's `limits` laid over them) against the
+/// run's peaks.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LimitsSummary {
     /// Stroke, m.
@@ -167,6 +177,12 @@ impl RunSummary {
             },
             model_form: scenario.model.form(),
             preset: scenario.preset.name(),
+            model_overrides: scenario
+                .overrides
+                .values()
+                .iter()
+                .map(|(key, value)| (key.name(), *value))
+                .collect(),
             hold_down_pressure_mpa: scenario.hold_down_pressure_pa / 1e6,
             samples: peaks.samples,
             duration_s: peaks.span_s.1 - peaks.span_s.0,
@@ -188,6 +204,7 @@ impl RunSummary {
                 .map(ExceedanceSummary::from)
                 .collect(),
             limits: LimitsSummary::new(peaks, &scenario.limits),
+            derived: scenario.derived.clone(),
             out: out.map(|p| p.display().to_string()),
         }
     }

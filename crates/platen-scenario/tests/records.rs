@@ -108,3 +108,123 @@ fn integrating_the_accelerograms_twice_reproduces_the_nga_velocity_and_displacem
         assert!(e <= 0.005, "{acc}: displacement RMS {e} cm");
     }
 }
+
+/// The table motion of `record` at 1024 Hz as a `ground_motion` scenario builds it, with the
+/// scenario's defaults (no further baseline correction: the records are PEER-processed).
+fn table_motion_1024(record: &std::path::Path) -> platen_integrate::Motion {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("gm.json");
+    let json = serde_json::json!({
+        "model": {"preset": "lhpost-2008"},
+        "excitation": {"ground_motion": {"record": record, "sample_rate_hz": 1024}},
+    });
+    std::fs::write(&path, json.to_string()).unwrap();
+    match platen_scenario::Scenario::load(&path).unwrap().run {
+        platen_scenario::Run::Inverse { motion } => motion,
+        other => panic!("not an inverse run: {other:?}"),
+    }
+}
+
+/// The simulated channel at PEER's own sample times `k·DT` (within the motion's span): linear
+/// between the 1024 Hz samples (off by at most Δt²·max|ẍ|/8, 1e-6 of the peaks here).
+fn at_peer_times(motion_t: &[f64], x: &[f64], dt_s: f64, n: usize) -> Vec<f64> {
+    let last = motion_t[motion_t.len() - 1];
+    let t: Vec<f64> = (0..n)
+        .map(|k| k as f64 * dt_s)
+        .take_while(|&t| t <= last + 1e-12)
+        .collect();
+    platen_signal::metrics::interpolate_linear(motion_t, x, &t).unwrap()
+}
+
+/// Against every PEER velocity (.VT2) and displacement (.DT2) file in the records folder —
+/// data nobody here made — the table motion of its acceleration (.AT2) at 1024 Hz:
+///
+/// * velocity NRMSE ≤ 1 % and displacement NRMSE ≤ 3 % (the issue's bars; measured 0.016 %
+///   and 0.07–0.12 %: the straight-line acceleration's exact integrals are PEER's trapezoids);
+/// * the peak velocity at PEER's sample times within 0.5 % of PEER's (measured ≤ 0.02 %).
+///
+/// Between PEER's samples the velocity may peak higher: where the acceleration changes sign
+/// inside a 50 Hz interval the velocity's extremum lies inside it. That peak is checked
+/// against its closed form from PEER's own numbers, `VT2[k] − a_k²/(2s)` with the straight
+/// line's slope `s = (a_{k+1} − a_k)/DT`, taken over every interval where `a` changes sign
+/// (TAR090: −112.9 cm/s against the −109.65 cm/s sample, +3.0 %).
+#[test]
+fn the_table_motion_at_1024_hz_reproduces_every_peer_velocity_and_displacement_file() {
+    let dir = need_records!();
+    let mut entries: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            p.extension()
+                .and_then(|e| e.to_str())
+                .is_some_and(|e| e.eq_ignore_ascii_case("VT2") || e.eq_ignore_ascii_case("DT2"))
+        })
+        .collect();
+    entries.sort();
+    assert!(
+        !entries.is_empty(),
+        "no .VT2/.DT2 file in {}",
+        dir.display()
+    );
+    let nrmse = |x: &[f64], reference: &[f64]| {
+        platen_signal::metrics::rms_difference(x, &reference[..x.len()]).unwrap()
+            / platen_signal::metrics::rms(&reference[..x.len()])
+    };
+    let peak = |x: &[f64]| x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    for file in entries {
+        let acc_path = file.with_extension("AT2");
+        let reference = read_peer(&file).unwrap();
+        let acc = read_peer(&acc_path).unwrap();
+        assert_eq!(acc.dt_s, reference.dt_s, "{}", file.display());
+        let motion = table_motion_1024(&acc_path);
+        let n = reference.values.len();
+        let name = file.file_name().unwrap().to_string_lossy().into_owned();
+        match reference.quantity {
+            Quantity::Velocity => {
+                let v = at_peer_times(motion.t_s(), motion.v_m_s(), acc.dt_s, n);
+                let e = nrmse(&v, &reference.values);
+                let peak_ratio = peak(&v) / peak(&reference.values);
+                // The velocity's extremum inside each interval where a changes sign.
+                let a = &acc.values;
+                let mut between = peak(&reference.values);
+                for k in 0..n - 1 {
+                    if a[k] * a[k + 1] < 0.0 {
+                        let slope = (a[k + 1] - a[k]) / acc.dt_s;
+                        between =
+                            between.max((reference.values[k] - a[k] * a[k] / (2.0 * slope)).abs());
+                    }
+                }
+                let table_peak = peak(motion.v_m_s());
+                eprintln!(
+                    "{name}: v NRMSE {:.4} %, peak at PEER's times {:+.4} %, peak at 1024 Hz \
+                     {:.4} m/s (PEER's samples {:.4} m/s, between them {:.4} m/s)",
+                    100.0 * e,
+                    100.0 * (peak_ratio - 1.0),
+                    table_peak,
+                    peak(&reference.values),
+                    between
+                );
+                assert!(e <= 0.01, "{name}: velocity NRMSE {e}");
+                assert!(
+                    (peak_ratio - 1.0).abs() <= 0.005,
+                    "{name}: peak {peak_ratio}"
+                );
+                assert!(
+                    (table_peak / between - 1.0).abs() <= 0.005,
+                    "{name}: 1024 Hz peak {table_peak} against {between} between PEER's samples"
+                );
+            }
+            Quantity::Displacement => {
+                let u = at_peer_times(motion.t_s(), motion.u_m(), acc.dt_s, n);
+                let e = nrmse(&u, &reference.values);
+                eprintln!(
+                    "{name}: u NRMSE {:.4} %, peak {:+.4} %",
+                    100.0 * e,
+                    100.0 * (peak(&u) / peak(&reference.values) - 1.0)
+                );
+                assert!(e <= 0.03, "{name}: displacement NRMSE {e}");
+            }
+            Quantity::Acceleration => unreachable!("{name} is not a .VT2/.DT2"),
+        }
+    }
+}

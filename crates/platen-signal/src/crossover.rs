@@ -7,6 +7,12 @@ use crate::calculus::{cumulative_trapezoid, differentiate, remove_polynomial};
 use crate::error::{Result, SignalError};
 use crate::{SampleRate, ZeroPhaseFilter};
 
+/// The crossover frequency platen uses wherever a record has no velocity channel, Hz: a motion
+/// file with `u_m` and `a_m_s2`, `compare` against such a recording, recorded-like data and
+/// identification's default. Table tests put their displacement content below it and the
+/// accelerometer's drift is far below it, so each path is used where it is accurate.
+pub const DEFAULT_CROSSOVER_HZ: f64 = 2.0;
+
 /// Velocity from a displacement record and an acceleration record by a crossover filter (the
 /// paper's §1.5, ref. \[14\]):
 ///
@@ -53,6 +59,15 @@ pub struct CrossoverVelocity<L = ButterworthLowpass> {
 }
 
 impl CrossoverVelocity<ButterworthLowpass> {
+    /// The crossover platen uses wherever a record has no velocity: 2nd-order Butterworth at
+    /// [`DEFAULT_CROSSOVER_HZ`].
+    ///
+    /// # Errors
+    /// As [`butterworth`](Self::butterworth) (a rate of at most 4 Hz).
+    pub fn standard(sample_rate_hz: f64) -> Result<Self> {
+        Self::butterworth(2, DEFAULT_CROSSOVER_HZ, sample_rate_hz)
+    }
+
     /// Crossover with a forward–backward Butterworth low-pass of `order` at `crossover_hz`
     /// (both paths weigh 0.5 there). Order 2 is a good default: a weight falling off as
     /// `(f/f_c)⁴` on each side.

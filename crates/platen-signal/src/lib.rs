@@ -41,6 +41,8 @@
 //!   velocity → displacement with a [`Baseline`] correction), [`remove_polynomial`].
 //! * [`CrossoverVelocity`]: velocity from displacement and acceleration (paper §1.5, ref. \[14\]).
 //! * [`Resampler`]: band-limited change of sample rate.
+//! * [`AccelerogramMotion`]: the table motion of a ground-acceleration record as PEER
+//!   integrates it (straight lines between samples, exact integrals), with a [`Baseline`].
 //! * [`Welch`]: power spectral density ([`Psd`], with [`Psd::rms_in_band`]).
 //!
 //! # Conventions
@@ -74,6 +76,7 @@
 
 #![warn(missing_docs)]
 
+mod accelerogram;
 mod butterworth;
 mod calculus;
 mod crossover;
@@ -86,12 +89,13 @@ mod spectral;
 mod welch;
 mod window;
 
+pub use accelerogram::{AccelerogramMotion, Kinematics};
 pub use butterworth::{ButterworthLowpass, MAX_BUTTERWORTH_ORDER};
 pub use calculus::{
     cumulative_trapezoid, differentiate, remove_polynomial, Baseline, InitialMotion, Motion,
     MotionIntegrator, MAX_BASELINE_ORDER,
 };
-pub use crossover::CrossoverVelocity;
+pub use crossover::{CrossoverVelocity, DEFAULT_CROSSOVER_HZ};
 pub use error::{Result, SignalError};
 pub use fir::{FirLowpass, MAX_FIR_ORDER};
 pub use resample::{Interpolation, Resampler};
