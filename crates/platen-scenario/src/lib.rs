@@ -16,6 +16,7 @@
 
 mod arrays;
 mod ctx;
+mod describe;
 pub mod error;
 mod excitation;
 mod execute;
@@ -28,6 +29,7 @@ mod summary;
 pub mod sweep;
 
 pub use arrays::Arrays;
+pub use describe::describe_model;
 pub use error::{Result, ScenarioError};
 pub use execute::{CsvSink, RunOutput};
 /// Column maps are part of the scenario format (`excitation.columns`).
