@@ -77,27 +77,7 @@ fn run_scenario(scenario: &Scenario, path: &Path) -> Result<(Trajectory, String)
 
 /// The trajectory's columns as NumPy arrays that take over its vectors.
 fn to_python(py: Python<'_>, (trajectory, summary): (Trajectory, String)) -> RunParts<'_> {
-    // Every field by name: a column added to the trajectory must be added here too.
-    let Trajectory {
-        t_s,
-        u_m,
-        v_m_s,
-        a_m_s2,
-        force_n,
-        inertial_force_n,
-        elastic_force_n,
-        dissipative_force_n,
-    } = trajectory;
-    let columns = [
-        t_s,
-        u_m,
-        v_m_s,
-        a_m_s2,
-        force_n,
-        inertial_force_n,
-        elastic_force_n,
-        dissipative_force_n,
-    ];
+    let columns = trajectory.into_columns();
     let arrays = columns.into_iter().map(|c| c.into_pyarray(py)).collect();
     (Trajectory::COLUMN_NAMES.to_vec(), arrays, summary)
 }
