@@ -357,7 +357,7 @@ def forward(
 ) -> Run:
     """The motion an actuator force produces: a forward run, with exact stick-slip.
 
-    * ``t_s``: sample times, s, uniformly sampled (within 0.1 %), strictly increasing.
+    * ``t_s``: sample times, s, on a uniform grid (stamps may be rounded: within 10 % of the fitted interval), strictly increasing.
     * ``force_n``: actuator force at those times, N (linear between samples).
     * ``model``: ``None`` (the ``lhpost-2008`` preset's identified model, Eq. 22/23, at
       13.8 MPa), a preset name, or the scenario format's ``model`` object, e.g.

@@ -103,7 +103,7 @@ def test_bad_arrays_name_the_array_and_the_index():
         ((np.where(t == t[5], t[4], t), f), "`platen.forward()`: time is not strictly increasing at sample 5"),
         ((t, f[:-1]), "`platen.forward()`: record columns differ in length: force_n has 99 values, expected 100"),
         ((t[:1], f[:1]), "`platen.forward()`: record has 1 samples; at least 2 are needed"),
-        ((np.r_[t[:50], t[50:] + 0.003], f), "`platen.forward()`: force record is not uniformly sampled: interval before sample 50"),
+        ((np.r_[t[:50], t[50:] + 0.003], f), "`platen.forward()`: record is not uniformly sampled: the interval before sample 50"),
         ((t.reshape(10, 10), f), "`platen.forward()`: t_s: expected a 1-D array, got shape (10, 10)"),
         ((t, f + 1j), "`platen.forward()`: force_n: expected real numbers (a float or integer array), got dtype complex128"),
         ((t, f > 0), "`platen.forward()`: force_n: expected real numbers (a float or integer array), got dtype bool"),

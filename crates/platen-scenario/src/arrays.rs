@@ -258,7 +258,7 @@ mod tests {
                     t_s: vec![0.0, 0.1, 0.2, 0.35, 0.4],
                     force_n: vec![0.0; 5],
                 },
-                "`platen.forward()`: force record is not uniformly sampled",
+                "`platen.forward()`: record is not uniformly sampled",
             ),
             (
                 Arrays::Motion {
