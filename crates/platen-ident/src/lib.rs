@@ -114,6 +114,7 @@
 
 #![warn(missing_docs)]
 
+pub mod anyrecord;
 mod cycle;
 mod dissipative;
 mod elastic;
@@ -129,6 +130,7 @@ mod paper_fit;
 mod record;
 mod regression;
 mod result;
+mod route;
 mod settings;
 pub mod summary;
 mod warning;
@@ -141,7 +143,17 @@ pub use estimate::{student_t_975, Estimate, Parameter};
 pub use identify::identify;
 pub use inertial::{MAX_MASS_RELATIVE_STD_ERROR, MIN_INERTIAL_TO_DISSIPATIVE};
 pub use platen_model::{DissipativeLaw, IdentifiedKey};
-pub use record::{TestKind, TestRecord, MIN_SAMPLES};
+pub use anyrecord::result::{
+    BandPoint, Correlations, EquationErrorFit, FitKind, FitUncertainty, FloorsReport,
+    OutputErrorFit, RecordIdentification, RecordReport, RecordWarning,
+};
+pub use anyrecord::settings::{RecordSettings, ValidRecordSettings};
+pub use anyrecord::{
+    fit_agreement, identify_records, LOW_VELOCITY_SIGNIFICANCE, MAX_CORRELATION,
+    MAX_RELATIVE_STD_ERROR, MIN_LOW_SPEED_FRACTION,
+};
+pub use record::{Floors, TestKind, TestRecord, MIN_SAMPLES};
+pub use route::{route, Method, Route};
 pub use result::{
     GlobalFit, Identification, LawReport, PaperFit, ParameterEstimates, PeakForce, PressureGroup,
     TestResult,
