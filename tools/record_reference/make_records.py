@@ -34,7 +34,7 @@ Outputs (tests/data/any-record/):
   wn-lab.csv                  white noise (0.3-15 Hz), 30 s, lab format
   wn-low-lab.csv              low-amplitude white noise (peak speed ~3 cm/s), 30 s
   eq-two-storey-lab.csv       earthquake-like with a two-storey specimen and floor accelerations
-  coverage-K.csv (K = 0..4)   noise-free truth in SI (u_m, a_m_s2, force_n), 12 s each, for the
+  coverage-K.csv (K = 0..4)   noise-free truth in SI (u_m, a_m_s2, force_n), 30 s each, for the
                               coverage study (the test adds seeded noise, offsets, rounding)
 
 Usage (from the repository root):  python3 tools/record_reference/make_records.py
@@ -348,7 +348,7 @@ def main():
     coverage = {}
     for k in range(5):
         kind = "eq" if k % 2 == 0 else "wn"
-        rec = make(kind, 12.0, 200 + k, 0.35, ())
+        rec = make(kind, 30.0, 200 + k, 0.35, ())
         name = f"coverage-{k}.csv"
         write_truth_si(name, rec)
         coverage[name] = dict(kind=kind, **summary(rec))

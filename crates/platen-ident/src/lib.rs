@@ -149,7 +149,7 @@ pub use anyrecord::result::{
 };
 pub use anyrecord::settings::{RecordSettings, ValidRecordSettings};
 pub use anyrecord::{
-    fit_agreement, identify_records, LOW_VELOCITY_SIGNIFICANCE, MAX_CORRELATION,
+    fit_agreement, identify_records, MAX_CORRELATION,
     MAX_RELATIVE_STD_ERROR, MIN_LOW_SPEED_FRACTION,
 };
 pub use record::{Floors, TestKind, TestRecord, MIN_SAMPLES};

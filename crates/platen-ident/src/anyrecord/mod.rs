@@ -10,6 +10,7 @@ mod output_error;
 pub(crate) mod result;
 mod separable;
 pub(crate) mod settings;
+pub mod summary;
 
 
 use std::cell::Cell;
@@ -41,8 +42,6 @@ pub const MAX_CORRELATION: f64 = 0.95;
 /// poorly determined ([`RecordWarning::Imprecise`]).
 pub const MAX_RELATIVE_STD_ERROR: f64 = 0.1;
 
-/// The low-velocity term `a·e^(−b|v|)` is kept only if `a` exceeds this many standard errors.
-pub const LOW_VELOCITY_SIGNIFICANCE: f64 = 2.0;
 
 /// Fewer than this fraction of the fitted samples below `3/b` draws
 /// [`RecordWarning::FewLowSpeedSamples`].
@@ -119,7 +118,7 @@ pub fn identify_records(
             Some(k) => (fit.full[LOW_FORCE], hac.cov[(k, k)].sqrt()),
             None => (0.0, f64::NAN),
         };
-        if !(a > LOW_VELOCITY_SIGNIFICANCE * se) {
+        if fit.clamped.contains(&LOW_FORCE) {
             warnings.push(RecordWarning::LowVelocityTermLeftOut {
                 force_n: a,
                 std_error_n: se,

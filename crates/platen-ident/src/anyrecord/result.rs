@@ -210,8 +210,8 @@ pub enum RecordWarning {
         /// Its value.
         value: f64,
     },
-    /// The low-velocity term was fitted but is not significant (`a` within two standard
-    /// errors of zero or negative): left out (`a = 0`, `b = 0`).
+    /// The low-velocity term was fitted but its force came out at its bound (`a = 0`: the
+    /// record is better fitted by a negative one): left out (`a = 0`, `b = 0`).
     LowVelocityTermLeftOut {
         /// `a`, N.
         force_n: f64,
@@ -315,7 +315,7 @@ impl fmt::Display for RecordWarning {
                 std_error_n,
             } => write!(
                 f,
-                "the low-velocity term is not significant in this record (a = {force_n:.0} ± {std_error_n:.0} N): left out (a = 0)"
+                "the low-velocity term is not supported by this record (a = {force_n:.0} ± {std_error_n:.0} N at its bound): left out (a = 0)"
             ),
             RecordWarning::FewLowSpeedSamples {
                 below_m_s,
