@@ -37,8 +37,8 @@ use serde::{Deserialize, Serialize};
 use platen_ident::anyrecord::summary::RecordSummary;
 use platen_ident::{
     identify, identify_records, route, Estimate, Flag, Identification, IdentificationSummary,
-    IdentifiedKey, Method, Parameter, RecordIdentification, RecordSettings, RecordWarning,
-    Route, Settings, TestKind, TestRecord,
+    IdentifiedKey, Method, Parameter, RecordIdentification, RecordSettings, RecordWarning, Route,
+    Settings, TestKind, TestRecord,
 };
 use platen_io::columns::{ColumnMap, ColumnSpec};
 use platen_io::json::parse_json_file;
@@ -303,7 +303,14 @@ fn run_records(
             f
         },
         |figures, rendered| {
-            record_html_report(&id, &rec_inputs, periodic.as_ref(), &per_owned, figures, rendered)
+            record_html_report(
+                &id,
+                &rec_inputs,
+                periodic.as_ref(),
+                &per_owned,
+                figures,
+                rendered,
+            )
         },
     )?;
     let method_name = match method {
@@ -451,7 +458,11 @@ fn parameter_lines(s: &mut String, params: &platen_ident::ParameterEstimates) {
                 d = digits
             ),
             Parameter::Fixed { value, reason } => {
-                format!("{:.d$} {unit}   (fixed: {reason})", value / scale, d = digits)
+                format!(
+                    "{:.d$} {unit}   (fixed: {reason})",
+                    value / scale,
+                    d = digits
+                )
             }
             Parameter::NotIdentifiable { reason } => format!("not identifiable: {reason}"),
         };
@@ -463,7 +474,12 @@ fn parameter_lines(s: &mut String, params: &platen_ident::ParameterEstimates) {
 fn correlation_lines(s: &mut String, fit: &str, c: &platen_ident::Correlations) {
     let _ = writeln!(s, "\nParameter correlations ({fit})");
     let names: Vec<&str> = c.keys.iter().map(|k| short(*k)).collect();
-    let _ = writeln!(s, "  {:>4} {}", "", names.iter().map(|n| format!("{n:>7}")).collect::<String>());
+    let _ = writeln!(
+        s,
+        "  {:>4} {}",
+        "",
+        names.iter().map(|n| format!("{n:>7}")).collect::<String>()
+    );
     for (i, row) in c.matrix.iter().enumerate() {
         let _ = writeln!(
             s,
@@ -510,7 +526,10 @@ fn record_html_report(
         sections.push(html::heading("Periodic tests (hysteresis-loop method)"));
         sections.push(html::preformatted(&report(p, periodic_inputs)));
     }
-    let files: Vec<String> = inputs.iter().map(|i| i.path.display().to_string()).collect();
+    let files: Vec<String> = inputs
+        .iter()
+        .map(|i| i.path.display().to_string())
+        .collect();
     html::page(&html::Page {
         title: "platen identify".into(),
         heading: "Identification from test records (equation error, output error)".into(),
@@ -518,7 +537,11 @@ fn record_html_report(
             ("records".to_owned(), id.records.len().to_string()),
             (
                 "files".to_owned(),
-                inputs.iter().map(|i| i.name.as_str()).collect::<Vec<_>>().join(", "),
+                inputs
+                    .iter()
+                    .map(|i| i.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
             ),
         ],
         sections,
@@ -798,7 +821,10 @@ impl<'a> ManifestReader<'a> {
                 );
             }
             floor_factor(f).with_context(|| {
-                format!("`{}`, at `floors[{i}].unit` (tests[{k}])", self.path.display())
+                format!(
+                    "`{}`, at `floors[{i}].unit` (tests[{k}])",
+                    self.path.display()
+                )
             })?;
         }
         let canon = std::fs::canonicalize(&path).ok();
@@ -875,9 +901,8 @@ fn floor_factor(f: &FloorSpec) -> Result<f64> {
             times_area_m2: None,
         },
     );
-    let map = ColumnMap::new(&spec, "floors").map_err(|(_, value, expected)| {
-        anyhow::anyhow!("{value}: expected {expected}")
-    })?;
+    let map = ColumnMap::new(&spec, "floors")
+        .map_err(|(_, value, expected)| anyhow::anyhow!("{value}: expected {expected}"))?;
     Ok(map.factor("a_m_s2"))
 }
 
@@ -885,9 +910,7 @@ fn read_record(input: &Input) -> Result<TestRecord> {
     let path = &input.path;
     let mut required = vec!["t_s", "u_m", "a_m_s2", "force_n"];
     required.extend(input.floors.iter().map(|f| f.column.as_str()));
-    let mut table = input
-        .columns
-        .read_table(path, &required, &["v_m_s"])?;
+    let mut table = input.columns.read_table(path, &required, &["v_m_s"])?;
     let t = table.take_column("t_s").expect("required column");
     let dt = uniform_step_s(path, &t)?;
     let take =

@@ -101,7 +101,11 @@ fn displacement(rec: &RecordReport, suffix: &str) -> Figure {
     let range = span(&t);
     let sim = rec.simulated_u_m.as_deref().unwrap_or_default();
     let mm = |x: &[f64]| x.iter().map(|v| v * 1e3).collect::<Vec<f64>>();
-    let residual: Vec<f64> = sim.iter().zip(&rec.u_m).map(|(s, u)| (s - u) * 1e3).collect();
+    let residual: Vec<f64> = sim
+        .iter()
+        .zip(&rec.u_m)
+        .map(|(s, u)| (s - u) * 1e3)
+        .collect();
     Figure {
         name: format!("record-displacement{suffix}"),
         title: format!("Displacement of {}: measured and simulated (output error)", rec.name),
@@ -134,21 +138,24 @@ fn displacement(rec: &RecordReport, suffix: &str) -> Figure {
 /// `|F_D|` against `|v|`: the records' points (force less the fitted inertial and elastic
 /// forces and offset, on the samples fitted), the law and its band.
 fn dissipative(id: &RecordIdentification) -> Figure {
-    let law = id.parameters.law();
+    let law = id.law;
     let mut speed = Vec::new();
     let mut force = Vec::new();
     for rec in &id.records {
         for i in (0..rec.samples).filter(|&i| rec.used[i]) {
             let v = rec.velocity_m_s[i];
             // F − (Mₑa + Kₑu + offset) = F_D(v̂) + (F − fitted): the law plus the residual.
-            let d = law.map_or(0.0, |l| l.smooth_signed_n(v));
+            let d = law.smooth_signed_n(v);
             speed.push(v.abs());
             force.push((d + rec.force_n[i] - rec.fitted_force_n[i]) * v.signum() / 1e3);
         }
     }
     let (pts, stride) = thinned(&speed, &force, MAX_SCATTER_POINTS);
     let band = &id.band;
-    let law: Vec<(f64, f64)> = band.iter().map(|b| (b.speed_m_s, b.force_n / 1e3)).collect();
+    let law: Vec<(f64, f64)> = band
+        .iter()
+        .map(|b| (b.speed_m_s, b.force_n / 1e3))
+        .collect();
     let low: Vec<(f64, f64)> = band.iter().map(|b| (b.speed_m_s, b.low_n / 1e3)).collect();
     let high: Vec<(f64, f64)> = band.iter().map(|b| (b.speed_m_s, b.high_n / 1e3)).collect();
     Figure {

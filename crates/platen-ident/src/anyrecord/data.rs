@@ -65,7 +65,10 @@ pub(crate) fn prepare(
                         rec.sample_rate_hz(),
                     )
                     .map_err(signal)?;
-                    (cross.estimate(rec.u_m(), rec.a_m_s2()).map_err(signal)?, false)
+                    (
+                        cross.estimate(rec.u_m(), rec.a_m_s2()).map_err(signal)?,
+                        false,
+                    )
                 }
             };
             let n = v.len();

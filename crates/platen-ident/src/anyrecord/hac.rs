@@ -45,6 +45,10 @@ pub(crate) const MIN_BLOCKS: usize = 6;
 pub(crate) struct Hac {
     /// Covariance matrix of the parameters (rows/columns of singular parameters are NaN).
     pub cov: DMatrix<f64>,
+    /// The same through the pseudo-inverse, singular directions dropped but not masked: the
+    /// variance `gᵀ·C·g` of a combination the data determine (`g` orthogonal to the singular
+    /// directions, as `F_μ + Cₑ` when `α = 0`) is right even where its terms are not.
+    pub cov_estimable: DMatrix<f64>,
     /// Whether each parameter lies in a singular direction of `JᵀJ`.
     pub singular: Vec<bool>,
     /// Condition number of `JᵀJ` scaled to unit diagonal.
@@ -169,8 +173,10 @@ pub(crate) fn covariance(
             scaled[(i, j)] / (scale[i] * scale[j])
         }
     });
+    let cov_estimable = DMatrix::from_fn(m, m, |i, j| scaled[(i, j)] / (scale[i] * scale[j]));
     Hac {
         cov,
+        cov_estimable,
         singular,
         condition,
         bandwidth,
@@ -228,5 +234,4 @@ mod tests {
         ratio /= reps as f64;
         assert!((ratio - 1.0).abs() < 0.10, "mean ratio {ratio}");
     }
-
 }

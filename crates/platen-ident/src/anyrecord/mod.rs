@@ -12,7 +12,6 @@ mod separable;
 pub(crate) mod settings;
 pub mod summary;
 
-
 use std::cell::Cell;
 
 use nalgebra::DMatrix;
@@ -41,7 +40,6 @@ pub const MAX_CORRELATION: f64 = 0.95;
 /// A parameter whose standard error exceeds this fraction of its value is reported as
 /// poorly determined ([`RecordWarning::Imprecise`]).
 pub const MAX_RELATIVE_STD_ERROR: f64 = 0.1;
-
 
 /// Fewer than this fraction of the fitted samples below `3/b` draws
 /// [`RecordWarning::FewLowSpeedSamples`].
@@ -151,7 +149,17 @@ pub fn identify_records(
         })
         .collect();
     let speeds = speed_range(&data);
-    ee_warnings(&fit, &hac, &free, &ee_params, &ee_corr, &data, settings, speeds, &mut warnings);
+    ee_warnings(
+        &fit,
+        &hac,
+        &free,
+        &ee_params,
+        &ee_corr,
+        &data,
+        settings,
+        speeds,
+        &mut warnings,
+    );
     let equation_error = EquationErrorFit {
         parameters: ee_params.clone(),
         offsets_n,
@@ -169,8 +177,14 @@ pub fn identify_records(
     let mut output_error = None;
     if settings.output_error {
         let model_free: Vec<usize> = free.iter().copied().filter(|&i| i < OFFSETS).collect();
-        match run_output_error(records, &velocities, &fit.full, &model_free, settings, &fixed_reason)
-        {
+        match run_output_error(
+            records,
+            &velocities,
+            &fit.full,
+            &model_free,
+            settings,
+            &fixed_reason,
+        ) {
             Ok(oe) => {
                 simulated = oe.simulated;
                 compare_fits(&ee_params, &oe.fit.parameters, &mut warnings);
@@ -181,8 +195,8 @@ pub fn identify_records(
         }
     }
     let band = band(
-        &ee_params,
-        &(free.clone(), hac.cov.clone(), hac.critical_value),
+        &fit.full,
+        &(free.clone(), hac.cov_estimable.clone(), hac.critical_value),
         speeds,
         settings.band_points,
     );
@@ -191,6 +205,7 @@ pub fn identify_records(
         parameters: ee_params,
         equation_error,
         output_error,
+        law: fitted_law(&fit.full),
         band,
         records: reports,
         warnings,
@@ -210,7 +225,13 @@ fn ee_covariance(fit: &SeparableFit, data: &Stacked) -> Hac {
 /// An estimate with the sandwich's variance and the fixed-b critical value; the degrees of
 /// freedom reported are the effective samples less the parameters.
 fn estimate(value: f64, var: f64, hac: &Hac, params: usize) -> Estimate {
-    estimate_with(value, var, hac.critical_value, hac.effective_samples, params)
+    estimate_with(
+        value,
+        var,
+        hac.critical_value,
+        hac.effective_samples,
+        params,
+    )
 }
 
 fn estimate_with(value: f64, var: f64, critical: f64, effective: f64, params: usize) -> Estimate {
@@ -499,7 +520,11 @@ fn oe_warnings(fit: &OutputErrorFit, warnings: &mut Vec<RecordWarning>) {
 }
 
 /// Warns where the two fits disagree.
-fn compare_fits(ee: &ParameterEstimates, oe: &ParameterEstimates, warnings: &mut Vec<RecordWarning>) {
+fn compare_fits(
+    ee: &ParameterEstimates,
+    oe: &ParameterEstimates,
+    warnings: &mut Vec<RecordWarning>,
+) {
     for (key, p) in ee.iter() {
         let (Some(a), Some(b)) = (p.estimate(), oe.get(key).estimate()) else {
             continue;
@@ -521,17 +546,17 @@ fn compare_fits(ee: &ParameterEstimates, oe: &ParameterEstimates, warnings: &mut
     }
 }
 
-/// `F_D(|v|)` of `params` with its pointwise 95 % band from the covariance `cov` (rows:
-/// full-vector indices `free`), at `points` speeds spaced evenly in `ln |v|` over `speeds`.
+/// `F_D(|v|)` of the fitted vector `full` with its pointwise 95 % band from the covariance
+/// `cov` (rows: full-vector indices `free`), at `points` speeds spaced evenly in `ln |v|`
+/// over `speeds`. The law is determined even where its parameters are not (the fit's
+/// minimum-norm solution along a singular direction changes no fitted force).
 fn band(
-    params: &ParameterEstimates,
+    full: &[f64],
     cov: &(Vec<usize>, DMatrix<f64>, f64),
     speeds: [f64; 2],
     points: usize,
 ) -> Vec<BandPoint> {
-    let Some(law) = params.law() else {
-        return Vec::new();
-    };
+    let law = fitted_law(full);
     let (free, c, critical) = cov;
     // Gradient order of DissipativeLaw::gradient: (F_μ, Cₑ, α, a, b) = full indices 2..=6.
     let law_index = [2, 3, 4, 5, 6];
@@ -567,6 +592,17 @@ fn band(
         .collect()
 }
 
+/// The law of a full parameter vector.
+fn fitted_law(q: &[f64]) -> DissipativeLaw {
+    DissipativeLaw {
+        coulomb_force_n: q[2],
+        viscous_coefficient: q[3],
+        exponent: Exponent::new(q[4].clamp(0.0, 1.0)),
+        low_velocity_force_n: q[5],
+        low_velocity_decay_s_per_m: q[6],
+    }
+}
+
 /// The per-record reports.
 fn record_reports(
     records: &[TestRecord],
@@ -575,13 +611,7 @@ fn record_reports(
     simulated: Vec<Option<Vec<f64>>>,
 ) -> Vec<RecordReport> {
     let q = &fit.full;
-    let law = DissipativeLaw {
-        coulomb_force_n: q[2],
-        viscous_coefficient: q[3],
-        exponent: Exponent::new(q[4].clamp(0.0, 1.0)),
-        low_velocity_force_n: q[5],
-        low_velocity_decay_s_per_m: q[6],
-    };
+    let law = fitted_law(q);
     records
         .iter()
         .zip(prepared)

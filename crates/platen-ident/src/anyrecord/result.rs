@@ -3,7 +3,7 @@
 
 use std::fmt;
 
-use platen_model::IdentifiedKey;
+use platen_model::{DissipativeLaw, IdentifiedKey};
 
 use crate::estimate::Estimate;
 use crate::result::ParameterEstimates;
@@ -166,6 +166,9 @@ pub struct RecordIdentification {
     pub equation_error: EquationErrorFit,
     /// The output-error refinement, if run.
     pub output_error: Option<OutputErrorFit>,
+    /// The equation error's dissipative law as fitted (also where its parameters are not
+    /// each identifiable: the law is).
+    pub law: DissipativeLaw,
     /// `F_D(|v|)` with its pointwise 95 % band over the speeds the records reach.
     pub band: Vec<BandPoint>,
     /// Per record, in input order.

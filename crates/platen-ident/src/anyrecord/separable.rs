@@ -290,7 +290,8 @@ impl<'a> Separable<'a> {
         // Assemble in Shape::linear order: Mₑ, Kₑ, F_μ, Cₑ, [a], offsets.
         let lin = self.shape.linear();
         let p = lin.len();
-        let pos = |full: usize| -> Option<usize> { self.fixed.cols.iter().position(|&c| c == full) };
+        let pos =
+            |full: usize| -> Option<usize> { self.fixed.cols.iter().position(|&c| c == full) };
         let entry = |x: usize, y: usize| -> f64 {
             match (x, y) {
                 (VISCOUS, VISCOUS) => cc,
@@ -298,10 +299,12 @@ impl<'a> Separable<'a> {
                 (VISCOUS, LOW_FORCE) | (LOW_FORCE, VISCOUS) => ce,
                 (VISCOUS, o) | (o, VISCOUS) => gc[pos(o).expect("fixed column")],
                 (LOW_FORCE, o) | (o, LOW_FORCE) => ge[pos(o).expect("fixed column")],
-                (o1, o2) => self.fixed.g[(
-                    pos(o1).expect("fixed column"),
-                    pos(o2).expect("fixed column"),
-                )],
+                (o1, o2) => {
+                    self.fixed.g[(
+                        pos(o1).expect("fixed column"),
+                        pos(o2).expect("fixed column"),
+                    )]
+                }
             }
         };
         let g = DMatrix::from_fn(p, p, |i, j| entry(lin[i], lin[j]));
@@ -376,11 +379,23 @@ impl<'a> Separable<'a> {
         let nonlinear = self.shape.nonlinear();
         let lower: Vec<f64> = nonlinear
             .iter()
-            .map(|&i| if i == EXPONENT { ALPHA_BOUNDS[0] } else { DECAY_BOUNDS[0] })
+            .map(|&i| {
+                if i == EXPONENT {
+                    ALPHA_BOUNDS[0]
+                } else {
+                    DECAY_BOUNDS[0]
+                }
+            })
             .collect();
         let upper: Vec<f64> = nonlinear
             .iter()
-            .map(|&i| if i == EXPONENT { ALPHA_BOUNDS[1] } else { DECAY_BOUNDS[1] })
+            .map(|&i| {
+                if i == EXPONENT {
+                    ALPHA_BOUNDS[1]
+                } else {
+                    DECAY_BOUNDS[1]
+                }
+            })
             .collect();
         let (q, iterations, converged) = if nonlinear.is_empty() {
             (Vec::new(), 0, true)

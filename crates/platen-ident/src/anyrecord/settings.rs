@@ -61,8 +61,9 @@ impl Default for RecordSettings {
     }
 }
 
-/// Checked [`RecordSettings`] ([`RecordSettings::build`]), read through `Deref`.
-#[derive(Debug, Clone, PartialEq)]
+/// Checked [`RecordSettings`] ([`RecordSettings::build`]), read through `Deref`. The
+/// default is [`RecordSettings::default`], which is valid.
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct ValidRecordSettings(RecordSettings);
 
 impl Deref for ValidRecordSettings {
@@ -70,12 +71,6 @@ impl Deref for ValidRecordSettings {
 
     fn deref(&self) -> &RecordSettings {
         &self.0
-    }
-}
-
-impl Default for ValidRecordSettings {
-    fn default() -> Self {
-        Self(RecordSettings::default())
     }
 }
 
@@ -122,11 +117,7 @@ impl RecordSettings {
             )?;
         }
         if !(2..=10_000).contains(&self.band_points) {
-            bad(
-                "band_points",
-                self.band_points as f64,
-                "2 to 10000 speeds",
-            )?;
+            bad("band_points", self.band_points as f64, "2 to 10000 speeds")?;
         }
         Ok(ValidRecordSettings(self.clone()))
     }

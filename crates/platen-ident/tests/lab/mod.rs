@@ -61,9 +61,8 @@ pub fn lab_record(file: &str, storeys: usize) -> TestRecord {
     let mut cols = vec!["Time", "Table Disp", "Table Acc", "dP"];
     cols.extend(floors.iter().map(String::as_str));
     let table = read_table(&path, &cols, &[]).unwrap();
-    let col = |c: &str, f: f64| -> Vec<f64> {
-        table.column(c).unwrap().iter().map(|x| x * f).collect()
-    };
+    let col =
+        |c: &str, f: f64| -> Vec<f64> { table.column(c).unwrap().iter().map(|x| x * f).collect() };
     let t = col("Time", 1.0);
     let area = truth()["area_m2"].as_f64().unwrap();
     let rec = TestRecord::from_rate(
