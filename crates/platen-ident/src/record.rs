@@ -291,3 +291,34 @@ impl TestRecord {
         self.kind
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Σ mᵢ·aᵢ leaves the force: 2 storeys of 10 t and 5 t at 1 and 2 m/s² take 20 kN.
+    #[test]
+    fn floors_take_their_base_shear_off_the_force() {
+        let n = 100;
+        let rec = TestRecord::from_rate("r", 100.0, vec![0.0; n], vec![0.0; n], vec![50e3; n])
+            .unwrap()
+            .with_floors(&[(10e3, vec![1.0; n]), (5e3, vec![2.0; n])])
+            .unwrap();
+        assert!(rec.force_n().iter().all(|&f| f == 30e3));
+        assert_eq!(rec.floors().unwrap().peak_base_shear_n, 20e3);
+    }
+
+    #[test]
+    fn a_bad_floor_is_rejected_naming_the_storey() {
+        let n = 100;
+        let rec =
+            TestRecord::from_rate("r", 100.0, vec![0.0; n], vec![0.0; n], vec![0.0; n]).unwrap();
+        let e = rec
+            .clone()
+            .with_floors(&[(-1.0, vec![0.0; n])])
+            .unwrap_err();
+        assert!(e.to_string().contains("storey 1 mass"), "{e}");
+        let e = rec.with_floors(&[(1.0, vec![0.0; 3])]).unwrap_err();
+        assert!(e.to_string().contains("storey 1 acceleration has 3"), "{e}");
+    }
+}

@@ -62,3 +62,33 @@ pub fn route(record: &TestRecord) -> Route {
         },
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record(u: Vec<f64>) -> TestRecord {
+        let n = u.len();
+        TestRecord::from_rate("r", 200.0, u, vec![0.0; n], vec![0.0; n]).unwrap()
+    }
+
+    #[test]
+    fn a_sine_is_periodic_and_a_chirp_is_not() {
+        let sine: Vec<f64> = (0..2000)
+            .map(|i| (std::f64::consts::TAU * 1.0 * i as f64 / 200.0).sin())
+            .collect();
+        assert!(
+            matches!(route(&record(sine)), Route::Periodic { frequency_hz }
+            if (frequency_hz - 1.0).abs() < 0.01)
+        );
+        // Frequency doubling over the record: crossings at irregular intervals.
+        let chirp: Vec<f64> = (0..2000)
+            .map(|i| {
+                let t = i as f64 / 200.0;
+                (std::f64::consts::TAU * (0.5 * t + 0.1 * t * t)).sin()
+            })
+            .collect();
+        let r = route(&record(chirp));
+        assert_eq!(r.method(), Method::Record, "{r:?}");
+    }
+}
