@@ -899,6 +899,9 @@ fn floor_factor(f: &FloorSpec) -> Result<f64> {
             name: Some(f.column.clone()),
             unit: f.unit.clone(),
             times_area_m2: None,
+            offset: None,
+            remove_mean: false,
+            zero_at_start: false,
         },
     );
     let map = ColumnMap::new(&spec, "floors")

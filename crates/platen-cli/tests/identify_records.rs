@@ -133,7 +133,6 @@ fn a_bad_floor_mass_is_an_input_error_naming_the_manifest() {
 /// against a fitted interval, not each interval against the median); today's check rejects
 /// the file at line 4.
 #[test]
-#[ignore = "needs issue 16's fitted-grid sampling check (rounded time stamps)"]
 fn a_lab_file_with_rounded_stamps_is_identified_as_recorded() {
     let csv = data().join("eq-lab.csv");
     let columns = data().join("columns.json");
