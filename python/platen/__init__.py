@@ -489,7 +489,9 @@ def identify(
     low_velocity_term: bool = True,
 ) -> Dict[str, Any]:
     """Identifies the platen's parameters from recorded periodic tests (the paper's
-    hysteresis-loop method, §3), as ``platen identify FILE… --json``.
+    hysteresis-loop method, §3), as ``platen identify FILE… --method periodic --json``.
+    The any-record method (earthquake and white-noise records) is not reachable from
+    Python yet; use the CLI for it.
 
     ``files``: recorded CSVs with ``t_s``, ``u_m``, ``a_m_s2``, ``force_n`` and optionally
     ``v_m_s`` (``columns`` maps a lab's own names and units, as for :func:`compare`).
