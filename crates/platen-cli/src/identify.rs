@@ -226,24 +226,25 @@ fn run_periodic(
         };
         // Through a `Value`, whose maps sort their keys at every level.
         let value = serde_json::to_value(&output)?;
-        println!("{}", serde_json::to_string_pretty(&value)?);
+        outln!("{}", serde_json::to_string_pretty(&value)?);
     } else {
-        print!("{}", report(&id, inputs));
-        print_written(&written, opts.report);
+        out!("{}", report(&id, inputs));
+        print_written(&written, opts.report)?;
     }
     Ok(())
 }
 
-fn print_written(written: &[PathBuf], report: Option<&Path>) {
+fn print_written(written: &[PathBuf], report: Option<&Path>) -> Result<()> {
     if !written.is_empty() {
-        println!("\nWrote {} figure files (SVG and PNG):", written.len());
+        outln!("\nWrote {} figure files (SVG and PNG):", written.len());
         for path in written {
-            println!("  {}", path.display());
+            outln!("  {}", path.display());
         }
     }
     if let Some(path) = report {
-        println!("Wrote report {}", path.display());
+        outln!("Wrote report {}", path.display());
     }
+    Ok(())
 }
 
 /// The any-record method on the records routed to it (every file with `--method record` or
@@ -333,14 +334,14 @@ fn run_records(
             report: opts.report.map(|path| path.display().to_string()),
         };
         let value = serde_json::to_value(&output)?;
-        println!("{}", serde_json::to_string_pretty(&value)?);
+        outln!("{}", serde_json::to_string_pretty(&value)?);
     } else {
-        print!("{}", record_report(&id, &rec_inputs));
+        out!("{}", record_report(&id, &rec_inputs));
         if let Some(p) = &periodic {
-            println!("\n== Periodic tests (hysteresis-loop method, §3) ==\n");
-            print!("{}", report(p, &per_owned));
+            outln!("\n== Periodic tests (hysteresis-loop method, §3) ==\n");
+            out!("{}", report(p, &per_owned));
         }
-        print_written(&written, opts.report);
+        print_written(&written, opts.report)?;
     }
     Ok(())
 }

@@ -5,6 +5,23 @@
 
 #![recursion_limit = "256"]
 
+/// `println!` for the verbs' standard output that returns an error instead of panicking when
+/// the output cannot be written (a reader that closed the pipe: `platen model | head -1`).
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout().lock(), $($arg)*).map_err(crate::stdout_error)?;
+    }};
+}
+
+/// `print!` for the verbs' standard output: see [`outln!`].
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        write!(std::io::stdout().lock(), $($arg)*).map_err(crate::stdout_error)?;
+    }};
+}
+
 mod bench;
 mod compare;
 mod generate;
@@ -239,10 +256,46 @@ pub(crate) enum Form {
 fn main() -> ExitCode {
     match run(Cli::parse().command) {
         Ok(()) => ExitCode::SUCCESS,
+        // The reader of standard output went away (`| head`): stop quietly, as filters do.
+        Err(e) if e.chain().any(|c| c.is::<ClosedPipe>()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::from(exit_code(&e))
         }
+    }
+}
+
+/// Standard output was closed by its reader.
+#[derive(Debug)]
+struct ClosedPipe;
+
+impl std::fmt::Display for ClosedPipe {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("standard output was closed by its reader")
+    }
+}
+
+impl std::error::Error for ClosedPipe {}
+
+/// Standard output could not be written (a full disk behind a redirection, say).
+#[derive(Debug)]
+struct StdoutFailed(std::io::Error);
+
+impl std::fmt::Display for StdoutFailed {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "writing to standard output: {}", self.0)
+    }
+}
+
+impl std::error::Error for StdoutFailed {}
+
+/// The error of a failed write to standard output: [`ClosedPipe`] for a closed pipe (exit 0),
+/// otherwise [`StdoutFailed`] (exit 5, an output that could not be written).
+fn stdout_error(e: std::io::Error) -> anyhow::Error {
+    if e.kind() == std::io::ErrorKind::BrokenPipe {
+        anyhow::Error::new(ClosedPipe)
+    } else {
+        anyhow::Error::new(StdoutFailed(e))
     }
 }
 
@@ -333,6 +386,9 @@ fn run(command: Command) -> anyhow::Result<()> {
 /// unwrapped here.
 fn exit_code(e: &anyhow::Error) -> u8 {
     for cause in e.chain() {
+        if cause.is::<StdoutFailed>() {
+            return 5;
+        }
         if let Some(ie) = cause.downcast_ref::<IntegrateError>() {
             return integrate_exit_code(ie);
         }

@@ -18,18 +18,18 @@ pub fn run(preset: &str, pressure_mpa: Option<f64>, form: Form, json_out: bool) 
     };
     let value = platen_scenario::describe_model(preset, pressure_pa, matches!(form, Form::Full))?;
     if json_out {
-        println!("{}", serde_json::to_string_pretty(&value)?);
+        outln!("{}", serde_json::to_string_pretty(&value)?);
     } else if let Value::Object(m) = &value {
         for (k, v) in m {
             if !v.is_object() {
-                println!("{k:>34}  {v}");
+                outln!("{k:>34}  {v}");
             }
         }
         for section in ["limits", "physical"] {
             if let Some(Value::Object(sub)) = m.get(section) {
-                println!("  {section}:");
+                outln!("  {section}:");
                 for (k, v) in sub {
-                    println!("{k:>34}  {v}");
+                    outln!("{k:>34}  {v}");
                 }
             }
         }
