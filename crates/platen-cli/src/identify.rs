@@ -1017,27 +1017,7 @@ fn report_parameters(s: &mut String, id: &Identification) {
             None => "hold-down pressure not given".to_owned(),
         }
     );
-    for (key, p) in id.parameters.iter() {
-        let (name, (unit, scale, digits)) = (key.name(), display_unit(key));
-        let text = match p {
-            Parameter::Estimated(e) => format!(
-                "{} {unit}   (95 % CI {:.d$} – {:.d$})",
-                pm(Some(e), scale, digits),
-                e.ci95_low / scale,
-                e.ci95_high / scale,
-                d = digits
-            ),
-            Parameter::Fixed { value, reason } => {
-                format!(
-                    "{:.d$} {unit}   (fixed: {reason})",
-                    value / scale,
-                    d = digits
-                )
-            }
-            Parameter::NotIdentifiable { reason } => format!("not identifiable: {reason}"),
-        };
-        let _ = writeln!(s, "  {name:<28} {text}");
-    }
+    parameter_lines(s, &id.parameters);
     if let Some(mu) = &id.friction_coefficient {
         let _ = writeln!(
             s,

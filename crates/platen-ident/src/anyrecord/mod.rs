@@ -529,14 +529,7 @@ fn compare_fits(
         let (Some(a), Some(b)) = (p.estimate(), oe.get(key).estimate()) else {
             continue;
         };
-        let diff = (a.value - b.value).abs();
-        let scale = if key == IdentifiedKey::ViscousExponent {
-            1.0
-        } else {
-            a.value.abs().max(b.value.abs()).max(f64::MIN_POSITIVE)
-        };
-        let combined = (a.std_error.powi(2) + b.std_error.powi(2)).sqrt();
-        if diff > 3.0 * combined && diff > fit_agreement(key) * scale {
+        if crate::estimate::fits_disagree(key, a, b, fit_agreement(key)) {
             warnings.push(RecordWarning::FitsDisagree {
                 key,
                 equation_error: a.value,
