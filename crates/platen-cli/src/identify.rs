@@ -219,9 +219,7 @@ fn run_periodic(
     if opts.json {
         let output = JsonOutput {
             summary: summary(&id, inputs),
-            figures: opts
-                .plot
-                .map(|_| written.iter().map(|p| p.display().to_string()).collect()),
+            figures: figure_list(opts, &written),
             report: opts.report.map(|path| path.display().to_string()),
         };
         // Through a `Value`, whose maps sort their keys at every level.
@@ -232,6 +230,12 @@ fn run_periodic(
         print_written(&written, opts.report)?;
     }
     Ok(())
+}
+
+/// The figure files written, for `--json` (absent without `--plot`).
+fn figure_list(opts: &Options, written: &[PathBuf]) -> Option<Vec<String>> {
+    opts.plot
+        .map(|_| written.iter().map(|p| p.display().to_string()).collect())
 }
 
 fn print_written(written: &[PathBuf], report: Option<&Path>) -> Result<()> {
@@ -328,9 +332,7 @@ fn run_records(
             summary: RecordSummary::new(&id, &files),
             method: method_name,
             periodic: periodic.as_ref().map(|p| summary(p, &per_owned)),
-            figures: opts
-                .plot
-                .map(|_| written.iter().map(|p| p.display().to_string()).collect()),
+            figures: figure_list(opts, &written),
             report: opts.report.map(|path| path.display().to_string()),
         };
         let value = serde_json::to_value(&output)?;

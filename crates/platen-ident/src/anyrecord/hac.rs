@@ -117,12 +117,7 @@ pub(crate) fn covariance(
     let bread = DMatrix::from_fn(m, m, |i, j| jtj[(i, j)] / (scale[i] * scale[j]));
     let eig = SymmetricEigen::new(bread);
     let max_ev = eig.eigenvalues.max();
-    let min_ev = eig.eigenvalues.min();
-    let condition = if min_ev > 0.0 {
-        max_ev / min_ev
-    } else {
-        f64::INFINITY
-    };
+    let condition = crate::lm::condition_number(&eig);
     let mut singular: Vec<bool> = (0..m).map(|k| jtj[(k, k)] <= 0.0).collect();
     let mut inv = DMatrix::zeros(m, m);
     for e in 0..m {
