@@ -11,7 +11,7 @@ fn platen(args: &[&str]) -> Output {
 }
 
 fn workspace() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
 fn scenario(name: &str) -> String {

@@ -41,7 +41,7 @@ fn every_shipped_scenario_validates_against_the_schema() {
     let (schemas, index) = compile(schema());
     let mut files = Vec::new();
     all_scenarios(
-        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios"),
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios"),
         &mut files,
     );
     assert!(files.len() > 80, "{} scenarios", files.len());
