@@ -30,7 +30,10 @@ fn all_scenarios(dir: &Path, out: &mut Vec<PathBuf>) {
         let p = e.unwrap().path();
         if p.is_dir() {
             all_scenarios(&p, out);
-        } else if p.extension().is_some_and(|x| x == "json") {
+        } else if p.extension().is_some_and(|x| x == "json")
+            // `platen identify`'s manifest of the paper's programme, not a scenario.
+            && p.file_name().is_some_and(|n| n != "manifest.json")
+        {
             out.push(p);
         }
     }
