@@ -2,7 +2,7 @@
 //! several steps and Dopri5 at several tolerances, on forward runs with stick phases against
 //! the independent SciPy references in `tests/data/reference/`.
 //!
-//! Run: `cargo run --release --example work_precision`. The README quotes its output.
+//! Run: `cargo run --release --example work_precision`. docs/accuracy.md quotes its output.
 
 use std::path::{Path, PathBuf};
 

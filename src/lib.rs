@@ -16,3 +16,27 @@ pub use platen_scenario::simulate;
 pub use platen_scenario::RunResult as Run;
 /// The validated scenario: [`Scenario::load`] then [`Scenario::run`] into any sink.
 pub use platen_scenario::Scenario;
+
+/// The pages under `docs/`, so that `cargo test --doc` compiles and runs their Rust examples
+/// as it does the README's (this crate's documentation).
+#[cfg(doctest)]
+pub mod docs {
+    #[doc = include_str!("../docs/library.md")]
+    pub struct Library;
+    #[doc = include_str!("../docs/cli.md")]
+    pub struct Cli;
+    #[doc = include_str!("../docs/compare.md")]
+    pub struct Compare;
+    #[doc = include_str!("../docs/identification.md")]
+    pub struct Identification;
+    #[doc = include_str!("../docs/records-and-signals.md")]
+    pub struct RecordsAndSignals;
+    #[doc = include_str!("../docs/model.md")]
+    pub struct Model;
+    #[doc = include_str!("../docs/accuracy.md")]
+    pub struct Accuracy;
+    #[doc = include_str!("../docs/performance.md")]
+    pub struct Performance;
+    #[doc = include_str!("../docs/python.md")]
+    pub struct Python;
+}

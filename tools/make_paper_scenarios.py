@@ -4,7 +4,8 @@ and II, as inverse scenarios (prescribed motion -> actuator force), at the three
 pressures the paper used (0, 6.9, 13.8 MPa).
 
 Run from the repository root: python3 tools/make_paper_scenarios.py
-The output is deterministic; the JSON files are committed.
+The output is deterministic; the JSON files are committed. manifest.json lists the 72 tests for
+`platen identify --manifest scenarios/paper-tests/manifest.json` (the paper's identification).
 
 Choices where the paper is silent (stated in each description):
 * S1-S3 (low-velocity sines, 1.0, 1.5, 2.5 cm/s peak) are at 0.1 Hz, which keeps their peak
@@ -96,6 +97,22 @@ def main():
                 }},
                 "duration_s": round(cycles * period, 9),
             })
+    write_manifest(root)
+
+
+def write_manifest(root):
+    """scenarios/paper-tests/manifest.json: the whole programme for `platen identify --manifest`.
+    Each entry names a scenario whose recorded-like data identify makes in memory (as
+    `platen generate recorded --seed N` would write them), each test with its own noise seed;
+    the hold-down pressure is the scenario's."""
+    entries = []
+    for folder, _ in PRESSURES:
+        for name in [s[0] for s in SINES] + [t[0] for t in TRIANGLES]:
+            entries.append(json.dumps({
+                "scenario": f"{folder}/{name}.json", "seed": len(entries) + 1, "name": f"{name}@{folder}",
+            }))
+    with open(os.path.join(root, "manifest.json"), "w") as f:
+        f.write('{\n  "tests": [\n    ' + ",\n    ".join(entries) + "\n  ]\n}\n")
 
 
 if __name__ == "__main__":

@@ -26,8 +26,10 @@ pub const PRESSURE_PA: f64 = 13.8e6;
 
 /// A sine force of `amplitude_n` at 0.5 Hz, sampled at 1024 Hz for `seconds`, from `t = 0`.
 ///
-/// * 600 kN (the workload of `platen bench` and the issue): the platen breaks away within
-///   0.02 s and then slips, reversing directly every half period: no stick phase.
+/// * 100 kN (the workload of `platen bench`, a table test within the LHPOST's limits:
+///   ±0.35 m, 1.09 m/s, 0.38 g): the platen breaks away from rest and then slips, reversing
+///   directly every half period: no stick phase. (600 kN, the load before issue 18, reached
+///   5.3 m, 16 m/s and 5.2 g: far past the table.)
 /// * 45 kN, just above the 37.5 kN static threshold: two stick phases per period (≈ 22 % of
 ///   the time stuck), each with a stop and a breakaway to locate.
 pub fn sine_force(amplitude_n: f64, seconds: usize) -> Vec<f64> {

@@ -51,17 +51,7 @@ pub fn run(what: What, scenario_path: &Path, out: &Path, seed: u64, json_out: bo
             }
         },
         What::Recorded => {
-            let Run::Inverse { motion } = &scenario.run else {
-                bail!(
-                    "`{}`: recorded-like data needs a motion scenario (motion_csv, sine_motion, triangle_motion, \
-                     white_noise_motion or ground_motion); this one is force-driven",
-                    scenario_path.display()
-                );
-            };
-            let rec = match &scenario.model {
-                Model::Identified(m) => recorded(m, motion, seed)?,
-                Model::Full(m) => recorded(&**m, motion, seed)?,
-            };
+            let rec = recorded_of(&scenario, scenario_path, seed)?;
             write_csv_atomic(out, &Recorded::COLUMN_NAMES, &rec.columns())?;
             report(
                 json_out,
@@ -72,6 +62,27 @@ pub fn run(what: What, scenario_path: &Path, out: &Path, seed: u64, json_out: bo
         }
     }
     Ok(())
+}
+
+/// The recorded-like data of a loaded motion scenario (`scenario_path` names it in
+/// messages): what `platen generate recorded` writes, and what `platen identify` makes of a
+/// manifest entry that names a scenario.
+pub(crate) fn recorded_of(
+    scenario: &Scenario,
+    scenario_path: &Path,
+    seed: u64,
+) -> Result<Recorded> {
+    let Run::Inverse { motion } = &scenario.run else {
+        bail!(
+            "`{}`: recorded-like data needs a motion scenario (motion_csv, sine_motion, triangle_motion, \
+             white_noise_motion or ground_motion); this one is force-driven",
+            scenario_path.display()
+        );
+    };
+    match &scenario.model {
+        Model::Identified(m) => recorded(m, motion, seed),
+        Model::Full(m) => recorded(&**m, motion, seed),
+    }
 }
 
 fn recorded<M: PlatenModel>(

@@ -22,6 +22,12 @@
 //! (`file` relative to the manifest; `kind` `sine` or `triangle`; every key but `file`
 //! optional). Files listed only in the manifest are identified too.
 //!
+//! An entry may name a motion scenario instead of a file, `{ "scenario": "13.8MPa/S9.json",
+//! "seed": 9 }`: its recorded-like data are made in memory exactly as `platen generate
+//! recorded --seed 9` writes them (the same numbers as identifying that CSV), and its
+//! hold-down pressure is the scenario's. `scenarios/paper-tests/manifest.json` lists the
+//! paper's whole programme this way.
+//!
 //! A data system's own channel names and units are mapped to platen's columns with the
 //! `columns` object of the scenario format ([`platen_scenario::columns`]): `--columns
 //! MAP.json` for every file, a manifest's top-level `columns` for the files it lists, or an
@@ -45,6 +51,8 @@ use platen_io::json::parse_json_file;
 use platen_scenario::sampling::uniform_step_s;
 
 use platen_report::{html, identify_figures, record_figures, Figure};
+
+use crate::generate;
 
 /// Options of `platen identify`.
 pub struct Options<'a> {
@@ -107,7 +115,15 @@ struct FloorSpec {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct ManifestEntry {
-    file: PathBuf,
+    /// A recorded CSV (this or `scenario`).
+    #[serde(default)]
+    file: Option<PathBuf>,
+    /// A motion scenario whose recorded-like data are identified (this or `file`).
+    #[serde(default)]
+    scenario: Option<PathBuf>,
+    /// The noise seed of a `scenario` entry's recorded-like data (default 1, as `generate`).
+    #[serde(default)]
+    seed: Option<u64>,
     #[serde(default)]
     kind: Option<KindName>,
     #[serde(default)]
@@ -144,6 +160,9 @@ struct Input {
     record: bool,
     /// The specimen's floor accelerometers.
     floors: Vec<FloorSpec>,
+    /// `Some(seed)`: `path` is a motion scenario whose recorded-like data (with this seed)
+    /// are identified, made in memory ([`generate::recorded_of`]).
+    generated_seed: Option<u64>,
 }
 
 /// Checks a `--pressure-mpa` value: finite and ≥ 0.
@@ -712,6 +731,7 @@ fn inputs(opts: &Options) -> Result<Vec<Input>> {
             columns: default_columns.clone(),
             record: false,
             floors: Vec::new(),
+            generated_seed: None,
         })
         .collect();
     if let Some(mpath) = opts.manifest {
@@ -794,10 +814,11 @@ impl<'a> ManifestReader<'a> {
                 );
             }
         }
-        let path = if entry.file.is_absolute() {
-            entry.file.clone()
+        let (given, generated_seed) = self.source(k, &entry)?;
+        let path = if given.is_absolute() {
+            given.to_path_buf()
         } else {
-            self.base.join(&entry.file)
+            self.base.join(given)
         };
         let columns = match (&entry.columns, &self.columns) {
             (Some(spec), _) => self.column_map(spec, &format!("tests[{k}].columns"))?,
@@ -838,6 +859,7 @@ impl<'a> ManifestReader<'a> {
             Some(input) => {
                 input.record = record;
                 input.floors = floors;
+                input.generated_seed = generated_seed;
                 self.merge(input, entry, kind, columns)?
             }
             None => inputs.push(Input {
@@ -853,9 +875,47 @@ impl<'a> ManifestReader<'a> {
                 columns,
                 record,
                 floors,
+                generated_seed,
             }),
         }
         Ok(())
+    }
+
+    /// Entry `k`'s source: its `file`, or its `scenario` with the seed of its recorded-like
+    /// data.
+    fn source<'e>(&self, k: usize, entry: &'e ManifestEntry) -> Result<(&'e Path, Option<u64>)> {
+        let at = |what: &str| format!("`{}`, at `tests[{k}]`: {what}", self.path.display());
+        match (&entry.file, &entry.scenario) {
+            (Some(file), None) => {
+                if entry.seed.is_some() {
+                    bail!(
+                        "{}",
+                        at("`seed` applies to a `scenario` entry, not to a `file`")
+                    );
+                }
+                Ok((file, None))
+            }
+            (None, Some(scenario)) => {
+                if entry.columns.is_some() || entry.floors.is_some() {
+                    bail!(
+                        "{}",
+                        at(
+                            "`columns` and `floors` apply to a recorded `file`; a `scenario` \
+                            entry's recorded-like data are in platen's own columns"
+                        )
+                    );
+                }
+                Ok((scenario, Some(entry.seed.unwrap_or(1))))
+            }
+            (Some(_), Some(_)) => bail!("{}", at("expected `file` or `scenario`, not both")),
+            (None, None) => bail!(
+                "{}",
+                at(
+                    "expected `file` (a recorded CSV) or `scenario` (a motion scenario whose \
+                    recorded-like data are identified)"
+                )
+            ),
+        }
     }
 
     /// Lays an entry over the command line's input of the same file.
@@ -913,6 +973,9 @@ fn floor_factor(f: &FloorSpec) -> Result<f64> {
 }
 
 fn read_record(input: &Input) -> Result<TestRecord> {
+    if let Some(seed) = input.generated_seed {
+        return generated_record(input, seed);
+    }
     let path = &input.path;
     let mut required = vec!["t_s", "u_m", "a_m_s2", "force_n"];
     required.extend(input.floors.iter().map(|f| f.column.as_str()));
@@ -952,6 +1015,50 @@ fn read_record(input: &Input) -> Result<TestRecord> {
         rec = rec.with_floors(&floors).with_context(context)?;
     }
     Ok(rec)
+}
+
+/// The recorded-like data of a manifest's `scenario` entry as a test record: the numbers
+/// `platen generate recorded` writes, so identifying them gives what identifying that CSV
+/// gives. The hold-down pressure is the scenario's (a different one in the manifest is an
+/// error: the data were made at the scenario's).
+fn generated_record(input: &Input, seed: u64) -> Result<TestRecord> {
+    let path = &input.path;
+    if !input.floors.is_empty() {
+        bail!(
+            "`{}`: a manifest's `floors` apply to recorded files; recorded-like data made from a \
+             scenario have no floor accelerometers",
+            path.display()
+        );
+    }
+    let scenario = platen_scenario::Scenario::load(path)?;
+    let pressure_pa = scenario.hold_down_pressure_pa;
+    if let Some(p) = input.pressure_mpa {
+        // The same number written twice (13.8 in both files) may differ in its last bit.
+        if (p * 1e6 - pressure_pa).abs() > 1e-9 * pressure_pa.abs().max(1.0) {
+            bail!(
+                "`{}`: hold-down pressure {p} MPa given for it, but the scenario runs at {} MPa",
+                path.display(),
+                pressure_pa / 1e6
+            );
+        }
+    }
+    let rec = generate::recorded_of(&scenario, path, seed)?;
+    let dt = uniform_step_s(path, &rec.t_s)?;
+    let context = || format!("`{}` (recorded-like, seed {seed})", path.display());
+    let mut test = TestRecord::from_rate(
+        input.name.clone(),
+        1.0 / dt,
+        rec.u_m,
+        rec.a_m_s2,
+        rec.force_n,
+    )
+    .and_then(|t| t.with_velocity(rec.v_m_s))
+    .and_then(|t| t.with_pressure_pa(pressure_pa))
+    .with_context(context)?;
+    if let Some(k) = input.kind {
+        test = test.with_kind(k);
+    }
+    Ok(test)
 }
 
 /// `value ± se` in a unit with `digits` decimals.

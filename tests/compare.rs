@@ -24,7 +24,7 @@ fn platen(args: &[&str]) -> Output {
 }
 
 fn workspace() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
 fn shipped(name: &str) -> String {

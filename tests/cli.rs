@@ -11,7 +11,7 @@ fn platen(args: &[&str]) -> Output {
 }
 
 fn workspace() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
 fn scenario(name: &str) -> String {
@@ -53,12 +53,10 @@ const CONTRACT_COLUMNS: [&str; 8] = [
     "dissipative_force_n",
 ];
 
-#[test]
-fn every_shipped_scenario_runs_and_writes_every_input_sample_with_the_contract_columns() {
-    let dir = tempfile::tempdir().unwrap();
-    let mut count = 0;
-    // The paper's periodic program (scenarios/paper-tests, 72 files) runs in
-    // tests/paper_program.rs at the workspace root; every other scenario runs here.
+/// The shipped scenarios but the paper's periodic program (scenarios/paper-tests, 72 files,
+/// run in tests/paper_program.rs): those that need a PEER record (a `ground_motion`) and the
+/// others.
+fn shipped_scenarios() -> (Vec<PathBuf>, Vec<PathBuf>) {
     let mut paths = Vec::new();
     for entry in std::fs::read_dir(workspace().join("scenarios")).unwrap() {
         let path = entry.unwrap().path();
@@ -68,69 +66,104 @@ fn every_shipped_scenario_runs_and_writes_every_input_sample_with_the_contract_c
             paths.push(path);
         }
     }
+    paths.retain(|p| p.extension().is_some_and(|e| e == "json"));
     paths.sort();
-    for path in paths {
-        if path.extension().is_none_or(|e| e != "json") {
-            continue;
-        }
-        count += 1;
-        let out = dir.path().join("out.csv");
-        let o = platen(&[
-            "simulate",
-            path.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--json",
-        ]);
-        let needs_records = std::fs::read_to_string(&path)
+    paths.into_iter().partition(|p| {
+        std::fs::read_to_string(p)
             .unwrap()
-            .contains("ground_motion");
-        if needs_records && std::env::var_os("PLATEN_RECORDS_DIR").is_none() {
-            // Without the records the run must fail cleanly and say where to get them.
-            assert_eq!(o.status.code(), Some(3), "{}", path.display());
-            assert!(stderr(&o).contains("PLATEN_RECORDS_DIR"), "{}", stderr(&o));
-            eprintln!(
-                "SKIPPED {}: set PLATEN_RECORDS_DIR to run it",
-                path.display()
-            );
-            continue;
-        }
-        assert!(o.status.success(), "{}: {}", path.display(), stderr(&o));
-        let summary: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-        let (header, rows) = read_csv(&out);
-        assert_eq!(header, CONTRACT_COLUMNS, "{}", path.display());
-        assert_eq!(rows.len() as u64, summary["samples"].as_u64().unwrap());
-        // Sample times are uniform and start at 0 for every shipped scenario.
-        assert_eq!(rows[0][0], 0.0);
-        for key in [
-            "peak_u_m",
-            "peak_v_m_s",
-            "peak_a_m_s2",
-            "peak_force_n",
-            "limit_exceedances",
-            "direction",
-        ] {
-            assert!(
-                summary.get(key).is_some(),
-                "{}: summary lacks {key}",
-                path.display()
-            );
-        }
-        // Every forward run closes its energy balance: the residual is integration error only
-        // (measured <= 2e-12 relative for RK4 at the record's rate, <= 2e-14 for Dopri5).
-        if summary["direction"] == "forward" {
-            let rel = summary["energy"]["relative_residual"].as_f64().unwrap();
-            assert!(
-                rel.abs() < 1e-9,
-                "{}: energy residual {rel}",
-                path.display()
-            );
-        }
+            .contains("ground_motion")
+    })
+}
+
+/// Runs a shipped scenario with `--out` and `--json` and checks what it wrote.
+fn check_shipped_scenario_run(path: &Path, dir: &Path) {
+    let out = dir.join("out.csv");
+    let o = platen(&[
+        "simulate",
+        path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}: {}", path.display(), stderr(&o));
+    let summary: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let (header, rows) = read_csv(&out);
+    assert_eq!(header, CONTRACT_COLUMNS, "{}", path.display());
+    assert_eq!(rows.len() as u64, summary["samples"].as_u64().unwrap());
+    // Sample times are uniform and start at 0 for every shipped scenario.
+    assert_eq!(rows[0][0], 0.0);
+    for key in [
+        "peak_u_m",
+        "peak_v_m_s",
+        "peak_a_m_s2",
+        "peak_force_n",
+        "limit_exceedances",
+        "direction",
+    ] {
+        assert!(
+            summary.get(key).is_some(),
+            "{}: summary lacks {key}",
+            path.display()
+        );
     }
+    // Every forward run closes its energy balance: the residual is integration error only
+    // (measured <= 2e-12 relative for RK4 at the record's rate, <= 2e-14 for Dopri5).
+    if summary["direction"] == "forward" {
+        let rel = summary["energy"]["relative_residual"].as_f64().unwrap();
+        assert!(
+            rel.abs() < 1e-9,
+            "{}: energy residual {rel}",
+            path.display()
+        );
+    }
+}
+
+#[test]
+fn every_shipped_scenario_without_a_record_runs_and_writes_every_input_sample_with_the_contract_columns(
+) {
+    let dir = tempfile::tempdir().unwrap();
+    let paths = shipped_scenarios().1;
     assert!(
-        count >= 3,
-        "expected at least three shipped scenarios, found {count}"
+        paths.len() >= 3,
+        "expected at least three shipped scenarios, found {}",
+        paths.len()
     );
+    for path in paths {
+        check_shipped_scenario_run(&path, dir.path());
+    }
+}
+
+#[test]
+#[cfg_attr(
+    not(platen_records),
+    ignore = "needs PLATEN_RECORDS_DIR: a folder of PEER NGA records"
+)]
+fn every_shipped_record_scenario_runs_and_writes_every_input_sample_with_the_contract_columns() {
+    let dir = tempfile::tempdir().unwrap();
+    let paths = shipped_scenarios().0;
+    assert!(paths.len() >= 2, "{paths:?}");
+    for path in paths {
+        check_shipped_scenario_run(&path, dir.path());
+    }
+}
+
+/// Without the records a scenario that needs one stops cleanly, says where to get them and
+/// writes nothing (the child runs without `PLATEN_RECORDS_DIR` whether or not it is set here).
+#[test]
+fn without_the_records_a_record_scenario_stops_with_exit_3_naming_platen_records_dir() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.csv");
+    for path in shipped_scenarios().0 {
+        let o = Command::new(env!("CARGO_BIN_EXE_platen"))
+            .args(["simulate", path.to_str().unwrap(), "--out"])
+            .arg(&out)
+            .env_remove("PLATEN_RECORDS_DIR")
+            .output()
+            .expect("run platen");
+        assert_eq!(o.status.code(), Some(3), "{}", path.display());
+        assert!(stderr(&o).contains("PLATEN_RECORDS_DIR"), "{}", stderr(&o));
+        assert!(!out.exists(), "{}", path.display());
+    }
 }
 
 #[test]
@@ -516,11 +549,11 @@ fn bad_dopri5_tolerances_name_their_json_path() {
 /// 1.7794 g peak sample, where the line has dropped by 291 m/s³ × 0.35 ms = 0.1 m/s²
 /// (0.0104 g): the peak acceleration is checked to 0.015 g.
 #[test]
+#[cfg_attr(
+    not(platen_records),
+    ignore = "needs PLATEN_RECORDS_DIR: a folder holding RSN1087_NORTHR_TAR090.AT2"
+)]
 fn the_tarzana_scenario_runs_from_the_real_record_within_the_table_limits() {
-    if std::env::var_os("PLATEN_RECORDS_DIR").is_none() {
-        eprintln!("SKIPPED: set PLATEN_RECORDS_DIR to a folder holding RSN1087_NORTHR_TAR090.AT2");
-        return;
-    }
     let o = platen(&[
         "simulate",
         &scenario("northridge-tarzana-100.json"),

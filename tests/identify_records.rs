@@ -15,7 +15,7 @@ fn platen(args: &[&str]) -> Output {
 }
 
 fn data() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/any-record")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/any-record")
 }
 
 /// A copy of a lab file in `dir` with its time stamps printed exactly (`k/204.8` in full),
