@@ -327,8 +327,12 @@ pub(crate) fn significant(v: f64, digits: i32) -> String {
     let magnitude = v.abs().log10().floor() as i32;
     let decimals = (digits - 1 - magnitude).max(0) as usize;
     // Digits left of the point beyond `digits` are rounded away (792 156 → 792 200).
-    let f = 10f64.powi((magnitude + 1 - digits).max(0));
-    let v = (v / f).round() * f;
+    let v = if magnitude >= digits {
+        let f = 10f64.powi(magnitude + 1 - digits);
+        (v / f).round() * f
+    } else {
+        v
+    };
     let mut s = format!("{v:.decimals$}");
     if s.contains('.') {
         while s.ends_with('0') && !s.ends_with(".0") {
