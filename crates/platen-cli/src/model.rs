@@ -105,7 +105,12 @@ const IDENTIFIED: &[Row] = &[
         "stiffness (hold-down struts)",
         Unit::MeganewtonPerMetre,
     ),
-    ("coulomb_force_n", "F_μ", "Coulomb friction force", Unit::Kilonewton),
+    (
+        "coulomb_force_n",
+        "F_μ",
+        "Coulomb friction force",
+        Unit::Kilonewton,
+    ),
     (
         "viscous_coefficient",
         "Cₑ",
@@ -219,7 +224,12 @@ const PHYSICAL: &[Row] = &[
         "nitrogen pre-charge pressure",
         Unit::Megapascal,
     ),
-    ("strut_area_m2", "A", "strut chamber area", Unit::SquareMetre),
+    (
+        "strut_area_m2",
+        "A",
+        "strut chamber area",
+        Unit::SquareMetre,
+    ),
     (
         "gas_heat_capacity_ratio",
         "γ",

@@ -115,7 +115,10 @@ fn model_text_values_are_aligned_on_the_decimal_point() {
             l[..byte].chars().count()
         })
         .collect();
-    assert!(columns.windows(2).all(|w| w[0] == w[1]), "{columns:?}\n{text}");
+    assert!(
+        columns.windows(2).all(|w| w[0] == w[1]),
+        "{columns:?}\n{text}"
+    );
 }
 
 /// `--json` is still the contract's object: the seven keys and the derived quantities in SI.
@@ -125,4 +128,81 @@ fn model_json_is_unchanged_by_the_text_form() {
     let m: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let want = platen_scenario::describe_model(Preset::Lhpost2008, 13.8e6, false).unwrap();
     assert_eq!(m, want);
+}
+
+/// The verbs of the contract.
+const VERBS: [&str; 8] = [
+    "simulate", "compare", "identify", "model", "generate", "bench", "schema", "sweep",
+];
+
+/// `platen --help` lists each verb on one line of at most 100 characters, and no line of the
+/// list continues the one before (a continuation would start with more than two spaces).
+#[test]
+fn the_verb_list_has_one_short_line_per_verb() {
+    let o = platen(&["--help"]);
+    assert!(o.status.success());
+    let help = stdout(&o);
+    let list: Vec<&str> = help
+        .lines()
+        .skip_while(|l| !l.starts_with("Commands:"))
+        .skip(1)
+        .take_while(|l| !l.trim().is_empty())
+        .collect();
+    for verb in VERBS {
+        let lines: Vec<&&str> = list
+            .iter()
+            .filter(|l| l.trim_start().starts_with(&format!("{verb} ")))
+            .collect();
+        assert_eq!(lines.len(), 1, "{verb}:\n{help}");
+        assert!(lines[0].chars().count() <= 100, "{}", lines[0]);
+    }
+    for l in &list {
+        let first = l.trim_start().split_whitespace().next().unwrap();
+        assert!(
+            VERBS.contains(&first) || first == "help",
+            "a line that is not a verb: {l:?}\n{help}"
+        );
+    }
+}
+
+/// Each verb's help, short and long, ends with examples that name the verb.
+#[test]
+fn each_verbs_help_ends_with_examples() {
+    for verb in VERBS {
+        for flag in ["-h", "--help"] {
+            let o = platen(&[verb, flag]);
+            assert!(o.status.success(), "{verb} {flag}");
+            let help = stdout(&o);
+            let at = help
+                .find("\nExample")
+                .unwrap_or_else(|| panic!("{verb} {flag}: no example in\n{help}"));
+            let examples = &help[at..];
+            assert!(
+                examples.contains(&format!("platen {verb} "))
+                    || examples.contains(&format!("platen {verb}\n")),
+                "{verb} {flag}:\n{examples}"
+            );
+            // The examples are the last thing printed.
+            assert!(!examples.contains("Options:"), "{verb} {flag}:\n{help}");
+        }
+    }
+}
+
+/// Every shipped file an example names exists (a renamed scenario breaks this test, not a
+/// user's first try).
+#[test]
+fn the_examples_name_shipped_files() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let mut named = 0;
+    for verb in VERBS {
+        let help = stdout(&platen(&[verb, "--help"]));
+        for word in help
+            .split_whitespace()
+            .filter(|w| w.starts_with("scenarios/"))
+        {
+            assert!(root.join(word).is_file(), "{verb} --help names {word}");
+            named += 1;
+        }
+    }
+    assert!(named >= 8, "only {named} shipped files named");
 }
