@@ -2,6 +2,9 @@
 //!
 //! Exit codes: 0 success, 2 usage error, 3 input error (a file, scenario or parameter that
 //! cannot be used), 4 numerical failure, 5 I/O error while writing output.
+//!
+//! Errors go to stderr as `error: MESSAGE`; with `--json`, as one JSON object instead (see
+//! [`error_json`]).
 
 #![recursion_limit = "256"]
 
@@ -24,6 +27,7 @@ macro_rules! out {
 
 mod bench;
 mod compare;
+mod error_json;
 mod generate;
 mod identify;
 mod model;
@@ -290,13 +294,54 @@ pub(crate) enum Form {
 }
 
 fn main() -> ExitCode {
-    match run(Cli::parse().command) {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // With --json a usage error is a JSON error object too; help and version print as
+        // usual.
+        Err(e) if e.use_stderr() && std::env::args_os().any(|a| a == "--json") => {
+            let rendered = e.to_string();
+            let message = rendered
+                .lines()
+                .take_while(|l| !l.starts_with("Usage:"))
+                .map(str::trim)
+                .filter(|l| !l.is_empty())
+                .collect::<Vec<_>>()
+                .join(" ");
+            let message = message.strip_prefix("error: ").unwrap_or(&message);
+            eprintln!("{}", error_json::usage(message));
+            return ExitCode::from(2);
+        }
+        Err(e) => e.exit(),
+    };
+    let json = cli.command.wants_json();
+    match run(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
         // The reader of standard output went away (`| head`): stop quietly, as filters do.
         Err(e) if e.chain().any(|c| c.is::<ClosedPipe>()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::from(exit_code(&e))
+            let code = exit_code(&e);
+            if json {
+                eprintln!("{}", error_json::object(&e, code));
+            } else {
+                eprintln!("error: {e:#}");
+            }
+            ExitCode::from(code)
+        }
+    }
+}
+
+impl Command {
+    /// Whether the verb was asked for machine-readable output (`--json`).
+    fn wants_json(&self) -> bool {
+        match self {
+            Command::Simulate { json, .. }
+            | Command::Compare { json, .. }
+            | Command::Model { json, .. }
+            | Command::Bench { json, .. }
+            | Command::Generate { json, .. }
+            | Command::Sweep { json, .. }
+            | Command::Identify { json, .. } => *json,
+            Command::Schema { .. } => false,
         }
     }
 }
