@@ -75,7 +75,7 @@ impl Unit {
             Unit::Meganewton => (v / 1e6, "MN".into()),
             Unit::KilonewtonPerVelocityTo(key) => {
                 let unit = match section.get(key).and_then(Value::as_f64) {
-                    Some(e) if e == 1.0 => "kN·s/m".to_string(),
+                    Some(1.0) => "kN·s/m".to_string(),
                     Some(e) => format!("kN/(m/s)^{e}"),
                     None => "kN/(m/s)^α".to_string(),
                 };

@@ -547,7 +547,16 @@ fn error_messages_name_the_field_once_and_say_what_is_wrong() {
 /// line), with the same exit code as without; usage errors too.
 #[test]
 fn with_json_errors_are_json_objects_on_stderr() {
-    let cases: [(&str, String, &[&str], i32, &str, Option<&str>); 4] = [
+    /// What, scenario, extra arguments, exit code, error kind, field named.
+    type JsonCase<'a> = (
+        &'a str,
+        String,
+        &'a [&'a str],
+        i32,
+        &'a str,
+        Option<&'a str>,
+    );
+    let cases: [JsonCase; 4] = [
         (
             "a wrong type",
             force_scenario(r#", "integrator": {"method": "rk4", "step_s": "fast"}"#),
