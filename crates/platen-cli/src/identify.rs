@@ -647,12 +647,17 @@ fn rows(params: &platen_ident::ParameterEstimates) -> Vec<Vec<String>> {
         .map(|(key, p)| {
             let (unit, scale, d) = display_unit(key);
             let (value, se, ci, status) = match p {
-                Parameter::Estimated(e) => (
-                    format!("{:.d$}", e.value / scale),
-                    format!("{:.d$}", e.std_error / scale, d = d + 1),
-                    format!("{:.d$} – {:.d$}", e.ci95_low / scale, e.ci95_high / scale),
-                    "estimated".to_owned(),
-                ),
+                Parameter::Estimated(e) => {
+                    // The decimals of the text's `value ± se`: the value, its standard error
+                    // and interval alike.
+                    let d = decimals(e, scale, d);
+                    (
+                        format!("{:.d$}", e.value / scale),
+                        format!("{:.d$}", e.std_error / scale),
+                        format!("{:.d$} – {:.d$}", e.ci95_low / scale, e.ci95_high / scale),
+                        "estimated".to_owned(),
+                    )
+                }
                 Parameter::Fixed { value, reason } => (
                     format!("{:.d$}", value / scale),
                     "—".into(),
