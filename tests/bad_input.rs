@@ -437,3 +437,190 @@ fn every_malformed_input_fails_cleanly_with_its_location_and_writes_nothing() {
         );
     }
 }
+
+/// Runs `simulate` on `scenario` (with a good force record beside it) and returns the exit
+/// code and stderr; `extra` arguments follow.
+fn simulate_bad(scenario: &str, extra: &[&str]) -> (Option<i32>, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let sc = dir.path().join("bad.json");
+    std::fs::write(&sc, scenario).unwrap();
+    std::fs::write(dir.path().join("f.csv"), good_force()).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_platen"))
+        .args(["simulate", "bad.json"])
+        .args(extra)
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    (
+        o.status.code(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// The messages read as sentences: the innermost field of a type error, a file that ends
+/// early said so with its line, the field and value said once, a missing output folder
+/// named as such.
+#[test]
+fn error_messages_name_the_field_once_and_say_what_is_wrong() {
+    for (what, scenario, extra, want, not) in [
+        (
+            "a string step",
+            force_scenario(",\n \"integrator\": {\"method\": \"rk4\",\n  \"step_s\": \"fast\"}"),
+            &[][..],
+            &[
+                "`bad.json`: integrator.step_s (line 3",
+                "\"fast\", expected a number",
+            ][..],
+            &["integrator (line"][..],
+        ),
+        (
+            "a string frequency in a generated motion",
+            motion_scenario(r#"{"sine_motion": {"amplitude_m": 0.1, "frequency_hz": "1 Hz"}}"#),
+            &[],
+            &["excitation.sine_motion.frequency_hz (line 1"],
+            &[],
+        ),
+        (
+            "a list where a number belongs",
+            force_scenario(r#", "initial": {"u_m": [0]}"#),
+            &[],
+            &["initial.u_m (line 1", "sequence, expected a number"],
+            &[],
+        ),
+        (
+            "a file cut off",
+            "{\n  \"model\": {\"preset\": \"lhpost-2008\"},\n".to_owned(),
+            &[],
+            &["`bad.json`: line 3: the file ends before the JSON is complete"],
+            &["?", "EOF"],
+        ),
+        (
+            "an empty file",
+            String::new(),
+            &[],
+            &["`bad.json`: line 1: the file is empty"],
+            &["EOF"],
+        ),
+        (
+            "a step that does not divide the interval",
+            force_scenario(r#", "integrator": {"method": "rk4", "step_s": 0.0007}"#),
+            &[],
+            &["integrator.step_s = 0.0007: expected a step that divides the sample interval"],
+            &["expected step_s"],
+        ),
+        (
+            "a zero step",
+            force_scenario(r#", "integrator": {"method": "rk4", "step_s": 0}"#),
+            &[],
+            &["integrator.step_s = 0: expected a finite step > 0 s"],
+            &["is invalid: expected"],
+        ),
+        (
+            "a huge step",
+            force_scenario(r#", "integrator": {"method": "rk4", "step_s": 1e300}"#),
+            &[],
+            &["integrator.step_s = 1e300: expected"],
+            &["000000000000"],
+        ),
+    ] {
+        let (code, err) = simulate_bad(&scenario, extra);
+        assert_eq!(code, Some(3), "{what}: {err}");
+        for w in want {
+            assert!(err.contains(w), "{what}: no {w:?} in {err}");
+        }
+        for n in not {
+            assert!(!err.contains(n), "{what}: {n:?} in {err}");
+        }
+        assert!(err.matches("expected").count() <= 1, "{what}: {err}");
+    }
+    // The output's folder is missing: exit 5 as before, and the message says so.
+    let (code, err) = simulate_bad(&force_scenario(""), &["--out", "no-such-folder/out.csv"]);
+    assert_eq!(code, Some(5), "{err}");
+    assert!(
+        err.contains("the output folder `no-such-folder` does not exist"),
+        "{err}"
+    );
+    assert!(!err.contains("temporary"), "{err}");
+}
+
+/// With `--json` an error is one JSON object on stderr (kind, exit code, message, file, field,
+/// line), with the same exit code as without; usage errors too.
+#[test]
+fn with_json_errors_are_json_objects_on_stderr() {
+    /// What, scenario, extra arguments, exit code, error kind, field named.
+    type JsonCase<'a> = (
+        &'a str,
+        String,
+        &'a [&'a str],
+        i32,
+        &'a str,
+        Option<&'a str>,
+    );
+    let cases: [JsonCase; 4] = [
+        (
+            "a wrong type",
+            force_scenario(r#", "integrator": {"method": "rk4", "step_s": "fast"}"#),
+            &[],
+            3,
+            "input",
+            Some("integrator.step_s"),
+        ),
+        (
+            "an impossible value",
+            force_scenario(r#", "integrator": {"method": "rk4", "step_s": 0}"#),
+            &[],
+            3,
+            "input",
+            Some("integrator.step_s"),
+        ),
+        (
+            "a missing output folder",
+            force_scenario(""),
+            &["--out", "nowhere/out.csv"],
+            5,
+            "output",
+            None,
+        ),
+        (
+            "an unknown flag",
+            force_scenario(""),
+            &["--colour"],
+            2,
+            "usage",
+            None,
+        ),
+    ];
+    for (what, scenario, extra, code, kind, field) in cases {
+        let (plain_code, _) = simulate_bad(&scenario, extra);
+        let mut args = extra.to_vec();
+        args.push("--json");
+        let (json_code, err) = simulate_bad(&scenario, &args);
+        assert_eq!(plain_code, Some(code), "{what}");
+        assert_eq!(json_code, Some(code), "{what}: {err}");
+        let v: serde_json::Value = serde_json::from_str(err.trim())
+            .unwrap_or_else(|e| panic!("{what}: stderr is not JSON ({e}): {err}"));
+        let e = &v["error"];
+        assert_eq!(e["kind"], kind, "{what}: {v}");
+        assert_eq!(e["exit_code"], code, "{what}: {v}");
+        assert!(
+            e["message"].as_str().is_some_and(|m| !m.is_empty()),
+            "{what}: {v}"
+        );
+        if let Some(field) = field {
+            assert!(
+                e["field"].as_str().unwrap().starts_with(field),
+                "{what}: {v}"
+            );
+            assert!(
+                e["file"].as_str().unwrap().ends_with("bad.json"),
+                "{what}: {v}"
+            );
+        }
+        if kind == "output" {
+            assert!(
+                e["file"].as_str().unwrap().ends_with("out.csv"),
+                "{what}: {v}"
+            );
+        }
+    }
+}

@@ -390,8 +390,8 @@ fn record_report(id: &RecordIdentification, inputs: &[&Input]) -> String {
     let ee = &id.equation_error;
     let _ = writeln!(
         s,
-        "Identified parameters from {} record(s) (any-record method: equation error, {} samples faster than {} mm/s; RMS force residual {:.0} N)",
-        id.records.len(),
+        "Identified parameters from {} (any-record method: equation error, {} samples faster than {} mm/s; RMS force residual {:.0} N)",
+        count(id.records.len(), "record"),
         ee.points,
         1e3 * ee.min_speed_m_s,
         ee.rms_residual_n
@@ -400,7 +400,7 @@ fn record_report(id: &RecordIdentification, inputs: &[&Input]) -> String {
     let u = &ee.uncertainty;
     let _ = writeln!(
         s,
-        "  (95 % intervals: batch-means sandwich over blocks of {} samples, t = {:.3}; residuals worth {:.0} independent samples)",
+        "  (± one standard error; 95 % intervals: batch-means sandwich over blocks of {} samples, t = {:.3}; residuals worth {:.0} independent samples)",
         u.bandwidth_samples, u.critical_value, u.effective_samples
     );
     let _ = writeln!(s, "\nRecords");
@@ -477,7 +477,7 @@ fn parameter_lines(s: &mut String, params: &platen_ident::ParameterEstimates) {
                 pm(Some(e), scale, digits),
                 e.ci95_low / scale,
                 e.ci95_high / scale,
-                d = digits
+                d = decimals(e, scale, digits)
             ),
             Parameter::Fixed { value, reason } => {
                 format!(
@@ -666,12 +666,17 @@ fn rows(params: &platen_ident::ParameterEstimates) -> Vec<Vec<String>> {
         .map(|(key, p)| {
             let (unit, scale, d) = display_unit(key);
             let (value, se, ci, status) = match p {
-                Parameter::Estimated(e) => (
-                    format!("{:.d$}", e.value / scale),
-                    format!("{:.d$}", e.std_error / scale, d = d + 1),
-                    format!("{:.d$} – {:.d$}", e.ci95_low / scale, e.ci95_high / scale),
-                    "estimated".to_owned(),
-                ),
+                Parameter::Estimated(e) => {
+                    // The decimals of the text's `value ± se`: the value, its standard error
+                    // and interval alike.
+                    let d = decimals(e, scale, d);
+                    (
+                        format!("{:.d$}", e.value / scale),
+                        format!("{:.d$}", e.std_error / scale),
+                        format!("{:.d$} – {:.d$}", e.ci95_low / scale, e.ci95_high / scale),
+                        "estimated".to_owned(),
+                    )
+                }
                 Parameter::Fixed { value, reason } => (
                     format!("{:.d$}", value / scale),
                     "—".into(),
@@ -1061,17 +1066,41 @@ fn generated_record(input: &Input, seed: u64) -> Result<TestRecord> {
     Ok(test)
 }
 
-/// `value ± se` in a unit with `digits` decimals.
+/// `value ± se` in a unit, `se` one standard error (the same quantity wherever a `±` is
+/// printed), with at least `digits` decimals and more when needed to show the standard
+/// error's first two significant digits (see [`decimals`]).
 fn pm(e: Option<&Estimate>, scale: f64, digits: usize) -> String {
     match e {
         Some(e) if e.std_error.is_finite() => format!(
             "{:.d$} ± {:.d$}",
             e.value / scale,
             e.std_error / scale,
-            d = digits
+            d = decimals(e, scale, digits)
         ),
         Some(e) => format!("{:.d$}", e.value / scale, d = digits),
         None => "—".to_owned(),
+    }
+}
+
+/// Decimals to print `e` with in a unit of `scale`: `digits`, or enough to show the first
+/// significant digit of a standard error smaller than that (never `± 0.00`), at most six
+/// more.
+fn decimals(e: &Estimate, scale: f64, digits: usize) -> usize {
+    let se = (e.std_error / scale).abs();
+    if se > 0.0 && se.is_finite() {
+        let needed = -(se.log10().floor() as i64);
+        (needed.max(digits as i64) as usize).min(digits + 6)
+    } else {
+        digits
+    }
+}
+
+/// `n` and `noun`, plural unless `n` is 1 ("1 test", "24 tests").
+fn count(n: usize, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
     }
 }
 
@@ -1119,8 +1148,8 @@ fn report(id: &Identification, inputs: &[Input]) -> String {
 fn report_parameters(s: &mut String, id: &Identification) {
     let _ = writeln!(
         s,
-        "Identified parameters ({} tests; {})",
-        id.tests.len(),
+        "Identified parameters ({}; {}; ± one standard error)",
+        count(id.tests.len(), "test"),
         match id.reference_pressure_pa {
             Some(p) => format!("reference hold-down pressure {} MPa", p / 1e6),
             None => "hold-down pressure not given".to_owned(),
@@ -1220,22 +1249,20 @@ fn report_pressures(s: &mut String, id: &Identification) {
     let _ = writeln!(s, "\nPer hold-down pressure");
     let _ = writeln!(
         s,
-        "  {:>5} {:>10} {:>22} {:>18} {:>14} {:>14}",
-        "MPa", "F_z MN", "Kₑ MN/m", "F_μ kN", "F_μ S (Eq.21)", "F_μ T (Eq.21)"
+        "  {:>5} {:>10} {:>22} {:>18} {:>18} {:>18}",
+        "MPa", "F_z MN", "Kₑ MN/m", "F_μ kN", "F_μ S kN (Eq.21)", "F_μ T kN (Eq.21)"
     );
     for g in &id.pressures {
         let _ = writeln!(
             s,
-            "  {:>5} {:>10} {:>22} {:>18} {:>14} {:>14}",
+            "  {:>5} {:>10} {:>22} {:>18} {:>18} {:>18}",
             pressure_text(g.pressure_pa),
             g.vertical_force_n
                 .map_or("—".to_owned(), |f| format!("{:.3}", f / 1e6)),
             pm(g.stiffness.as_ref(), 1e6, 4),
             pm(g.coulomb_force.as_ref(), 1e3, 2),
-            g.paper_coulomb_force_sine
-                .map_or("—".to_owned(), |e| format!("{:.2}", e.value / 1e3)),
-            g.paper_coulomb_force_triangle
-                .map_or("—".to_owned(), |e| format!("{:.2}", e.value / 1e3)),
+            pm(g.paper_coulomb_force_sine.as_ref(), 1e3, 2),
+            pm(g.paper_coulomb_force_triangle.as_ref(), 1e3, 2),
         );
     }
 }

@@ -2,6 +2,9 @@
 //!
 //! Exit codes: 0 success, 2 usage error, 3 input error (a file, scenario or parameter that
 //! cannot be used), 4 numerical failure, 5 I/O error while writing output.
+//!
+//! Errors go to stderr as `error: MESSAGE`; with `--json`, as one JSON object instead (see
+//! [`error_json`]).
 
 #![recursion_limit = "256"]
 
@@ -24,6 +27,7 @@ macro_rules! out {
 
 mod bench;
 mod compare;
+mod error_json;
 mod generate;
 mod identify;
 mod model;
@@ -56,6 +60,9 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Run a scenario: forward (force → motion) or inverse (motion → force).
+    #[command(after_help = "Examples:\n  \
+        platen simulate scenarios/paper-forward-force.json --out forward.csv\n  \
+        platen simulate scenarios/s9-sine-motion.json --json")]
     Simulate {
         /// Scenario JSON file.
         scenario: PathBuf,
@@ -67,10 +74,16 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Run a scenario and compare it with a recorded test: forward scenarios compare the
-    /// displacement u_m and velocity v_m_s, inverse scenarios the actuator force force_n, on
-    /// the recorded time base. Per channel: RMS error, NRMSE (normalised by the recorded RMS),
-    /// signed peaks and their ratio, correlation and lag by cross-correlation.
+    /// Run a scenario and compare it with a recorded test, channel by channel.
+    ///
+    /// Forward scenarios compare the displacement u_m and velocity v_m_s, inverse scenarios
+    /// the actuator force force_n, on the recorded time base. Per channel: RMS error, NRMSE
+    /// (normalised by the recorded RMS), signed peaks and their ratio, correlation and lag by
+    /// cross-correlation.
+    #[command(after_help = "Examples:\n  \
+        platen compare scenarios/sr9/sr9-forward.json --recorded scenarios/sr9/sr9-recorded.csv\n  \
+        platen compare scenarios/sr9/sr9-forward.json --recorded scenarios/sr9/sr9-recorded.csv \\\n      \
+        --plot figures --report sr9.html")]
     Compare {
         /// Scenario JSON file.
         scenario: PathBuf,
@@ -101,6 +114,13 @@ enum Command {
         max_lag: f64,
     },
     /// Print a preset's parameters and derived quantities.
+    ///
+    /// The text groups the simulated model's parameters, the quantities derived from the full
+    /// model (Eq. 5–8), the physical parameters and the table's limits, in engineering units;
+    /// --json prints the same in SI under the contract's keys.
+    #[command(after_help = "Examples:\n  \
+        platen model\n  \
+        platen model --form full --pressure-mpa 6.9 --json")]
     Model {
         /// Preset name.
         #[arg(long, default_value = "lhpost-2008")]
@@ -115,8 +135,13 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Time the standard workloads (forward RK4 on both model forms, Dopri5, inverse) on the
-    /// lhpost-2008 preset next to a plain-loop RK4 baseline measured in the same run.
+    /// Time the standard workloads against a baseline measured in the same run.
+    ///
+    /// The workloads are forward RK4 on both model forms, Dopri5 and the inverse, on the
+    /// lhpost-2008 preset, next to a plain-loop RK4 baseline.
+    #[command(after_help = "Examples:\n  \
+        platen bench\n  \
+        platen bench --seconds 60 --repeats 3 --json")]
     Bench {
         /// Print a machine-readable summary on stdout (keys rk4_ns_per_step, …).
         #[arg(long)]
@@ -128,14 +153,20 @@ enum Command {
         #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
         repeats: u32,
     },
-    /// Print the JSON Schema of the scenario format (point an editor at it to get completion
-    /// and checking while writing scenarios).
+    /// Print the JSON Schema of the scenario format.
+    ///
+    /// Point an editor at it to get completion and checking while writing scenarios.
+    #[command(after_help = "Example:\n  \
+        platen schema --out scenario.schema.json")]
     Schema {
         /// Write the schema to this file instead of standard output.
         #[arg(long)]
         out: Option<PathBuf>,
     },
     /// Write a scenario's excitation, or recorded-like data for a motion scenario.
+    #[command(after_help = "Examples:\n  \
+        platen generate excitation scenarios/s9-sine-motion.json --out s9-motion.csv\n  \
+        platen generate recorded scenarios/s9-sine-motion.json --seed 3 --out s9-recorded.csv")]
     Generate {
         /// What to write.
         #[arg(value_enum)]
@@ -152,7 +183,7 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Run a grid of variants of a scenario in parallel on every core, one summary row per case.
+    /// Run a grid of variants of a scenario in parallel, one summary row per case.
     ///
     /// The cases are the Cartesian product of the axes given (scale outermost, then pressure,
     /// then each --set in order, the last varying fastest); an axis not given holds the
@@ -161,6 +192,10 @@ enum Command {
     /// stderr when it is a terminal and CI is unset. Each row: case, scale,
     /// hold_down_pressure_mpa, one column per --set, peak_u_m, peak_v_m_s, peak_a_m_s2,
     /// peak_force_n (signed), stick_time_s, events, limits_exceeded, status.
+    #[command(after_help = "Examples:\n  \
+        platen sweep scenarios/paper-forward-force.json --scale 0.5,1,1.5 --pressure-mpa 0,6.9,13.8\n  \
+        platen sweep scenarios/paper-forward-force.json --set identified.coulomb_force_n=20e3,25e3 \\\n      \
+        --out cases.csv")]
     Sweep {
         /// Scenario JSON file.
         scenario: PathBuf,
@@ -182,15 +217,20 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Identify the platen's parameters from test records: periodic sine and triangle tests
-    /// by the paper's hysteresis-loop method (§3, with a global fit of Eq. 23 as a
-    /// cross-check), any other record (earthquake, white noise) by the any-record method
-    /// (equation error by separable least squares, output-error check, standard errors
-    /// robust to correlated residuals, the dissipative law with its 95 % band).
+    /// Identify the platen's parameters from test records.
+    ///
+    /// Periodic sine and triangle tests go to the paper's hysteresis-loop method (§3, with a
+    /// global fit of Eq. 23 as a cross-check), any other record (earthquake, white noise) to
+    /// the any-record method (equation error by separable least squares, output-error check,
+    /// standard errors robust to correlated residuals, the dissipative law with its 95 %
+    /// band).
     ///
     /// Each FILE is a recorded CSV with t_s, u_m, a_m_s2, force_n and optionally v_m_s
     /// (otherwise the crossover estimate is made). Which method a file goes to, and sine or
     /// triangle, is recognised from the data; file names play no part.
+    #[command(after_help = "Examples:\n  \
+        platen identify T1.csv T2.csv S4.csv S5.csv --pressure-mpa 13.8\n  \
+        platen identify --manifest tests.json --plot figures --report identify.html")]
     Identify {
         /// Recorded test CSV files.
         #[arg(required_unless_present = "manifest")]
@@ -254,13 +294,54 @@ pub(crate) enum Form {
 }
 
 fn main() -> ExitCode {
-    match run(Cli::parse().command) {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // With --json a usage error is a JSON error object too; help and version print as
+        // usual.
+        Err(e) if e.use_stderr() && std::env::args_os().any(|a| a == "--json") => {
+            let rendered = e.to_string();
+            let message = rendered
+                .lines()
+                .take_while(|l| !l.starts_with("Usage:"))
+                .map(str::trim)
+                .filter(|l| !l.is_empty())
+                .collect::<Vec<_>>()
+                .join(" ");
+            let message = message.strip_prefix("error: ").unwrap_or(&message);
+            eprintln!("{}", error_json::usage(message));
+            return ExitCode::from(2);
+        }
+        Err(e) => e.exit(),
+    };
+    let json = cli.command.wants_json();
+    match run(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
         // The reader of standard output went away (`| head`): stop quietly, as filters do.
         Err(e) if e.chain().any(|c| c.is::<ClosedPipe>()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::from(exit_code(&e))
+            let code = exit_code(&e);
+            if json {
+                eprintln!("{}", error_json::object(&e, code));
+            } else {
+                eprintln!("error: {e:#}");
+            }
+            ExitCode::from(code)
+        }
+    }
+}
+
+impl Command {
+    /// Whether the verb was asked for machine-readable output (`--json`).
+    fn wants_json(&self) -> bool {
+        match self {
+            Command::Simulate { json, .. }
+            | Command::Compare { json, .. }
+            | Command::Model { json, .. }
+            | Command::Bench { json, .. }
+            | Command::Generate { json, .. }
+            | Command::Sweep { json, .. }
+            | Command::Identify { json, .. } => *json,
+            Command::Schema { .. } => false,
         }
     }
 }

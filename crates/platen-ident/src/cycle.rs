@@ -58,9 +58,13 @@ pub struct CycleInfo {
     /// Start of the analysed cycle, s: the upward zero crossing of the displacement about its
     /// offset, so that `u > 0` over the cycle's first half.
     pub cycle_start_s: f64,
-    /// Displacement amplitude about the offset, m.
+    /// Displacement amplitude about the offset, m: half the recorded displacement's
+    /// peak-to-peak over the analysed cycle. The recorded samples, not the low-passed ones: a
+    /// triangle through the 4× fundamental low-pass loses its corners (T1: 4.81 cm low-passed
+    /// against 5.005 cm recorded); transducer noise adds its peak (tens of µm) at most.
     pub amplitude_m: f64,
-    /// Displacement offset (mid-range), m.
+    /// Displacement offset, m: the mid-range of the recorded displacement over the analysed
+    /// cycle.
     pub offset_m: f64,
     /// Fraction of the cycle at constant velocity (within 3 % of the plateau speed).
     pub plateau_fraction: f64,
@@ -401,8 +405,6 @@ fn filter(
 /// The cycle analysed and its grid, in samples of the record.
 struct CycleChoice {
     period: f64,
-    amplitude: f64,
-    offset: f64,
     full_cycles: usize,
     cycle_used: usize,
     /// Start of the cycle (first grid point).
@@ -462,8 +464,6 @@ fn choose_cycle(u4: &[f64], rate: f64, errors: &Errors) -> Result<CycleChoice> {
     };
     Ok(CycleChoice {
         period,
-        amplitude: amp4,
-        offset: mid4,
         full_cycles,
         cycle_used,
         tau: first_up + m_used as f64 * period,
@@ -473,6 +473,15 @@ fn choose_cycle(u4: &[f64], rate: f64, errors: &Errors) -> Result<CycleChoice> {
 }
 
 impl CycleChoice {
+    /// Half the peak-to-peak and the mid-range of `u` over the recorded samples of the
+    /// cycle, `τ ≤ i ≤ τ + T`.
+    fn recorded_amplitude(&self, u: &[f64]) -> (f64, f64) {
+        let first = self.tau.ceil().max(0.0) as usize;
+        let last = ((self.tau + self.period).floor() as usize).min(u.len() - 1);
+        let (lo, hi) = min_max(&u[first.min(last)..=last]);
+        (0.5 * (hi - lo), 0.5 * (hi + lo))
+    }
+
     /// `x` interpolated on the cycle's grid.
     fn on_grid(&self, x: &[f64]) -> Vec<f64> {
         (0..self.n)
@@ -635,6 +644,7 @@ pub(crate) fn analyse(
     let kind = rec.kind().unwrap_or(detected_kind);
     let (a4, g4) = inertial_channels(rec, &filtered, kind, &errors)?;
     let g_u4 = cycle.on_grid(&filtered.u4);
+    let (amplitude_m, offset_m) = cycle.recorded_amplitude(rec.u_m());
     let thd = harmonic_distortion(&g_u4);
     let mut rec_usable = usable_samples(&filtered, rate);
     // The filter's 0.5 % settling time: how far the arcs' inertial transients reach.
@@ -649,8 +659,8 @@ pub(crate) fn analyse(
         full_cycles: cycle.full_cycles,
         cycle_used: cycle.cycle_used,
         cycle_start_s: rec.start_s() + cycle.tau / rate,
-        amplitude_m: cycle.amplitude,
-        offset_m: cycle.offset,
+        amplitude_m,
+        offset_m,
         plateau_fraction,
         harmonic_distortion: thd,
         detected_kind,

@@ -143,11 +143,24 @@ pub(crate) fn fit_dissipative(
                     else {
                         break;
                     };
-                    *slot = Some(Estimate::new(
-                        f.law.coulomb_force_n,
-                        f.std_errors[law::COULOMB],
-                        f.dof,
-                    ));
+                    // One standard error everywhere: the reference pressure's `F_μ` is the
+                    // joint fit's (the top-level value and its standard error); another
+                    // pressure's carries the uncertainty of the law held from that fit too.
+                    *slot = Some(if g == reference_group {
+                        Estimate::new(
+                            fit.law.coulomb_force_n,
+                            fit.std_errors[law::COULOMB],
+                            fit.dof,
+                        )
+                    } else {
+                        let se = law::coulomb_std_error_with_held(
+                            &pts,
+                            &f.law,
+                            f.std_errors[law::COULOMB],
+                            &fit.covariance,
+                        );
+                        Estimate::new(f.law.coulomb_force_n, se, f.dof.min(fit.dof))
+                    });
                     law_g.coulomb_force_n = f.law.coulomb_force_n;
                 }
                 if g == reference_group {

@@ -15,7 +15,9 @@ pub struct Estimate {
     pub ci95_low: f64,
     /// Upper end of the 95 % confidence interval.
     pub ci95_high: f64,
-    /// Degrees of freedom behind the interval.
+    /// Effective degrees of freedom behind the interval: independent observations minus
+    /// parameters fitted, where `n` residuals correlated over `ℓ` samples count as `n/ℓ`
+    /// independent observations, so in general not a whole number.
     pub dof: f64,
 }
 

@@ -200,6 +200,9 @@ pub(crate) struct Covariance {
     pub condition: f64,
     /// Degrees of freedom of the residual: independent observations minus parameters (≥ 1).
     pub dof: f64,
+    /// The covariance matrix of the parameters (its diagonal is `std_errors²`); rows and
+    /// columns of singular parameters are NaN.
+    pub matrix: DMatrix<f64>,
 }
 
 /// Scaled `JᵀJ` eigenvalues below this fraction of the largest count as singular: the
@@ -234,6 +237,7 @@ pub(crate) fn covariance(jac: &DMatrix<f64>, ssr: f64, correlation_samples: f64)
     let jtj = jac.tr_mul(jac);
     let d: Vec<f64> = (0..m).map(|i| jtj[(i, i)].sqrt()).collect();
     let mut std_errors = vec![f64::INFINITY; m];
+    let mut matrix = DMatrix::from_element(m, m, f64::NAN);
     let live: Vec<usize> = (0..m).filter(|&i| d[i] > 0.0 && d[i].is_finite()).collect();
     // A parameter the residuals do not depend on at all is singular from the start.
     let mut singular: Vec<bool> = (0..m).map(|i| !live.contains(&i)).collect();
@@ -243,6 +247,7 @@ pub(crate) fn covariance(jac: &DMatrix<f64>, ssr: f64, correlation_samples: f64)
             singular,
             condition: f64::INFINITY,
             dof,
+            matrix,
         };
     }
     let k = live.len();
@@ -271,6 +276,11 @@ pub(crate) fn covariance(jac: &DMatrix<f64>, ssr: f64, correlation_samples: f64)
     for (a, &i) in live.iter().enumerate() {
         if !singular[i] {
             std_errors[i] = (l * s2 * inv[(a, a)]).sqrt() / d[i];
+            for (b, &j) in live.iter().enumerate() {
+                if !singular[j] {
+                    matrix[(i, j)] = l * s2 * inv[(a, b)] / (d[i] * d[j]);
+                }
+            }
         }
     }
     Covariance {
@@ -278,6 +288,7 @@ pub(crate) fn covariance(jac: &DMatrix<f64>, ssr: f64, correlation_samples: f64)
         singular,
         condition,
         dof,
+        matrix,
     }
 }
 

@@ -55,7 +55,7 @@ pub(crate) fn paper_fit(
         fit.std_errors[law::VISCOUS],
         fit.dof,
     );
-    let per_pressure = paper_coulomb_forces(work, groups, c.value);
+    let per_pressure = paper_coulomb_forces(work, groups, &c);
     let friction = if per_pressure.len() >= 2 {
         friction_coefficient(per_pressure.into_iter())
     } else {
@@ -90,26 +90,40 @@ fn peak_points(work: &[Work], reference_group: usize, sine_only: bool) -> LawPoi
 
 /// `F_μ = F_D − Cₑ√v` per pressure group and waveform from the peak points (into `groups`),
 /// and the mean of the two waveforms' `F_μ` against `F_z` per group with a known pressure.
+///
+/// The standard error of a mean over `n ≥ 2` tests is that of every other estimate: the
+/// scatter's `s/√n` and `Cₑ`'s own standard error carried through the mean `√v̄`,
+/// `se² = s²/n + (mean √v)²·se(Cₑ)²` (the least-squares intercept's, where the tests are
+/// the ones `Cₑ` was fitted to). One test gives a value without a standard error.
 fn paper_coulomb_forces(
     work: &[Work],
     groups: &mut [PressureGroup],
-    viscous_coefficient: f64,
+    viscous: &Estimate,
 ) -> Vec<(f64, Estimate)> {
+    let viscous_coefficient = viscous.value;
     let mut per_pressure = Vec::new();
     for (g, group) in groups.iter_mut().enumerate() {
         let mut both = Vec::new();
         for kind in [TestKind::Sine, TestKind::Triangle] {
-            let values: Vec<f64> = work
+            let peaks: Vec<_> = work
                 .iter()
                 .filter(|w| w.group == g && w.kind == kind)
                 .filter_map(|w| w.peak)
                 .filter(|p| p.velocity_m_s >= LOW_SPEED_M_S)
+                .collect();
+            let values: Vec<f64> = peaks
+                .iter()
                 .map(|p| p.force_n - viscous_coefficient * p.velocity_m_s.sqrt())
                 .collect();
             let est = match values.len() {
                 0 => None,
                 1 => Some(Estimate::new(values[0], f64::NAN, 0.0)),
-                _ => Estimate::mean_of(&values),
+                n => Estimate::mean_of(&values).map(|m| {
+                    let mean_sqrt_v =
+                        peaks.iter().map(|p| p.velocity_m_s.sqrt()).sum::<f64>() / n as f64;
+                    let se = m.std_error.hypot(mean_sqrt_v * viscous.std_error);
+                    Estimate::new(m.value, se, m.dof.min(viscous.dof))
+                }),
             };
             if let Some(e) = est {
                 both.push(e.value);

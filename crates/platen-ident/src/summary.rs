@@ -101,8 +101,10 @@ pub struct EstimateSummary {
     pub std_error: f64,
     /// The 95 % confidence interval.
     pub ci95: [f64; 2],
-    /// Degrees of freedom.
-    pub dof: f64,
+    /// The effective degrees of freedom of the interval's Student t: independent observations
+    /// minus parameters, where residuals correlated over `ℓ` samples count `n/ℓ` independent
+    /// observations (so not a whole number in general; see [`Estimate::dof`]).
+    pub effective_dof: f64,
 }
 
 impl EstimateSummary {
@@ -112,7 +114,7 @@ impl EstimateSummary {
             value: e.value,
             std_error: e.std_error,
             ci95: [e.ci95_low, e.ci95_high],
-            dof: e.dof,
+            effective_dof: e.dof,
         }
     }
 }
@@ -128,8 +130,8 @@ pub enum ParameterSummary {
         std_error: f64,
         /// 95 % confidence interval.
         ci95: [f64; 2],
-        /// Degrees of freedom.
-        dof: f64,
+        /// Effective degrees of freedom (see [`EstimateSummary::effective_dof`]).
+        effective_dof: f64,
     },
     /// Held at a value.
     Fixed {
@@ -152,7 +154,7 @@ impl ParameterSummary {
             Parameter::Estimated(e) => ParameterSummary::Estimated {
                 std_error: e.std_error,
                 ci95: [e.ci95_low, e.ci95_high],
-                dof: e.dof,
+                effective_dof: e.dof,
             },
             Parameter::Fixed { value, reason } => ParameterSummary::Fixed {
                 value: *value,

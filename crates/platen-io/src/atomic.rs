@@ -29,6 +29,7 @@ impl AtomicFile {
     /// Creates the temporary file (`.NAME.XXXXXX.tmp`) in the folder of `path`.
     ///
     /// # Errors
+    /// [`IoError::OutputFolderMissing`] if the folder of `path` does not exist;
     /// [`IoError::Io`] ([`IoAction::CreatingTemporary`]) if `path` names no file or the
     /// folder does not take a new file.
     pub fn create(path: &Path) -> Result<Self> {
@@ -38,6 +39,13 @@ impl AtomicFile {
                 io::Error::new(io::ErrorKind::InvalidInput, "the path names no file"),
             ));
         };
+        let folder = directory_of(path);
+        if !folder.is_dir() {
+            return Err(IoError::OutputFolderMissing {
+                path: path.to_path_buf(),
+                folder: folder.to_path_buf(),
+            });
+        }
         let temp = tempfile::Builder::new()
             .prefix(&format!(".{}.", file_name.to_string_lossy()))
             .suffix(".tmp")

@@ -937,16 +937,23 @@ mod tests {
     }
 
     #[test]
-    fn a_write_that_cannot_create_its_temporary_file_fails_and_touches_nothing() {
+    fn a_write_into_a_missing_folder_fails_naming_it_and_touches_nothing() {
         let dir = tempfile::tempdir().unwrap();
         let existing = dir.path().join("keep.csv");
         fs::write(&existing, "t_s\n0\n").unwrap();
         let target = dir.path().join("no_such_dir").join("out.csv");
         let error = write_csv_atomic(&target, &["t_s"], &[&[1.0]]).unwrap_err();
         let message = error.to_string();
-        assert!(matches!(error, IoError::Io { .. }), "{error:?}");
         assert!(
-            message.contains("out.csv") && message.contains("temporary"),
+            matches!(error, IoError::OutputFolderMissing { .. }),
+            "{error:?}"
+        );
+        assert!(error.is_output_failure());
+        assert!(
+            message.contains("out.csv")
+                && message.contains("the output folder")
+                && message.contains("no_such_dir")
+                && message.contains("does not exist"),
             "{message}"
         );
         assert!(!target.exists());

@@ -30,6 +30,19 @@ pub enum IoError {
         source: std::io::Error,
     },
 
+    /// The folder an output is to be written in does not exist (or is not a folder).
+    #[error(
+        "cannot write `{}`: the output folder `{}` does not exist (create it first)",
+        path.display(),
+        folder.display()
+    )]
+    OutputFolderMissing {
+        /// The output file.
+        path: PathBuf,
+        /// Its folder.
+        folder: PathBuf,
+    },
+
     /// The CSV text itself is malformed (invalid UTF-8, misplaced blank line, …).
     #[error("`{}`, line {line}: malformed CSV: {message}", path.display())]
     CsvSyntax {
@@ -303,10 +316,67 @@ impl std::fmt::Display for IoAction {
 }
 
 impl IoError {
+    /// The file the error is about (for an output, the output file).
+    pub fn file(&self) -> &std::path::Path {
+        match self {
+            IoError::Io { path, .. }
+            | IoError::OutputFolderMissing { path, .. }
+            | IoError::CsvSyntax { path, .. }
+            | IoError::MissingColumn { path, .. }
+            | IoError::DuplicateColumn { path, .. }
+            | IoError::NonNumeric { path, .. }
+            | IoError::NonFinite { path, .. }
+            | IoError::Empty { path, .. }
+            | IoError::TimeNotIncreasing { path, .. }
+            | IoError::RaggedRow { path, .. }
+            | IoError::NonUniform { path, .. }
+            | IoError::OffGrid { path, .. }
+            | IoError::TooShort { path, .. }
+            | IoError::HeaderMismatch { path, .. }
+            | IoError::ColumnLengthMismatch { path, .. }
+            | IoError::InvalidColumnName { path, .. }
+            | IoError::Json { path, .. }
+            | IoError::InvalidField { path, .. }
+            | IoError::Record { path, .. } => path,
+        }
+    }
+
+    /// The 1-based line of the file the error is about, where it is known (CSV rows).
+    pub fn line(&self) -> Option<u64> {
+        match self {
+            IoError::CsvSyntax { line, .. }
+            | IoError::NonNumeric { line, .. }
+            | IoError::NonFinite { line, .. }
+            | IoError::TimeNotIncreasing { line, .. }
+            | IoError::RaggedRow { line, .. }
+            | IoError::NonUniform { line, .. }
+            | IoError::OffGrid { line, .. } => Some(*line),
+            _ => None,
+        }
+    }
+
+    /// The field the error is about, where there is one: a CSV column's name, or the JSON
+    /// path of a scenario field (for a JSON syntax or type error, the path followed by the
+    /// line and column, or the line alone).
+    pub fn field(&self) -> Option<&str> {
+        match self {
+            IoError::MissingColumn { column, .. }
+            | IoError::DuplicateColumn { column, .. }
+            | IoError::NonNumeric { column, .. }
+            | IoError::NonFinite { column, .. }
+            | IoError::ColumnLengthMismatch { column, .. }
+            | IoError::InvalidColumnName { column, .. } => Some(column),
+            IoError::Json { json_path, .. } | IoError::InvalidField { json_path, .. } => {
+                Some(json_path)
+            }
+            _ => None,
+        }
+    }
     /// Whether this error is a failure to write an output (as opposed to a bad or missing
     /// input): front ends give it its own exit code.
     pub fn is_output_failure(&self) -> bool {
         matches!(self, IoError::Io { action, .. } if *action != IoAction::Reading)
+            || matches!(self, IoError::OutputFolderMissing { .. })
     }
 }
 

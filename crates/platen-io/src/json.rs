@@ -22,31 +22,131 @@ pub fn parse_json_file<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T>
 /// column) of any error: for scenario files and the other JSON inputs of platen (column
 /// maps, identification manifests).
 ///
+/// The path names the innermost field: where serde loses it (a field inside an internally
+/// tagged or flattened object, reported at the object), the document is read a second time
+/// as plain JSON and the one field under that object holding the value the message quotes
+/// is named. A file that ends early (empty, or cut off) says so with the line it ends on.
+///
 /// # Errors
 /// [`IoError::Json`].
 pub fn parse_json<T: serde::de::DeserializeOwned>(path: &Path, text: &str) -> Result<T> {
     let de = &mut serde_json::Deserializer::from_str(text);
     serde_path_to_error::deserialize(de).map_err(|e| {
         let inner = e.inner();
-        let json_path = e.path().to_string();
-        let json_path = if json_path == "." || json_path.is_empty() {
-            format!("line {} column {}", inner.line(), inner.column())
-        } else {
-            format!(
-                "{json_path} (line {} column {})",
-                inner.line(),
-                inner.column()
-            )
-        };
+        let (line, column) = (inner.line(), inner.column());
+        if inner.is_eof() {
+            return IoError::Json {
+                path: path.to_owned(),
+                json_path: format!("line {line}"),
+                message: if text.trim().is_empty() {
+                    "the file is empty: expected a JSON object".to_owned()
+                } else {
+                    "the file ends before the JSON is complete (a bracket, brace or quote is \
+                     not closed)"
+                        .to_owned()
+                },
+            };
+        }
         // serde_json appends " at line L column C"; the location is already in json_path.
         let mut message = inner.to_string();
         if let Some(pos) = message.rfind(" at line ") {
             message.truncate(pos);
         }
+        if let Some(rest) = message.strip_suffix(", expected f64") {
+            message = format!("{rest}, expected a number");
+        }
+        let segments: Vec<String> = e
+            .path()
+            .iter()
+            .map(|s| match s {
+                serde_path_to_error::Segment::Seq { index } => format!("[{index}]"),
+                serde_path_to_error::Segment::Map { key } => key.clone(),
+                serde_path_to_error::Segment::Enum { variant } => variant.clone(),
+                serde_path_to_error::Segment::Unknown => "?".to_owned(),
+            })
+            .collect();
+        let mut json_path = e.path().to_string();
+        if inner.is_data() && !segments.iter().any(|s| s == "?") {
+            if let Some(field) = innermost_field(text, &segments, &message) {
+                json_path = if json_path == "." || json_path.is_empty() {
+                    field
+                } else {
+                    format!("{json_path}.{field}")
+                };
+            }
+        }
+        let json_path = if json_path == "." || json_path.is_empty() {
+            format!("line {line} column {column}")
+        } else {
+            format!("{json_path} (line {line} column {column})")
+        };
         IoError::Json {
             path: path.to_owned(),
             json_path,
             message,
         }
     })
+}
+
+/// The relative path of the one field below `segments` whose value is the one `message`
+/// quotes (`invalid type: string "fast", expected f64`), if the message quotes a value and
+/// exactly one field there holds it.
+fn innermost_field(text: &str, segments: &[String], message: &str) -> Option<String> {
+    let quoted = message
+        .strip_prefix("invalid type: ")
+        .or_else(|| message.strip_prefix("invalid value: "))?;
+    let quoted = &quoted[..quoted.rfind(", expected ")?];
+    let doc: serde_json::Value = serde_json::from_str(text).ok()?;
+    let mut node = &doc;
+    for s in segments {
+        node = match (node, s.strip_prefix('[').and_then(|i| i.strip_suffix(']'))) {
+            (serde_json::Value::Array(a), Some(i)) => a.get(i.parse::<usize>().ok()?)?,
+            (serde_json::Value::Object(m), _) => m.get(s)?,
+            _ => return None,
+        };
+    }
+    let mut found = Vec::new();
+    matching_fields(node, String::new(), quoted, &mut found);
+    match found.as_slice() {
+        [one] if !one.is_empty() => Some(one.clone()),
+        _ => None,
+    }
+}
+
+/// The paths (relative to `node`) of the values under `node` that serde would describe as
+/// `quoted` in an "invalid type" message.
+fn matching_fields(node: &serde_json::Value, here: String, quoted: &str, found: &mut Vec<String>) {
+    use serde_json::Value;
+    let join = |k: &str| {
+        if here.is_empty() {
+            k.to_owned()
+        } else {
+            format!("{here}.{k}")
+        }
+    };
+    let described = match node {
+        Value::Null => "null".to_owned(),
+        Value::Bool(b) => format!("boolean `{b}`"),
+        Value::Number(n) if n.is_f64() => format!(
+            "floating point `{}`",
+            serde_json::Value::from(n.as_f64().unwrap_or(f64::NAN))
+        ),
+        Value::Number(n) => format!("integer `{n}`"),
+        Value::String(s) => format!("string {s:?}"),
+        Value::Array(a) => {
+            for (i, v) in a.iter().enumerate() {
+                matching_fields(v, format!("{here}[{i}]"), quoted, found);
+            }
+            "sequence".to_owned()
+        }
+        Value::Object(m) => {
+            for (k, v) in m {
+                matching_fields(v, join(k), quoted, found);
+            }
+            "map".to_owned()
+        }
+    };
+    if described == quoted {
+        found.push(here);
+    }
 }

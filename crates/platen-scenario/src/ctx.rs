@@ -20,11 +20,24 @@ impl Ctx<'_> {
         value: impl ToString,
         expected: impl Into<String>,
     ) -> ScenarioError {
+        // A number far from 1 as `1e300`, not three hundred digits.
+        let mut value = value.to_string();
+        if value.len() > 17 {
+            if let Ok(v) = value.parse::<f64>() {
+                value = format!("{v:e}");
+            }
+        }
+        // A lower layer's sentence ("step_s = 0 is invalid: expected a finite number > 0")
+        // keeps only what it expects: the field and value are said once, here.
+        let mut expected = expected.into();
+        if let Some(at) = expected.rfind(": expected ") {
+            expected.drain(..at + ": expected ".len());
+        }
         ScenarioError::Io(IoError::InvalidField {
             path: self.path.to_owned(),
             json_path: json_path.to_owned(),
-            value: value.to_string(),
-            expected: expected.into(),
+            value,
+            expected,
         })
     }
 

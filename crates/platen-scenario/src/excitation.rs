@@ -107,7 +107,17 @@ fn samples_for(
     let Some(d) = duration_s else { return Ok(len) };
     check_positive(ctx, "duration_s", d)?;
     // Tolerate rounding of the duration to about a millionth of a sample.
-    let n = (d / dt + 1e-6).floor() as usize + 1;
+    // In f64 first: a duration far past the record (1e300 s) saturates `as usize`.
+    let intervals = (d / dt + 1e-6).floor();
+    if intervals >= len as f64 {
+        return Err(ScenarioError::RecordTooShort {
+            path: record_path.to_owned(),
+            span_s: len.saturating_sub(1) as f64 * dt,
+            samples: Some(len),
+            duration_s: d,
+        });
+    }
+    let n = intervals as usize + 1;
     if n > len {
         return Err(ScenarioError::RecordTooShort {
             path: record_path.to_owned(),
@@ -720,10 +730,10 @@ fn forward_run(
             // between two rounded stamps); the integrator then steps at that interval / k.
             let k = platen_integrate::sampling_grid(record.t_s())
                 .and_then(|grid| grid.steps_per_interval(step))
-                .map_err(|e| ctx.invalid("integrator.step_s", step, e.to_string()))?;
+                .map_err(|e| ctx.invalid("integrator.step_s", step, step_expected(&e)))?;
             Method::Rk4(
                 Rk4::with_steps_per_sample(k)
-                    .map_err(|e| ctx.invalid("integrator.step_s", step, e.to_string()))?,
+                    .map_err(|e| ctx.invalid("integrator.step_s", step, step_expected(&e)))?,
             )
         }
         Some(IntegratorSpec::Dopri5(spec)) => {
@@ -770,4 +780,18 @@ fn forward_run(
         initial: State { u_m, v_m_s },
         samples,
     })
+}
+
+/// What an RK4 `step_s` must be, for the integrator's rejection `e` of it.
+fn step_expected(e: &platen_integrate::IntegrateError) -> String {
+    match e {
+        platen_integrate::IntegrateError::StepNotDivisor {
+            sample_interval_s, ..
+        } => format!(
+            "a step that divides the sample interval {sample_interval_s} s into a whole number \
+             of steps (the interval / k for an integer k >= 1)"
+        ),
+        platen_integrate::IntegrateError::InvalidStep { .. } => "a finite step > 0 s".into(),
+        other => other.to_string(),
+    }
 }

@@ -1,0 +1,102 @@
+//! The error object a verb run with `--json` prints on stderr, one line, instead of the
+//! `error: …` text:
+//!
+//! ```json
+//! {"error": {"kind": "input", "exit_code": 3,
+//!            "message": "`s.json`: integrator.step_s (line 3 column 21): invalid type: …",
+//!            "file": "s.json", "field": "integrator.step_s (line 3 column 21)", "line": null}}
+//! ```
+//!
+//! - `kind`: `usage` (exit 2: the command line), `input` (3: a file, scenario or parameter
+//!   that cannot be used), `numerical` (4: the integration failed), `output` (5: an output
+//!   could not be written);
+//! - `exit_code`: the process's exit code (the same with or without `--json`);
+//! - `message`: the text the plain form prints after `error: `;
+//! - `file`: the file the error is about, where one is known, else null;
+//! - `field`: the JSON path of a scenario field (with the line and column of a syntax or type
+//!   error) or the name of a CSV column, else null;
+//! - `line`: the 1-based line of a CSV file, else null.
+
+use serde_json::{json, Value};
+
+use platen_compare::CompareError;
+use platen_io::IoError;
+use platen_report::ReportError;
+use platen_scenario::ScenarioError;
+
+/// The `kind` of an exit code.
+fn kind(code: u8) -> &'static str {
+    match code {
+        2 => "usage",
+        4 => "numerical",
+        5 => "output",
+        _ => "input",
+    }
+}
+
+/// The error object of a usage error (the command line itself), exit code 2.
+pub(crate) fn usage(message: &str) -> Value {
+    json!({"error": {
+        "kind": kind(2),
+        "exit_code": 2,
+        "message": message,
+        "file": null,
+        "field": null,
+        "line": null,
+    }})
+}
+
+/// The error object of `e`, which exits with `code`.
+pub(crate) fn object(e: &anyhow::Error, code: u8) -> Value {
+    let (file, field, line) = match io_error(e) {
+        Some(io) => (
+            Some(io.file().display().to_string()),
+            io.field().map(str::to_owned),
+            io.line(),
+        ),
+        None => (scenario_file(e), None, None),
+    };
+    json!({"error": {
+        "kind": kind(code),
+        "exit_code": code,
+        "message": format!("{e:#}"),
+        "file": file,
+        "field": field,
+        "line": line,
+    }})
+}
+
+/// The file I/O error in `e`'s chain, looking through the transparent wrappers that hide it
+/// from `chain()` (as [`crate::exit_code`] does).
+fn io_error(e: &anyhow::Error) -> Option<&IoError> {
+    e.chain().find_map(|cause| {
+        let scenario = match cause.downcast_ref::<CompareError>() {
+            Some(CompareError::Scenario(se)) => Some(se),
+            Some(CompareError::Io(io)) => return Some(io),
+            _ => cause.downcast_ref::<ScenarioError>(),
+        };
+        if let Some(ScenarioError::Io(io)) = scenario {
+            return Some(io);
+        }
+        if let Some(ReportError::Write(io)) = cause.downcast_ref::<ReportError>() {
+            return Some(io);
+        }
+        cause.downcast_ref::<IoError>()
+    })
+}
+
+/// The record file a scenario error names.
+fn scenario_file(e: &anyhow::Error) -> Option<String> {
+    e.chain().find_map(|cause| {
+        let se = match cause.downcast_ref::<CompareError>() {
+            Some(CompareError::Scenario(se)) => se,
+            _ => cause.downcast_ref::<ScenarioError>()?,
+        };
+        match se {
+            ScenarioError::RecordTooShort { path, .. }
+            | ScenarioError::RecordRejected { path, .. }
+            | ScenarioError::NotAcceleration { path } => Some(path.display().to_string()),
+            _ => None,
+        }
+    })
+}
