@@ -27,6 +27,7 @@ mod compare;
 mod generate;
 mod identify;
 mod model;
+mod plot;
 mod schema;
 mod simulate;
 mod sweep;
@@ -66,6 +67,13 @@ enum Command {
         /// Print a machine-readable summary on stdout.
         #[arg(long)]
         json: bool,
+        /// Write the run's figures to this folder as SVG and PNG: motion and actuator force
+        /// over time (with the table's limits near a peak), the force decomposition
+        /// F_A = F_I + F_E + F_D, hysteresis loops of F_A against u, v and a.
+        #[arg(long, value_name = "DIR")]
+        plot: Option<PathBuf>,
+        #[command(flatten)]
+        size: plot::SizeArgs,
     },
     /// Run a scenario and compare it with a recorded test: forward scenarios compare the
     /// displacement u_m and velocity v_m_s, inverse scenarios the actuator force force_n, on
@@ -99,6 +107,8 @@ enum Command {
         /// Largest lag searched by cross-correlation, either way, s.
         #[arg(long, value_name = "S", default_value_t = 0.25, value_parser = compare::parse_max_lag)]
         max_lag: f64,
+        #[command(flatten)]
+        size: plot::SizeArgs,
     },
     /// Print a preset's parameters and derived quantities.
     Model {
@@ -181,6 +191,12 @@ enum Command {
         /// Print a machine-readable summary of every case on stdout.
         #[arg(long)]
         json: bool,
+        /// Write figures to this folder as SVG and PNG: for each axis with two or more
+        /// values, the peaks of every case against it with the table's limits.
+        #[arg(long, value_name = "DIR")]
+        plot: Option<PathBuf>,
+        #[command(flatten)]
+        size: plot::SizeArgs,
     },
     /// Identify the platen's parameters from test records: periodic sine and triangle tests
     /// by the paper's hysteresis-loop method (§3, with a global fit of Eq. 23 as a
@@ -242,6 +258,8 @@ enum Command {
         /// measured motion).
         #[arg(long)]
         no_output_error: bool,
+        #[command(flatten)]
+        size: plot::SizeArgs,
     },
 }
 
@@ -306,7 +324,15 @@ fn run(command: Command) -> anyhow::Result<()> {
             scenario,
             out,
             json,
-        } => simulate::run(&scenario, out.as_deref(), json),
+            plot,
+            size,
+        } => simulate::run(&simulate::Options {
+            scenario: &scenario,
+            out: out.as_deref(),
+            json,
+            plot: plot.as_deref(),
+            size: size.size(),
+        }),
         Command::Compare {
             scenario,
             recorded,
@@ -316,6 +342,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             report,
             columns,
             max_lag,
+            size,
         } => compare::run(&compare::Options {
             scenario: &scenario,
             recorded: &recorded,
@@ -325,6 +352,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             report: report.as_deref(),
             columns: columns.as_deref(),
             max_lag_s: max_lag,
+            size: size.size(),
         }),
         Command::Model {
             preset,
@@ -352,7 +380,20 @@ fn run(command: Command) -> anyhow::Result<()> {
             set,
             out,
             json,
-        } => sweep::run(&scenario, &scale, &pressure_mpa, &set, out.as_deref(), json),
+            plot,
+            size,
+        } => sweep::run(
+            &scenario,
+            &scale,
+            &pressure_mpa,
+            &set,
+            out.as_deref(),
+            json,
+            &sweep::Plot {
+                dir: plot.as_deref(),
+                size: size.size(),
+            },
+        ),
         Command::Identify {
             files,
             pressure_mpa,
@@ -365,6 +406,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             columns,
             method,
             no_output_error,
+            size,
         } => identify::run(&identify::Options {
             files: &files,
             pressure_mpa: &pressure_mpa,
@@ -377,6 +419,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             columns: columns.as_deref(),
             method,
             no_output_error,
+            size: size.size(),
         }),
     }
 }

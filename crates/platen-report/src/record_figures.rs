@@ -91,6 +91,7 @@ fn force(rec: &RecordReport, suffix: &str) -> Figure {
             ),
         ],
         columns: 1,
+        rows: Vec::new(),
         size: (1400, 900),
     }
 }
@@ -131,6 +132,7 @@ fn displacement(rec: &RecordReport, suffix: &str) -> Figure {
             ),
         ],
         columns: 1,
+        rows: Vec::new(),
         size: (1400, 900),
     }
 }
@@ -177,6 +179,7 @@ fn dissipative(id: &RecordIdentification) -> Figure {
             ],
         )],
         columns: 1,
+        rows: Vec::new(),
         size: (1100, 800),
     }
 }
