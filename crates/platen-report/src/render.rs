@@ -171,3 +171,58 @@ fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
     write_bytes_atomic(path, bytes)?;
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::figure::{Panel, RECORDED};
+    use crate::series::line;
+
+    fn png_size(png: &[u8]) -> (u32, u32) {
+        assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+        let be = |b: &[u8]| u32::from_be_bytes(b.try_into().unwrap());
+        (be(&png[16..20]), be(&png[20..24]))
+    }
+
+    /// Both sides given replace both; one keeps the proportions; none keeps the figure's.
+    #[test]
+    fn figure_size_of() {
+        let size = |w, h| FigureSize {
+            width_px: w,
+            height_px: h,
+            png_scale: 1.0,
+        };
+        assert_eq!(size(Some(800), Some(300)).of((1200, 900)), (800, 300));
+        assert_eq!(size(Some(800), None).of((1200, 900)), (800, 600));
+        assert_eq!(size(None, Some(450)).of((1200, 900)), (600, 450));
+        assert_eq!(size(None, None).of((1260, 520)), (1260, 520));
+    }
+
+    /// The SVG is drawn at the size asked and the PNG at `png_scale` times it; rendering twice
+    /// gives the same bytes.
+    #[test]
+    fn png_scale_multiplies_the_pixels() {
+        let figure = Figure {
+            name: "f".into(),
+            title: "t".into(),
+            caption: String::new(),
+            panels: vec![Panel::new(
+                "",
+                "x",
+                "y",
+                vec![line("a", vec![(0.0, 0.0), (1.0, 2.0)], RECORDED, 2)],
+            )],
+            columns: 1,
+            rows: Vec::new(),
+            size: (640, 360),
+        };
+        let svg = figure.to_svg().unwrap();
+        assert!(svg.contains("width=\"640\" height=\"360\""));
+        assert_eq!(png_size(&svg_to_png(&svg, 1.0).unwrap()), (640, 360));
+        let twice = svg_to_png(&svg, 2.0).unwrap();
+        assert_eq!(png_size(&twice), (1280, 720));
+        assert_eq!(twice, svg_to_png(&svg, 2.0).unwrap());
+        assert!(svg_to_png(&svg, 0.0).is_err());
+        assert!(svg_to_png(&svg, f64::NAN).is_err());
+    }
+}
