@@ -254,11 +254,12 @@ fn mass_panel(id: &Identification) -> Panel {
             .filter(|t| t.effective_mass.is_some())
             .map(|t| t.peak_acceleration_m_s2)
             .fold(0.0, f64::max);
-        series.push(line(
+        series.push(patterned(
             format!("Mₑ = {:.2} t (mean of the used)", m / 1e3),
             vec![(0.0, m / 1e3), (x_max, m / 1e3)],
             MODEL,
             2,
+            Dash::Dashed,
         ));
     }
     Panel::new(
@@ -442,7 +443,7 @@ fn dissipative_force(id: &Identification) -> Option<Figure> {
     let mut series = dissipative_series(id, v_max);
     if let Some(p) = &id.paper_fit {
         let (fmu, ce) = (p.coulomb_force.value, p.viscous_coefficient.value);
-        series.push(line(
+        series.push(patterned(
             "Eq. 21 fit: F_μ + Cₑ·|v|^0.5",
             speed_grid(v_max)
                 .into_iter()
@@ -450,6 +451,7 @@ fn dissipative_force(id: &Identification) -> Option<Figure> {
                 .collect(),
             PAPER_FIT,
             2,
+            Dash::Dashed,
         ));
     }
     let peaks: Vec<(f64, f64)> = id
@@ -538,11 +540,12 @@ fn friction(id: &Identification) -> Option<Figure> {
         }
     }
     let mut series = est.into_series("F_μ per pressure", GROUP_COLORS[0]);
-    series.push(line(
+    series.push(patterned(
         format!("μₑ·F_z, μₑ = {:.4} %", 100.0 * mu.value),
         vec![(0.0, 0.0), (f_z_max, mu.value * f_z_max * 1e3)],
         MODEL,
         2,
+        Dash::Dashed,
     ));
     Some(Figure {
         name: "friction".into(),
