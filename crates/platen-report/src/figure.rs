@@ -1,5 +1,6 @@
 //! What a figure is made of: a title over a grid of panels, each a set of axes holding line,
-//! point or segment series, with its legend in a strip above the axes (never over the data). Drawing is [`Figure::to_svg`], rendering and writing in
+//! point or segment series, with its legend in a strip above the axes (never over the data;
+//! one strip under the title when every panel has the same legend). Drawing is [`Figure::to_svg`], rendering and writing in
 //! [`crate::render`].
 
 use plotters::style::RGBColor;
@@ -62,7 +63,7 @@ impl Dash {
 }
 
 /// How a series is drawn.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Style {
     /// A polyline.
     Line {

@@ -48,7 +48,6 @@ impl Figure {
                 (self.size.0 as i32 / 2, title_height as i32 / 2 + 2),
             )
             .map_err(draw_error)?;
-            let areas = self.panel_areas(&body);
             // One y label width for the whole figure, so that stacked axes line up.
             let y_area = self
                 .panels
@@ -56,12 +55,47 @@ impl Figure {
                 .map(|p| y_label_area(ranges(p).1))
                 .max()
                 .unwrap_or(60);
+            let shared = self.shared_legend();
+            let body = match shared {
+                Some(panel) => {
+                    let (_, _, margin_left, margin_right) = MARGINS;
+                    let left = y_area + margin_left;
+                    let rows = legend_rows(
+                        panel,
+                        f64::from(self.size.0) - f64::from(left + margin_right),
+                    );
+                    let (strip, rest) =
+                        body.split_vertically(rows.len() as u32 * LEGEND_ROW_PX + 4);
+                    draw_legend(&strip, &rows, left as i32, 0)?;
+                    rest
+                }
+                None => body,
+            };
+            let areas = self.panel_areas(&body);
             for (panel, area) in self.panels.iter().zip(&areas) {
-                draw_panel(panel, area, y_area)?;
+                draw_panel(panel, area, y_area, shared.is_none())?;
             }
             root.present().map_err(draw_error)?;
         }
         Ok(with_dash_patterns(&svg))
+    }
+
+    /// The panel whose legend every panel shares (the same labels drawn the same way, in the
+    /// same order), drawn once under the title; `None` for one panel or different legends.
+    fn shared_legend(&self) -> Option<&Panel> {
+        let legend = |p: &'_ Panel| -> Vec<(String, Style)> {
+            p.series
+                .iter()
+                .filter(|s| !s.label.is_empty())
+                .map(|s| (s.label.clone(), s.style))
+                .collect()
+        };
+        let first = self.panels.first()?;
+        let entries = legend(first);
+        (self.panels.len() > 1
+            && !entries.is_empty()
+            && self.panels.iter().all(|p| legend(p) == entries))
+        .then_some(first)
     }
 
     /// The drawing area of every panel: `columns` per row, or the row lengths of `rows`.
@@ -205,13 +239,18 @@ fn legend_rows(panel: &Panel, width: f64) -> Vec<Vec<(&Series, i32)>> {
     rows
 }
 
-/// A panel: its caption and legend strip above the axes, then the axes and the series.
-fn draw_panel(panel: &Panel, area: &Area<'_>, y_area: u32) -> Result<()> {
+/// A panel: its caption and (with `legend`) its legend strip above the axes, then the axes
+/// and the series.
+fn draw_panel(panel: &Panel, area: &Area<'_>, y_area: u32, legend: bool) -> Result<()> {
     let (w, _) = area.dim_in_pixel();
     let (_, _, margin_left, margin_right) = MARGINS;
     let left = (y_area + margin_left) as i32;
     let width = f64::from(w) - f64::from(y_area + margin_left + margin_right);
-    let legend = legend_rows(panel, width);
+    let legend = if legend {
+        legend_rows(panel, width)
+    } else {
+        Vec::new()
+    };
     let caption_px = if panel.title.is_empty() {
         0
     } else {
@@ -233,12 +272,7 @@ fn draw_panel(panel: &Panel, area: &Area<'_>, y_area: u32) -> Result<()> {
         )
         .map_err(draw_error)?;
     }
-    for (r, row) in legend.iter().enumerate() {
-        let y = (caption_px + r as u32 * LEGEND_ROW_PX + LEGEND_ROW_PX / 2) as i32 + 2;
-        for &(series, x) in row {
-            draw_legend_entry(&head, series, (left + x, y))?;
-        }
-    }
+    draw_legend(&head, &legend, left, caption_px as i32)?;
     let layout = Layout::new(panel, &body, y_area);
     let mut chart = draw_axes(panel, &body, y_area, &layout)?;
     if let Some((a, b)) = panel.shade_x {
@@ -252,6 +286,17 @@ fn draw_panel(panel: &Panel, area: &Area<'_>, y_area: u32) -> Result<()> {
     }
     for series in &panel.series {
         draw_series(&mut chart, series)?;
+    }
+    Ok(())
+}
+
+/// Legend rows (from [`legend_rows`]) from `left` px across and `top` px down `area`.
+fn draw_legend(area: &Area<'_>, rows: &[Vec<(&Series, i32)>], left: i32, top: i32) -> Result<()> {
+    for (r, row) in rows.iter().enumerate() {
+        let y = top + (r as u32 * LEGEND_ROW_PX + LEGEND_ROW_PX / 2) as i32 + 2;
+        for &(series, x) in row {
+            draw_legend_entry(area, series, (left + x, y))?;
+        }
     }
     Ok(())
 }

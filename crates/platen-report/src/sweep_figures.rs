@@ -10,13 +10,28 @@ use platen_scenario::sweep::{Case, Outcome};
 use platen_scenario::Scenario;
 
 use crate::figure::{Dash, Figure, Panel, Series, MODEL};
-use crate::identify_figures::GROUP_COLORS;
 use crate::series::{patterned, series};
 use crate::text::significant;
 
+/// Colours of the lines (ColorBrewer Dark2: tell apart in print and by most colour-blind
+/// readers).
+const LINE_COLORS: [RGBColor; 7] = [
+    RGBColor(27, 158, 119),
+    RGBColor(217, 95, 2),
+    RGBColor(117, 112, 179),
+    RGBColor(231, 41, 138),
+    RGBColor(102, 166, 30),
+    RGBColor(230, 171, 2),
+    RGBColor(166, 118, 29),
+];
+
 /// Most lines that get their own colour and legend entry; beyond, every line is grey and one
 /// legend entry says what a line is.
-const MAX_LABELLED: usize = 6;
+const MAX_LABELLED: usize = LINE_COLORS.len();
+
+/// A limit is drawn when the largest peak reaches this fraction of it (the axis then spans
+/// at most 1/0.25 = 4 times the data); below, the panel's title gives the limit instead.
+const LIMIT_DRAWN_FROM: f64 = 0.25;
 
 /// Colour of the lines when there are too many to tell apart.
 const MANY: RGBColor = RGBColor(120, 120, 120);
@@ -164,7 +179,7 @@ fn axis_figure(
                         } else {
                             label
                         };
-                        (label, GROUP_COLORS[g % GROUP_COLORS.len()])
+                        (label, LINE_COLORS[g % LINE_COLORS.len()])
                     };
                     series(
                         label,
@@ -189,26 +204,41 @@ fn axis_figure(
                 })
                 .collect();
             let limit = limit_si * scale;
+            let largest = lines
+                .iter()
+                .flat_map(|s| s.points.iter().map(|p| p.1))
+                .fold(0.0, f64::max);
+            let drawn = largest >= LIMIT_DRAWN_FROM * limit;
+            // The same legend text in every panel (the limit's value is in the title), so
+            // the figure's panels share one legend.
             lines.push(patterned(
-                format!("table limit {} {unit}", limit_text(limit)),
-                vec![x_range.0, x_range.1]
-                    .into_iter()
-                    .map(|x| (x, limit))
-                    .collect(),
+                "table limit",
+                vec![(x_range.0, limit), (x_range.1, limit)],
                 MODEL,
                 2,
                 Dash::Dashed,
             ));
+            if !drawn {
+                if let Some(limit_line) = lines.last_mut() {
+                    limit_line.points.clear();
+                }
+            }
             lines.extend(markers);
-            let top = lines
-                .iter()
-                .flat_map(|s| s.points.iter().map(|p| p.1))
-                .fold(0.0, f64::max);
+            let top = if drawn { largest.max(limit) } else { largest };
+            let title = if drawn {
+                format!("peak |{quantity}|, table limit {} {unit}", limit_text(limit))
+            } else {
+                format!(
+                    "peak |{quantity}| (table limit {} {unit}, off the scale: {:.0} % of it at most)",
+                    limit_text(limit),
+                    100.0 * largest / limit
+                )
+            };
             Panel {
                 x_range: Some(x_range),
                 y_range: Some((0.0, 1.04 * top.max(f64::MIN_POSITIVE))),
                 ..Panel::new(
-                    format!("peak |{quantity}|"),
+                    title,
                     axis.label.clone(),
                     format!("|peak {quantity}| ({unit})"),
                     lines,
@@ -222,7 +252,8 @@ fn axis_figure(
         title: format!("{}: peak responses against {}", scenario.name, axis.label),
         caption: format!(
             "The largest magnitude of displacement, velocity, acceleration and actuator force \
-             of each case (markers) against {}, {}, with the table's limits (dashed){}.",
+             of each case (markers) against {}, {}, with the table's limits (dashed) where \
+             a peak reaches a quarter of one{}.",
             axis.label,
             if others.is_empty() {
                 "the other axes held".to_owned()
