@@ -93,6 +93,10 @@ pub fn figures(
         .collect()
 }
 
+/// A peak plotted: name, display unit, display units per SI unit, the table's limit (SI),
+/// and the signed peak of an outcome (SI).
+type Quantity = (&'static str, &'static str, f64, f64, fn(&Outcome) -> f64);
+
 /// How many different values.
 fn distinct(values: &[f64]) -> usize {
     let mut v: Vec<f64> = values.to_vec();
@@ -121,7 +125,7 @@ fn axis_figure(
     }
     let many = groups.len() > MAX_LABELLED;
     let l = &scenario.limits;
-    let quantities: [(&str, &str, f64, f64, fn(&Outcome) -> f64); 4] = [
+    let quantities: [Quantity; 4] = [
         ("displacement", "m", 1.0, l.stroke_m, |o| o.peaks.u_m.value),
         ("velocity", "m/s", 1.0, l.velocity_m_s, |o| {
             o.peaks.v_m_s.value
