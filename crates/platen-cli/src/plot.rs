@@ -40,8 +40,10 @@ impl SizeArgs {
             clap::Error::raw(
                 clap::error::ErrorKind::ValueValidation,
                 format!(
-                    "--png-scale {}: the PNG of a {}×{} px figure would be wider than {} px\n",
-                    self.png_scale, largest.0, largest.1, PNG_SIDE_MAX_PX
+                    "--png-scale {}: figures up to {} px a side would give PNGs over {} px\n",
+                    self.png_scale,
+                    largest.0.max(largest.1),
+                    PNG_SIDE_MAX_PX
                 ),
             )
             .exit();

@@ -316,4 +316,19 @@ fn size_options_set_every_figure_and_png_size() {
         assert!(stderr(&o).contains(bad[0]), "{bad:?}: {}", stderr(&o));
         assert!(!out.exists());
     }
+    // A PNG over 20 000 px a side is refused too.
+    let out = dir.path().join("huge");
+    let o = platen(&[
+        "simulate",
+        &scenario("paper-forward-force.json"),
+        "--plot",
+        out.to_str().unwrap(),
+        "--width",
+        "5000",
+        "--png-scale",
+        "8",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("20000 px"), "{}", stderr(&o));
+    assert!(!out.exists());
 }
