@@ -14,7 +14,7 @@ use platen_scenario::{Model, Run, Scenario};
 use serde_json::Value;
 
 mod common;
-use common::{check_png, series_counts, svg_content};
+use common::{check_png, folder_bytes, series_counts, svg_content};
 
 fn platen(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_platen"))
@@ -398,17 +398,7 @@ fn the_figures_and_the_report_are_the_same_bytes_every_run() {
             html.to_str().unwrap(),
         ]);
         assert!(o.status.success(), "{}", stderr(&o));
-        let mut files: Vec<(String, Vec<u8>)> = fs::read_dir(&plots)
-            .unwrap()
-            .map(|e| {
-                let e = e.unwrap();
-                (
-                    e.file_name().to_string_lossy().into_owned(),
-                    fs::read(e.path()).unwrap(),
-                )
-            })
-            .collect();
-        files.sort();
+        let mut files = folder_bytes(&plots);
         files.push(("report".into(), fs::read(&html).unwrap()));
         files
     };

@@ -8,7 +8,7 @@ use std::process::{Command, Output};
 use serde_json::Value;
 
 mod common;
-use common::svg_content;
+use common::{folder_bytes as folder, png_size, svg_content};
 
 fn platen(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_platen"))
@@ -38,29 +38,6 @@ fn ok_json(o: &Output) -> Value {
 const SIMULATED: &str = "#D95F02";
 const RECORDED: &str = "#1F77B4";
 const LIMIT: &str = "#000000";
-
-/// Every file of a folder, by name, with its bytes.
-fn folder(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut files: Vec<(String, Vec<u8>)> = fs::read_dir(dir)
-        .unwrap()
-        .map(|e| {
-            let e = e.unwrap();
-            (
-                e.file_name().to_string_lossy().into_owned(),
-                fs::read(e.path()).unwrap(),
-            )
-        })
-        .collect();
-    files.sort();
-    files
-}
-
-fn png_size(path: &Path) -> (u32, u32) {
-    let png = fs::read(path).unwrap();
-    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "{}", path.display());
-    let be = |b: &[u8]| u32::from_be_bytes(b.try_into().unwrap());
-    (be(&png[16..20]), be(&png[20..24]))
-}
 
 /// The largest |value| of a CSV column (written by `simulate --out`, not by the figures).
 fn csv_peak(path: &Path, column: &str) -> f64 {
@@ -296,39 +273,22 @@ fn size_options_set_every_figure_and_png_size() {
     assert_eq!((c.width, c.height), (630, 260));
     assert_eq!(png_size(&plots.join("hysteresis.png")), (630, 260));
 
-    // Sizes out of range are usage errors, before anything runs.
-    for bad in [
-        ["--width", "10"],
-        ["--height", "big"],
-        ["--png-scale", "0"],
-        ["--png-scale", "9"],
+    // Sizes out of range, and a PNG over 20 000 px a side, are usage errors before anything
+    // runs.
+    for (bad, says) in [
+        (&["--width", "10"][..], "--width"),
+        (&["--height", "big"], "--height"),
+        (&["--png-scale", "0"], "--png-scale"),
+        (&["--png-scale", "9"], "--png-scale"),
+        (&["--width", "5000", "--png-scale", "8"], "20000 px"),
     ] {
         let out = dir.path().join("bad");
-        let o = platen(&[
-            "simulate",
-            &scenario("paper-forward-force.json"),
-            "--plot",
-            out.to_str().unwrap(),
-            bad[0],
-            bad[1],
-        ]);
+        let path = scenario("paper-forward-force.json");
+        let mut args = vec!["simulate", &path, "--plot", out.to_str().unwrap()];
+        args.extend_from_slice(bad);
+        let o = platen(&args);
         assert_eq!(o.status.code(), Some(2), "{bad:?}: {}", stderr(&o));
-        assert!(stderr(&o).contains(bad[0]), "{bad:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(says), "{bad:?}: {}", stderr(&o));
         assert!(!out.exists());
     }
-    // A PNG over 20 000 px a side is refused too.
-    let out = dir.path().join("huge");
-    let o = platen(&[
-        "simulate",
-        &scenario("paper-forward-force.json"),
-        "--plot",
-        out.to_str().unwrap(),
-        "--width",
-        "5000",
-        "--png-scale",
-        "8",
-    ]);
-    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(stderr(&o).contains("20000 px"), "{}", stderr(&o));
-    assert!(!out.exists());
 }
