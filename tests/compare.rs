@@ -14,7 +14,7 @@ use platen_scenario::{Model, Run, Scenario};
 use serde_json::Value;
 
 mod common;
-use common::{check_png, series_counts, svg_content};
+use common::{check_png, folder_bytes, series_counts, svg_content};
 
 fn platen(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_platen"))
@@ -245,7 +245,8 @@ fn every_figure_of_a_forward_comparison_is_valid_svg_with_its_series() {
     for name in ["time-history-u_m", "time-history-v_m_s", "input-force"] {
         let path = plots.join(format!("{name}.svg"));
         let c = svg_content(&path);
-        assert_eq!(series_counts(&c), [4, 4], "{name}: {:?}", c.polylines);
+        // Two panels of each series, and one legend under the title that both panels share.
+        assert_eq!(series_counts(&c), [3, 3], "{name}: {:?}", c.polylines);
         assert!(c.text.contains("time t (s)"), "{name}");
         assert!(c.text.contains("recorded"), "{name}");
         assert!(c.text.contains("zoom"), "{name}");
@@ -265,7 +266,7 @@ fn every_figure_of_a_forward_comparison_is_valid_svg_with_its_series() {
     assert!(residual.text.contains("v sim − rec (mm/s)"));
 
     let loops = svg_content(&plots.join("hysteresis.svg"));
-    assert_eq!(series_counts(&loops), [6, 6], "{:?}", loops.polylines);
+    assert_eq!(series_counts(&loops), [4, 4], "{:?}", loops.polylines);
     for label in [
         "displacement u (m)",
         "velocity v (m/s)",
@@ -329,14 +330,14 @@ fn every_figure_of_an_inverse_comparison_is_valid_svg_with_its_series() {
         ]
     );
     let th = svg_content(&plots.join("time-history-force_n.svg"));
-    assert_eq!(series_counts(&th), [4, 4]);
+    assert_eq!(series_counts(&th), [3, 3]);
     assert!(th.text.contains("actuator force F_A (kN)"));
     let residual = svg_content(&plots.join("residual.svg"));
     assert_eq!(series_counts(&residual), [1]);
     assert!(residual.text.contains("F_A sim − rec (kN)"));
     assert_eq!(
         series_counts(&svg_content(&plots.join("hysteresis.svg"))),
-        [6, 6]
+        [4, 4]
     );
     let fd = svg_content(&plots.join("dissipative-force.svg"));
     assert_eq!(series_counts(&fd), [2]);
@@ -397,17 +398,7 @@ fn the_figures_and_the_report_are_the_same_bytes_every_run() {
             html.to_str().unwrap(),
         ]);
         assert!(o.status.success(), "{}", stderr(&o));
-        let mut files: Vec<(String, Vec<u8>)> = fs::read_dir(&plots)
-            .unwrap()
-            .map(|e| {
-                let e = e.unwrap();
-                (
-                    e.file_name().to_string_lossy().into_owned(),
-                    fs::read(e.path()).unwrap(),
-                )
-            })
-            .collect();
-        files.sort();
+        let mut files = folder_bytes(&plots);
         files.push(("report".into(), fs::read(&html).unwrap()));
         files
     };

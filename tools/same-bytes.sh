@@ -79,6 +79,10 @@ run sweep_forward sweep scenarios/sr9-like-sine-force.json --scale 0.5,1,1.5 --p
 run sweep_full sweep scenarios/full-model-large-stroke.json --scale 0.8,1.2 --set full.strut_area_m2=0.14,0.16 --json
 run sweep_inverse sweep scenarios/s9-sine-motion.json --scale 0.5,2 --pressure-mpa 0,13.8 --json
 run sweep_plain sweep scenarios/paper-forward-force.json --out "$out/sweep-plain.csv"
+run sweep_plot sweep scenarios/sr9-like-sine-force.json --scale 0.5,1,1.5 --pressure-mpa 6.9,13.8 \
+  --plot "$out/sweep-figures" --width 1000
+run simulate_plot simulate scenarios/paper-forward-force.json --json --plot "$out/simulate-figures" \
+  --png-scale 0.5
 
 # Model and schema.
 for form in identified full; do

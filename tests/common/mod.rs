@@ -66,13 +66,36 @@ pub fn series_counts(c: &SvgContent) -> Vec<usize> {
     c.polylines.values().copied().collect()
 }
 
+/// The pixel size of a PNG file (which must be one).
+pub fn png_size(path: &Path) -> (u32, u32) {
+    let png = fs::read(path).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "{}", path.display());
+    let be = |b: &[u8]| u32::from_be_bytes(b.try_into().unwrap());
+    (be(&png[16..20]), be(&png[20..24]))
+}
+
 /// The PNG copy next to an SVG: a PNG of the SVG's pixel size.
 pub fn check_png(svg: &Path, content: &SvgContent) {
-    let png = fs::read(svg.with_extension("png")).unwrap();
-    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "{}", svg.display());
-    let width = u32::from_be_bytes(png[16..20].try_into().unwrap());
-    let height = u32::from_be_bytes(png[20..24].try_into().unwrap());
-    assert_eq!((width, height), (content.width, content.height));
+    assert_eq!(
+        png_size(&svg.with_extension("png")),
+        (content.width, content.height)
+    );
+}
+
+/// Every file of a folder, by name, with its bytes, in name order.
+pub fn folder_bytes(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut files: Vec<(String, Vec<u8>)> = fs::read_dir(dir)
+        .unwrap()
+        .map(|e| {
+            let e = e.unwrap();
+            (
+                e.file_name().to_string_lossy().into_owned(),
+                fs::read(e.path()).unwrap(),
+            )
+        })
+        .collect();
+    files.sort();
+    files
 }
 
 /// Rewrites a platen CSV as a data system would export it: each `(platen column, header,

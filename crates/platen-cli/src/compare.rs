@@ -65,6 +65,8 @@ pub struct Options<'a> {
     pub max_lag_s: f64,
     /// JSON file mapping the record's own channel names and units to platen's columns.
     pub columns: Option<&'a Path>,
+    /// Size of the figures.
+    pub size: platen_report::FigureSize,
 }
 
 /// Runs `platen compare`.
@@ -82,6 +84,7 @@ pub fn run(options: &Options<'_>) -> Result<()> {
     let written = platen_report::write_outputs(
         options.plot,
         options.report,
+        &options.size,
         || compare_figures::figures(&comparison),
         |figures, rendered| html::compare_page(&comparison, figures, rendered),
     )?;

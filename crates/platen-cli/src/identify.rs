@@ -66,6 +66,8 @@ pub struct Options<'a> {
     pub plot: Option<&'a Path>,
     /// Self-contained HTML report.
     pub report: Option<&'a Path>,
+    /// Size of the figures.
+    pub size: platen_report::FigureSize,
     /// JSON file mapping the files' own channel names and units to platen's columns.
     pub columns: Option<&'a Path>,
     /// The method forced on every file (`None`: each file by its data).
@@ -232,6 +234,7 @@ fn run_periodic(
     let written = platen_report::write_outputs(
         opts.plot,
         opts.report,
+        &opts.size,
         || identify_figures::figures(&id),
         |figures, rendered| html_report(&id, inputs, figures, rendered),
     )?;
@@ -319,6 +322,7 @@ fn run_records(
     let written = platen_report::write_outputs(
         opts.plot,
         opts.report,
+        &opts.size,
         || {
             let mut f = record_figures::figures(&id);
             if let Some(p) = &periodic {

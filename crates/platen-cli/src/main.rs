@@ -31,6 +31,7 @@ mod error_json;
 mod generate;
 mod identify;
 mod model;
+mod plot;
 mod schema;
 mod simulate;
 mod sweep;
@@ -73,6 +74,13 @@ enum Command {
         /// Print a machine-readable summary on stdout.
         #[arg(long)]
         json: bool,
+        /// Write the run's figures to this folder as SVG and PNG: motion and actuator force
+        /// over time (with the table's limits near a peak), the force decomposition
+        /// F_A = F_I + F_E + F_D, hysteresis loops of F_A against u, v and a.
+        #[arg(long, value_name = "DIR")]
+        plot: Option<PathBuf>,
+        #[command(flatten)]
+        size: plot::SizeArgs,
     },
     /// Run a scenario and compare it with a recorded test, channel by channel.
     ///
@@ -112,6 +120,8 @@ enum Command {
         /// Largest lag searched by cross-correlation, either way, s.
         #[arg(long, value_name = "S", default_value_t = 0.25, value_parser = compare::parse_max_lag)]
         max_lag: f64,
+        #[command(flatten)]
+        size: plot::SizeArgs,
     },
     /// Print a preset's parameters and derived quantities.
     ///
@@ -216,6 +226,12 @@ enum Command {
         /// Print a machine-readable summary of every case on stdout.
         #[arg(long)]
         json: bool,
+        /// Write figures to this folder as SVG and PNG: for each axis with two or more
+        /// values, the peaks of every case against it with the table's limits.
+        #[arg(long, value_name = "DIR")]
+        plot: Option<PathBuf>,
+        #[command(flatten)]
+        size: plot::SizeArgs,
     },
     /// Identify the platen's parameters from test records.
     ///
@@ -282,6 +298,8 @@ enum Command {
         /// measured motion).
         #[arg(long)]
         no_output_error: bool,
+        #[command(flatten)]
+        size: plot::SizeArgs,
     },
 }
 
@@ -387,7 +405,15 @@ fn run(command: Command) -> anyhow::Result<()> {
             scenario,
             out,
             json,
-        } => simulate::run(&scenario, out.as_deref(), json),
+            plot,
+            size,
+        } => simulate::run(&simulate::Options {
+            scenario: &scenario,
+            out: out.as_deref(),
+            json,
+            plot: plot.as_deref(),
+            size: size.size(),
+        }),
         Command::Compare {
             scenario,
             recorded,
@@ -397,6 +423,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             report,
             columns,
             max_lag,
+            size,
         } => compare::run(&compare::Options {
             scenario: &scenario,
             recorded: &recorded,
@@ -406,6 +433,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             report: report.as_deref(),
             columns: columns.as_deref(),
             max_lag_s: max_lag,
+            size: size.size(),
         }),
         Command::Model {
             preset,
@@ -433,7 +461,20 @@ fn run(command: Command) -> anyhow::Result<()> {
             set,
             out,
             json,
-        } => sweep::run(&scenario, &scale, &pressure_mpa, &set, out.as_deref(), json),
+            plot,
+            size,
+        } => sweep::run(
+            &scenario,
+            &scale,
+            &pressure_mpa,
+            &set,
+            out.as_deref(),
+            json,
+            &sweep::Plot {
+                dir: plot.as_deref(),
+                size: size.size(),
+            },
+        ),
         Command::Identify {
             files,
             pressure_mpa,
@@ -446,6 +487,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             columns,
             method,
             no_output_error,
+            size,
         } => identify::run(&identify::Options {
             files: &files,
             pressure_mpa: &pressure_mpa,
@@ -458,6 +500,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             columns: columns.as_deref(),
             method,
             no_output_error,
+            size: size.size(),
         }),
     }
 }

@@ -10,30 +10,72 @@ use anyhow::Result;
 
 use platen_integrate::{ForwardIntegrator, Peaks, RunStats, Sample, SampleSink};
 use platen_model::STANDARD_GRAVITY_M_S2;
+use platen_report::{run_figures, run_figures::RunRecorder, FigureSize};
 use platen_scenario::{CsvSink, Run, RunSummary, Scenario};
 
-pub fn run(path: &Path, out: Option<&Path>, json_out: bool) -> Result<()> {
+/// The options of `platen simulate`.
+pub struct Options<'a> {
+    /// Scenario JSON file.
+    pub scenario: &'a Path,
+    /// CSV file for the time series.
+    pub out: Option<&'a Path>,
+    /// Print JSON on stdout.
+    pub json: bool,
+    /// Folder for the figures (SVG and PNG).
+    pub plot: Option<&'a Path>,
+    /// Size of the figures.
+    pub size: FigureSize,
+}
+
+pub fn run(opts: &Options<'_>) -> Result<()> {
+    let (path, out) = (opts.scenario, opts.out);
     let scenario = Scenario::load(path)?;
     // Create the temporary output first, so that an unwritable path fails before the run.
     let mut stream = out.map(CsvSink::create).transpose()?;
-    let output = match stream.as_mut() {
-        Some(sink) => scenario.run(sink)?,
-        None => scenario.run(&mut NoOutput)?,
+    // The figures' points are collected as the run goes, in memory that does not grow with it.
+    let mut recorder = opts.plot.map(|_| RunRecorder::new(&scenario.run));
+    let output = match (stream.as_mut(), recorder.as_mut()) {
+        (Some(sink), Some(rec)) => scenario.run(&mut (sink, rec))?,
+        (Some(sink), None) => scenario.run(sink)?,
+        (None, Some(rec)) => scenario.run(rec)?,
+        (None, None) => scenario.run(&mut NoOutput)?,
     };
     if let Some(stream) = stream {
         stream.finish()?;
     }
-    if json_out {
+    let written = match recorder {
+        Some(recorder) => platen_report::write_outputs(
+            opts.plot,
+            None,
+            &opts.size,
+            || run_figures::figures(recorder, &scenario),
+            |_, _| String::new(),
+        )?,
+        None => Vec::new(),
+    };
+    if opts.json {
         let summary = RunSummary::new(path, &scenario, &output, out);
         // Through a Value, so the keys come out in alphabetical order.
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&serde_json::to_value(&summary)?)?
-        );
+        let mut value = serde_json::to_value(&summary)?;
+        if let (Some(_), Some(map)) = (opts.plot, value.as_object_mut()) {
+            map.insert("figures".into(), figure_list(&written).into());
+        }
+        outln!("{}", serde_json::to_string_pretty(&value)?);
     } else {
         print_summary(&scenario, &output.peaks, output.stats.as_ref(), out)?;
+        if !written.is_empty() {
+            outln!("  wrote {} figure files (SVG and PNG):", written.len());
+            for path in &written {
+                outln!("    {}", path.display());
+            }
+        }
     }
     Ok(())
+}
+
+/// The figure files written, as the `figures` list of `--json`.
+pub fn figure_list(written: &[std::path::PathBuf]) -> Vec<String> {
+    written.iter().map(|p| p.display().to_string()).collect()
 }
 
 /// `", overridden: name = value, …"` when the scenario lays values over its preset's.

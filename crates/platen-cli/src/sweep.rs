@@ -96,6 +96,14 @@ pub fn parse_set(s: &str) -> std::result::Result<SetAxis, String> {
     })
 }
 
+/// Where `platen sweep` writes its figures, and their size.
+pub struct Plot<'a> {
+    /// Folder for the figures (SVG and PNG).
+    pub dir: Option<&'a Path>,
+    /// Size of the figures.
+    pub size: platen_report::FigureSize,
+}
+
 /// Runs every case of the grid over the scenario at `path` and reports one row per case.
 pub fn run(
     path: &Path,
@@ -104,6 +112,7 @@ pub fn run(
     sets: &[SetAxis],
     out: Option<&Path>,
     json_out: bool,
+    plot: &Plot<'_>,
 ) -> Result<()> {
     let scenario = Scenario::load(path)?;
     check_axes(path, &scenario, sets);
@@ -127,11 +136,32 @@ pub fn run(
         let csv = sweep::csv_text(&scenario, set_names, cases, &outcomes);
         write_bytes_atomic(out, csv.as_bytes())?;
     }
+    let written = platen_report::write_outputs(
+        plot.dir,
+        None,
+        &plot.size,
+        || platen_report::sweep_figures::figures(&scenario, set_names, cases, &outcomes),
+        |_, _| String::new(),
+    )?;
     if json_out {
-        let summary = sweep::json_summary(path, &scenario, set_names, cases, &outcomes, out);
+        let mut summary = sweep::json_summary(path, &scenario, set_names, cases, &outcomes, out);
+        if let (Some(_), Some(map)) = (plot.dir, summary.as_object_mut()) {
+            map.insert(
+                "figures".into(),
+                crate::simulate::figure_list(&written).into(),
+            );
+        }
         outln!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
         print_summary(&scenario, set_names, cases, &outcomes, out, wall_s)?;
+        if plot.dir.is_some() {
+            if written.is_empty() {
+                outln!("  no figures: every axis holds one value (give two or more to plot peaks against it)");
+            }
+            for path in &written {
+                outln!("  wrote {}", path.display());
+            }
+        }
     }
     failures(&outcomes, out.is_some())
 }

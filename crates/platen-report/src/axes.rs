@@ -1,10 +1,7 @@
 //! Axes: the data ranges of a panel, tick spacing and labels (the same search plotters makes,
-//! so the decimals tell the drawn ticks apart), the width of the y label area, and where the
-//! legend goes.
+//! so the decimals tell the drawn ticks apart) and the width of the y label area.
 
-use plotters::chart::SeriesLabelPosition;
-
-use crate::figure::{Panel, Series, AXIS_DESC_SIZE, LEGEND_SIZE, TICK_SIZE, Y_LABELS_MAX};
+use crate::figure::{Panel, AXIS_DESC_SIZE, TICK_SIZE, Y_LABELS_MAX};
 
 /// The range of `values` widened by 4 % each way (a unit band around a constant).
 fn padded_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
@@ -80,7 +77,8 @@ pub(crate) fn format_tick(value: f64, decimals: usize) -> String {
     }
 }
 
-/// The x and y ranges of a panel: the given or data x range, and the data's y range over it.
+/// The x and y ranges of a panel: the given or data x range, and the given or data y range
+/// over it.
 pub(crate) fn ranges(panel: &Panel) -> ((f64, f64), (f64, f64)) {
     let x = panel.x_range.unwrap_or_else(|| {
         padded_range(
@@ -90,13 +88,15 @@ pub(crate) fn ranges(panel: &Panel) -> ((f64, f64), (f64, f64)) {
                 .flat_map(|s| s.points.iter().map(|p| p.0)),
         )
     });
-    let y = padded_range(
-        panel
-            .series
-            .iter()
-            .flat_map(|s| s.points.iter().filter(|p| p.0 >= x.0 && p.0 <= x.1))
-            .map(|p| p.1),
-    );
+    let y = panel.y_range.unwrap_or_else(|| {
+        padded_range(
+            panel
+                .series
+                .iter()
+                .flat_map(|s| s.points.iter().filter(|p| p.0 >= x.0 && p.0 <= x.1))
+                .map(|p| p.1),
+        )
+    });
     (x, y)
 }
 
@@ -111,68 +111,6 @@ pub(crate) fn y_label_area(y: (f64, f64)) -> u32 {
         .max()
         .unwrap_or(4);
     (widest as f64 * 0.62 * TICK_SIZE / 1.24 + 1.9 * AXIS_DESC_SIZE) as u32 + 8
-}
-
-/// Where the legend goes and the y range that leaves room for it.
-///
-/// The legend box (its size estimated from its text) goes in the corner of the plotting area
-/// that holds the fewest data points; if every corner holds some, the y range is extended
-/// upwards by the legend's height and the legend sits in that headroom, top right, so it
-/// never hides data.
-pub(crate) fn place_legend(
-    panel: &Panel,
-    x: (f64, f64),
-    y: (f64, f64),
-    plot_px: (f64, f64),
-) -> (SeriesLabelPosition, (f64, f64)) {
-    let labelled: Vec<&Series> = panel
-        .series
-        .iter()
-        .filter(|s| !s.label.is_empty())
-        .collect();
-    let longest = labelled
-        .iter()
-        .map(|s| s.label.chars().count())
-        .max()
-        .unwrap_or(0);
-    let em = LEGEND_SIZE / 1.24;
-    let legend_w = longest as f64 * 0.6 * em + 36.0 + 40.0;
-    let legend_h = labelled.len() as f64 * 1.55 * em + 30.0;
-    let (fw, fh) = (
-        (legend_w / plot_px.0).min(1.0),
-        (legend_h / plot_px.1).min(0.9),
-    );
-    let corners = [
-        ((1.0 - fw, 1.0), (1.0 - fh, 1.0)),
-        ((0.0, fw), (1.0 - fh, 1.0)),
-        ((1.0 - fw, 1.0), (0.0, fh)),
-        ((0.0, fw), (0.0, fh)),
-    ];
-    let mut counts = [0usize; 4];
-    for s in &panel.series {
-        for &(px, py) in &s.points {
-            let fx = (px - x.0) / (x.1 - x.0);
-            let fy = (py - y.0) / (y.1 - y.0);
-            for (count, (cx, cy)) in counts.iter_mut().zip(&corners) {
-                if (cx.0..=cx.1).contains(&fx) && (cy.0..=cy.1).contains(&fy) {
-                    *count += 1;
-                }
-            }
-        }
-    }
-    let best = (0..4).min_by_key(|&i| counts[i]).unwrap_or(0);
-    if labelled.is_empty() || counts[best] == 0 {
-        let position = match best {
-            0 => SeriesLabelPosition::UpperRight,
-            1 => SeriesLabelPosition::UpperLeft,
-            2 => SeriesLabelPosition::LowerRight,
-            _ => SeriesLabelPosition::LowerLeft,
-        };
-        return (position, y);
-    }
-    // Headroom: the data keep the lower (1 − fh) of the height.
-    let top = y.0 + (y.1 - y.0) / (1.0 - fh);
-    (SeriesLabelPosition::UpperRight, (y.0, top))
 }
 
 #[cfg(test)]

@@ -8,9 +8,9 @@ use plotters::style::RGBColor;
 use platen_compare::{ComparedChannel, Comparison, Direction};
 use platen_signal::metrics::signed_peak;
 
-use crate::figure::{Figure, Panel, MODEL, RECORDED, RESIDUAL, SIMULATED};
+use crate::figure::{Dash, Figure, Panel, MODEL, RECORDED, RESIDUAL, SIMULATED};
 use crate::series::{
-    envelope, every, line, points, scaled, thinned, MAX_LOOP_POINTS, MAX_SCATTER_POINTS,
+    envelope, every, line, patterned, points, scaled, thinned, MAX_LOOP_POINTS, MAX_SCATTER_POINTS,
 };
 use crate::text::{display_units, significant};
 
@@ -56,11 +56,11 @@ impl<'a> Context<'a> {
     }
 
     /// Two time-history panels: the whole record with the zoomed interval shaded, and the
-    /// zoom; `series` are (label, values, colour, width).
+    /// zoom; `series` are (label, values, colour, width, pattern).
     fn whole_and_zoom(
         &self,
         y_label: String,
-        series: [(&str, &[f64], RGBColor, u32); 2],
+        series: [(&str, &[f64], RGBColor, u32, Dash); 2],
         note: &str,
     ) -> Vec<Panel> {
         let (z0, z1) = self.zoom;
@@ -70,17 +70,19 @@ impl<'a> Context<'a> {
             y_label: y_label.clone(),
             series: series
                 .iter()
-                .map(|&(label, y, color, width)| {
-                    line(
+                .map(|&(label, y, color, width, dash)| {
+                    patterned(
                         label,
                         envelope(&self.c.t_s, y, range, BUCKETS),
                         color,
                         width,
+                        dash,
                     )
                 })
                 .collect(),
             x_range: Some(range),
             shade_x: shade,
+            y_range: None,
         };
         vec![
             panel(
@@ -108,8 +110,8 @@ fn time_history(ctx: &Context<'_>, ch: &ComparedChannel) -> Figure {
             channel.symbol()
         ),
         caption: format!(
-            "{} of {} (blue, drawn wider) and of the simulation (orange, on top): \
-             whole record, and the shaded interval zoomed below ({zoom_note}).",
+            "{} of {} (solid blue, drawn wider) and of the simulation (dashed orange, on \
+             top): whole record, and the shaded interval zoomed below ({zoom_note}).",
             capitalised(channel.quantity()),
             ctx.rec_name
         ),
@@ -121,12 +123,13 @@ fn time_history(ctx: &Context<'_>, ch: &ComparedChannel) -> Figure {
                 units.unit
             ),
             [
-                ("recorded", &rec, RECORDED, 4),
-                ("simulated", &sim, SIMULATED, 2),
+                ("recorded", &rec, RECORDED, 4, Dash::Solid),
+                ("simulated", &sim, SIMULATED, 2, Dash::Dashed),
             ],
             &format!(" ({zoom_note})"),
         ),
         columns: 1,
+        rows: Vec::new(),
         size: (1200, 900),
     }
 }
@@ -139,24 +142,26 @@ fn input_force(ctx: &Context<'_>, recorded_n: &[f64]) -> Figure {
         name: "input-force".into(),
         title: "Actuator force: recorded and as it drives the model".into(),
         caption: format!(
-            "The force column of {} as recorded (blue) and the scenario's excitation \
-             that drove the forward run, after any low-pass the scenario sets (orange).",
+            "The force column of {} as recorded (solid blue) and the scenario's excitation \
+             that drove the forward run, after any low-pass the scenario sets (dashed orange).",
             ctx.rec_name
         ),
         panels: ctx.whole_and_zoom(
             "actuator force F_A (kN)".into(),
             [
-                ("recorded", &rec, RECORDED, 2),
+                ("recorded", &rec, RECORDED, 3, Dash::Solid),
                 (
                     "driving the model (scenario excitation)",
                     &drv,
                     SIMULATED,
                     2,
+                    Dash::Dashed,
                 ),
             ],
             "",
         ),
         columns: 1,
+        rows: Vec::new(),
         size: (1200, 900),
     }
 }
@@ -185,6 +190,7 @@ fn residuals(ctx: &Context<'_>) -> Figure {
             )],
             x_range: Some(ctx.span),
             shade_x: c.window.map(|w| (w.start_s, w.end_s)),
+            y_range: None,
         }
     };
     Figure {
@@ -197,6 +203,7 @@ fn residuals(ctx: &Context<'_>) -> Figure {
         ),
         panels: c.channels.iter().map(panel).collect(),
         columns: 1,
+        rows: Vec::new(),
         size: (1200, 420 * c.channels.len() as u32 + 60),
     }
 }
@@ -236,8 +243,8 @@ fn hysteresis(c: &Comparison) -> Figure {
             format!("{quantity} {symbol} ({unit})"),
             "actuator force F_A (kN)",
             vec![
-                line("recorded", rec_points, RECORDED, 1),
-                line(sim_label, sim_points, SIMULATED, 2),
+                line("recorded", rec_points, RECORDED, 3),
+                patterned(sim_label, sim_points, SIMULATED, 1, Dash::Dashed),
             ],
         ));
     }
@@ -251,7 +258,8 @@ fn hysteresis(c: &Comparison) -> Figure {
         title: "Hysteresis loops: actuator force against the motion".into(),
         caption: format!(
             "Actuator force against displacement, velocity and acceleration (as the paper's Figs \
-             4–6 and 11): recorded ({}) and simulated ({}){thinning}.",
+             4–6 and 11): recorded ({}; solid blue, drawn wider) and simulated ({}; dashed \
+             orange, on top){thinning}.",
             c.recorded.sources.loops,
             match c.direction {
                 Direction::Forward =>
@@ -261,6 +269,7 @@ fn hysteresis(c: &Comparison) -> Figure {
         ),
         panels: loops,
         columns: 3,
+        rows: Vec::new(),
         size: (1260, 520),
     }
 }
@@ -297,6 +306,7 @@ fn dissipative_force(c: &Comparison) -> Figure {
             ],
         )],
         columns: 1,
+        rows: Vec::new(),
         size: (1200, 800),
     }
 }

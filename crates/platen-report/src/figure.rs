@@ -1,5 +1,6 @@
 //! What a figure is made of: a title over a grid of panels, each a set of axes holding line,
-//! point or segment series. Drawing is [`Figure::to_svg`], rendering and writing in
+//! point or segment series, with its legend in a strip above the axes (never over the data;
+//! one strip under the title when every panel has the same legend). Drawing is [`Figure::to_svg`], rendering and writing in
 //! [`crate::render`].
 
 use plotters::style::RGBColor;
@@ -27,8 +28,42 @@ pub(crate) const X_LABELS_MAX: usize = 14;
 /// Most tick labels on a vertical axis.
 pub(crate) const Y_LABELS_MAX: usize = 12;
 
+/// The stroke pattern of a line, so that series differ without colour (a figure printed in
+/// grey or read by a colour-blind reader): recorded data solid, simulated dashed, model
+/// terms dotted or dash-dotted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Dash {
+    /// A continuous line.
+    #[default]
+    Solid,
+    /// Dashes about five widths long.
+    Dashed,
+    /// Round dots.
+    Dotted,
+    /// Alternating dashes and dots.
+    DashDot,
+}
+
+impl Dash {
+    /// The SVG `stroke-dasharray` of the pattern for a line `width` px wide (`None`: solid).
+    pub fn dasharray(self, width: u32) -> Option<String> {
+        let w = f64::from(width.max(1));
+        match self {
+            Dash::Solid => None,
+            Dash::Dashed => Some(format!("{} {}", 4.0 * w + 4.0, 2.0 * w + 2.0)),
+            Dash::Dotted => Some(format!("0.1 {}", 2.0 * w + 1.0)),
+            Dash::DashDot => Some(format!(
+                "{} {} 0.1 {}",
+                4.0 * w + 4.0,
+                2.0 * w + 1.0,
+                2.0 * w + 1.0
+            )),
+        }
+    }
+}
+
 /// How a series is drawn.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Style {
     /// A polyline.
     Line {
@@ -36,6 +71,8 @@ pub enum Style {
         color: RGBColor,
         /// Stroke width, px.
         width: u32,
+        /// Stroke pattern.
+        dash: Dash,
     },
     /// Filled circles.
     Points {
@@ -78,6 +115,8 @@ pub struct Panel {
     pub series: Vec<Series>,
     /// Horizontal range (default: the data's).
     pub x_range: Option<(f64, f64)>,
+    /// Vertical range (default: the data's over the horizontal range, widened 4 % each way).
+    pub y_range: Option<(f64, f64)>,
     /// A horizontal interval to shade (a zoomed window).
     pub shade_x: Option<(f64, f64)>,
 }
@@ -113,6 +152,9 @@ pub struct Figure {
     pub panels: Vec<Panel>,
     /// Panels per row.
     pub columns: usize,
+    /// Panels in each row, top to bottom, when the rows differ (a wide panel over a row of
+    /// small ones); empty: every row has `columns` panels.
+    pub rows: Vec<usize>,
     /// Size in px.
     pub size: (u32, u32),
 }

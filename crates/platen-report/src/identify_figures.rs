@@ -15,8 +15,8 @@ use plotters::style::RGBColor;
 
 use platen_ident::{DissipativeLaw, Estimate, Identification, PressureGroup, TestKind, TestResult};
 
-use crate::figure::{Figure, Panel, Series, MODEL};
-use crate::series::{line, points, segments, thinned, Points, MAX_SCATTER_POINTS};
+use crate::figure::{Dash, Figure, Panel, Series, MODEL};
+use crate::series::{line, patterned, points, segments, thinned, Points, MAX_SCATTER_POINTS};
 
 /// Colours of the pressure groups, by increasing pressure (repeated beyond four groups).
 pub const GROUP_COLORS: [RGBColor; 4] = [
@@ -186,6 +186,7 @@ fn estimates(id: &Identification, triangles: bool, sines: bool) -> Option<Figure
             .into(),
         panels,
         columns,
+        rows: Vec::new(),
         size: (700 * columns as u32, 620),
     })
 }
@@ -253,11 +254,12 @@ fn mass_panel(id: &Identification) -> Panel {
             .filter(|t| t.effective_mass.is_some())
             .map(|t| t.peak_acceleration_m_s2)
             .fold(0.0, f64::max);
-        series.push(line(
+        series.push(patterned(
             format!("Mₑ = {:.2} t (mean of the used)", m / 1e3),
             vec![(0.0, m / 1e3), (x_max, m / 1e3)],
             MODEL,
             2,
+            Dash::Dashed,
         ));
     }
     Panel::new(
@@ -268,7 +270,9 @@ fn mass_panel(id: &Identification) -> Panel {
     )
 }
 
-/// Elastic force against displacement, per pressure, with Kₑ·u and what Kₑ·u leaves.
+/// Elastic force against displacement, per pressure, with Kₑ·u (top), and what Kₑ·u leaves,
+/// one panel per pressure on a shared scale (below: the pressures' residuals have the same
+/// shape and would hide one another in one panel).
 fn elastic_force(id: &Identification) -> Figure {
     let (mut lines, mut data, mut residuals) = (Vec::new(), Vec::new(), Vec::new());
     for (i, g) in id.pressures.iter().enumerate() {
@@ -290,108 +294,142 @@ fn elastic_force(id: &Identification) -> Figure {
         ));
         if let (Some(k), Some(residual)) = (stiffness, residual) {
             let (lo, hi) = range_of(curve.iter().map(|p| p[0]));
-            lines.push(line(
+            lines.push(patterned(
                 format!("Kₑ·u, Kₑ = {:.4} MN/m", k / 1e6),
                 vec![(lo, k * lo / 1e3), (hi, k * hi / 1e3)],
                 color,
                 2,
+                Dash::Dashed,
             ));
-            residuals.push(points(group_name(g.pressure_pa), residual, color, 2));
+            residuals.push((
+                g.pressure_pa,
+                points(group_name(g.pressure_pa), residual, color, 2),
+            ));
         }
     }
-    // The lines first, so that the data drawn over them stay visible.
-    lines.extend(data);
-    fit_figure(
-        (
-            "elastic-force",
-            "Elastic force against displacement (Eq. 16/17)",
-        ),
-        "Top: the elastic part of the actuator force over the constant-velocity \
-         portions of the triangle tests (the dissipative part removed with the \
-         opposite-velocity half cycle), by hold-down pressure, with each \
-         pressure's stiffness line. Bottom: what the line leaves; a curvature \
-         there is the hold-down struts' cubic term K′ₑ(u/h)²u, which the \
-         identified model does not have.",
-        ("displacement u (m)", "elastic force F_E (kN)"),
-        (lines, residuals),
-        ("Residual of the stiffness line", "F_E − Kₑ·u (kN)"),
-    )
+    // The data first, the dashed lines over them (the data are dense enough to hide a line).
+    data.extend(lines);
+    let (x_label, residual_label) = ("displacement u (m)", "F_E − Kₑ·u (kN)");
+    let shared = padded(range_of(
+        residuals
+            .iter()
+            .flat_map(|(_, s)| s.points.iter().map(|p| p.1)),
+    ));
+    let mut panels = vec![Panel::new("", x_label, "elastic force F_E (kN)", data)];
+    let row = residuals.len();
+    panels.extend(residuals.into_iter().map(|(p, series)| Panel {
+        y_range: shared,
+        ..Panel::new(
+            format!("residual at {}", group_name(p)),
+            x_label,
+            residual_label,
+            vec![Series {
+                label: String::new(),
+                ..series
+            }],
+        )
+    }));
+    Figure {
+        name: "elastic-force".into(),
+        title: "Elastic force against displacement (Eq. 16/17)".into(),
+        caption: "Top: the elastic part of the actuator force over the constant-velocity \
+                  portions of the triangle tests (the dissipative part removed with the \
+                  opposite-velocity half cycle), by hold-down pressure (points), with each \
+                  pressure's stiffness line (dashed). Below, one panel per pressure on one \
+                  scale: what the line leaves; a curvature there is the hold-down struts' \
+                  cubic term K′ₑ(u/h)²u, which the identified model does not have."
+            .into(),
+        columns: 1,
+        rows: if row > 0 { vec![1, row] } else { Vec::new() },
+        panels,
+        size: (1200, 1200),
+    }
 }
 
-/// Inertial force against acceleration, with Mₑ·a and what Mₑ·a leaves.
+/// The range widened by 4 % each way (`None` for no values).
+fn padded((lo, hi): (f64, f64)) -> Option<(f64, f64)> {
+    if !(lo.is_finite() && hi.is_finite()) {
+        return None;
+    }
+    let pad = 0.04 * (hi - lo).max(1e-9 * lo.abs().max(hi.abs()).max(1.0));
+    Some((lo - pad, hi + pad))
+}
+
+/// What the mass line leaves of the sine tests' inertial force: in kN against the
+/// acceleration (top), and per test relative to its own peak inertial force against its own
+/// normalised acceleration (below), where the flagged tests (tiny accelerations, near a = 0
+/// above) show how far from the line they are.
 fn inertial_force(id: &Identification) -> Figure {
     let mass = effective_mass_kg(id);
-    let (mut series, mut residuals) = (Vec::new(), Vec::new());
-    if let Some(m) = mass {
-        let a_max = id
-            .tests
-            .iter()
-            .flat_map(|t| t.inertial_curve.iter().map(|p| p[0].abs()))
-            .fold(0.0, f64::max);
-        series.push(line(
-            format!("Mₑ·a, Mₑ = {:.2} t", m / 1e3),
-            vec![(-a_max, -m * a_max / 1e3), (a_max, m * a_max / 1e3)],
-            MODEL,
-            2,
-        ));
-    }
+    let (mut absolute, mut relative) = (Vec::new(), Vec::new());
     for (used, label, color) in [
         (true, "used tests", GROUP_COLORS[0]),
         (false, "flagged tests (not used)", UNUSED),
     ] {
-        let curve: Vec<[f64; 2]> = id
+        let tests: Vec<&TestResult> = id
             .tests
             .iter()
             .filter(|t| {
                 t.kind == TestKind::Sine && t.effective_mass.is_some() && t.used_for_mass == used
             })
+            .collect();
+        let curve: Vec<[f64; 2]> = tests
+            .iter()
             .flat_map(|t| t.inertial_curve.iter().copied())
             .collect();
-        if curve.is_empty() {
+        let Some(m) = mass.filter(|_| !curve.is_empty()) else {
             continue;
+        };
+        if let (_, Some(residual)) = scatter_and_residual(&curve, Some(m)) {
+            absolute.push(points(label, residual, color, 2));
         }
-        let (pts, residual) = scatter_and_residual(&curve, mass);
-        series.push(points(label, pts, color, 2));
-        if let Some(residual) = residual {
-            residuals.push(points(label, residual, color, 2));
+        let (mut x, mut y) = (Vec::new(), Vec::new());
+        for t in &tests {
+            let a_peak = t
+                .inertial_curve
+                .iter()
+                .map(|p| p[0].abs())
+                .fold(0.0, f64::max);
+            if a_peak > 0.0 {
+                for p in &t.inertial_curve {
+                    x.push(p[0] / a_peak);
+                    y.push(100.0 * (p[1] - m * p[0]) / (m * a_peak));
+                }
+            }
         }
+        relative.push(points(
+            label,
+            thinned(&x, &y, MAX_SCATTER_POINTS).0,
+            color,
+            2,
+        ));
     }
-    fit_figure(
-        (
-            "inertial-force",
-            "Inertial force against acceleration (Eq. 18/19)",
-        ),
-        "Top: the inertial part of the actuator force of the sine tests (the \
-         elastic and dissipative parts removed by the half-period symmetry of the \
-         cycle), with the line of the final Mₑ. Bottom: what the line leaves. \
-         Flagged tests (too small an inertial force, distorted or imprecise) in \
-         grey: their accelerations are tiny, so they sit near a = 0.",
-        ("acceleration a (m/s²)", "inertial force F_I (kN)"),
-        (series, residuals),
-        ("Residual of the mass line", "F_I − Mₑ·a (kN)"),
-    )
-}
-
-/// A decomposed force with its fitted line (top) and what the line leaves (bottom):
-/// `(name, title)`, caption, the top panel's `(x label, y label)`, the `(top, bottom)`
-/// series and the bottom panel's `(title, y label)`.
-fn fit_figure(
-    (name, title): (&str, &str),
-    caption: &str,
-    (x_label, y_label): (&str, &str),
-    (series, residuals): (Vec<Series>, Vec<Series>),
-    (residual_title, residual_label): (&str, &str),
-) -> Figure {
+    let title = match mass {
+        Some(m) => format!("Residual of the mass line Mₑ·a, Mₑ = {:.2} t", m / 1e3),
+        None => "No effective mass identified".to_owned(),
+    };
     Figure {
-        name: name.into(),
-        title: title.into(),
-        caption: caption.into(),
+        name: "inertial-force".into(),
+        title: "Inertial force against acceleration: what the mass line leaves (Eq. 18/19)".into(),
+        caption: "The inertial part of the actuator force of the sine tests (the elastic and \
+                  dissipative parts removed by the half-period symmetry of the cycle) less \
+                  the final Mₑ·a. Top: in kN against the acceleration. Below: per test, \
+                  relative to the test's peak inertial force Mₑ·a_peak, against its \
+                  acceleration over its peak, so every test spans −1 to 1. Flagged tests \
+                  (too small an inertial force, distorted or imprecise) in grey."
+            .into(),
         panels: vec![
-            Panel::new("", x_label, y_label, series),
-            Panel::new(residual_title, x_label, residual_label, residuals),
+            Panel::new(title, "acceleration a (m/s²)", "F_I − Mₑ·a (kN)", absolute),
+            Panel::new(
+                "Relative to each test's peak inertial force",
+                "acceleration over the test's peak a/a_peak",
+                "(F_I − Mₑ·a)/(Mₑ·a_peak) (%)",
+                relative,
+            ),
         ],
         columns: 1,
-        size: (1200, 1200),
+        rows: Vec::new(),
+        size: (1200, 1100),
     }
 }
 
@@ -405,7 +443,7 @@ fn dissipative_force(id: &Identification) -> Option<Figure> {
     let mut series = dissipative_series(id, v_max);
     if let Some(p) = &id.paper_fit {
         let (fmu, ce) = (p.coulomb_force.value, p.viscous_coefficient.value);
-        series.push(line(
+        series.push(patterned(
             "Eq. 21 fit: F_μ + Cₑ·|v|^0.5",
             speed_grid(v_max)
                 .into_iter()
@@ -413,6 +451,7 @@ fn dissipative_force(id: &Identification) -> Option<Figure> {
                 .collect(),
             PAPER_FIT,
             2,
+            Dash::Dashed,
         ));
     }
     let peaks: Vec<(f64, f64)> = id
@@ -442,6 +481,7 @@ fn dissipative_force(id: &Identification) -> Option<Figure> {
             series,
         )],
         columns: 1,
+        rows: Vec::new(),
         size: (1200, 800),
     })
 }
@@ -500,11 +540,12 @@ fn friction(id: &Identification) -> Option<Figure> {
         }
     }
     let mut series = est.into_series("F_μ per pressure", GROUP_COLORS[0]);
-    series.push(line(
+    series.push(patterned(
         format!("μₑ·F_z, μₑ = {:.4} %", 100.0 * mu.value),
         vec![(0.0, 0.0), (f_z_max, mu.value * f_z_max * 1e3)],
         MODEL,
         2,
+        Dash::Dashed,
     ));
     Some(Figure {
         name: "friction".into(),
@@ -520,6 +561,7 @@ fn friction(id: &Identification) -> Option<Figure> {
             series,
         )],
         columns: 1,
+        rows: Vec::new(),
         size: (1000, 700),
     })
 }

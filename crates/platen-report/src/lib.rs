@@ -6,6 +6,9 @@
 //! * [`compare_figures`] and [`identify_figures`] build the figures of a
 //!   [`Comparison`](platen_compare::Comparison) and of an
 //!   [`Identification`](platen_ident::Identification).
+//! * [`run_figures`] builds the figures of a run without a recording (`simulate --plot`),
+//!   collected while it runs ([`run_figures::RunRecorder`]), and [`sweep_figures`] the peaks
+//!   of a sweep against each of its axes, with the table's limits.
 //! * [`render`] writes them: SVG, PNG copies rendered by resvg with the embedded Noto Sans,
 //!   and the HTML page, every file atomically ([`write_outputs`]).
 //! * [`html`] builds self-contained pages; [`text`] the numbers, metric rows and terminal
@@ -42,8 +45,10 @@
 //!   and forces in kN ([`text::display_units`]), residuals of motion in mm and mm/s.
 //! * **Residual** = **simulated − recorded**, on the recorded time base.
 //! * **Lag** > 0 means the simulation is late.
-//! * Colours: recorded data blue ([`figure::RECORDED`]), simulated orange
-//!   ([`figure::SIMULATED`]), model laws and fits black ([`figure::MODEL`]).
+//! * Colours and strokes: recorded data solid blue ([`figure::RECORDED`]), simulated dashed
+//!   orange ([`figure::SIMULATED`]), model laws and fits black ([`figure::MODEL`]), so that
+//!   recorded and simulated differ without colour too ([`figure::Dash`]).
+//! * Legends sit in a strip above each panel's axes: they never hide data or stretch an axis.
 
 mod axes;
 pub mod compare_figures;
@@ -53,10 +58,12 @@ pub mod html;
 pub mod identify_figures;
 pub mod record_figures;
 pub mod render;
+pub mod run_figures;
 pub mod series;
 mod svg;
+pub mod sweep_figures;
 pub mod text;
 
 pub use error::{ReportError, Result};
 pub use figure::{Figure, Panel, Series, Style};
-pub use render::{render_all, svg_to_png, write_figures, write_outputs};
+pub use render::{render_all, svg_to_png, write_figures, write_outputs, FigureSize};

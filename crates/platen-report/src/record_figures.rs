@@ -4,15 +4,16 @@
 //! output error's simulation; and the dissipative force against speed, with the law and its
 //! 95 % band.
 //!
-//! Colours: recorded data blue ([`RECORDED`]), fitted or simulated orange ([`SIMULATED`]),
-//! residuals purple ([`RESIDUAL`]), the law black ([`MODEL`]) with its band grey.
+//! Colours: recorded data solid blue ([`RECORDED`]), fitted or simulated dashed orange
+//! ([`SIMULATED`]), residuals purple ([`RESIDUAL`]), the law black ([`MODEL`]) with its band
+//! grey.
 
 use plotters::style::RGBColor;
 
 use platen_ident::{RecordIdentification, RecordReport};
 
-use crate::figure::{Figure, Panel, MODEL, RECORDED, RESIDUAL, SIMULATED};
-use crate::series::{envelope, line, points, thinned, MAX_SCATTER_POINTS};
+use crate::figure::{Dash, Figure, Panel, MODEL, RECORDED, RESIDUAL, SIMULATED};
+use crate::series::{envelope, line, patterned, points, thinned, MAX_SCATTER_POINTS};
 
 /// Colour of the law's confidence band.
 pub const BAND: RGBColor = RGBColor(150, 150, 150);
@@ -79,8 +80,8 @@ fn force(rec: &RecordReport, suffix: &str) -> Figure {
                 "t (s)",
                 "force (kN)",
                 vec![
-                    line("measured", envelope(&t, &kn(&rec.force_n), range, BUCKETS), RECORDED, 1),
-                    line("fitted", envelope(&t, &kn(&rec.fitted_force_n), range, BUCKETS), SIMULATED, 1),
+                    line("measured", envelope(&t, &kn(&rec.force_n), range, BUCKETS), RECORDED, 2),
+                    patterned("fitted", envelope(&t, &kn(&rec.fitted_force_n), range, BUCKETS), SIMULATED, 1, Dash::Dashed),
                 ],
             ),
             Panel::new(
@@ -91,6 +92,7 @@ fn force(rec: &RecordReport, suffix: &str) -> Figure {
             ),
         ],
         columns: 1,
+        rows: Vec::new(),
         size: (1400, 900),
     }
 }
@@ -119,8 +121,8 @@ fn displacement(rec: &RecordReport, suffix: &str) -> Figure {
                 "t (s)",
                 "u (mm)",
                 vec![
-                    line("measured", envelope(&t, &mm(&rec.u_m), range, BUCKETS), RECORDED, 1),
-                    line("simulated", envelope(&t, &mm(sim), range, BUCKETS), SIMULATED, 1),
+                    line("measured", envelope(&t, &mm(&rec.u_m), range, BUCKETS), RECORDED, 2),
+                    patterned("simulated", envelope(&t, &mm(sim), range, BUCKETS), SIMULATED, 1, Dash::Dashed),
                 ],
             ),
             Panel::new(
@@ -131,6 +133,7 @@ fn displacement(rec: &RecordReport, suffix: &str) -> Figure {
             ),
         ],
         columns: 1,
+        rows: Vec::new(),
         size: (1400, 900),
     }
 }
@@ -177,6 +180,7 @@ fn dissipative(id: &RecordIdentification) -> Figure {
             ],
         )],
         columns: 1,
+        rows: Vec::new(),
         size: (1100, 800),
     }
 }

@@ -3,7 +3,7 @@
 
 use plotters::style::RGBColor;
 
-use crate::figure::{Series, Style};
+use crate::figure::{Dash, Series, Style};
 
 /// Points `(x, y)` of a series, in the panel's units.
 pub type Points = Vec<(f64, f64)>;
@@ -77,9 +77,28 @@ pub fn series(label: impl Into<String>, points: Vec<(f64, f64)>, style: Style) -
     }
 }
 
-/// A line series.
+/// A solid line series.
 pub fn line(label: impl Into<String>, points: Points, color: RGBColor, width: u32) -> Series {
-    series(label, points, Style::Line { color, width })
+    series(
+        label,
+        points,
+        Style::Line {
+            color,
+            width,
+            dash: Dash::Solid,
+        },
+    )
+}
+
+/// A line series with a stroke pattern.
+pub fn patterned(
+    label: impl Into<String>,
+    points: Points,
+    color: RGBColor,
+    width: u32,
+    dash: Dash,
+) -> Series {
+    series(label, points, Style::Line { color, width, dash })
 }
 
 /// A point series: filled circles of `radius` px.

@@ -7,17 +7,19 @@
 //!
 //! Every data series is one `<polyline>` (lines) or a run of `<circle>`s (points) in its own
 //! colour, and its legend entry repeats that colour once, so a figure's series can be counted
-//! from the file.
+//! from the file. A line's stroke pattern ([`Dash`]) is its `stroke-dasharray`. Legends sit
+//! in a strip between a panel's caption and its axes, so they never hide data and never
+//! stretch an axis.
 
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use crate::axes::{format_tick, label_count, place_legend, ranges, tick_decimals, y_label_area};
+use crate::axes::{format_tick, label_count, ranges, tick_decimals, y_label_area};
 use crate::error::{ReportError, Result};
 use crate::figure::{
-    Figure, Panel, Series, Style, AXIS_DESC_SIZE, CAPTION_SIZE, FONT, LEGEND_SIZE, SHADE,
+    Dash, Figure, Panel, Series, Style, AXIS_DESC_SIZE, CAPTION_SIZE, FONT, LEGEND_SIZE, SHADE,
     TICK_SIZE, TITLE_SIZE, X_LABELS_MAX, Y_LABELS_MAX,
 };
 
@@ -46,9 +48,6 @@ impl Figure {
                 (self.size.0 as i32 / 2, title_height as i32 / 2 + 2),
             )
             .map_err(draw_error)?;
-            let columns = self.columns.max(1);
-            let rows = self.panels.len().div_ceil(columns);
-            let areas = body.split_evenly((rows, columns));
             // One y label width for the whole figure, so that stacked axes line up.
             let y_area = self
                 .panels
@@ -56,12 +55,61 @@ impl Figure {
                 .map(|p| y_label_area(ranges(p).1))
                 .max()
                 .unwrap_or(60);
+            let shared = self.shared_legend();
+            let body = match shared {
+                Some(panel) => {
+                    let (_, _, margin_left, margin_right) = MARGINS;
+                    let left = y_area + margin_left;
+                    let rows = legend_rows(
+                        panel,
+                        f64::from(self.size.0) - f64::from(left + margin_right),
+                    );
+                    let (strip, rest) =
+                        body.split_vertically(rows.len() as u32 * LEGEND_ROW_PX + 4);
+                    draw_legend(&strip, &rows, left as i32, 0)?;
+                    rest
+                }
+                None => body,
+            };
+            let areas = self.panel_areas(&body);
             for (panel, area) in self.panels.iter().zip(&areas) {
-                draw_panel(panel, area, y_area)?;
+                draw_panel(panel, area, y_area, shared.is_none())?;
             }
             root.present().map_err(draw_error)?;
         }
-        Ok(svg)
+        Ok(with_dash_patterns(&svg))
+    }
+
+    /// The panel whose legend every panel shares (the same labels drawn the same way, in the
+    /// same order), drawn once under the title; `None` for one panel or different legends.
+    fn shared_legend(&self) -> Option<&Panel> {
+        let legend = |p: &'_ Panel| -> Vec<(String, Style)> {
+            p.series
+                .iter()
+                .filter(|s| !s.label.is_empty())
+                .map(|s| (s.label.clone(), s.style))
+                .collect()
+        };
+        let first = self.panels.first()?;
+        let entries = legend(first);
+        (self.panels.len() > 1
+            && !entries.is_empty()
+            && self.panels.iter().all(|p| legend(p) == entries))
+        .then_some(first)
+    }
+
+    /// The drawing area of every panel: `columns` per row, or the row lengths of `rows`.
+    fn panel_areas<'a>(&self, body: &Area<'a>) -> Vec<Area<'a>> {
+        if self.rows.is_empty() {
+            let columns = self.columns.max(1);
+            let rows = self.panels.len().div_ceil(columns);
+            return body.split_evenly((rows, columns));
+        }
+        body.split_evenly((self.rows.len(), 1))
+            .iter()
+            .zip(&self.rows)
+            .flat_map(|(row, &n)| row.split_evenly((1, n.max(1))))
+            .collect()
     }
 }
 
@@ -72,11 +120,73 @@ fn draw_error<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) ->
 /// Margins around a panel's axes (top, bottom, left, right), px.
 const MARGINS: (u32, u32, u32, u32) = (6, 8, 10, 32);
 
+/// Height of one row of legend entries, px.
+const LEGEND_ROW_PX: u32 = 26;
+/// Length of a legend entry's line sample, px.
+const LEGEND_SAMPLE_PX: i32 = 40;
+
+/// The SVG `opacity` plotters writes for a line drawn with a stroke pattern: a value no other
+/// element has (exact binary fractions, printed exactly), replaced after drawing by
+/// `opacity="1"` and the pattern's `stroke-dasharray` ([`with_dash_patterns`]), since
+/// plotters' SVG backend has no dashes of its own.
+fn dash_marker(dash: Dash) -> Option<f64> {
+    match dash {
+        Dash::Solid => None,
+        Dash::Dashed => Some(1.0 - 1.0 / 512.0),
+        Dash::Dotted => Some(1.0 - 2.0 / 512.0),
+        Dash::DashDot => Some(1.0 - 3.0 / 512.0),
+    }
+}
+
+/// The stroke of a line series: its colour, width and (through [`dash_marker`]) pattern.
+fn line_style(color: RGBColor, width: u32, dash: Dash) -> ShapeStyle {
+    match dash_marker(dash) {
+        Some(alpha) => color.mix(alpha).stroke_width(width),
+        None => color.stroke_width(width),
+    }
+}
+
+/// Gives every polyline drawn with a [`dash_marker`] opacity its `stroke-dasharray` (round
+/// caps for dotted patterns). plotters writes one element per line.
+fn with_dash_patterns(svg: &str) -> String {
+    let markers: Vec<(String, Dash)> = [Dash::Dashed, Dash::Dotted, Dash::DashDot]
+        .into_iter()
+        .filter_map(|d| dash_marker(d).map(|a| (format!("opacity=\"{a}\""), d)))
+        .collect();
+    let mut out = String::with_capacity(svg.len() + 1024);
+    for line in svg.split_inclusive('\n') {
+        let found = markers.iter().find(|(m, _)| line.contains(m.as_str()));
+        match found {
+            Some((marker, dash)) => {
+                let width = line
+                    .split("stroke-width=\"")
+                    .nth(1)
+                    .and_then(|rest| rest.split('"').next())
+                    .and_then(|w| w.parse::<u32>().ok())
+                    .unwrap_or(1);
+                let pattern = dash.dasharray(width).unwrap_or_default();
+                let caps = if *dash == Dash::Dashed {
+                    ""
+                } else {
+                    " stroke-linecap=\"round\""
+                };
+                out.push_str(&line.replacen(
+                    marker.as_str(),
+                    &format!("opacity=\"1\" stroke-dasharray=\"{pattern}\"{caps}"),
+                    1,
+                ));
+            }
+            None => out.push_str(line),
+        }
+    }
+    out
+}
+
 /// Where a panel's axes, ticks and legend go.
 struct Layout {
     /// Horizontal range.
     x: (f64, f64),
-    /// Vertical range, with headroom for the legend if it needs it.
+    /// Vertical range.
     y: (f64, f64),
     /// Height of the x label area, px.
     x_area: u32,
@@ -84,42 +194,87 @@ struct Layout {
     labels: (usize, usize),
     /// Decimals of the tick labels on each axis.
     decimals: (usize, usize),
-    /// Where the legend goes.
-    legend: SeriesLabelPosition,
 }
 
 impl Layout {
     fn new(panel: &Panel, area: &Area<'_>, y_area: u32) -> Self {
-        let (x, y_data) = ranges(panel);
+        let (x, y) = ranges(panel);
         let (margin_top, margin_bottom, margin_left, margin_right) = MARGINS;
         let x_area = (2.6 * AXIS_DESC_SIZE) as u32;
-        let caption_px = if panel.title.is_empty() {
-            0.0
-        } else {
-            CAPTION_SIZE * 1.3
-        };
         let (w, h) = area.dim_in_pixel();
         let plot_px = (
             (f64::from(w) - f64::from(y_area + margin_left + margin_right)).max(50.0),
-            (f64::from(h) - f64::from(x_area + margin_top + margin_bottom) - caption_px).max(50.0),
+            (f64::from(h) - f64::from(x_area + margin_top + margin_bottom)).max(50.0),
         );
-        let (legend, y) = place_legend(panel, x, y_data, plot_px);
         let x_labels = label_count(plot_px.0, 55.0, X_LABELS_MAX);
-        let y_labels = label_count(plot_px.1, 40.0, Y_LABELS_MAX);
+        let y_labels = label_count(plot_px.1, 30.0, Y_LABELS_MAX);
         Self {
             x,
             y,
             x_area,
             labels: (x_labels, y_labels),
             decimals: (tick_decimals(x, x_labels), tick_decimals(y, y_labels)),
-            legend,
         }
     }
 }
 
-fn draw_panel(panel: &Panel, area: &Area<'_>, y_area: u32) -> Result<()> {
-    let layout = Layout::new(panel, area, y_area);
-    let mut chart = draw_axes(panel, area, y_area, &layout)?;
+/// The legend entries of a panel laid out in rows across `width` px: per row, the series
+/// and the x offset of each entry.
+fn legend_rows(panel: &Panel, width: f64) -> Vec<Vec<(&Series, i32)>> {
+    let em = LEGEND_SIZE / 1.24;
+    let mut rows: Vec<Vec<(&Series, i32)>> = Vec::new();
+    let mut x = 0.0;
+    for s in panel.series.iter().filter(|s| !s.label.is_empty()) {
+        // Sample, gap, text (about 0.6 em a character), space before the next entry.
+        let entry = f64::from(LEGEND_SAMPLE_PX) + 8.0 + 0.6 * em * s.label.chars().count() as f64;
+        if rows.is_empty() || (x > 0.0 && x + entry > width) {
+            rows.push(Vec::new());
+            x = 0.0;
+        }
+        if let Some(row) = rows.last_mut() {
+            row.push((s, x as i32));
+        }
+        x += entry + 24.0;
+    }
+    rows
+}
+
+/// A panel: its caption and (with `legend`) its legend strip above the axes, then the axes
+/// and the series.
+fn draw_panel(panel: &Panel, area: &Area<'_>, y_area: u32, legend: bool) -> Result<()> {
+    let (w, _) = area.dim_in_pixel();
+    let (_, _, margin_left, margin_right) = MARGINS;
+    let left = (y_area + margin_left) as i32;
+    let width = f64::from(w) - f64::from(y_area + margin_left + margin_right);
+    let legend = if legend {
+        legend_rows(panel, width)
+    } else {
+        Vec::new()
+    };
+    let caption_px = if panel.title.is_empty() {
+        0
+    } else {
+        (CAPTION_SIZE * 1.3) as u32
+    };
+    let legend_px = if legend.is_empty() {
+        0
+    } else {
+        legend.len() as u32 * LEGEND_ROW_PX + 4
+    };
+    let (head, body) = area.split_vertically(caption_px + legend_px);
+    if !panel.title.is_empty() {
+        head.draw_text(
+            &panel.title,
+            &TextStyle::from((FONT, CAPTION_SIZE).into_font())
+                .color(&BLACK)
+                .pos(Pos::new(HPos::Center, VPos::Center)),
+            (w as i32 / 2, caption_px as i32 / 2 + 2),
+        )
+        .map_err(draw_error)?;
+    }
+    draw_legend(&head, &legend, left, caption_px as i32)?;
+    let layout = Layout::new(panel, &body, y_area);
+    let mut chart = draw_axes(panel, &body, y_area, &layout)?;
     if let Some((a, b)) = panel.shade_x {
         let y = layout.y;
         chart
@@ -132,19 +287,56 @@ fn draw_panel(panel: &Panel, area: &Area<'_>, y_area: u32) -> Result<()> {
     for series in &panel.series {
         draw_series(&mut chart, series)?;
     }
-    if panel.series.iter().any(|s| !s.label.is_empty()) {
-        chart
-            .configure_series_labels()
-            .position(layout.legend)
-            .margin(10)
-            .legend_area_size(36)
-            .label_font((FONT, LEGEND_SIZE))
-            .background_style(WHITE.mix(0.88))
-            .border_style(RGBColor(150, 150, 150))
-            .draw()
-            .map_err(draw_error)?;
+    Ok(())
+}
+
+/// Legend rows (from [`legend_rows`]) from `left` px across and `top` px down `area`.
+fn draw_legend(area: &Area<'_>, rows: &[Vec<(&Series, i32)>], left: i32, top: i32) -> Result<()> {
+    for (r, row) in rows.iter().enumerate() {
+        let y = top + (r as u32 * LEGEND_ROW_PX + LEGEND_ROW_PX / 2) as i32 + 2;
+        for &(series, x) in row {
+            draw_legend_entry(area, series, (left + x, y))?;
+        }
     }
     Ok(())
+}
+
+/// One legend entry at `(x, y)` (the middle of its row): a sample drawn as the series is,
+/// then its label.
+fn draw_legend_entry(area: &Area<'_>, series: &Series, (x, y): (i32, i32)) -> Result<()> {
+    let end = x + LEGEND_SAMPLE_PX;
+    match series.style {
+        Style::Line { color, width, dash } => area
+            .draw(&PathElement::new(
+                vec![(x, y), (end, y)],
+                line_style(color, width.max(2), dash),
+            ))
+            .map_err(draw_error)?,
+        Style::Points { color, .. } => area
+            .draw(&Circle::new(
+                (x + LEGEND_SAMPLE_PX / 2, y),
+                5,
+                color.filled(),
+            ))
+            .map_err(draw_error)?,
+        Style::Segments { color, width } => area
+            .draw(&PathElement::new(
+                vec![
+                    (x + LEGEND_SAMPLE_PX / 2, y - 8),
+                    (x + LEGEND_SAMPLE_PX / 2, y + 8),
+                ],
+                color.stroke_width(width),
+            ))
+            .map_err(draw_error)?,
+    }
+    area.draw_text(
+        &series.label,
+        &TextStyle::from((FONT, LEGEND_SIZE).into_font())
+            .color(&BLACK)
+            .pos(Pos::new(HPos::Left, VPos::Center)),
+        (end + 8, y),
+    )
+    .map_err(draw_error)
 }
 
 /// The panel's caption, axes, grid, tick labels and axis descriptions.
@@ -156,11 +348,7 @@ fn draw_axes<'a, 'b>(
 ) -> Result<Chart<'a, 'b>> {
     let (margin_top, margin_bottom, margin_left, margin_right) = MARGINS;
     let (x, y) = (layout.x, layout.y);
-    let mut builder = ChartBuilder::on(area);
-    if !panel.title.is_empty() {
-        builder.caption(&panel.title, (FONT, CAPTION_SIZE));
-    }
-    let mut chart = builder
+    let mut chart = ChartBuilder::on(area)
         .margin_top(margin_top)
         .margin_bottom(margin_bottom)
         .margin_left(margin_left)
@@ -190,24 +378,20 @@ fn draw_axes<'a, 'b>(
     Ok(chart)
 }
 
-/// One series, with its legend entry if it has a label.
+/// One series (its legend entry is drawn above the axes, by [`draw_legend_entry`]).
 fn draw_series(chart: &mut Chart<'_, '_>, series: &Series) -> Result<()> {
-    let label = series.label.clone();
     match series.style {
-        Style::Line { color, width } => {
-            let style = color.stroke_width(width);
-            let drawn = chart
-                .draw_series(LineSeries::new(series.points.iter().copied(), style))
+        Style::Line { color, width, dash } => {
+            chart
+                .draw_series(LineSeries::new(
+                    series.points.iter().copied(),
+                    line_style(color, width, dash),
+                ))
                 .map_err(draw_error)?;
-            if !label.is_empty() {
-                drawn.label(label).legend(move |(lx, ly)| {
-                    PathElement::new(vec![(lx, ly), (lx + 28, ly)], color.stroke_width(3))
-                });
-            }
         }
         Style::Points { color, radius } => {
             let style = color.mix(0.55).filled();
-            let drawn = chart
+            chart
                 .draw_series(
                     series
                         .points
@@ -215,15 +399,10 @@ fn draw_series(chart: &mut Chart<'_, '_>, series: &Series) -> Result<()> {
                         .map(move |&p| Circle::new(p, radius, style)),
                 )
                 .map_err(draw_error)?;
-            if !label.is_empty() {
-                drawn
-                    .label(label)
-                    .legend(move |(lx, ly)| Circle::new((lx + 14, ly), 5, color.filled()));
-            }
         }
         Style::Segments { color, width } => {
             let style = color.stroke_width(width);
-            let drawn = chart
+            chart
                 .draw_series(
                     series
                         .points
@@ -231,12 +410,139 @@ fn draw_series(chart: &mut Chart<'_, '_>, series: &Series) -> Result<()> {
                         .map(move |pair| PathElement::new(vec![pair[0], pair[1]], style)),
                 )
                 .map_err(draw_error)?;
-            if !label.is_empty() {
-                drawn.label(label).legend(move |(lx, ly)| {
-                    PathElement::new(vec![(lx + 14, ly - 8), (lx + 14, ly + 8)], style)
-                });
-            }
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::figure::{RECORDED, SIMULATED};
+    use crate::series::{line, patterned};
+
+    /// A panel of a recorded and a simulated sine, drawn over the data's ranges.
+    fn figure(size: (u32, u32)) -> Figure {
+        let t: Vec<f64> = (0..400).map(|i| f64::from(i) * 0.01).collect();
+        let rec: Vec<(f64, f64)> = t.iter().map(|&t| (t, 0.38 * (3.0 * t).sin())).collect();
+        let sim: Vec<(f64, f64)> = t
+            .iter()
+            .map(|&t| (t, 0.37 * (3.0 * t - 0.05).sin()))
+            .collect();
+        Figure {
+            name: "test".into(),
+            title: "a test".into(),
+            caption: String::new(),
+            panels: vec![Panel::new(
+                "displacement",
+                "t (s)",
+                "u (m)",
+                vec![
+                    line("recorded", rec, RECORDED, 3),
+                    patterned("simulated", sim, SIMULATED, 2, Dash::Dashed),
+                ],
+            )],
+            columns: 1,
+            rows: Vec::new(),
+            size,
+        }
+    }
+
+    fn points(node: roxmltree::Node<'_, '_>) -> Vec<(f64, f64)> {
+        node.attribute("points")
+            .unwrap_or_default()
+            .split_whitespace()
+            .filter_map(|p| {
+                let (x, y) = p.split_once(',')?;
+                Some((x.parse().ok()?, y.parse().ok()?))
+            })
+            .collect()
+    }
+
+    /// Recorded is a solid polyline, simulated a dashed one (in the data and in the legend),
+    /// and nothing else is dashed.
+    #[test]
+    fn recorded_is_solid_and_simulated_dashed() {
+        let svg = figure((900, 500)).to_svg().unwrap();
+        let doc = roxmltree::Document::parse(&svg).unwrap();
+        let lines = |stroke: &str| -> Vec<Option<String>> {
+            doc.descendants()
+                .filter(|n| n.has_tag_name("polyline") && n.attribute("stroke") == Some(stroke))
+                .map(|n| n.attribute("stroke-dasharray").map(str::to_owned))
+                .collect()
+        };
+        // The data line and its legend sample each.
+        assert_eq!(lines("#1F77B4"), [None, None]);
+        let dashed = lines("#D95F02");
+        assert_eq!(dashed.len(), 2);
+        assert!(
+            dashed.iter().all(|d| d.as_deref() == Some("12 6")),
+            "{dashed:?}"
+        );
+        assert_eq!(svg.matches("stroke-dasharray").count(), 2);
+        assert!(!svg.contains("opacity=\"0.998046875\""));
+    }
+
+    /// The legend sits above the plotted data (its texts' baselines above the data's top
+    /// pixel), and the y axis spans the data to within the 4 % padding each way: the data's
+    /// pixel height is at least 1/1.1 of the axis's (the old legend headroom gave 0.38 m of
+    /// data on 0.6 m of axis, 0.63).
+    #[test]
+    fn legend_is_outside_the_data_and_does_not_stretch_the_axis() {
+        let svg = figure((900, 500)).to_svg().unwrap();
+        let doc = roxmltree::Document::parse(&svg).unwrap();
+        let data: Vec<(f64, f64)> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("polyline"))
+            .map(points)
+            .filter(|p| p.len() > 100)
+            .flatten()
+            .collect();
+        let top = data.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
+        let bottom = data.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
+        for label in ["recorded", "simulated"] {
+            let text = doc
+                .descendants()
+                .find(|n| n.has_tag_name("text") && n.text().map(str::trim) == Some(label))
+                .unwrap();
+            let y: f64 = text.attribute("y").unwrap().parse().unwrap();
+            // Half a line of text below the anchor at most.
+            assert!(y + 10.0 < top, "{label} at y = {y}, data from {top}");
+        }
+        // The y axis: the vertical axis line (plotters draws it in the axis colour).
+        let axis = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("polyline") && n.attribute("stroke") == Some("#5A5A5A"))
+            .map(points)
+            .find(|p| p.len() == 2 && p[0].0 == p[1].0)
+            .unwrap();
+        let axis_px = (axis[1].1 - axis[0].1).abs();
+        let ratio = (bottom - top) / axis_px;
+        assert!((1.0 / 1.1..=1.0).contains(&ratio), "data/axis {ratio}");
+    }
+
+    /// Rows of different lengths: a wide panel over three.
+    #[test]
+    fn rows_split_the_body_as_asked() {
+        let mut f = figure((1200, 900));
+        let p = f.panels[0].clone();
+        f.panels = vec![p.clone(), p.clone(), p.clone(), p];
+        f.rows = vec![1, 3];
+        let mut svg = String::new();
+        let root = SVGBackend::with_string(&mut svg, f.size).into_drawing_area();
+        let areas: Vec<_> = f
+            .panel_areas(&root)
+            .iter()
+            .map(|a| (a.get_base_pixel(), a.dim_in_pixel()))
+            .collect();
+        assert_eq!(
+            areas,
+            [
+                ((0, 0), (1200, 450)),
+                ((0, 450), (400, 450)),
+                ((400, 450), (400, 450)),
+                ((800, 450), (400, 450)),
+            ]
+        );
+    }
 }
