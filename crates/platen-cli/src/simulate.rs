@@ -15,7 +15,10 @@ use platen_scenario::{CsvSink, Run, RunSummary, Scenario};
 pub fn run(path: &Path, out: Option<&Path>, json_out: bool) -> Result<()> {
     let scenario = Scenario::load(path)?;
     // Create the temporary output first, so that an unwritable path fails before the run.
-    let mut stream = out.map(CsvSink::create).transpose()?;
+    let storeys = scenario.storeys();
+    let mut stream = out
+        .map(|p| CsvSink::create_with_storeys(p, storeys))
+        .transpose()?;
     let output = match stream.as_mut() {
         Some(sink) => scenario.run(sink)?,
         None => scenario.run(&mut NoOutput)?,

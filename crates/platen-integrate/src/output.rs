@@ -185,6 +185,12 @@ pub struct Peaks {
     pub force_n: Peak,
     /// Samples at which the platen was stuck.
     pub stuck_samples: usize,
+    /// Peak base shear, N (runs with a specimen).
+    pub base_shear_n: Peak,
+    /// Peak storey drifts `zᵢ − zᵢ₋₁`, m, bottom first (the first `storeys` are used).
+    pub drift_m: [Peak; Specimen::MAX_STOREYS],
+    /// Storeys of the specimen (0 without one).
+    pub storeys: usize,
 }
 
 impl SampleSink for Peaks {
@@ -200,6 +206,13 @@ impl SampleSink for Peaks {
         self.a_m_s2.update(s.a_m_s2, s.t_s);
         self.force_n.update(s.terms.actuator_n, s.t_s);
         self.stuck_samples += usize::from(s.stuck);
+        if let Some(sp) = &s.specimen {
+            self.storeys = sp.storeys;
+            self.base_shear_n.update(sp.base_shear_n, s.t_s);
+            for (peak, &d) in self.drift_m.iter_mut().zip(&sp.drift_m[..sp.storeys]) {
+                peak.update(d, s.t_s);
+            }
+        }
     }
 }
 
