@@ -305,9 +305,9 @@ pub fn run(seconds: f64, repeats: u32, json_out: bool) -> Result<()> {
         baseline_end,
     };
     if json_out {
-        println!("{}", serde_json::to_string_pretty(&report.json())?);
+        outln!("{}", serde_json::to_string_pretty(&report.json())?);
     } else {
-        report.print_text();
+        report.print_text()?;
     }
     Ok(())
 }
@@ -384,17 +384,22 @@ impl Report<'_> {
     }
 
     /// The text table.
-    fn print_text(&self) {
+    fn print_text(&self) -> anyhow::Result<()> {
         let (simulated_s, base) = (self.simulated_s, self.base_ns());
-        println!(
+        outln!(
             "platen bench: lhpost-2008 at {} MPa, {simulated_s} s records at {RATE_HZ} Hz from rest, \
              median of {} runs",
             PRESSURE_PA / 1e6,
             self.repeats
         );
-        println!(
+        outln!(
             "  {:<54} {:>14} {:>10} {:>10} {:>12} {:>6}",
-            "workload", "unit", "ns/unit", "units/s", "sim s/wall s", "ratio"
+            "workload",
+            "unit",
+            "ns/unit",
+            "units/s",
+            "sim s/wall s",
+            "ratio"
         );
         for w in self.workloads {
             let ratio = if w.unit == "step" {
@@ -402,7 +407,7 @@ impl Report<'_> {
             } else {
                 "-".to_owned()
             };
-            println!(
+            outln!(
                 "  {:<54} {:>14} {:>10.1} {:>10.3e} {:>12.0} {:>6}",
                 w.title,
                 w.unit,
@@ -412,7 +417,8 @@ impl Report<'_> {
                 ratio
             );
         }
-        println!("  ratio: ns/step over the baseline's, measured in the same run");
+        outln!("  ratio: ns/step over the baseline's, measured in the same run");
+        Ok(())
     }
 }
 

@@ -88,9 +88,9 @@ pub fn run(options: &Options<'_>) -> Result<()> {
     if options.json {
         let summary = comparison.summary(&written, options.report);
         let summary = serde_json::to_value(&summary)?;
-        println!("{}", serde_json::to_string_pretty(&summary)?);
+        outln!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
-        print!(
+        out!(
             "{}",
             text::compare_summary(&comparison, &written, options.report)
         );

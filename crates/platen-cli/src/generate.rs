@@ -39,7 +39,7 @@ pub fn run(what: What, scenario_path: &Path, out: &Path, seed: u64, json_out: bo
                     &["t_s", "force_n"],
                     &[&record.t_s()[..n], &record.force_n()[..n]],
                 )?;
-                report(json_out, out, n, json!({"kind": "force"}));
+                report(json_out, out, n, json!({"kind": "force"}))?;
             }
             Run::Inverse { motion } => {
                 write_csv_atomic(
@@ -47,7 +47,7 @@ pub fn run(what: What, scenario_path: &Path, out: &Path, seed: u64, json_out: bo
                     &["t_s", "u_m", "v_m_s", "a_m_s2"],
                     &[motion.t_s(), motion.u_m(), motion.v_m_s(), motion.a_m_s2()],
                 )?;
-                report(json_out, out, motion.len(), json!({"kind": "motion"}));
+                report(json_out, out, motion.len(), json!({"kind": "motion"}))?;
             }
         },
         What::Recorded => {
@@ -68,7 +68,7 @@ pub fn run(what: What, scenario_path: &Path, out: &Path, seed: u64, json_out: bo
                 out,
                 rec.t_s.len(),
                 json!({"kind": "recorded", "seed": seed}),
-            );
+            )?;
         }
     }
     Ok(())
@@ -91,14 +91,20 @@ fn recorded<M: PlatenModel>(
     .context("recorded-like data could not be made")
 }
 
-fn report(json_out: bool, out: &Path, samples: usize, extra: serde_json::Value) {
+fn report(
+    json_out: bool,
+    out: &Path,
+    samples: usize,
+    extra: serde_json::Value,
+) -> anyhow::Result<()> {
     if json_out {
         let mut v = json!({"out": out.display().to_string(), "samples": samples});
         if let (Some(m), serde_json::Value::Object(e)) = (v.as_object_mut(), extra) {
             m.extend(e);
         }
-        println!("{v}");
+        outln!("{v}");
     } else {
-        println!("wrote {} ({samples} samples)", out.display());
+        outln!("wrote {} ({samples} samples)", out.display());
     }
+    Ok(())
 }

@@ -1,5 +1,15 @@
 //! `platen identify`: the platen's parameters from periodic sine and triangle tests (the
-//! paper's hysteresis-loop method, §3, with its fits and a global fit as a cross-check).
+//! paper's hysteresis-loop method, §3, with its fits and a global fit as a cross-check) and
+//! from any other record (earthquake, white noise: the any-record method of
+//! [`platen_ident::identify_records`]). Each file is routed by its data
+//! ([`platen_ident::route`]); `--method periodic|record|both` forces the method.
+//! When every file is periodic and no method is forced, the output is the periodic method's
+//! alone, as before.
+//!
+//! A manifest entry's `kind` may also be `record` (the any-record method whatever the
+//! data), and `floors` (top level, or per entry) lists a specimen's floor accelerometers
+//! with their storey masses, whose base shear `Σ mᵢ·aᵢ` is taken off the force:
+//! `"floors": [{"column": "Floor 1 Acc", "unit": "mm/s2", "mass_kg": 14000}, …]`.
 //!
 //! Input: recorded CSVs with `t_s`, `u_m`, `a_m_s2`, `force_n` and optionally `v_m_s`. Whether
 //! a test is a sine or a triangle is recognised from its data, and file names play no part;
@@ -24,15 +34,17 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
+use platen_ident::anyrecord::summary::RecordSummary;
 use platen_ident::{
-    identify, Estimate, Flag, Identification, IdentificationSummary, IdentifiedKey, Parameter,
+    identify, identify_records, route, Estimate, Flag, Identification, IdentificationSummary,
+    IdentifiedKey, Method, Parameter, RecordIdentification, RecordSettings, RecordWarning, Route,
     Settings, TestKind, TestRecord,
 };
 use platen_io::columns::{ColumnMap, ColumnSpec};
 use platen_io::json::parse_json_file;
 use platen_scenario::sampling::uniform_step_s;
 
-use platen_report::{html, identify_figures, Figure};
+use platen_report::{html, identify_figures, record_figures, Figure};
 
 /// Options of `platen identify`.
 pub struct Options<'a> {
@@ -48,6 +60,22 @@ pub struct Options<'a> {
     pub report: Option<&'a Path>,
     /// JSON file mapping the files' own channel names and units to platen's columns.
     pub columns: Option<&'a Path>,
+    /// The method forced on every file (`None`: each file by its data).
+    pub method: Option<MethodChoice>,
+    /// Skip the any-record method's output-error check.
+    pub no_output_error: bool,
+}
+
+/// `--method`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum MethodChoice {
+    /// The paper's hysteresis-loop method on every file (each must be a periodic test).
+    Periodic,
+    /// The any-record method on every file, fitted jointly.
+    Record,
+    /// Periodic tests through both methods, the rest through the any-record method (every
+    /// file enters the any-record fit).
+    Both,
 }
 
 /// The manifest file.
@@ -58,6 +86,22 @@ struct Manifest {
     /// Channel names and units of every listed file (an entry's own `columns` wins).
     #[serde(default)]
     columns: Option<BTreeMap<String, ColumnSpec>>,
+    /// Floor accelerometers of every listed file (an entry's own `floors` wins).
+    #[serde(default)]
+    floors: Option<Vec<FloorSpec>>,
+}
+
+/// A specimen floor's accelerometer and its storey mass.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FloorSpec {
+    /// The column's header.
+    column: String,
+    /// Its unit (default m/s2).
+    #[serde(default)]
+    unit: Option<String>,
+    /// The storey's mass, kg.
+    mass_kg: f64,
 }
 
 #[derive(Debug, Deserialize)]
@@ -72,6 +116,8 @@ struct ManifestEntry {
     name: Option<String>,
     #[serde(default)]
     columns: Option<BTreeMap<String, ColumnSpec>>,
+    #[serde(default)]
+    floors: Option<Vec<FloorSpec>>,
 }
 
 #[derive(Debug, Clone, Copy, Deserialize)]
@@ -79,9 +125,11 @@ struct ManifestEntry {
 enum KindName {
     Sine,
     Triangle,
+    Record,
 }
 
 /// One input file with what is known about it.
+#[derive(Clone)]
 struct Input {
     path: PathBuf,
     /// The test's name in messages (the path as given, or the manifest's name).
@@ -92,6 +140,10 @@ struct Input {
     pressure_mpa: Option<f64>,
     /// How the file's channels map to platen's columns.
     columns: ColumnMap,
+    /// Declared `kind: record` in the manifest.
+    record: bool,
+    /// The specimen's floor accelerometers.
+    floors: Vec<FloorSpec>,
 }
 
 /// Checks a `--pressure-mpa` value: finite and ≥ 0.
@@ -134,37 +186,373 @@ pub fn run(opts: &Options) -> Result<()> {
     }
     .build()
     .context("identification failed")?;
-    let id = identify(&records, &settings).context("identification failed")?;
+    // Where each file goes: forced, declared `record`, or by its data.
+    let routes: Vec<Route> = records.iter().map(route).collect();
+    let periodic_only = match opts.method {
+        Some(MethodChoice::Periodic) => true,
+        Some(_) => false,
+        None => inputs
+            .iter()
+            .zip(&routes)
+            .all(|(i, r)| !i.record && r.method() == Method::Periodic),
+    };
+    if periodic_only {
+        return run_periodic(opts, &inputs, &records, &settings);
+    }
+    run_records(opts, &inputs, records, &routes, &settings)
+}
+
+/// The paper's method on every file: the output as it has always been.
+fn run_periodic(
+    opts: &Options,
+    inputs: &[Input],
+    records: &[TestRecord],
+    settings: &platen_ident::ValidSettings,
+) -> Result<()> {
+    let id = identify(records, settings).context("identification failed")?;
     let written = platen_report::write_outputs(
         opts.plot,
         opts.report,
         || identify_figures::figures(&id),
-        |figures, rendered| html_report(&id, &inputs, figures, rendered),
+        |figures, rendered| html_report(&id, inputs, figures, rendered),
     )?;
     if opts.json {
         let output = JsonOutput {
-            summary: summary(&id, &inputs),
-            figures: opts
-                .plot
-                .map(|_| written.iter().map(|p| p.display().to_string()).collect()),
+            summary: summary(&id, inputs),
+            figures: figure_list(opts, &written),
             report: opts.report.map(|path| path.display().to_string()),
         };
         // Through a `Value`, whose maps sort their keys at every level.
         let value = serde_json::to_value(&output)?;
-        println!("{}", serde_json::to_string_pretty(&value)?);
+        outln!("{}", serde_json::to_string_pretty(&value)?);
     } else {
-        print!("{}", report(&id, &inputs));
-        if !written.is_empty() {
-            println!("\nWrote {} figure files (SVG and PNG):", written.len());
-            for path in &written {
-                println!("  {}", path.display());
-            }
-        }
-        if let Some(path) = opts.report {
-            println!("Wrote report {}", path.display());
-        }
+        out!("{}", report(&id, inputs));
+        print_written(&written, opts.report)?;
     }
     Ok(())
+}
+
+/// The figure files written, for `--json` (absent without `--plot`).
+fn figure_list(opts: &Options, written: &[PathBuf]) -> Option<Vec<String>> {
+    opts.plot
+        .map(|_| written.iter().map(|p| p.display().to_string()).collect())
+}
+
+fn print_written(written: &[PathBuf], report: Option<&Path>) -> Result<()> {
+    if !written.is_empty() {
+        outln!("\nWrote {} figure files (SVG and PNG):", written.len());
+        for path in written {
+            outln!("  {}", path.display());
+        }
+    }
+    if let Some(path) = report {
+        outln!("Wrote report {}", path.display());
+    }
+    Ok(())
+}
+
+/// The any-record method on the records routed to it (every file with `--method record` or
+/// `both`), and the paper's method on the periodic tests when there are any and the method
+/// is not `record`.
+fn run_records(
+    opts: &Options,
+    inputs: &[Input],
+    records: Vec<TestRecord>,
+    routes: &[Route],
+    settings: &platen_ident::ValidSettings,
+) -> Result<()> {
+    let method = opts.method;
+    let periodic_route = |k: usize| !inputs[k].record && routes[k].method() == Method::Periodic;
+    let periodic_idx: Vec<usize> = (0..inputs.len())
+        .filter(|&k| method != Some(MethodChoice::Record) && periodic_route(k))
+        .collect();
+    let record_idx: Vec<usize> = (0..inputs.len())
+        .filter(|&k| method.is_some() || !periodic_route(k))
+        .collect();
+    let periodic = if periodic_idx.is_empty() {
+        None
+    } else {
+        let recs: Vec<TestRecord> = periodic_idx.iter().map(|&k| records[k].clone()).collect();
+        Some(identify(&recs, settings).context("identification failed (periodic tests)")?)
+    };
+    let record_settings = RecordSettings {
+        viscous_exponent: opts.viscous_exponent,
+        low_velocity_term: !opts.no_low_velocity_term,
+        output_error: !opts.no_output_error,
+        ..RecordSettings::default()
+    }
+    .build()
+    .context("identification failed")?;
+    let recs: Vec<TestRecord> = record_idx.iter().map(|&k| records[k].clone()).collect();
+    let mut id =
+        identify_records(&recs, &record_settings).context("identification failed (records)")?;
+    for &k in &record_idx {
+        if let (Some(_), Route::Record { reason }) = (inputs[k].kind, &routes[k]) {
+            id.warnings.push(RecordWarning::DeclaredPeriodicButNot {
+                test: inputs[k].name.clone(),
+                reason: reason.clone(),
+            });
+        }
+    }
+    let rec_inputs: Vec<&Input> = record_idx.iter().map(|&k| &inputs[k]).collect();
+    let per_inputs: Vec<&Input> = periodic_idx.iter().map(|&k| &inputs[k]).collect();
+    let per_owned: Vec<Input> = per_inputs.iter().map(|i| (*i).clone()).collect();
+    let written = platen_report::write_outputs(
+        opts.plot,
+        opts.report,
+        || {
+            let mut f = record_figures::figures(&id);
+            if let Some(p) = &periodic {
+                f.extend(identify_figures::figures(p));
+            }
+            f
+        },
+        |figures, rendered| {
+            record_html_report(
+                &id,
+                &rec_inputs,
+                periodic.as_ref(),
+                &per_owned,
+                figures,
+                rendered,
+            )
+        },
+    )?;
+    let method_name = match method {
+        Some(MethodChoice::Both) => "both",
+        _ if periodic.is_some() => "mixed",
+        _ => "record",
+    };
+    if opts.json {
+        let files: Vec<String> = rec_inputs
+            .iter()
+            .map(|i| i.path.display().to_string())
+            .collect();
+        let output = RecordJsonOutput {
+            summary: RecordSummary::new(&id, &files),
+            method: method_name,
+            periodic: periodic.as_ref().map(|p| summary(p, &per_owned)),
+            figures: figure_list(opts, &written),
+            report: opts.report.map(|path| path.display().to_string()),
+        };
+        let value = serde_json::to_value(&output)?;
+        outln!("{}", serde_json::to_string_pretty(&value)?);
+    } else {
+        out!("{}", record_report(&id, &rec_inputs));
+        if let Some(p) = &periodic {
+            outln!("\n== Periodic tests (hysteresis-loop method, §3) ==\n");
+            out!("{}", report(p, &per_owned));
+        }
+        print_written(&written, opts.report)?;
+    }
+    Ok(())
+}
+
+/// What `--json` prints for the any-record method.
+#[derive(Serialize)]
+struct RecordJsonOutput {
+    #[serde(flatten)]
+    summary: RecordSummary,
+    /// `record` (any-record method only), `mixed` (periodic tests by the paper's method
+    /// too), `both` (forced).
+    method: &'static str,
+    /// The paper's method on the periodic tests, when run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    periodic: Option<IdentificationSummary>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    figures: Option<Vec<String>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    report: Option<String>,
+}
+
+/// The text report of the any-record method.
+fn record_report(id: &RecordIdentification, inputs: &[&Input]) -> String {
+    let mut s = String::new();
+    let ee = &id.equation_error;
+    let _ = writeln!(
+        s,
+        "Identified parameters from {} record(s) (any-record method: equation error, {} samples faster than {} mm/s; RMS force residual {:.0} N)",
+        id.records.len(),
+        ee.points,
+        1e3 * ee.min_speed_m_s,
+        ee.rms_residual_n
+    );
+    parameter_lines(&mut s, &id.parameters);
+    let u = &ee.uncertainty;
+    let _ = writeln!(
+        s,
+        "  (95 % intervals: batch-means sandwich over blocks of {} samples, t = {:.3}; residuals worth {:.0} independent samples)",
+        u.bandwidth_samples, u.critical_value, u.effective_samples
+    );
+    let _ = writeln!(s, "\nRecords");
+    for (r, (rec, input)) in id.records.iter().zip(inputs).enumerate() {
+        let _ = writeln!(
+            s,
+            "  {}: {} samples at {} Hz, velocity {}, {} fitted over {:.1}–{:.0} mm/s, force offset {}{}",
+            input.label,
+            rec.samples,
+            rec.sample_rate_hz,
+            if rec.velocity_given { "given" } else { "from the crossover estimate" },
+            rec.used_samples,
+            1e3 * rec.speed_range_m_s[0],
+            1e3 * rec.speed_range_m_s[1],
+            pm(ee.offsets_n.get(r), 1e3, 2) + " kN",
+            rec.floors.as_ref().map_or(String::new(), |f| format!(
+                ", base shear of {} storeys ({:.0} kg) removed (peak {:.0} kN)",
+                f.masses_kg.len(),
+                f.masses_kg.iter().sum::<f64>(),
+                f.peak_base_shear_n / 1e3
+            ))
+        );
+    }
+    correlation_lines(&mut s, "equation error", &u.correlations);
+    if let Some(oe) = &id.output_error {
+        let _ = writeln!(
+            s,
+            "\nOutput-error check (forward simulation with exact stick-slip fitted to u and a; {} iterations, {} simulations{}):",
+            oe.iterations,
+            oe.simulations,
+            if oe.converged { "" } else { ", NOT converged" }
+        );
+        parameter_lines(&mut s, &oe.parameters);
+        for (k, (u, a)) in oe.rms_u_m.iter().zip(&oe.rms_a_m_s2).enumerate() {
+            let _ = writeln!(
+                s,
+                "  record {}: RMS residual u {:.3} → {:.3} mm, a {:.4} → {:.4} m/s²",
+                k + 1,
+                1e3 * u[0],
+                1e3 * u[1],
+                a[0],
+                a[1]
+            );
+        }
+    }
+    let _ = writeln!(s, "\nDissipative force F_D(|v|) with its 95 % band");
+    let step = (id.band.len() / 8).max(1);
+    for b in id.band.iter().step_by(step) {
+        let _ = writeln!(
+            s,
+            "  {:>9.1} mm/s  {:>8.2} kN  ({:.2} – {:.2})",
+            1e3 * b.speed_m_s,
+            b.force_n / 1e3,
+            b.low_n / 1e3,
+            b.high_n / 1e3
+        );
+    }
+    if !id.warnings.is_empty() {
+        let _ = writeln!(s, "\nWarnings");
+        for w in &id.warnings {
+            let _ = writeln!(s, "  - {w}");
+        }
+    }
+    s
+}
+
+/// The seven parameters, one line each.
+fn parameter_lines(s: &mut String, params: &platen_ident::ParameterEstimates) {
+    for (key, p) in params.iter() {
+        let (name, (unit, scale, digits)) = (key.name(), display_unit(key));
+        let text = match p {
+            Parameter::Estimated(e) => format!(
+                "{} {unit}   (95 % CI {:.d$} – {:.d$})",
+                pm(Some(e), scale, digits),
+                e.ci95_low / scale,
+                e.ci95_high / scale,
+                d = digits
+            ),
+            Parameter::Fixed { value, reason } => {
+                format!(
+                    "{:.d$} {unit}   (fixed: {reason})",
+                    value / scale,
+                    d = digits
+                )
+            }
+            Parameter::NotIdentifiable { reason } => format!("not identifiable: {reason}"),
+        };
+        let _ = writeln!(s, "  {name:<28} {text}");
+    }
+}
+
+/// The correlation matrix of a fit.
+fn correlation_lines(s: &mut String, fit: &str, c: &platen_ident::Correlations) {
+    let _ = writeln!(s, "\nParameter correlations ({fit})");
+    let names: Vec<&str> = c.keys.iter().map(|k| short(*k)).collect();
+    let _ = writeln!(
+        s,
+        "  {:>4} {}",
+        "",
+        names.iter().map(|n| format!("{n:>7}")).collect::<String>()
+    );
+    for (i, row) in c.matrix.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "  {:>4} {}",
+            names[i],
+            row.iter().map(|x| format!("{x:>+7.3}")).collect::<String>()
+        );
+    }
+}
+
+fn short(key: IdentifiedKey) -> &'static str {
+    match key {
+        IdentifiedKey::EffectiveMass => "Me",
+        IdentifiedKey::Stiffness => "Ke",
+        IdentifiedKey::CoulombForce => "Fmu",
+        IdentifiedKey::ViscousCoefficient => "Ce",
+        IdentifiedKey::ViscousExponent => "alpha",
+        IdentifiedKey::LowVelocityForce => "a",
+        IdentifiedKey::LowVelocityDecay => "b",
+    }
+}
+
+/// The HTML report of the any-record method (and of the periodic tests, if any).
+fn record_html_report(
+    id: &RecordIdentification,
+    inputs: &[&Input],
+    periodic: Option<&Identification>,
+    periodic_inputs: &[Input],
+    figures: &[Figure],
+    rendered: &[(String, String)],
+) -> String {
+    let mut sections = vec![html::heading("Identified parameters (any-record method)")];
+    sections.push(html::table(
+        &["key", "value", "unit", "std. error", "95 % CI", "status"],
+        &rows(&id.parameters),
+        true,
+    ));
+    for w in &id.warnings {
+        sections.push(html::paragraph(&w.to_string(), Some("note")));
+    }
+    sections.push(html::heading("Report"));
+    sections.push(html::preformatted(&record_report(id, inputs)));
+    if let Some(p) = periodic {
+        sections.push(html::heading("Periodic tests (hysteresis-loop method)"));
+        sections.push(html::preformatted(&report(p, periodic_inputs)));
+    }
+    let files: Vec<String> = inputs
+        .iter()
+        .map(|i| i.path.display().to_string())
+        .collect();
+    html::page(&html::Page {
+        title: "platen identify".into(),
+        heading: "Identification from test records (equation error, output error)".into(),
+        items: vec![
+            ("records".to_owned(), id.records.len().to_string()),
+            (
+                "files".to_owned(),
+                inputs
+                    .iter()
+                    .map(|i| i.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            ),
+        ],
+        sections,
+        figures,
+        rendered,
+        summary: serde_json::to_value(RecordSummary::new(id, &files))
+            .expect("a summary of numbers, strings and string-keyed maps serialises"),
+    })
 }
 
 /// What `--json` prints: the identification's summary, and the files written.
@@ -249,7 +637,12 @@ fn html_items(id: &Identification, inputs: &[Input]) -> Vec<(String, String)> {
 
 /// The HTML table's rows: key, value, unit, standard error, interval, status.
 fn parameter_rows(id: &Identification) -> Vec<Vec<String>> {
-    id.parameters
+    rows(&id.parameters)
+}
+
+/// The HTML table's rows of a set of parameters.
+fn rows(params: &platen_ident::ParameterEstimates) -> Vec<Vec<String>> {
+    params
         .iter()
         .map(|(key, p)| {
             let (unit, scale, d) = display_unit(key);
@@ -317,6 +710,8 @@ fn inputs(opts: &Options) -> Result<Vec<Input>> {
                 _ => Some(opts.pressure_mpa[i]),
             },
             columns: default_columns.clone(),
+            record: false,
+            floors: Vec::new(),
         })
         .collect();
     if let Some(mpath) = opts.manifest {
@@ -348,18 +743,21 @@ struct ManifestReader<'a> {
     columns: Option<ColumnMap>,
     /// `--columns`, or platen's own names.
     default_columns: ColumnMap,
+    /// The manifest's own `floors`, if any.
+    floors: Option<Vec<FloorSpec>>,
 }
 
 impl<'a> ManifestReader<'a> {
     fn read(path: &'a Path, default_columns: ColumnMap) -> Result<ManifestTests<'a>> {
         let manifest: Manifest = parse_json_file(path).context(
-            "reading the identification manifest (expected {\"tests\": [{\"file\": PATH, \"kind\": \"sine\"|\"triangle\", \"pressure_mpa\": P, \"name\": NAME, \"columns\": MAP}], \"columns\": MAP}, with only `file` required)",
+            "reading the identification manifest (expected {\"tests\": [{\"file\": PATH, \"kind\": \"sine\"|\"triangle\"|\"record\", \"pressure_mpa\": P, \"name\": NAME, \"columns\": MAP, \"floors\": [{\"column\": NAME, \"unit\": UNIT, \"mass_kg\": M}]}], \"columns\": MAP, \"floors\": FLOORS}, with only `file` required)",
         )?;
         let mut reader = ManifestReader {
             path,
             base: path.parent().unwrap_or(Path::new(".")),
             columns: None,
             default_columns,
+            floors: manifest.floors.clone(),
         };
         reader.columns = match &manifest.columns {
             Some(spec) => Some(reader.column_map(spec, "columns")?),
@@ -406,16 +804,42 @@ impl<'a> ManifestReader<'a> {
             (None, Some(map)) => map.clone(),
             (None, None) => self.default_columns.clone(),
         };
-        let kind = entry.kind.map(|k| match k {
-            KindName::Sine => TestKind::Sine,
-            KindName::Triangle => TestKind::Triangle,
+        let record = matches!(entry.kind, Some(KindName::Record));
+        let kind = entry.kind.and_then(|k| match k {
+            KindName::Sine => Some(TestKind::Sine),
+            KindName::Triangle => Some(TestKind::Triangle),
+            KindName::Record => None,
         });
+        let floors = entry
+            .floors
+            .clone()
+            .or_else(|| self.floors.clone())
+            .unwrap_or_default();
+        for (i, f) in floors.iter().enumerate() {
+            if !(f.mass_kg.is_finite() && f.mass_kg > 0.0) {
+                bail!(
+                    "`{}`, at `floors[{i}].mass_kg` (tests[{k}]): {}: expected a mass > 0 kg",
+                    self.path.display(),
+                    f.mass_kg
+                );
+            }
+            floor_factor(f).with_context(|| {
+                format!(
+                    "`{}`, at `floors[{i}].unit` (tests[{k}])",
+                    self.path.display()
+                )
+            })?;
+        }
         let canon = std::fs::canonicalize(&path).ok();
         let existing = inputs
             .iter_mut()
             .find(|i| canon.is_some() && std::fs::canonicalize(&i.path).ok() == canon);
         match existing {
-            Some(input) => self.merge(input, entry, kind, columns)?,
+            Some(input) => {
+                input.record = record;
+                input.floors = floors;
+                self.merge(input, entry, kind, columns)?
+            }
             None => inputs.push(Input {
                 label: entry.name.clone().unwrap_or_else(|| file_label(&path)),
                 name: entry.name.unwrap_or_else(|| path.display().to_string()),
@@ -427,6 +851,8 @@ impl<'a> ManifestReader<'a> {
                     _ => None,
                 }),
                 columns,
+                record,
+                floors,
             }),
         }
         Ok(())
@@ -467,12 +893,30 @@ fn file_label(path: &Path) -> String {
     )
 }
 
+/// The factor from a floor channel's unit to m/s² (checked like a column map's acceleration).
+fn floor_factor(f: &FloorSpec) -> Result<f64> {
+    let mut spec = BTreeMap::new();
+    spec.insert(
+        "a_m_s2".to_owned(),
+        ColumnSpec {
+            name: Some(f.column.clone()),
+            unit: f.unit.clone(),
+            times_area_m2: None,
+            offset: None,
+            remove_mean: false,
+            zero_at_start: false,
+        },
+    );
+    let map = ColumnMap::new(&spec, "floors")
+        .map_err(|(_, value, expected)| anyhow::anyhow!("{value}: expected {expected}"))?;
+    Ok(map.factor("a_m_s2"))
+}
+
 fn read_record(input: &Input) -> Result<TestRecord> {
     let path = &input.path;
-    let mut table =
-        input
-            .columns
-            .read_table(path, &["t_s", "u_m", "a_m_s2", "force_n"], &["v_m_s"])?;
+    let mut required = vec!["t_s", "u_m", "a_m_s2", "force_n"];
+    required.extend(input.floors.iter().map(|f| f.column.as_str()));
+    let mut table = input.columns.read_table(path, &required, &["v_m_s"])?;
     let t = table.take_column("t_s").expect("required column");
     let dt = uniform_step_s(path, &t)?;
     let take =
@@ -492,6 +936,20 @@ fn read_record(input: &Input) -> Result<TestRecord> {
     }
     if let Some(k) = input.kind {
         rec = rec.with_kind(k);
+    }
+    if !input.floors.is_empty() {
+        let mut floors = Vec::with_capacity(input.floors.len());
+        for f in &input.floors {
+            let factor = floor_factor(f)?;
+            let acc = table
+                .take_column(&f.column)
+                .expect("required column")
+                .into_iter()
+                .map(|a| a * factor)
+                .collect();
+            floors.push((f.mass_kg, acc));
+        }
+        rec = rec.with_floors(&floors).with_context(context)?;
     }
     Ok(rec)
 }
@@ -561,27 +1019,7 @@ fn report_parameters(s: &mut String, id: &Identification) {
             None => "hold-down pressure not given".to_owned(),
         }
     );
-    for (key, p) in id.parameters.iter() {
-        let (name, (unit, scale, digits)) = (key.name(), display_unit(key));
-        let text = match p {
-            Parameter::Estimated(e) => format!(
-                "{} {unit}   (95 % CI {:.d$} – {:.d$})",
-                pm(Some(e), scale, digits),
-                e.ci95_low / scale,
-                e.ci95_high / scale,
-                d = digits
-            ),
-            Parameter::Fixed { value, reason } => {
-                format!(
-                    "{:.d$} {unit}   (fixed: {reason})",
-                    value / scale,
-                    d = digits
-                )
-            }
-            Parameter::NotIdentifiable { reason } => format!("not identifiable: {reason}"),
-        };
-        let _ = writeln!(s, "  {name:<28} {text}");
-    }
+    parameter_lines(s, &id.parameters);
     if let Some(mu) = &id.friction_coefficient {
         let _ = writeln!(
             s,

@@ -5,6 +5,23 @@
 
 #![recursion_limit = "256"]
 
+/// `println!` for the verbs' standard output that returns an error instead of panicking when
+/// the output cannot be written (a reader that closed the pipe: `platen model | head -1`).
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout().lock(), $($arg)*).map_err(crate::stdout_error)?;
+    }};
+}
+
+/// `print!` for the verbs' standard output: see [`outln!`].
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        write!(std::io::stdout().lock(), $($arg)*).map_err(crate::stdout_error)?;
+    }};
+}
+
 mod bench;
 mod compare;
 mod generate;
@@ -165,13 +182,15 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Identify the platen's parameters from periodic sine and triangle tests (the paper's
-    /// hysteresis-loop method, §3): mass, stiffness, Coulomb friction, viscous law, and a
-    /// global fit of Eq. 23 as a cross-check.
+    /// Identify the platen's parameters from test records: periodic sine and triangle tests
+    /// by the paper's hysteresis-loop method (§3, with a global fit of Eq. 23 as a
+    /// cross-check), any other record (earthquake, white noise) by the any-record method
+    /// (equation error by separable least squares, output-error check, standard errors
+    /// robust to correlated residuals, the dissipative law with its 95 % band).
     ///
     /// Each FILE is a recorded CSV with t_s, u_m, a_m_s2, force_n and optionally v_m_s
-    /// (otherwise the crossover estimate is made). Sine or triangle is recognised from the
-    /// data; file names play no part.
+    /// (otherwise the crossover estimate is made). Which method a file goes to, and sine or
+    /// triangle, is recognised from the data; file names play no part.
     Identify {
         /// Recorded test CSV files.
         #[arg(required_unless_present = "manifest")]
@@ -181,8 +200,11 @@ enum Command {
         /// their own group.
         #[arg(long, value_delimiter = ',', allow_negative_numbers = true, value_parser = identify::parse_pressure_mpa)]
         pressure_mpa: Vec<f64>,
-        /// JSON manifest: {"tests": [{"file": PATH, "kind": "sine"|"triangle",
-        /// "pressure_mpa": P, "name": NAME}]}, paths relative to the manifest.
+        /// JSON manifest: {"tests": [{"file": PATH, "kind": "sine"|"triangle"|"record",
+        /// "pressure_mpa": P, "name": NAME, "columns": MAP, "floors": [{"column": NAME,
+        /// "unit": UNIT, "mass_kg": M}]}], "columns": MAP, "floors": FLOORS}, paths relative
+        /// to the manifest; floors are a specimen's accelerometers whose base shear Σ mᵢ·aᵢ is
+        /// taken off the force.
         #[arg(long)]
         manifest: Option<PathBuf>,
         /// Hold the viscous exponent α at this value (Eq. 21: 0.5) instead of fitting it.
@@ -210,6 +232,16 @@ enum Command {
         /// (a manifest's own `columns` win).
         #[arg(long, value_name = "MAP.json")]
         columns: Option<PathBuf>,
+        /// Force the method: `periodic` (the paper's, every file a periodic test), `record`
+        /// (the any-record method on every file, fitted jointly) or `both` (periodic tests
+        /// through both). Default: periodic tests to the paper's method, any other record
+        /// (earthquake, white noise) to the any-record method.
+        #[arg(long, value_enum)]
+        method: Option<identify::MethodChoice>,
+        /// Skip the any-record method's output-error check (forward simulation fitted to the
+        /// measured motion).
+        #[arg(long)]
+        no_output_error: bool,
     },
 }
 
@@ -224,10 +256,46 @@ pub(crate) enum Form {
 fn main() -> ExitCode {
     match run(Cli::parse().command) {
         Ok(()) => ExitCode::SUCCESS,
+        // The reader of standard output went away (`| head`): stop quietly, as filters do.
+        Err(e) if e.chain().any(|c| c.is::<ClosedPipe>()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::from(exit_code(&e))
         }
+    }
+}
+
+/// Standard output was closed by its reader.
+#[derive(Debug)]
+struct ClosedPipe;
+
+impl std::fmt::Display for ClosedPipe {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("standard output was closed by its reader")
+    }
+}
+
+impl std::error::Error for ClosedPipe {}
+
+/// Standard output could not be written (a full disk behind a redirection, say).
+#[derive(Debug)]
+struct StdoutFailed(std::io::Error);
+
+impl std::fmt::Display for StdoutFailed {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "writing to standard output: {}", self.0)
+    }
+}
+
+impl std::error::Error for StdoutFailed {}
+
+/// The error of a failed write to standard output: [`ClosedPipe`] for a closed pipe (exit 0),
+/// otherwise [`StdoutFailed`] (exit 5, an output that could not be written).
+fn stdout_error(e: std::io::Error) -> anyhow::Error {
+    if e.kind() == std::io::ErrorKind::BrokenPipe {
+        anyhow::Error::new(ClosedPipe)
+    } else {
+        anyhow::Error::new(StdoutFailed(e))
     }
 }
 
@@ -295,6 +363,8 @@ fn run(command: Command) -> anyhow::Result<()> {
             plot,
             report,
             columns,
+            method,
+            no_output_error,
         } => identify::run(&identify::Options {
             files: &files,
             pressure_mpa: &pressure_mpa,
@@ -305,6 +375,8 @@ fn run(command: Command) -> anyhow::Result<()> {
             plot: plot.as_deref(),
             report: report.as_deref(),
             columns: columns.as_deref(),
+            method,
+            no_output_error,
         }),
     }
 }
@@ -314,6 +386,9 @@ fn run(command: Command) -> anyhow::Result<()> {
 /// unwrapped here.
 fn exit_code(e: &anyhow::Error) -> u8 {
     for cause in e.chain() {
+        if cause.is::<StdoutFailed>() {
+            return 5;
+        }
         if let Some(ie) = cause.downcast_ref::<IntegrateError>() {
             return integrate_exit_code(ie);
         }

@@ -10,7 +10,7 @@ pub fn run(out: Option<&Path>) -> Result<()> {
     let text = serde_json::to_string_pretty(&platen_scenario::scenario::json_schema())? + "\n";
     match out {
         Some(path) => write_bytes_atomic(path, text.as_bytes())?,
-        None => print!("{text}"),
+        None => out!("{text}"),
     }
     Ok(())
 }

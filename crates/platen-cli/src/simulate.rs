@@ -29,12 +29,12 @@ pub fn run(path: &Path, out: Option<&Path>, json_out: bool) -> Result<()> {
     if json_out {
         let summary = RunSummary::new(path, &scenario, &output, out);
         // Through a Value, so the keys come out in alphabetical order.
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&serde_json::to_value(&summary)?)?
         );
     } else {
-        print_summary(&scenario, &output.peaks, output.stats.as_ref(), out);
+        print_summary(&scenario, &output.peaks, output.stats.as_ref(), out)?;
     }
     Ok(())
 }
@@ -66,13 +66,18 @@ impl SampleSink for NoOutput {
     fn accept(&mut self, _: &Sample) {}
 }
 
-fn print_summary(s: &Scenario, peaks: &Peaks, stats: Option<&RunStats>, out: Option<&Path>) {
+fn print_summary(
+    s: &Scenario,
+    peaks: &Peaks,
+    stats: Option<&RunStats>,
+    out: Option<&Path>,
+) -> anyhow::Result<()> {
     let dir = if stats.is_some() {
         "forward (force → motion)"
     } else {
         "inverse (motion → force)"
     };
-    println!(
+    outln!(
         "{}: {dir}, {} model, {} at {:.2} MPa{}",
         s.name,
         s.model.form(),
@@ -80,39 +85,44 @@ fn print_summary(s: &Scenario, peaks: &Peaks, stats: Option<&RunStats>, out: Opt
         s.hold_down_pressure_pa / 1e6,
         overridden(s)
     );
-    println!(
+    outln!(
         "  {} samples over {:.3} s",
         peaks.samples,
         peaks.span_s.1 - peaks.span_s.0
     );
     for (channel, how) in &s.derived {
-        println!("  derived {channel}: {how}");
+        outln!("  derived {channel}: {how}");
     }
-    println!(
+    outln!(
         "  peak displacement {:>+10.4} m     at {:.3} s",
-        peaks.u_m.value, peaks.u_m.t_s
+        peaks.u_m.value,
+        peaks.u_m.t_s
     );
-    println!(
+    outln!(
         "  peak velocity     {:>+10.4} m/s   at {:.3} s",
-        peaks.v_m_s.value, peaks.v_m_s.t_s
+        peaks.v_m_s.value,
+        peaks.v_m_s.t_s
     );
-    println!(
+    outln!(
         "  peak acceleration {:>+10.4} m/s²  at {:.3} s ({:.3} g)",
         peaks.a_m_s2.value,
         peaks.a_m_s2.t_s,
         peaks.a_m_s2.value / STANDARD_GRAVITY_M_S2
     );
-    println!(
+    outln!(
         "  peak force        {:>+10.1} kN    at {:.3} s",
         peaks.force_n.value / 1e3,
         peaks.force_n.t_s
     );
     if let (Some(st), Run::Forward { integrator, .. }) = (stats, &s.run) {
-        println!(
+        outln!(
             "  stick: {:.3} s in all, {} stops, {} breakaways, {} reversals",
-            st.stick_time_s, st.stick_events, st.breakaways, st.reversals
+            st.stick_time_s,
+            st.stick_events,
+            st.breakaways,
+            st.reversals
         );
-        println!(
+        outln!(
             "  solver: {}, {} steps ({} rejected), {} right-hand-side evaluations, {} events located",
             integrator.name(),
             st.steps,
@@ -120,7 +130,7 @@ fn print_summary(s: &Scenario, peaks: &Peaks, stats: Option<&RunStats>, out: Opt
             st.rhs_evaluations,
             st.events()
         );
-        println!(
+        outln!(
             "  energy: actuator work {:.4e} J = ΔE_kin + ΔE_el + dissipated {:.4e} J; residual {:.2e} J ({:.1e} relative)",
             st.energy.actuator_work_j,
             st.energy.dissipated_j,
@@ -131,7 +141,7 @@ fn print_summary(s: &Scenario, peaks: &Peaks, stats: Option<&RunStats>, out: Opt
     let ex = peaks.exceedances(&s.limits);
     if ex.is_empty() {
         let l = &s.limits;
-        println!(
+        outln!(
             "  within the table's limits (stroke ±{} m, {} m/s, {} g, {} MN)",
             l.stroke_m,
             l.velocity_m_s,
@@ -140,12 +150,16 @@ fn print_summary(s: &Scenario, peaks: &Peaks, stats: Option<&RunStats>, out: Opt
         );
     }
     for e in ex {
-        println!(
+        outln!(
             "  EXCEEDS {} limit: peak {:+.4} vs limit {:.4} (SI units) at {:.3} s",
-            e.quantity, e.peak, e.limit, e.t_s
+            e.quantity,
+            e.peak,
+            e.limit,
+            e.t_s
         );
     }
     if let Some(out) = out {
-        println!("  wrote {}", out.display());
+        outln!("  wrote {}", out.display());
     }
+    Ok(())
 }

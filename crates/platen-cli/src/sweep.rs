@@ -135,9 +135,9 @@ pub fn run(
     }
     if json_out {
         let summary = sweep::json_summary(path, &scenario, set_names, cases, &outcomes, out);
-        println!("{}", serde_json::to_string_pretty(&summary)?);
+        outln!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
-        print_summary(&scenario, set_names, cases, &outcomes, out, wall_s);
+        print_summary(&scenario, set_names, cases, &outcomes, out, wall_s)?;
     }
     failures(&outcomes, out.is_some())
 }
@@ -206,8 +206,8 @@ fn print_summary(
     outs: &[Outcome],
     out: Option<&Path>,
     wall_s: f64,
-) {
-    println!(
+) -> anyhow::Result<()> {
+    outln!(
         "{}: {} cases ({} model, {}) in {wall_s:.2} s on {} threads",
         scenario.name,
         cases.len(),
@@ -224,7 +224,7 @@ fn print_summary(
         " {:>9} {:>9} {:>8} {:>10} {:>8} {:>6}  limits exceeded",
         "u (m)", "v (m/s)", "a (g)", "F (kN)", "stick s", "events"
     );
-    println!("{head}");
+    outln!("{head}");
     for (i, (case, o)) in cases.iter().zip(outs).enumerate() {
         let mut line = format!("  {i:>5} {:>8} {:>8}", case.scale, case.pressure_mpa);
         for v in &case.sets {
@@ -232,7 +232,7 @@ fn print_summary(
         }
         if let Some(e) = &o.error {
             let _ = write!(line, "  FAILED: {e}");
-            println!("{line}");
+            outln!("{line}");
             continue;
         }
         let (stick, events) = match &o.stats {
@@ -248,9 +248,10 @@ fn print_summary(
             o.peaks.force_n.value / 1e3,
             sweep::exceeded(scenario, &o.peaks),
         );
-        println!("{line}");
+        outln!("{line}");
     }
     if let Some(out) = out {
-        println!("  wrote {}", out.display());
+        outln!("  wrote {}", out.display());
     }
+    Ok(())
 }

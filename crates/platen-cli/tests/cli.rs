@@ -637,3 +637,23 @@ fn a_lab_export_with_its_own_channel_names_and_units_is_mapped() {
         stderr(&o)
     );
 }
+
+/// A reader that closes the pipe early (`platen model | head -1`) stops the verb quietly:
+/// exit 0, nothing on stderr, no panic. The reader here closes before the first write.
+#[test]
+fn a_closed_standard_output_is_not_a_panic() {
+    for args in [&["model"][..], &["schema"], &["model", "--json"]] {
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_platen"))
+            .args(args)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{args:?}: {:?} {stderr}", out.status);
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert!(stderr.is_empty(), "{args:?}: {stderr}");
+    }
+}

@@ -306,6 +306,16 @@ fn fundamental_hz(u: &[f64], rate: f64, errors: &Errors) -> Result<f64> {
     Ok(rate / rough_period)
 }
 
+/// Whether `rec` is a periodic test: its displacement crosses its mid-range at least three
+/// times, at regular intervals (the first check of [`analyse`]). `Err` says why not.
+pub(crate) fn periodicity(rec: &TestRecord) -> Result<f64> {
+    fundamental_hz(
+        rec.u_m(),
+        rec.sample_rate_hz(),
+        &Errors { test: rec.name() },
+    )
+}
+
 /// Every channel of a record through the two low-passes.
 struct Filtered {
     sr: SampleRate,

@@ -155,6 +155,25 @@ pub fn student_t_975(dof: f64) -> f64 {
     z + g1 / dof + g2 / (dof * dof) + g3 / (dof * dof * dof)
 }
 
+/// Whether two estimates of the parameter `key` from different fits disagree: by more than
+/// three of their combined standard errors *and* by more than `relative` of the larger value
+/// (of 1 for the exponent α, which is dimensionless and near 1).
+pub(crate) fn fits_disagree(
+    key: platen_model::IdentifiedKey,
+    a: &Estimate,
+    b: &Estimate,
+    relative: f64,
+) -> bool {
+    let diff = (a.value - b.value).abs();
+    let scale = if key == platen_model::IdentifiedKey::ViscousExponent {
+        1.0
+    } else {
+        a.value.abs().max(b.value.abs()).max(f64::MIN_POSITIVE)
+    };
+    let combined = (a.std_error.powi(2) + b.std_error.powi(2)).sqrt();
+    diff > 3.0 * combined && diff > relative * scale
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

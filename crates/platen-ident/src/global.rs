@@ -373,14 +373,7 @@ fn compare(params: &ParameterEstimates, global: &GlobalFit, warnings: &mut Vec<W
         let (Some(a), Some(b)) = (p.estimate(), global.parameters.get(key).estimate()) else {
             continue;
         };
-        let diff = (a.value - b.value).abs();
-        let scale = if key == IdentifiedKey::ViscousExponent {
-            1.0
-        } else {
-            a.value.abs().max(b.value.abs()).max(f64::MIN_POSITIVE)
-        };
-        let combined = (a.std_error.powi(2) + b.std_error.powi(2)).sqrt();
-        if diff > 3.0 * combined && diff > agreement(key) * scale {
+        if crate::estimate::fits_disagree(key, a, b, agreement(key)) {
             warnings.push(Warning::GlobalDisagreement {
                 key,
                 loop_value: a.value,

@@ -214,6 +214,17 @@ pub(crate) const SINGULAR_RELATIVE_EIGENVALUE: f64 = 1e-10;
 /// independent observation: residuals of low-passed records are correlated over about
 /// `f_s/(2f_c)` samples, and treating them as independent would understate the errors by
 /// `√L`. The degrees of freedom are `n/L − p`, at least 1.
+/// The condition number of a symmetric matrix from its eigen-decomposition: the ratio of its
+/// largest to its smallest eigenvalue, infinite if the smallest is not positive.
+pub(crate) fn condition_number(eig: &SymmetricEigen<f64, nalgebra::Dyn>) -> f64 {
+    let (max_ev, min_ev) = (eig.eigenvalues.max(), eig.eigenvalues.min());
+    if min_ev > 0.0 {
+        max_ev / min_ev
+    } else {
+        f64::INFINITY
+    }
+}
+
 pub(crate) fn covariance(jac: &DMatrix<f64>, ssr: f64, correlation_samples: f64) -> Covariance {
     let n = jac.nrows();
     let m = jac.ncols();
@@ -241,12 +252,7 @@ pub(crate) fn covariance(jac: &DMatrix<f64>, ssr: f64, correlation_samples: f64)
     });
     let eig = SymmetricEigen::new(scaled);
     let max_ev = eig.eigenvalues.max();
-    let min_ev = eig.eigenvalues.min();
-    let condition = if min_ev > 0.0 {
-        max_ev / min_ev
-    } else {
-        f64::INFINITY
-    };
+    let condition = condition_number(&eig);
     // Pseudo-inverse of the scaled matrix without its singular directions.
     let mut inv = DMatrix::zeros(k, k);
     for e in 0..k {

@@ -41,6 +41,17 @@ pub struct TestRecord {
     force_n: Vec<f64>,
     pressure_pa: Option<f64>,
     kind: Option<TestKind>,
+    floors: Option<Floors>,
+}
+
+/// The specimen floors of a record whose base shear was removed from its force
+/// ([`TestRecord::with_floors`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Floors {
+    /// The storeys' masses, kg, bottom first.
+    pub masses_kg: Vec<f64>,
+    /// Largest |Σ mᵢ·aᵢ| removed, N.
+    pub peak_base_shear_n: f64,
 }
 
 /// Fewest samples a record may have: far below any real test (a cycle of the paper's
@@ -125,6 +136,7 @@ impl TestRecord {
             force_n,
             pressure_pa: None,
             kind: None,
+            floors: None,
         })
     }
 
@@ -172,6 +184,61 @@ impl TestRecord {
         Ok(self)
     }
 
+    /// Removes the base shear of a specimen from the force: a shear building fixed on the
+    /// platen is pushed by it with `Σ mᵢ·aᵢ` (storey masses `mᵢ`, their absolute
+    /// accelerations `aᵢ`), which the recorded actuator force includes and the platen's model
+    /// does not. `floors` holds `(mᵢ, aᵢ)` per storey, m/s².
+    ///
+    /// # Errors
+    /// [`IdentError::InvalidRecord`] for a mass that is not finite and positive, or a floor
+    /// channel of another length or with a non-finite value.
+    pub fn with_floors(mut self, floors: &[(f64, Vec<f64>)]) -> Result<Self> {
+        let n = self.u_m.len();
+        let mut shear = vec![0.0; n];
+        for (k, (mass, acc)) in floors.iter().enumerate() {
+            let invalid = |message: String| IdentError::InvalidRecord {
+                test: self.name.clone(),
+                message,
+            };
+            if !(mass.is_finite() && *mass > 0.0) {
+                return Err(invalid(format!(
+                    "storey {} mass {mass} kg: expected a finite mass > 0",
+                    k + 1
+                )));
+            }
+            if acc.len() != n {
+                return Err(invalid(format!(
+                    "storey {} acceleration has {} samples, `u_m` has {n}",
+                    k + 1,
+                    acc.len()
+                )));
+            }
+            if let Some(i) = acc.iter().position(|x| !x.is_finite()) {
+                return Err(invalid(format!(
+                    "storey {} acceleration sample {i} is {}: expected a finite number",
+                    k + 1,
+                    acc[i]
+                )));
+            }
+            for (s, a) in shear.iter_mut().zip(acc) {
+                *s += mass * a;
+            }
+        }
+        for (f, s) in self.force_n.iter_mut().zip(&shear) {
+            *f -= s;
+        }
+        self.floors = Some(Floors {
+            masses_kg: floors.iter().map(|(m, _)| *m).collect(),
+            peak_base_shear_n: shear.iter().fold(0.0, |m, s| f64::max(m, s.abs())),
+        });
+        Ok(self)
+    }
+
+    /// The floors whose base shear was removed, if any.
+    pub fn floors(&self) -> Option<&Floors> {
+        self.floors.as_ref()
+    }
+
     /// Declares the waveform (otherwise recognised from the data).
     pub fn with_kind(mut self, kind: TestKind) -> Self {
         self.kind = Some(kind);
@@ -210,7 +277,8 @@ impl TestRecord {
     pub fn a_m_s2(&self) -> &[f64] {
         &self.a_m_s2
     }
-    /// Total actuator force, N.
+    /// Total actuator force, N (less the specimen's base shear after
+    /// [`TestRecord::with_floors`]).
     pub fn force_n(&self) -> &[f64] {
         &self.force_n
     }
@@ -221,5 +289,36 @@ impl TestRecord {
     /// Declared waveform, if given.
     pub fn kind(&self) -> Option<TestKind> {
         self.kind
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Σ mᵢ·aᵢ leaves the force: 2 storeys of 10 t and 5 t at 1 and 2 m/s² take 20 kN.
+    #[test]
+    fn floors_take_their_base_shear_off_the_force() {
+        let n = 100;
+        let rec = TestRecord::from_rate("r", 100.0, vec![0.0; n], vec![0.0; n], vec![50e3; n])
+            .unwrap()
+            .with_floors(&[(10e3, vec![1.0; n]), (5e3, vec![2.0; n])])
+            .unwrap();
+        assert!(rec.force_n().iter().all(|&f| f == 30e3));
+        assert_eq!(rec.floors().unwrap().peak_base_shear_n, 20e3);
+    }
+
+    #[test]
+    fn a_bad_floor_is_rejected_naming_the_storey() {
+        let n = 100;
+        let rec =
+            TestRecord::from_rate("r", 100.0, vec![0.0; n], vec![0.0; n], vec![0.0; n]).unwrap();
+        let e = rec
+            .clone()
+            .with_floors(&[(-1.0, vec![0.0; n])])
+            .unwrap_err();
+        assert!(e.to_string().contains("storey 1 mass"), "{e}");
+        let e = rec.with_floors(&[(1.0, vec![0.0; 3])]).unwrap_err();
+        assert!(e.to_string().contains("storey 1 acceleration has 3"), "{e}");
     }
 }

@@ -135,6 +135,30 @@ impl Trajectory {
     }
 }
 
+impl Trajectory {
+    /// The columns in the order of [`Trajectory::COLUMN_NAMES`], moved out (no copy): for a
+    /// front end that hands them on, as Python's NumPy arrays.
+    ///
+    /// ```
+    /// use platen_integrate::Trajectory;
+    /// let t = Trajectory { t_s: vec![0.0, 0.5], u_m: vec![1.0, 2.0], ..Trajectory::default() };
+    /// let moved = t.clone().into_columns();
+    /// assert_eq!(moved.iter().map(Vec::as_slice).collect::<Vec<_>>(), t.columns());
+    /// ```
+    pub fn into_columns(self) -> [Vec<f64>; 8] {
+        [
+            self.t_s,
+            self.u_m,
+            self.v_m_s,
+            self.a_m_s2,
+            self.force_n,
+            self.inertial_force_n,
+            self.elastic_force_n,
+            self.dissipative_force_n,
+        ]
+    }
+}
+
 impl SampleSink for Trajectory {
     #[inline]
     fn accept(&mut self, s: &Sample) {

@@ -34,7 +34,7 @@ use serde::Deserialize;
 
 use crate::csv::{read_table, Table};
 use crate::error::{IoError, Result};
-use crate::json::parse_json_file;
+use crate::json::{parse_json, parse_json_file};
 
 use crate::STANDARD_GRAVITY_M_S2;
 
@@ -255,7 +255,21 @@ impl ColumnMap {
     /// column or unit.
     pub fn load(path: &Path) -> Result<Self> {
         let spec: BTreeMap<String, ColumnSpec> = parse_json_file(path)?;
-        Self::new(&spec, "columns").map_err(|(json_path, value, expected)| IoError::InvalidField {
+        Self::checked(path, &spec)
+    }
+
+    /// A column map given as JSON text (the object [`ColumnMap::load`] reads from a file,
+    /// e.g. from Python's `columns=` dict); `origin` names it in messages.
+    ///
+    /// # Errors
+    /// As [`ColumnMap::load`], but for reading a file.
+    pub fn from_json(origin: &Path, text: &str) -> Result<Self> {
+        let spec: BTreeMap<String, ColumnSpec> = parse_json(origin, text)?;
+        Self::checked(origin, &spec)
+    }
+
+    fn checked(path: &Path, spec: &BTreeMap<String, ColumnSpec>) -> Result<Self> {
+        Self::new(spec, "columns").map_err(|(json_path, value, expected)| IoError::InvalidField {
             path: path.to_owned(),
             json_path,
             value,
@@ -356,6 +370,26 @@ mod tests {
     fn map(json: &str) -> Result<ColumnMap, (String, String, String)> {
         let spec: BTreeMap<String, ColumnSpec> = serde_json::from_str(json).unwrap();
         ColumnMap::new(&spec, "excitation.columns")
+    }
+
+    #[test]
+    fn a_map_given_as_json_text_is_checked_and_named_by_its_origin() {
+        let m = ColumnMap::from_json(
+            Path::new("columns="),
+            r#"{"u_m": {"name": "disp", "unit": "mm"}}"#,
+        )
+        .unwrap();
+        assert_eq!((m.header("u_m"), m.factor("u_m")), ("disp", 1e-3));
+        let e = ColumnMap::from_json(Path::new("columns="), r#"{"u_m": {"unit": "furlong"}}"#)
+            .unwrap_err();
+        assert!(
+            matches!(&e, IoError::InvalidField { json_path, .. } if json_path == "columns.u_m.unit"),
+            "{e:?}"
+        );
+        assert!(
+            e.to_string().starts_with("`columns=`: columns.u_m.unit"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -51,6 +51,7 @@ mod error;
 pub mod figure;
 pub mod html;
 pub mod identify_figures;
+pub mod record_figures;
 pub mod render;
 pub mod series;
 mod svg;

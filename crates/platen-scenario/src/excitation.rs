@@ -134,18 +134,7 @@ enum Source<'a> {
 impl<'a> Source<'a> {
     /// The one source of `ex`, or an error listing those given.
     fn of(ctx: &Ctx, ex: &'a ExcitationSpec) -> Result<Self> {
-        let given: Vec<Source<'a>> = [
-            ex.force_csv.as_deref().map(Source::ForceCsv),
-            ex.motion_csv.as_deref().map(Source::MotionCsv),
-            ex.sine_force.as_ref().map(Source::SineForce),
-            ex.sine_motion.as_ref().map(Source::SineMotion),
-            ex.triangle_motion.as_ref().map(Source::TriangleMotion),
-            ex.white_noise_motion.as_ref().map(Source::WhiteNoiseMotion),
-            ex.ground_motion.as_ref().map(Source::GroundMotion),
-        ]
-        .into_iter()
-        .flatten()
-        .collect();
+        let given = Source::given(ex);
         match given.as_slice() {
             [source] => Ok(*source),
             _ => {
@@ -157,6 +146,22 @@ impl<'a> Source<'a> {
                 ))
             }
         }
+    }
+
+    /// Every source `ex` names.
+    fn given(ex: &'a ExcitationSpec) -> Vec<Source<'a>> {
+        [
+            ex.force_csv.as_deref().map(Source::ForceCsv),
+            ex.motion_csv.as_deref().map(Source::MotionCsv),
+            ex.sine_force.as_ref().map(Source::SineForce),
+            ex.sine_motion.as_ref().map(Source::SineMotion),
+            ex.triangle_motion.as_ref().map(Source::TriangleMotion),
+            ex.white_noise_motion.as_ref().map(Source::WhiteNoiseMotion),
+            ex.ground_motion.as_ref().map(Source::GroundMotion),
+        ]
+        .into_iter()
+        .flatten()
+        .collect()
     }
 
     /// The key of this source in `excitation`.
@@ -178,26 +183,35 @@ impl<'a> Source<'a> {
     }
 }
 
+/// The keys of the sources `ex` names (none for a scenario whose records are given in
+/// memory: [`crate::Scenario::from_arrays`]).
+pub(crate) fn named_sources(ex: &ExcitationSpec) -> Vec<&'static str> {
+    Source::given(ex).into_iter().map(Source::name).collect()
+}
+
 /// What the scenario file's excitation, integrator, initial state and duration run, and
 /// which channels of the excitation were derived (not given by the file or generator).
 pub(crate) fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<(Run, Derived)> {
-    let ex = &file.excitation;
-    let source = Source::of(ctx, ex)?;
-    check_direction_fields(ctx, file, source)?;
+    let source = Source::of(ctx, &file.excitation)?;
+    check_direction_fields(ctx, file, source.is_force())?;
+    let (run, derived) = build_source(ctx, file, source)?;
+    Ok((with_rest_velocity(ctx, file, run)?, derived))
+}
+
+/// An inverse run with the excitation's velocity dead band (`rest_velocity_m_s`), if any.
+pub(crate) fn with_rest_velocity(ctx: &Ctx, file: &ScenarioFile, run: Run) -> Result<Run> {
     let here = "excitation.rest_velocity_m_s";
-    let band = (ex.rest_velocity_m_s)
+    let band = (file.excitation.rest_velocity_m_s)
         .map(|b| check_positive(ctx, here, b))
         .transpose()?;
-    let (run, derived) = build_source(ctx, file, source)?;
-    let run = match (run, band) {
+    Ok(match (run, band) {
         (Run::Inverse { motion }, Some(band)) => Run::Inverse {
             motion: motion
                 .with_rest_velocity(band)
                 .map_err(|e| ctx.invalid(here, band, e.to_string()))?,
         },
         (run, _) => run,
-    };
-    Ok((run, derived))
+    })
 }
 
 /// The run of the excitation's one source.
@@ -253,9 +267,9 @@ fn build_source(ctx: &Ctx, file: &ScenarioFile, source: Source) -> Result<(Run, 
 
 /// Fields that only one direction takes: a low-pass (forces), an integrator and an initial
 /// state (forward runs).
-fn check_direction_fields(ctx: &Ctx, file: &ScenarioFile, source: Source) -> Result<()> {
+pub(crate) fn check_direction_fields(ctx: &Ctx, file: &ScenarioFile, is_force: bool) -> Result<()> {
     let ex = &file.excitation;
-    if source.is_force() {
+    if is_force {
         if let Some(band) = ex.rest_velocity_m_s {
             return Err(ctx.invalid(
                 "excitation.rest_velocity_m_s",
@@ -344,9 +358,23 @@ fn force_csv_run(ctx: &Ctx, file: &ScenarioFile, path: &Path) -> Result<Run> {
         (Some(u), Some(v)) => Some((u[0], v[0])),
         _ => None,
     };
-    let dt = uniform_step_s(path, &t)?;
-    let samples = samples_for(ctx, path, file.duration_s, dt, t.len())?;
+    // Checked here first, so that a bad time column is reported with its line.
+    uniform_step_s(path, &t)?;
     let record = ForceRecord::new(t, f).map_err(|cause| rejected(path, cause))?;
+    force_run(ctx, file, path, record, recorded_state)
+}
+
+/// A forward run of `record` read from `path` (a file, or the caller that gave the arrays),
+/// cut to the duration and low-passed.
+pub(crate) fn force_run(
+    ctx: &Ctx,
+    file: &ScenarioFile,
+    path: &Path,
+    record: ForceRecord,
+    recorded_state: Option<(f64, f64)>,
+) -> Result<Run> {
+    let ex = &file.excitation;
+    let samples = samples_for(ctx, path, file.duration_s, record.dt_s(), record.len())?;
     let record = lowpass(ctx, ex, record, samples)?;
     forward_run(ctx, file, record, samples, recorded_state)
 }
@@ -362,6 +390,21 @@ fn motion_csv(ctx: &Ctx, file: &ScenarioFile, path: &Path) -> Result<(Run, Deriv
     let u = cols.remove("u_m").unwrap_or_default();
     let v = cols.remove("v_m_s");
     let a = cols.remove("a_m_s2");
+    motion_run(ctx, file, path, t, u, v, a)
+}
+
+/// An inverse run of the motion `t`, `u` (and `v`, `a` where given) read from `path` (a
+/// file, or the caller that gave the arrays), cut to the duration; missing velocity and
+/// acceleration are derived from the displacement.
+pub(crate) fn motion_run(
+    ctx: &Ctx,
+    file: &ScenarioFile,
+    path: &Path,
+    t: Vec<f64>,
+    u: Vec<f64>,
+    v: Option<Vec<f64>>,
+    a: Option<Vec<f64>>,
+) -> Result<(Run, Derived)> {
     let samples = match file.duration_s {
         None => t.len(),
         Some(d) => {
@@ -465,7 +508,7 @@ fn white_noise(gen: &Generated, g: &WhiteNoiseMotion) -> Result<Run> {
 }
 
 /// A record the integrator's checks reject.
-fn rejected(path: &Path, cause: IntegrateError) -> ScenarioError {
+pub(crate) fn rejected(path: &Path, cause: IntegrateError) -> ScenarioError {
     ScenarioError::RecordRejected {
         path: path.to_owned(),
         cause,

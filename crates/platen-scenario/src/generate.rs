@@ -65,6 +65,36 @@ fn sample_count(rate_hz: f64, duration_s: f64) -> Result<usize, GenerateError> {
     Ok(n as usize)
 }
 
+/// A frequency below the Nyquist frequency of the sample rate: a waveform above it would be
+/// sampled as a lower one (aliasing).
+fn below_nyquist(frequency_hz: f64, rate_hz: f64) -> Result<f64, GenerateError> {
+    check(
+        "frequency_hz",
+        frequency_hz,
+        frequency_hz < 0.5 * rate_hz,
+        &format!(
+            "a frequency below the Nyquist frequency of the sample rate ({} Hz)",
+            0.5 * rate_hz
+        ),
+    )
+}
+
+/// The generated samples as a motion, or the error of the parameter `name = value` that made
+/// them unusable (a waveform too large for double precision: `A·(2πf)²` overflows).
+fn generated_motion(
+    t: Vec<f64>,
+    u: Vec<f64>,
+    v: Vec<f64>,
+    a: Vec<f64>,
+    (name, value): (&'static str, f64),
+) -> Result<Motion, GenerateError> {
+    Motion::new(t, u, v, a).map_err(|e| GenerateError::Invalid {
+        name,
+        value,
+        expected: format!("a value for which the generated motion is finite ({e})"),
+    })
+}
+
 fn times(rate_hz: f64, n: usize) -> Vec<f64> {
     (0..n).map(|j| j as f64 / rate_hz).collect()
 }
@@ -72,7 +102,8 @@ fn times(rate_hz: f64, n: usize) -> Vec<f64> {
 /// `u = A·sin(2πft)` with exact velocity and acceleration (the paper's S tests).
 ///
 /// # Errors
-/// Non-finite amplitude, frequency ≤ 0, rate ≤ 0, duration ≤ 0.
+/// Non-finite amplitude, frequency ≤ 0 or at or above the Nyquist frequency `rate/2`,
+/// rate ≤ 0, duration ≤ 0, or a waveform too large for double precision.
 pub fn sine_motion(
     amplitude_m: f64,
     frequency_hz: f64,
@@ -87,6 +118,7 @@ pub fn sine_motion(
         "a frequency > 0",
     )?;
     let n = sample_count(rate_hz, duration_s)?;
+    below_nyquist(frequency_hz, rate_hz)?;
     let w = 2.0 * PI * frequency_hz;
     let t = times(rate_hz, n);
     let u = t.iter().map(|&t| amplitude_m * (w * t).sin()).collect();
@@ -95,13 +127,14 @@ pub fn sine_motion(
         .iter()
         .map(|&t| -amplitude_m * w * w * (w * t).sin())
         .collect();
-    Ok(Motion::new(t, u, v, a).expect("generated samples are finite and ordered"))
+    generated_motion(t, u, v, a, ("amplitude_m", amplitude_m))
 }
 
 /// `F = r(t)·A·sin(2πft)` with `r` a linear ramp from 0 to 1 over `ramp_s` (0: none).
 ///
 /// # Errors
-/// Non-finite amplitude, frequency < 0, ramp < 0, rate ≤ 0, duration ≤ 0.
+/// Non-finite amplitude, frequency < 0 or at or above the Nyquist frequency `rate/2`,
+/// ramp < 0, rate ≤ 0, duration ≤ 0.
 pub fn sine_force(
     amplitude_n: f64,
     frequency_hz: f64,
@@ -118,6 +151,7 @@ pub fn sine_force(
     )?;
     check("ramp_s", ramp_s, ramp_s >= 0.0, "a ramp length >= 0")?;
     let n = sample_count(rate_hz, duration_s)?;
+    below_nyquist(frequency_hz, rate_hz)?;
     let force = times(rate_hz, n)
         .iter()
         .map(|&t| {
@@ -129,7 +163,11 @@ pub fn sine_force(
             r * amplitude_n * (2.0 * PI * frequency_hz * t).sin()
         })
         .collect();
-    Ok(ForceRecord::from_rate(rate_hz, force).expect("generated samples are finite and uniform"))
+    ForceRecord::from_rate(rate_hz, force).map_err(|e| GenerateError::Invalid {
+        name: "amplitude_n",
+        value: amplitude_n,
+        expected: format!("a value for which the generated force is finite ({e})"),
+    })
 }
 
 /// A triangle displacement wave with rounded reversals (the paper's T tests): constant
@@ -204,7 +242,7 @@ pub fn triangle_motion(
         v.push(vi);
         a.push(ai);
     }
-    Ok(Motion::new(t, u, v, a).expect("generated samples are finite and ordered"))
+    generated_motion(t, u, v, a, ("amplitude_m", amplitude_m))
 }
 
 /// SplitMix64: a small, fast, well-mixed generator; seeded runs are reproducible everywhere.
@@ -309,12 +347,36 @@ pub fn white_noise_motion(
     let a = synth(&|_, ph| Complex::from_polar(c, ph));
     let v = synth(&|w, ph| Complex::from_polar(c / w, ph) * Complex::new(0.0, -1.0));
     let u = synth(&|w, ph| Complex::from_polar(-c / (w * w), ph));
-    Ok(Motion::new(times(rate_hz, n), u, v, a).expect("generated samples are finite and ordered"))
+    let t = times(rate_hz, n);
+    generated_motion(t, u, v, a, ("rms_acceleration_m_s2", rms_acceleration_m_s2))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Frequencies at or above the Nyquist frequency, and waveforms too large for double
+    /// precision, are parameter errors naming the parameter, never a panic.
+    #[test]
+    fn extreme_parameters_are_errors_not_panics() {
+        let name = |r: Result<Motion, GenerateError>| match r {
+            Err(GenerateError::Invalid { name, .. }) => name,
+            Ok(_) => "accepted",
+        };
+        assert_eq!(name(sine_motion(0.1, 1e300, 1024.0, 1.0)), "frequency_hz");
+        assert_eq!(name(sine_motion(0.1, 512.0, 1024.0, 1.0)), "frequency_hz");
+        assert_eq!(name(sine_motion(1e305, 400.0, 1024.0, 1.0)), "amplitude_m");
+        assert_eq!(name(sine_motion(0.1, 511.0, 1024.0, 1.0)), "accepted");
+        let force = sine_force(1e5, 600.0, 0.0, 1024.0, 1.0);
+        assert!(matches!(
+            force,
+            Err(GenerateError::Invalid {
+                name: "frequency_hz",
+                ..
+            })
+        ));
+        assert!(sine_force(f64::MAX, 100.0, 0.0, 1024.0, 1.0).is_ok());
+    }
 
     fn rms(x: &[f64]) -> f64 {
         (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt()

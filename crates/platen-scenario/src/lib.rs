@@ -2,6 +2,8 @@
 //!
 //! * [`scenario`]: the scenario JSON format ([`Scenario::load`] validates a file and loads
 //!   its records before anything is simulated);
+//! * [`Scenario::from_arrays`]: the same format with the records given in memory (Python's
+//!   `platen.forward` and `platen.inverse`);
 //! * [`Scenario::run`]: the executor every front end calls (CLI, sweep, bench, Python).
 //!
 //! # Conventions
@@ -12,7 +14,9 @@
 
 #![warn(missing_docs)]
 
+mod arrays;
 mod ctx;
+mod describe;
 pub mod error;
 mod excitation;
 mod execute;
@@ -24,6 +28,8 @@ pub mod scenario;
 mod summary;
 pub mod sweep;
 
+pub use arrays::Arrays;
+pub use describe::describe_model;
 pub use error::{Result, ScenarioError};
 pub use execute::{CsvSink, RunOutput};
 /// Column maps are part of the scenario format (`excitation.columns`).

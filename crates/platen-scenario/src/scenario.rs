@@ -148,6 +148,16 @@ impl Scenario {
     /// # Errors
     /// As [`Scenario::load`].
     pub fn from_file(path: &Path, file: ScenarioFile) -> Result<Self> {
+        Self::validate(path, &file, build_run)
+    }
+
+    /// Validates `file`'s model and settings, with `run` building what it runs (from the
+    /// file's excitation, or from records given in memory: [`Scenario::from_arrays`]).
+    pub(crate) fn validate(
+        path: &Path,
+        file: &ScenarioFile,
+        run: impl FnOnce(&Ctx, &ScenarioFile) -> Result<(Run, Derived)>,
+    ) -> Result<Self> {
         let ctx = Ctx { path };
         let preset = Preset::from_name(&file.model.preset).map_err(|e| {
             ctx.invalid(
@@ -166,7 +176,7 @@ impl Scenario {
         let overrides = model_overrides(&ctx, &file.model)?;
         let model = build_model(&ctx, preset, pressure_pa, &overrides)?;
         let limits = table_limits(&ctx, preset, file.limits.as_ref())?;
-        let (run, derived) = build_run(&ctx, &file)?;
+        let (run, derived) = run(&ctx, file)?;
         let specimen = build_specimen(&ctx, file.specimen.as_ref(), &run)?;
         let name = file.name.clone().unwrap_or_else(|| {
             path.file_stem()

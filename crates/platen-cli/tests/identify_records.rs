@@ -1,0 +1,149 @@
+//! `platen identify` on records that are not periodic tests: routing, the JSON contract (the
+//! seven keys at the top level), a specimen's floors from a manifest, and lab files as
+//! recorded. The records are the independent NumPy ones of `tests/data/any-record`.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+fn platen(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_platen"))
+        .args(args)
+        .output()
+        .expect("run platen")
+}
+
+fn data() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/any-record")
+}
+
+/// A copy of a lab file in `dir` with its time stamps printed exactly (`k/204.8` in full),
+/// for the checks that do not depend on accepting rounded stamps.
+fn exact_stamps(dir: &Path, file: &str) -> PathBuf {
+    let text = std::fs::read_to_string(data().join(file)).unwrap();
+    let mut lines = text.lines();
+    let mut out = String::from(lines.next().unwrap());
+    out.push('\n');
+    for (k, line) in lines.enumerate() {
+        let rest = line.split_once(',').unwrap().1;
+        out.push_str(&format!("{:?},{rest}\n", k as f64 / 204.8));
+    }
+    let path = dir.join(file);
+    std::fs::write(&path, out).unwrap();
+    path
+}
+
+fn json(o: &Output) -> Value {
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
+const KEYS: [&str; 7] = [
+    "effective_mass_kg",
+    "stiffness_n_per_m",
+    "coulomb_force_n",
+    "viscous_coefficient",
+    "viscous_exponent",
+    "low_velocity_force_n",
+    "low_velocity_decay_s_per_m",
+];
+
+#[test]
+fn an_earthquake_record_goes_to_the_any_record_method_with_the_seven_keys_at_the_top() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = exact_stamps(dir.path(), "eq-lab.csv");
+    let columns = data().join("columns.json");
+    let v = json(&platen(&[
+        "identify",
+        csv.to_str().unwrap(),
+        "--columns",
+        columns.to_str().unwrap(),
+        "--no-output-error",
+        "--json",
+    ]));
+    assert_eq!(v["method"], "record");
+    for key in KEYS {
+        assert!(v[key].as_f64().is_some(), "{key}: {}", v[key]);
+        assert_eq!(v["uncertainty"][key]["status"], "estimated", "{key}");
+    }
+    let m = v["effective_mass_kg"].as_f64().unwrap();
+    assert!((m / 118e3 - 1.0).abs() < 0.02, "{m}");
+    assert!(v["dissipative_band"].as_array().unwrap().len() > 10);
+    assert_eq!(v["records"][0]["velocity"], "crossover");
+    let c = &v["equation_error"]["statistics"]["correlations"];
+    assert_eq!(c["keys"].as_array().unwrap().len(), 7);
+}
+
+#[test]
+fn a_manifest_with_floors_removes_the_specimens_base_shear() {
+    let dir = tempfile::tempdir().unwrap();
+    exact_stamps(dir.path(), "eq-two-storey-lab.csv");
+    let manifest = dir.path().join("m.json");
+    std::fs::copy(data().join("two-storey-manifest.json"), &manifest).unwrap();
+    let v = json(&platen(&[
+        "identify",
+        "--manifest",
+        manifest.to_str().unwrap(),
+        "--no-output-error",
+        "--json",
+    ]));
+    let m = v["effective_mass_kg"].as_f64().unwrap();
+    let k = v["stiffness_n_per_m"].as_f64().unwrap();
+    assert!((m / 118e3 - 1.0).abs() < 0.02, "{m}");
+    assert!((k / 0.95e6 - 1.0).abs() < 0.02, "{k}");
+    assert_eq!(
+        v["records"][0]["floor_masses_kg"],
+        serde_json::json!([14000.0, 11000.0])
+    );
+}
+
+#[test]
+fn forcing_the_periodic_method_on_an_earthquake_is_the_old_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = exact_stamps(dir.path(), "eq-lab.csv");
+    let columns = data().join("columns.json");
+    let o = platen(&[
+        "identify",
+        csv.to_str().unwrap(),
+        "--columns",
+        columns.to_str().unwrap(),
+        "--method",
+        "periodic",
+    ]);
+    assert_eq!(o.status.code(), Some(3));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("not a periodic test"));
+}
+
+#[test]
+fn a_bad_floor_mass_is_an_input_error_naming_the_manifest() {
+    let dir = tempfile::tempdir().unwrap();
+    exact_stamps(dir.path(), "eq-two-storey-lab.csv");
+    let text = std::fs::read_to_string(data().join("two-storey-manifest.json")).unwrap();
+    let manifest = dir.path().join("m.json");
+    std::fs::write(&manifest, text.replace("14000", "-1")).unwrap();
+    let o = platen(&["identify", "--manifest", manifest.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(3));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("m.json") && err.contains("mass_kg"), "{err}");
+}
+
+/// The lab file exactly as written: stamps rounded to 10⁻⁵ s (intervals 4.88 and 4.89 ms
+/// against 4.8828 ms). Needs the fitted-grid sampling check of issue 16 (uniformity judged
+/// against a fitted interval, not each interval against the median); today's check rejects
+/// the file at line 4.
+#[test]
+fn a_lab_file_with_rounded_stamps_is_identified_as_recorded() {
+    let csv = data().join("eq-lab.csv");
+    let columns = data().join("columns.json");
+    let v = json(&platen(&[
+        "identify",
+        csv.to_str().unwrap(),
+        "--columns",
+        columns.to_str().unwrap(),
+        "--no-output-error",
+        "--json",
+    ]));
+    let m = v["effective_mass_kg"].as_f64().unwrap();
+    assert!((m / 118e3 - 1.0).abs() < 0.02, "{m}");
+}

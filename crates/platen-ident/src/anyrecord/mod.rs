@@ -1,0 +1,647 @@
+//! Identification from any test record (earthquake, white noise, periodic): equation error
+//! by separable least squares, refined by output error, with uncertainties that account for
+//! serially correlated residuals.
+//!
+//! See [`identify_records`].
+
+mod data;
+mod hac;
+mod output_error;
+pub(crate) mod result;
+mod separable;
+pub(crate) mod settings;
+pub mod summary;
+
+use std::cell::Cell;
+
+use nalgebra::DMatrix;
+use platen_model::{DissipativeLaw, Exponent, IdentifiedKey};
+
+use crate::error::{IdentError, Result};
+use crate::estimate::{Estimate, Parameter};
+use crate::record::TestRecord;
+use crate::result::ParameterEstimates;
+
+use data::{prepare, Prepared, Stacked};
+use hac::Hac;
+use output_error::OutputError;
+use result::{
+    BandPoint, Correlations, EquationErrorFit, FitKind, FitUncertainty, FloorsReport,
+    OutputErrorFit, RecordIdentification, RecordReport, RecordWarning,
+};
+use separable::{Separable, SeparableFit, Shape, LOW_DECAY, LOW_FORCE, OFFSETS};
+use settings::ValidRecordSettings;
+
+/// Estimates correlated beyond this (in absolute value) are reported as not separable
+/// ([`RecordWarning::NotSeparable`]): at 0.95 the variance of either alone is ten times what
+/// it would be with the other known.
+pub const MAX_CORRELATION: f64 = 0.95;
+
+/// A parameter whose standard error exceeds this fraction of its value is reported as
+/// poorly determined ([`RecordWarning::Imprecise`]).
+pub const MAX_RELATIVE_STD_ERROR: f64 = 0.1;
+
+/// Fewer than this fraction of the fitted samples below `3/b` draws
+/// [`RecordWarning::FewLowSpeedSamples`].
+pub const MIN_LOW_SPEED_FRACTION: f64 = 0.02;
+
+/// Largest relative difference between the equation-error and output-error estimates of a
+/// parameter before [`RecordWarning::FitsDisagree`] (when also beyond three combined
+/// standard errors): 2 % for mass and stiffness, 5 % for `F_μ` and `Cₑ`, 0.05 (absolute)
+/// for `α`, 20 % for the low-velocity term, which the two fits see differently (the equation
+/// error only above its minimum speed).
+pub fn fit_agreement(key: IdentifiedKey) -> f64 {
+    match key {
+        IdentifiedKey::EffectiveMass | IdentifiedKey::Stiffness => 0.02,
+        IdentifiedKey::CoulombForce | IdentifiedKey::ViscousCoefficient => 0.05,
+        IdentifiedKey::ViscousExponent => 0.05,
+        IdentifiedKey::LowVelocityForce | IdentifiedKey::LowVelocityDecay => 0.2,
+    }
+}
+
+/// Full-vector index of each key.
+fn index(key: IdentifiedKey) -> usize {
+    match key {
+        IdentifiedKey::EffectiveMass => 0,
+        IdentifiedKey::Stiffness => 1,
+        IdentifiedKey::CoulombForce => 2,
+        IdentifiedKey::ViscousCoefficient => 3,
+        IdentifiedKey::ViscousExponent => 4,
+        IdentifiedKey::LowVelocityForce => 5,
+        IdentifiedKey::LowVelocityDecay => 6,
+    }
+}
+
+/// Identifies the platen's parameters from any records (see the crate docs, "Any record").
+///
+/// All records are fitted jointly: one set of the seven parameters, one force offset per
+/// record. Records with floor accelerations have had the base shear removed from their force
+/// ([`TestRecord::with_floors`]).
+///
+/// # Errors
+/// [`IdentError::NoTests`] for no records; [`IdentError::InvalidRecord`] if the records hold
+/// too few samples faster than the minimum speed; [`IdentError::Signal`] if the crossover
+/// filter cannot be made for a record's rate.
+pub fn identify_records(
+    records: &[TestRecord],
+    settings: &ValidRecordSettings,
+) -> Result<RecordIdentification> {
+    if records.is_empty() {
+        return Err(IdentError::NoTests);
+    }
+    let prepared = prepare(records, settings)?;
+    let data = Stacked::new(records, &prepared);
+    let mut shape = Shape {
+        alpha: settings.viscous_exponent,
+        low: settings.low_velocity_term,
+        records: records.len(),
+    };
+    let needed = 10 * (shape.free().len() + 2);
+    if data.len() < needed {
+        return Err(IdentError::InvalidRecord {
+            test: records[0].name().to_owned(),
+            message: format!(
+                "{} samples move faster than {} m/s over all records; the any-record method needs at least {needed}",
+                data.len(),
+                settings.min_speed_m_s
+            ),
+        });
+    }
+    let mut warnings = Vec::new();
+    let mut fit = Separable::new(&data, shape).fit();
+    let mut hac = ee_covariance(&fit, &data);
+    let mut low_dropped = None;
+    if shape.low {
+        let (a, se) = match fit.free.iter().position(|&i| i == LOW_FORCE) {
+            Some(k) => (fit.full[LOW_FORCE], hac.cov[(k, k)].sqrt()),
+            None => (0.0, f64::NAN),
+        };
+        if fit.clamped.contains(&LOW_FORCE) {
+            warnings.push(RecordWarning::LowVelocityTermLeftOut {
+                force_n: a,
+                std_error_n: se,
+            });
+            low_dropped = Some((a, se));
+            shape.low = false;
+            fit = Separable::new(&data, shape).fit();
+            hac = ee_covariance(&fit, &data);
+        }
+    }
+    let clamped = fit.clamped.clone();
+    let fixed_reason = |key: IdentifiedKey| -> String {
+        match key {
+            _ if clamped.contains(&index(key)) => {
+                "at its bound (0): a negative value fits this record better".to_owned()
+            }
+            IdentifiedKey::ViscousExponent => "held at the value given".to_owned(),
+            _ if low_dropped.is_some() => {
+                "left out: the low-velocity term is not significant in this record".to_owned()
+            }
+            _ => "not fitted (low-velocity term off)".to_owned(),
+        }
+    };
+    let free = fit.free.clone();
+    let (ee_params, ee_corr) = parameters(&fit.full, &free, &hac, &fixed_reason);
+    let offsets_n = (0..records.len())
+        .map(|r| {
+            let k = free_position(&free, OFFSETS + r);
+            estimate(fit.full[OFFSETS + r], hac.cov[(k, k)], &hac, free.len())
+        })
+        .collect();
+    let speeds = speed_range(&data);
+    ee_warnings(
+        &fit,
+        &hac,
+        &free,
+        &ee_params,
+        &ee_corr,
+        &data,
+        settings,
+        speeds,
+        &mut warnings,
+    );
+    let equation_error = EquationErrorFit {
+        parameters: ee_params.clone(),
+        offsets_n,
+        uncertainty: uncertainty(&hac, ee_corr),
+        rms_residual_n: (fit.residual.iter().map(|r| r * r).sum::<f64>() / data.len() as f64)
+            .sqrt(),
+        points: data.len(),
+        min_speed_m_s: settings.min_speed_m_s,
+        iterations: fit.iterations,
+        converged: fit.converged,
+    };
+
+    let velocities: Vec<Vec<f64>> = prepared.iter().map(|p| p.v_m_s.clone()).collect();
+    let mut simulated = vec![None; records.len()];
+    let mut output_error = None;
+    if settings.output_error {
+        let model_free: Vec<usize> = free.iter().copied().filter(|&i| i < OFFSETS).collect();
+        match run_output_error(
+            records,
+            &velocities,
+            &fit.full,
+            &model_free,
+            settings,
+            &fixed_reason,
+        ) {
+            Ok(oe) => {
+                simulated = oe.simulated;
+                compare_fits(&ee_params, &oe.fit.parameters, &mut warnings);
+                oe_warnings(&oe.fit, &mut warnings);
+                output_error = Some(oe.fit);
+            }
+            Err(reason) => warnings.push(RecordWarning::OutputErrorNotUsed { reason }),
+        }
+    }
+    let band = band(
+        &fit.full,
+        &(free.clone(), hac.cov_estimable.clone(), hac.critical_value),
+        speeds,
+        settings.band_points,
+    );
+    let reports = record_reports(records, &prepared, &fit, simulated);
+    Ok(RecordIdentification {
+        parameters: ee_params,
+        equation_error,
+        output_error,
+        law: fitted_law(&fit.full),
+        band,
+        records: reports,
+        warnings,
+    })
+}
+
+fn free_position(free: &[usize], full: usize) -> usize {
+    free.iter()
+        .position(|&i| i == full)
+        .expect("the parameter is fitted")
+}
+
+fn ee_covariance(fit: &SeparableFit, data: &Stacked) -> Hac {
+    hac::covariance(&fit.jacobian, &fit.residual, &data.time, &data.record)
+}
+
+/// An estimate with the sandwich's variance and the fixed-b critical value; the degrees of
+/// freedom reported are the effective samples less the parameters.
+fn estimate(value: f64, var: f64, hac: &Hac, params: usize) -> Estimate {
+    estimate_with(
+        value,
+        var,
+        hac.critical_value,
+        hac.effective_samples,
+        params,
+    )
+}
+
+fn estimate_with(value: f64, var: f64, critical: f64, effective: f64, params: usize) -> Estimate {
+    let se = var.max(0.0).sqrt();
+    Estimate {
+        value,
+        std_error: se,
+        ci95_low: value - critical * se,
+        ci95_high: value + critical * se,
+        dof: (effective - params as f64).max(1.0),
+    }
+}
+
+/// The seven parameters and their correlations from a fit's full vector and covariance
+/// (`free`: full-vector indices of the covariance's rows).
+fn parameters(
+    full: &[f64],
+    free: &[usize],
+    hac: &Hac,
+    fixed_reason: &dyn Fn(IdentifiedKey) -> String,
+) -> (ParameterEstimates, Correlations) {
+    let param = |key: IdentifiedKey| -> Parameter {
+        let i = index(key);
+        match free.iter().position(|&x| x == i) {
+            None => Parameter::Fixed {
+                value: full[i],
+                reason: fixed_reason(key),
+            },
+            Some(k) if hac.singular[k] => Parameter::NotIdentifiable {
+                reason: "singular: the record does not determine it".to_owned(),
+            },
+            Some(k) => Parameter::Estimated(estimate(full[i], hac.cov[(k, k)], hac, free.len())),
+        }
+    };
+    let p = ParameterEstimates {
+        effective_mass_kg: param(IdentifiedKey::EffectiveMass),
+        stiffness_n_per_m: param(IdentifiedKey::Stiffness),
+        coulomb_force_n: param(IdentifiedKey::CoulombForce),
+        viscous_coefficient: param(IdentifiedKey::ViscousCoefficient),
+        viscous_exponent: param(IdentifiedKey::ViscousExponent),
+        low_velocity_force_n: param(IdentifiedKey::LowVelocityForce),
+        low_velocity_decay_s_per_m: param(IdentifiedKey::LowVelocityDecay),
+    };
+    let keys: Vec<IdentifiedKey> = IdentifiedKey::ALL
+        .into_iter()
+        .filter(|&k| p.get(k).estimate().is_some())
+        .collect();
+    let pos = |k: IdentifiedKey| free_position(free, index(k));
+    let matrix = keys
+        .iter()
+        .map(|&a| {
+            keys.iter()
+                .map(|&b| {
+                    let (i, j) = (pos(a), pos(b));
+                    hac.cov[(i, j)] / (hac.cov[(i, i)] * hac.cov[(j, j)]).sqrt()
+                })
+                .collect()
+        })
+        .collect();
+    (p, Correlations { keys, matrix })
+}
+
+fn uncertainty(hac: &Hac, correlations: Correlations) -> FitUncertainty {
+    FitUncertainty {
+        correlations,
+        bandwidth_samples: hac.bandwidth,
+        critical_value: hac.critical_value,
+        effective_samples: hac.effective_samples,
+        condition_number: hac.condition,
+    }
+}
+
+/// Smallest and largest speed of the fitted samples, m/s.
+fn speed_range(data: &Stacked) -> [f64; 2] {
+    data.w
+        .iter()
+        .fold([f64::INFINITY, 0.0], |[lo, hi], &w| [lo.min(w), hi.max(w)])
+}
+
+/// The equation error's identifiability warnings.
+#[allow(clippy::too_many_arguments)]
+fn ee_warnings(
+    fit: &SeparableFit,
+    hac: &Hac,
+    free: &[usize],
+    params: &ParameterEstimates,
+    corr: &Correlations,
+    data: &Stacked,
+    settings: &ValidRecordSettings,
+    speeds: [f64; 2],
+    warnings: &mut Vec<RecordWarning>,
+) {
+    for &i in fit.at_bound.iter().chain(&fit.clamped) {
+        let key = IdentifiedKey::ALL[i];
+        warnings.push(RecordWarning::AtBound {
+            key,
+            value: fit.full[i],
+        });
+    }
+    for (k, &i) in free.iter().enumerate() {
+        if i < OFFSETS && hac.singular[k] {
+            warnings.push(RecordWarning::NotIdentifiable {
+                fit: FitKind::EquationError,
+                key: IdentifiedKey::ALL[i],
+            });
+        }
+    }
+    let b = fit.full[LOW_DECAY];
+    correlation_warnings(FitKind::EquationError, params, corr, speeds, b, warnings);
+    if params.low_velocity_force_n.estimate().is_some() && b > 0.0 {
+        let reach = 3.0 / b;
+        let below = data.w.iter().filter(|&&w| w < reach).count() as f64 / data.len() as f64;
+        if below < MIN_LOW_SPEED_FRACTION {
+            warnings.push(RecordWarning::FewLowSpeedSamples {
+                below_m_s: reach,
+                fraction: below,
+                min_speed_m_s: settings.min_speed_m_s,
+            });
+        }
+    }
+}
+
+/// Correlated pairs and imprecise parameters of a fit.
+fn correlation_warnings(
+    fit: FitKind,
+    params: &ParameterEstimates,
+    corr: &Correlations,
+    speeds: [f64; 2],
+    b: f64,
+    warnings: &mut Vec<RecordWarning>,
+) {
+    for (i, &a) in corr.keys.iter().enumerate() {
+        for (j, &c) in corr.keys.iter().enumerate().skip(i + 1) {
+            let r = corr.matrix[i][j];
+            if r.abs() > MAX_CORRELATION {
+                let pair = (a, c) == (IdentifiedKey::CoulombForce, IdentifiedKey::LowVelocityForce);
+                warnings.push(RecordWarning::NotSeparable {
+                    fit,
+                    first: a,
+                    second: c,
+                    correlation: r,
+                    speeds_m_s: if pair && b > 0.0 {
+                        [speeds[0], 3.0 / b]
+                    } else {
+                        speeds
+                    },
+                });
+            }
+        }
+    }
+    for (key, p) in params.iter() {
+        if let Some(e) = p.estimate() {
+            let rel = if key == IdentifiedKey::ViscousExponent {
+                e.std_error
+            } else {
+                e.relative_std_error()
+            };
+            if rel > MAX_RELATIVE_STD_ERROR {
+                warnings.push(RecordWarning::Imprecise {
+                    fit,
+                    key,
+                    relative_std_error: rel,
+                });
+            }
+        }
+    }
+}
+
+/// What the output error found.
+struct OeOutcome {
+    fit: OutputErrorFit,
+    simulated: Vec<Option<Vec<f64>>>,
+}
+
+/// Counts the simulations of an output-error problem.
+struct Counted<'a> {
+    inner: &'a OutputError,
+    count: Cell<usize>,
+}
+
+impl crate::lm::Problem for Counted<'_> {
+    fn residual_count(&self) -> usize {
+        self.inner.residual_count()
+    }
+    fn parameter_count(&self) -> usize {
+        self.inner.parameter_count()
+    }
+    fn residuals(&self, p: &[f64], r: &mut [f64]) {
+        self.count.set(self.count.get() + 1);
+        self.inner.residuals(p, r);
+    }
+    fn jacobian(&self, p: &[f64], j: &mut DMatrix<f64>) {
+        self.count.set(self.count.get() + p.len() + 1);
+        self.inner.jacobian(p, j);
+    }
+}
+
+use crate::lm::Problem as _;
+
+fn run_output_error(
+    records: &[TestRecord],
+    velocities: &[Vec<f64>],
+    ee_full: &[f64],
+    model_free: &[usize],
+    settings: &ValidRecordSettings,
+    fixed_reason: &dyn Fn(IdentifiedKey) -> String,
+) -> std::result::Result<OeOutcome, String> {
+    let (problem, start) = OutputError::new(
+        records,
+        velocities,
+        ee_full,
+        model_free.to_vec(),
+        settings.steps_per_sample,
+    )
+    .ok_or_else(|| {
+        "the equation error's parameters give no valid model to simulate, or the simulation failed"
+            .to_owned()
+    })?;
+    let counted = Counted {
+        inner: &problem,
+        count: Cell::new(0),
+    };
+    let rms_start = problem.rms(&start);
+    let res = crate::lm::minimize(
+        &counted,
+        &start,
+        &problem.bounds().0,
+        &problem.bounds().1,
+        crate::lm::LmSettings {
+            max_iterations: settings.output_error_iterations,
+            cost_tolerance: 1e-6,
+            step_tolerance: 1e-6,
+        },
+    );
+    let rms_end = problem.rms(&res.params);
+    let mut resid = vec![0.0; problem.residual_count()];
+    problem.residuals(&res.params, &mut resid);
+    let (time, group) = problem.residual_layout();
+    let hac = hac::covariance(&res.jacobian, &resid, &time, &group);
+    let q = problem.model_vector(&res.params);
+    let mut full = q.to_vec();
+    full.extend(std::iter::repeat_n(0.0, records.len()));
+    // Covariance rows: the model parameters first (model_free order), then the states.
+    let mut free_full: Vec<usize> = model_free.to_vec();
+    free_full.extend((0..2 * records.len()).map(|k| 1000 + k));
+    let (params, corr) = parameters(&full, &free_full, &hac, fixed_reason);
+    let simulated = (0..records.len())
+        .map(|r| problem.simulate(&res.params, r).map(|(u, _)| u))
+        .collect();
+    Ok(OeOutcome {
+        fit: OutputErrorFit {
+            parameters: params,
+            uncertainty: uncertainty(&hac, corr),
+            rms_u_m: rms_start
+                .iter()
+                .zip(&rms_end)
+                .map(|(s, e)| [s.0, e.0])
+                .collect(),
+            rms_a_m_s2: rms_start
+                .iter()
+                .zip(&rms_end)
+                .map(|(s, e)| [s.1, e.1])
+                .collect(),
+            iterations: res.iterations,
+            converged: res.converged,
+            simulations: counted.count.get(),
+        },
+        simulated,
+    })
+}
+
+fn oe_warnings(fit: &OutputErrorFit, warnings: &mut Vec<RecordWarning>) {
+    if !fit.converged {
+        warnings.push(RecordWarning::OutputErrorNotUsed {
+            reason: format!("it did not converge in {} iterations", fit.iterations),
+        });
+    }
+    for (key, p) in fit.parameters.iter() {
+        if matches!(p, Parameter::NotIdentifiable { .. }) {
+            warnings.push(RecordWarning::NotIdentifiable {
+                fit: FitKind::OutputError,
+                key,
+            });
+        }
+    }
+}
+
+/// Warns where the two fits disagree.
+fn compare_fits(
+    ee: &ParameterEstimates,
+    oe: &ParameterEstimates,
+    warnings: &mut Vec<RecordWarning>,
+) {
+    for (key, p) in ee.iter() {
+        let (Some(a), Some(b)) = (p.estimate(), oe.get(key).estimate()) else {
+            continue;
+        };
+        if crate::estimate::fits_disagree(key, a, b, fit_agreement(key)) {
+            warnings.push(RecordWarning::FitsDisagree {
+                key,
+                equation_error: a.value,
+                output_error: b.value,
+            });
+        }
+    }
+}
+
+/// `F_D(|v|)` of the fitted vector `full` with its pointwise 95 % band from the covariance
+/// `cov` (rows: full-vector indices `free`), at `points` speeds spaced evenly in `ln |v|`
+/// over `speeds`. The law is determined even where its parameters are not (the fit's
+/// minimum-norm solution along a singular direction changes no fitted force).
+fn band(
+    full: &[f64],
+    cov: &(Vec<usize>, DMatrix<f64>, f64),
+    speeds: [f64; 2],
+    points: usize,
+) -> Vec<BandPoint> {
+    let law = fitted_law(full);
+    let (free, c, critical) = cov;
+    // Gradient order of DissipativeLaw::gradient: (F_μ, Cₑ, α, a, b) = full indices 2..=6.
+    let law_index = [2, 3, 4, 5, 6];
+    let (lo, hi) = (speeds[0].max(1e-6), speeds[1].max(speeds[0] * 1.0001));
+    (0..points)
+        .map(|k| {
+            let w = lo * (hi / lo).powf(k as f64 / (points - 1) as f64);
+            let g = law.gradient(w, w.ln());
+            let mut var = 0.0;
+            for (a, &ia) in law_index.iter().enumerate() {
+                let Some(pa) = free.iter().position(|&x| x == ia) else {
+                    continue;
+                };
+                for (b, &ib) in law_index.iter().enumerate() {
+                    let Some(pb) = free.iter().position(|&x| x == ib) else {
+                        continue;
+                    };
+                    let x = c[(pa, pb)];
+                    if x.is_finite() {
+                        var += g[a] * g[b] * x;
+                    }
+                }
+            }
+            let f = law.magnitude_from_ln_n(w, w.ln());
+            let half = critical * var.max(0.0).sqrt();
+            BandPoint {
+                speed_m_s: w,
+                force_n: f,
+                low_n: f - half,
+                high_n: f + half,
+            }
+        })
+        .collect()
+}
+
+/// The law of a full parameter vector.
+fn fitted_law(q: &[f64]) -> DissipativeLaw {
+    DissipativeLaw {
+        coulomb_force_n: q[2],
+        viscous_coefficient: q[3],
+        exponent: Exponent::new(q[4].clamp(0.0, 1.0)),
+        low_velocity_force_n: q[5],
+        low_velocity_decay_s_per_m: q[6],
+    }
+}
+
+/// The per-record reports.
+fn record_reports(
+    records: &[TestRecord],
+    prepared: &[Prepared],
+    fit: &SeparableFit,
+    simulated: Vec<Option<Vec<f64>>>,
+) -> Vec<RecordReport> {
+    let q = &fit.full;
+    let law = fitted_law(q);
+    records
+        .iter()
+        .zip(prepared)
+        .zip(simulated)
+        .enumerate()
+        .map(|(r, ((rec, p), sim))| {
+            let fitted = (0..rec.len())
+                .map(|i| {
+                    q[0] * rec.a_m_s2()[i]
+                        + q[1] * rec.u_m()[i]
+                        + law.smooth_signed_n(p.v_m_s[i])
+                        + q[OFFSETS + r]
+                })
+                .collect();
+            let speeds = (0..rec.len())
+                .filter(|&i| p.used[i])
+                .map(|i| p.v_m_s[i].abs())
+                .fold([f64::INFINITY, 0.0], |[lo, hi], w| [lo.min(w), hi.max(w)]);
+            RecordReport {
+                name: rec.name().to_owned(),
+                sample_rate_hz: rec.sample_rate_hz(),
+                start_s: rec.start_s(),
+                samples: rec.len(),
+                velocity_given: p.velocity_given,
+                used_samples: p.used.iter().filter(|&&u| u).count(),
+                speed_range_m_s: speeds,
+                floors: rec.floors().map(|f| FloorsReport {
+                    masses_kg: f.masses_kg.clone(),
+                    peak_base_shear_n: f.peak_base_shear_n,
+                }),
+                force_n: rec.force_n().to_vec(),
+                fitted_force_n: fitted,
+                used: p.used.clone(),
+                velocity_m_s: p.v_m_s.clone(),
+                u_m: rec.u_m().to_vec(),
+                simulated_u_m: sim,
+            }
+        })
+        .collect()
+}

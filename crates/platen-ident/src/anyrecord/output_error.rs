@@ -1,0 +1,306 @@
+//! The output-error refinement: the identified model is run forward (RK4 with exact
+//! stick-slip, [`platen_integrate::forward_rk4`]) under each record's force, less the
+//! equation error's force offset, and its displacement and acceleration are fitted to the
+//! measured ones by Levenberg–Marquardt with a forward-difference Jacobian.
+//!
+//! Residuals per record and channel have their mean removed (a constant displacement or
+//! accelerometer offset is not the model's business: with the force offset held, a
+//! displacement offset `d` and an accelerometer offset `e` leave `u_sim = u_rec + Mₑe/Kₑ`,
+//! `a_sim = a_rec − e` up to the initial state), and are divided by their RMS at the start,
+//! so each channel weighs the same whatever its unit. The initial state `(u₀, v₀)` of each
+//! record is fitted too.
+//!
+//! Unlike the equation error this sees the platen at rest: how long it sticks and where it
+//! stops depend on `F_s = F_μ + a` exactly, so the low-velocity behaviour that the equation
+//! error leaves out (samples below its minimum speed) enters here.
+
+use nalgebra::DMatrix;
+
+use platen_integrate::{forward_rk4, ForceRecord, Rk4, Sample, SampleSink, State};
+use platen_model::IdentifiedParams;
+
+use crate::lm::Problem;
+use crate::record::TestRecord;
+
+use super::separable::{
+    COULOMB, EXPONENT, LOW_DECAY, LOW_FORCE, MASS, OFFSETS, STIFFNESS, VISCOUS,
+};
+
+/// Collects `u` and `a` of a run into preallocated buffers.
+struct MotionSink<'a> {
+    u: &'a mut [f64],
+    a: &'a mut [f64],
+}
+
+impl SampleSink for MotionSink<'_> {
+    #[inline]
+    fn accept(&mut self, s: &Sample) {
+        self.u[s.index] = s.u_m;
+        self.a[s.index] = s.a_m_s2;
+    }
+}
+
+/// One record as the output error sees it.
+struct OeRecord {
+    force: ForceRecord,
+    u: Vec<f64>,
+    a: Vec<f64>,
+    /// 1/RMS of the start's de-meaned residual, per channel.
+    weight_u: f64,
+    weight_a: f64,
+}
+
+/// The output-error problem. Parameter vector: the model parameters fitted (full-vector
+/// indices `model_free`), then `(u₀, v₀)` of each record.
+pub(crate) struct OutputError {
+    records: Vec<OeRecord>,
+    model_free: Vec<usize>,
+    /// The full model vector (held parameters at their values).
+    base: [f64; 7],
+    rk4: Rk4,
+}
+
+/// Lower and upper bounds of the model parameters, in full-vector order (`Mₑ > 0`, the
+/// others as [`IdentifiedParams::build`] requires).
+const LOWER: [f64; 7] = [1e-6, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+const UPPER: [f64; 7] = [
+    f64::INFINITY,
+    f64::INFINITY,
+    f64::INFINITY,
+    f64::INFINITY,
+    1.0,
+    f64::INFINITY,
+    1e4,
+];
+
+/// Forward-difference step, relative to the parameter (or to `FLOOR` for a parameter near
+/// zero). 10⁻⁴ is far above the simulation's rounding (~10⁻¹² of the motion) and small
+/// against the parameters' standard errors (≥ 10⁻³ of their values on the test records), so
+/// the difference quotient is the derivative of the fitted quantity to < 1 %.
+const RELATIVE_STEP: f64 = 1e-4;
+const FLOOR: [f64; 7] = [1e3, 1e4, 1e2, 1e2, 0.1, 1e2, 1.0];
+/// Absolute steps of the initial state, m and m/s.
+const STATE_STEP: [f64; 2] = [1e-6, 1e-6];
+
+impl OutputError {
+    /// The problem for `records` with force offsets `offsets_n` (from the equation error),
+    /// starting at `full` (`[Mₑ, Kₑ, F_μ, Cₑ, α, a, b, …]`), fitting the parameters in
+    /// `model_free`.
+    pub(crate) fn new(
+        records: &[TestRecord],
+        velocities: &[Vec<f64>],
+        full: &[f64],
+        model_free: Vec<usize>,
+        steps_per_sample: u32,
+    ) -> Option<(Self, Vec<f64>)> {
+        let mut base = [0.0; 7];
+        for (k, b) in base.iter_mut().enumerate() {
+            *b = full[k].clamp(LOWER[k], UPPER[k]);
+        }
+        let mut oe = Vec::with_capacity(records.len());
+        let mut start: Vec<f64> = model_free.iter().map(|&i| base[i]).collect();
+        for (r, rec) in records.iter().enumerate() {
+            let offset = full[OFFSETS + r];
+            let force = ForceRecord::from_rate(
+                rec.sample_rate_hz(),
+                rec.force_n().iter().map(|f| f - offset).collect(),
+            )
+            .ok()?;
+            oe.push(OeRecord {
+                force,
+                u: rec.u_m().to_vec(),
+                a: rec.a_m_s2().to_vec(),
+                weight_u: 1.0,
+                weight_a: 1.0,
+            });
+            start.push(rec.u_m()[0]);
+            start.push(velocities[r][0]);
+        }
+        let mut problem = Self {
+            records: oe,
+            model_free,
+            base,
+            rk4: Rk4::with_steps_per_sample(steps_per_sample).ok()?,
+        };
+        // Channel weights from the start's residuals.
+        let q = problem.full(&start);
+        for r in 0..problem.records.len() {
+            let (ru, ra) = problem.raw_residuals(&q, &start, r)?;
+            let rms = |x: &[f64]| (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt();
+            let (su, sa) = (rms(&ru), rms(&ra));
+            let rec = &mut problem.records[r];
+            rec.weight_u = if su > 0.0 { 1.0 / su } else { 1.0 };
+            rec.weight_a = if sa > 0.0 { 1.0 / sa } else { 1.0 };
+        }
+        Some((problem, start))
+    }
+
+    /// The model vector at `p`.
+    fn full(&self, p: &[f64]) -> [f64; 7] {
+        let mut q = self.base;
+        for (k, &i) in self.model_free.iter().enumerate() {
+            q[i] = p[k];
+        }
+        q
+    }
+
+    fn params(q: &[f64; 7]) -> IdentifiedParams {
+        IdentifiedParams {
+            effective_mass_kg: q[MASS],
+            stiffness_n_per_m: q[STIFFNESS],
+            coulomb_force_n: q[COULOMB],
+            viscous_coefficient: q[VISCOUS],
+            viscous_exponent: q[EXPONENT],
+            low_velocity_force_n: q[LOW_FORCE],
+            low_velocity_decay_s_per_m: q[LOW_DECAY],
+        }
+    }
+
+    /// Simulated − measured displacement and acceleration of record `r`, each with its
+    /// mean removed; `None` if the model is invalid or the run fails.
+    fn raw_residuals(&self, q: &[f64; 7], p: &[f64], r: usize) -> Option<(Vec<f64>, Vec<f64>)> {
+        let model = Self::params(q).build().ok()?;
+        let rec = &self.records[r];
+        let n = rec.u.len();
+        let k = self.model_free.len() + 2 * r;
+        let initial = State {
+            u_m: p[k],
+            v_m_s: p[k + 1],
+        };
+        let mut u = vec![0.0; n];
+        let mut a = vec![0.0; n];
+        let mut sink = MotionSink {
+            u: &mut u,
+            a: &mut a,
+        };
+        forward_rk4(&model, &rec.force, self.rk4, initial, n, &mut sink).ok()?;
+        for (x, m) in u.iter_mut().zip(&rec.u) {
+            *x -= m;
+        }
+        for (x, m) in a.iter_mut().zip(&rec.a) {
+            *x -= m;
+        }
+        for x in [&mut u, &mut a] {
+            let mean = x.iter().sum::<f64>() / n as f64;
+            x.iter_mut().for_each(|v| *v -= mean);
+        }
+        Some((u, a))
+    }
+
+    /// Lower and upper bounds of the parameter vector.
+    pub(crate) fn bounds(&self) -> (Vec<f64>, Vec<f64>) {
+        let mut lo: Vec<f64> = self.model_free.iter().map(|&i| LOWER[i]).collect();
+        let mut hi: Vec<f64> = self.model_free.iter().map(|&i| UPPER[i]).collect();
+        for _ in &self.records {
+            lo.extend([f64::NEG_INFINITY; 2]);
+            hi.extend([f64::INFINITY; 2]);
+        }
+        (lo, hi)
+    }
+
+    /// For each residual: (record, sample index).
+    pub(crate) fn residual_layout(&self) -> (Vec<usize>, Vec<usize>) {
+        let mut group = Vec::new();
+        let mut time = Vec::new();
+        for (r, rec) in self.records.iter().enumerate() {
+            let n = rec.u.len();
+            for _channel in 0..2 {
+                group.extend(std::iter::repeat_n(r, n));
+                time.extend(0..n);
+            }
+        }
+        (time, group)
+    }
+
+    /// Unweighted RMS of the displacement and acceleration residuals of every record at `p`.
+    pub(crate) fn rms(&self, p: &[f64]) -> Vec<(f64, f64)> {
+        let q = self.full(p);
+        (0..self.records.len())
+            .map(|r| match self.raw_residuals(&q, p, r) {
+                Some((u, a)) => {
+                    let rms =
+                        |x: &[f64]| (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt();
+                    (rms(&u), rms(&a))
+                }
+                None => (f64::NAN, f64::NAN),
+            })
+            .collect()
+    }
+
+    /// The simulated displacement and acceleration of record `r` at `p`.
+    pub(crate) fn simulate(&self, p: &[f64], r: usize) -> Option<(Vec<f64>, Vec<f64>)> {
+        let q = self.full(p);
+        let (ru, ra) = self.raw_residuals(&q, p, r)?;
+        let rec = &self.records[r];
+        // Back from de-meaned residuals to the simulation: add the measured channels and
+        // the mean offsets (a constant per channel, shown as fitted).
+        Some((
+            ru.iter().zip(&rec.u).map(|(x, m)| x + m).collect(),
+            ra.iter().zip(&rec.a).map(|(x, m)| x + m).collect(),
+        ))
+    }
+
+    /// The model parameters at `p`, full vector.
+    pub(crate) fn model_vector(&self, p: &[f64]) -> [f64; 7] {
+        self.full(p)
+    }
+
+    fn step(&self, p: &[f64], k: usize) -> f64 {
+        let nm = self.model_free.len();
+        if k < nm {
+            let i = self.model_free[k];
+            let h = RELATIVE_STEP * p[k].abs().max(FLOOR[i]);
+            // Step inwards at an upper bound (α = 1).
+            if p[k] + h > UPPER[i] {
+                -h
+            } else {
+                h
+            }
+        } else {
+            STATE_STEP[(k - nm) % 2]
+        }
+    }
+}
+
+impl Problem for OutputError {
+    fn residual_count(&self) -> usize {
+        self.records.iter().map(|r| 2 * r.u.len()).sum()
+    }
+    fn parameter_count(&self) -> usize {
+        self.model_free.len() + 2 * self.records.len()
+    }
+    fn residuals(&self, p: &[f64], out: &mut [f64]) {
+        let q = self.full(p);
+        let mut at = 0;
+        for (r, rec) in self.records.iter().enumerate() {
+            let n = rec.u.len();
+            match self.raw_residuals(&q, p, r) {
+                Some((u, a)) => {
+                    for i in 0..n {
+                        out[at + i] = rec.weight_u * u[i];
+                        out[at + n + i] = rec.weight_a * a[i];
+                    }
+                }
+                None => out[at..at + 2 * n].fill(f64::INFINITY),
+            }
+            at += 2 * n;
+        }
+    }
+    fn jacobian(&self, p: &[f64], j: &mut DMatrix<f64>) {
+        let m = self.residual_count();
+        let mut base = vec![0.0; m];
+        self.residuals(p, &mut base);
+        let mut trial = p.to_vec();
+        let mut r = vec![0.0; m];
+        for k in 0..p.len() {
+            let h = self.step(p, k);
+            trial[k] = p[k] + h;
+            self.residuals(&trial, &mut r);
+            trial[k] = p[k];
+            for i in 0..m {
+                let d = (r[i] - base[i]) / h;
+                j[(i, k)] = if d.is_finite() { d } else { 0.0 };
+            }
+        }
+    }
+}

@@ -1,0 +1,177 @@
+"""The Python API gives what the command-line tool gives: the same samples to the last bit,
+the same --json objects, the same sweep rows."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import platen
+from conftest import SCENARIOS, read_csv
+
+SHIPPED = [
+    "sr9-like-sine-force.json",
+    "paper-forward-force-dopri5.json",
+    "full-model-large-stroke.json",
+    "s9-sine-motion.json",
+    "sr9/sr9-forward.json",
+]
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_simulate_gives_the_clis_csv_to_the_last_bit_and_its_json(name, cli_json, tmp_path):
+    path = SCENARIOS / name
+    out = tmp_path / "out.csv"
+    expected_summary = cli_json("simulate", path, "--out", out)
+    expected = read_csv(out)
+    run = platen.simulate(path)
+    assert run.columns == tuple(expected), "columns in CSV order"
+    for column in run.columns:
+        a = run[column]
+        assert a.dtype == np.float64 and a.ndim == 1 and a.flags.c_contiguous
+        assert np.array_equal(a, expected[column]), f"{column} differs from the CLI's CSV"
+    assert run.summary.pop("out") is None
+    assert expected_summary.pop("out") == str(out)
+    assert run.summary == expected_summary
+
+
+def test_a_scenario_dict_runs_as_its_file():
+    path = SCENARIOS / "sr9" / "sr9-forward.json"
+    scenario = json.loads(path.read_text())
+    scenario["excitation"]["force_csv"] = str(path.parent / scenario["excitation"]["force_csv"])
+    from_dict = platen.simulate(scenario)
+    from_file = platen.simulate(str(path))
+    for column in from_file.columns:
+        assert np.array_equal(from_dict[column], from_file[column]), column
+    assert from_dict.summary.pop("scenario") == "scenario dict"
+    from_file.summary.pop("scenario")
+    assert from_dict.summary == from_file.summary
+
+
+def test_forward_on_arrays_gives_simulate_of_the_same_record():
+    """A force CSV read in Python and given as arrays runs exactly as the scenario that
+    names it (the SR9 record with its 0.6 Hz low-pass and recorded initial state)."""
+    path = SCENARIOS / "sr9" / "sr9-forward.json"
+    rec = read_csv(path.parent / "sr9-recorded.csv")
+    run = platen.forward(
+        rec["t_s"],
+        rec["force_n"],
+        integrator={"method": "rk4", "step_s": 1 / 1024},
+        initial={"u_m": rec["u_m"][0], "v_m_s": rec["v_m_s"][0]},
+        duration_s=20.0,
+        lowpass_hz=0.6,
+        lowpass_filter="brickwall",
+    )
+    expected = platen.simulate(path)
+    for column in expected.columns:
+        assert np.array_equal(run[column], expected[column]), column
+
+
+def test_compare_gives_the_clis_json_and_the_readmes_sr9_numbers(cli_json):
+    scenario = SCENARIOS / "sr9" / "sr9-forward.json"
+    recorded = SCENARIOS / "sr9" / "sr9-recorded.csv"
+    result = platen.compare(scenario, recorded)
+    assert result == cli_json("compare", scenario, "--recorded", recorded)
+    # The README's SR9 check: displacement NRMSE 0.694 %, velocity 1.454 %, peak ratios
+    # 0.9992 and 0.9991, correlation 0.99998 and 0.99990, lag +1.0 ms.
+    u, v = result["u_m"], result["v_m_s"]
+    assert round(100 * u["nrmse"], 3) == 0.694 and round(100 * v["nrmse"], 3) == 1.454
+    assert round(u["peak_ratio"], 4) == 0.9992 and round(v["peak_ratio"], 4) == 0.9991
+    assert round(u["correlation"], 5) == 0.99998 and round(v["correlation"], 5) == 0.99990
+    assert round(1e3 * u["lag_s"], 1) == 1.0
+
+
+def test_compare_nrmse_is_numpys_on_the_simulated_and_recorded_columns():
+    """NRMSE = RMS(simulated − recorded) / RMS(recorded), computed here in NumPy from the run's
+    columns and the recorded CSV (they share their time stamps): the README's 14 digits."""
+    scenario = SCENARIOS / "sr9" / "sr9-forward.json"
+    recorded = read_csv(SCENARIOS / "sr9" / "sr9-recorded.csv")
+    run = platen.simulate(scenario)
+    n = len(run)
+    assert np.array_equal(run["t_s"], recorded["t_s"][:n])
+    result = platen.compare(scenario, SCENARIOS / "sr9" / "sr9-recorded.csv")
+    for column, readme in [("u_m", 0.6942888859e-2), ("v_m_s", 1.4537857852e-2)]:
+        rec = recorded[column][:n]
+        nrmse = np.sqrt(np.mean((run[column] - rec) ** 2)) / np.sqrt(np.mean(rec**2))
+        # Summation order differs between NumPy and the library: 1e-12 relative.
+        assert abs(result[column]["nrmse"] / nrmse - 1) < 1e-12, (column, result[column]["nrmse"], nrmse)
+        assert abs(nrmse - readme) < 1e-12, (column, nrmse)
+
+
+@pytest.mark.parametrize(
+    "kwargs, args",
+    [
+        ({}, []),
+        ({"pressure_mpa": 6.9, "form": "full"}, ["--pressure-mpa", "6.9", "--form", "full"]),
+        ({"pressure_mpa": None}, []),
+    ],
+)
+def test_model_gives_the_clis_json(kwargs, args, cli_json):
+    assert platen.model(**kwargs) == cli_json("model", *args)
+
+
+def test_sweep_rows_are_the_clis_csv(cli, tmp_path):
+    scenario = SCENARIOS / "sr9-like-sine-force.json"
+    out = tmp_path / "cases.csv"
+    cli(
+        "sweep", scenario, "--scale", "0.5,1,1.5", "--pressure-mpa", "6.9,13.8",
+        "--set", "identified.coulomb_force_n=20e3,25e3", "--out", out,
+    )
+    rows = platen.sweep(
+        scenario,
+        scale=[0.5, 1, 1.5],
+        pressure_mpa=[6.9, 13.8],
+        set={"identified.coulomb_force_n": [20e3, 25e3]},
+        as_frame=False,
+    )
+    expected = out.read_text().splitlines()
+    header = expected[0].split(",")
+    assert len(rows) == 12 == len(expected) - 1
+    assert list(rows[0]) == header
+    for row, line in zip(rows, expected[1:]):
+        cells = line.split(",")
+        for name, cell in zip(header, cells):
+            value = row[name]
+            if cell == "":
+                assert value is None, (name, value)
+            elif name in ("limits_exceeded", "status"):
+                assert value == cell, (name, cell, value)
+            else:
+                # Shortest round-trip text: the same double.
+                assert float(cell) == value and type(value) is (int if name in ("case", "events") else float)
+    assert all(r["status"] == "ok" for r in rows)
+
+
+def test_sweep_with_no_axis_is_the_scenario_itself():
+    scenario = SCENARIOS / "sr9-like-sine-force.json"
+    [row] = platen.sweep(scenario, as_frame=False)
+    s = platen.simulate(scenario).summary
+    assert (row["peak_u_m"], row["peak_force_n"], row["stick_time_s"]) == (
+        s["peak_u_m"],
+        s["peak_force_n"],
+        s["stick_time_s"],
+    )
+
+
+def test_sweep_returns_a_dataframe_when_pandas_is_installed():
+    pd = pytest.importorskip("pandas", reason="SKIPPED: pandas is not installed")
+    frame = platen.sweep(SCENARIOS / "sr9-like-sine-force.json", scale=[0.5, 1])
+    assert isinstance(frame, pd.DataFrame)
+    assert list(frame["scale"]) == [0.5, 1.0]
+    assert frame["peak_u_m"].dtype == np.float64
+
+
+def test_identify_gives_the_clis_json(cli, cli_json, tmp_path):
+    """Recorded-like tests made by the CLI (two sines, two triangles at 13.8 MPa)."""
+    files = []
+    for name in ["S9", "S11", "T7", "T9"]:
+        out = tmp_path / f"{name}.csv"
+        cli("generate", "recorded", SCENARIOS / "paper-tests" / "13.8MPa" / f"{name}.json", "--seed", "3", "--out", out)
+        files.append(out)
+    expected = cli_json("identify", *files, "--pressure-mpa", "13.8")
+    result = platen.identify(files, pressure_mpa=13.8)
+    assert result == expected
+    assert abs(result["effective_mass_kg"] / 144e3 - 1) < 0.01
+    assert abs(result["stiffness_n_per_m"] / 1.266e6 - 1) < 0.01
