@@ -116,6 +116,9 @@ struct Stepper<'a, M> {
     /// Platen acceleration at the current state (0 in stick and creep).
     a: f64,
     w_stiff: f64,
+    /// The actuator force's rate in the current grid interval, N/s (the force is linear
+    /// between samples).
+    f_rate: f64,
     stats: RunStats,
 }
 
@@ -134,8 +137,10 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
             k: [0.0; LEN],
             a: 0.0,
             w_stiff: 0.0,
+            f_rate: 0.0,
             stats: RunStats::default(),
         };
+        s.f_rate = s.force_rate(0);
         let f0 = s.grid.force[0];
         let mode = Mode::initial(model, y[U], y[V], f0 - s.base_shear(&y));
         s.enter(mode, f0);
@@ -143,6 +148,15 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
         s.stats.energy.specimen_start_j = s.specimen_energy(&y);
         s.stats.energy.specimen_end_j = s.stats.energy.specimen_start_j;
         s
+    }
+
+    /// The actuator force's rate between samples `j` and `j + 1`, N/s (0 past the record).
+    fn force_rate(&self, j: usize) -> f64 {
+        let g = &self.grid;
+        match (g.force.get(j), g.force.get(j + 1)) {
+            (Some(f0), Some(f1)) => (f1 - f0) * g.inv_k / g.h,
+            _ => 0.0,
+        }
     }
 
     #[inline(always)]
@@ -184,7 +198,11 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
                 dy[V] = 0.0;
                 dy[W] = f * s * w;
                 dy[DI] = self.model.dissipative_magnitude_n(y[U], w) * w;
-                0.0
+                if w > 0.0 {
+                    self.creep_acceleration(dir, y, w)
+                } else {
+                    0.0
+                }
             }
         };
         let n = self.n;
@@ -194,6 +212,51 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
             .spec
             .storey_accelerations(a, zs, zds, &mut dy[ZD..ZD + n]);
         a
+    }
+
+    /// The platen's acceleration `a = s·ẇ` in creep at speed `w` (`0 < w < w_*`): the rate of
+    /// the creep speed, which the specimen feels as base acceleration.
+    ///
+    /// The creep speed solves `E(u, w) = s·(F_A − B)` with
+    /// `E = F_s(u) + D_excess(u, w) + s·F_vi(u, s·w) + s·F_E(u)`. With `u̇ = s·w` and
+    /// `Ḃ = Ḃ₀ + c₁·a` (`Ḃ₀` the base-shear rate at zero base acceleration: the base shear
+    /// `−(k₁z₁ + c₁ż₁)` feels `a` through `z̈₁ = z̈₁⁰ − a`), differentiating gives
+    /// `ẇ = (s·(Ḟ_A − Ḃ₀) − E_u·s·w) / (E_w + c₁)`. The partial derivatives are central
+    /// differences (relative steps 1e-4 in `w`, 1e-6 in `u`; `a` is itself small, O(h), so their error is far below
+    /// the integration error). Feeding this `a` to the storeys keeps the specimen's energy
+    /// balance exact in creep: without it the storeys' absolute kinetic energy changes by
+    /// `Σmᵢ(v + żᵢ)·Δv` with no work behind it, an error of order `h²`.
+    fn creep_acceleration(&self, dir: Direction, y: &Y, w: f64) -> f64 {
+        let (s, u) = (dir.sign(), y[U]);
+        let m = self.model;
+        // The speed-dependent part apart: next to F_s and F_E it is below their rounding.
+        let e_speed = |w: f64| m.dissipative_excess_n(u, w) + s * m.velocity_inertial_force_n(u, s * w);
+        let e_static = |u: f64| {
+            m.static_threshold_n(u)
+                + m.dissipative_excess_n(u, w)
+                + s * m.velocity_inertial_force_n(u, s * w)
+                + s * m.elastic_force_n(u)
+        };
+        let dw = 1e-4 * w;
+        let e_w = (e_speed(w + dw) - e_speed(w - dw)) / (2.0 * dw);
+        if !(e_w.is_finite() && e_w > 0.0) {
+            return 0.0;
+        }
+        let du = 1e-6 * u.abs().max(1e-3);
+        let e_u = (e_static(u + du) - e_static(u - du)) / (2.0 * du);
+        let n = self.n;
+        let mut zdd0 = [0.0; NS];
+        self.spec
+            .storey_accelerations(0.0, &y[Z..Z + n], &y[ZD..ZD + n], &mut zdd0[..n]);
+        let st = self.spec.storeys()[0];
+        let b_rate0 = -(st.stiffness_n_per_m * y[ZD] + st.damping_n_s_per_m * zdd0[0]);
+        let w_rate =
+            (s * (self.f_rate - b_rate0) - e_u * s * w) / (e_w + st.damping_n_s_per_m);
+        if w_rate.is_finite() {
+            s * w_rate
+        } else {
+            0.0
+        }
     }
 
     /// One RK4 step of length `len` (fraction of `h`) from fraction `s` of step `n`, from `y`
@@ -295,11 +358,11 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
     }
 
     /// Whether the event function may dip to zero inside a piece of length `len` (fraction
-    /// of `h`) of step `n` from the current state (force `f0`) to `y1` (force `f1`, rates
+    /// of `h`) from the current state (force `f0`) to `y1` (force `f1`, rates
     /// `k1`, platen acceleration `a1`): the cubic Hermite interpolant of the speed (slip) or
     /// of `F_s ∓ N` (stick) touches zero.
     #[allow(clippy::too_many_arguments)]
-    fn dips(&self, n: GridStep, len: f64, f0: f64, y1: &Y, f1: f64, k1: &Y, a1: f64) -> bool {
+    fn dips(&self, len: f64, f0: f64, y1: &Y, f1: f64, k1: &Y, a1: f64) -> bool {
         let span = len * self.grid.h;
         match self.mode {
             Mode::Slip(dir) => {
@@ -308,8 +371,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
             }
             Mode::Stick => {
                 // Ṅ = Ḟ_A − Ḃ = Ḟ_A + k₁ż₁ + c₁z̈₁ (u fixed), times the piece's length.
-                let slope = (self.grid.force[n.j + 1] - self.grid.force[n.j]) * self.grid.inv_k
-                    / self.grid.h;
+                let slope = self.f_rate;
                 let st = self.spec.storeys()[0];
                 let n_rate = |k: &Y| {
                     (slope + st.stiffness_n_per_m * k[Z] + st.damping_n_s_per_m * k[ZD]) * span
@@ -342,6 +404,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
     /// Advances from grid point `n` to `n + 1`, handling every event inside the step.
     fn step(&mut self, n: GridStep) -> Result<()> {
         self.stats.steps += 1;
+        self.f_rate = self.force_rate(n.j);
         let mut tau = 0.0;
         let mut events = 0u32;
         loop {
@@ -393,7 +456,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
                 let mut k1 = [0.0; LEN];
                 let a1 = self.rates(self.mode, f1, &y1, &mut k1);
                 self.stats.rhs_evaluations += 1;
-                if !self.dips(n, len, f0, &y1, f1, &k1, a1) {
+                if !self.dips(len, f0, &y1, f1, &k1, a1) {
                     if !a1.is_finite() {
                         return Err(self.non_finite(n, tau + len));
                     }

@@ -335,3 +335,119 @@ fn the_inverse_with_a_specimen_matches_the_closed_form() {
         "{worst:?} vs peak {peak}"
     );
 }
+
+/// The columns of a reference CSV under `tests/data/reference` (test helper, not the product
+/// reader).
+fn reference_columns(name: &str) -> Vec<Vec<f64>> {
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../tests/data/reference")
+        .join(name);
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let mut lines = text.lines().filter(|l| !l.trim().is_empty());
+    let width = lines.next().expect("header").split(',').count();
+    let mut cols = vec![Vec::new(); width];
+    for line in lines {
+        for (c, cell) in line.split(',').enumerate() {
+            cols[c].push(cell.trim().parse::<f64>().expect("number"));
+        }
+    }
+    cols
+}
+
+/// The specimen of `tools/reference/specimen_cases.py` (`M_ST`, `K_ST`, `C_ST`).
+fn reference_specimen() -> Specimen {
+    Specimen::new(vec![
+        Storey {
+            mass_kg: 20e3,
+            stiffness_n_per_m: 1.6e7,
+            damping_n_s_per_m: 4.0e4,
+        },
+        Storey {
+            mass_kg: 15e3,
+            stiffness_n_per_m: 1.2e7,
+            damping_n_s_per_m: 3.0e4,
+        },
+    ])
+    .unwrap()
+}
+
+/// Forward with stick phases and a ringing 2-storey frame, against the independent
+/// event-located SciPy reference of `tools/reference/specimen_cases.py` (DOP853 at rtol 1e-12
+/// on the full state, v = 0 and the breakaway |N(t)| = F_s located as events on the integrated
+/// specimen): platen and storey displacements within 1e-7 m at every sample with RK4 at
+/// h = Δt = 1/1024 s. The bound is the issue's; RK4's global error on the 6.8 Hz mode at this
+/// step is near 1e-9 m, so the bound fails if an event is misplaced by more than ~1e-7 s·v.
+#[test]
+fn forward_with_stick_phases_matches_the_event_located_reference() {
+    let model = params().build().unwrap();
+    let spec = reference_specimen();
+    let force = reference_columns("specimen_force.csv");
+    let reference = reference_columns("specimen_reference.csv");
+    let sticks = reference_columns("specimen_sticks.csv");
+    let record = ForceRecord::new(force[0].clone(), force[1].clone()).unwrap();
+    let mut run = Specimens::default();
+    let stats = forward_rk4_specimen(
+        &model,
+        &spec,
+        &record,
+        Rk4::with_steps_per_sample(1).unwrap(),
+        State::default(),
+        record.len(),
+        &mut run,
+    )
+    .unwrap();
+    assert_eq!(run.samples.len(), reference[0].len());
+    let mut worst = [0.0f64; 3];
+    for (s, i) in run.samples.iter().zip(0..) {
+        let spec_sample = s.specimen.unwrap();
+        let got = [s.u_m, spec_sample.u_m[0], spec_sample.u_m[1]];
+        let want = [reference[1][i], reference[3][i], reference[4][i]];
+        for c in 0..3 {
+            worst[c] = worst[c].max((got[c] - want[c]).abs());
+        }
+    }
+    eprintln!("forward vs reference: largest |Δ| (u, z1, z2) = {worst:?} m; {stats:?}");
+    assert!(
+        worst.iter().all(|w| *w < 1e-7),
+        "largest differences (u, z1, z2) = {worst:?} m"
+    );
+    // The reference sticks 4 times (from rest at t = 0, then 3 stops); the run does too.
+    assert_eq!(sticks[0].len(), 4);
+    assert_eq!(stats.stick_events, 3, "{stats:?}");
+    assert!(stats.breakaways >= 4, "{stats:?}");
+    // The time spent stuck agrees with the reference's stick intervals (the last ends before
+    // the record does): a misplaced stop or breakaway would show here first.
+    let stuck_s: f64 = sticks[0].iter().zip(&sticks[1]).map(|(a, b)| b - a).sum();
+    assert!(
+        (stats.stick_time_s - stuck_s).abs() < 1e-6,
+        "stuck {} s against the reference's {stuck_s} s",
+        stats.stick_time_s
+    );
+}
+
+/// The inverse with a specimen against the exact solution of
+/// `tools/reference/specimen_cases.py`: a prescribed motion (three sines) whose base
+/// acceleration is linear between the 1024 Hz samples drives the damped 2-storey frame, solved
+/// there per interval with the matrix exponential. Force and base shear within 1e-6 of the
+/// peak force (the bound; 8 RK4 sub-steps per sample on a 6.8 Hz mode leave ~1e-12).
+#[test]
+fn the_inverse_with_a_specimen_matches_the_exact_reference() {
+    let model = params().build().unwrap();
+    let spec = reference_specimen();
+    let r = reference_columns("specimen_inverse.csv");
+    let motion = Motion::new(r[0].clone(), r[1].clone(), r[2].clone(), r[3].clone()).unwrap();
+    let mut inv = Specimens::default();
+    inverse_specimen(&model, &spec, &motion, &mut inv);
+    let peak = r[5].iter().fold(0.0f64, |m, f| m.max(f.abs()));
+    let mut worst = (0.0f64, 0.0f64);
+    for (s, i) in inv.samples.iter().zip(0..) {
+        worst.0 = worst.0.max((s.terms.actuator_n - r[5][i]).abs());
+        worst.1 = worst.1.max((s.specimen.unwrap().base_shear_n - r[4][i]).abs());
+    }
+    eprintln!("inverse vs reference: largest |Δ| (force, base shear) = {worst:?} N, peak {peak} N");
+    assert!(peak > 1e5, "{peak}");
+    assert!(
+        worst.0 < 1e-6 * peak && worst.1 < 1e-6 * peak,
+        "largest differences (force, base shear) = {worst:?} N against a peak of {peak} N"
+    );
+}
