@@ -132,7 +132,7 @@ fn run_model<M: PlatenModel, S: SampleSink>(
 /// holds no trajectory in memory, and a failed run leaves no partial file.
 #[derive(Debug)]
 pub struct CsvSink {
-    writer: CsvWriter<'static>,
+    writer: CsvWriter,
     error: Option<IoError>,
     /// The row being written (allocated once).
     row: Vec<f64>,
@@ -155,20 +155,17 @@ impl CsvSink {
     /// # Errors
     /// As [`CsvSink::create`].
     pub fn create_with_storeys(path: &Path, storeys: usize) -> Result<Self> {
-        let names: &'static [&'static str] = if storeys == 0 {
-            &Trajectory::COLUMN_NAMES
-        } else {
-            // The writer keeps its header for its messages; a specimen's header (a few dozen
-            // bytes, once per run) is leaked to give it the writer's lifetime.
-            let mut names: Vec<&'static str> = Trajectory::COLUMN_NAMES.to_vec();
-            let mut add = |s: String| names.push(Box::leak(s.into_boxed_str()));
-            add("base_shear_n".into());
-            (1..=storeys).for_each(|i| add(format!("storey{i}_u_m")));
-            (1..=storeys).for_each(|i| add(format!("storey{i}_a_m_s2")));
-            Box::leak(names.into_boxed_slice())
-        };
+        let mut names: Vec<String> = Trajectory::COLUMN_NAMES
+            .iter()
+            .map(|&n| n.to_owned())
+            .collect();
+        if storeys > 0 {
+            names.push("base_shear_n".into());
+            names.extend((1..=storeys).map(|i| format!("storey{i}_u_m")));
+            names.extend((1..=storeys).map(|i| format!("storey{i}_a_m_s2")));
+        }
         Ok(Self {
-            writer: CsvWriter::create(path, names)?,
+            writer: CsvWriter::create(path, &names)?,
             error: None,
             row: Vec::with_capacity(names.len()),
         })
