@@ -52,17 +52,19 @@ use crate::stop::{Failure, StopReason};
 
 const NS: usize = Specimen::MAX_STOREYS;
 /// Positions in the state vector: displacement, velocity, actuator work, platen dissipation,
-/// storey dissipation, storey displacements, storey velocities.
+/// storey dissipation, then the `n` storey displacements from `Z` and the `n` storey
+/// velocities from `Z + n` (the stepper's `zd`): the live state is the prefix `5 + 2n` of the
+/// fixed-size array, and the RK4 loops run over that prefix only.
 const U: usize = 0;
 const V: usize = 1;
 const W: usize = 2;
 const DI: usize = 3;
 const SD: usize = 4;
 const Z: usize = 5;
-const ZD: usize = 5 + NS;
-const LEN: usize = 5 + 2 * NS;
 
-type Y = [f64; LEN];
+/// The state of a specimen of `(L − 5)/2` storeys: the stepper is compiled for each length
+/// (a 3-storey specimen steps arrays of 11, not of the largest specimen's 29).
+type Y<const L: usize> = [f64; L];
 
 /// Runs the model with `specimen` on the platen forward under `record` from `initial` (the
 /// specimen at rest relative to the platen), with fixed-step RK4 and exact stick-slip,
@@ -80,6 +82,28 @@ pub fn forward_rk4_specimen<M: PlatenModel, S: SampleSink>(
     sink: &mut S,
 ) -> Result<RunStats> {
     check_run(record, initial, samples)?;
+    macro_rules! by_storeys {
+        ($($n:literal => $len:literal),*) => {
+            match specimen.len() {
+                $($n => run::<M, S, $len>(model, specimen, record, rk4, initial, samples, sink),)*
+                other => unreachable!("a validated specimen has 1 to {NS} storeys, not {other}"),
+            }
+        };
+    }
+    by_storeys!(1 => 7, 2 => 9, 3 => 11, 4 => 13, 5 => 15, 6 => 17, 7 => 19, 8 => 21,
+                9 => 23, 10 => 25, 11 => 27, 12 => 29)
+}
+
+/// [`forward_rk4_specimen`] with the state length `L = 5 + 2n` fixed at compile time.
+fn run<M: PlatenModel, S: SampleSink, const L: usize>(
+    model: &M,
+    specimen: &Specimen,
+    record: &ForceRecord,
+    rk4: Rk4,
+    initial: State,
+    samples: usize,
+    sink: &mut S,
+) -> Result<RunStats> {
     let k = u64::from(rk4.steps_per_sample());
     let grid = Grid {
         force: record.force_n(),
@@ -87,7 +111,7 @@ pub fn forward_rk4_specimen<M: PlatenModel, S: SampleSink>(
         h: record.dt_s() / k as f64,
         t0: record.t_s()[0],
     };
-    let mut stepper = Stepper::new(model, specimen, grid, initial);
+    let mut stepper = Stepper::<M, L>::new(model, specimen, grid, initial);
     let times = record.t_s();
     if samples == 0 {
         return Ok(stepper.finish(times[0]));
@@ -104,15 +128,14 @@ pub fn forward_rk4_specimen<M: PlatenModel, S: SampleSink>(
     Ok(stepper.finish(times[samples - 1]))
 }
 
-struct Stepper<'a, M> {
+struct Stepper<'a, M, const L: usize> {
     model: &'a M,
     spec: &'a Specimen,
-    n: usize,
     grid: Grid<'a>,
-    y: Y,
+    y: Y<L>,
     mode: Mode,
     /// Rates at the current state in the current mode.
-    k: Y,
+    k: Y<L>,
     /// Platen acceleration at the current state (0 in stick and creep).
     a: f64,
     w_stiff: f64,
@@ -122,19 +145,23 @@ struct Stepper<'a, M> {
     stats: RunStats,
 }
 
-impl<'a, M: PlatenModel> Stepper<'a, M> {
+impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
+    /// The number of storeys.
+    const N: usize = (L - Z) / 2;
+    /// Where the storey velocities start.
+    const ZD: usize = Z + Self::N;
+
     fn new(model: &'a M, spec: &'a Specimen, grid: Grid<'a>, initial: State) -> Self {
-        let mut y = [0.0; LEN];
+        let mut y = [0.0; L];
         y[U] = initial.u_m;
         y[V] = initial.v_m_s;
         let mut s = Self {
             model,
             spec,
-            n: spec.len(),
             grid,
             y,
             mode: Mode::Stick,
-            k: [0.0; LEN],
+            k: [0.0; L],
             a: 0.0,
             w_stiff: 0.0,
             f_rate: 0.0,
@@ -160,19 +187,19 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
     }
 
     #[inline(always)]
-    fn base_shear(&self, y: &Y) -> f64 {
-        self.spec.base_shear_n(y[Z], y[ZD])
+    fn base_shear(&self, y: &Y<L>) -> f64 {
+        self.spec.base_shear_n(y[Z], y[Self::ZD])
     }
 
-    fn specimen_energy(&self, y: &Y) -> f64 {
-        let n = self.n;
-        self.spec.energy_j(y[V], &y[Z..Z + n], &y[ZD..ZD + n])
+    fn specimen_energy(&self, y: &Y<L>) -> f64 {
+        let (n, zd) = (Self::N, Self::ZD);
+        self.spec.energy_j(y[V], &y[Z..Z + n], &y[zd..zd + n])
     }
 
     /// The rates of the full state in `mode` under actuator force `f`, into `dy`; returns the
     /// platen acceleration.
     #[inline(always)]
-    fn rates(&self, mode: Mode, f: f64, y: &Y, dy: &mut Y) -> f64 {
+    fn rates(&self, mode: Mode, f: f64, y: &Y<L>, dy: &mut Y<L>) -> f64 {
         let bs = self.base_shear(y);
         let a = match mode {
             Mode::Slip(dir) => {
@@ -205,12 +232,12 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
                 }
             }
         };
-        let n = self.n;
-        dy[Z..Z + n].copy_from_slice(&y[ZD..ZD + n]);
-        let (zs, zds) = (&y[Z..Z + n], &y[ZD..ZD + n]);
+        let (n, zd) = (Self::N, Self::ZD);
+        dy[Z..Z + n].copy_from_slice(&y[zd..zd + n]);
+        let (zs, zds) = (&y[Z..Z + n], &y[zd..zd + n]);
         dy[SD] = self
             .spec
-            .storey_accelerations(a, zs, zds, &mut dy[ZD..ZD + n]);
+            .storey_accelerations(a, zs, zds, &mut dy[zd..zd + n]);
         a
     }
 
@@ -226,11 +253,12 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
     /// the integration error). Feeding this `a` to the storeys keeps the specimen's energy
     /// balance exact in creep: without it the storeys' absolute kinetic energy changes by
     /// `Σmᵢ(v + żᵢ)·Δv` with no work behind it, an error of order `h²`.
-    fn creep_acceleration(&self, dir: Direction, y: &Y, w: f64) -> f64 {
+    fn creep_acceleration(&self, dir: Direction, y: &Y<L>, w: f64) -> f64 {
         let (s, u) = (dir.sign(), y[U]);
         let m = self.model;
         // The speed-dependent part apart: next to F_s and F_E it is below their rounding.
-        let e_speed = |w: f64| m.dissipative_excess_n(u, w) + s * m.velocity_inertial_force_n(u, s * w);
+        let e_speed =
+            |w: f64| m.dissipative_excess_n(u, w) + s * m.velocity_inertial_force_n(u, s * w);
         let e_static = |u: f64| {
             m.static_threshold_n(u)
                 + m.dissipative_excess_n(u, w)
@@ -244,14 +272,13 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
         }
         let du = 1e-6 * u.abs().max(1e-3);
         let e_u = (e_static(u + du) - e_static(u - du)) / (2.0 * du);
-        let n = self.n;
+        let (n, zd) = (Self::N, Self::ZD);
         let mut zdd0 = [0.0; NS];
         self.spec
-            .storey_accelerations(0.0, &y[Z..Z + n], &y[ZD..ZD + n], &mut zdd0[..n]);
+            .storey_accelerations(0.0, &y[Z..Z + n], &y[zd..zd + n], &mut zdd0[..n]);
         let st = self.spec.storeys()[0];
-        let b_rate0 = -(st.stiffness_n_per_m * y[ZD] + st.damping_n_s_per_m * zdd0[0]);
-        let w_rate =
-            (s * (self.f_rate - b_rate0) - e_u * s * w) / (e_w + st.damping_n_s_per_m);
+        let b_rate0 = -(st.stiffness_n_per_m * y[zd] + st.damping_n_s_per_m * zdd0[0]);
+        let w_rate = (s * (self.f_rate - b_rate0) - e_u * s * w) / (e_w + st.damping_n_s_per_m);
         if w_rate.is_finite() {
             s * w_rate
         } else {
@@ -262,21 +289,21 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
     /// One RK4 step of length `len` (fraction of `h`) from fraction `s` of step `n`, from `y`
     /// with rates `k1` there: the state at the end and the smallest stage speed `dir·v` (slip).
     #[inline(always)]
-    fn rk4(&mut self, n: GridStep, s: f64, len: f64, y: &Y, k1: &Y) -> (Y, f64) {
+    fn rk4(&mut self, n: GridStep, s: f64, len: f64, y: &Y<L>, k1: &Y<L>) -> (Y<L>, f64) {
         let mode = self.mode;
         let h = len * self.grid.h;
         let (f_mid, f_end) = (
             self.grid.force(n, s + 0.5 * len),
             self.grid.force(n, s + len),
         );
-        let combine = |base: &Y, k: &Y, c: f64| {
+        let combine = |base: &Y<L>, k: &Y<L>, c: f64| {
             let mut out = *base;
-            for i in 0..LEN {
+            for i in 0..L {
                 out[i] += c * k[i];
             }
             out
         };
-        let (mut k2, mut k3, mut k4) = ([0.0; LEN], [0.0; LEN], [0.0; LEN]);
+        let (mut k2, mut k3, mut k4) = ([0.0; L], [0.0; L], [0.0; L]);
         let y2 = combine(y, k1, 0.5 * h);
         self.rates(mode, f_mid, &y2, &mut k2);
         let y3 = combine(y, &k2, 0.5 * h);
@@ -286,7 +313,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
         self.stats.rhs_evaluations += 3;
         let h6 = h / 6.0;
         let mut y1 = *y;
-        for i in 0..LEN {
+        for i in 0..L {
             y1[i] += h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
         }
         let stage_min = match mode {
@@ -303,7 +330,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
     }
 
     /// The signed creep velocity at state `y` under force `f`.
-    fn creep_velocity(&self, dir: Direction, y: &Y, f: f64) -> f64 {
+    fn creep_velocity(&self, dir: Direction, y: &Y<L>, f: f64) -> f64 {
         let w = creep_speed_m_s(self.model, dir, y[U], f - self.base_shear(y), self.w_stiff)
             .unwrap_or(self.w_stiff);
         dir.sign() * w
@@ -311,7 +338,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
 
     /// The current mode's state over a length `x` (fraction of `h`) from fraction `tau` of step
     /// `n`, split by `grading`; with the smallest stage speed.
-    fn piece(&mut self, n: GridStep, tau: f64, x: f64, grading: Grading) -> (Y, f64) {
+    fn piece(&mut self, n: GridStep, tau: f64, x: f64, grading: Grading) -> (Y<L>, f64) {
         let (mut y, mut k) = (self.y, self.k);
         let mut stage_min = f64::INFINITY;
         let mut s = tau;
@@ -332,13 +359,13 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
 
     /// The net force `N = F_A − F_E(u) − B` at state `y` under force `f`.
     #[inline(always)]
-    fn net(&self, y: &Y, f: f64) -> f64 {
+    fn net(&self, y: &Y<L>, f: f64) -> f64 {
         f - self.model.elastic_force_n(y[U]) - self.base_shear(y)
     }
 
     /// The current mode's event function: positive until the mode ends.
     #[inline(always)]
-    fn event_g(&self, y: &Y, f: f64) -> f64 {
+    fn event_g(&self, y: &Y<L>, f: f64) -> f64 {
         match self.mode {
             Mode::Slip(dir) => dir.sign() * y[V],
             Mode::Stick => self.model.static_threshold_n(y[U]) - self.net(y, f).abs(),
@@ -362,7 +389,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
     /// `k1`, platen acceleration `a1`): the cubic Hermite interpolant of the speed (slip) or
     /// of `F_s ∓ N` (stick) touches zero.
     #[allow(clippy::too_many_arguments)]
-    fn dips(&self, len: f64, f0: f64, y1: &Y, f1: f64, k1: &Y, a1: f64) -> bool {
+    fn dips(&self, len: f64, f0: f64, y1: &Y<L>, f1: f64, k1: &Y<L>, a1: f64) -> bool {
         let span = len * self.grid.h;
         match self.mode {
             Mode::Slip(dir) => {
@@ -373,8 +400,9 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
                 // Ṅ = Ḟ_A − Ḃ = Ḟ_A + k₁ż₁ + c₁z̈₁ (u fixed), times the piece's length.
                 let slope = self.f_rate;
                 let st = self.spec.storeys()[0];
-                let n_rate = |k: &Y| {
-                    (slope + st.stiffness_n_per_m * k[Z] + st.damping_n_s_per_m * k[ZD]) * span
+                let n_rate = |k: &Y<L>| {
+                    (slope + st.stiffness_n_per_m * k[Z] + st.damping_n_s_per_m * k[Self::ZD])
+                        * span
                 };
                 let fs = self.model.static_threshold_n(self.y[U]);
                 let (n0, n1) = (self.net(&self.y, f0), self.net(y1, f1));
@@ -395,7 +423,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
             let y = self.y;
             self.y[V] = self.creep_velocity(dir, &y, f);
         }
-        let (y, mut k) = (self.y, [0.0; LEN]);
+        let (y, mut k) = (self.y, [0.0; L]);
         self.a = self.rates(mode, f, &y, &mut k);
         self.k = k;
         self.stats.rhs_evaluations += 1;
@@ -453,7 +481,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
             let f1 = self.grid.force(n, tau + len);
             let g1 = self.event_g(&y1, f1);
             if g1 > 0.0 && stage_min > 0.0 {
-                let mut k1 = [0.0; LEN];
+                let mut k1 = [0.0; L];
                 let a1 = self.rates(self.mode, f1, &y1, &mut k1);
                 self.stats.rhs_evaluations += 1;
                 if !self.dips(len, f0, &y1, f1, &k1, a1) {
@@ -500,7 +528,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
 
     /// The reset at the current mode's event, located at `x` (fraction of `h`) past fraction
     /// `tau` of step `n` with state `y_event` there.
-    fn event(&mut self, n: GridStep, tau: f64, x: f64, y_event: Y) -> StepStop {
+    fn event(&mut self, n: GridStep, tau: f64, x: f64, y_event: Y<L>) -> StepStop {
         let mut at = tau + x;
         if 1.0 - at < 1e-12 {
             at = 1.0;
@@ -600,7 +628,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
     }
 
     /// The stuck state over a length `x` from fraction `tau` of step `n` (one RK4 step).
-    fn piece_at_rest(&mut self, n: GridStep, tau: f64, x: f64) -> (Y, f64) {
+    fn piece_at_rest(&mut self, n: GridStep, tau: f64, x: f64) -> (Y<L>, f64) {
         self.piece(n, tau, x, Grading::Single)
     }
 
@@ -639,15 +667,15 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
         sample.terms.actuator_n = f;
         let mut spec = SpecimenSample {
             base_shear_n: bs,
-            storeys: self.n,
+            storeys: Self::N,
             u_m: [0.0; NS],
             a_m_s2: [0.0; NS],
             drift_m: [0.0; NS],
         };
         let mut below = 0.0;
-        for i in 0..self.n {
+        for i in 0..Self::N {
             spec.u_m[i] = self.y[Z + i];
-            spec.a_m_s2[i] = self.a + self.k[ZD + i];
+            spec.a_m_s2[i] = self.a + self.k[Self::ZD + i];
             spec.drift_m[i] = self.y[Z + i] - below;
             below = self.y[Z + i];
         }

@@ -442,7 +442,9 @@ fn the_inverse_with_a_specimen_matches_the_exact_reference() {
     let mut worst = (0.0f64, 0.0f64);
     for (s, i) in inv.samples.iter().zip(0..) {
         worst.0 = worst.0.max((s.terms.actuator_n - r[5][i]).abs());
-        worst.1 = worst.1.max((s.specimen.unwrap().base_shear_n - r[4][i]).abs());
+        worst.1 = worst
+            .1
+            .max((s.specimen.unwrap().base_shear_n - r[4][i]).abs());
     }
     eprintln!("inverse vs reference: largest |Δ| (force, base shear) = {worst:?} N, peak {peak} N");
     assert!(peak > 1e5, "{peak}");

@@ -236,21 +236,22 @@ impl Specimen {
     #[inline]
     pub fn storey_accelerations(&self, a_m_s2: f64, z: &[f64], zd: &[f64], out: &mut [f64]) -> f64 {
         let n = self.len();
+        let (storeys, z, zd, out) = (&self.storeys[..n], &z[..n], &zd[..n], &mut out[..n]);
         let mut power = 0.0;
         // The shear Vᵢ of each storey from the bottom; floor i−1 feels −Vᵢ₋₁ + Vᵢ, the top
         // floor −Vₙ.
         let (mut z_prev, mut zd_prev, mut shear_prev) = (0.0, 0.0, 0.0);
         for i in 0..n {
-            let s = &self.storeys[i];
+            let s = &storeys[i];
             let (d, dd) = (z[i] - z_prev, zd[i] - zd_prev);
             let shear = s.stiffness_n_per_m * d + s.damping_n_s_per_m * dd;
             power += s.damping_n_s_per_m * dd * dd;
             if i > 0 {
-                out[i - 1] = (shear - shear_prev) / self.storeys[i - 1].mass_kg - a_m_s2;
+                out[i - 1] = (shear - shear_prev) / storeys[i - 1].mass_kg - a_m_s2;
             }
             (z_prev, zd_prev, shear_prev) = (z[i], zd[i], shear);
         }
-        out[n - 1] = -shear_prev / self.storeys[n - 1].mass_kg - a_m_s2;
+        out[n - 1] = -shear_prev / storeys[n - 1].mass_kg - a_m_s2;
         power
     }
 
