@@ -88,7 +88,26 @@ fn check_shipped_scenario_run(path: &Path, dir: &Path) {
     assert!(o.status.success(), "{}: {}", path.display(), stderr(&o));
     let summary: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let (header, rows) = read_csv(&out);
-    assert_eq!(header, CONTRACT_COLUMNS, "{}", path.display());
+    assert_eq!(
+        header[..CONTRACT_COLUMNS.len()],
+        CONTRACT_COLUMNS,
+        "{}",
+        path.display()
+    );
+    if let Some(n) = summary["specimen"]["storeys"].as_u64() {
+        // A specimen adds base_shear_n, storey{i}_u_m, storey{i}_a_m_s2 (contract).
+        let mut extra = vec!["base_shear_n".to_string()];
+        extra.extend((1..=n).map(|i| format!("storey{i}_u_m")));
+        extra.extend((1..=n).map(|i| format!("storey{i}_a_m_s2")));
+        assert_eq!(
+            header[CONTRACT_COLUMNS.len()..],
+            extra,
+            "{}",
+            path.display()
+        );
+    } else {
+        assert_eq!(header.len(), CONTRACT_COLUMNS.len(), "{}", path.display());
+    }
     assert_eq!(rows.len() as u64, summary["samples"].as_u64().unwrap());
     // Sample times are uniform and start at 0 for every shipped scenario.
     assert_eq!(rows[0][0], 0.0);

@@ -31,7 +31,7 @@ fn generated() -> &'static (tempfile::TempDir, Vec<Test>) {
     static DATA: OnceLock<(tempfile::TempDir, Vec<Test>)> = OnceLock::new();
     DATA.get_or_init(|| {
         let dir = tempfile::tempdir().unwrap();
-        let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/paper-tests");
+        let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/paper-tests");
         let mut tests = Vec::new();
         for (p, folder) in [(13.8, "13.8MPa"), (6.9, "6.9MPa")] {
             for name in ["S4", "S6", "S9", "S10", "T1", "T4", "T6", "T8", "T10"] {

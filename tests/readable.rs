@@ -192,7 +192,7 @@ fn each_verbs_help_ends_with_examples() {
 /// user's first try).
 #[test]
 fn the_examples_name_shipped_files() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).to_path_buf();
     let mut named = 0;
     for verb in VERBS {
         let help = stdout(&platen(&[verb, "--help"]));

@@ -15,6 +15,9 @@
 //! * `rk4`: [`Method::Rk4`] on the identified model, exact stick-slip, one step per sample,
 //!   every output sample kept in memory in a [`Trajectory`] (no file I/O), same force;
 //! * `rk4_full`: the same on the full Lagrangian model;
+//! * `rk4_specimen`: the `rk4` workload with a 3-storey specimen on the platen
+//!   ([`bench_specimen`]: 60 t, fixed-base modes 2.9, 7.6 and 11.3 Hz), through
+//!   [`forward_rk4_specimen`];
 //! * `dopri5`: [`Method::Dopri5`] at rtol 1e-8, atol 1e-11 on the identified model, same
 //!   force, timed per accepted step;
 //! * `inverse`: [`inverse`] of the paper's S9 sine motion (0.2 m, 0.6 Hz) on the identified
@@ -33,9 +36,10 @@ use anyhow::{ensure, Context, Result};
 use serde_json::{json, Map, Value};
 
 use platen_integrate::{
-    inverse, Dopri5Settings, ForceRecord, ForwardIntegrator, Method, Motion, Rk4, State, Trajectory,
+    forward_rk4_specimen, inverse, Dopri5Settings, ForceRecord, ForwardIntegrator, Method, Motion,
+    Rk4, State, Trajectory,
 };
-use platen_model::{preset, FullModel, IdentifiedModel, IdentifiedParams};
+use platen_model::{preset, FullModel, IdentifiedModel, IdentifiedParams, Specimen, Storey};
 
 /// The plain-loop measuring stick, compiled from the one file the criterion benches use.
 #[path = "../../../benches/common/baseline.rs"]
@@ -73,6 +77,9 @@ enum Job {
     /// A forward run of a model with a method; one unit per accepted step (every step for
     /// the RK4).
     Forward(Form, Method),
+    /// [`forward_rk4_specimen`] on the identified model with [`bench_specimen`]; one unit per
+    /// step.
+    ForwardSpecimen(Rk4),
     /// [`inverse`] of the motion on the identified model; one unit per sample.
     Inverse,
 }
@@ -156,6 +163,12 @@ fn workloads() -> Result<Vec<Workload>> {
             Job::Forward(Form::Full, rk4),
         ),
         Workload::new(
+            "rk4_specimen",
+            "rk4_specimen: rk4 with a 3-storey specimen",
+            "step",
+            Job::ForwardSpecimen(Rk4::with_steps_per_sample(1)?),
+        ),
+        Workload::new(
             "dopri5",
             "dopri5: rtol 1e-8, identified model, output kept",
             "accepted step",
@@ -180,6 +193,23 @@ struct Inputs {
     identified_params: IdentifiedParams,
     identified: IdentifiedModel,
     full: FullModel,
+    specimen: Specimen,
+}
+
+/// The 3-storey specimen of the `rk4_specimen` workload: 20 t floors, storey stiffnesses 40,
+/// 32 and 24 MN/m, stiffness-proportional storey dampers (3 ms times each stiffness: 2.8 % of
+/// critical in the first mode). Fixed-base modes near 2.9, 7.6 and 11.3 Hz.
+fn bench_specimen() -> Result<Specimen> {
+    let storey = |k: f64| Storey {
+        mass_kg: 20e3,
+        stiffness_n_per_m: k,
+        damping_n_s_per_m: 3e-3 * k,
+    };
+    Ok(Specimen::new(vec![
+        storey(40e6),
+        storey(32e6),
+        storey(24e6),
+    ])?)
 }
 
 impl Inputs {
@@ -215,6 +245,7 @@ impl Inputs {
             identified: identified_params.build()?,
             identified_params,
             full: preset::lhpost_2008_physical(PRESSURE_PA).build()?,
+            specimen: bench_specimen()?,
         })
     }
 }
@@ -261,6 +292,24 @@ impl Job {
                     Method::Rk4(_) => "bench forward RK4 run",
                     Method::Dopri5(_) => "bench forward Dopri5 run",
                 })?;
+                black_box(&*out);
+                Ok((s, stats.accepted_steps, None))
+            }
+            Job::ForwardSpecimen(rk4) => {
+                clear(out);
+                let record = black_box(&inputs.record);
+                let (s, stats) = time(|| {
+                    forward_rk4_specimen(
+                        black_box(&inputs.identified),
+                        black_box(&inputs.specimen),
+                        record,
+                        rk4,
+                        State::default(),
+                        samples,
+                        out,
+                    )
+                });
+                let stats = stats.context("bench forward RK4 run with a specimen")?;
                 black_box(&*out);
                 Ok((s, stats.accepted_steps, None))
             }
@@ -354,6 +403,15 @@ impl Report<'_> {
         m.insert("force_frequency_hz".into(), json!(FORCE_FREQUENCY_HZ));
         m.insert("rk4_ns_per_step".into(), json!(rk4.ns_per_unit()));
         m.insert("rk4_full_ns_per_step".into(), json!(rk4_full.ns_per_unit()));
+        let specimen = self.get("rk4_specimen");
+        m.insert(
+            "rk4_specimen_ns_per_step".into(),
+            json!(specimen.ns_per_unit()),
+        );
+        m.insert(
+            "rk4_specimen_ratio_to_baseline".into(),
+            json!(specimen.ns_per_unit() / base),
+        );
         m.insert(
             "dopri5_ns_per_accepted_step".into(),
             json!(self.get("dopri5").ns_per_unit()),

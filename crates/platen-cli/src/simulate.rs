@@ -31,7 +31,10 @@ pub fn run(opts: &Options<'_>) -> Result<()> {
     let (path, out) = (opts.scenario, opts.out);
     let scenario = Scenario::load(path)?;
     // Create the temporary output first, so that an unwritable path fails before the run.
-    let mut stream = out.map(CsvSink::create).transpose()?;
+    let storeys = scenario.storeys();
+    let mut stream = out
+        .map(|p| CsvSink::create_with_storeys(p, storeys))
+        .transpose()?;
     // The figures' points are collected as the run goes, in memory that does not grow with it.
     let mut recorder = opts.plot.map(|_| RunRecorder::new(&scenario.run));
     let output = match (stream.as_mut(), recorder.as_mut()) {

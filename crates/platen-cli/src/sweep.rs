@@ -115,6 +115,12 @@ pub fn run(
     plot: &Plot<'_>,
 ) -> Result<()> {
     let scenario = Scenario::load(path)?;
+    if scenario.specimen.is_some() {
+        anyhow::bail!(
+            "{}: sweeps of a scenario with a specimen are not supported yet (simulate runs it)",
+            path.display()
+        );
+    }
     check_axes(path, &scenario, sets);
     // The base case must reproduce the scenario's own model exactly.
     let base = scenario.model_at(scenario.hold_down_pressure_pa, &[])?;

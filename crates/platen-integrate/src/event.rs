@@ -162,7 +162,7 @@ pub(crate) fn arrive_at_rest<M: PlatenModel>(
 /// condition (a breakaway where `|N|` is not yet above `F_s`) just past it, so the next mode's
 /// precondition holds at the state it starts from. `holds(end)` must be true.
 #[inline]
-pub(crate) fn just_past(at: f64, end: f64, holds: impl Fn(f64) -> bool) -> f64 {
+pub(crate) fn just_past(at: f64, end: f64, mut holds: impl FnMut(f64) -> bool) -> f64 {
     let mut x = at;
     let mut eps = 4.0 * f64::EPSILON * end.abs().max(1.0);
     for _ in 0..64 {

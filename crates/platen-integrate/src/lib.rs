@@ -48,18 +48,20 @@ mod output;
 mod record;
 mod rk4;
 mod run;
+mod specimen;
 mod stop;
 
 pub use dopri5::{forward_dopri5, Dopri5Settings};
 pub use error::{IntegrateError, Result};
 pub use event::EventKind;
-pub use inverse::inverse;
+pub use inverse::{inverse, inverse_specimen, INVERSE_SPECIMEN_SUBSTEPS};
 pub use method::{ForwardIntegrator, Method};
-pub use output::{Exceedance, Peak, Peaks, Sample, SampleSink, Trajectory};
+pub use output::{Exceedance, Peak, Peaks, Sample, SampleSink, SpecimenSample, Trajectory};
 pub use record::{
     derivative, sampling_grid, second_derivative, uniform_interval_s, ForceRecord, Motion,
     SamplingGrid, UNIFORM_RELATIVE_TOLERANCE,
 };
 pub use rk4::{forward_rk4, Rk4};
 pub use run::{EnergyBalance, RunStats, State};
+pub use specimen::forward_rk4_specimen;
 pub use stop::{AdaptiveFailure, Failure, StopReason};

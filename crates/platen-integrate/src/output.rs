@@ -1,6 +1,6 @@
 //! Output of a run: one [`Sample`] per input sample time, delivered to a [`SampleSink`].
 
-use platen_model::{ForceTerms, TableLimits};
+use platen_model::{ForceTerms, Specimen, TableLimits};
 
 /// The state of the platen and the decomposition of the actuator force at one output time.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -20,6 +20,24 @@ pub struct Sample {
     pub terms: ForceTerms,
     /// Whether the platen is stuck (friction holds it at rest).
     pub stuck: bool,
+    /// The specimen's channels, for a run with a specimen.
+    pub specimen: Option<SpecimenSample>,
+}
+
+/// The specimen's channels at one output time (see [`platen_model::Specimen`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpecimenSample {
+    /// Base shear `B = Σmᵢ·(a + z̈ᵢ)`, N: the force the platen exerts on the specimen. The
+    /// actuator force is `F_I + F_E + F_D + B`.
+    pub base_shear_n: f64,
+    /// Number of storeys (the first `storeys` entries of the arrays are used).
+    pub storeys: usize,
+    /// Storey displacements relative to the platen, m, bottom first.
+    pub u_m: [f64; Specimen::MAX_STOREYS],
+    /// Storey absolute accelerations `a + z̈ᵢ`, m/s², bottom first.
+    pub a_m_s2: [f64; Specimen::MAX_STOREYS],
+    /// Storey drifts `zᵢ − zᵢ₋₁`, m, bottom first.
+    pub drift_m: [f64; Specimen::MAX_STOREYS],
 }
 
 /// Receives the samples of a run in time order.
@@ -191,6 +209,12 @@ pub struct Peaks {
     pub force_n: Peak,
     /// Samples at which the platen was stuck.
     pub stuck_samples: usize,
+    /// Peak base shear, N (runs with a specimen).
+    pub base_shear_n: Peak,
+    /// Peak storey drifts `zᵢ − zᵢ₋₁`, m, bottom first (the first `storeys` are used).
+    pub drift_m: [Peak; Specimen::MAX_STOREYS],
+    /// Storeys of the specimen (0 without one).
+    pub storeys: usize,
 }
 
 impl SampleSink for Peaks {
@@ -206,6 +230,13 @@ impl SampleSink for Peaks {
         self.a_m_s2.update(s.a_m_s2, s.t_s);
         self.force_n.update(s.terms.actuator_n, s.t_s);
         self.stuck_samples += usize::from(s.stuck);
+        if let Some(sp) = &s.specimen {
+            self.storeys = sp.storeys;
+            self.base_shear_n.update(sp.base_shear_n, s.t_s);
+            for (peak, &d) in self.drift_m.iter_mut().zip(&sp.drift_m[..sp.storeys]) {
+                peak.update(d, s.t_s);
+            }
+        }
     }
 }
 

@@ -96,26 +96,26 @@ impl Rk4 {
 /// Grid step `n` (from `t₀`), which is sub-step `i` of the sample interval that starts at
 /// sample `j` (`n = j·k + i`). Carried together so that the hot loop never divides.
 #[derive(Debug, Clone, Copy)]
-struct GridStep {
-    n: u64,
-    j: usize,
+pub(crate) struct GridStep {
+    pub(crate) n: u64,
+    pub(crate) j: usize,
     /// `i` as a number (exact: `i < k ≤ 1e9`).
-    i: f64,
+    pub(crate) i: f64,
 }
 
 /// The force record seen from the integer time grid.
-struct Grid<'a> {
-    force: &'a [f64],
-    inv_k: f64,
-    h: f64,
-    t0: f64,
+pub(crate) struct Grid<'a> {
+    pub(crate) force: &'a [f64],
+    pub(crate) inv_k: f64,
+    pub(crate) h: f64,
+    pub(crate) t0: f64,
 }
 
 impl Grid<'_> {
     /// Force at fraction `tau ∈ [0, 1]` of grid step `n`: linear between the two samples
     /// that bracket the step, exact at both samples.
     #[inline(always)]
-    fn force(&self, n: GridStep, tau: f64) -> f64 {
+    pub(crate) fn force(&self, n: GridStep, tau: f64) -> f64 {
         let j = n.j;
         let w = (n.i + tau) * self.inv_k;
         if w == 0.0 {
@@ -126,7 +126,7 @@ impl Grid<'_> {
     }
 
     #[inline]
-    fn time_s(&self, n: GridStep, tau: f64) -> f64 {
+    pub(crate) fn time_s(&self, n: GridStep, tau: f64) -> f64 {
         self.t0 + (n.n as f64 + tau) * self.h
     }
 }
@@ -234,7 +234,7 @@ pub fn forward_rk4<M: PlatenModel, S: SampleSink>(
 /// end make the step that holds it `2⁵` times shorter, which removes that error to the
 /// 1e-10 m level, at the cost of a few extra stages per event only.
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Grading {
+pub(crate) enum Grading {
     /// One plain RK4 step.
     Single,
     /// Singular at the start (leaving rest).
@@ -277,7 +277,7 @@ const GRADED_BOTH: [f64; 12] = [
 ];
 
 impl Grading {
-    fn pieces(self) -> &'static [f64] {
+    pub(crate) fn pieces(self) -> &'static [f64] {
         match self {
             Grading::Single => &[1.0],
             Grading::Start => &GRADED_START,
@@ -289,7 +289,7 @@ impl Grading {
 
 /// Halvings of a careful piece before its start is taken as a state at rest (2⁻⁶⁰ of a step:
 /// the speed there is below what a piece that short can resolve).
-const MAX_HALVINGS: u32 = 60;
+pub(crate) const MAX_HALVINGS: u32 = 60;
 
 /// The mutable state of a forward RK4 run.
 struct Stepper<'a, M> {

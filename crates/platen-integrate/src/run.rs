@@ -67,6 +67,12 @@ pub struct EnergyBalance {
     pub elastic_end_j: f64,
     /// Energy dissipated, `∫D·|v| dt`, J.
     pub dissipated_j: f64,
+    /// Energy of the specimen at the start, `½Σmᵢ(v + żᵢ)² + ½Σkᵢdᵢ²`, J (0 without one).
+    pub specimen_start_j: f64,
+    /// Energy of the specimen at the end, J (0 without one).
+    pub specimen_end_j: f64,
+    /// Energy dissipated by the specimen's storey dampers, `∫Σcᵢḋᵢ² dt`, J (0 without one).
+    pub specimen_dissipated_j: f64,
 }
 
 impl EnergyBalance {
@@ -99,22 +105,25 @@ impl EnergyBalance {
         self.elastic_end_j = model.elastic_energy_j(u);
     }
 
-    /// `W − ΔE_kin − ΔE_el − E_diss`, J: zero for an exact solution.
+    /// `W − ΔE_kin − ΔE_el − E_diss − ΔE_specimen − E_specimen,diss`, J: zero for an exact
+    /// solution (the specimen's terms are zero without one).
     pub fn residual_j(&self) -> f64 {
         self.actuator_work_j
             - (self.kinetic_end_j - self.kinetic_start_j)
             - (self.elastic_end_j - self.elastic_start_j)
             - self.dissipated_j
+            - (self.specimen_end_j - self.specimen_start_j)
+            - self.specimen_dissipated_j
     }
 
-    /// The residual relative to the largest energy flow of the run (actuator work or
-    /// dissipated energy), or 0 for a run in which nothing moved.
+    /// The residual relative to the largest energy flow of the run (actuator work, dissipated
+    /// energy, or the energy at the start), or 0 for a run in which nothing moved.
     pub fn relative_residual(&self) -> f64 {
         let scale = self
             .actuator_work_j
             .abs()
             .max(self.dissipated_j)
-            .max(self.kinetic_start_j + self.elastic_start_j);
+            .max(self.kinetic_start_j + self.elastic_start_j + self.specimen_start_j);
         if scale > 0.0 {
             self.residual_j() / scale
         } else {
@@ -214,5 +223,6 @@ pub(crate) fn sample_at<M: PlatenModel>(
             actuator_n: f,
         },
         stuck,
+        specimen: None,
     }
 }

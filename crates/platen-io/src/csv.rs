@@ -462,19 +462,21 @@ pub fn write_csv_atomic(path: &Path, header: &[&str], columns: &[&[f64]]) -> Res
 /// [`write_csv_atomic`] writes for the same columns. Dropped unfinished, it removes its
 /// temporary file.
 #[derive(Debug)]
-pub struct CsvWriter<'h> {
+pub struct CsvWriter {
     file: AtomicFile,
-    header: &'h [&'h str],
+    /// The column names, kept for the messages of [`CsvWriter::write_row`].
+    header: Vec<String>,
     rows: u64,
 }
 
-impl<'h> CsvWriter<'h> {
+impl CsvWriter {
     /// Creates the temporary file next to `path` and writes the header.
     ///
     /// # Errors
     /// [`InvalidColumnName`](IoError::InvalidColumnName) for a name that is empty or needs
     /// CSV quoting; [`IoError::Io`] if the temporary file cannot be created or written.
-    pub fn create(path: &Path, header: &'h [&'h str]) -> Result<Self> {
+    pub fn create<S: AsRef<str>>(path: &Path, header: &[S]) -> Result<Self> {
+        let header: Vec<String> = header.iter().map(|n| n.as_ref().to_owned()).collect();
         if let Some(name) = header.iter().find(|n| !valid_column_name(n)) {
             return Err(IoError::InvalidColumnName {
                 path: path.to_path_buf(),

@@ -22,6 +22,14 @@ pub enum ModelError {
         /// The preset names that exist, comma separated.
         known: &'static str,
     },
+    /// A storey of a specimen with an invalid value.
+    #[error("storey {} (from the bottom): {source}", index + 1)]
+    InvalidStorey {
+        /// Zero-based index of the storey, bottom first.
+        index: usize,
+        /// What is wrong with it.
+        source: Box<ModelError>,
+    },
     /// A parameter name that the form does not have.
     #[error("unknown {form} parameter; expected one of {known}")]
     UnknownParameter {

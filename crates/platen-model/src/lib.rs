@@ -45,6 +45,7 @@ mod law;
 mod physical_keys;
 mod power;
 pub mod preset;
+mod specimen;
 
 pub use error::{ModelError, Result};
 pub use full::{DerivedQuantities, FullModel, PhysicalParams};
@@ -57,6 +58,7 @@ pub use preset::{
     Preset, TableLimits, LHPOST_HOLD_DOWN_FORCE_AT_NOMINAL_N, LHPOST_NOMINAL_PRESSURE_PA,
     LHPOST_SUPPORTED_WEIGHT_N,
 };
+pub use specimen::{Specimen, Storey};
 
 /// Standard gravity, m/s² (used only to express accelerations in g).
 pub const STANDARD_GRAVITY_M_S2: f64 = 9.806_65;

@@ -3,11 +3,12 @@
 use std::path::Path;
 
 use platen_integrate::{
-    inverse, ForwardIntegrator, IntegrateError, Peaks, RunStats, Sample, SampleSink, Trajectory,
+    forward_rk4_specimen, inverse, inverse_specimen, ForwardIntegrator, IntegrateError, Method,
+    Peaks, RunStats, Sample, SampleSink, Trajectory,
 };
 use platen_io::csv::CsvWriter;
 use platen_io::IoError;
-use platen_model::PlatenModel;
+use platen_model::{PlatenModel, Specimen};
 
 use crate::error::{Result, ScenarioError};
 use crate::scenario::{Model, Run, Scenario};
@@ -30,7 +31,11 @@ impl Scenario {
     /// [`ScenarioError::Run`] when a forward run fails numerically (the cause names the
     /// time); samples before the failure have been delivered to `sink`.
     pub fn run<S: SampleSink>(&self, sink: &mut S) -> Result<RunOutput> {
-        self.model.run(&self.run, sink).map_err(ScenarioError::Run)
+        match &self.specimen {
+            None => self.model.run(&self.run, sink),
+            Some(specimen) => self.model.run_with_specimen(&self.run, specimen, sink),
+        }
+        .map_err(ScenarioError::Run)
     }
 }
 
@@ -50,6 +55,51 @@ impl Model {
             Model::Full(m) => run_model(&**m, run, sink),
         }
     }
+
+    /// [`Model::run`] with `specimen` on the platen (forward runs with RK4).
+    ///
+    /// # Errors
+    /// As [`Model::run`]; a forward run with another integrator than RK4 is refused
+    /// ([`IntegrateError::InvalidStep`]: scenarios refuse it when they are validated).
+    pub fn run_with_specimen<S: SampleSink>(
+        &self,
+        run: &Run,
+        specimen: &Specimen,
+        sink: &mut S,
+    ) -> std::result::Result<RunOutput, IntegrateError> {
+        match self {
+            Model::Identified(m) => run_specimen(m, run, specimen, sink),
+            Model::Full(m) => run_specimen(&**m, run, specimen, sink),
+        }
+    }
+}
+
+fn run_specimen<M: PlatenModel, S: SampleSink>(
+    model: &M,
+    run: &Run,
+    specimen: &Specimen,
+    sink: &mut S,
+) -> std::result::Result<RunOutput, IntegrateError> {
+    let mut sink = (sink, Peaks::default());
+    let stats = match run {
+        Run::Forward {
+            record,
+            integrator: Method::Rk4(rk4),
+            initial,
+            samples,
+        } => Some(forward_rk4_specimen(
+            model, specimen, record, *rk4, *initial, *samples, &mut sink,
+        )?),
+        Run::Forward { .. } => return Err(IntegrateError::InvalidStep { step_s: f64::NAN }),
+        Run::Inverse { motion } => {
+            inverse_specimen(model, specimen, motion, &mut sink);
+            None
+        }
+    };
+    Ok(RunOutput {
+        peaks: sink.1,
+        stats,
+    })
 }
 
 /// Runs `run` on `model`, delivering every sample to `sink` and to a [`Peaks`].
@@ -82,8 +132,10 @@ fn run_model<M: PlatenModel, S: SampleSink>(
 /// holds no trajectory in memory, and a failed run leaves no partial file.
 #[derive(Debug)]
 pub struct CsvSink {
-    writer: CsvWriter<'static>,
+    writer: CsvWriter,
     error: Option<IoError>,
+    /// The row being written (allocated once).
+    row: Vec<f64>,
 }
 
 impl CsvSink {
@@ -93,9 +145,29 @@ impl CsvSink {
     /// # Errors
     /// [`ScenarioError::Io`] if the temporary file cannot be created or written.
     pub fn create(path: &Path) -> Result<Self> {
+        Self::create_with_storeys(path, 0)
+    }
+
+    /// [`CsvSink::create`] for a run with a specimen of `storeys` storeys (0: none): the
+    /// contract's columns, then `base_shear_n`, `storey{i}_u_m` and `storey{i}_a_m_s2` for
+    /// `i = 1…storeys`.
+    ///
+    /// # Errors
+    /// As [`CsvSink::create`].
+    pub fn create_with_storeys(path: &Path, storeys: usize) -> Result<Self> {
+        let mut names: Vec<String> = Trajectory::COLUMN_NAMES
+            .iter()
+            .map(|&n| n.to_owned())
+            .collect();
+        if storeys > 0 {
+            names.push("base_shear_n".into());
+            names.extend((1..=storeys).map(|i| format!("storey{i}_u_m")));
+            names.extend((1..=storeys).map(|i| format!("storey{i}_a_m_s2")));
+        }
         Ok(Self {
-            writer: CsvWriter::create(path, &Trajectory::COLUMN_NAMES)?,
+            writer: CsvWriter::create(path, &names)?,
             error: None,
+            row: Vec::with_capacity(names.len()),
         })
     }
 
@@ -128,7 +200,18 @@ impl SampleSink for CsvSink {
             s.terms.elastic_n,
             s.terms.dissipative_n,
         ];
-        if let Err(error) = self.writer.write_row(&row) {
+        let result = match &s.specimen {
+            None => self.writer.write_row(&row),
+            Some(sp) => {
+                self.row.clear();
+                self.row.extend_from_slice(&row);
+                self.row.push(sp.base_shear_n);
+                self.row.extend_from_slice(&sp.u_m[..sp.storeys]);
+                self.row.extend_from_slice(&sp.a_m_s2[..sp.storeys]);
+                self.writer.write_row(&self.row)
+            }
+        };
+        if let Err(error) = result {
             self.error = Some(error);
         }
     }

@@ -36,6 +36,28 @@ pub struct ScenarioFile {
     /// The table's limits, laid over the preset's (default: the preset's; the LHPOST's are
     /// ±0.75 m, 1.8 m/s, 4.2 g, 6.8 MN).
     pub limits: Option<LimitsSpec>,
+    /// A specimen on the platen: a shear building, bottom storey first.
+    pub specimen: Option<SpecimenSpec>,
+}
+
+/// `specimen`: a linear shear building fixed on the platen.
+#[derive(Debug, Clone, Deserialize, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SpecimenSpec {
+    /// The storeys, bottom first (1 to 12).
+    pub storeys: Vec<StoreySpec>,
+}
+
+/// One storey of `specimen.storeys`.
+#[derive(Debug, Clone, Deserialize, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct StoreySpec {
+    /// Floor mass, kg (> 0).
+    pub mass_kg: f64,
+    /// Storey stiffness, N/m (> 0).
+    pub stiffness_n_per_m: f64,
+    /// Storey viscous damping, N·s/m (≥ 0).
+    pub damping_n_s_per_m: f64,
 }
 
 /// `limits`: any of the table's four limits, each a number > 0 in SI units; a limit not given

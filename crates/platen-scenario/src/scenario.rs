@@ -26,6 +26,9 @@
 //!   `{"method": "rk4", "step_s": Δt/k}` or `{"method": "dopri5", "rtol": 1e-8, "atol": 1e-11}`.
 //! * `initial` (forward runs only; default at rest at 0).
 //! * `duration_s` defaults to the record's span; required for generated excitations.
+//! * `specimen` (optional): `{"storeys": [{"mass_kg", "stiffness_n_per_m",
+//!   "damping_n_s_per_m"}, …]}`, bottom storey first: a shear building on the platen
+//!   ([`platen_model::Specimen`]); forward runs with one use RK4.
 //! * `limits` (optional): any of `stroke_m`, `velocity_m_s`, `acceleration_m_s2`, `force_n`,
 //!   laid over the preset's table limits; the summary checks the run's peaks against them.
 //!
@@ -33,9 +36,10 @@
 
 use std::path::Path;
 
-use platen_integrate::IntegrateError;
+use platen_integrate::{IntegrateError, Method};
 use platen_model::{
-    FullModel, IdentifiedKey, IdentifiedModel, ModelError, PhysicalKey, Preset, TableLimits,
+    FullModel, IdentifiedKey, IdentifiedModel, ModelError, PhysicalKey, Preset, Specimen, Storey,
+    TableLimits,
 };
 
 use crate::ctx::{check_positive, Ctx};
@@ -87,9 +91,16 @@ pub struct Scenario {
     /// The excitation's channels that platen derived (not given by the file or generator), by
     /// name, with how: what the summary reports under `derived`.
     pub derived: Derived,
+    /// The specimen on the platen, if any.
+    pub specimen: Option<Specimen>,
 }
 
 impl Scenario {
+    /// Number of storeys of the specimen (0 without one).
+    pub fn storeys(&self) -> usize {
+        self.specimen.as_ref().map_or(0, Specimen::len)
+    }
+
     /// The same scenario with its excitation multiplied by `k` (see [`Run::scaled`]).
     ///
     /// # Errors
@@ -104,6 +115,7 @@ impl Scenario {
             limits: self.limits,
             run: self.run.scaled(k)?.into_owned(),
             derived: self.derived.clone(),
+            specimen: self.specimen.clone(),
         })
     }
 
@@ -165,6 +177,7 @@ impl Scenario {
         let model = build_model(&ctx, preset, pressure_pa, &overrides)?;
         let limits = table_limits(&ctx, preset, file.limits.as_ref())?;
         let (run, derived) = run(&ctx, file)?;
+        let specimen = build_specimen(&ctx, file.specimen.as_ref(), &run)?;
         let name = file.name.clone().unwrap_or_else(|| {
             path.file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
@@ -179,8 +192,52 @@ impl Scenario {
             limits,
             run,
             derived,
+            specimen,
         })
     }
+}
+
+/// The validated `specimen`, with JSON paths in its errors; forward runs with a specimen
+/// need the RK4 integrator.
+fn build_specimen(ctx: &Ctx, given: Option<&SpecimenSpec>, run: &Run) -> Result<Option<Specimen>> {
+    let Some(given) = given else {
+        return Ok(None);
+    };
+    if let Run::Forward {
+        integrator: Method::Dopri5(_),
+        ..
+    } = run
+    {
+        return Err(ctx.invalid(
+            "integrator.method",
+            "dopri5",
+            "\"rk4\": forward runs with a specimen use the RK4 integrator",
+        ));
+    }
+    let storeys = given
+        .storeys
+        .iter()
+        .map(|s| Storey {
+            mass_kg: s.mass_kg,
+            stiffness_n_per_m: s.stiffness_n_per_m,
+            damping_n_s_per_m: s.damping_n_s_per_m,
+        })
+        .collect();
+    Specimen::new(storeys).map(Some).map_err(|e| match e {
+        ModelError::InvalidStorey { index, source } => match *source {
+            ModelError::InvalidParameter {
+                name,
+                value,
+                expected,
+            } => ctx.invalid(
+                &format!("specimen.storeys[{index}].{name}"),
+                value,
+                expected,
+            ),
+            other => ctx.invalid(&format!("specimen.storeys[{index}]"), "", other.to_string()),
+        },
+        other => ctx.invalid("specimen.storeys", given.storeys.len(), other.to_string()),
+    })
 }
 
 /// The preset's table limits with the scenario's `limits` laid over them.

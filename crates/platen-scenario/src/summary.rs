@@ -66,6 +66,22 @@ pub struct RunSummary {
     pub derived: Derived,
     /// The CSV written, if any.
     pub out: Option<String>,
+    /// The specimen's peaks (absent without a specimen).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub specimen: Option<SpecimenSummary>,
+}
+
+/// The peaks of a specimen run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SpecimenSummary {
+    /// Number of storeys.
+    pub storeys: usize,
+    /// Signed peak base shear (force of the platen on the specimen), N.
+    pub peak_base_shear_n: f64,
+    /// When it occurred, s.
+    pub peak_base_shear_n_t_s: f64,
+    /// Signed peak drift of each storey, m, bottom first.
+    pub peak_drift_m: Vec<f64>,
 }
 
 /// What only a forward run reports.
@@ -119,6 +135,15 @@ pub struct EnergySummary {
     pub elastic_end_j: f64,
     /// Energy dissipated, J.
     pub dissipated_j: f64,
+    /// Energy of the specimen at the start, J (absent without a specimen).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub specimen_start_j: Option<f64>,
+    /// Energy of the specimen at the end, J (absent without a specimen).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub specimen_end_j: Option<f64>,
+    /// Energy dissipated by the specimen's storey dampers, J (absent without a specimen).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub specimen_dissipated_j: Option<f64>,
     /// What the balance leaves, J: an accuracy indicator.
     pub residual_j: f64,
     /// The residual relative to the largest term.
@@ -197,7 +222,7 @@ impl RunSummary {
             forward: output
                 .stats
                 .as_ref()
-                .map(|st| ForwardSummary::new(st, &scenario.run)),
+                .map(|st| ForwardSummary::new(st, &scenario.run, scenario.specimen.is_some())),
             limit_exceedances: peaks
                 .exceedances(&scenario.limits)
                 .iter()
@@ -206,12 +231,22 @@ impl RunSummary {
             limits: LimitsSummary::new(peaks, &scenario.limits),
             derived: scenario.derived.clone(),
             out: out.map(|p| p.display().to_string()),
+            specimen: (peaks.storeys > 0).then(|| SpecimenSummary {
+                storeys: peaks.storeys,
+                peak_base_shear_n: peaks.base_shear_n.value,
+                peak_base_shear_n_t_s: peaks.base_shear_n.t_s,
+                peak_drift_m: peaks.drift_m[..peaks.storeys]
+                    .iter()
+                    .map(|p| p.value)
+                    .collect(),
+            }),
         }
     }
 }
 
 impl ForwardSummary {
-    fn new(st: &RunStats, run: &Run) -> Self {
+    fn new(st: &RunStats, run: &Run, with_specimen: bool) -> Self {
+        let specimen = |x: f64| with_specimen.then_some(x);
         let method = match run {
             Run::Forward { integrator, .. } => integrator.name(),
             Run::Inverse { .. } => "none",
@@ -238,6 +273,9 @@ impl ForwardSummary {
                 elastic_start_j: e.elastic_start_j,
                 elastic_end_j: e.elastic_end_j,
                 dissipated_j: e.dissipated_j,
+                specimen_start_j: specimen(e.specimen_start_j),
+                specimen_end_j: specimen(e.specimen_end_j),
+                specimen_dissipated_j: specimen(e.specimen_dissipated_j),
                 residual_j: e.residual_j(),
                 relative_residual: e.relative_residual(),
             },

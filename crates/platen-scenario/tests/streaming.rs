@@ -25,6 +25,7 @@ fn sample(index: usize, u_m: f64) -> Sample {
         a_m_s2: 0.0,
         terms: ForceTerms::default(),
         stuck: true,
+        specimen: None,
     }
 }
 
