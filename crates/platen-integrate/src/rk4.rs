@@ -111,7 +111,17 @@ pub(crate) struct Grid<'a> {
     pub(crate) t0: f64,
 }
 
-impl Grid<'_> {
+impl<'a> Grid<'a> {
+    /// The grid of `k` steps per sample interval of `record`.
+    pub(crate) fn new(record: &'a ForceRecord, k: u64) -> Self {
+        Grid {
+            force: record.force_n(),
+            inv_k: 1.0 / k as f64,
+            h: record.dt_s() / k as f64,
+            t0: record.t_s()[0],
+        }
+    }
+
     /// Force at fraction `tau ∈ [0, 1]` of grid step `n`: linear between the two samples
     /// that bracket the step, exact at both samples.
     #[inline(always)]
@@ -203,14 +213,30 @@ pub fn forward_rk4<M: PlatenModel, S: SampleSink>(
 ) -> Result<RunStats> {
     check_run(record, initial, samples)?;
     let k = u64::from(rk4.steps_per_sample);
-    let grid = Grid {
-        force: record.force_n(),
-        inv_k: 1.0 / k as f64,
-        h: record.dt_s() / k as f64,
-        t0: record.t_s()[0],
-    };
-    let mut stepper = Stepper::new(model, grid, initial);
-    let times = record.t_s();
+    let mut stepper = Stepper::new(model, Grid::new(record, k), initial);
+    drive(&mut stepper, record.t_s(), k, samples, sink)
+}
+
+/// A fixed-step integrator on the integer time grid: what [`drive`] runs.
+pub(crate) trait GridStepper {
+    /// Advances from grid point `n` to `n + 1`, handling every event inside the step.
+    fn step(&mut self, n: GridStep) -> Result<()>;
+    /// The output sample at sample `j` of the record (grid point `j·k`), at time `t_s`.
+    fn sample(&self, j: usize, t_s: f64) -> Sample;
+    /// Closes the run's statistics, the run having finished at `t_s`.
+    fn finish(&mut self, t_s: f64) -> RunStats;
+}
+
+/// Runs `stepper` over the first `samples` sample `times` (`k` steps per interval), delivering
+/// every sample to `sink`.
+#[inline(always)]
+pub(crate) fn drive<T: GridStepper, S: SampleSink>(
+    stepper: &mut T,
+    times: &[f64],
+    k: u64,
+    samples: usize,
+    sink: &mut S,
+) -> Result<RunStats> {
     if samples == 0 {
         return Ok(stepper.finish(times[0]));
     }
@@ -224,6 +250,21 @@ pub fn forward_rk4<M: PlatenModel, S: SampleSink>(
         sink.accept(&stepper.sample(j + 1, times[j + 1]));
     }
     Ok(stepper.finish(times[samples - 1]))
+}
+
+impl<M: PlatenModel> GridStepper for Stepper<'_, M> {
+    #[inline(always)]
+    fn step(&mut self, n: GridStep) -> Result<()> {
+        Stepper::step(self, n)
+    }
+    #[inline(always)]
+    fn sample(&self, j: usize, t_s: f64) -> Sample {
+        Stepper::sample(self, j, t_s)
+    }
+    #[inline(always)]
+    fn finish(&mut self, t_s: f64) -> RunStats {
+        Stepper::finish(self, t_s)
+    }
 }
 
 /// How a slip interval is split into RK4 sub-steps.

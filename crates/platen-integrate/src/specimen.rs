@@ -46,7 +46,7 @@ use crate::event::{
 };
 use crate::output::{Sample, SampleSink, SpecimenSample};
 use crate::record::ForceRecord;
-use crate::rk4::{Grading, Grid, GridStep, Rk4, MAX_HALVINGS};
+use crate::rk4::{drive, Grading, Grid, GridStep, GridStepper, Rk4, MAX_HALVINGS};
 use crate::run::{check_run, sample_at, EnergyBalance, Kin, RunStats, State};
 use crate::stop::{Failure, StopReason};
 
@@ -105,27 +105,23 @@ fn run<M: PlatenModel, S: SampleSink, const L: usize>(
     sink: &mut S,
 ) -> Result<RunStats> {
     let k = u64::from(rk4.steps_per_sample());
-    let grid = Grid {
-        force: record.force_n(),
-        inv_k: 1.0 / k as f64,
-        h: record.dt_s() / k as f64,
-        t0: record.t_s()[0],
-    };
-    let mut stepper = Stepper::<M, L>::new(model, specimen, grid, initial);
-    let times = record.t_s();
-    if samples == 0 {
-        return Ok(stepper.finish(times[0]));
+    let mut stepper = Stepper::<M, L>::new(model, specimen, Grid::new(record, k), initial);
+    drive(&mut stepper, record.t_s(), k, samples, sink)
+}
+
+impl<M: PlatenModel, const L: usize> GridStepper for Stepper<'_, M, L> {
+    #[inline(always)]
+    fn step(&mut self, n: GridStep) -> Result<()> {
+        Stepper::step(self, n)
     }
-    sink.accept(&stepper.sample(0, times[0]));
-    let mut n = 0u64;
-    for j in 0..samples - 1 {
-        for i in 0..k {
-            stepper.step(GridStep { n, j, i: i as f64 })?;
-            n += 1;
-        }
-        sink.accept(&stepper.sample(j + 1, times[j + 1]));
+    #[inline(always)]
+    fn sample(&self, j: usize, t_s: f64) -> Sample {
+        Stepper::sample(self, j, t_s)
     }
-    Ok(stepper.finish(times[samples - 1]))
+    #[inline(always)]
+    fn finish(&mut self, t_s: f64) -> RunStats {
+        Stepper::finish(self, t_s)
+    }
 }
 
 struct Stepper<'a, M, const L: usize> {
