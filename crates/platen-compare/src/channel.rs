@@ -122,8 +122,12 @@ impl Channel {
             Channel::Velocity => "v_m_s",
             Channel::Force => "force_n",
             Channel::BaseShear => SpecimenColumns::BASE_SHEAR_NAME,
-            Channel::StoreyDisplacement(i) => SpecimenColumns::STOREY_U_NAMES[Self::storey_index(i)],
-            Channel::StoreyAcceleration(i) => SpecimenColumns::STOREY_A_NAMES[Self::storey_index(i)],
+            Channel::StoreyDisplacement(i) => {
+                SpecimenColumns::STOREY_U_NAMES[Self::storey_index(i)]
+            }
+            Channel::StoreyAcceleration(i) => {
+                SpecimenColumns::STOREY_A_NAMES[Self::storey_index(i)]
+            }
         }
     }
 
@@ -207,8 +211,14 @@ mod tests {
     #[test]
     fn storey_channels_name_their_storey() {
         for i in 1..=Specimen::MAX_STOREYS as u8 {
-            assert_eq!(Channel::StoreyDisplacement(i).name(), format!("storey{i}_u_m"));
-            assert_eq!(Channel::StoreyAcceleration(i).name(), format!("storey{i}_a_m_s2"));
+            assert_eq!(
+                Channel::StoreyDisplacement(i).name(),
+                format!("storey{i}_u_m")
+            );
+            assert_eq!(
+                Channel::StoreyAcceleration(i).name(),
+                format!("storey{i}_a_m_s2")
+            );
             assert_eq!(Channel::StoreyDisplacement(i).symbol(), format!("z_{i}"));
             assert!(Channel::StoreyAcceleration(i)
                 .quantity()
@@ -217,7 +227,13 @@ mod tests {
         let names: Vec<_> = Channel::specimen_channels(2).map(Channel::name).collect();
         assert_eq!(
             names,
-            ["base_shear_n", "storey1_u_m", "storey2_u_m", "storey1_a_m_s2", "storey2_a_m_s2"]
+            [
+                "base_shear_n",
+                "storey1_u_m",
+                "storey2_u_m",
+                "storey1_a_m_s2",
+                "storey2_a_m_s2"
+            ]
         );
     }
 }

@@ -194,12 +194,18 @@ impl Comparison {
         // one and the simulated B otherwise.
         let base_shear_n = match series.iter().find(|s| s.0 == Channel::BaseShear) {
             Some((_, rec, _)) => {
-                recorded.sources.dissipative.push_str(", less the recorded base shear B");
+                recorded
+                    .sources
+                    .dissipative
+                    .push_str(", less the recorded base shear B");
                 Some(rec.clone())
             }
             None if scenario.specimen.is_some() => {
                 let b = Channel::BaseShear.of(&sim).unwrap_or_default();
-                recorded.sources.dissipative.push_str(", less the simulated base shear B");
+                recorded
+                    .sources
+                    .dissipative
+                    .push_str(", less the simulated base shear B");
                 recorded.sources.notes.push(format!(
                     "`{}` has no base_shear_n column: the recorded F_D subtracts the simulated \
                      base shear.",

@@ -137,7 +137,9 @@ impl Recording {
                 storeys,
             });
         }
-        Ok(Channel::specimen_channels(storeys).filter(present).collect())
+        Ok(Channel::specimen_channels(storeys)
+            .filter(present)
+            .collect())
     }
 
     /// The specimen's columns this recording has, in report order.

@@ -153,8 +153,18 @@ impl SpecimenColumns {
     /// ```
     pub fn columns(&self) -> Vec<(&'static str, &[f64])> {
         let mut out = vec![(Self::BASE_SHEAR_NAME, self.base_shear_n.as_slice())];
-        out.extend(Self::STOREY_U_NAMES.iter().copied().zip(self.u_m.iter().map(Vec::as_slice)));
-        out.extend(Self::STOREY_A_NAMES.iter().copied().zip(self.a_m_s2.iter().map(Vec::as_slice)));
+        out.extend(
+            Self::STOREY_U_NAMES
+                .iter()
+                .copied()
+                .zip(self.u_m.iter().map(Vec::as_slice)),
+        );
+        out.extend(
+            Self::STOREY_A_NAMES
+                .iter()
+                .copied()
+                .zip(self.a_m_s2.iter().map(Vec::as_slice)),
+        );
         out
     }
 

@@ -158,7 +158,8 @@ impl SampleSink for RunRecorder {
                     .map(|_| Envelope::new(self.span_s, self.expected))
                     .collect();
             }
-            let values = std::iter::once(sp.base_shear_n).chain(sp.drift_m[..sp.storeys].iter().copied());
+            let values =
+                std::iter::once(sp.base_shear_n).chain(sp.drift_m[..sp.storeys].iter().copied());
             for (channel, y) in self.specimen.iter_mut().zip(values) {
                 channel.push(self.samples, s.t_s, y);
             }
@@ -217,7 +218,10 @@ pub fn figures(recorder: RunRecorder, scenario: &Scenario) -> Vec<Figure> {
         .map(|(i, c)| {
             // Base shear in kN, drifts in mm.
             let scale = if i == 0 { 1e-3 } else { 1e3 };
-            c.finish().into_iter().map(|(t, y)| (t, y * scale)).collect()
+            c.finish()
+                .into_iter()
+                .map(|(t, y)| (t, y * scale))
+                .collect()
         })
         .collect();
     let r = Recorded {
@@ -271,7 +275,10 @@ fn specimen_figure(r: &Recorded, scenario: &Scenario) -> Figure {
     let height = if storeys > 3 { 240 } else { 300 } * panels.len() as u32 + 120;
     Figure {
         name: "specimen".into(),
-        title: format!("{}: the specimen's base shear and storey drifts", scenario.name),
+        title: format!(
+            "{}: the specimen's base shear and storey drifts",
+            scenario.name
+        ),
         caption: format!(
             "Base shear B (the force the platen exerts on the specimen, part of the actuator \
              force F_A = F_I + F_E + F_D + B) and the drift d_i = z_i − z_(i−1) of each of the \
