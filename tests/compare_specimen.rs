@@ -385,3 +385,60 @@ fn simulate_plot_of_a_specimen_run_draws_the_base_shear_and_drifts() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(!bare.join("specimen.svg").exists());
 }
+
+/// The figures and the HTML report show the specimen's channels: a time history per channel
+/// (recorded and simulated, two panels and a shared legend), one residual panel per compared
+/// channel, the channels in the report's metrics table, and F_D less B in the dissipative
+/// figure.
+#[test]
+fn the_figures_and_the_report_show_the_specimen_channels() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = simulated_csv(dir.path(), "frame-forward.json");
+    let (plots, html) = (dir.path().join("plots"), dir.path().join("report.html"));
+    let s = ok_json(&platen(&[
+        "compare",
+        &specimen_scenario("frame-forward.json"),
+        "--recorded",
+        csv.to_str().unwrap(),
+        "--plot",
+        plots.to_str().unwrap(),
+        "--report",
+        html.to_str().unwrap(),
+        "--json",
+    ]));
+    let compared = channels(&s);
+    assert_eq!(compared.len(), 7, "{compared:?}");
+    for (name, label) in [
+        ("base_shear_n", "base shear B (kN)"),
+        ("storey2_u_m", "z_2 (m)"),
+        ("storey1_a_m_s2", "a_1 (m/s²)"),
+    ] {
+        let path = plots.join(format!("time-history-{name}.svg"));
+        let c = svg_content(&path);
+        assert_eq!(series_counts(&c), [3, 3], "{name}: {:?}", c.polylines);
+        assert!(c.text.contains(label), "{label} in\n{}", c.text);
+        check_png(&path, &c);
+    }
+    let residual = svg_content(&plots.join("residual.svg"));
+    assert_eq!(series_counts(&residual), [7], "{:?}", residual.polylines);
+    assert!(
+        residual.text.contains("B sim − rec (kN)"),
+        "{}",
+        residual.text
+    );
+    assert!(
+        residual.text.contains("z_2 sim − rec (mm)"),
+        "{}",
+        residual.text
+    );
+    let fd = svg_content(&plots.join("dissipative-force.svg"));
+    assert!(fd.text.contains("F_A − M·a − F_E − B"), "{}", fd.text);
+    let page = fs::read_to_string(&html).unwrap();
+    for name in &compared {
+        assert!(page.contains(&format!("<td><code>{name}</code>")), "{name}");
+        assert!(
+            page.contains(&format!("id=\"time-history-{name}\"")),
+            "{name}"
+        );
+    }
+}
