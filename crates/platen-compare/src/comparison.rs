@@ -92,7 +92,8 @@ pub struct Comparison {
     pub window: Option<Window>,
     /// The lag search bound, s.
     pub max_lag_s: f64,
-    /// The compared channels, in [`Direction::channels`] order.
+    /// The compared channels: the platen's in [`Direction::channels`] order, then the
+    /// specimen's the recording has ([`Channel::specimen_channels`] order).
     pub channels: Vec<ComparedChannel>,
     /// Recorded data (with substitutes where the file lacks a column).
     pub recorded: Quantities,
@@ -100,7 +101,9 @@ pub struct Comparison {
     pub simulated: Quantities,
     /// The recorded force of a forward run (when the file has one), N.
     pub recorded_input_force_n: Option<Vec<f64>>,
-    /// `F_A − F_I − F_E` from the recorded data, N.
+    /// Storeys of the scenario's specimen (0 without one).
+    pub specimen_storeys: usize,
+    /// `F_A − F_I − F_E` from the recorded data (`− B` with a specimen), N.
     pub recorded_dissipative_n: Vec<f64>,
     /// The model's dissipative law `(v, F_D)`, m/s and N.
     pub law: Vec<(f64, f64)>,
@@ -135,8 +138,9 @@ impl Comparison {
     /// names the scenario in messages and in the summary.
     ///
     /// # Errors
-    /// [`CompareError::RecordTooShort`], [`CompareError::TooFewRecordedSamples`] and
-    /// [`CompareError::WindowOutside`] before the run; [`CompareError::Scenario`] if the run
+    /// [`CompareError::RecordTooShort`], [`CompareError::TooFewRecordedSamples`],
+    /// [`CompareError::WindowOutside`] and [`CompareError::StoreyNotInSpecimen`] before the
+    /// run; [`CompareError::Scenario`] if the run
     /// fails; [`CompareError::TooFewSimulatedSamples`], [`CompareError::Align`],
     /// [`CompareError::SampleRate`], [`CompareError::Settings`] and
     /// [`CompareError::Metrics`] after it.
@@ -149,16 +153,73 @@ impl Comparison {
         let direction = Direction::of(scenario);
         let sim_span = scenario.run.time_span_s();
         let range = recording.compared_range(scenario_path, sim_span, settings.window)?;
+        let specimen_channels = recording.specimen_channels(scenario.storeys())?;
         let sim = simulate(scenario, scenario_path)?;
         debug_assert_eq!((sim.t_s[0], sim.t_s[sim.len() - 1]), sim_span);
         let t_s = recording.t_s[range.clone()].to_vec();
         let simulated = aligned(&sim, &t_s)?;
         let rate = SampleRate::new(1.0 / recording.step_s).map_err(CompareError::SampleRate)?;
         let mut recorded = recorded_quantities(&recording, &range, direction, &simulated, rate)?;
-        let channels = compare_channels(direction, &recorded, &simulated, rate, &t_s, settings)?;
+        let mut series: Vec<(Channel, Vec<f64>, Vec<f64>)> = direction
+            .channels()
+            .iter()
+            .map(|&channel| {
+                let (rec, sim) = match channel {
+                    Channel::Displacement => (&recorded.u_m, &simulated.u_m),
+                    Channel::Velocity => (&recorded.v_m_s, &simulated.v_m_s),
+                    _ => (&recorded.force_n, &simulated.force_n),
+                };
+                (channel, rec.clone(), sim.clone())
+            })
+            .collect();
+        for channel in specimen_channels {
+            let rec = recording.column(channel.name(), &range).unwrap_or_default();
+            let sim = interpolate_linear(&sim.t_s, channel.of(&sim).unwrap_or_default(), &t_s)
+                .map_err(CompareError::Align)?;
+            series.push((channel, rec, sim));
+        }
+        if scenario.specimen.is_none() {
+            let unused = recording.specimen_columns();
+            if !unused.is_empty() {
+                recorded.sources.notes.push(format!(
+                    "`{}` has the specimen's columns {}: the scenario has no specimen, so they \
+                     are not compared.",
+                    recording.path.display(),
+                    unused.join(", ")
+                ));
+            }
+        }
+        // With a specimen the actuator force also carries the base shear: the recorded
+        // dissipative force is F_A − F_I − F_E − B, with the recorded B where the file has
+        // one and the simulated B otherwise.
+        let base_shear_n = match series.iter().find(|s| s.0 == Channel::BaseShear) {
+            Some((_, rec, _)) => {
+                recorded
+                    .sources
+                    .dissipative
+                    .push_str(", less the recorded base shear B");
+                Some(rec.clone())
+            }
+            None if scenario.specimen.is_some() => {
+                let b = Channel::BaseShear.of(&sim).unwrap_or_default();
+                recorded
+                    .sources
+                    .dissipative
+                    .push_str(", less the simulated base shear B");
+                recorded.sources.notes.push(format!(
+                    "`{}` has no base_shear_n column: the recorded F_D subtracts the simulated \
+                     base shear.",
+                    recording.path.display()
+                ));
+                Some(interpolate_linear(&sim.t_s, b, &t_s).map_err(CompareError::Align)?)
+            }
+            None => None,
+        };
+        let channels = compare_channels(series, rate, &t_s, settings)?;
+        let b = base_shear_n.as_deref();
         let (recorded_dissipative_n, law, law_label) = match &scenario.model {
-            Model::Identified(m) => dissipative(m, &recorded, "(Eq. 22)"),
-            Model::Full(m) => dissipative(&**m, &recorded, "at u = 0 (Eq. 4)"),
+            Model::Identified(m) => dissipative(m, &recorded, b, "(Eq. 22)"),
+            Model::Full(m) => dissipative(&**m, &recorded, b, "at u = 0 (Eq. 4)"),
         };
         let recorded_input_force_n = match direction {
             Direction::Forward => recording.column("force_n", &range),
@@ -187,6 +248,7 @@ impl Comparison {
             recorded,
             simulated,
             recorded_input_force_n,
+            specimen_storeys: scenario.storeys(),
             recorded_dissipative_n,
             law,
             law_label,
@@ -232,11 +294,9 @@ fn aligned(sim: &Trajectory, t_s: &[f64]) -> Result<Quantities> {
     })
 }
 
-/// The metrics of every channel compared in `direction`.
+/// The metrics of every compared channel, given as (channel, recorded, simulated).
 fn compare_channels(
-    direction: Direction,
-    recorded: &Quantities,
-    simulated: &Quantities,
+    series: Vec<(Channel, Vec<f64>, Vec<f64>)>,
     rate: SampleRate,
     t_s: &[f64],
     settings: &Settings,
@@ -249,19 +309,14 @@ fn compare_channels(
             .map_err(CompareError::Settings)?;
     }
     let mut channels = Vec::new();
-    for &channel in direction.channels() {
-        let (rec, sim) = match channel {
-            Channel::Displacement => (&recorded.u_m, &simulated.u_m),
-            Channel::Velocity => (&recorded.v_m_s, &simulated.v_m_s),
-            Channel::Force => (&recorded.force_n, &simulated.force_n),
-        };
+    for (channel, recorded, simulated) in series {
         let metrics = comparator
-            .compare(rec, sim)
+            .compare(&recorded, &simulated)
             .map_err(|source| CompareError::Metrics { channel, source })?;
         channels.push(ComparedChannel {
             channel,
-            recorded: rec.clone(),
-            simulated: sim.clone(),
+            recorded,
+            simulated,
             metrics,
         });
     }
@@ -363,17 +418,20 @@ fn recorded_quantities(
     })
 }
 
-/// `F_A − F_I − F_E` of the recorded data, and the model's law `sign(v)·D(0, |v|)` over the
-/// recorded velocity range (with the jump at v = 0 drawn as the vertical segment ±F_s).
+/// `F_A − F_I − F_E` of the recorded data (less the base shear `B` of a specimen run), and
+/// the model's law `sign(v)·D(0, |v|)` over the recorded velocity range (with the jump at
+/// v = 0 drawn as the vertical segment ±F_s).
 fn dissipative<M: PlatenModel + ?Sized>(
     model: &M,
     rec: &Quantities,
+    base_shear_n: Option<&[f64]>,
     form: &str,
 ) -> (Vec<f64>, Vec<(f64, f64)>, String) {
     let fd: Vec<f64> = (0..rec.u_m.len())
         .map(|i| {
             let terms = force_terms(model, rec.u_m[i], rec.v_m_s[i], rec.a_m_s2[i]);
-            rec.force_n[i] - terms.inertial_n - terms.elastic_n
+            let b = base_shear_n.map_or(0.0, |b| b[i]);
+            rec.force_n[i] - terms.inertial_n - terms.elastic_n - b
         })
         .collect();
     let (lo, hi) = rec

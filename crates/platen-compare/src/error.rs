@@ -118,6 +118,21 @@ pub enum CompareError {
         source: SignalError,
     },
 
+    /// The recording has a column for a storey the scenario's specimen does not have.
+    #[error(
+        "`{}` has a column `{column}` but the scenario's specimen has {storeys} storey(s): \
+         expected storey columns storey1…storey{storeys} only",
+        recorded.display()
+    )]
+    StoreyNotInSpecimen {
+        /// Recorded file.
+        recorded: PathBuf,
+        /// The column.
+        column: &'static str,
+        /// Storeys of the specimen.
+        storeys: usize,
+    },
+
     /// The metrics of a channel could not be computed.
     #[error("comparing {channel}")]
     Metrics {

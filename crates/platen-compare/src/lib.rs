@@ -5,6 +5,9 @@
 //!   the model) compare the actuator force `force_n` ([`Direction::channels`]). The scenario
 //!   runs as it is, through [`Scenario::run`](platen_scenario::Scenario::run): its own
 //!   excitation drives it (for a test, the recorded force or motion).
+//! * A scenario with a specimen also compares the record's `base_shear_n`, `storey{i}_u_m` and
+//!   `storey{i}_a_m_s2` where it has them ([`Channel::specimen_channels`]); a column for a
+//!   storey the specimen lacks is [`CompareError::StoreyNotInSpecimen`].
 //! * The record is read and checked (uniform sampling, coverage of the scenario's span within
 //!   half a recorded sample interval at each end, the window inside the compared span)
 //!   **before** anything is simulated, so a bad record fails fast.

@@ -9,10 +9,13 @@ use platen_io::csv::Table;
 use platen_scenario::sampling::uniform_step_s;
 
 use crate::error::{CompareError, Result};
-use crate::{Direction, Window};
+use platen_model::Specimen;
+
+use crate::{Channel, Direction, Window};
 
 /// A recorded test read for a comparison: uniformly sampled, with the columns its direction
-/// needs (see [`Direction::record_columns`]) in SI units.
+/// needs (see [`Direction::record_columns`]) and the specimen's columns it has
+/// (`base_shear_n`, `storey{i}_u_m`, `storey{i}_a_m_s2`), in SI units.
 #[derive(Debug)]
 pub struct Recording {
     /// The file it was read from.
@@ -35,7 +38,14 @@ impl Recording {
     /// non-uniform time base.
     pub fn read(path: &Path, direction: Direction, columns: &ColumnMap) -> Result<Self> {
         let (required, optional) = direction.record_columns();
-        let mut table = columns.read_table(path, required, optional)?;
+        // The specimen's columns are read where present: which are compared is decided
+        // against the scenario's specimen (see `Recording::specimen_channels`).
+        let optional: Vec<&str> = optional
+            .iter()
+            .copied()
+            .chain(Channel::specimen_channels(Specimen::MAX_STOREYS).map(Channel::name))
+            .collect();
+        let mut table = columns.read_table(path, required, &optional)?;
         let t_s = table.take_column("t_s").unwrap_or_default();
         let step_s = uniform_step_s(path, &t_s)?;
         Ok(Self {
@@ -99,5 +109,44 @@ impl Recording {
     /// The column `key` on `range`, if the record has it.
     pub(crate) fn column(&self, key: &str, range: &Range<usize>) -> Option<Vec<f64>> {
         self.table.column(key).map(|c| c[range.clone()].to_vec())
+    }
+
+    /// The specimen's channels that this recording has and a specimen of `storeys` storeys
+    /// produces, in report order ([`Channel::specimen_channels`]).
+    ///
+    /// # Errors
+    /// [`CompareError::StoreyNotInSpecimen`] for a storey column of a storey the specimen
+    /// does not have (checked only with a specimen: `storeys > 0`).
+    pub(crate) fn specimen_channels(&self, storeys: usize) -> Result<Vec<Channel>> {
+        if storeys == 0 {
+            return Ok(Vec::new());
+        }
+        let present = |c: &Channel| self.table.has_column(c.name());
+        if let Some(extra) = Channel::specimen_channels(Specimen::MAX_STOREYS)
+            .filter(|c| match c {
+                Channel::StoreyDisplacement(i) | Channel::StoreyAcceleration(i) => {
+                    usize::from(*i) > storeys
+                }
+                _ => false,
+            })
+            .find(present)
+        {
+            return Err(CompareError::StoreyNotInSpecimen {
+                recorded: self.path.clone(),
+                column: extra.name(),
+                storeys,
+            });
+        }
+        Ok(Channel::specimen_channels(storeys)
+            .filter(present)
+            .collect())
+    }
+
+    /// The specimen's columns this recording has, in report order.
+    pub(crate) fn specimen_columns(&self) -> Vec<&'static str> {
+        Channel::specimen_channels(Specimen::MAX_STOREYS)
+            .map(Channel::name)
+            .filter(|name| self.table.has_column(name))
+            .collect()
     }
 }

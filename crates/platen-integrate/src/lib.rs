@@ -56,7 +56,9 @@ pub use error::{IntegrateError, Result};
 pub use event::EventKind;
 pub use inverse::{inverse, inverse_specimen, INVERSE_SPECIMEN_SUBSTEPS};
 pub use method::{ForwardIntegrator, Method};
-pub use output::{Exceedance, Peak, Peaks, Sample, SampleSink, SpecimenSample, Trajectory};
+pub use output::{
+    Exceedance, Peak, Peaks, Sample, SampleSink, SpecimenColumns, SpecimenSample, Trajectory,
+};
 pub use record::{
     derivative, sampling_grid, second_derivative, uniform_interval_s, ForceRecord, Motion,
     SamplingGrid, UNIFORM_RELATIVE_TOLERANCE,

@@ -80,6 +80,110 @@ pub struct Trajectory {
     pub elastic_force_n: Vec<f64>,
     /// Dissipative force `F_D`, N.
     pub dissipative_force_n: Vec<f64>,
+    /// The specimen's columns, for a run with a specimen (`None` otherwise).
+    pub specimen: Option<SpecimenColumns>,
+}
+
+/// Builds `[concat!("storey1", suffix), …, concat!("storey12", suffix)]`.
+macro_rules! storey_names {
+    ($suffix:literal) => {
+        [
+            concat!("storey1", $suffix),
+            concat!("storey2", $suffix),
+            concat!("storey3", $suffix),
+            concat!("storey4", $suffix),
+            concat!("storey5", $suffix),
+            concat!("storey6", $suffix),
+            concat!("storey7", $suffix),
+            concat!("storey8", $suffix),
+            concat!("storey9", $suffix),
+            concat!("storey10", $suffix),
+            concat!("storey11", $suffix),
+            concat!("storey12", $suffix),
+        ]
+    };
+}
+
+/// The specimen's columns of a run kept in memory (see [`SpecimenSample`]), in the order of
+/// the CSV a specimen run writes: `base_shear_n`, `storey{i}_u_m` for every storey, then
+/// `storey{i}_a_m_s2`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SpecimenColumns {
+    /// Base shear `B`, N (the force the platen exerts on the specimen).
+    pub base_shear_n: Vec<f64>,
+    /// Per storey, bottom first: displacement relative to the platen, m.
+    pub u_m: Vec<Vec<f64>>,
+    /// Per storey, bottom first: absolute acceleration, m/s².
+    pub a_m_s2: Vec<Vec<f64>>,
+}
+
+impl SpecimenColumns {
+    /// The name of the base-shear column.
+    pub const BASE_SHEAR_NAME: &'static str = "base_shear_n";
+    /// `storey{i}_u_m` for `i = 1…`[`Specimen::MAX_STOREYS`] (index `i − 1`).
+    pub const STOREY_U_NAMES: [&'static str; Specimen::MAX_STOREYS] = storey_names!("_u_m");
+    /// `storey{i}_a_m_s2` for `i = 1…`[`Specimen::MAX_STOREYS`] (index `i − 1`).
+    pub const STOREY_A_NAMES: [&'static str; Specimen::MAX_STOREYS] = storey_names!("_a_m_s2");
+
+    /// Empty columns for a specimen of `storeys` storeys.
+    pub fn new(storeys: usize) -> Self {
+        Self {
+            base_shear_n: Vec::new(),
+            u_m: vec![Vec::new(); storeys],
+            a_m_s2: vec![Vec::new(); storeys],
+        }
+    }
+
+    /// Number of storeys.
+    pub fn storeys(&self) -> usize {
+        self.u_m.len()
+    }
+
+    /// The column names and columns, in the CSV's order: `base_shear_n`, `storey1_u_m`…,
+    /// `storey1_a_m_s2`….
+    ///
+    /// ```
+    /// use platen_integrate::SpecimenColumns;
+    /// let c = SpecimenColumns::new(2);
+    /// let names: Vec<&str> = c.columns().iter().map(|(name, _)| *name).collect();
+    /// assert_eq!(
+    ///     names,
+    ///     ["base_shear_n", "storey1_u_m", "storey2_u_m", "storey1_a_m_s2", "storey2_a_m_s2"]
+    /// );
+    /// ```
+    pub fn columns(&self) -> Vec<(&'static str, &[f64])> {
+        let mut out = vec![(Self::BASE_SHEAR_NAME, self.base_shear_n.as_slice())];
+        out.extend(
+            Self::STOREY_U_NAMES
+                .iter()
+                .copied()
+                .zip(self.u_m.iter().map(Vec::as_slice)),
+        );
+        out.extend(
+            Self::STOREY_A_NAMES
+                .iter()
+                .copied()
+                .zip(self.a_m_s2.iter().map(Vec::as_slice)),
+        );
+        out
+    }
+
+    /// The column `name`, if it is one of these.
+    pub fn column(&self, name: &str) -> Option<&[f64]> {
+        self.columns()
+            .into_iter()
+            .find_map(|(n, c)| (n == name).then_some(c))
+    }
+
+    fn accept(&mut self, s: &SpecimenSample) {
+        self.base_shear_n.push(s.base_shear_n);
+        for (col, &z) in self.u_m.iter_mut().zip(&s.u_m[..s.storeys]) {
+            col.push(z);
+        }
+        for (col, &a) in self.a_m_s2.iter_mut().zip(&s.a_m_s2[..s.storeys]) {
+            col.push(a);
+        }
+    }
 }
 
 impl Trajectory {
@@ -95,6 +199,7 @@ impl Trajectory {
             inertial_force_n: v(),
             elastic_force_n: v(),
             dissipative_force_n: v(),
+            specimen: None,
         }
     }
 
@@ -137,7 +242,8 @@ impl Trajectory {
 
 impl Trajectory {
     /// The columns in the order of [`Trajectory::COLUMN_NAMES`], moved out (no copy): for a
-    /// front end that hands them on, as Python's NumPy arrays.
+    /// front end that hands them on, as Python's NumPy arrays. The specimen's columns
+    /// ([`Trajectory::specimen`]) are not among them.
     ///
     /// ```
     /// use platen_integrate::Trajectory;
@@ -170,6 +276,11 @@ impl SampleSink for Trajectory {
         self.inertial_force_n.push(s.terms.inertial_n);
         self.elastic_force_n.push(s.terms.elastic_n);
         self.dissipative_force_n.push(s.terms.dissipative_n);
+        if let Some(sp) = &s.specimen {
+            self.specimen
+                .get_or_insert_with(|| SpecimenColumns::new(sp.storeys))
+                .accept(sp);
+        }
     }
 }
 

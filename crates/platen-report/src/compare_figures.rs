@@ -204,7 +204,11 @@ fn residuals(ctx: &Context<'_>) -> Figure {
         panels: c.channels.iter().map(panel).collect(),
         columns: 1,
         rows: Vec::new(),
-        size: (1200, 420 * c.channels.len() as u32 + 60),
+        // Shorter panels when a specimen adds channels, so that 12 storeys stay drawable.
+        size: (
+            1200,
+            if c.channels.len() > 3 { 300 } else { 420 } * c.channels.len() as u32 + 60,
+        ),
     }
 }
 
@@ -282,11 +286,16 @@ fn dissipative_force(c: &Comparison) -> Figure {
         MAX_SCATTER_POINTS,
     );
     let law: Vec<(f64, f64)> = c.law.iter().map(|&(v, f)| (v, f * 1e-3)).collect();
+    let recorded_fd = if c.specimen_storeys > 0 {
+        "F_A − M·a − F_E − B"
+    } else {
+        "F_A − M·a − F_E"
+    };
     Figure {
         name: "dissipative-force".into(),
         title: "Dissipative force against velocity".into(),
         caption: format!(
-            "F_D = F_A − M·a − F_E from the recorded data ({}{}), with the model's law {} \
+            "F_D = {recorded_fd} from the recorded data ({}{}), with the model's law {} \
              (as the paper's Figs 7 and 10).",
             c.recorded.sources.dissipative,
             if k > 1 {
@@ -301,7 +310,7 @@ fn dissipative_force(c: &Comparison) -> Figure {
             "velocity v (m/s)",
             "dissipative force F_D (kN)",
             vec![
-                points("recorded: F_A − M·a − F_E", recorded, RECORDED, 2),
+                points(format!("recorded: {recorded_fd}"), recorded, RECORDED, 2),
                 line(format!("model law {}", c.law_label), law, MODEL, 3),
             ],
         )],

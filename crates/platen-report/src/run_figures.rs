@@ -1,6 +1,7 @@
 //! The figures of a run without a recording (`platen simulate SCENARIO --plot DIR`): the
 //! motion and the actuator force over time, the force decomposition over time, and the
-//! hysteresis loops (actuator force against displacement, velocity and acceleration).
+//! hysteresis loops (actuator force against displacement, velocity and acceleration), and for
+//! a run with a specimen its base shear and storey drifts over time.
 //!
 //! A [`RunRecorder`] is a [`SampleSink`] that keeps, while the run goes, only what the
 //! figures draw: per channel the smallest and largest sample of each of [`BUCKETS`] equal
@@ -103,6 +104,12 @@ pub struct RunRecorder {
     stride: usize,
     /// Samples seen.
     samples: usize,
+    /// The run's span and sample count, for the specimen's envelopes.
+    span_s: (f64, f64),
+    expected: usize,
+    /// Envelopes of the base shear (N) and of each storey's drift (m), for a run with a
+    /// specimen (made at its first sample).
+    specimen: Vec<Envelope>,
 }
 
 impl RunRecorder {
@@ -123,6 +130,9 @@ impl RunRecorder {
             loops: Vec::with_capacity(samples.div_ceil(stride)),
             stride,
             samples: 0,
+            span_s,
+            expected: samples,
+            specimen: Vec::new(),
         }
     }
 }
@@ -142,6 +152,18 @@ impl SampleSink for RunRecorder {
         for (channel, y) in self.channels.iter_mut().zip(values) {
             channel.push(self.samples, s.t_s, y);
         }
+        if let Some(sp) = &s.specimen {
+            if self.specimen.is_empty() {
+                self.specimen = (0..=sp.storeys)
+                    .map(|_| Envelope::new(self.span_s, self.expected))
+                    .collect();
+            }
+            let values =
+                std::iter::once(sp.base_shear_n).chain(sp.drift_m[..sp.storeys].iter().copied());
+            for (channel, y) in self.specimen.iter_mut().zip(values) {
+                channel.push(self.samples, s.t_s, y);
+            }
+        }
         if self.samples % self.stride == 0 {
             self.loops
                 .push([s.u_m, s.v_m_s, s.a_m_s2, terms.actuator_n]);
@@ -157,6 +179,8 @@ struct Recorded {
     loops: Vec<[f64; 4]>,
     stride: usize,
     samples: usize,
+    /// Base shear (kN) and storey drifts (mm), for a run with a specimen.
+    specimen: Vec<Points>,
 }
 
 /// A channel of a run: name, symbol, unit, display scale, its limit (SI) if the table has one.
@@ -187,20 +211,86 @@ pub fn figures(recorder: RunRecorder, scenario: &Scenario) -> Vec<Figure> {
             points
         })
         .collect();
+    let specimen = recorder
+        .specimen
+        .into_iter()
+        .enumerate()
+        .map(|(i, c)| {
+            // Base shear in kN, drifts in mm.
+            let scale = if i == 0 { 1e-3 } else { 1e3 };
+            c.finish()
+                .into_iter()
+                .map(|(t, y)| (t, y * scale))
+                .collect()
+        })
+        .collect();
     let r = Recorded {
         channels,
         loops: recorder.loops,
         stride,
         samples,
+        specimen,
     };
     if r.samples == 0 {
         return Vec::new();
     }
-    vec![
+    let mut out = vec![
         motion(&r, scenario),
         decomposition(&r, scenario),
         hysteresis(&r, scenario),
-    ]
+    ];
+    if !r.specimen.is_empty() {
+        out.push(specimen_figure(&r, scenario));
+    }
+    out
+}
+
+/// The specimen's base shear and storey drifts over time (a run with a specimen).
+fn specimen_figure(r: &Recorded, scenario: &Scenario) -> Figure {
+    let storeys = r.specimen.len() - 1;
+    let panels: Vec<Panel> = r
+        .specimen
+        .iter()
+        .enumerate()
+        .map(|(i, points)| {
+            let (quantity, symbol, unit) = if i == 0 {
+                ("base shear".to_string(), "B".to_string(), "kN")
+            } else {
+                (format!("storey {i} drift"), format!("d_{i}"), "mm")
+            };
+            Panel {
+                x_range: Some(span(points)),
+                ..Panel::new(
+                    format!(
+                        "{quantity} {symbol}: peak |{symbol}| {} {unit}",
+                        significant(peak_magnitude(points), 4)
+                    ),
+                    "time t (s)",
+                    format!("{symbol} ({unit})"),
+                    vec![line("", points.clone(), SIMULATED, 1)],
+                )
+            }
+        })
+        .collect();
+    let height = if storeys > 3 { 240 } else { 300 } * panels.len() as u32 + 120;
+    Figure {
+        name: "specimen".into(),
+        title: format!(
+            "{}: the specimen's base shear and storey drifts",
+            scenario.name
+        ),
+        caption: format!(
+            "Base shear B (the force the platen exerts on the specimen, part of the actuator \
+             force F_A = F_I + F_E + F_D + B) and the drift d_i = z_i − z_(i−1) of each of the \
+             {storeys} storey(s) over time ({} samples; the smallest and largest sample of each \
+             of {BUCKETS} equal time intervals).",
+            r.samples
+        ),
+        panels,
+        columns: 1,
+        rows: Vec::new(),
+        size: (1200, height),
+    }
 }
 
 /// The largest magnitude of the points' values.

@@ -20,7 +20,8 @@ pub struct DisplayUnits {
     pub residual_unit: &'static str,
 }
 
-/// The display units of `channel`: m and mm, m/s and mm/s, kN and kN.
+/// The display units of `channel`: m and mm (platen and storey displacements), m/s and mm/s,
+/// kN and kN (actuator force, base shear), m/s² and m/s² (storey accelerations).
 pub fn display_units(channel: Channel) -> DisplayUnits {
     match channel {
         Channel::Displacement => DisplayUnits {
@@ -35,11 +36,23 @@ pub fn display_units(channel: Channel) -> DisplayUnits {
             residual_scale: 1e3,
             residual_unit: "mm/s",
         },
-        Channel::Force => DisplayUnits {
+        Channel::Force | Channel::BaseShear => DisplayUnits {
             scale: 1e-3,
             unit: "kN",
             residual_scale: 1e-3,
             residual_unit: "kN",
+        },
+        Channel::StoreyDisplacement(_) => DisplayUnits {
+            scale: 1.0,
+            unit: "m",
+            residual_scale: 1e3,
+            residual_unit: "mm",
+        },
+        Channel::StoreyAcceleration(_) => DisplayUnits {
+            scale: 1.0,
+            unit: "m/s²",
+            residual_scale: 1.0,
+            residual_unit: "m/s²",
         },
     }
 }

@@ -322,15 +322,23 @@ pub struct RunResult {
 
 impl RunResult {
     /// The names of the output columns, in CSV order (`t_s`, `u_m`, `v_m_s`, `a_m_s2`,
-    /// `force_n`, `inertial_force_n`, `elastic_force_n`, `dissipative_force_n`).
-    pub fn columns(&self) -> &'static [&'static str] {
-        &Trajectory::COLUMN_NAMES
+    /// `force_n`, `inertial_force_n`, `elastic_force_n`, `dissipative_force_n`; a run with a
+    /// specimen adds `base_shear_n`, `storey{i}_u_m`…, `storey{i}_a_m_s2`…).
+    pub fn columns(&self) -> Vec<&'static str> {
+        let mut names = Trajectory::COLUMN_NAMES.to_vec();
+        if let Some(sp) = &self.trajectory.specimen {
+            names.extend(sp.columns().into_iter().map(|(name, _)| name));
+        }
+        names
     }
 
-    /// The output column `name` (SI units), or `None` for a name that is not a column.
+    /// The output column `name` (SI units), or `None` for a name that is not a column
+    /// (the specimen's columns are found in a run with a specimen).
     pub fn column(&self, name: &str) -> Option<&[f64]> {
-        let j = Trajectory::COLUMN_NAMES.iter().position(|c| *c == name)?;
-        Some(self.trajectory.columns()[j])
+        match Trajectory::COLUMN_NAMES.iter().position(|c| *c == name) {
+            Some(j) => Some(self.trajectory.columns()[j]),
+            None => self.trajectory.specimen.as_ref()?.column(name),
+        }
     }
 }
 
