@@ -239,12 +239,20 @@ def _model_spec(model: Union[None, str, Mapping], origin: str) -> Dict[str, Any]
     )
 
 
-def _no_specimen(specimen: Any, origin: str) -> None:
-    if specimen is not None:
-        raise ScenarioError(
-            f"`{origin}`: specimen: a specimen on the platen (table–structure interaction) is not "
-            "supported yet by this version of platen; give specimen=None to run the bare platen"
-        )
+def _specimen_spec(specimen: Any, origin: str) -> Optional[Dict[str, Any]]:
+    """The scenario format's ``specimen`` object from ``specimen=``: ``None``, the object
+    itself (``{"storeys": [...]}``) or the list of storeys, bottom first."""
+    if specimen is None:
+        return None
+    if isinstance(specimen, Mapping):
+        return dict(specimen)
+    if isinstance(specimen, (list, tuple)):
+        return {"storeys": [dict(s) if isinstance(s, Mapping) else s for s in specimen]}
+    raise ScenarioError(
+        f"`{origin}`: specimen = {type(specimen).__name__}: expected None, "
+        '{"storeys": [{"mass_kg": …, "stiffness_n_per_m": …, "damping_n_s_per_m": …}, …]} '
+        "or the list of storeys, bottom first"
+    )
 
 
 def _settings(name: str, model: Any, origin: str, **rest: Any) -> str:
@@ -266,7 +274,8 @@ class Run:
     ``run["u_m"]`` is one output column as a 1-D NumPy float64 array (SI units, one value
     per input sample); ``run.columns`` names them in CSV order (``t_s``, ``u_m``, ``v_m_s``,
     ``a_m_s2``, ``force_n``, ``inertial_force_n``, ``elastic_force_n``,
-    ``dissipative_force_n``); ``run.summary`` is the dict ``platen simulate --json`` prints
+    ``dissipative_force_n``, then with a specimen ``base_shear_n``, ``storey{i}_u_m``,
+    ``storey{i}_a_m_s2``); ``run.summary`` is the dict ``platen simulate --json`` prints
     (peaks and their times, stick-slip counts, solver statistics, energy balance, limits).
     ``len(run)`` is the number of samples; ``run.to_pandas()`` makes a DataFrame.
     """
@@ -366,7 +375,11 @@ def forward(
     * ``integrator``: ``{"method": "rk4", "step_s": Δt/k}`` (default: RK4 at the sample
       interval) or ``{"method": "dopri5", "rtol": 1e-8, "atol": 1e-11}``.
     * ``initial``: ``{"u_m": …, "v_m_s": …}``, m and m/s (default: at rest at 0).
-    * ``specimen``: not supported yet: anything but ``None`` raises :class:`ScenarioError`.
+    * ``specimen``: a shear building on the platen, bottom storey first: the scenario
+      format's ``{"storeys": [{"mass_kg", "stiffness_n_per_m", "damping_n_s_per_m"}, …]}``
+      or just the list of storeys. Its base shear enters the platen's equation and the run
+      gains the columns ``base_shear_n``, ``storey{i}_u_m``, ``storey{i}_a_m_s2``
+      (``docs/specimen.md``). RK4 only.
     * ``duration_s`` (s, default the record's span), ``lowpass_hz`` (Hz) and
       ``lowpass_filter`` (``"brickwall"``, ``"fir"``, ``"butterworth"``): as in a scenario.
 
@@ -374,7 +387,6 @@ def forward(
     :class:`Run` with one sample per input sample.
     """
     origin = "platen.forward()"
-    _no_specimen(specimen, origin)
     t = _array(t_s, "t_s", origin)
     f = _array(force_n, "force_n", origin)
     text = _settings(
@@ -383,6 +395,7 @@ def forward(
         origin,
         integrator=integrator,
         initial=initial,
+        specimen=_specimen_spec(specimen, origin),
         duration_s=duration_s,
         lowpass_hz=lowpass_hz,
         lowpass_filter=lowpass_filter,
@@ -407,18 +420,20 @@ def inverse(
     * ``u_m``: displacement, m; ``v_m_s`` (m/s) and ``a_m_s2`` (m/s²) where known — a
       missing one is derived from the displacement by second-order finite differences.
     * ``model``: as for :func:`forward`.
-    * ``specimen``: not supported yet: anything but ``None`` raises :class:`ScenarioError`.
+    * ``specimen``: as for :func:`forward`; the prescribed motion drives it and the force
+      adds its base shear.
 
     Returns a :class:`Run`: ``force_n`` = ``inertial_force_n`` + ``elastic_force_n`` +
-    ``dissipative_force_n``.
+    ``dissipative_force_n`` (+ ``base_shear_n`` with a specimen).
     """
     origin = "platen.inverse()"
-    _no_specimen(specimen, origin)
     t = _array(t_s, "t_s", origin)
     u = _array(u_m, "u_m", origin)
     v = None if v_m_s is None else _array(v_m_s, "v_m_s", origin)
     a = None if a_m_s2 is None else _array(a_m_s2, "a_m_s2", origin)
-    text = _settings(name, model, origin, duration_s=duration_s)
+    text = _settings(
+        name, model, origin, specimen=_specimen_spec(specimen, origin), duration_s=duration_s
+    )
     return _run(_native(_platen.inverse, text, origin, t, u, v, a))
 
 

@@ -17,6 +17,8 @@ SHIPPED = [
     "full-model-large-stroke.json",
     "s9-sine-motion.json",
     "sr9/sr9-forward.json",
+    "specimen/frame-forward.json",
+    "specimen/frame-inverse.json",
 ]
 
 
@@ -175,3 +177,30 @@ def test_identify_gives_the_clis_json(cli, cli_json, tmp_path):
     assert result == expected
     assert abs(result["effective_mass_kg"] / 144e3 - 1) < 0.01
     assert abs(result["stiffness_n_per_m"] / 1.266e6 - 1) < 0.01
+
+
+def test_forward_and_inverse_with_a_specimen_give_the_scenarios_run():
+    """``specimen=`` on arrays runs exactly as the shipped specimen scenarios, with the
+    specimen's columns after the contract's."""
+    path = SCENARIOS / "specimen" / "frame-forward.json"
+    scenario = json.loads(path.read_text())
+    from_file = platen.simulate(path)
+    assert from_file.columns[8:] == (
+        "base_shear_n", "storey1_u_m", "storey2_u_m", "storey1_a_m_s2", "storey2_a_m_s2"
+    )
+    exc = scenario["excitation"]["sine_force"]
+    t = from_file["t_s"]
+    force = from_file["force_n"]
+    run = platen.forward(
+        t, force, integrator=scenario["integrator"], specimen=scenario["specimen"]["storeys"]
+    )
+    assert run.columns == from_file.columns
+    for column in run.columns:
+        assert np.array_equal(run[column], from_file[column]), column
+    assert exc["amplitude_n"] == pytest.approx(np.max(np.abs(force)))
+    inv = platen.inverse(
+        run["t_s"], run["u_m"], run["v_m_s"], run["a_m_s2"], specimen=scenario["specimen"]
+    )
+    # The inverse's force is Eq. 23 plus the base shear of the specimen it drives.
+    parts = inv["inertial_force_n"] + inv["elastic_force_n"] + inv["dissipative_force_n"]
+    assert np.allclose(inv["force_n"], parts + inv["base_shear_n"], rtol=0, atol=1e-6)

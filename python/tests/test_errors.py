@@ -135,13 +135,15 @@ def test_settings_errors_name_the_argument():
         platen.forward(t, f, model=3)
 
 
-def test_a_specimen_is_refused_until_platen_supports_one():
+def test_a_bad_specimen_is_refused_naming_the_storey():
     t = np.arange(0, 1025) / 1024
-    storeys = {"storeys": [{"mass_kg": 30e3, "stiffness_n_per_m": 5e7, "damping_n_s_per_m": 1e5}]}
-    with pytest.raises(platen.ScenarioError, match="specimen: a specimen on the platen .* is not supported yet"):
-        platen.forward(t, np.sin(t), specimen=storeys)
-    with pytest.raises(platen.ScenarioError, match="specimen: .* not supported yet"):
-        platen.inverse(t, 0.01 * np.sin(t), specimen=storeys)
+    with pytest.raises(platen.ScenarioError, match=r"specimen = int: expected None"):
+        platen.forward(t, np.sin(t), specimen=3)
+    storeys = [{"mass_kg": -30e3, "stiffness_n_per_m": 5e7, "damping_n_s_per_m": 1e5}]
+    with pytest.raises(platen.ScenarioError, match=r"specimen.storeys\[0\].mass_kg = -30000"):
+        platen.forward(t, 1e4 * np.sin(t), specimen=storeys)
+    with pytest.raises(platen.ScenarioError, match=r"specimen.storeys\[0\].mass_kg"):
+        platen.inverse(t, 0.01 * np.sin(t), specimen={"storeys": storeys})
 
 
 def test_model_errors(cli):

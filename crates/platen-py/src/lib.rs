@@ -22,7 +22,7 @@ use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 
 use platen_compare::{Comparison, Direction, Recording, Settings, Window};
-use platen_integrate::Trajectory;
+use platen_integrate::{SpecimenColumns, Trajectory};
 use platen_io::columns::ColumnMap;
 use platen_model::{IdentifiedKey, PhysicalKey, Preset};
 use platen_scenario::sweep::{csv_text, json_summary, SetAxis, Sweep};
@@ -75,11 +75,26 @@ fn run_scenario(scenario: &Scenario, path: &Path) -> Result<(Trajectory, String)
     Ok((trajectory, json_text(&summary)?))
 }
 
-/// The trajectory's columns as NumPy arrays that take over its vectors.
-fn to_python(py: Python<'_>, (trajectory, summary): (Trajectory, String)) -> RunParts<'_> {
-    let columns = trajectory.into_columns();
-    let arrays = columns.into_iter().map(|c| c.into_pyarray(py)).collect();
-    (Trajectory::COLUMN_NAMES.to_vec(), arrays, summary)
+/// The trajectory's columns as NumPy arrays that take over its vectors, the specimen's after
+/// the contract's (the CSV's order).
+fn to_python(py: Python<'_>, (mut trajectory, summary): (Trajectory, String)) -> RunParts<'_> {
+    let specimen = trajectory.specimen.take();
+    let mut names = Trajectory::COLUMN_NAMES.to_vec();
+    let mut arrays: Vec<_> = trajectory
+        .into_columns()
+        .into_iter()
+        .map(|c| c.into_pyarray(py))
+        .collect();
+    if let Some(sp) = specimen {
+        let n = sp.storeys();
+        names.push(SpecimenColumns::BASE_SHEAR_NAME);
+        names.extend(&SpecimenColumns::STOREY_U_NAMES[..n]);
+        names.extend(&SpecimenColumns::STOREY_A_NAMES[..n]);
+        arrays.push(sp.base_shear_n.into_pyarray(py));
+        arrays.extend(sp.u_m.into_iter().map(|c| c.into_pyarray(py)));
+        arrays.extend(sp.a_m_s2.into_iter().map(|c| c.into_pyarray(py)));
+    }
+    (names, arrays, summary)
 }
 
 /// Runs a scenario file or a scenario dict's JSON text: `platen.simulate`.
