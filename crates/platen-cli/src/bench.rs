@@ -507,6 +507,11 @@ fn clear(t: &mut Trajectory) {
     ] {
         column.clear();
     }
+    // A specimen run's columns too (kept, with their buffers, for the next specimen run).
+    if let Some(sp) = &mut t.specimen {
+        sp.base_shear_n.clear();
+        sp.u_m.iter_mut().chain(&mut sp.a_m_s2).for_each(Vec::clear);
+    }
 }
 
 /// `--seconds`: a finite number of simulated seconds, at least 2/1024 and at most 1e6.

@@ -233,7 +233,7 @@ impl Specimen {
     /// The relative storey accelerations `z̈ᵢ` under platen acceleration `a`, written into
     /// `out[..n]`, from the relative displacements `z[..n]` and velocities `zd[..n]`; returns
     /// the power `Σcᵢḋᵢ² ≥ 0` dissipated by the storey dampers, W.
-    #[inline]
+    #[inline(always)]
     pub fn storey_accelerations(&self, a_m_s2: f64, z: &[f64], zd: &[f64], out: &mut [f64]) -> f64 {
         let n = self.len();
         let (storeys, z, zd, out) = (&self.storeys[..n], &z[..n], &zd[..n], &mut out[..n]);
