@@ -26,7 +26,7 @@ run() {
   set -e
 }
 
-records=$(ls scenarios/*.json scenarios/sr9/*.json scenarios/paper-tests/*/*.json)
+records=$(ls scenarios/*.json scenarios/sr9/*.json scenarios/specimen/*.json scenarios/paper-tests/*/*.json)
 for s in $records; do
   if grep -q '"ground_motion"\|elcentro' "$s" && [ -z "${PLATEN_RECORDS_DIR:-}" ]; then
     continue
