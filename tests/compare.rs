@@ -4,7 +4,7 @@
 
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use platen_integrate::{inverse, Trajectory};
 use platen_io::csv::write_csv_atomic;
@@ -15,13 +15,7 @@ use serde_json::Value;
 
 mod common;
 use common::{check_png, folder_bytes, series_counts, svg_content};
-
-fn platen(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_platen"))
-        .args(args)
-        .output()
-        .expect("run platen")
-}
+use common::{platen, stderr};
 
 fn workspace() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -41,10 +35,6 @@ fn sr9_forward() -> String {
 
 fn sr9_recorded() -> String {
     shipped("sr9/sr9-recorded.csv")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
 fn ok_json(o: &Output) -> Value {

@@ -5,7 +5,7 @@
 
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use platen_compare::{Comparison, Settings};
 use platen_io::csv::{read_table, write_csv_atomic};
@@ -13,13 +13,7 @@ use serde_json::Value;
 
 mod common;
 use common::{check_png, series_counts, svg_content};
-
-fn platen(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_platen"))
-        .args(args)
-        .output()
-        .expect("run platen")
-}
+use common::{platen, stderr};
 
 fn specimen_scenario(name: &str) -> String {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -27,10 +21,6 @@ fn specimen_scenario(name: &str) -> String {
         .join(name)
         .display()
         .to_string()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
 fn ok_json(o: &Output) -> Value {

@@ -2,21 +2,9 @@
 //! recorded` from scenarios with a table that is not the paper's, identified back.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 use std::sync::OnceLock;
 
 use serde_json::{json, Value};
-
-fn platen(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_platen"))
-        .args(args)
-        .output()
-        .expect("run platen")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
 
 fn workspace() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -330,6 +318,7 @@ fn a_negative_pressure_is_a_usage_error() {
 
 mod common;
 use common::{check_png, svg_content};
+use common::{platen, stderr};
 
 /// Series colours of the identification figures (`platen_report::identify_figures`): the
 /// first pressure group, flagged tests, the final fit, the paper's Eq. 21 fit.

@@ -2,21 +2,13 @@
 //! every `±` is one standard error of the value it follows, in the summary and in the tables.
 
 use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::process::Output;
 use std::sync::OnceLock;
 
 use serde_json::{json, Value};
 
-fn platen(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_platen"))
-        .args(args)
-        .output()
-        .expect("run platen")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+mod common;
+use common::{platen, stderr};
 
 /// One generated test: its file, its pressure and the amplitude its scenario asks for.
 struct Test {

@@ -8,20 +8,12 @@
 //! (`crates/platen-ident/tests/paper.rs`), which states why each is what it is.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use serde_json::Value;
 
-fn platen(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_platen"))
-        .args(args)
-        .output()
-        .expect("run platen")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+mod common;
+use common::{platen, stderr};
 
 fn paper_tests() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/paper-tests")

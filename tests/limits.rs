@@ -1,16 +1,12 @@
 //! A scenario states its own table's limits (`limits`, laid over the preset's), and a model
 //! whose values are overridden is named as such.
 
-use std::process::{Command, Output};
+use std::process::Output;
 
 use serde_json::Value;
 
-fn platen(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_platen"))
-        .args(args)
-        .output()
-        .expect("run platen")
-}
+mod common;
+use common::platen;
 
 fn stdout(o: &Output) -> String {
     assert_eq!(

@@ -1,15 +1,11 @@
 //! What a person reads: `platen model`'s grouped text, the verbs' help.
 
-use std::process::{Command, Output};
+use std::process::Output;
 
 use platen_model::Preset;
 
-fn platen(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_platen"))
-        .args(args)
-        .output()
-        .unwrap()
-}
+mod common;
+use common::platen;
 
 fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()

@@ -5,16 +5,12 @@
 //! (`platen_integrate::sampling_grid`).
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
 use serde_json::Value;
 
-fn platen(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_platen"))
-        .args(args)
-        .output()
-        .expect("run platen")
-}
+mod common;
+use common::platen;
 
 fn ok(o: Output) -> Output {
     assert_eq!(

@@ -1,10 +1,24 @@
-//! Helpers shared by the CLI's figure tests: read an SVG as XML and tally its series.
+//! Helpers shared by the CLI's tests: run the binary, read an SVG as XML and tally its series.
 
 #![allow(dead_code)]
 
 use std::collections::BTreeMap;
 use std::fs;
 use std::path::Path;
+use std::process::{Command, Output};
+
+/// Runs the `platen` binary this test run built with `args`.
+pub fn platen(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_platen"))
+        .args(args)
+        .output()
+        .expect("run platen")
+}
+
+/// A run's standard error as text.
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
 
 /// What one SVG holds: polylines by stroke colour, circles by fill colour, all text.
 pub struct SvgContent {
