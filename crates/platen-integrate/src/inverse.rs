@@ -40,6 +40,7 @@ pub fn inverse<M: PlatenModel, S: SampleSink>(model: &M, motion: &Motion, sink: 
             terms,
             stuck: at_rest || (v[i] == 0.0 && a[i] == 0.0),
             specimen: None,
+            system: None,
         });
     }
 }
@@ -162,6 +163,7 @@ pub fn inverse_specimen<M: PlatenModel, S: SampleSink>(
             terms,
             stuck: at_rest || (v[i] == 0.0 && a[i] == 0.0),
             specimen: Some(spec),
+            system: None,
         });
     }
 }

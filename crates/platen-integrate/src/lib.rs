@@ -6,6 +6,8 @@
 //! * [`forward_dopri5`]: the same with the adaptive Dormand–Prince 5(4) of `ode_solvers`.
 //! * [`ForwardIntegrator`] and [`Method`]: one entry point for both, as a scenario selects it.
 //! * [`inverse`]: a prescribed motion → the actuator force it needs and its decomposition.
+//! * [`forward_closed_loop`]: a displacement command → the table system's controller, valves
+//!   and actuators ([`platen_system::TableSystem`]) → the platen, in closed loop.
 //!
 //! Both forward integrators share one event module (the friction modes, the `v = 0` root
 //! finder, the stick decision and the exact breakaway; the [`EventKind`]s it counts in
@@ -50,6 +52,7 @@ mod rk4;
 mod run;
 mod specimen;
 mod stop;
+mod system;
 
 pub use dopri5::{forward_dopri5, Dopri5Settings};
 pub use error::{IntegrateError, Result};
@@ -57,7 +60,8 @@ pub use event::EventKind;
 pub use inverse::{inverse, inverse_specimen, INVERSE_SPECIMEN_SUBSTEPS};
 pub use method::{ForwardIntegrator, Method};
 pub use output::{
-    Exceedance, Peak, Peaks, Sample, SampleSink, SpecimenColumns, SpecimenSample, Trajectory,
+    Exceedance, Peak, Peaks, Sample, SampleSink, SpecimenColumns, SpecimenSample, SystemSample,
+    Trajectory,
 };
 pub use record::{
     derivative, sampling_grid, second_derivative, uniform_interval_s, ForceRecord, Motion,
@@ -67,3 +71,4 @@ pub use rk4::{forward_rk4, Rk4};
 pub use run::{EnergyBalance, RunStats, State};
 pub use specimen::forward_rk4_specimen;
 pub use stop::{AdaptiveFailure, Failure, StopReason};
+pub use system::{forward_closed_loop, LoopMethod, LoopRun, LoopStats};

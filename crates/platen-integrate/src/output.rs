@@ -22,6 +22,30 @@ pub struct Sample {
     pub stuck: bool,
     /// The specimen's channels, for a run with a specimen.
     pub specimen: Option<SpecimenSample>,
+    /// The table system's channels, for a closed-loop run.
+    pub system: Option<SystemSample>,
+}
+
+/// The table system's channels at one output time (a closed-loop run, see
+/// [`crate::forward_closed_loop`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SystemSample {
+    /// The displacement command `u_ref`, m.
+    pub command_u_m: f64,
+    /// The drive the controller holds (`|d| ≤ 1`).
+    pub drive: f64,
+    /// The spool opening the valves' flow sees (clamped to `±1`).
+    pub spool_opening: f64,
+    /// Pressure difference `p_a − p_b`, Pa.
+    pub delta_p_pa: f64,
+    /// Cap-side chamber pressure (absolute), Pa.
+    pub p_a_pa: f64,
+    /// Rod-side chamber pressure (absolute), Pa.
+    pub p_b_pa: f64,
+    /// Flow of all valves into the cap-side chambers, m³/s (negative: out of them).
+    pub flow_m3_s: f64,
+    /// Supply pressure, Pa.
+    pub supply_pressure_pa: f64,
 }
 
 /// The specimen's channels at one output time (see [`platen_model::Specimen`]).

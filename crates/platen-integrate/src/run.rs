@@ -224,5 +224,6 @@ pub(crate) fn sample_at<M: PlatenModel>(
         },
         stuck,
         specimen: None,
+        system: None,
     }
 }

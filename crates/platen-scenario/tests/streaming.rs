@@ -26,6 +26,7 @@ fn sample(index: usize, u_m: f64) -> Sample {
         terms: ForceTerms::default(),
         stuck: true,
         specimen: None,
+        system: None,
     }
 }
 

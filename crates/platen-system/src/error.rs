@@ -1,0 +1,54 @@
+//! Why a table system was rejected.
+
+/// A rejected table-system parameter, named by its path inside `table_system`.
+#[non_exhaustive]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SystemError {
+    /// A value that is non-finite or outside its physical range.
+    #[error("`{path}` = {value} is invalid: expected {expected}")]
+    Invalid {
+        /// Path of the value inside `table_system` (`actuator.cap_side_area_m2`).
+        path: &'static str,
+        /// The rejected value.
+        value: f64,
+        /// What a valid value looks like.
+        expected: String,
+    },
+    /// An unknown preset name.
+    #[error("unknown table-system preset `{name}`: expected one of {known}")]
+    UnknownPreset {
+        /// The name that was asked for.
+        name: String,
+        /// The names that exist.
+        known: &'static str,
+    },
+}
+
+/// Result alias of this crate.
+pub type Result<T, E = SystemError> = std::result::Result<T, E>;
+
+pub(crate) fn invalid(path: &'static str, value: f64, expected: impl Into<String>) -> SystemError {
+    SystemError::Invalid {
+        path,
+        value,
+        expected: expected.into(),
+    }
+}
+
+/// `value` finite and `> 0`.
+pub(crate) fn positive(path: &'static str, value: f64) -> Result<()> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(invalid(path, value, "a finite number > 0"))
+    }
+}
+
+/// `value` finite and `≥ 0`.
+pub(crate) fn non_negative(path: &'static str, value: f64) -> Result<()> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(())
+    } else {
+        Err(invalid(path, value, "a finite number ≥ 0"))
+    }
+}

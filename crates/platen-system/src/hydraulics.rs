@@ -1,0 +1,163 @@
+//! The continuous part of the loop: spool, valve flows, chambers, supply.
+
+use crate::params::{Supply, TableSystem};
+
+/// Below this fraction of the rated drop the orifice law turns laminar (linear in the drop)
+/// so that its slope stays finite at zero drop: `q = K·x·Δp/√p_t` for `|Δp| < p_t`, the
+/// turbulent `K·x·sgn(Δp)·√|Δp|` above (continuous at `p_t`). 1e-4 of the rated drop is a few
+/// hundred Pa: far below any working drop, so the rating is untouched.
+pub const LAMINAR_FRACTION: f64 = 1e-4;
+
+/// The hydraulic state of the loop (all actuators alike).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HydraulicState {
+    /// Cap-side chamber pressure (absolute), Pa.
+    pub p_a_pa: f64,
+    /// Rod-side chamber pressure (absolute), Pa.
+    pub p_b_pa: f64,
+    /// Spool position, fraction of full opening (the flow sees it clamped to ±1).
+    pub spool: f64,
+    /// Spool velocity, 1/s.
+    pub spool_rate_1_s: f64,
+    /// Oil held in the accumulator bank, m³ (0 with a constant supply).
+    pub accumulator_oil_m3: f64,
+}
+
+/// The rates of a [`HydraulicState`] and what they come from.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct HydraulicRates {
+    /// `ṗ_a`, Pa/s.
+    pub p_a: f64,
+    /// `ṗ_b`, Pa/s.
+    pub p_b: f64,
+    /// Spool velocity, 1/s.
+    pub spool: f64,
+    /// Spool acceleration, 1/s².
+    pub spool_rate: f64,
+    /// Rate of the accumulator's oil, m³/s.
+    pub accumulator_oil: f64,
+    /// Flow into chamber `a` of one actuator, m³/s.
+    pub q_a_m3_s: f64,
+    /// Flow out of chamber `b` of one actuator, m³/s.
+    pub q_b_m3_s: f64,
+    /// Flow drawn from the supply by all actuators, m³/s (negative: pushed back).
+    pub supply_flow_m3_s: f64,
+    /// Hydraulic power delivered into the chambers of all actuators, `n·(p_a·q_a − p_b·q_b)`, W.
+    pub hydraulic_power_w: f64,
+}
+
+/// `sgn(Δp)·√|Δp|` with the laminar transition of [`LAMINAR_FRACTION`] below `p_t`.
+#[inline(always)]
+fn root(dp: f64, p_t: f64) -> f64 {
+    if dp.abs() >= p_t {
+        dp.signum() * dp.abs().sqrt()
+    } else {
+        dp / p_t.sqrt()
+    }
+}
+
+impl TableSystem {
+    /// The supply pressure, Pa, with `oil_m3` in the accumulator (the constant pressure
+    /// without one).
+    #[inline(always)]
+    pub fn supply_pressure_at(&self, oil_m3: f64) -> f64 {
+        match &self.supply {
+            Supply::Constant => self.supply_pressure_pa,
+            Supply::Accumulator(acc) => {
+                let gas = (acc.volume_m3 - oil_m3).max(1e-9 * acc.volume_m3);
+                acc.precharge_pressure_pa * (acc.volume_m3 / gas).powf(acc.polytropic_exponent)
+            }
+        }
+    }
+
+    /// The accumulator's oil at the supply (set) pressure, m³ (0 without one).
+    pub fn charged_oil_m3(&self) -> f64 {
+        match &self.supply {
+            Supply::Constant => 0.0,
+            Supply::Accumulator(acc) => {
+                let ratio = acc.precharge_pressure_pa / self.supply_pressure_pa;
+                acc.volume_m3 * (1.0 - ratio.powf(1.0 / acc.polytropic_exponent))
+            }
+        }
+    }
+
+    /// The state at rest at `u = 0`: a centred spool, the null pressures, a charged bank.
+    pub fn rest_state(&self) -> HydraulicState {
+        let (p_a, p_b) = self.null_pressures_pa();
+        HydraulicState {
+            p_a_pa: p_a,
+            p_b_pa: p_b,
+            spool: 0.0,
+            spool_rate_1_s: 0.0,
+            accumulator_oil_m3: self.charged_oil_m3(),
+        }
+    }
+
+    /// Flows `(q_a, q_b)` of one actuator's valves at spool opening `x` (clamped to ±1):
+    /// into chamber `a` and out of chamber `b`, m³/s, with supply pressure `p_s`.
+    #[inline(always)]
+    pub fn valve_flows_m3_s(&self, x: f64, p_a: f64, p_b: f64, p_s: f64) -> (f64, f64) {
+        let x = x.clamp(-1.0, 1.0);
+        let k = self.land_coefficient();
+        let p_t = LAMINAR_FRACTION * self.servo_valve.rated_pressure_drop_pa;
+        let p_r = self.return_pressure_pa;
+        if x >= 0.0 {
+            (k * x * root(p_s - p_a, p_t), k * x * root(p_b - p_r, p_t))
+        } else {
+            (k * x * root(p_a - p_r, p_t), k * x * root(p_s - p_b, p_t))
+        }
+    }
+
+    /// The rates of the hydraulic state at platen displacement `u_m` and velocity `v_m_s`,
+    /// with valve input `drive` (the delayed, held controller output, `|drive| ≤ 1`).
+    ///
+    /// Pressures never fall below zero (absolute): a chamber at the floor does not fall
+    /// further (the cavitation floor); its pressure is read as `max(p, 0)`.
+    #[inline(always)]
+    pub fn hydraulic_rates(
+        &self,
+        u_m: f64,
+        v_m_s: f64,
+        drive: f64,
+        s: &HydraulicState,
+    ) -> HydraulicRates {
+        let act = &self.actuator;
+        let (p_a, p_b) = (s.p_a_pa.max(0.0), s.p_b_pa.max(0.0));
+        let p_s = self.supply_pressure_at(s.accumulator_oil_m3);
+        let (q_a, q_b) = self.valve_flows_m3_s(s.spool, p_a, p_b, p_s);
+        let (v_a, v_b) = self.chamber_volumes_m3(u_m);
+        let beta = self.oil_bulk_modulus_pa;
+        let leak = act.leakage_m3_s_per_pa * (p_a - p_b);
+        let mut dp_a = beta / v_a * (q_a - act.cap_area_m2 * v_m_s - leak);
+        let mut dp_b = beta / v_b * (-q_b + act.rod_area_m2 * v_m_s + leak);
+        if s.p_a_pa <= 0.0 && dp_a < 0.0 {
+            dp_a = 0.0;
+        }
+        if s.p_b_pa <= 0.0 && dp_b < 0.0 {
+            dp_b = 0.0;
+        }
+        let wv = std::f64::consts::TAU * self.servo_valve.natural_frequency_hz;
+        let zeta = self.servo_valve.damping_ratio;
+        let n = f64::from(act.count);
+        let drawn = n * if s.spool >= 0.0 { q_a } else { -q_b };
+        let oil = match &self.supply {
+            Supply::Constant => 0.0,
+            Supply::Accumulator(acc) => {
+                let band = 0.01 * self.supply_pressure_pa;
+                let taper = ((self.supply_pressure_pa - p_s) / band).clamp(0.0, 1.0);
+                acc.pump_flow_m3_s * taper - drawn
+            }
+        };
+        HydraulicRates {
+            p_a: dp_a,
+            p_b: dp_b,
+            spool: s.spool_rate_1_s,
+            spool_rate: wv * wv * (drive - s.spool) - 2.0 * zeta * wv * s.spool_rate_1_s,
+            accumulator_oil: oil,
+            q_a_m3_s: q_a,
+            q_b_m3_s: q_b,
+            supply_flow_m3_s: drawn,
+            hydraulic_power_w: n * (p_a * q_a - p_b * q_b),
+        }
+    }
+}

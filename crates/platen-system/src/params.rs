@@ -1,0 +1,288 @@
+//! The parameters of the table system, validated ([`TableSystem::validate`]).
+
+use crate::error::{invalid, non_negative, positive, Result};
+
+/// The actuators: `count` identical actuators acting together along `u` (a positive chamber
+/// pressure difference `A_a·p_a − A_b·p_b` pushes the platen towards `+u`).
+///
+/// Chamber `a` (cap side) grows with `u`: `V_a(u) = V_a0 + A_a·u`; chamber `b` (rod side)
+/// shrinks: `V_b(u) = V_b0 − A_b·u`. A double-ended actuator has `A_a = A_b`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Actuator {
+    /// Number of actuators acting together.
+    pub count: u32,
+    /// Piston area on the cap side (chamber `a`), m².
+    pub cap_area_m2: f64,
+    /// Annulus area on the rod side (chamber `b`), m².
+    pub rod_area_m2: f64,
+    /// Volume of chamber `a` at mid-stroke (`u = 0`), lines to the valve included, m³.
+    pub cap_volume_m3: f64,
+    /// Volume of chamber `b` at mid-stroke, lines included, m³.
+    pub rod_volume_m3: f64,
+    /// Cross-port leakage coefficient `C_L`: flow from `a` to `b` per Pa of `p_a − p_b`.
+    pub leakage_m3_s_per_pa: f64,
+}
+
+/// The servo-valves of one actuator: `count` identical valves in parallel.
+///
+/// Rated as manufacturers rate them: `rated_flow_m3_s` through a fully open valve at a
+/// total pressure drop of `rated_pressure_drop_pa` across both lands (half on each), so each
+/// land passes `Q = K·x_v·√Δp_land` with `K = Q_r/√(Δp_r/2)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ServoValve {
+    /// Valves per actuator.
+    pub count: u32,
+    /// Rated flow of one valve, m³/s.
+    pub rated_flow_m3_s: f64,
+    /// Total pressure drop at which the flow is rated, Pa.
+    pub rated_pressure_drop_pa: f64,
+    /// Natural frequency of the spool's second-order response, Hz.
+    pub natural_frequency_hz: f64,
+    /// Damping ratio of the spool's response.
+    pub damping_ratio: f64,
+    /// Pure delay between the drive and the spool's response, s.
+    pub delay_s: f64,
+}
+
+/// An accumulator bank fed by pumps: the supply pressure droops when the valves draw more
+/// than the pumps give.
+///
+/// The gas follows `P·V_g^n = P₀·V₀^n` (precharge `P₀` at the bank's gas volume `V₀`, when
+/// empty of oil). The pumps deliver their full flow below the set pressure (the table's
+/// `supply_pressure_pa`) and taper linearly to nothing over the 1 % of it just below.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Accumulator {
+    /// Gas precharge pressure, Pa (absolute), below the supply pressure.
+    pub precharge_pressure_pa: f64,
+    /// Total gas volume of the bank at precharge, m³.
+    pub volume_m3: f64,
+    /// Polytropic exponent of the gas (1 isothermal, 1.4 adiabatic nitrogen).
+    pub polytropic_exponent: f64,
+    /// Largest flow the pumps deliver, m³/s.
+    pub pump_flow_m3_s: f64,
+}
+
+/// The digital controller (three-variable style), run at `sample_rate_hz` with a
+/// zero-order hold on its drive:
+///
+/// `d = K_p·e + K_i·∫e + K_vf·v_ref + K_af·a_ref − K_vb·v − K_ab·a − K_Δp·HP(Δp)`,
+/// `e = u_ref − u`, saturated at `|d| ≤ 1`. `HP` is a first-order high-pass filter at
+/// `delta_p_highpass_hz` (Tustin; 0 Hz passes `Δp` unfiltered). The integrator stops while
+/// the drive is saturated in the direction it would push (no wind-up). Absent gains are 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Controller {
+    /// Sample rate, Hz.
+    pub sample_rate_hz: f64,
+    /// `K_p`, drive per m of error.
+    pub displacement_gain_per_m: f64,
+    /// `K_i`, drive per m·s of integrated error.
+    pub integral_gain_per_m_s: f64,
+    /// `K_vf`, drive per m/s of command velocity.
+    pub velocity_feedforward_s_per_m: f64,
+    /// `K_af`, drive per m/s² of command acceleration.
+    pub acceleration_feedforward_s2_per_m: f64,
+    /// `K_vb`, drive per m/s of platen velocity.
+    pub velocity_feedback_s_per_m: f64,
+    /// `K_ab`, drive per m/s² of platen acceleration.
+    pub acceleration_feedback_s2_per_m: f64,
+    /// `K_Δp`, drive per Pa of (high-passed) pressure difference `p_a − p_b`.
+    pub delta_p_gain_per_pa: f64,
+    /// Corner of the high-pass filter on `Δp`, Hz (0: no filter).
+    pub delta_p_highpass_hz: f64,
+}
+
+/// Where the valves take their oil from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Supply {
+    /// A constant supply pressure.
+    Constant,
+    /// An accumulator bank fed by pumps (see [`Accumulator`]).
+    Accumulator(Accumulator),
+}
+
+/// The complete loop around the platen: command → controller → servo-valves → actuator
+/// chambers → actuator force.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TableSystem {
+    /// The actuators.
+    pub actuator: Actuator,
+    /// The servo-valves of each actuator.
+    pub servo_valve: ServoValve,
+    /// Effective bulk modulus of the oil (lines, hoses and entrained air included), Pa.
+    pub oil_bulk_modulus_pa: f64,
+    /// Supply pressure (absolute), Pa: the constant pressure, or the pumps' set pressure and
+    /// the accumulator's initial pressure.
+    pub supply_pressure_pa: f64,
+    /// Return (tank) pressure (absolute), Pa.
+    pub return_pressure_pa: f64,
+    /// Constant supply or accumulator bank.
+    pub supply: Supply,
+    /// The controller.
+    pub controller: Controller,
+}
+
+impl TableSystem {
+    /// Checks every value and that the chambers keep oil over the stroke `±stroke_m`:
+    /// `V_a0 − A_a·stroke > 0` and `V_b0 − A_b·stroke > 0`.
+    ///
+    /// # Errors
+    /// [`crate::SystemError::Invalid`] naming the first offending value by its path.
+    pub fn validate(&self, stroke_m: f64) -> Result<()> {
+        let a = &self.actuator;
+        if a.count == 0 {
+            return Err(invalid("actuator.count", 0.0, "at least 1 actuator"));
+        }
+        positive("actuator.cap_side_area_m2", a.cap_area_m2)?;
+        positive("actuator.rod_side_area_m2", a.rod_area_m2)?;
+        positive("actuator.chamber_volume_m3", a.cap_volume_m3)?;
+        positive("actuator.chamber_volume_m3", a.rod_volume_m3)?;
+        non_negative("actuator.leakage_m3_s_per_pa", a.leakage_m3_s_per_pa)?;
+        if stroke_m.is_finite() && stroke_m > 0.0 {
+            let left_a = a.cap_volume_m3 - a.cap_area_m2 * stroke_m;
+            if left_a <= 0.0 {
+                return Err(invalid(
+                    "actuator.chamber_volume_m3",
+                    a.cap_volume_m3,
+                    format!(
+                        "more than A_a·stroke = {:.6} m³: the cap-side chamber would empty \
+                         at u = −{stroke_m} m",
+                        a.cap_area_m2 * stroke_m
+                    ),
+                ));
+            }
+            let left_b = a.rod_volume_m3 - a.rod_area_m2 * stroke_m;
+            if left_b <= 0.0 {
+                return Err(invalid(
+                    "actuator.chamber_volume_m3",
+                    a.rod_volume_m3,
+                    format!(
+                        "more than A_b·stroke = {:.6} m³: the rod-side chamber would empty \
+                         at u = +{stroke_m} m",
+                        a.rod_area_m2 * stroke_m
+                    ),
+                ));
+            }
+        }
+        let v = &self.servo_valve;
+        if v.count == 0 {
+            return Err(invalid("servo_valve.count", 0.0, "at least 1 valve"));
+        }
+        positive("servo_valve.rated_flow_m3_s", v.rated_flow_m3_s)?;
+        positive(
+            "servo_valve.rated_pressure_drop_pa",
+            v.rated_pressure_drop_pa,
+        )?;
+        positive("servo_valve.natural_frequency_hz", v.natural_frequency_hz)?;
+        positive("servo_valve.damping_ratio", v.damping_ratio)?;
+        non_negative("servo_valve.delay_s", v.delay_s)?;
+        if v.delay_s > 1.0 {
+            return Err(invalid("servo_valve.delay_s", v.delay_s, "at most 1 s"));
+        }
+        positive("oil_bulk_modulus_pa", self.oil_bulk_modulus_pa)?;
+        positive("supply_pressure_pa", self.supply_pressure_pa)?;
+        non_negative("return_pressure_pa", self.return_pressure_pa)?;
+        if self.return_pressure_pa >= self.supply_pressure_pa {
+            return Err(invalid(
+                "return_pressure_pa",
+                self.return_pressure_pa,
+                format!("below the supply pressure {} Pa", self.supply_pressure_pa),
+            ));
+        }
+        if let Supply::Accumulator(acc) = &self.supply {
+            positive(
+                "accumulator.precharge_pressure_pa",
+                acc.precharge_pressure_pa,
+            )?;
+            if acc.precharge_pressure_pa >= self.supply_pressure_pa {
+                return Err(invalid(
+                    "accumulator.precharge_pressure_pa",
+                    acc.precharge_pressure_pa,
+                    format!("below the supply pressure {} Pa", self.supply_pressure_pa),
+                ));
+            }
+            positive("accumulator.volume_m3", acc.volume_m3)?;
+            if !(acc.polytropic_exponent.is_finite()
+                && (1.0..=1.7).contains(&acc.polytropic_exponent))
+            {
+                return Err(invalid(
+                    "accumulator.polytropic_exponent",
+                    acc.polytropic_exponent,
+                    "between 1 (isothermal) and 1.7",
+                ));
+            }
+            non_negative("accumulator.pump_flow_m3_s", acc.pump_flow_m3_s)?;
+        }
+        let c = &self.controller;
+        positive("controller.sample_rate_hz", c.sample_rate_hz)?;
+        for (path, value) in [
+            (
+                "controller.displacement_gain_per_m",
+                c.displacement_gain_per_m,
+            ),
+            ("controller.integral_gain_per_m_s", c.integral_gain_per_m_s),
+            (
+                "controller.velocity_feedforward_s_per_m",
+                c.velocity_feedforward_s_per_m,
+            ),
+            (
+                "controller.acceleration_feedforward_s2_per_m",
+                c.acceleration_feedforward_s2_per_m,
+            ),
+            (
+                "controller.velocity_feedback_s_per_m",
+                c.velocity_feedback_s_per_m,
+            ),
+            (
+                "controller.acceleration_feedback_s2_per_m",
+                c.acceleration_feedback_s2_per_m,
+            ),
+            ("controller.delta_p_gain_per_pa", c.delta_p_gain_per_pa),
+            ("controller.delta_p_highpass_hz", c.delta_p_highpass_hz),
+        ] {
+            non_negative(path, value)?;
+        }
+        if c.delta_p_highpass_hz >= 0.5 * c.sample_rate_hz {
+            return Err(invalid(
+                "controller.delta_p_highpass_hz",
+                c.delta_p_highpass_hz,
+                format!(
+                    "below the controller's Nyquist frequency {} Hz",
+                    0.5 * c.sample_rate_hz
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// `K = Q_r/√(Δp_r/2)` of all the valves of one actuator together: the land
+    /// coefficient, m³/s per √Pa at full opening.
+    pub fn land_coefficient(&self) -> f64 {
+        let v = &self.servo_valve;
+        f64::from(v.count) * v.rated_flow_m3_s / (0.5 * v.rated_pressure_drop_pa).sqrt()
+    }
+
+    /// The null pressures `(p_a0, p_b0)` of a centred valve with no load: equal drops on
+    /// both lands (`p_a0 + p_b0 = P_s + P_R`) and no net force (`A_a·p_a0 = A_b·p_b0`).
+    pub fn null_pressures_pa(&self) -> (f64, f64) {
+        let (aa, ab) = (self.actuator.cap_area_m2, self.actuator.rod_area_m2);
+        let sum = self.supply_pressure_pa + self.return_pressure_pa;
+        (sum * ab / (aa + ab), sum * aa / (aa + ab))
+    }
+
+    /// Chamber volumes `(V_a, V_b)` at displacement `u_m`, m³.
+    #[inline(always)]
+    pub fn chamber_volumes_m3(&self, u_m: f64) -> (f64, f64) {
+        let a = &self.actuator;
+        (
+            a.cap_volume_m3 + a.cap_area_m2 * u_m,
+            a.rod_volume_m3 - a.rod_area_m2 * u_m,
+        )
+    }
+
+    /// The actuator force `n·(A_a·p_a − A_b·p_b)` of all actuators, N.
+    #[inline(always)]
+    pub fn force_n(&self, p_a_pa: f64, p_b_pa: f64) -> f64 {
+        let a = &self.actuator;
+        f64::from(a.count) * (a.cap_area_m2 * p_a_pa - a.rod_area_m2 * p_b_pa)
+    }
+}
