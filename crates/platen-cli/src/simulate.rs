@@ -33,7 +33,7 @@ pub fn run(opts: &Options<'_>) -> Result<()> {
     // Create the temporary output first, so that an unwritable path fails before the run.
     let storeys = scenario.storeys();
     let mut stream = out
-        .map(|p| CsvSink::create_with_storeys(p, storeys))
+        .map(|p| CsvSink::create_for(p, storeys, scenario.closed_loop.is_some()))
         .transpose()?;
     // The figures' points are collected as the run goes, in memory that does not grow with it.
     let mut recorder = opts.plot.map(|_| RunRecorder::new(&scenario.run));
@@ -56,8 +56,11 @@ pub fn run(opts: &Options<'_>) -> Result<()> {
         )?,
         None => Vec::new(),
     };
+    let summary = RunSummary::new(path, &scenario, &output, out);
+    for warning in &summary.warnings {
+        eprintln!("warning: {warning}");
+    }
     if opts.json {
-        let summary = RunSummary::new(path, &scenario, &output, out);
         // Through a Value, so the keys come out in alphabetical order.
         let mut value = serde_json::to_value(&summary)?;
         if let (Some(_), Some(map)) = (opts.plot, value.as_object_mut()) {
@@ -66,6 +69,7 @@ pub fn run(opts: &Options<'_>) -> Result<()> {
         outln!("{}", serde_json::to_string_pretty(&value)?);
     } else {
         print_summary(&scenario, &output.peaks, output.stats.as_ref(), out)?;
+        print_loop(&summary)?;
         if !written.is_empty() {
             outln!("  wrote {} figure files (SVG and PNG):", written.len());
             for path in &written {
@@ -108,13 +112,66 @@ impl SampleSink for NoOutput {
     fn accept(&mut self, _: &Sample) {}
 }
 
+/// The closed loop's lines of the text summary.
+fn print_loop(summary: &RunSummary) -> anyhow::Result<()> {
+    let (Some(ts), Some(f)) = (&summary.table_system, summary.oil_column_frequency_hz) else {
+        return Ok(());
+    };
+    outln!(
+        "  closed loop: oil column {f:.2} Hz at mid-stroke; {} controller samples, {} steps each",
+        ts.controller_samples,
+        ts.steps_per_controller_period
+    );
+    outln!(
+        "  tracking: displacement error {:.3} mm RMS, {:+.3} mm peak at {:.3} s",
+        ts.tracking_displacement_rms_m * 1e3,
+        ts.tracking_displacement_peak_m * 1e3,
+        ts.tracking_displacement_peak_t_s
+    );
+    outln!(
+        "            acceleration error {:.4} m/s² RMS, {:+.4} m/s² peak at {:.3} s",
+        ts.tracking_acceleration_rms_m_s2,
+        ts.tracking_acceleration_peak_m_s2,
+        ts.tracking_acceleration_peak_t_s
+    );
+    outln!(
+        "  valves: peak flow {:+.4} m³/s of {:.4} m³/s capacity ({:.0} %), saturated {:.3} s",
+        ts.peak_flow_m3_s,
+        ts.valve_flow_capacity_m3_s,
+        100.0 * ts.peak_flow_m3_s.abs() / ts.valve_flow_capacity_m3_s,
+        ts.valve_saturated_time_s
+    );
+    outln!(
+        "  supply: lowest {:.2} MPa{}",
+        ts.min_supply_pressure_pa / 1e6,
+        ts.cavitation_at_s
+            .map_or(String::new(), |t| format!("; CAVITATION at {t:.4} s"))
+    );
+    let m = &ts.loop_margins;
+    outln!(
+        "  loop (linearised): {}, gain margin {}, phase margin {}",
+        if m.stable { "stable" } else { "UNSTABLE" },
+        m.gain_margin_db.map_or("none".into(), |g| format!(
+            "{g:.1} dB at {:.1} Hz",
+            m.phase_crossover_hz.unwrap_or(0.0)
+        )),
+        m.phase_margin_deg.map_or("none".into(), |p| format!(
+            "{p:.1}° at {:.2} Hz",
+            m.gain_crossover_hz.unwrap_or(0.0)
+        ))
+    );
+    Ok(())
+}
+
 fn print_summary(
     s: &Scenario,
     peaks: &Peaks,
     stats: Option<&RunStats>,
     out: Option<&Path>,
 ) -> anyhow::Result<()> {
-    let dir = if stats.is_some() {
+    let dir = if s.closed_loop.is_some() {
+        "closed loop (command → controller → valves → platen)"
+    } else if stats.is_some() {
         "forward (force → motion)"
     } else {
         "inverse (motion → force)"

@@ -60,8 +60,8 @@ pub use event::EventKind;
 pub use inverse::{inverse, inverse_specimen, INVERSE_SPECIMEN_SUBSTEPS};
 pub use method::{ForwardIntegrator, Method};
 pub use output::{
-    Exceedance, Peak, Peaks, Sample, SampleSink, SpecimenColumns, SpecimenSample, SystemSample,
-    Trajectory,
+    Exceedance, Peak, Peaks, Sample, SampleSink, SpecimenColumns, SpecimenSample, SystemColumns,
+    SystemSample, Trajectory,
 };
 pub use record::{
     derivative, sampling_grid, second_derivative, uniform_interval_s, ForceRecord, Motion,

@@ -106,6 +106,99 @@ pub struct Trajectory {
     pub dissipative_force_n: Vec<f64>,
     /// The specimen's columns, for a run with a specimen (`None` otherwise).
     pub specimen: Option<SpecimenColumns>,
+    /// The table system's columns, for a closed-loop run (`None` otherwise).
+    pub system: Option<SystemColumns>,
+}
+
+/// The table system's columns of a closed-loop run kept in memory (see [`SystemSample`]),
+/// in the order of the CSV: [`SystemColumns::NAMES`].
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SystemColumns {
+    /// Displacement command, m.
+    pub command_u_m: Vec<f64>,
+    /// Drive (`|d| ≤ 1`).
+    pub drive: Vec<f64>,
+    /// Spool opening (`±1`).
+    pub spool_opening: Vec<f64>,
+    /// `p_a − p_b`, Pa.
+    pub delta_p_pa: Vec<f64>,
+    /// Flow into the cap-side chambers, m³/s.
+    pub flow_m3_s: Vec<f64>,
+    /// Supply pressure, Pa.
+    pub supply_pressure_pa: Vec<f64>,
+    /// Cap-side pressure, Pa.
+    pub cap_pressure_pa: Vec<f64>,
+    /// Rod-side pressure, Pa.
+    pub rod_pressure_pa: Vec<f64>,
+}
+
+impl SystemColumns {
+    /// The column names, in CSV order.
+    pub const NAMES: [&'static str; 8] = [
+        "command_u_m",
+        "drive",
+        "spool_opening",
+        "delta_p_pa",
+        "flow_m3_s",
+        "supply_pressure_pa",
+        "cap_pressure_pa",
+        "rod_pressure_pa",
+    ];
+
+    /// The values of one sample in the order of [`SystemColumns::NAMES`].
+    pub fn row(s: &SystemSample) -> [f64; 8] {
+        [
+            s.command_u_m,
+            s.drive,
+            s.spool_opening,
+            s.delta_p_pa,
+            s.flow_m3_s,
+            s.supply_pressure_pa,
+            s.p_a_pa,
+            s.p_b_pa,
+        ]
+    }
+
+    /// The column names and columns, in CSV order.
+    pub fn columns(&self) -> Vec<(&'static str, &[f64])> {
+        let cols: [&[f64]; 8] = [
+            &self.command_u_m,
+            &self.drive,
+            &self.spool_opening,
+            &self.delta_p_pa,
+            &self.flow_m3_s,
+            &self.supply_pressure_pa,
+            &self.cap_pressure_pa,
+            &self.rod_pressure_pa,
+        ];
+        Self::NAMES.iter().copied().zip(cols).collect()
+    }
+
+    /// The column `name`, if it is one of these.
+    pub fn column(&self, name: &str) -> Option<&[f64]> {
+        self.columns()
+            .into_iter()
+            .find_map(|(n, c)| (n == name).then_some(c))
+    }
+
+    fn accept(&mut self, s: &SystemSample) {
+        let row = Self::row(s);
+        for (col, v) in [
+            &mut self.command_u_m,
+            &mut self.drive,
+            &mut self.spool_opening,
+            &mut self.delta_p_pa,
+            &mut self.flow_m3_s,
+            &mut self.supply_pressure_pa,
+            &mut self.cap_pressure_pa,
+            &mut self.rod_pressure_pa,
+        ]
+        .into_iter()
+        .zip(row)
+        {
+            col.push(v);
+        }
+    }
 }
 
 /// Builds `[concat!("storey1", suffix), …, concat!("storey12", suffix)]`.
@@ -224,6 +317,7 @@ impl Trajectory {
             elastic_force_n: v(),
             dissipative_force_n: v(),
             specimen: None,
+            system: None,
         }
     }
 
@@ -304,6 +398,11 @@ impl SampleSink for Trajectory {
             self.specimen
                 .get_or_insert_with(|| SpecimenColumns::new(sp.storeys))
                 .accept(sp);
+        }
+        if let Some(sy) = &s.system {
+            self.system
+                .get_or_insert_with(SystemColumns::default)
+                .accept(sy);
         }
     }
 }

@@ -297,6 +297,10 @@ pub(crate) fn check_direction_fields(ctx: &Ctx, file: &ScenarioFile, is_force: b
             "no low-pass on a motion: it applies to force excitations (force_csv, sine_force)",
         ));
     }
+    if file.table_system.is_some() {
+        // A closed loop: the motion is the command, integrated forward.
+        return Ok(());
+    }
     if file.integrator.is_some() {
         return Err(ctx.invalid(
             "integrator",

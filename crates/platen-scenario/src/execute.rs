@@ -3,8 +3,9 @@
 use std::path::Path;
 
 use platen_integrate::{
-    forward_rk4_specimen, inverse, inverse_specimen, ForwardIntegrator, IntegrateError, Method,
-    Peaks, RunStats, Sample, SampleSink, Trajectory,
+    forward_closed_loop, forward_rk4_specimen, inverse, inverse_specimen, ForwardIntegrator,
+    IntegrateError, LoopRun, LoopStats, Method, Motion, Peak, Peaks, RunStats, Sample, SampleSink,
+    SystemColumns, Trajectory,
 };
 use platen_io::csv::CsvWriter;
 use platen_io::IoError;
@@ -12,6 +13,7 @@ use platen_model::{PlatenModel, Specimen};
 
 use crate::error::{Result, ScenarioError};
 use crate::scenario::{Model, Run, Scenario};
+use crate::system::ClosedLoop;
 
 /// What a run leaves besides its samples: the peaks (and span) of every output channel and,
 /// for a forward run, the solver's statistics and energy balance.
@@ -21,6 +23,72 @@ pub struct RunOutput {
     pub peaks: Peaks,
     /// Solver statistics of a forward run; `None` for an inverse run.
     pub stats: Option<RunStats>,
+    /// What a closed-loop run reports besides (`None` for the others).
+    pub system: Option<LoopOutput>,
+}
+
+/// What a closed-loop run reports besides its samples and peaks.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LoopOutput {
+    /// The loop's statistics (saturation, cavitation, supply).
+    pub stats: LoopStats,
+    /// How well the platen followed the command.
+    pub tracking: Tracking,
+}
+
+/// Tracking of a closed-loop run, accumulated as samples stream past: the achieved
+/// displacement and acceleration against the command's, and the valves' peak flow.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Tracking {
+    samples: usize,
+    sum_du2: f64,
+    sum_da2: f64,
+    /// Signed peak of `u − u_ref`, m.
+    pub displacement_peak: Peak,
+    /// Signed peak of `a − a_ref`, m/s².
+    pub acceleration_peak: Peak,
+    /// Signed peak flow into the cap-side chambers, m³/s.
+    pub flow_peak: Peak,
+}
+
+impl Tracking {
+    /// RMS of `u − u_ref`, m.
+    pub fn displacement_rms_m(&self) -> f64 {
+        (self.sum_du2 / self.samples.max(1) as f64).sqrt()
+    }
+
+    /// RMS of `a − a_ref`, m/s².
+    pub fn acceleration_rms_m_s2(&self) -> f64 {
+        (self.sum_da2 / self.samples.max(1) as f64).sqrt()
+    }
+}
+
+/// A sink that tracks the platen against `command`.
+struct TrackingSink<'a> {
+    command: &'a Motion,
+    tracking: Tracking,
+}
+
+impl SampleSink for TrackingSink<'_> {
+    fn accept(&mut self, s: &Sample) {
+        let du = s.u_m - self.command.u_m()[s.index];
+        let da = s.a_m_s2 - self.command.a_m_s2()[s.index];
+        let t = &mut self.tracking;
+        t.samples += 1;
+        t.sum_du2 += du * du;
+        t.sum_da2 += da * da;
+        update(&mut t.displacement_peak, du, s.t_s);
+        update(&mut t.acceleration_peak, da, s.t_s);
+        if let Some(sy) = &s.system {
+            update(&mut t.flow_peak, sy.flow_m3_s, s.t_s);
+        }
+    }
+}
+
+fn update(p: &mut Peak, value: f64, t_s: f64) {
+    if value.abs() > p.value.abs() {
+        *p = Peak { value, t_s };
+    }
 }
 
 impl Scenario {
@@ -31,6 +99,12 @@ impl Scenario {
     /// [`ScenarioError::Run`] when a forward run fails numerically (the cause names the
     /// time); samples before the failure have been delivered to `sink`.
     pub fn run<S: SampleSink>(&self, sink: &mut S) -> Result<RunOutput> {
+        if let (Some(cl), Run::Inverse { motion }) = (&self.closed_loop, &self.run) {
+            return self
+                .model
+                .run_closed_loop(cl, motion, self.specimen.as_ref(), sink)
+                .map_err(ScenarioError::Run);
+        }
         match &self.specimen {
             None => self.model.run(&self.run, sink),
             Some(specimen) => self.model.run_with_specimen(&self.run, specimen, sink),
@@ -99,7 +173,49 @@ fn run_specimen<M: PlatenModel, S: SampleSink>(
     Ok(RunOutput {
         peaks: sink.1,
         stats,
+        system: None,
     })
+}
+
+impl Model {
+    /// Runs the closed loop `cl` on this model with `command` as the displacement command
+    /// (and `specimen` on the platen), delivering every sample to `sink`.
+    ///
+    /// # Errors
+    /// The integrator's error when the run fails numerically, with its time.
+    pub fn run_closed_loop<S: SampleSink>(
+        &self,
+        cl: &ClosedLoop,
+        command: &Motion,
+        specimen: Option<&Specimen>,
+        sink: &mut S,
+    ) -> std::result::Result<RunOutput, IntegrateError> {
+        let tracker = TrackingSink {
+            command,
+            tracking: Tracking::default(),
+        };
+        let mut sink = (sink, (Peaks::default(), tracker));
+        let run = LoopRun {
+            system: &cl.system,
+            specimen,
+            command,
+            method: cl.method,
+            initial: cl.initial_state(command.u_m()[0]),
+        };
+        let stats = match self {
+            Model::Identified(m) => forward_closed_loop(m, &run, command.len(), &mut sink)?,
+            Model::Full(m) => forward_closed_loop(&**m, &run, command.len(), &mut sink)?,
+        };
+        let (peaks, tracker) = sink.1;
+        Ok(RunOutput {
+            peaks,
+            stats: Some(stats.run),
+            system: Some(LoopOutput {
+                stats,
+                tracking: tracker.tracking,
+            }),
+        })
+    }
 }
 
 /// Runs `run` on `model`, delivering every sample to `sink` and to a [`Peaks`].
@@ -124,6 +240,7 @@ fn run_model<M: PlatenModel, S: SampleSink>(
     Ok(RunOutput {
         peaks: sink.1,
         stats,
+        system: None,
     })
 }
 
@@ -155,6 +272,15 @@ impl CsvSink {
     /// # Errors
     /// As [`CsvSink::create`].
     pub fn create_with_storeys(path: &Path, storeys: usize) -> Result<Self> {
+        Self::create_for(path, storeys, false)
+    }
+
+    /// [`CsvSink::create_with_storeys`] for a closed-loop run too (`system`): then the table
+    /// system's columns ([`SystemColumns::NAMES`]) follow.
+    ///
+    /// # Errors
+    /// As [`CsvSink::create`].
+    pub fn create_for(path: &Path, storeys: usize, system: bool) -> Result<Self> {
         let mut names: Vec<String> = Trajectory::COLUMN_NAMES
             .iter()
             .map(|&n| n.to_owned())
@@ -163,6 +289,9 @@ impl CsvSink {
             names.push("base_shear_n".into());
             names.extend((1..=storeys).map(|i| format!("storey{i}_u_m")));
             names.extend((1..=storeys).map(|i| format!("storey{i}_a_m_s2")));
+        }
+        if system {
+            names.extend(SystemColumns::NAMES.iter().map(|&n| n.to_owned()));
         }
         Ok(Self {
             writer: CsvWriter::create(path, &names)?,
@@ -200,14 +329,19 @@ impl SampleSink for CsvSink {
             s.terms.elastic_n,
             s.terms.dissipative_n,
         ];
-        let result = match &s.specimen {
-            None => self.writer.write_row(&row),
-            Some(sp) => {
+        let result = match (&s.specimen, &s.system) {
+            (None, None) => self.writer.write_row(&row),
+            (sp, sy) => {
                 self.row.clear();
                 self.row.extend_from_slice(&row);
-                self.row.push(sp.base_shear_n);
-                self.row.extend_from_slice(&sp.u_m[..sp.storeys]);
-                self.row.extend_from_slice(&sp.a_m_s2[..sp.storeys]);
+                if let Some(sp) = sp {
+                    self.row.push(sp.base_shear_n);
+                    self.row.extend_from_slice(&sp.u_m[..sp.storeys]);
+                    self.row.extend_from_slice(&sp.a_m_s2[..sp.storeys]);
+                }
+                if let Some(sy) = sy {
+                    self.row.extend_from_slice(&SystemColumns::row(sy));
+                }
                 self.writer.write_row(&self.row)
             }
         };

@@ -38,6 +38,10 @@ pub struct ScenarioFile {
     pub limits: Option<LimitsSpec>,
     /// A specimen on the platen: a shear building, bottom storey first.
     pub specimen: Option<SpecimenSpec>,
+    /// The loop around the platen (controller, valves, actuators, supply): with one, a motion
+    /// excitation is the displacement command of a closed-loop forward run
+    /// ([`crate::system`]).
+    pub table_system: Option<crate::system::TableSystemSpec>,
 }
 
 /// `specimen`: a linear shear building fixed on the platen.

@@ -27,11 +27,12 @@ pub mod sampling;
 pub mod scenario;
 mod summary;
 pub mod sweep;
+pub mod system;
 
 pub use arrays::Arrays;
 pub use describe::describe_model;
 pub use error::{Result, ScenarioError};
-pub use execute::{CsvSink, RunOutput};
+pub use execute::{CsvSink, LoopOutput, RunOutput, Tracking};
 /// Column maps are part of the scenario format (`excitation.columns`).
 pub use platen_io::columns;
 pub use scenario::{Model, ModelKey, ModelOverrides, Run, Scenario};
@@ -39,3 +40,4 @@ pub use summary::{
     simulate, EnergySummary, ExceedanceSummary, ForwardSummary, LimitCheck, LimitsSummary,
     RunResult, RunSummary, SolverSummary,
 };
+pub use system::{ClosedLoop, TableSystemSpec};

@@ -38,14 +38,16 @@ use std::path::Path;
 
 use platen_integrate::{IntegrateError, Method};
 use platen_model::{
-    FullModel, IdentifiedKey, IdentifiedModel, ModelError, PhysicalKey, Preset, Specimen, Storey,
-    TableLimits,
+    FullModel, IdentifiedKey, IdentifiedModel, ModelError, PhysicalKey, PlatenModel, Preset,
+    Specimen, Storey, TableLimits,
 };
 
-use crate::ctx::{check_positive, Ctx};
+use crate::ctx::{check_finite, check_positive, Ctx};
 use crate::error::Result;
 use crate::excitation::build_run;
 use crate::file::given_values;
+use crate::system::{build_table_system, loop_method, ClosedLoop, TableSystemSpec};
+use platen_integrate::State;
 use platen_io::json::parse_json_file;
 
 pub use crate::excitation::{Derived, Run};
@@ -61,6 +63,14 @@ pub enum Model {
 }
 
 impl Model {
+    /// The platen's mass at displacement `u_m`, kg.
+    pub fn mass_kg_at(&self, u_m: f64) -> f64 {
+        match self {
+            Model::Identified(m) => m.mass_kg(u_m),
+            Model::Full(m) => m.mass_kg(u_m),
+        }
+    }
+
     /// `"identified"` or `"full"`.
     pub fn form(&self) -> &'static str {
         match self {
@@ -93,6 +103,9 @@ pub struct Scenario {
     pub derived: Derived,
     /// The specimen on the platen, if any.
     pub specimen: Option<Specimen>,
+    /// The loop around the platen, if any: the run's motion is then the displacement command
+    /// of a closed-loop forward run.
+    pub closed_loop: Option<ClosedLoop>,
 }
 
 impl Scenario {
@@ -116,6 +129,7 @@ impl Scenario {
             run: self.run.scaled(k)?.into_owned(),
             derived: self.derived.clone(),
             specimen: self.specimen.clone(),
+            closed_loop: self.closed_loop,
         })
     }
 
@@ -178,6 +192,18 @@ impl Scenario {
         let limits = table_limits(&ctx, preset, file.limits.as_ref())?;
         let (run, derived) = run(&ctx, file)?;
         let specimen = build_specimen(&ctx, file.specimen.as_ref(), &run)?;
+        let closed_loop = match &file.table_system {
+            None => None,
+            Some(spec) => Some(closed_loop(
+                &ctx,
+                file,
+                spec,
+                &run,
+                &model,
+                specimen.as_ref(),
+                &limits,
+            )?),
+        };
         let name = file.name.clone().unwrap_or_else(|| {
             path.file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
@@ -193,8 +219,59 @@ impl Scenario {
             run,
             derived,
             specimen,
+            closed_loop,
         })
     }
+}
+
+/// The validated closed loop of a scenario with a `table_system`: its excitation must be a
+/// motion (the command).
+fn closed_loop(
+    ctx: &Ctx,
+    file: &ScenarioFile,
+    spec: &TableSystemSpec,
+    run: &Run,
+    model: &Model,
+    specimen: Option<&Specimen>,
+    limits: &TableLimits,
+) -> Result<ClosedLoop> {
+    if let Run::Forward { .. } = run {
+        let key = if file.excitation.force_csv.is_some() {
+            "excitation.force_csv"
+        } else {
+            "excitation"
+        };
+        return Err(ctx.invalid(
+            key,
+            "a force",
+            "a motion excitation (motion_csv, ground_motion, sine_motion, …): with a \
+             `table_system` the motion is the displacement command and the loop makes the force",
+        ));
+    }
+    let system = build_table_system(ctx, spec, limits.stroke_m)?;
+    let mass = model.mass_kg_at(0.0) + specimen.map_or(0.0, Specimen::total_mass_kg);
+    let method = loop_method(ctx, file, &system, mass, limits.stroke_m)?;
+    let initial = match &file.initial {
+        None => None,
+        Some(init) => {
+            if init.from_record {
+                return Err(ctx.invalid(
+                    "initial.from_record",
+                    true,
+                    "`u_m` and `v_m_s`: a closed loop has no force record to take them from",
+                ));
+            }
+            Some(State {
+                u_m: check_finite(ctx, "initial.u_m", init.u_m.unwrap_or(0.0))?,
+                v_m_s: check_finite(ctx, "initial.v_m_s", init.v_m_s.unwrap_or(0.0))?,
+            })
+        }
+    };
+    Ok(ClosedLoop {
+        system,
+        method,
+        initial,
+    })
 }
 
 /// The validated `specimen`, with JSON paths in its errors; forward runs with a specimen

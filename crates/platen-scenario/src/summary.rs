@@ -69,6 +69,106 @@ pub struct RunSummary {
     /// The specimen's peaks (absent without a specimen).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub specimen: Option<SpecimenSummary>,
+    /// The oil-column frequency of the table system at mid-stroke, linearised, with the
+    /// specimen's mass as a rigid payload, Hz (closed-loop runs only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub oil_column_frequency_hz: Option<f64>,
+    /// The closed loop's figures (closed-loop runs only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub table_system: Option<SystemSummary>,
+    /// What the run wants its user to know (an unstable loop, cavitation, saturated valves).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
+}
+
+/// A closed-loop run's figures.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SystemSummary {
+    /// RMS of the displacement error `u − u_ref`, m.
+    pub tracking_displacement_rms_m: f64,
+    /// Signed peak of the displacement error, m.
+    pub tracking_displacement_peak_m: f64,
+    /// When, s.
+    pub tracking_displacement_peak_t_s: f64,
+    /// RMS of the acceleration error `a − a_ref`, m/s².
+    pub tracking_acceleration_rms_m_s2: f64,
+    /// Signed peak of the acceleration error, m/s².
+    pub tracking_acceleration_peak_m_s2: f64,
+    /// When, s.
+    pub tracking_acceleration_peak_t_s: f64,
+    /// Time with the drive saturated, s.
+    pub valve_saturated_time_s: f64,
+    /// Signed peak flow of the valves into the cap-side chambers, m³/s.
+    pub peak_flow_m3_s: f64,
+    /// When, s.
+    pub peak_flow_t_s: f64,
+    /// The valves' flow at full opening with the null drop on each land, m³/s.
+    pub valve_flow_capacity_m3_s: f64,
+    /// Lowest supply pressure, Pa.
+    pub min_supply_pressure_pa: f64,
+    /// First time a chamber reached the cavitation floor, s (absent: never).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cavitation_at_s: Option<f64>,
+    /// Hydraulic energy delivered into the chambers, J.
+    pub hydraulic_energy_j: f64,
+    /// Controller samples.
+    pub controller_samples: u64,
+    /// Integration steps per controller period.
+    pub steps_per_controller_period: u32,
+    /// The linearised loop's stability and margins.
+    pub loop_margins: MarginsSummary,
+}
+
+/// The linearised loop's margins ([`platen_system::Margins`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MarginsSummary {
+    /// Whether the closed loop is stable (Nyquist).
+    pub stable: bool,
+    /// Gain margin, dB (absent: no phase crossover).
+    pub gain_margin_db: Option<f64>,
+    /// Its frequency, Hz.
+    pub phase_crossover_hz: Option<f64>,
+    /// Phase margin, degrees (absent: no gain crossover).
+    pub phase_margin_deg: Option<f64>,
+    /// Its frequency, Hz.
+    pub gain_crossover_hz: Option<f64>,
+    /// The closed loop's largest gain command → displacement.
+    pub peak_gain: f64,
+    /// Its frequency, Hz.
+    pub peak_gain_hz: f64,
+}
+
+impl From<&platen_system::Margins> for MarginsSummary {
+    fn from(m: &platen_system::Margins) -> Self {
+        Self {
+            stable: m.stable,
+            gain_margin_db: m.gain_margin_db,
+            phase_crossover_hz: m.phase_crossover_hz,
+            phase_margin_deg: m.phase_margin_deg,
+            gain_crossover_hz: m.gain_crossover_hz,
+            peak_gain: m.peak_gain,
+            peak_gain_hz: m.peak_gain_hz,
+        }
+    }
+}
+
+impl Scenario {
+    /// The linearised loop of a closed-loop scenario: its mechanics (the model's mass, the
+    /// slope of its elastic force and its secant damping, with the specimen as a rigid
+    /// payload) at mid-stroke, and its margins.
+    pub fn loop_linearisation(
+        &self,
+    ) -> Option<(platen_system::Linearisation, platen_system::Margins)> {
+        let cl = self.closed_loop.as_ref()?;
+        let payload = self.specimen.as_ref().map_or(0.0, |s| s.total_mass_kg());
+        let mech = match &self.model {
+            crate::Model::Identified(m) => platen_system::Mechanics::of_model(m, payload),
+            crate::Model::Full(m) => platen_system::Mechanics::of_model(&**m, payload),
+        };
+        let lin = cl.system.linearise(mech, 0.0);
+        let margins = cl.system.margins(&lin);
+        Some((lin, margins))
+    }
 }
 
 /// The peaks of a specimen run.
@@ -231,6 +331,9 @@ impl RunSummary {
             limits: LimitsSummary::new(peaks, &scenario.limits),
             derived: scenario.derived.clone(),
             out: out.map(|p| p.display().to_string()),
+            oil_column_frequency_hz: None,
+            table_system: None,
+            warnings: Vec::new(),
             specimen: (peaks.storeys > 0).then(|| SpecimenSummary {
                 storeys: peaks.storeys,
                 peak_base_shear_n: peaks.base_shear_n.value,
@@ -241,6 +344,73 @@ impl RunSummary {
                     .collect(),
             }),
         }
+        .with_loop(scenario, output)
+    }
+}
+
+impl RunSummary {
+    /// The summary with a closed-loop run's figures and warnings laid in.
+    fn with_loop(mut self, scenario: &Scenario, output: &RunOutput) -> Self {
+        let (Some(cl), Some(lo)) = (&scenario.closed_loop, &output.system) else {
+            return self;
+        };
+        if let Some(f) = self.forward.as_mut() {
+            f.solver.method = match cl.method {
+                platen_integrate::LoopMethod::Rk4 { .. } => "rk4",
+                platen_integrate::LoopMethod::Dopri5 { .. } => "dopri5",
+            };
+        }
+        let (lin, margins) = scenario
+            .loop_linearisation()
+            .expect("a closed-loop scenario has a linearisation");
+        self.oil_column_frequency_hz = Some(
+            cl.system
+                .oil_column_frequency_hz(lin.mechanics.mass_kg, 0.0),
+        );
+        let (st, tr) = (&lo.stats, &lo.tracking);
+        let capacity = cl.system.capacities().valve_flow_m3_s;
+        if !margins.stable {
+            self.warnings.push(format!(
+                "the linearised loop is unstable (gain margin {}, phase margin {}): the run \
+                 shows what the table would do, but check the controller's gains",
+                margins
+                    .gain_margin_db
+                    .map_or("none".into(), |g| format!("{g:.1} dB")),
+                margins
+                    .phase_margin_deg
+                    .map_or("none".into(), |p| format!("{p:.1}°")),
+            ));
+        }
+        if let Some(t) = st.cavitation_at_s {
+            self.warnings.push(format!(
+                "a chamber pressure reached the cavitation floor (0 Pa absolute) at {t:.4} s"
+            ));
+        }
+        if st.saturated_time_s > 0.0 {
+            self.warnings.push(format!(
+                "the drive was saturated for {:.3} s: the valves were fully open",
+                st.saturated_time_s
+            ));
+        }
+        self.table_system = Some(SystemSummary {
+            tracking_displacement_rms_m: tr.displacement_rms_m(),
+            tracking_displacement_peak_m: tr.displacement_peak.value,
+            tracking_displacement_peak_t_s: tr.displacement_peak.t_s,
+            tracking_acceleration_rms_m_s2: tr.acceleration_rms_m_s2(),
+            tracking_acceleration_peak_m_s2: tr.acceleration_peak.value,
+            tracking_acceleration_peak_t_s: tr.acceleration_peak.t_s,
+            valve_saturated_time_s: st.saturated_time_s,
+            peak_flow_m3_s: tr.flow_peak.value,
+            peak_flow_t_s: tr.flow_peak.t_s,
+            valve_flow_capacity_m3_s: capacity,
+            min_supply_pressure_pa: st.min_supply_pressure_pa,
+            cavitation_at_s: st.cavitation_at_s,
+            hydraulic_energy_j: st.hydraulic_energy_j,
+            controller_samples: st.controller_samples,
+            steps_per_controller_period: cl.method.steps_per_period(),
+            loop_margins: MarginsSummary::from(&margins),
+        });
+        self
     }
 }
 
@@ -329,6 +499,9 @@ impl RunResult {
         if let Some(sp) = &self.trajectory.specimen {
             names.extend(sp.columns().into_iter().map(|(name, _)| name));
         }
+        if self.trajectory.system.is_some() {
+            names.extend(platen_integrate::SystemColumns::NAMES);
+        }
         names
     }
 
@@ -337,7 +510,9 @@ impl RunResult {
     pub fn column(&self, name: &str) -> Option<&[f64]> {
         match Trajectory::COLUMN_NAMES.iter().position(|c| *c == name) {
             Some(j) => Some(self.trajectory.columns()[j]),
-            None => self.trajectory.specimen.as_ref()?.column(name),
+            None => (self.trajectory.specimen.as_ref())
+                .and_then(|sp| sp.column(name))
+                .or_else(|| self.trajectory.system.as_ref()?.column(name)),
         }
     }
 }

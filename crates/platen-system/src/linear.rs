@@ -89,8 +89,9 @@ pub struct Margins {
     /// Frequency of that gain crossover, Hz.
     pub gain_crossover_hz: Option<f64>,
     /// Whether the closed loop is stable by the Nyquist criterion: the open loop is stable
-    /// (but for the integrator, whose indentation is counted), so the closed loop is stable
-    /// when `1 + L` does not encircle the origin.
+    /// but for its poles at `s = 0` (the integrator, and the platen's displacement on a table
+    /// without stiffness), whose indentations are counted, so the closed loop is stable when
+    /// `1 + L` does not encircle the origin.
     pub stable: bool,
     /// The largest closed-loop gain command → displacement up to the controller's Nyquist
     /// frequency (the resonance peak), and where it is.
@@ -318,10 +319,15 @@ impl TableSystem {
             }
             (f0, m0, i0) = (f1, m1, i1);
         }
-        // The full contour is this half, its mirror image and, with an integrator (L(0⁺)
-        // infinite at −90°), the indentation around s = 0, which turns 1 + L by −π.
+        // The full contour is this half, its mirror image and, for each pole of L at s = 0,
+        // the indentation around it, which turns 1 + L by −π.
         let total = unwrapped - first_arg;
-        let integrators = f64::from(u8::from(self.controller.integral_gain_per_m_s > 0.0));
+        // Poles of L at s = 0 (the controller's integrator; the platen's displacement when
+        // nothing restores it): the slope of |L| a decade below the grid.
+        let slope = (self.loop_gain(lin, f_min * 0.01).norm()
+            / self.loop_gain(lin, f_min * 0.1).norm())
+        .log10();
+        let integrators = slope.round().max(0.0);
         let windings = (2.0 * total - std::f64::consts::PI * integrators) / std::f64::consts::TAU;
         out.stable = windings.round() == 0.0;
         out

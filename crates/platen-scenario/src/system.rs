@@ -1,0 +1,450 @@
+//! `table_system`: the loop around the platen (controller, servo-valves, actuators, supply).
+//! With one, a motion excitation is the displacement **command** and the run is the closed
+//! loop, forward ([`platen_integrate::forward_closed_loop`]).
+//!
+//! ```json
+//! "table_system": { "preset": "lhpost-2008" }
+//! "table_system": {
+//!   "actuator": { "count": 1, "area_m2": 0.02, "chamber_volume_m3": 0.012,
+//!                 "leakage_m3_s_per_pa": 1e-11 },
+//!   "servo_valve": { "count": 1, "rated_flow_m3_s": 0.01, "rated_pressure_drop_pa": 7e6,
+//!                    "natural_frequency_hz": 120, "damping_ratio": 0.7, "delay_s": 0.0005 },
+//!   "oil_bulk_modulus_pa": 1.2e9, "supply_pressure_pa": 21e6, "return_pressure_pa": 3e5,
+//!   "controller": { "sample_rate_hz": 4096, "displacement_gain_per_m": 20,
+//!                   "velocity_feedforward_s_per_m": 0.9, "delta_p_gain_per_pa": 2e-8,
+//!                   "delta_p_highpass_hz": 1 }
+//! }
+//! ```
+//!
+//! With a `preset`, every value given is laid over the preset's (`"accumulator": null`
+//! replaces its bank by a constant supply); without one, every value is required but the
+//! accumulator (absent: constant supply), the leakage (0), the delay (0) and the controller's
+//! gains (absent gains are 0). `chamber_volume_m3` is one volume for both chambers or
+//! `[cap, rod]`; `area_m2` is a double-ended actuator's area, `cap_side_area_m2` and
+//! `rod_side_area_m2` a single-ended one's.
+//!
+//! The integrator: RK4 (default) at `step_s`, which must divide the controller's period (the
+//! default is the largest such step with `h·ω_max ≤ 0.25` for the loop's fastest mode: the
+//! spool, or the oil column at the stroke's ends), or Dopri5 at `rtol`/`atol`. A step that
+//! cannot resolve the fastest mode (`h·ω_max > 1`) is refused.
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Deserializer, Serialize};
+
+use platen_integrate::{LoopMethod, State};
+use platen_system::{
+    preset as system_preset, Accumulator, Controller, Supply, SystemError, TableSystem,
+};
+
+use crate::ctx::Ctx;
+use crate::error::Result;
+use crate::file::{IntegratorSpec, ScenarioFile, DEFAULT_ATOL, DEFAULT_RTOL};
+
+/// `table_system`, as written.
+#[derive(Debug, Clone, Default, Deserialize, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct TableSystemSpec {
+    /// A named system (`lhpost-2008`) that the other values are laid over.
+    pub preset: Option<String>,
+    /// The actuators.
+    pub actuator: Option<ActuatorSpec>,
+    /// The servo-valves of each actuator.
+    pub servo_valve: Option<ServoValveSpec>,
+    /// Effective bulk modulus of the oil, Pa.
+    pub oil_bulk_modulus_pa: Option<f64>,
+    /// Supply pressure (absolute), Pa.
+    pub supply_pressure_pa: Option<f64>,
+    /// Return pressure (absolute), Pa.
+    pub return_pressure_pa: Option<f64>,
+    /// An accumulator bank fed by pumps; `null` for a constant supply.
+    #[serde(default, deserialize_with = "present")]
+    #[schemars(with = "Option<AccumulatorSpec>")]
+    pub accumulator: Option<Option<AccumulatorSpec>>,
+    /// The controller.
+    pub controller: Option<ControllerSpec>,
+}
+
+/// A key given as `null` is `Some(None)`, an absent one `None`.
+fn present<'de, D: Deserializer<'de>, T: Deserialize<'de>>(
+    d: D,
+) -> Result<Option<Option<T>>, D::Error> {
+    Option::<T>::deserialize(d).map(Some)
+}
+
+/// `table_system.actuator`.
+#[derive(Debug, Clone, Default, Deserialize, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ActuatorSpec {
+    /// Number of actuators acting together.
+    pub count: Option<u32>,
+    /// Piston area of a double-ended actuator, m².
+    pub area_m2: Option<f64>,
+    /// Cap-side piston area of a single-ended actuator, m².
+    pub cap_side_area_m2: Option<f64>,
+    /// Rod-side annulus area of a single-ended actuator, m².
+    pub rod_side_area_m2: Option<f64>,
+    /// Each chamber's volume at mid-stroke, lines included, m³: one number, or `[cap, rod]`.
+    pub chamber_volume_m3: Option<ChamberVolumes>,
+    /// Cross-port leakage, m³/s per Pa.
+    pub leakage_m3_s_per_pa: Option<f64>,
+}
+
+/// `chamber_volume_m3`: one volume for both chambers, or `[cap, rod]`.
+#[derive(Debug, Clone, Copy, Deserialize, Serialize, JsonSchema)]
+#[serde(untagged)]
+pub enum ChamberVolumes {
+    /// Both chambers alike.
+    Both(f64),
+    /// `[cap, rod]`.
+    Each([f64; 2]),
+}
+
+/// `table_system.servo_valve`.
+#[derive(Debug, Clone, Default, Deserialize, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ServoValveSpec {
+    /// Valves per actuator.
+    pub count: Option<u32>,
+    /// Rated flow of one valve, m³/s.
+    pub rated_flow_m3_s: Option<f64>,
+    /// Total pressure drop of the rating, Pa.
+    pub rated_pressure_drop_pa: Option<f64>,
+    /// Spool natural frequency, Hz.
+    pub natural_frequency_hz: Option<f64>,
+    /// Spool damping ratio.
+    pub damping_ratio: Option<f64>,
+    /// Pure delay, s.
+    pub delay_s: Option<f64>,
+}
+
+/// `table_system.accumulator`.
+#[derive(Debug, Clone, Default, Deserialize, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct AccumulatorSpec {
+    /// Gas precharge pressure, Pa.
+    pub precharge_pressure_pa: Option<f64>,
+    /// Gas volume of the bank at precharge, m³.
+    pub volume_m3: Option<f64>,
+    /// Polytropic exponent of the gas.
+    pub polytropic_exponent: Option<f64>,
+    /// Largest pump flow, m³/s.
+    pub pump_flow_m3_s: Option<f64>,
+}
+
+/// `table_system.controller` (absent gains are 0).
+#[derive(Debug, Clone, Default, Deserialize, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+#[allow(missing_docs)]
+pub struct ControllerSpec {
+    /// Sample rate, Hz.
+    pub sample_rate_hz: Option<f64>,
+    pub displacement_gain_per_m: Option<f64>,
+    pub integral_gain_per_m_s: Option<f64>,
+    pub velocity_feedforward_s_per_m: Option<f64>,
+    pub acceleration_feedforward_s2_per_m: Option<f64>,
+    pub velocity_feedback_s_per_m: Option<f64>,
+    pub acceleration_feedback_s2_per_m: Option<f64>,
+    pub delta_p_gain_per_pa: Option<f64>,
+    pub delta_p_highpass_hz: Option<f64>,
+}
+
+/// A validated closed loop: the system, its integrator and the platen's initial state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClosedLoop {
+    /// The table system.
+    pub system: TableSystem,
+    /// The integrator.
+    pub method: LoopMethod,
+    /// The platen's state at the command's first sample (`None`: at rest at the command's
+    /// first displacement).
+    pub initial: Option<State>,
+}
+
+impl ClosedLoop {
+    /// The platen's initial state for `command_u0_m`, the command's first displacement.
+    pub fn initial_state(&self, command_u0_m: f64) -> State {
+        self.initial.unwrap_or(State {
+            u_m: command_u0_m,
+            v_m_s: 0.0,
+        })
+    }
+}
+
+/// Builds the table system of `spec` (a preset with values laid over it, or explicit), with
+/// every error named by its JSON path under `table_system`.
+pub(crate) fn build_table_system(
+    ctx: &Ctx,
+    spec: &TableSystemSpec,
+    stroke_m: f64,
+) -> Result<TableSystem> {
+    let base =
+        match &spec.preset {
+            Some(name) => Some(system_preset::by_name(name).map_err(|e| {
+                ctx.invalid("table_system.preset", format!("{name:?}"), e.to_string())
+            })?),
+            None => None,
+        };
+    let need = |path: &str, given: Option<f64>, base: Option<f64>| -> Result<f64> {
+        given.or(base).ok_or_else(|| {
+            ctx.invalid(
+                &format!("table_system.{path}"),
+                "(missing)",
+                "a value (or a `preset` to take it from)",
+            )
+        })
+    };
+    let a = spec.actuator.clone().unwrap_or_default();
+    let ba = base.map(|b| b.actuator);
+    let count = a
+        .count
+        .or(ba.map(|b| b.count))
+        .ok_or_else(|| ctx.invalid("table_system.actuator.count", "(missing)", "a count ≥ 1"))?;
+    let (cap, rod) = match (a.area_m2, a.cap_side_area_m2, a.rod_side_area_m2) {
+        (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
+            return Err(ctx.invalid(
+                "table_system.actuator.area_m2",
+                a.area_m2.unwrap_or(f64::NAN),
+                "either `area_m2` (double-ended) or `cap_side_area_m2` and `rod_side_area_m2`, not both",
+            ))
+        }
+        (Some(area), None, None) => (area, area),
+        (None, c, r) => (
+            need("actuator.cap_side_area_m2", c, ba.map(|b| b.cap_area_m2))?,
+            need("actuator.rod_side_area_m2", r, ba.map(|b| b.rod_area_m2))?,
+        ),
+    };
+    let (v_cap, v_rod) = match a.chamber_volume_m3 {
+        Some(ChamberVolumes::Both(v)) => (v, v),
+        Some(ChamberVolumes::Each([c, r])) => (c, r),
+        None => match ba {
+            Some(b) => (b.cap_volume_m3, b.rod_volume_m3),
+            None => {
+                return Err(ctx.invalid(
+                    "table_system.actuator.chamber_volume_m3",
+                    "(missing)",
+                    "a volume, or [cap, rod]",
+                ))
+            }
+        },
+    };
+    let leakage = a
+        .leakage_m3_s_per_pa
+        .or(ba.map(|b| b.leakage_m3_s_per_pa))
+        .unwrap_or(0.0);
+    let v = spec.servo_valve.clone().unwrap_or_default();
+    let bv = base.map(|b| b.servo_valve);
+    let valve_count = v
+        .count
+        .or(bv.map(|b| b.count))
+        .ok_or_else(|| ctx.invalid("table_system.servo_valve.count", "(missing)", "a count ≥ 1"))?;
+    let mut system = TableSystem {
+        actuator: platen_system::Actuator {
+            count,
+            cap_area_m2: cap,
+            rod_area_m2: rod,
+            cap_volume_m3: v_cap,
+            rod_volume_m3: v_rod,
+            leakage_m3_s_per_pa: leakage,
+        },
+        servo_valve: platen_system::ServoValve {
+            count: valve_count,
+            rated_flow_m3_s: need(
+                "servo_valve.rated_flow_m3_s",
+                v.rated_flow_m3_s,
+                bv.map(|b| b.rated_flow_m3_s),
+            )?,
+            rated_pressure_drop_pa: need(
+                "servo_valve.rated_pressure_drop_pa",
+                v.rated_pressure_drop_pa,
+                bv.map(|b| b.rated_pressure_drop_pa),
+            )?,
+            natural_frequency_hz: need(
+                "servo_valve.natural_frequency_hz",
+                v.natural_frequency_hz,
+                bv.map(|b| b.natural_frequency_hz),
+            )?,
+            damping_ratio: need(
+                "servo_valve.damping_ratio",
+                v.damping_ratio,
+                bv.map(|b| b.damping_ratio),
+            )?,
+            delay_s: v.delay_s.or(bv.map(|b| b.delay_s)).unwrap_or(0.0),
+        },
+        oil_bulk_modulus_pa: need(
+            "oil_bulk_modulus_pa",
+            spec.oil_bulk_modulus_pa,
+            base.map(|b| b.oil_bulk_modulus_pa),
+        )?,
+        supply_pressure_pa: need(
+            "supply_pressure_pa",
+            spec.supply_pressure_pa,
+            base.map(|b| b.supply_pressure_pa),
+        )?,
+        return_pressure_pa: need(
+            "return_pressure_pa",
+            spec.return_pressure_pa,
+            base.map(|b| b.return_pressure_pa),
+        )?,
+        supply: Supply::Constant,
+        controller: controller(ctx, spec.controller.as_ref(), base.map(|b| b.controller))?,
+    };
+    let base_bank = match base.map(|b| b.supply) {
+        Some(Supply::Accumulator(acc)) => Some(acc),
+        _ => None,
+    };
+    system.supply = match &spec.accumulator {
+        Some(None) => Supply::Constant,
+        None => base_bank.map_or(Supply::Constant, Supply::Accumulator),
+        Some(Some(acc)) => {
+            let field = |name: &str, given: Option<f64>, base: Option<f64>| {
+                need(&format!("accumulator.{name}"), given, base)
+            };
+            Supply::Accumulator(Accumulator {
+                precharge_pressure_pa: field(
+                    "precharge_pressure_pa",
+                    acc.precharge_pressure_pa,
+                    base_bank.map(|b| b.precharge_pressure_pa),
+                )?,
+                volume_m3: field("volume_m3", acc.volume_m3, base_bank.map(|b| b.volume_m3))?,
+                polytropic_exponent: field(
+                    "polytropic_exponent",
+                    acc.polytropic_exponent,
+                    base_bank.map(|b| b.polytropic_exponent),
+                )?,
+                pump_flow_m3_s: field(
+                    "pump_flow_m3_s",
+                    acc.pump_flow_m3_s,
+                    base_bank.map(|b| b.pump_flow_m3_s),
+                )?,
+            })
+        }
+    };
+    system.validate(stroke_m).map_err(|e| match e {
+        SystemError::Invalid {
+            path,
+            value,
+            expected,
+        } => ctx.invalid(&format!("table_system.{path}"), value, expected),
+        other => ctx.invalid("table_system", "", other.to_string()),
+    })?;
+    Ok(system)
+}
+
+fn controller(
+    ctx: &Ctx,
+    given: Option<&ControllerSpec>,
+    base: Option<Controller>,
+) -> Result<Controller> {
+    let c = given.cloned().unwrap_or_default();
+    let rate = c
+        .sample_rate_hz
+        .or(base.map(|b| b.sample_rate_hz))
+        .ok_or_else(|| {
+            ctx.invalid(
+                "table_system.controller.sample_rate_hz",
+                "(missing)",
+                "the controller's sample rate, Hz",
+            )
+        })?;
+    let gain = |given: Option<f64>, base: Option<f64>| given.or(base).unwrap_or(0.0);
+    Ok(Controller {
+        sample_rate_hz: rate,
+        displacement_gain_per_m: gain(
+            c.displacement_gain_per_m,
+            base.map(|b| b.displacement_gain_per_m),
+        ),
+        integral_gain_per_m_s: gain(
+            c.integral_gain_per_m_s,
+            base.map(|b| b.integral_gain_per_m_s),
+        ),
+        velocity_feedforward_s_per_m: gain(
+            c.velocity_feedforward_s_per_m,
+            base.map(|b| b.velocity_feedforward_s_per_m),
+        ),
+        acceleration_feedforward_s2_per_m: gain(
+            c.acceleration_feedforward_s2_per_m,
+            base.map(|b| b.acceleration_feedforward_s2_per_m),
+        ),
+        velocity_feedback_s_per_m: gain(
+            c.velocity_feedback_s_per_m,
+            base.map(|b| b.velocity_feedback_s_per_m),
+        ),
+        acceleration_feedback_s2_per_m: gain(
+            c.acceleration_feedback_s2_per_m,
+            base.map(|b| b.acceleration_feedback_s2_per_m),
+        ),
+        delta_p_gain_per_pa: gain(c.delta_p_gain_per_pa, base.map(|b| b.delta_p_gain_per_pa)),
+        delta_p_highpass_hz: gain(c.delta_p_highpass_hz, base.map(|b| b.delta_p_highpass_hz)),
+    })
+}
+
+/// The closed loop's integrator: RK4 at a step that divides the controller period and
+/// resolves the loop's fastest mode, or Dopri5.
+pub(crate) fn loop_method(
+    ctx: &Ctx,
+    file: &ScenarioFile,
+    system: &TableSystem,
+    mass_kg: f64,
+    stroke_m: f64,
+) -> Result<LoopMethod> {
+    let period = system.controller.period_s();
+    let fastest = system.fastest_rate_rad_s(mass_kg, stroke_m);
+    match &file.integrator {
+        None => Ok(LoopMethod::Rk4 {
+            steps_per_period: system.default_steps_per_period(mass_kg, stroke_m),
+        }),
+        Some(IntegratorSpec::Rk4(spec)) => {
+            let Some(step) = spec.step_s else {
+                return Ok(LoopMethod::Rk4 {
+                    steps_per_period: system.default_steps_per_period(mass_kg, stroke_m),
+                });
+            };
+            let here = "integrator.step_s";
+            if !(step.is_finite() && step > 0.0) {
+                return Err(ctx.invalid(here, step, "a finite step > 0 s"));
+            }
+            let k = (period / step).round();
+            if k < 1.0 || (k * step - period).abs() > 1e-9 * period {
+                return Err(ctx.invalid(
+                    here,
+                    step,
+                    format!(
+                        "the controller's period {period} s divided by a whole number \
+                         (it updates the drive every {period} s)"
+                    ),
+                ));
+            }
+            if step * fastest > 1.0 {
+                let k_default = system.default_steps_per_period(mass_kg, stroke_m);
+                return Err(ctx.invalid(
+                    here,
+                    step,
+                    format!(
+                        "a step that resolves the loop's fastest mode ({:.1} Hz): at most {:.3e} s \
+                         (default {:.3e} s)",
+                        fastest / std::f64::consts::TAU,
+                        1.0 / fastest,
+                        period / f64::from(k_default)
+                    ),
+                ));
+            }
+            Ok(LoopMethod::Rk4 {
+                steps_per_period: k as u32,
+            })
+        }
+        Some(IntegratorSpec::Dopri5(spec)) => {
+            let rtol = spec.rtol.unwrap_or(DEFAULT_RTOL);
+            let atol = spec.atol.unwrap_or(DEFAULT_ATOL);
+            for (path, v) in [("integrator.rtol", rtol), ("integrator.atol", atol)] {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(ctx.invalid(path, v, "a finite tolerance > 0"));
+                }
+            }
+            Ok(LoopMethod::Dopri5 {
+                steps_per_period: 1,
+                rtol,
+                atol,
+            })
+        }
+    }
+}
