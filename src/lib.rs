@@ -9,6 +9,7 @@ pub use platen_model as model;
 pub use platen_report as report;
 pub use platen_scenario as scenario;
 pub use platen_signal as signal;
+pub use platen_system as system;
 
 /// Loads and runs a scenario file, keeping every column in memory.
 pub use platen_scenario::simulate;

@@ -21,7 +21,11 @@
 //! * `dopri5`: [`Method::Dopri5`] at rtol 1e-8, atol 1e-11 on the identified model, same
 //!   force, timed per accepted step;
 //! * `inverse`: [`inverse`] of the paper's S9 sine motion (0.2 m, 0.6 Hz) on the identified
-//!   model, timed per sample.
+//!   model, timed per sample;
+//! * `table_system`: the closed loop ([`forward_closed_loop`]) of the `lhpost-2008` table
+//!   system (controller at 1024 Hz, valves, single-ended actuators, accumulator) on the
+//!   identified model, commanded with that S9 motion, at its default step (7 RK4 steps per
+//!   controller period, resolving the 246 Hz spool), timed per integration step.
 //!
 //! The workloads are data ([`workloads`]): one timing loop ([`time_round_robin`]) runs them
 //! round-robin `repeats` times and the median wall time of each is reported, so that a slow
@@ -36,10 +40,11 @@ use anyhow::{ensure, Context, Result};
 use serde_json::{json, Map, Value};
 
 use platen_integrate::{
-    forward_rk4_specimen, inverse, Dopri5Settings, ForceRecord, ForwardIntegrator, Method, Motion,
-    Rk4, State, Trajectory,
+    forward_closed_loop, forward_rk4_specimen, inverse, Dopri5Settings, ForceRecord,
+    ForwardIntegrator, LoopMethod, LoopRun, Method, Motion, Rk4, State, Trajectory,
 };
 use platen_model::{preset, FullModel, IdentifiedModel, IdentifiedParams, Specimen, Storey};
+use platen_system::TableSystem;
 
 /// The plain-loop measuring stick, compiled from the one file the criterion benches use.
 #[path = "../../../benches/common/baseline.rs"]
@@ -82,6 +87,9 @@ enum Job {
     ForwardSpecimen(Rk4),
     /// [`inverse`] of the motion on the identified model; one unit per sample.
     Inverse,
+    /// [`forward_closed_loop`] of the preset's table system commanded with the motion; one
+    /// unit per integration step.
+    TableSystem,
 }
 
 /// One timed workload.
@@ -180,6 +188,12 @@ fn workloads() -> Result<Vec<Workload>> {
             "sample",
             Job::Inverse,
         ),
+        Workload::new(
+            "table_system",
+            "table_system: closed loop, S9 command, output kept",
+            "step",
+            Job::TableSystem,
+        ),
     ])
 }
 
@@ -194,6 +208,7 @@ struct Inputs {
     identified: IdentifiedModel,
     full: FullModel,
     specimen: Specimen,
+    system: TableSystem,
 }
 
 /// The 3-storey specimen of the `rk4_specimen` workload: 20 t floors, storey stiffnesses 40,
@@ -246,6 +261,7 @@ impl Inputs {
             identified_params,
             full: preset::lhpost_2008_physical(PRESSURE_PA).build()?,
             specimen: bench_specimen()?,
+            system: platen_system::preset::lhpost_2008(),
         })
     }
 }
@@ -312,6 +328,24 @@ impl Job {
                 let stats = stats.context("bench forward RK4 run with a specimen")?;
                 black_box(&*out);
                 Ok((s, stats.accepted_steps, None))
+            }
+            Job::TableSystem => {
+                clear(out);
+                let system = &inputs.system;
+                let run = LoopRun {
+                    system,
+                    specimen: None,
+                    command: black_box(&inputs.motion),
+                    method: LoopMethod::Rk4 {
+                        steps_per_period: system.default_steps_per_period(144e3, 0.75),
+                    },
+                    initial: State::default(),
+                };
+                let model = black_box(&inputs.identified);
+                let (s, stats) = time(|| forward_closed_loop(model, &run, samples, out));
+                let stats = stats.context("bench closed-loop run")?;
+                black_box(&*out);
+                Ok((s, stats.run.steps, None))
             }
             Job::Inverse => {
                 clear(out);
@@ -421,6 +455,15 @@ impl Report<'_> {
             json!(self.get("inverse").ns_per_unit()),
         );
         m.insert("baseline_ns_per_step".into(), json!(base));
+        let system = self.get("table_system");
+        m.insert(
+            "table_system_ns_per_step".into(),
+            json!(system.ns_per_unit()),
+        );
+        m.insert(
+            "table_system_ratio_to_baseline".into(),
+            json!(system.ns_per_unit() / base),
+        );
         m.insert(
             "rk4_ratio_to_baseline".into(),
             json!(rk4.ns_per_unit() / base),
@@ -511,6 +554,20 @@ fn clear(t: &mut Trajectory) {
     if let Some(sp) = &mut t.specimen {
         sp.base_shear_n.clear();
         sp.u_m.iter_mut().chain(&mut sp.a_m_s2).for_each(Vec::clear);
+    }
+    if let Some(sy) = &mut t.system {
+        for column in [
+            &mut sy.command_u_m,
+            &mut sy.drive,
+            &mut sy.spool_opening,
+            &mut sy.delta_p_pa,
+            &mut sy.flow_m3_s,
+            &mut sy.supply_pressure_pa,
+            &mut sy.cap_pressure_pa,
+            &mut sy.rod_pressure_pa,
+        ] {
+            column.clear();
+        }
     }
 }
 

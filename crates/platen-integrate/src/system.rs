@@ -72,10 +72,12 @@ const OIL: usize = 9;
 const EH: usize = 10;
 /// Energy lost to cross-port leakage, `∫n·C_L(p_a − p_b)² dt`, J.
 const EL: usize = 11;
-const Z: usize = 12;
-const CAP: usize = Z + 2 * NS;
-
-type Y = [f64; CAP];
+/// Supply pressure, Pa.
+const PS: usize = 12;
+const Z: usize = 13;
+/// The state of a loop with `(L − Z)/2` storeys: the stepper is compiled per length so that a
+/// bare platen steps arrays of 12, not of the largest specimen's 36.
+type Y<const L: usize> = [f64; L];
 
 /// The integrator of a closed-loop run.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -181,12 +183,24 @@ pub fn forward_closed_loop<M: PlatenModel, S: SampleSink>(
     if samples == 0 {
         return Ok(LoopStats::default());
     }
-    let mut stepper = Loop::new(model, run, period / f64::from(k));
-    stepper.run(k, samples, sink)?;
-    Ok(stepper.finish())
+    let h = period / f64::from(k);
+    macro_rules! by_storeys {
+        ($($n:literal => $len:literal),*) => {
+            match run.specimen.map_or(0, Specimen::len) {
+                $($n => {
+                    let mut stepper = Loop::<M, $len>::new(model, run, h);
+                    stepper.run(k, samples, sink)?;
+                    Ok(stepper.finish())
+                })*
+                other => unreachable!("a validated specimen has 1 to {NS} storeys, not {other}"),
+            }
+        };
+    }
+    by_storeys!(0 => 13, 1 => 15, 2 => 17, 3 => 19, 4 => 21, 5 => 23, 6 => 25, 7 => 27,
+                8 => 29, 9 => 31, 10 => 33, 11 => 35, 12 => 37)
 }
 
-struct Loop<'a, M> {
+struct Loop<'a, M, const L: usize> {
     model: &'a M,
     sys: &'a TableSystem,
     spec: Option<&'a Specimen>,
@@ -194,14 +208,12 @@ struct Loop<'a, M> {
     method: LoopMethod,
     /// Storeys.
     n: usize,
-    /// Live state length.
-    len: usize,
     h: f64,
     t0: f64,
     /// Time at the start of the current segment, s.
     t: f64,
-    y: Y,
-    k: Y,
+    y: Y<L>,
+    k: Y<L>,
     a: f64,
     mode: Mode,
     w_stiff: f64,
@@ -215,17 +227,18 @@ struct Loop<'a, M> {
     stats: LoopStats,
 }
 
-impl<'a, M: PlatenModel> Loop<'a, M> {
+impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
     fn new(model: &'a M, run: &LoopRun<'a>, h: f64) -> Self {
         let (sys, spec, command, method) = (run.system, run.specimen, run.command, run.method);
         let n = spec.map_or(0, Specimen::len);
-        let mut y = [0.0; CAP];
+        let mut y = [0.0; L];
         let rest = sys.rest_state();
         y[U] = run.initial.u_m;
         y[V] = run.initial.v_m_s;
         y[PA] = rest.p_a_pa;
         y[PB] = rest.p_b_pa;
         y[OIL] = rest.accumulator_oil_m3;
+        y[PS] = rest.supply_pressure_pa;
         let t0 = command.t_s()[0];
         let delay = sys.servo_valve.delay_s;
         let slots = (delay * sys.controller.sample_rate_hz).ceil() as usize + 2;
@@ -236,12 +249,11 @@ impl<'a, M: PlatenModel> Loop<'a, M> {
             command,
             method,
             n,
-            len: Z + 2 * n,
             h,
             t0,
             t: t0,
             y,
-            k: [0.0; CAP],
+            k: [0.0; L],
             a: 0.0,
             mode: Mode::Stick,
             w_stiff: 0.0,
@@ -263,30 +275,31 @@ impl<'a, M: PlatenModel> Loop<'a, M> {
         s
     }
 
-    fn hydraulic_state(y: &Y) -> HydraulicState {
+    fn hydraulic_state(y: &Y<L>) -> HydraulicState {
         HydraulicState {
             p_a_pa: y[PA],
             p_b_pa: y[PB],
             spool: y[XV],
             spool_rate_1_s: y[XR],
             accumulator_oil_m3: y[OIL],
+            supply_pressure_pa: y[PS],
         }
     }
 
     #[inline(always)]
-    fn force(&self, y: &Y) -> f64 {
+    fn force(&self, y: &Y<L>) -> f64 {
         self.sys.force_n(y[PA].max(0.0), y[PB].max(0.0))
     }
 
     #[inline(always)]
-    fn base_shear(&self, y: &Y) -> f64 {
+    fn base_shear(&self, y: &Y<L>) -> f64 {
         match self.spec {
             Some(spec) => spec.base_shear_n(y[Z], y[Z + self.n]),
             None => 0.0,
         }
     }
 
-    fn specimen_energy(&self, y: &Y) -> f64 {
+    fn specimen_energy(&self, y: &Y<L>) -> f64 {
         match self.spec {
             Some(spec) => {
                 let (n, zd) = (self.n, Z + self.n);
@@ -298,14 +311,14 @@ impl<'a, M: PlatenModel> Loop<'a, M> {
 
     /// The net force on the platen less its elastic force: `N = F_A − F_E(u) − B`.
     #[inline(always)]
-    fn net(&self, y: &Y) -> f64 {
+    fn net(&self, y: &Y<L>) -> f64 {
         self.force(y) - self.model.elastic_force_n(y[U]) - self.base_shear(y)
     }
 
     /// The rates of the state in `mode`, into `dy`; returns the platen acceleration and the
     /// hydraulic rates.
     #[inline(always)]
-    fn rates(&self, mode: Mode, y: &Y, dy: &mut Y) -> (f64, HydraulicRates) {
+    fn rates(&self, mode: Mode, y: &Y<L>, dy: &mut Y<L>) -> (f64, HydraulicRates) {
         let f = self.force(y);
         let f_eff = f - self.base_shear(y);
         let (a, v_eff) = match mode {
@@ -340,6 +353,7 @@ impl<'a, M: PlatenModel> Loop<'a, M> {
         dy[XV] = hr.spool;
         dy[XR] = hr.spool_rate;
         dy[OIL] = hr.accumulator_oil;
+        dy[PS] = hr.supply_pressure;
         dy[EH] = hr.hydraulic_power_w;
         let act = &self.sys.actuator;
         let dp = y[PA].max(0.0) - y[PB].max(0.0);
@@ -354,7 +368,7 @@ impl<'a, M: PlatenModel> Loop<'a, M> {
     }
 
     /// The rate of the net force `Ṅ` from the rates `k` (stick: `u` fixed).
-    fn net_rate(&self, k: &Y) -> f64 {
+    fn net_rate(&self, k: &Y<L>) -> f64 {
         let act = &self.sys.actuator;
         let df = f64::from(act.count) * (act.cap_area_m2 * k[PA] - act.rod_area_m2 * k[PB]);
         match self.spec {
@@ -367,7 +381,7 @@ impl<'a, M: PlatenModel> Loop<'a, M> {
     }
 
     /// The current mode's event function: positive until the mode ends.
-    fn event_g(&self, y: &Y) -> f64 {
+    fn event_g(&self, y: &Y<L>) -> f64 {
         match self.mode {
             Mode::Slip(dir) => dir.sign() * y[V],
             Mode::Stick => self.model.static_threshold_n(y[U]) - self.net(y).abs(),
@@ -385,7 +399,7 @@ impl<'a, M: PlatenModel> Loop<'a, M> {
             + s * self.model.velocity_inertial_force_n(u, s * self.w_stiff)
     }
 
-    fn creep_velocity(&self, dir: Direction, y: &Y) -> f64 {
+    fn creep_velocity(&self, dir: Direction, y: &Y<L>) -> f64 {
         let f_eff = self.force(y) - self.base_shear(y);
         let w = creep_speed_m_s(self.model, dir, y[U], f_eff, self.w_stiff).unwrap_or(self.w_stiff);
         dir.sign() * w
@@ -398,7 +412,7 @@ impl<'a, M: PlatenModel> Loop<'a, M> {
             let y = self.y;
             self.y[V] = self.creep_velocity(dir, &y);
         }
-        let (y, mut k) = (self.y, [0.0; CAP]);
+        let (y, mut k) = (self.y, [0.0; L]);
         self.a = self.rates(mode, &y, &mut k).0;
         self.k = k;
         self.stats.run.rhs_evaluations += 1;
@@ -408,17 +422,16 @@ impl<'a, M: PlatenModel> Loop<'a, M> {
 
     /// One RK4 step of `dt` seconds from `y` with rates `k1`: the end state and the smallest
     /// stage speed along the slip direction.
-    fn rk4(&mut self, dt: f64, y: &Y, k1: &Y) -> (Y, f64) {
+    fn rk4(&mut self, dt: f64, y: &Y<L>, k1: &Y<L>) -> (Y<L>, f64) {
         let mode = self.mode;
-        let len = self.len;
-        let combine = |base: &Y, k: &Y, c: f64| {
+        let combine = |base: &Y<L>, k: &Y<L>, c: f64| {
             let mut out = *base;
-            for i in 0..len {
+            for i in 0..L {
                 out[i] += c * k[i];
             }
             out
         };
-        let (mut k2, mut k3, mut k4) = ([0.0; CAP], [0.0; CAP], [0.0; CAP]);
+        let (mut k2, mut k3, mut k4) = ([0.0; L], [0.0; L], [0.0; L]);
         let y2 = combine(y, k1, 0.5 * dt);
         self.rates(mode, &y2, &mut k2);
         let y3 = combine(y, &k2, 0.5 * dt);
@@ -428,7 +441,7 @@ impl<'a, M: PlatenModel> Loop<'a, M> {
         self.stats.run.rhs_evaluations += 3;
         let h6 = dt / 6.0;
         let mut y1 = *y;
-        for i in 0..len {
+        for i in 0..L {
             y1[i] += h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
         }
         let stage_min = match mode {
@@ -454,6 +467,7 @@ impl<'a, M: PlatenModel> Loop<'a, M> {
                 Supply::Accumulator(acc) => acc.volume_m3,
                 Supply::Constant => 1.0,
             },
+            PS => self.sys.supply_pressure_pa * 1e3,
             V => 1.0,
             W | DI | SD | EH | EL => return f64::INFINITY,
             _ => 1.0,
@@ -463,7 +477,7 @@ impl<'a, M: PlatenModel> Loop<'a, M> {
 
     /// Adaptive Dormand–Prince 5(4) over `dt` from `y` with rates `k1`: the end state and
     /// the smallest speed along the slip direction at its stages.
-    fn dopri5(&mut self, dt: f64, y: &Y, k1: &Y, rtol: f64, atol: f64) -> (Y, f64) {
+    fn dopri5(&mut self, dt: f64, y: &Y<L>, k1: &Y<L>, rtol: f64, atol: f64) -> (Y<L>, f64) {
         const C: [f64; 6] = [0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0];
         const A: [[f64; 6]; 6] = [
             [0.2, 0.0, 0.0, 0.0, 0.0, 0.0],
@@ -504,7 +518,7 @@ impl<'a, M: PlatenModel> Loop<'a, M> {
             -1.0 / 40.0,
         ];
         let _ = C;
-        let (mode, len) = (self.mode, self.len);
+        let mode = self.mode;
         let (mut yc, mut kc) = (*y, *k1);
         let mut done = 0.0;
         let mut stage_min = f64::INFINITY;
@@ -514,12 +528,12 @@ impl<'a, M: PlatenModel> Loop<'a, M> {
             guard += 1;
             let last = dt - done <= hs * (1.0 + 1e-12);
             let step = if last { dt - done } else { hs };
-            let mut ks = [[0.0; CAP]; 7];
+            let mut ks = [[0.0; L]; 7];
             ks[0] = kc;
             let mut ys = [yc; 6];
             for s in 0..6 {
                 let mut yi = yc;
-                for i in 0..len {
+                for i in 0..L {
                     let mut acc = 0.0;
                     for (j, kj) in ks.iter().enumerate().take(s + 1) {
                         acc += A[s][j] * kj[i];
@@ -527,14 +541,14 @@ impl<'a, M: PlatenModel> Loop<'a, M> {
                     yi[i] += step * acc;
                 }
                 ys[s] = yi;
-                let mut kn = [0.0; CAP];
+                let mut kn = [0.0; L];
                 self.rates(mode, &yi, &mut kn);
                 ks[s + 1] = kn;
             }
             self.stats.run.rhs_evaluations += 6;
             let y_new = ys[5];
             let mut err: f64 = 0.0;
-            for i in 0..len {
+            for i in 0..L {
                 let mut e = 0.0;
                 for (j, kj) in ks.iter().enumerate() {
                     e += E[j] * kj[i];
@@ -575,7 +589,7 @@ impl<'a, M: PlatenModel> Loop<'a, M> {
 
     /// The current mode's state over `x` seconds from the current state, as the method maps
     /// it (RK4 graded by `grading`); with the smallest stage speed.
-    fn piece(&mut self, x: f64, grading: Grading) -> (Y, f64) {
+    fn piece(&mut self, x: f64, grading: Grading) -> (Y<L>, f64) {
         let (y, k) = (self.y, self.k);
         match self.method {
             LoopMethod::Dopri5 { rtol, atol, .. } => self.dopri5(x, &y, &k, rtol, atol),
@@ -600,7 +614,7 @@ impl<'a, M: PlatenModel> Loop<'a, M> {
 
     /// Whether the event function may dip to zero inside a piece of `x` seconds to `y1`
     /// (rates `k1`, platen acceleration `a1`).
-    fn dips(&self, x: f64, y1: &Y, k1: &Y, a1: f64) -> bool {
+    fn dips(&self, x: f64, y1: &Y<L>, k1: &Y<L>, a1: f64) -> bool {
         match self.mode {
             Mode::Slip(dir) => {
                 let d = dir.sign();
@@ -656,19 +670,19 @@ impl<'a, M: PlatenModel> Loop<'a, M> {
         let mut len = rest;
         for _ in 0..=MAX_HALVINGS {
             let (y1, stage_min) = self.piece(len, try_grading);
-            if !y1[..self.len].iter().all(|x| x.is_finite()) {
+            if !y1.iter().all(|x| x.is_finite()) {
                 return Err(self.non_finite());
             }
             let g1 = self.event_g(&y1);
             if g1 > 0.0 && stage_min > 0.0 {
-                let mut k1 = [0.0; CAP];
+                let mut k1 = [0.0; L];
                 let (a1, _) = self.rates(self.mode, &y1, &mut k1);
                 self.stats.run.rhs_evaluations += 1;
                 if !self.dips(len, &y1, &k1, a1) {
                     if self.mode == Mode::Stick {
                         self.stats.run.stick_time_s += len;
                     }
-                    self.commit(y1, self.t + len);
+                    self.commit_with(y1, k1, a1, self.t + len);
                     return Ok(len);
                 }
             } else if g1 <= 0.0 {
@@ -698,23 +712,30 @@ impl<'a, M: PlatenModel> Loop<'a, M> {
     }
 
     /// Accepts `y` as the state at time `t` (pressures held at the cavitation floor).
-    fn commit(&mut self, mut y: Y, t: f64) {
-        for i in [PA, PB] {
-            if y[i] < 0.0 {
-                y[i] = 0.0;
-                self.stats.cavitation_at_s.get_or_insert(t);
-            }
-        }
-        let mut k = [0.0; CAP];
+    fn commit(&mut self, y: Y<L>, t: f64) {
+        let mut k = [0.0; L];
         let (a, _) = self.rates(self.mode, &y, &mut k);
         self.stats.run.rhs_evaluations += 1;
+        self.commit_with(y, k, a, t);
+    }
+
+    /// [`Loop::commit`] with the rates `k` and acceleration `a` at `y` already known (they
+    /// are recomputed only if a pressure is held at the floor).
+    fn commit_with(&mut self, mut y: Y<L>, mut k: Y<L>, mut a: f64, t: f64) {
+        if y[PA] < 0.0 || y[PB] < 0.0 {
+            for i in [PA, PB] {
+                y[i] = y[i].max(0.0);
+            }
+            self.stats.cavitation_at_s.get_or_insert(t);
+            a = self.rates(self.mode, &y, &mut k).0;
+            self.stats.run.rhs_evaluations += 1;
+        }
         (self.y, self.k, self.a) = (y, k, a);
-        let ps = self.sys.supply_pressure_at(y[OIL]);
-        self.stats.min_supply_pressure_pa = self.stats.min_supply_pressure_pa.min(ps);
+        self.stats.min_supply_pressure_pa = self.stats.min_supply_pressure_pa.min(y[PS]);
     }
 
     /// The reset at the current mode's event, located `x` seconds on (at most `rest`).
-    fn event(&mut self, x: f64, rest: f64, y_event: Y) -> f64 {
+    fn event(&mut self, x: f64, rest: f64, y_event: Y<L>) -> f64 {
         let mut at = x;
         if rest - at < 1e-12 * self.h {
             at = rest;
@@ -895,7 +916,7 @@ impl<'a, M: PlatenModel> Loop<'a, M> {
             }
             sample.specimen = Some(sp);
         }
-        let ps = self.sys.supply_pressure_at(self.y[OIL]);
+        let ps = self.y[PS];
         let (p_a, p_b) = (self.y[PA].max(0.0), self.y[PB].max(0.0));
         let (q_a, _) = self.sys.valve_flows_m3_s(self.y[XV], p_a, p_b, ps);
         sample.system = Some(SystemSample {

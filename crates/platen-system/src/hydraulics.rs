@@ -21,6 +21,10 @@ pub struct HydraulicState {
     pub spool_rate_1_s: f64,
     /// Oil held in the accumulator bank, m³ (0 with a constant supply).
     pub accumulator_oil_m3: f64,
+    /// The supply pressure, Pa: the bank's gas pressure, integrated alongside its oil
+    /// (`Ṗ = n·P·Q/V_g`, so that no power law is evaluated per step; `P·V_g^n` stays
+    /// constant to the integration's accuracy), or the constant supply pressure.
+    pub supply_pressure_pa: f64,
 }
 
 /// The rates of a [`HydraulicState`] and what they come from.
@@ -36,6 +40,8 @@ pub struct HydraulicRates {
     pub spool_rate: f64,
     /// Rate of the accumulator's oil, m³/s.
     pub accumulator_oil: f64,
+    /// Rate of the supply pressure, Pa/s.
+    pub supply_pressure: f64,
     /// Flow into chamber `a` of one actuator, m³/s.
     pub q_a_m3_s: f64,
     /// Flow out of chamber `b` of one actuator, m³/s.
@@ -90,6 +96,7 @@ impl TableSystem {
             spool: 0.0,
             spool_rate_1_s: 0.0,
             accumulator_oil_m3: self.charged_oil_m3(),
+            supply_pressure_pa: self.supply_pressure_pa,
         }
     }
 
@@ -98,6 +105,9 @@ impl TableSystem {
     #[inline(always)]
     pub fn valve_flows_m3_s(&self, x: f64, p_a: f64, p_b: f64, p_s: f64) -> (f64, f64) {
         let x = x.clamp(-1.0, 1.0);
+        if x == 0.0 {
+            return (0.0, 0.0);
+        }
         let k = self.land_coefficient();
         let p_t = LAMINAR_FRACTION * self.servo_valve.rated_pressure_drop_pa;
         let p_r = self.return_pressure_pa;
@@ -123,7 +133,7 @@ impl TableSystem {
     ) -> HydraulicRates {
         let act = &self.actuator;
         let (p_a, p_b) = (s.p_a_pa.max(0.0), s.p_b_pa.max(0.0));
-        let p_s = self.supply_pressure_at(s.accumulator_oil_m3);
+        let p_s = s.supply_pressure_pa;
         let (q_a, q_b) = self.valve_flows_m3_s(s.spool, p_a, p_b, p_s);
         let (v_a, v_b) = self.chamber_volumes_m3(u_m);
         let beta = self.oil_bulk_modulus_pa;
@@ -140,12 +150,14 @@ impl TableSystem {
         let zeta = self.servo_valve.damping_ratio;
         let n = f64::from(act.count);
         let drawn = n * if s.spool >= 0.0 { q_a } else { -q_b };
-        let oil = match &self.supply {
-            Supply::Constant => 0.0,
+        let (oil, d_ps) = match &self.supply {
+            Supply::Constant => (0.0, 0.0),
             Supply::Accumulator(acc) => {
                 let band = 0.01 * self.supply_pressure_pa;
                 let taper = ((self.supply_pressure_pa - p_s) / band).clamp(0.0, 1.0);
-                acc.pump_flow_m3_s * taper - drawn
+                let q = acc.pump_flow_m3_s * taper - drawn;
+                let gas = (acc.volume_m3 - s.accumulator_oil_m3).max(1e-9 * acc.volume_m3);
+                (q, acc.polytropic_exponent * p_s * q / gas)
             }
         };
         HydraulicRates {
@@ -154,6 +166,7 @@ impl TableSystem {
             spool: s.spool_rate_1_s,
             spool_rate: wv * wv * (drive - s.spool) - 2.0 * zeta * wv * s.spool_rate_1_s,
             accumulator_oil: oil,
+            supply_pressure: d_ps,
             q_a_m3_s: q_a,
             q_b_m3_s: q_b,
             supply_flow_m3_s: drawn,
