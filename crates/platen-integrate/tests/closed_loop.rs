@@ -529,28 +529,21 @@ fn sine_fit(t: &[f64], y: &[f64], w: f64) -> (f64, f64) {
     let mut r = [0.0; 3];
     for (&ti, &yi) in t.iter().zip(y) {
         let basis = [(w * ti).sin(), (w * ti).cos(), 1.0];
-        for i in 0..3 {
+        for (i, row) in m.iter_mut().enumerate() {
             r[i] += basis[i] * yi;
-            for j in 0..3 {
-                m[i][j] += basis[i] * basis[j];
-            }
+            row.iter_mut().zip(basis).for_each(|(x, b)| *x += basis[i] * b);
         }
     }
     // Gauss–Jordan on the 3 × 3 normal equations.
     for c in 0..3 {
         let p = m[c][c];
-        for j in 0..3 {
-            m[c][j] /= p;
-        }
+        m[c].iter_mut().for_each(|x| *x /= p);
         r[c] /= p;
-        for i in 0..3 {
-            if i != c {
-                let f = m[i][c];
-                for j in 0..3 {
-                    m[i][j] -= f * m[c][j];
-                }
-                r[i] -= f * r[c];
-            }
+        let pivot = m[c];
+        for i in (0..3).filter(|&i| i != c) {
+            let f = m[i][c];
+            m[i].iter_mut().zip(pivot).for_each(|(x, p)| *x -= f * p);
+            r[i] -= f * r[c];
         }
     }
     let (a, b) = (r[0], r[1]);
