@@ -22,7 +22,7 @@ use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 
 use platen_compare::{Comparison, Direction, Recording, Settings, Window};
-use platen_integrate::{SpecimenColumns, Trajectory};
+use platen_integrate::{SpecimenColumns, SystemColumns, Trajectory};
 use platen_io::columns::ColumnMap;
 use platen_model::{IdentifiedKey, PhysicalKey, Preset};
 use platen_scenario::sweep::{csv_text, json_summary, SetAxis, Sweep};
@@ -76,9 +76,10 @@ fn run_scenario(scenario: &Scenario, path: &Path) -> Result<(Trajectory, String)
 }
 
 /// The trajectory's columns as NumPy arrays that take over its vectors, the specimen's after
-/// the contract's (the CSV's order).
+/// the contract's and the table system's last (the CSV's order).
 fn to_python(py: Python<'_>, (mut trajectory, summary): (Trajectory, String)) -> RunParts<'_> {
     let specimen = trajectory.specimen.take();
+    let system = trajectory.system.take();
     let mut names = Trajectory::COLUMN_NAMES.to_vec();
     let mut arrays: Vec<_> = trajectory
         .into_columns()
@@ -93,6 +94,34 @@ fn to_python(py: Python<'_>, (mut trajectory, summary): (Trajectory, String)) ->
         arrays.push(sp.base_shear_n.into_pyarray(py));
         arrays.extend(sp.u_m.into_iter().map(|c| c.into_pyarray(py)));
         arrays.extend(sp.a_m_s2.into_iter().map(|c| c.into_pyarray(py)));
+    }
+    if let Some(sy) = system {
+        names.extend(SystemColumns::NAMES);
+        let SystemColumns {
+            command_u_m,
+            drive,
+            spool_opening,
+            delta_p_pa,
+            flow_m3_s,
+            supply_pressure_pa,
+            cap_pressure_pa,
+            rod_pressure_pa,
+        } = sy;
+        // In the order of `SystemColumns::NAMES`.
+        arrays.extend(
+            [
+                command_u_m,
+                drive,
+                spool_opening,
+                delta_p_pa,
+                flow_m3_s,
+                supply_pressure_pa,
+                cap_pressure_pa,
+                rod_pressure_pa,
+            ]
+            .into_iter()
+            .map(|c| c.into_pyarray(py)),
+        );
     }
     (names, arrays, summary)
 }

@@ -5,7 +5,7 @@
 //! ```json
 //! "table_system": { "preset": "lhpost-2008" }
 //! "table_system": {
-//!   "actuator": { "count": 1, "area_m2": 0.02, "chamber_volume_m3": 0.012,
+//!   "actuator": { "count": 1, "area_m2": 0.02, "chamber_volume_m3": 0.02,
 //!                 "leakage_m3_s_per_pa": 1e-11 },
 //!   "servo_valve": { "count": 1, "rated_flow_m3_s": 0.01, "rated_pressure_drop_pa": 7e6,
 //!                    "natural_frequency_hz": 120, "damping_ratio": 0.7, "delay_s": 0.0005 },
@@ -56,8 +56,13 @@ pub struct TableSystemSpec {
     pub supply_pressure_pa: Option<f64>,
     /// Return pressure (absolute), Pa.
     pub return_pressure_pa: Option<f64>,
-    /// An accumulator bank fed by pumps; `null` for a constant supply.
-    #[serde(default, deserialize_with = "present")]
+    /// An accumulator bank fed by pumps; `null` for a constant supply. (Absent is not
+    /// `null`: it keeps the preset's bank, so it is not written as `null` either.)
+    #[serde(
+        default,
+        deserialize_with = "present",
+        skip_serializing_if = "Option::is_none"
+    )]
     #[schemars(with = "Option<AccumulatorSpec>")]
     pub accumulator: Option<Option<AccumulatorSpec>>,
     /// The controller.
@@ -90,13 +95,53 @@ pub struct ActuatorSpec {
 }
 
 /// `chamber_volume_m3`: one volume for both chambers, or `[cap, rod]`.
-#[derive(Debug, Clone, Copy, Deserialize, Serialize, JsonSchema)]
+#[derive(Debug, Clone, Copy, Serialize, JsonSchema)]
 #[serde(untagged)]
 pub enum ChamberVolumes {
     /// Both chambers alike.
     Both(f64),
     /// `[cap, rod]`.
     Each([f64; 2]),
+}
+
+/// By hand rather than `untagged`, so that a wrong value says what was expected (serde's
+/// untagged enums only say that no variant matched).
+impl<'de> Deserialize<'de> for ChamberVolumes {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Volumes;
+        impl<'de> serde::de::Visitor<'de> for Volumes {
+            type Value = ChamberVolumes;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a volume in m³ for both chambers, or [cap, rod]")
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Self::Value, E> {
+                Ok(ChamberVolumes::Both(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Self::Value, E> {
+                Ok(ChamberVolumes::Both(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Self::Value, E> {
+                Ok(ChamberVolumes::Both(v as f64))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> Result<Self::Value, A::Error> {
+                use serde::de::Error;
+                let mut each = [0.0; 2];
+                for (i, slot) in each.iter_mut().enumerate() {
+                    *slot = seq
+                        .next_element()?
+                        .ok_or_else(|| A::Error::invalid_length(i, &"[cap, rod]: two volumes"))?;
+                }
+                if seq.next_element::<serde::de::IgnoredAny>()?.is_some() {
+                    return Err(A::Error::invalid_length(3, &"[cap, rod]: two volumes"));
+                }
+                Ok(ChamberVolumes::Each(each))
+            }
+        }
+        d.deserialize_any(Volumes)
+    }
 }
 
 /// `table_system.servo_valve`.
@@ -378,6 +423,46 @@ fn controller(
     })
 }
 
+/// The most RK4 steps per controller period, as
+/// [`TableSystem::default_steps_per_period`] clamps them.
+const MAX_STEPS_PER_PERIOD: f64 = 1e6;
+
+/// The error of a loop whose fastest mode RK4 cannot resolve within
+/// [`MAX_STEPS_PER_PERIOD`] steps per controller period, named by the value that makes it
+/// fast: the spool's natural frequency, or the oil column (stiff oil, small chambers).
+fn unresolvable(
+    ctx: &Ctx,
+    system: &TableSystem,
+    period: f64,
+    fastest: f64,
+) -> crate::error::ScenarioError {
+    let tau = std::f64::consts::TAU;
+    let f_max = MAX_STEPS_PER_PERIOD / (tau * period);
+    let remedy = format!(
+        "RK4 resolves modes up to {f_max:.3e} Hz with the controller at {} Hz \
+         ({MAX_STEPS_PER_PERIOD:e} steps per controller period); use \
+         {{\"method\": \"dopri5\"}} or a faster controller",
+        system.controller.sample_rate_hz
+    );
+    let valve_hz = system.servo_valve.natural_frequency_hz;
+    if tau * valve_hz >= fastest {
+        ctx.invalid(
+            "table_system.servo_valve.natural_frequency_hz",
+            valve_hz,
+            format!("a spool RK4 can resolve: {remedy}"),
+        )
+    } else {
+        ctx.invalid(
+            "table_system",
+            format!(
+                "(an oil column of {:.4e} Hz at the stroke's ends)",
+                fastest / tau
+            ),
+            format!("a loop RK4 can resolve: {remedy}"),
+        )
+    }
+}
+
 /// The closed loop's integrator: RK4 at a step that divides the controller period and
 /// resolves the loop's fastest mode, or Dopri5.
 pub(crate) fn loop_method(
@@ -389,15 +474,23 @@ pub(crate) fn loop_method(
 ) -> Result<LoopMethod> {
     let period = system.controller.period_s();
     let fastest = system.fastest_rate_rad_s(mass_kg, stroke_m);
+    // The default step: the least `k` with `h·ω_max ≤ 0.25`, but at most
+    // `MAX_STEPS_PER_PERIOD`; a loop that this many steps cannot resolve is refused (RK4 at
+    // the clamped step would blow up within a few steps).
+    let default_rk4 = || -> Result<LoopMethod> {
+        let k = system.default_steps_per_period(mass_kg, stroke_m);
+        if period / f64::from(k) * fastest > 1.0 {
+            return Err(unresolvable(ctx, system, period, fastest));
+        }
+        Ok(LoopMethod::Rk4 {
+            steps_per_period: k,
+        })
+    };
     match &file.integrator {
-        None => Ok(LoopMethod::Rk4 {
-            steps_per_period: system.default_steps_per_period(mass_kg, stroke_m),
-        }),
+        None => default_rk4(),
         Some(IntegratorSpec::Rk4(spec)) => {
             let Some(step) = spec.step_s else {
-                return Ok(LoopMethod::Rk4 {
-                    steps_per_period: system.default_steps_per_period(mass_kg, stroke_m),
-                });
+                return default_rk4();
             };
             let here = "integrator.step_s";
             if !(step.is_finite() && step > 0.0) {
@@ -411,6 +504,17 @@ pub(crate) fn loop_method(
                     format!(
                         "the controller's period {period} s divided by a whole number \
                          (it updates the drive every {period} s)"
+                    ),
+                ));
+            }
+            if k > MAX_STEPS_PER_PERIOD {
+                return Err(ctx.invalid(
+                    here,
+                    step,
+                    format!(
+                        "at least the controller's period {period} s divided by \
+                         {MAX_STEPS_PER_PERIOD:e} ({:e} s)",
+                        period / MAX_STEPS_PER_PERIOD
                     ),
                 ));
             }
