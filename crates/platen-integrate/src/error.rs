@@ -142,6 +142,14 @@ pub enum IntegrateError {
         /// What ode_solvers reported.
         reason: AdaptiveFailure,
     },
+    /// A closed-loop run drove the platen to the end of its actuators.
+    #[error("the platen reached the end of its actuators at t = {t_s} s (u = {u_m} m): a chamber's oil volume is gone; the command asks for more stroke than the actuators have (check it against the table's stroke)")]
+    EndStop {
+        /// Time, s.
+        t_s: f64,
+        /// Displacement, m.
+        u_m: f64,
+    },
     /// The stick-slip event loop stopped advancing inside one step.
     #[error("numerical failure at t = {t_s} s: {events} stick-slip events inside one step; the event loop does not advance")]
     EventLoopStalled {
@@ -163,6 +171,7 @@ impl IntegrateError {
                 IntegrateError::EventLoopStalled { t_s, events }
             }
             Failure::AdaptiveFailed(reason) => IntegrateError::AdaptiveFailed { t_s, reason },
+            Failure::EndStop { u_m } => IntegrateError::EndStop { t_s, u_m },
         }
     }
 
@@ -180,6 +189,7 @@ impl IntegrateError {
             IntegrateError::AdaptiveFailed { t_s, reason } => {
                 (t_s, Failure::AdaptiveFailed(reason))
             }
+            IntegrateError::EndStop { t_s, u_m } => (t_s, Failure::EndStop { u_m }),
             _ => return None,
         };
         Some(StopReason::Failed { t_s, cause })

@@ -50,6 +50,13 @@ pub enum Failure {
     },
     /// The adaptive integrator (Dopri5) gave up.
     AdaptiveFailed(AdaptiveFailure),
+    /// A closed-loop run drove the platen to the end of its actuators: a chamber's volume
+    /// (lines included) is gone. Not a numerical failure: the command asks for more stroke
+    /// than the actuators have.
+    EndStop {
+        /// Displacement, m.
+        u_m: f64,
+    },
 }
 
 /// Why ode_solvers' Dopri5 gave up.

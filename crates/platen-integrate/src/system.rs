@@ -360,7 +360,7 @@ impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
         dy[EL] = f64::from(act.count) * act.leakage_m3_s_per_pa * dp * dp;
         if let Some(spec) = self.spec {
             let (n, zd) = (self.n, Z + self.n);
-            dy.copy_within(zd..zd + n, Z);
+            dy[Z..Z + n].copy_from_slice(&y[zd..zd + n]);
             let (zs, rest) = (&y[Z..Z + n], &y[zd..zd + n]);
             dy[SD] = spec.storey_accelerations(a, zs, rest, &mut dy[zd..zd + n]);
         }
@@ -672,6 +672,11 @@ impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
             let (y1, stage_min) = self.piece(len, try_grading);
             if !y1.iter().all(|x| x.is_finite()) {
                 return Err(self.non_finite());
+            }
+            let (v_a, v_b) = self.sys.chamber_volumes_m3(y1[U]);
+            if v_a <= 0.0 || v_b <= 0.0 {
+                let cause = Failure::EndStop { u_m: y1[U] };
+                return Err(IntegrateError::failed(self.t + len, cause));
             }
             let g1 = self.event_g(&y1);
             if g1 > 0.0 && stage_min > 0.0 {

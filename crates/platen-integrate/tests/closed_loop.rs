@@ -531,7 +531,9 @@ fn sine_fit(t: &[f64], y: &[f64], w: f64) -> (f64, f64) {
         let basis = [(w * ti).sin(), (w * ti).cos(), 1.0];
         for (i, row) in m.iter_mut().enumerate() {
             r[i] += basis[i] * yi;
-            row.iter_mut().zip(basis).for_each(|(x, b)| *x += basis[i] * b);
+            row.iter_mut()
+                .zip(basis)
+                .for_each(|(x, b)| *x += basis[i] * b);
         }
     }
     // Gauss–Jordan on the 3 × 3 normal equations.
@@ -626,4 +628,85 @@ fn the_small_signal_response_matches_the_independent_linear_reference() {
         assert!(wrap(h.arg().to_degrees() - phase_u).abs() < 1e-4);
     }
     println!("worst: gain {worst_gain:.2e}, phase {worst_phase:.3}°");
+}
+
+/// A command beyond the actuators' reach stops the run cleanly at the end stop (a chamber's
+/// volume gone), with its time and displacement, instead of running on to nonsense.
+#[test]
+fn a_command_past_the_actuators_reach_stops_at_the_end_stop() {
+    let sys = preset::lhpost_2008();
+    let model = lhpost_model();
+    let w = std::f64::consts::TAU * 0.2;
+    let cmd = command(1024.0, 5.0, |t| {
+        (
+            1.2 * (w * t).sin(),
+            1.2 * w * (w * t).cos(),
+            -1.2 * w * w * (w * t).sin(),
+        )
+    });
+    let run = LoopRun {
+        system: &sys,
+        specimen: None,
+        command: &cmd,
+        method: LoopMethod::Rk4 {
+            steps_per_period: sys.default_steps_per_period(144e3, 0.75),
+        },
+        initial: State::default(),
+    };
+    let err = forward_closed_loop(&model, &run, cmd.len(), &mut Keep(Vec::new())).unwrap_err();
+    match err {
+        platen_integrate::IntegrateError::EndStop { t_s, u_m } => {
+            // The cap side empties at V_a0/A_a = 0.2122/0.2051 = 1.0346 m.
+            assert!(
+                (u_m - 0.2122 / 0.2051).abs() < 1e-3 && t_s > 0.5 && t_s < 1.25,
+                "{u_m} {t_s}"
+            );
+        }
+        other => panic!("{other}"),
+    }
+}
+
+/// A stiff specimen (storey modes far above the oil column) moves with the platen as a rigid
+/// payload: the oil column rings at the closed form with `M + Σmᵢ`, within 0.5 % (the storeys'
+/// own modes, above 140 Hz, add `(7.6/140)²/2 ≈ 0.15 %` of effective mass).
+#[test]
+fn a_stiff_specimen_lowers_the_oil_column_like_a_rigid_payload() {
+    let sys = symmetric(1, 0.0);
+    let model = linear(20_000.0, 0.0, 0.0);
+    let storey = |m: f64| platen_model::Storey {
+        mass_kg: m,
+        stiffness_n_per_m: m * (std::f64::consts::TAU * 200.0).powi(2),
+        damping_n_s_per_m: 0.0,
+    };
+    let specimen = platen_model::Specimen::new(vec![storey(8000.0), storey(7000.0)]).unwrap();
+    let cmd = command(4096.0, 2.0, |_| (0.0, 0.0, 0.0));
+    let mut keep = Keep(Vec::new());
+    let run = LoopRun {
+        system: &sys,
+        specimen: Some(&specimen),
+        command: &cmd,
+        method: LoopMethod::Rk4 {
+            steps_per_period: 8,
+        },
+        initial: State {
+            u_m: 0.0,
+            v_m_s: 0.01,
+        },
+    };
+    let stats = forward_closed_loop(&model, &run, cmd.len(), &mut keep).unwrap();
+    // The platen's and the specimen's energy balance closes (work of the actuators = change
+    // of kinetic, elastic and specimen energy + dissipation) to the integration's accuracy.
+    let residual = stats.run.energy.relative_residual();
+    println!("energy balance with the specimen: relative residual {residual:.2e}");
+    assert!(residual.abs() < 1e-8, "{residual}");
+    let t: Vec<f64> = keep.0.iter().map(|s| s.t_s).collect();
+    let v: Vec<f64> = keep.0.iter().map(|s| s.v_m_s).collect();
+    let f = crossing_frequency_hz(&t, &v);
+    let expected = sys.oil_column_frequency_hz(35_000.0, 0.0);
+    println!("stiff specimen: {f:.4} Hz, rigid payload closed form {expected:.4} Hz");
+    assert!((f / expected - 1.0).abs() < 5e-3);
+    assert!(keep
+        .0
+        .iter()
+        .all(|s| s.specimen.is_some() && s.system.is_some()));
 }

@@ -238,6 +238,8 @@ fn closed_loop(
     if let Run::Forward { .. } = run {
         let key = if file.excitation.force_csv.is_some() {
             "excitation.force_csv"
+        } else if file.excitation.sine_force.is_some() {
+            "excitation.sine_force"
         } else {
             "excitation"
         };
