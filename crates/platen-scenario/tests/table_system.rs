@@ -370,7 +370,7 @@ fn a_force_excitation_with_a_table_system_is_refused() {
         "excitation",
         json!({"sine_force": {"amplitude_n": 1e5, "frequency_hz": 1}}),
     );
-    let message = refused(&s, "excitation", "a motion excitation");
+    let message = refused(&s, "excitation.sine_force", "a motion excitation");
     assert!(message.contains("displacement command"), "{message}");
 }
 
