@@ -113,6 +113,178 @@ fn simulate_plot_writes_time_histories_decomposition_and_loops() {
     assert_eq!(loops.polylines.get(SIMULATED), Some(&3));
 }
 
+/// The figure's text holds a title "… peak |SYMBOL| X …" with X the `peak` to the four
+/// significant digits printed.
+fn assert_shown_peak(text: &str, symbol: &str, peak: f64) {
+    let marker = format!("peak |{symbol}| ");
+    let title = text
+        .lines()
+        .find(|l| l.contains(&marker))
+        .unwrap_or_else(|| panic!("no `{marker}` in {text}"));
+    let shown: f64 = title
+        .split(&marker)
+        .nth(1)
+        .and_then(|r| r.split_whitespace().next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    let tol = 0.5 * 10f64.powf(peak.log10().floor() - 3.0);
+    assert!(
+        (shown - peak).abs() <= tol * 1.0001,
+        "{title}: expected {peak}"
+    );
+}
+
+/// A short closed-loop run (the lhpost-2008 table system following a 5 cm, 1 Hz sine
+/// command for 2 s), written to `dir`.
+fn closed_loop_scenario(dir: &Path) -> String {
+    let path = dir.join("closed-loop.json");
+    fs::write(
+        &path,
+        r#"{"model": {"preset": "lhpost-2008"}, "table_system": {"preset": "lhpost-2008"},
+            "excitation": {"sine_motion": {"amplitude_m": 0.05, "frequency_hz": 1.0,
+            "sample_rate_hz": 1024}}, "duration_s": 2.0}"#,
+    )
+    .unwrap();
+    path.display().to_string()
+}
+
+/// `simulate --plot` of a closed-loop run: the run's three figures and the loop's six
+/// (command and achieved motion, tracking errors, drive and spool, pressures, flow against
+/// the valves' capacity, supply pressure), each a valid SVG with its PNG, listed in
+/// `--json`, the same bytes on a second run; the command solid blue and the achieved motion
+/// dashed orange, the capacity as ± dashed black lines, the peaks as the summary's.
+#[test]
+fn simulate_plot_of_a_closed_loop_run_adds_the_loop_figures() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = closed_loop_scenario(dir.path());
+    let run = |plots: &Path| {
+        ok_json(&platen(&[
+            "simulate",
+            &path,
+            "--json",
+            "--plot",
+            plots.to_str().unwrap(),
+        ]))
+    };
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    let summary = run(&a);
+    run(&b);
+    let names = [
+        "time-history",
+        "force-decomposition",
+        "hysteresis",
+        "tracking",
+        "tracking-error",
+        "valve",
+        "pressure-difference",
+        "flow",
+        "supply-pressure",
+    ];
+    let listed: Vec<&str> = summary["figures"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_str().unwrap())
+        .collect();
+    assert_eq!(listed.len(), 2 * names.len(), "{listed:?}");
+    for name in names {
+        for ext in ["svg", "png"] {
+            let file = a.join(format!("{name}.{ext}"));
+            assert!(listed.contains(&file.to_str().unwrap()), "{listed:?}");
+        }
+        let svg = a.join(format!("{name}.svg"));
+        common::check_png(&svg, &svg_content(&svg));
+    }
+    assert!(folder(&a) == folder(&b), "a second run gives other bytes");
+
+    // Command and achieved displacement and acceleration, whole and zoomed: four panels of a
+    // solid blue command and a dashed orange achieved motion, one legend under the title.
+    let tracking = svg_content(&a.join("tracking.svg"));
+    assert_eq!(
+        tracking.polylines.get(RECORDED),
+        Some(&5),
+        "{:?}",
+        tracking.polylines
+    );
+    assert_eq!(
+        tracking.polylines.get(SIMULATED),
+        Some(&5),
+        "{:?}",
+        tracking.polylines
+    );
+    assert!(
+        tracking.text.contains("peak |u_ref| 0.05000 m"),
+        "{}",
+        tracking.text
+    );
+    assert!(
+        tracking.text.contains("achieved (simulated)"),
+        "{}",
+        tracking.text
+    );
+    let svg = fs::read_to_string(a.join("tracking.svg")).unwrap();
+    let doc = roxmltree::Document::parse(&svg).unwrap();
+    for (stroke, dashed) in [(RECORDED, false), (SIMULATED, true)] {
+        assert!(
+            doc.descendants()
+                .filter(|n| n.has_tag_name("polyline") && n.attribute("stroke") == Some(stroke))
+                .all(|n| n.attribute("stroke-dasharray").is_some() == dashed),
+            "{stroke}"
+        );
+    }
+    let ts = &summary["table_system"];
+    // The tracking errors' peaks are the summary's (to the four digits shown).
+    let errors = svg_content(&a.join("tracking-error.svg"));
+    for (symbol, key, scale) in [
+        ("u − u_ref", "tracking_displacement_peak_m", 1e3),
+        ("a − a_ref", "tracking_acceleration_peak_m_s2", 1.0),
+    ] {
+        let peak = ts[key].as_f64().unwrap().abs() * scale;
+        assert_shown_peak(&errors.text, symbol, peak);
+    }
+
+    let valve = svg_content(&a.join("valve.svg"));
+    assert!(valve.text.contains("drive d: peak |d|"), "{}", valve.text);
+    assert!(valve.text.contains("spool opening x_v"), "{}", valve.text);
+    let pressures = svg_content(&a.join("pressure-difference.svg"));
+    assert!(
+        pressures.text.contains("Δp = p_a − p_b (MPa)"),
+        "{}",
+        pressures.text
+    );
+    assert!(
+        pressures.text.contains("p_b (rod side)"),
+        "{}",
+        pressures.text
+    );
+
+    // The flow against ±capacity: two dashed black lines and the legend's sample.
+    let flow = svg_content(&a.join("flow.svg"));
+    assert_eq!(flow.polylines.get(LIMIT), Some(&3), "{:?}", flow.polylines);
+    let capacity = ts["valve_flow_capacity_m3_s"].as_f64().unwrap();
+    assert!(
+        flow.text
+            .contains(&format!("valve capacity ±{capacity:.3} m³/s")),
+        "{capacity}: {}",
+        flow.text
+    );
+    assert_shown_peak(
+        &flow.text,
+        "Q",
+        ts["peak_flow_m3_s"].as_f64().unwrap().abs(),
+    );
+    assert!(flow.text.contains("% of the capacity"), "{}", flow.text);
+
+    let supply = svg_content(&a.join("supply-pressure.svg"));
+    assert!(
+        supply.text.contains("set pressure 20.7 MPa"),
+        "{}",
+        supply.text
+    );
+    assert!(supply.text.contains("lowest"), "{}", supply.text);
+}
+
 /// `sweep --plot`: one figure per axis with two or more values; per panel one line and one
 /// marker per case of each combination of the other axes, the table's limit as a dashed
 /// black line (and its legend sample); nothing for a single case; the same bytes twice.

@@ -123,14 +123,24 @@ enum Command {
         #[command(flatten)]
         size: plot::SizeArgs,
     },
-    /// Print a preset's parameters and derived quantities.
+    /// Print a preset's parameters and derived quantities, and a table system's.
     ///
     /// The text groups the simulated model's parameters, the quantities derived from the full
     /// model (Eq. 5–8), the physical parameters and the table's limits, in engineering units;
     /// --json prints the same in SI under the contract's keys.
+    ///
+    /// With a table system (--system, or a --scenario with a table_system) it adds, under
+    /// `table_system` in --json: the system's parameters; the oil-column frequency at
+    /// mid-stroke with the model's mass (oil_column_frequency_hz), with the specimen as a
+    /// rigid payload, and at both ends of the stroke; the valve-limited velocities and the
+    /// valves' flow capacity; the push and pull force capacities; the linearisation about
+    /// mid-stroke (flow gains, compliances, mechanics); the linearised loop's margins, peak
+    /// and bandwidth; and the default RK4 steps per controller period of a closed-loop run.
     #[command(after_help = "Examples:\n  \
         platen model\n  \
-        platen model --form full --pressure-mpa 6.9 --json")]
+        platen model --form full --pressure-mpa 6.9 --json\n  \
+        platen model --system lhpost-2008 --plot bode\n  \
+        platen model --scenario scenarios/table-system/northridge-closed-loop.json --json")]
     Model {
         /// Preset name.
         #[arg(long, default_value = "lhpost-2008")]
@@ -141,9 +151,30 @@ enum Command {
         /// Which form to describe.
         #[arg(long, value_enum, default_value_t = Form::Identified)]
         form: Form,
+        /// Describe this table system too (a table-system preset: lhpost-2008); with
+        /// --scenario it replaces the scenario's table_system.
+        #[arg(long, value_name = "PRESET")]
+        system: Option<String>,
+        /// Describe the model, table_system and specimen of this scenario (its model
+        /// preset, pressure, form and values; its excitation, integrator, initial state and
+        /// duration are not read).
+        #[arg(
+            long,
+            value_name = "FILE",
+            conflicts_with_all = ["preset", "pressure_mpa", "form"]
+        )]
+        scenario: Option<PathBuf>,
         /// Print JSON on stdout.
         #[arg(long)]
         json: bool,
+        /// Write the Bode plots of the linearised loop to this folder as SVG and PNG: the
+        /// closed loop command → displacement (bode-closed-loop) and the loop gain L broken
+        /// at the drive (bode-loop-gain), magnitude and phase, 0.1 Hz to the controller's
+        /// Nyquist frequency or 200 Hz. Needs a table system (--system or --scenario).
+        #[arg(long, value_name = "DIR")]
+        plot: Option<PathBuf>,
+        #[command(flatten)]
+        size: plot::SizeArgs,
     },
     /// Time the standard workloads against a baseline measured in the same run.
     ///
@@ -439,8 +470,21 @@ fn run(command: Command) -> anyhow::Result<()> {
             preset,
             pressure_mpa,
             form,
+            system,
+            scenario,
             json,
-        } => model::run(&preset, pressure_mpa, form, json),
+            plot,
+            size,
+        } => model::run(&model::Options {
+            preset: &preset,
+            pressure_mpa,
+            form,
+            system: system.as_deref(),
+            scenario: scenario.as_deref(),
+            json,
+            plot: plot.as_deref(),
+            size: size.size(),
+        }),
         Command::Schema { out } => schema::run(out.as_deref()),
         Command::Generate {
             what,

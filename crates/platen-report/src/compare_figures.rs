@@ -83,6 +83,7 @@ impl<'a> Context<'a> {
             x_range: Some(range),
             shade_x: shade,
             y_range: None,
+            x_log: false,
         };
         vec![
             panel(
@@ -191,6 +192,7 @@ fn residuals(ctx: &Context<'_>) -> Figure {
             x_range: Some(ctx.span),
             shade_x: c.window.map(|w| (w.start_s, w.end_s)),
             y_range: None,
+            x_log: false,
         }
     };
     Figure {

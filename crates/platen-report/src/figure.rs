@@ -119,6 +119,11 @@ pub struct Panel {
     pub y_range: Option<(f64, f64)>,
     /// A horizontal interval to shade (a zoomed window).
     pub shade_x: Option<(f64, f64)>,
+    /// A logarithmic horizontal axis (a frequency response): the points' x, `x_range` and
+    /// `shade_x` stay in the data's units (points at x ≤ 0 are not drawn), the grid has a
+    /// line at every 1…9 × 10^k and labels at 1, 2 and 5 × 10^k (only at 10^k when those
+    /// would crowd).
+    pub x_log: bool,
 }
 
 impl Panel {

@@ -8,7 +8,11 @@
 //!   [`Identification`](platen_ident::Identification).
 //! * [`run_figures`] builds the figures of a run without a recording (`simulate --plot`),
 //!   collected while it runs ([`run_figures::RunRecorder`]), and [`sweep_figures`] the peaks
-//!   of a sweep against each of its axes, with the table's limits.
+//!   of a sweep against each of its axes, with the table's limits; a closed-loop run adds
+//!   the loop's figures (tracking, valve, pressures, flow, supply).
+//! * [`system_figures`] draws the Bode plots of a table system's linearised loop
+//!   (`platen model --system … --plot`), on a logarithmic frequency axis
+//!   ([`Panel::x_log`]).
 //! * [`render`] writes them: SVG, PNG copies rendered by resvg with the embedded Noto Sans,
 //!   and the HTML page, every file atomically ([`write_outputs`]).
 //! * [`html`] builds self-contained pages; [`text`] the numbers, metric rows and terminal
@@ -62,6 +66,7 @@ pub mod run_figures;
 pub mod series;
 mod svg;
 pub mod sweep_figures;
+pub mod system_figures;
 pub mod text;
 
 pub use error::{ReportError, Result};

@@ -3,18 +3,26 @@
 //! hysteresis loops (actuator force against displacement, velocity and acceleration), and for
 //! a run with a specimen its base shear and storey drifts over time.
 //!
+//! A closed-loop run (a scenario with a `table_system`) adds the loop's figures: the command
+//! and the achieved displacement and acceleration (whole run, and zoomed on the command's
+//! largest acceleration), the tracking errors, the drive and the spool opening, the pressure
+//! difference and the chamber pressures, the valves' flow against their capacity and the
+//! supply pressure, over time.
+//!
 //! A [`RunRecorder`] is a [`SampleSink`] that keeps, while the run goes, only what the
 //! figures draw: per channel the smallest and largest sample of each of [`BUCKETS`] equal
-//! time buckets (the same points [`envelope`](crate::series::envelope) picks from the whole
-//! record), and every k-th sample for the loops. Its memory does not grow with the run's
-//! length, so a one-hour run can be plotted as it streams to CSV.
+//! time buckets (the same points [`envelope`] picks from the whole record), and every k-th
+//! sample for the loops; for a closed-loop run also its loop's channels and every sample of
+//! the zoomed interval (at most [`ZOOM_S`]). Its memory does not grow with the run's length,
+//! so a one-hour run can be plotted as it streams to CSV.
 
 use platen_integrate::{Sample, SampleSink};
 use platen_model::TableLimits;
 use platen_scenario::{Run, Scenario};
+use platen_system::{Supply, TableSystem};
 
-use crate::figure::{Dash, Figure, Panel, MODEL, SIMULATED};
-use crate::series::{every, line, patterned, Points, MAX_LOOP_POINTS};
+use crate::figure::{Dash, Figure, Panel, MODEL, RECORDED, RESIDUAL, SIMULATED};
+use crate::series::{envelope, every, line, patterned, Points, MAX_LOOP_POINTS};
 use crate::text::significant;
 
 /// Time buckets of the envelopes (about the pixels of a full-width panel).
@@ -94,9 +102,62 @@ impl Envelope {
     }
 }
 
-/// Collects, while a run goes, what its figures draw (see the module's documentation).
+/// Longest zoomed interval of a closed-loop run's tracking figure, s (a quarter of a shorter
+/// run).
+pub const ZOOM_S: f64 = 2.0;
+
+/// The closed loop's channels a recorder keeps the envelopes of, in this order.
+const LOOP_CHANNELS: usize = 11;
+/// Indices into the closed loop's envelopes.
+const CMD_U: usize = 0;
+const ERR_U: usize = 1;
+const CMD_A: usize = 2;
+const ERR_A: usize = 3;
+const DRIVE: usize = 4;
+const SPOOL: usize = 5;
+const DELTA_P: usize = 6;
+const P_A: usize = 7;
+const P_B: usize = 8;
+const FLOW: usize = 9;
+const SUPPLY: usize = 10;
+
+/// The prescribed motion of a run, which a closed-loop run reads as its displacement command.
 #[derive(Debug, Clone)]
-pub struct RunRecorder {
+struct Command<'a> {
+    /// The command's acceleration at each output sample, m/s².
+    a_m_s2: &'a [f64],
+    /// The interval the tracking figure zooms on: at most [`ZOOM_S`] (a quarter of the run)
+    /// around the command's largest |acceleration|, inside the run.
+    zoom_s: (f64, f64),
+}
+
+impl<'a> Command<'a> {
+    fn new(t_s: &[f64], a_m_s2: &'a [f64]) -> Option<Self> {
+        let (&t0, &t1) = (t_s.first()?, t_s.last()?);
+        let peak = a_m_s2
+            .iter()
+            .enumerate()
+            .fold((0, f64::NEG_INFINITY), |best, (i, a)| {
+                if a.abs() > best.1 {
+                    (i, a.abs())
+                } else {
+                    best
+                }
+            })
+            .0;
+        let width = ZOOM_S.min(0.25 * (t1 - t0));
+        let start = (t_s.get(peak).copied().unwrap_or(t0) - 0.5 * width).clamp(t0, t1 - width);
+        Some(Self {
+            a_m_s2,
+            zoom_s: (start, start + width),
+        })
+    }
+}
+
+/// Collects, while a run goes, what its figures draw (see the module's documentation). It
+/// borrows the run's prescribed motion (`'a`), which a closed-loop run reads as its command.
+#[derive(Debug, Clone)]
+pub struct RunRecorder<'a> {
     /// Envelopes of u, v, a, F_A, F_I, F_E, F_D (SI units).
     channels: [Envelope; 7],
     /// Every `stride`-th sample's (u, v, a, F_A).
@@ -110,16 +171,26 @@ pub struct RunRecorder {
     /// Envelopes of the base shear (N) and of each storey's drift (m), for a run with a
     /// specimen (made at its first sample).
     specimen: Vec<Envelope>,
+    /// The run's prescribed motion (`None` for a forward run).
+    command: Option<Command<'a>>,
+    /// Envelopes of the closed loop's channels (SI units; `CMD_U` … `SUPPLY`), for a
+    /// closed-loop run (made at its first sample).
+    system: Vec<Envelope>,
+    /// Every sample of a closed-loop run inside the command's zoomed interval:
+    /// `(t, u, a, u_ref, a_ref)`.
+    zoom: Vec<[f64; 5]>,
 }
 
-impl RunRecorder {
+impl<'a> RunRecorder<'a> {
     /// A recorder for `run` (its time span and sample count are known before it runs).
-    pub fn new(run: &Run) -> Self {
-        let samples = match run {
-            Run::Forward { samples, .. } => *samples,
-            Run::Inverse { motion } => motion.len(),
-        };
-        Self::with_span(run.time_span_s(), samples)
+    pub fn new(run: &'a Run) -> Self {
+        match run {
+            Run::Forward { samples, .. } => Self::with_span(run.time_span_s(), *samples),
+            Run::Inverse { motion } => Self {
+                command: Command::new(motion.t_s(), motion.a_m_s2()),
+                ..Self::with_span(run.time_span_s(), motion.len())
+            },
+        }
     }
 
     /// A recorder for `samples` samples over `span_s`.
@@ -133,11 +204,14 @@ impl RunRecorder {
             span_s,
             expected: samples,
             specimen: Vec::new(),
+            command: None,
+            system: Vec::new(),
+            zoom: Vec::new(),
         }
     }
 }
 
-impl SampleSink for RunRecorder {
+impl SampleSink for RunRecorder<'_> {
     fn accept(&mut self, s: &Sample) {
         let terms = &s.terms;
         let values = [
@@ -162,6 +236,40 @@ impl SampleSink for RunRecorder {
                 std::iter::once(sp.base_shear_n).chain(sp.drift_m[..sp.storeys].iter().copied());
             for (channel, y) in self.specimen.iter_mut().zip(values) {
                 channel.push(self.samples, s.t_s, y);
+            }
+        }
+        if let Some(sys) = &s.system {
+            if self.system.is_empty() {
+                self.system = (0..LOOP_CHANNELS)
+                    .map(|_| Envelope::new(self.span_s, self.expected))
+                    .collect();
+            }
+            let a_ref = self
+                .command
+                .as_ref()
+                .and_then(|c| c.a_m_s2.get(s.index))
+                .copied()
+                .unwrap_or(f64::NAN);
+            let mut values = [0.0; LOOP_CHANNELS];
+            values[CMD_U] = sys.command_u_m;
+            values[ERR_U] = s.u_m - sys.command_u_m;
+            values[CMD_A] = a_ref;
+            values[ERR_A] = s.a_m_s2 - a_ref;
+            values[DRIVE] = sys.drive;
+            values[SPOOL] = sys.spool_opening;
+            values[DELTA_P] = sys.delta_p_pa;
+            values[P_A] = sys.p_a_pa;
+            values[P_B] = sys.p_b_pa;
+            values[FLOW] = sys.flow_m3_s;
+            values[SUPPLY] = sys.supply_pressure_pa;
+            for (channel, y) in self.system.iter_mut().zip(values) {
+                channel.push(self.samples, s.t_s, y);
+            }
+            if let Some(c) = &self.command {
+                if s.t_s >= c.zoom_s.0 && s.t_s <= c.zoom_s.1 {
+                    self.zoom
+                        .push([s.t_s, s.u_m, s.a_m_s2, sys.command_u_m, a_ref]);
+                }
             }
         }
         if self.samples % self.stride == 0 {
@@ -189,13 +297,27 @@ struct Channel {
     symbol: &'static str,
     unit: &'static str,
     limit: Option<f64>,
+    /// What the limit is, in its legend entry (`table limit`).
+    limit_name: &'static str,
+    /// The limit's lines are drawn when the peak reaches this fraction of it.
+    limit_shown_from: f64,
 }
 
 /// The figures of a run: the motion and force over time, the force decomposition, the
-/// hysteresis loops. `scenario` gives the name and the table's limits.
-pub fn figures(recorder: RunRecorder, scenario: &Scenario) -> Vec<Figure> {
+/// hysteresis loops, and those of the specimen and of the closed loop when the run has them.
+/// `scenario` gives the name, the table's limits and the table system.
+pub fn figures(recorder: RunRecorder<'_>, scenario: &Scenario) -> Vec<Figure> {
     let stride = recorder.stride;
     let samples = recorder.samples;
+    let closed_loop = match (&scenario.closed_loop, &recorder.command) {
+        (Some(cl), Some(command)) if !recorder.system.is_empty() => Some(LoopRecord {
+            system: cl.system,
+            channels: recorder.system.into_iter().map(Envelope::finish).collect(),
+            zoom_s: command.zoom_s,
+            zoom: recorder.zoom,
+        }),
+        _ => None,
+    };
     let kn = [false, false, false, true, true, true, true];
     let channels: Vec<Points> = recorder
         .channels
@@ -241,6 +363,9 @@ pub fn figures(recorder: RunRecorder, scenario: &Scenario) -> Vec<Figure> {
     ];
     if !r.specimen.is_empty() {
         out.push(specimen_figure(&r, scenario));
+    }
+    if let Some(lo) = &closed_loop {
+        out.extend(loop_figures(&r, lo, scenario));
     }
     out
 }
@@ -311,21 +436,29 @@ fn span(points: &Points) -> (f64, f64) {
 fn channel_panel(c: &Channel, points: &Points, color: plotters::style::RGBColor) -> Panel {
     let peak = peak_magnitude(points);
     let t = span(points);
+    // " m", or nothing for a dimensionless channel.
+    let unit = if c.unit.is_empty() {
+        String::new()
+    } else {
+        format!(" {}", c.unit)
+    };
     let mut series = vec![line("", points.clone(), color, 1)];
     let mut title = format!(
-        "{} {}: peak |{}| {} {}",
+        "{} {}: peak |{}| {}{unit}",
         c.quantity,
         c.symbol,
         c.symbol,
         significant(peak, 4),
-        c.unit
     );
-    if let Some(limit) = c.limit.filter(|l| *l > 0.0 && peak >= LIMIT_SHOWN_FROM * l) {
+    if let Some(limit) = c
+        .limit
+        .filter(|l| *l > 0.0 && peak >= c.limit_shown_from * l)
+    {
         series.push(patterned(
             format!(
-                "table limit ±{} {}",
+                "{} ±{}{unit}",
+                c.limit_name,
                 crate::sweep_figures::limit_text(limit),
-                c.unit
             ),
             vec![(t.0, limit), (t.1, limit)],
             MODEL,
@@ -343,14 +476,14 @@ fn channel_panel(c: &Channel, points: &Points, color: plotters::style::RGBColor)
             title.push_str(" (EXCEEDS the limit)");
         }
     }
+    let y_label = if c.unit.is_empty() {
+        c.symbol.to_owned()
+    } else {
+        format!("{} ({})", c.symbol, c.unit)
+    };
     Panel {
         x_range: Some(t),
-        ..Panel::new(
-            title,
-            "time t (s)",
-            format!("{} ({})", c.symbol, c.unit),
-            series,
-        )
+        ..Panel::new(title, "time t (s)", y_label, series)
     }
 }
 
@@ -373,6 +506,8 @@ fn motion(r: &Recorded, scenario: &Scenario) -> Figure {
                     symbol,
                     unit,
                     limit,
+                    limit_name: "table limit",
+                    limit_shown_from: LIMIT_SHOWN_FROM,
                 },
                 points,
                 SIMULATED,
@@ -478,6 +613,277 @@ fn hysteresis(r: &Recorded, scenario: &Scenario) -> Figure {
         columns: 3,
         rows: Vec::new(),
         size: (1260, 520),
+    }
+}
+
+/// What a recorder kept of a closed-loop run (SI units).
+struct LoopRecord {
+    /// The table system.
+    system: TableSystem,
+    /// Envelopes of the loop's channels (`CMD_U` … `SUPPLY`).
+    channels: Vec<Points>,
+    /// The zoomed interval, s.
+    zoom_s: (f64, f64),
+    /// Every sample inside it: `(t, u, a, u_ref, a_ref)`.
+    zoom: Vec<[f64; 5]>,
+}
+
+/// `points` with every value times `k`.
+fn times(points: &Points, k: f64) -> Points {
+    points.iter().map(|&(t, y)| (t, y * k)).collect()
+}
+
+/// The smallest value of the points.
+fn lowest(points: &Points) -> f64 {
+    points.iter().map(|p| p.1).fold(f64::INFINITY, f64::min)
+}
+
+/// The figures of a closed-loop run: tracking, tracking errors, valve, pressures, flow,
+/// supply.
+fn loop_figures(r: &Recorded, lo: &LoopRecord, scenario: &Scenario) -> Vec<Figure> {
+    let c = &lo.channels;
+    let channel = |quantity, symbol, unit, limit: Option<f64>, limit_name, shown_from| Channel {
+        quantity,
+        symbol,
+        unit,
+        limit,
+        limit_name,
+        limit_shown_from: shown_from,
+    };
+    let mut out = vec![tracking(r, lo, scenario)];
+    out.push(Figure {
+        name: "tracking-error".into(),
+        title: format!("{}: tracking errors (achieved − command)", scenario.name),
+        caption: format!(
+            "The displacement error u − u_ref (mm) and the acceleration error a − a_ref \
+             (m/s²) of the closed loop over the run ({} samples; the smallest and largest \
+             sample of each of {BUCKETS} equal time intervals).",
+            r.samples
+        ),
+        panels: vec![
+            channel_panel(
+                &channel("displacement error", "u − u_ref", "mm", None, "", 1.0),
+                &times(&c[ERR_U], 1e3),
+                RESIDUAL,
+            ),
+            channel_panel(
+                &channel("acceleration error", "a − a_ref", "m/s²", None, "", 1.0),
+                &c[ERR_A],
+                RESIDUAL,
+            ),
+        ],
+        columns: 1,
+        rows: Vec::new(),
+        size: (1200, 800),
+    });
+    let full = |quantity, symbol| {
+        channel(
+            quantity,
+            symbol,
+            "",
+            Some(1.0),
+            "full opening",
+            LIMIT_SHOWN_FROM,
+        )
+    };
+    out.push(Figure {
+        name: "valve".into(),
+        title: format!("{}: drive and spool opening", scenario.name),
+        caption: format!(
+            "The controller's drive d (held between its samples, |d| ≤ 1) and the spool \
+             opening x_v the valves' flow sees (clamped to ±1), fractions of full opening, \
+             with ±1 (dashed) where a peak reaches {:.0} % of it.",
+            100.0 * LIMIT_SHOWN_FROM
+        ),
+        panels: [("drive", "d", DRIVE), ("spool opening", "x_v", SPOOL)]
+            .iter()
+            .map(|&(quantity, symbol, i)| Panel {
+                y_label: format!("{symbol} (1 = full opening)"),
+                ..channel_panel(&full(quantity, symbol), &c[i], SIMULATED)
+            })
+            .collect(),
+        columns: 1,
+        rows: Vec::new(),
+        size: (1200, 800),
+    });
+    let mut dp = channel_panel(
+        &channel("pressure difference", "Δp", "MPa", None, "", 1.0),
+        &times(&c[DELTA_P], 1e-6),
+        SIMULATED,
+    );
+    dp.y_label = "Δp = p_a − p_b (MPa)".into();
+    let (p_a, p_b) = (times(&c[P_A], 1e-6), times(&c[P_B], 1e-6));
+    let floor = lowest(&p_a).min(lowest(&p_b));
+    let chambers = Panel {
+        x_range: Some(span(&p_a)),
+        ..Panel::new(
+            format!(
+                "chamber pressures (absolute): lowest {} MPa{}",
+                significant(floor, 4),
+                if floor <= 0.0 { " (CAVITATION)" } else { "" }
+            ),
+            "time t (s)",
+            "pressure p (MPa)",
+            vec![
+                line("p_a (cap side)", p_a, SIMULATED, 1),
+                patterned("p_b (rod side)", p_b, RESIDUAL, 1, Dash::Dashed),
+            ],
+        )
+    };
+    out.push(Figure {
+        name: "pressure-difference".into(),
+        title: format!("{}: actuator chamber pressures", scenario.name),
+        caption: "The pressure difference Δp = p_a − p_b across the pistons, and the \
+                  absolute pressures of the cap-side and rod-side chambers (a chamber at 0 \
+                  cavitates), over time."
+            .into(),
+        panels: vec![dp, chambers],
+        columns: 1,
+        rows: Vec::new(),
+        size: (1200, 800),
+    });
+    let capacity = lo.system.capacities().valve_flow_m3_s;
+    let mut flow = channel_panel(
+        &channel(
+            "valve flow",
+            "Q",
+            "m³/s",
+            Some(capacity),
+            "valve capacity",
+            0.0,
+        ),
+        &c[FLOW],
+        SIMULATED,
+    );
+    flow.title.push_str(&format!(
+        ", {:.0} % of the capacity",
+        100.0 * peak_magnitude(&c[FLOW]) / capacity
+    ));
+    out.push(Figure {
+        name: "flow".into(),
+        title: format!("{}: valve flow against the valves' capacity", scenario.name),
+        caption: "The flow of all servo-valves into the cap-side chambers (negative: out of \
+                  them) over time, against the valves' capacity ±Q_max (dashed): their flow \
+                  at full opening with the null pressure drop on each land."
+            .into(),
+        panels: vec![flow],
+        columns: 1,
+        rows: Vec::new(),
+        size: (1200, 520),
+    });
+    out.push(supply(&times(&c[SUPPLY], 1e-6), &lo.system, scenario));
+    out
+}
+
+/// The command and the achieved displacement and acceleration, whole and zoomed.
+fn tracking(r: &Recorded, lo: &LoopRecord, scenario: &Scenario) -> Figure {
+    let c = &lo.channels;
+    let (u, a) = (&r.channels[0], &r.channels[2]);
+    let whole = span(u);
+    let (z0, z1) = lo.zoom_s;
+    let t: Vec<f64> = lo.zoom.iter().map(|z| z[0]).collect();
+    let zoomed = |k: usize| -> Points {
+        let y: Vec<f64> = lo.zoom.iter().map(|z| z[k]).collect();
+        envelope(&t, &y, lo.zoom_s, BUCKETS)
+    };
+    let pair = |command: Points, achieved: Points| {
+        vec![
+            line("command", command, RECORDED, 4),
+            patterned("achieved (simulated)", achieved, SIMULATED, 2, Dash::Dashed),
+        ]
+    };
+    let mut panels = Vec::new();
+    for (quantity, symbol, unit, achieved, command, k) in [
+        ("displacement", "u", "m", u, &c[CMD_U], 1),
+        ("acceleration", "a", "m/s²", a, &c[CMD_A], 2),
+    ] {
+        panels.push(Panel {
+            x_range: Some(whole),
+            shade_x: (!lo.zoom.is_empty()).then_some(lo.zoom_s),
+            ..Panel::new(
+                format!(
+                    "{quantity}, whole run: peak |{symbol}_ref| {} {unit}, peak |{symbol}| {} {unit}",
+                    significant(peak_magnitude(command), 4),
+                    significant(peak_magnitude(achieved), 4)
+                ),
+                "time t (s)",
+                format!("{quantity} {symbol} ({unit})"),
+                pair(command.clone(), achieved.clone()),
+            )
+        });
+        if !lo.zoom.is_empty() {
+            panels.push(Panel {
+                x_range: Some((z0, z1)),
+                ..Panel::new(
+                    format!(
+                        "{quantity}, zoom {z0:.2}–{z1:.2} s (around the command's largest \
+                         acceleration)"
+                    ),
+                    "time t (s)",
+                    format!("{quantity} {symbol} ({unit})"),
+                    pair(zoomed(k + 2), zoomed(k)),
+                )
+            });
+        }
+    }
+    Figure {
+        name: "tracking".into(),
+        title: format!("{}: command and achieved motion", scenario.name),
+        caption: format!(
+            "The displacement command u_ref and its acceleration a_ref (solid blue, drawn \
+             wider) and the table's displacement u and acceleration a (dashed orange, on top), \
+             over the whole run ({} samples; the smallest and largest sample of each of \
+             {BUCKETS} equal time intervals) and zoomed on {:.2} s around the command's largest \
+             acceleration (shaded above).",
+            r.samples,
+            z1 - z0
+        ),
+        columns: 1,
+        rows: Vec::new(),
+        size: (1200, 300 * panels.len() as u32 + 160),
+        panels,
+    }
+}
+
+/// The supply pressure over time (MPa), with the set pressure.
+fn supply(points: &Points, system: &TableSystem, scenario: &Scenario) -> Figure {
+    let set = system.supply_pressure_pa * 1e-6;
+    let t = span(points);
+    let kind = match system.supply {
+        Supply::Constant => "constant supply",
+        Supply::Accumulator(_) => "accumulator bank",
+    };
+    Figure {
+        name: "supply-pressure".into(),
+        title: format!("{}: supply pressure", scenario.name),
+        caption: "The pressure the valves draw their oil from over time: constant, or an \
+                  accumulator bank's, which droops while the valves draw more than the pumps \
+                  give; the pumps' set pressure dashed."
+            .into(),
+        panels: vec![Panel {
+            x_range: Some(t),
+            ..Panel::new(
+                format!(
+                    "supply pressure P_s ({kind}): lowest {} MPa",
+                    significant(lowest(points), 4)
+                ),
+                "time t (s)",
+                "P_s (MPa)",
+                vec![
+                    line("", points.clone(), SIMULATED, 1),
+                    patterned(
+                        format!("set pressure {} MPa", crate::sweep_figures::limit_text(set)),
+                        vec![(t.0, set), (t.1, set)],
+                        MODEL,
+                        2,
+                        Dash::Dashed,
+                    ),
+                ],
+            )
+        }],
+        columns: 1,
+        rows: Vec::new(),
+        size: (1200, 520),
     }
 }
 

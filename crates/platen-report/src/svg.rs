@@ -11,6 +11,7 @@
 //! in a strip between a panel's caption and its axes, so they never hide data and never
 //! stretch an axis.
 
+use plotters::coord::ranged1d::{KeyPointHint, NoDefaultFormatting, Ranged, ValueFormatter};
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -26,7 +27,10 @@ use crate::figure::{
 /// The SVG drawing area of a panel.
 type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
 /// The axes of a panel, ready to draw series on.
-type Chart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+type Chart<'a, 'b> = AnyChart<'a, 'b, RangedCoordf64>;
+/// The axes of a panel with the horizontal coordinate `X` (linear, or logarithmic in
+/// decades with its own ticks).
+type AnyChart<'a, 'b, X> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<X, RangedCoordf64>>;
 
 impl Figure {
     /// Renders the figure as an SVG document.
@@ -273,8 +277,23 @@ fn draw_panel(panel: &Panel, area: &Area<'_>, y_area: u32, legend: bool) -> Resu
         .map_err(draw_error)?;
     }
     draw_legend(&head, &legend, left, caption_px as i32)?;
+    if panel.x_log {
+        let panel = &log_panel(panel);
+        let layout = Layout::new(panel, &body, y_area);
+        let mut chart = draw_log_axes(panel, &body, y_area, &layout)?;
+        return draw_data(&mut chart, panel, &layout);
+    }
     let layout = Layout::new(panel, &body, y_area);
     let mut chart = draw_axes(panel, &body, y_area, &layout)?;
+    draw_data(&mut chart, panel, &layout)
+}
+
+/// The shaded interval and the series of a panel, on its axes.
+fn draw_data<X: Ranged<ValueType = f64>>(
+    chart: &mut AnyChart<'_, '_, X>,
+    panel: &Panel,
+    layout: &Layout,
+) -> Result<()> {
     if let Some((a, b)) = panel.shade_x {
         let y = layout.y;
         chart
@@ -285,9 +304,178 @@ fn draw_panel(panel: &Panel, area: &Area<'_>, y_area: u32, legend: bool) -> Resu
             .map_err(draw_error)?;
     }
     for series in &panel.series {
-        draw_series(&mut chart, series)?;
+        draw_series(chart, series)?;
     }
     Ok(())
+}
+
+/// A logarithmic panel in decades: every x (and the ranges) replaced by its `log10`, points
+/// at x ≤ 0 dropped.
+fn log_panel(panel: &Panel) -> Panel {
+    let log = |(a, b): (f64, f64)| (a.log10(), b.log10());
+    let positive = |(a, b): &(f64, f64)| *a > 0.0 && *b > 0.0;
+    Panel {
+        series: panel
+            .series
+            .iter()
+            .map(|s| Series {
+                label: s.label.clone(),
+                points: s
+                    .points
+                    .iter()
+                    .filter(|p| p.0 > 0.0 && p.0.is_finite())
+                    .map(|&(x, y)| (x.log10(), y))
+                    .collect(),
+                style: s.style,
+            })
+            .collect(),
+        x_range: panel.x_range.filter(positive).map(log),
+        shade_x: panel.shade_x.filter(positive).map(log),
+        x_log: false,
+        ..panel.clone()
+    }
+}
+
+/// The ticks of a logarithmic axis over `range` (decades, `log10` of the values): the
+/// labelled ones (1, 2, 5 × 10^k, or only 10^k when more than `max_labels` of those), and
+/// the other multiples 1…9 × 10^k for the minor grid.
+fn log_ticks(range: (f64, f64), max_labels: usize) -> (Vec<f64>, Vec<f64>) {
+    let (lo, hi) = (range.0.min(range.1), range.0.max(range.1));
+    let tol = 1e-9 * (hi - lo).max(1e-12);
+    let mut every = Vec::new();
+    if lo.is_finite() && hi.is_finite() {
+        for decade in (lo.floor() as i32)..=(hi.ceil() as i32) {
+            for m in 1..=9 {
+                let v = f64::from(decade) + f64::from(m).log10();
+                if v >= lo - tol && v <= hi + tol {
+                    every.push((m, v.clamp(lo, hi)));
+                }
+            }
+        }
+    }
+    let pick = |ms: &[i32]| -> Vec<f64> {
+        every
+            .iter()
+            .filter(|(m, _)| ms.contains(m))
+            .map(|p| p.1)
+            .collect()
+    };
+    let mut labelled = pick(&[1, 2, 5]);
+    if labelled.len() > max_labels.max(2) {
+        labelled = pick(&[1]);
+    }
+    let minor = every
+        .iter()
+        .map(|p| p.1)
+        .filter(|v| !labelled.contains(v))
+        .collect();
+    (labelled, minor)
+}
+
+/// The label of a logarithmic tick at `log10` value `v`: `10^v` to 6 significant digits,
+/// without trailing zeros (0.1, 2, 50, 200).
+fn log_tick_label(v: f64) -> String {
+    let x = 10f64.powf(v);
+    let decimals = (5 - x.abs().log10().floor() as i64).clamp(0, 12) as usize;
+    let text = format!("{x:.decimals$}");
+    let text = if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_owned()
+    } else {
+        text
+    };
+    text.replace('-', "−")
+}
+
+/// A logarithmic axis in decades (`log10` of the values), with its ticks and grid lines at
+/// the values given and labels as [`log_tick_label`] writes them.
+struct LogAxis {
+    /// The decades, mapped linearly.
+    decades: RangedCoordf64,
+    /// The labelled ticks, in decades.
+    labelled: Vec<f64>,
+}
+
+impl Ranged for LogAxis {
+    type ValueType = f64;
+    type FormatOption = NoDefaultFormatting;
+
+    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
+        self.decades.map(value, limit)
+    }
+
+    fn key_points<Hint: KeyPointHint>(&self, hint: Hint) -> Vec<f64> {
+        if hint.weight().allow_light_points() {
+            // The minor grid is drawn as series (see `draw_log_axes`).
+            Vec::new()
+        } else {
+            self.labelled.clone()
+        }
+    }
+
+    fn range(&self) -> std::ops::Range<f64> {
+        self.decades.range()
+    }
+}
+
+impl ValueFormatter<f64> for LogAxis {
+    fn format(value: &f64) -> String {
+        log_tick_label(*value)
+    }
+}
+
+/// The axes of a panel with a logarithmic horizontal axis (after [`log_panel`]): labels
+/// and grid lines at [`log_ticks`]' labelled ticks, the minor grid lighter.
+fn draw_log_axes<'a, 'b>(
+    panel: &Panel,
+    area: &'a Area<'b>,
+    y_area: u32,
+    layout: &Layout,
+) -> Result<AnyChart<'a, 'b, LogAxis>> {
+    let (margin_top, margin_bottom, margin_left, margin_right) = MARGINS;
+    let (x, y) = (layout.x, layout.y);
+    let (labelled, minor) = log_ticks(x, layout.labels.0);
+    let mut chart = ChartBuilder::on(area)
+        .margin_top(margin_top)
+        .margin_bottom(margin_bottom)
+        .margin_left(margin_left)
+        .margin_right(margin_right)
+        .x_label_area_size(layout.x_area)
+        .y_label_area_size(y_area)
+        .build_cartesian_2d(
+            LogAxis {
+                decades: (x.0..x.1).into(),
+                labelled,
+            },
+            y.0..y.1,
+        )
+        .map_err(draw_error)?;
+    let y_dec = layout.decimals.1;
+    let x_fmt = |v: &f64| log_tick_label(*v);
+    let y_fmt = move |v: &f64| format_tick(*v, y_dec);
+    chart
+        .configure_mesh()
+        .x_desc(panel.x_label.as_str())
+        .y_desc(panel.y_label.as_str())
+        .x_labels(layout.labels.0)
+        .y_labels(layout.labels.1)
+        .x_label_formatter(&x_fmt)
+        .y_label_formatter(&y_fmt)
+        .label_style((FONT, TICK_SIZE))
+        .axis_desc_style((FONT, AXIS_DESC_SIZE))
+        .bold_line_style(RGBColor(225, 225, 225))
+        .light_line_style(TRANSPARENT)
+        .axis_style(RGBColor(90, 90, 90))
+        .draw()
+        .map_err(draw_error)?;
+    let style = RGBColor(242, 242, 242).stroke_width(1);
+    chart
+        .draw_series(
+            minor
+                .into_iter()
+                .map(move |v| PathElement::new(vec![(v, y.0), (v, y.1)], style)),
+        )
+        .map_err(draw_error)?;
+    Ok(chart)
 }
 
 /// Legend rows (from [`legend_rows`]) from `left` px across and `top` px down `area`.
@@ -379,7 +567,10 @@ fn draw_axes<'a, 'b>(
 }
 
 /// One series (its legend entry is drawn above the axes, by [`draw_legend_entry`]).
-fn draw_series(chart: &mut Chart<'_, '_>, series: &Series) -> Result<()> {
+fn draw_series<X: Ranged<ValueType = f64>>(
+    chart: &mut AnyChart<'_, '_, X>,
+    series: &Series,
+) -> Result<()> {
     match series.style {
         Style::Line { color, width, dash } => {
             chart
