@@ -39,7 +39,8 @@ use std::convert::Infallible;
 
 use platen_model::{PlatenModel, Specimen};
 use platen_system::{
-    ControllerInput, ControllerState, HydraulicRates, HydraulicState, Supply, TableSystem,
+    ControllerInput, ControllerState, HydraulicConstants, HydraulicRates, HydraulicState, Supply,
+    TableSystem,
 };
 
 use crate::creep::{creep_speed_m_s, stiff_speed_m_s};
@@ -203,6 +204,8 @@ pub fn forward_closed_loop<M: PlatenModel, S: SampleSink>(
 struct Loop<'a, M, const L: usize> {
     model: &'a M,
     sys: &'a TableSystem,
+    /// The right-hand side's constants.
+    consts: HydraulicConstants,
     spec: Option<&'a Specimen>,
     command: &'a Motion,
     method: LoopMethod,
@@ -245,6 +248,7 @@ impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
         let mut s = Self {
             model,
             sys,
+            consts: sys.constants(),
             spec,
             command,
             method,
@@ -347,7 +351,9 @@ impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
         };
         dy[W] = f * v_eff;
         let hs = Self::hydraulic_state(y);
-        let hr = self.sys.hydraulic_rates(y[U], v_eff, self.input, &hs);
+        let hr = self
+            .sys
+            .hydraulic_rates_with(&self.consts, y[U], v_eff, self.input, &hs);
         dy[PA] = hr.p_a;
         dy[PB] = hr.p_b;
         dy[XV] = hr.spool;
@@ -923,7 +929,9 @@ impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
         }
         let ps = self.y[PS];
         let (p_a, p_b) = (self.y[PA].max(0.0), self.y[PB].max(0.0));
-        let (q_a, _) = self.sys.valve_flows_m3_s(self.y[XV], p_a, p_b, ps);
+        let (q_a, _) = self
+            .sys
+            .valve_flows_with(&self.consts, self.y[XV], p_a, p_b, ps);
         sample.system = Some(SystemSample {
             command_u_m: self.command.u_m()[j],
             drive: self.controller.drive,

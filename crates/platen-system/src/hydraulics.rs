@@ -52,13 +52,28 @@ pub struct HydraulicRates {
     pub hydraulic_power_w: f64,
 }
 
+/// What the right-hand side needs of the parameters, computed once per run
+/// ([`TableSystem::constants`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HydraulicConstants {
+    /// The land coefficient of one actuator's valves, [`TableSystem::land_coefficient`].
+    pub land_coefficient: f64,
+    /// The drop below which the orifice is laminar, Pa ([`LAMINAR_FRACTION`] of the rated
+    /// drop).
+    pub laminar_drop_pa: f64,
+    /// `1/√p_t`, the laminar slope's factor.
+    pub laminar_slope: f64,
+    /// The spool's natural frequency, rad/s.
+    pub spool_rad_s: f64,
+}
+
 /// `sgn(Δp)·√|Δp|` with the laminar transition of [`LAMINAR_FRACTION`] below `p_t`.
 #[inline(always)]
-fn root(dp: f64, p_t: f64) -> f64 {
-    if dp.abs() >= p_t {
+fn root(dp: f64, c: &HydraulicConstants) -> f64 {
+    if dp.abs() >= c.laminar_drop_pa {
         dp.signum() * dp.abs().sqrt()
     } else {
-        dp / p_t.sqrt()
+        dp * c.laminar_slope
     }
 }
 
@@ -104,17 +119,40 @@ impl TableSystem {
     /// into chamber `a` and out of chamber `b`, m³/s, with supply pressure `p_s`.
     #[inline(always)]
     pub fn valve_flows_m3_s(&self, x: f64, p_a: f64, p_b: f64, p_s: f64) -> (f64, f64) {
+        self.valve_flows_with(&self.constants(), x, p_a, p_b, p_s)
+    }
+
+    /// The constants of the right-hand side.
+    pub fn constants(&self) -> HydraulicConstants {
+        let p_t = LAMINAR_FRACTION * self.servo_valve.rated_pressure_drop_pa;
+        HydraulicConstants {
+            land_coefficient: self.land_coefficient(),
+            laminar_drop_pa: p_t,
+            laminar_slope: 1.0 / p_t.sqrt(),
+            spool_rad_s: std::f64::consts::TAU * self.servo_valve.natural_frequency_hz,
+        }
+    }
+
+    /// [`TableSystem::valve_flows_m3_s`] with its constants computed once.
+    #[inline(always)]
+    pub fn valve_flows_with(
+        &self,
+        c: &HydraulicConstants,
+        x: f64,
+        p_a: f64,
+        p_b: f64,
+        p_s: f64,
+    ) -> (f64, f64) {
         let x = x.clamp(-1.0, 1.0);
         if x == 0.0 {
             return (0.0, 0.0);
         }
-        let k = self.land_coefficient();
-        let p_t = LAMINAR_FRACTION * self.servo_valve.rated_pressure_drop_pa;
+        let k = c.land_coefficient;
         let p_r = self.return_pressure_pa;
         if x >= 0.0 {
-            (k * x * root(p_s - p_a, p_t), k * x * root(p_b - p_r, p_t))
+            (k * x * root(p_s - p_a, c), k * x * root(p_b - p_r, c))
         } else {
-            (k * x * root(p_a - p_r, p_t), k * x * root(p_s - p_b, p_t))
+            (k * x * root(p_a - p_r, c), k * x * root(p_s - p_b, c))
         }
     }
 
@@ -123,9 +161,22 @@ impl TableSystem {
     ///
     /// Pressures never fall below zero (absolute): a chamber at the floor does not fall
     /// further (the cavitation floor); its pressure is read as `max(p, 0)`.
-    #[inline(always)]
     pub fn hydraulic_rates(
         &self,
+        u_m: f64,
+        v_m_s: f64,
+        drive: f64,
+        s: &HydraulicState,
+    ) -> HydraulicRates {
+        self.hydraulic_rates_with(&self.constants(), u_m, v_m_s, drive, s)
+    }
+
+    /// [`TableSystem::hydraulic_rates`] with its constants computed once (what an
+    /// integrator calls per stage).
+    #[inline(always)]
+    pub fn hydraulic_rates_with(
+        &self,
+        c: &HydraulicConstants,
         u_m: f64,
         v_m_s: f64,
         drive: f64,
@@ -134,7 +185,7 @@ impl TableSystem {
         let act = &self.actuator;
         let (p_a, p_b) = (s.p_a_pa.max(0.0), s.p_b_pa.max(0.0));
         let p_s = s.supply_pressure_pa;
-        let (q_a, q_b) = self.valve_flows_m3_s(s.spool, p_a, p_b, p_s);
+        let (q_a, q_b) = self.valve_flows_with(c, s.spool, p_a, p_b, p_s);
         let (v_a, v_b) = self.chamber_volumes_m3(u_m);
         let beta = self.oil_bulk_modulus_pa;
         let leak = act.leakage_m3_s_per_pa * (p_a - p_b);
@@ -146,7 +197,7 @@ impl TableSystem {
         if s.p_b_pa <= 0.0 && dp_b < 0.0 {
             dp_b = 0.0;
         }
-        let wv = std::f64::consts::TAU * self.servo_valve.natural_frequency_hz;
+        let wv = c.spool_rad_s;
         let zeta = self.servo_valve.damping_ratio;
         let n = f64::from(act.count);
         let drawn = n * if s.spool >= 0.0 { q_a } else { -q_b };

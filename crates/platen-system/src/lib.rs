@@ -47,6 +47,6 @@ pub mod preset;
 
 pub use controller::{ControllerInput, ControllerState};
 pub use error::{Result, SystemError};
-pub use hydraulics::{HydraulicRates, HydraulicState, LAMINAR_FRACTION};
+pub use hydraulics::{HydraulicConstants, HydraulicRates, HydraulicState, LAMINAR_FRACTION};
 pub use linear::{Capacities, Linearisation, Margins, Mechanics, SECANT_SPEED_M_S};
 pub use params::{Accumulator, Actuator, Controller, ServoValve, Supply, TableSystem};

@@ -49,13 +49,13 @@ pub fn by_name(name: &str) -> Result<TableSystem> {
 ///
 /// Gains (assumed; tuned on the linearised loop with the identified platen, its secant
 /// damping at 0.1 m/s, for a flat command → displacement response with margins of at least
-/// 8 dB and 45°): displacement gain 16 /m (a position loop of about 8 Hz through the valves'
+/// 8 dB and 45°): displacement gain 16 /m (a velocity constant of 60 /s through the valves'
 /// 3.8 m/s per unit opening); velocity feedforward 0.2 s/m, three quarters of the inverse of
 /// that velocity gain (the full inverse overshoots near the oil column); acceleration
 /// feedforward 0.008 s²/m; `Δp` feedback 2·10⁻⁸ /Pa (a 1 MPa difference takes 2 % of the
 /// drive) through a 0.1 Hz high-pass, which damps the oil column without fighting the static
 /// load of the hold-down struts. They give a gain margin of 14.3 dB (at 140 Hz), a phase
-/// margin of 74° and a closed-loop peak of 1.44; `platen model --system lhpost-2008` prints
+/// margin of 74° and a closed-loop peak of 1.45 at 7.6 Hz; `platen model --system lhpost-2008` prints
 /// them. On Northridge (Tarzana, 100 %) the platen follows the command within 2.0 mm RMS.
 pub fn lhpost_2008() -> TableSystem {
     TableSystem {
