@@ -60,15 +60,18 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Run a scenario: forward (force → motion) or inverse (motion → force).
+    /// Run a scenario: forward (force → motion), inverse (motion → force), or closed loop
+    /// (a scenario with a table_system: displacement command → controller → valves → platen).
     #[command(after_help = "Examples:\n  \
         platen simulate scenarios/paper-forward-force.json --out forward.csv\n  \
-        platen simulate scenarios/s9-sine-motion.json --json")]
+        platen simulate scenarios/s9-sine-motion.json --json\n  \
+        platen simulate scenarios/table-system/s9-closed-loop.json --plot closed-loop")]
     Simulate {
         /// Scenario JSON file.
         scenario: PathBuf,
         /// Write the time series (t_s, u_m, v_m_s, a_m_s2, force_n, inertial_force_n,
-        /// elastic_force_n, dissipative_force_n) to this CSV file.
+        /// elastic_force_n, dissipative_force_n; then a specimen's and a closed loop's
+        /// columns) to this CSV file.
         #[arg(long)]
         out: Option<PathBuf>,
         /// Print a machine-readable summary on stdout.
@@ -76,7 +79,9 @@ enum Command {
         json: bool,
         /// Write the run's figures to this folder as SVG and PNG: motion and actuator force
         /// over time (with the table's limits near a peak), the force decomposition
-        /// F_A = F_I + F_E + F_D, hysteresis loops of F_A against u, v and a.
+        /// F_A = F_I + F_E + F_D, hysteresis loops of F_A against u, v and a; for a closed
+        /// loop also command against achieved motion, tracking error, drive and spool,
+        /// pressure difference, flow against the valves' capacity, supply pressure.
         #[arg(long, value_name = "DIR")]
         plot: Option<PathBuf>,
         #[command(flatten)]
