@@ -165,7 +165,8 @@ fn the_drive_saturates_and_the_integrator_does_not_wind_up() {
 #[test]
 fn impossible_systems_are_refused_with_their_path() {
     let good = symmetric(0.02, 0.04, 1e9);
-    let cases: Vec<(&str, Box<dyn Fn(&mut TableSystem)>)> = vec![
+    type Spoil = Box<dyn Fn(&mut TableSystem)>;
+    let cases: Vec<(&str, Spoil)> = vec![
         (
             "actuator.cap_side_area_m2",
             Box::new(|s| s.actuator.cap_area_m2 = -1.0),
