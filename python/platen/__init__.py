@@ -275,7 +275,9 @@ class Run:
     per input sample); ``run.columns`` names them in CSV order (``t_s``, ``u_m``, ``v_m_s``,
     ``a_m_s2``, ``force_n``, ``inertial_force_n``, ``elastic_force_n``,
     ``dissipative_force_n``, then with a specimen ``base_shear_n``, ``storey{i}_u_m``,
-    ``storey{i}_a_m_s2``); ``run.summary`` is the dict ``platen simulate --json`` prints
+    ``storey{i}_a_m_s2``, then for a closed loop (a scenario with a ``table_system``)
+    ``command_u_m``, ``drive``, ``spool_opening``, ``delta_p_pa``, ``flow_m3_s``,
+    ``supply_pressure_pa``, ``cap_pressure_pa``, ``rod_pressure_pa``); ``run.summary`` is the dict ``platen simulate --json`` prints
     (peaks and their times, stick-slip counts, solver statistics, energy balance, limits).
     ``len(run)`` is the number of samples; ``run.to_pandas()`` makes a DataFrame.
     """
