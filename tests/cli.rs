@@ -86,20 +86,35 @@ fn check_shipped_scenario_run(path: &Path, dir: &Path) {
         "{}",
         path.display()
     );
+    // A specimen adds base_shear_n, storey{i}_u_m, storey{i}_a_m_s2 (contract); a closed loop
+    // (a table_system) then adds the loop's columns (contract, then the chamber pressures).
+    let mut extra: Vec<String> = Vec::new();
     if let Some(n) = summary["specimen"]["storeys"].as_u64() {
-        // A specimen adds base_shear_n, storey{i}_u_m, storey{i}_a_m_s2 (contract).
-        let mut extra = vec!["base_shear_n".to_string()];
+        extra.push("base_shear_n".to_string());
         extra.extend((1..=n).map(|i| format!("storey{i}_u_m")));
         extra.extend((1..=n).map(|i| format!("storey{i}_a_m_s2")));
-        assert_eq!(
-            header[CONTRACT_COLUMNS.len()..],
-            extra,
-            "{}",
-            path.display()
-        );
-    } else {
-        assert_eq!(header.len(), CONTRACT_COLUMNS.len(), "{}", path.display());
     }
+    if summary.get("table_system").is_some() {
+        extra.extend(
+            [
+                "command_u_m",
+                "drive",
+                "spool_opening",
+                "delta_p_pa",
+                "flow_m3_s",
+                "supply_pressure_pa",
+                "cap_pressure_pa",
+                "rod_pressure_pa",
+            ]
+            .map(String::from),
+        );
+    }
+    assert_eq!(
+        header[CONTRACT_COLUMNS.len()..],
+        extra,
+        "{}",
+        path.display()
+    );
     assert_eq!(rows.len() as u64, summary["samples"].as_u64().unwrap());
     // Sample times are uniform and start at 0 for every shipped scenario.
     assert_eq!(rows[0][0], 0.0);
