@@ -127,8 +127,8 @@ fn model_json_is_unchanged_by_the_text_form() {
 }
 
 /// The verbs of the contract.
-const VERBS: [&str; 8] = [
-    "simulate", "compare", "identify", "model", "generate", "bench", "schema", "sweep",
+const VERBS: [&str; 9] = [
+    "simulate", "compare", "identify", "model", "generate", "bench", "schema", "sweep", "plan",
 ];
 
 /// `platen --help` lists each verb on one line of at most 100 characters, and no line of the

@@ -31,6 +31,7 @@ mod error_json;
 mod generate;
 mod identify;
 mod model;
+mod plan;
 mod plot;
 mod schema;
 mod simulate;
@@ -60,12 +61,14 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Run a scenario: forward (force → motion), inverse (motion → force), or closed loop
-    /// (a scenario with a table_system: displacement command → controller → valves → platen).
+    /// Run a scenario: forward (force → motion), inverse (motion → force) or closed loop.
+    ///
+    /// A scenario with a table_system runs the closed loop: its motion is the displacement
+    /// command of the controller, whose valves and actuators make the force.
     #[command(after_help = "Examples:\n  \
         platen simulate scenarios/paper-forward-force.json --out forward.csv\n  \
         platen simulate scenarios/s9-sine-motion.json --json\n  \
-        platen simulate scenarios/table-system/s9-closed-loop.json --plot closed-loop")]
+        platen simulate scenarios/table-system/wn10g-closed-loop.json --plot closed-loop")]
     Simulate {
         /// Scenario JSON file.
         scenario: PathBuf,
@@ -337,6 +340,20 @@ enum Command {
         #[command(flatten)]
         size: plot::SizeArgs,
     },
+    /// Plan a test: feasibility, largest scale, and the drive that reproduces a target.
+    ///
+    /// The target's own command (an acceleration integrated with a baseline treatment that
+    /// starts and ends at rest, or a displacement) runs through the scenario's closed loop
+    /// (model, table_system, specimen): peaks and margins of stroke, velocity, acceleration,
+    /// actuator force, valve flow and supply pressure; the limits that fail; the largest scale
+    /// that fits, by bisection on the simulated loop. Then offline drive iteration
+    /// D ← D + g·Ĥ⁻¹(T − R) in the frequency domain, with the acceleration NRMSE, the
+    /// displacement NRMSE and the 5 %-damped response-spectrum error (0.05–2 s) per
+    /// iteration. An infeasible target is an answer (exit 0). See docs/planning.md.
+    #[command(after_help = "Examples:\n  \
+        platen plan scenarios/table-system/northridge-closed-loop.json --target target.csv --out drive.csv\n  \
+        platen plan scenario.json --target target.csv --out drive.csv --frf measured --iterations 15 --json")]
+    Plan(plan::Args),
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -395,6 +412,7 @@ impl Command {
             | Command::Generate { json, .. }
             | Command::Sweep { json, .. }
             | Command::Identify { json, .. } => *json,
+            Command::Plan(args) => args.json,
             Command::Schema { .. } => false,
         }
     }
@@ -551,6 +569,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             no_output_error,
             size: size.size(),
         }),
+        Command::Plan(args) => plan::run(&args),
     }
 }
 

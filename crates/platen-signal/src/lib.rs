@@ -44,6 +44,8 @@
 //! * [`AccelerogramMotion`]: the table motion of a ground-acceleration record as PEER
 //!   integrates it (straight lines between samples, exact integrals), with a [`Baseline`].
 //! * [`Welch`]: power spectral density ([`Psd`], with [`Psd::rms_in_band`]).
+//! * [`ResponseSpectrum`]: damped SDOF response spectra (pseudo-acceleration) by the exact
+//!   piecewise-linear step of Nigam & Jennings ([`SdofOscillator`]).
 //!
 //! # Conventions
 //!
@@ -85,6 +87,7 @@ mod extend;
 mod fir;
 pub mod metrics;
 mod resample;
+mod response_spectrum;
 mod spectral;
 mod welch;
 mod window;
@@ -99,6 +102,7 @@ pub use crossover::{CrossoverVelocity, DEFAULT_CROSSOVER_HZ};
 pub use error::{Result, SignalError};
 pub use fir::{FirLowpass, MAX_FIR_ORDER};
 pub use resample::{Interpolation, Resampler};
+pub use response_spectrum::{ResponseSpectrum, SdofOscillator};
 pub use spectral::{trim_to_whole_periods, whole_periods, SpectralLowpass, WholePeriods};
 pub use welch::{Psd, Welch};
 pub use window::Window;

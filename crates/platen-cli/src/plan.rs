@@ -1,0 +1,349 @@
+//! `platen plan`: can the scenario's table run the target, what limits it, the largest scale
+//! that fits, and the drive (displacement command) that makes the simulated table reproduce
+//! it. Everything is computed by `platen_plan`; this file parses, prints and writes.
+//!
+//! The drive CSV's temporary file is created first (an unwritable destination fails before
+//! anything runs) and renamed over `--out` only when the plan is complete: a failed plan
+//! leaves nothing and does not touch an existing file.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::ValueEnum;
+
+use platen_io::csv::CsvWriter;
+use platen_io::IoError;
+use platen_model::STANDARD_GRAVITY_M_S2;
+use platen_plan::{
+    load_scenario, plan, FrfSource, MaxScaleSettings, NoiseSettings, PlanError, PlanSettings,
+    Target,
+};
+
+/// The arguments of `platen plan`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Scenario JSON file with a `table_system` (its model, table system, specimen and limits
+    /// are used; its excitation, if any, is ignored: the target takes its place).
+    pub scenario: PathBuf,
+    /// Target CSV: `t_s` and `a_m_s2` (an acceleration record), or `t_s` and `u_m` (a
+    /// displacement), uniformly sampled at most at the controller's rate (a slower target is
+    /// put on the controller's rate).
+    #[arg(long, value_name = "TARGET.csv")]
+    pub target: PathBuf,
+    /// Write the drive (`t_s`, `u_m`: the displacement command, at the controller's rate) to
+    /// this CSV file.
+    #[arg(long, value_name = "DRIVE.csv")]
+    pub out: PathBuf,
+    /// Most drive corrections (0: run the target's own command only).
+    #[arg(long, value_name = "N", default_value_t = 10, value_parser = clap::value_parser!(u16).range(0..=200))]
+    pub iterations: u16,
+    /// Gain g of the iteration D ← D + g·Ĥ⁻¹(T − R), in (0, 2).
+    #[arg(long, value_name = "G", default_value_t = platen_plan::iterate::DEFAULT_GAIN, value_parser = parse_gain)]
+    pub gain: f64,
+    /// Stop when the acceleration NRMSE is at most this (a fraction).
+    #[arg(long, value_name = "E", default_value_t = 0.02, value_parser = parse_nrmse)]
+    pub target_nrmse: f64,
+    /// Where Ĥ comes from: the model's linearisation, or measured on the simulated table with
+    /// a white-noise command at the target's RMS acceleration (sees a specimen's modes);
+    /// auto: measured when the scenario has a specimen, linearised otherwise.
+    #[arg(long, value_enum, default_value_t = Frf::Auto)]
+    pub frf: Frf,
+    /// Correction band, Hz (default 0.1 to the smaller of 50 Hz and 0.45 times the rate).
+    #[arg(long, value_name = "LO,HI", value_parser = parse_band)]
+    pub band_hz: Option<(f64, f64)>,
+    /// Do not search the largest scale that fits (saves about ten closed-loop runs).
+    #[arg(long)]
+    pub no_max_scale: bool,
+    /// Print the plan as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `--frf`.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum Frf {
+    /// Measured with a specimen, linearised without.
+    Auto,
+    /// The model's linearisation about mid-stroke (the specimen as a rigid payload).
+    Linearised,
+    /// Measured on the simulated table with band-limited white noise (64 s).
+    Measured,
+}
+
+fn parse_number(s: &str) -> std::result::Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}`: expected a number"))?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("`{s}`: expected a finite number"))
+    }
+}
+
+/// `--gain`: in (0, 2).
+fn parse_gain(s: &str) -> std::result::Result<f64, String> {
+    let g = parse_number(s)?;
+    if g > 0.0 && g < 2.0 {
+        Ok(g)
+    } else {
+        Err(format!("{g}: expected a gain in (0, 2)"))
+    }
+}
+
+/// `--target-nrmse`: a fraction >= 0.
+fn parse_nrmse(s: &str) -> std::result::Result<f64, String> {
+    let e = parse_number(s)?;
+    if e >= 0.0 {
+        Ok(e)
+    } else {
+        Err(format!("{e}: expected an NRMSE >= 0 (a fraction)"))
+    }
+}
+
+/// `--band-hz LO,HI` with `0 < LO < HI`.
+fn parse_band(s: &str) -> std::result::Result<(f64, f64), String> {
+    let (lo, hi) = s
+        .split_once(',')
+        .ok_or_else(|| format!("`{s}`: expected LO,HI in Hz"))?;
+    let (lo, hi) = (parse_number(lo)?, parse_number(hi)?);
+    if lo > 0.0 && hi > lo {
+        Ok((lo, hi))
+    } else {
+        Err(format!("`{s}`: expected 0 < LO < HI, Hz"))
+    }
+}
+
+/// The error of the plan, unwrapped so that the exit code and the JSON error object see the
+/// file and line errors it holds (as for every verb).
+fn cli_error(e: PlanError) -> anyhow::Error {
+    match e {
+        PlanError::Scenario(se) => se.into(),
+        PlanError::Io(io) => io.into(),
+        PlanError::Run { what, source } => {
+            anyhow::Error::new(source).context(format!("the closed-loop run of {what} failed"))
+        }
+        PlanError::TargetRate {
+            origin,
+            rate_hz,
+            controller_hz,
+        } => IoError::Record {
+            path: origin,
+            message: format!(
+                "sampled at {rate_hz} Hz, faster than the controller's {controller_hz} Hz: the \
+                 controller reads its command once a period, so the drive is at its rate and \
+                 cannot carry the target's content above {} Hz (resample the target to at most \
+                 {controller_hz} Hz)",
+                0.5 * controller_hz
+            ),
+        }
+        .into(),
+        PlanError::NoTableSystem { scenario } => IoError::InvalidField {
+            path: scenario,
+            json_path: "table_system".to_owned(),
+            value: "(missing)".to_owned(),
+            expected: "the loop around the platen, {\"preset\": \"lhpost-2008\"} or an explicit \
+                       system: planning runs the closed loop"
+                .to_owned(),
+        }
+        .into(),
+        other => other.into(),
+    }
+}
+
+pub fn run(args: &Args) -> Result<()> {
+    let settings = PlanSettings {
+        iteration: platen_plan::IterationSettings {
+            max_iterations: usize::from(args.iterations),
+            gain: args.gain,
+            target_nrmse: args.target_nrmse,
+            band_hz: args.band_hz,
+            frf: match args.frf {
+                Frf::Auto => FrfSource::Auto,
+                Frf::Linearised => FrfSource::Linearised,
+                Frf::Measured => FrfSource::Measured(NoiseSettings::default()),
+            },
+            ..Default::default()
+        },
+        max_scale: (!args.no_max_scale).then(MaxScaleSettings::default),
+        ..Default::default()
+    };
+    // The drive's temporary file first: an unwritable destination fails before any run.
+    let mut writer = CsvWriter::create(&args.out, &["t_s", "u_m"])?;
+    let scenario = load_scenario(&args.scenario).map_err(cli_error)?;
+    let target = Target::read_csv(&args.target).map_err(cli_error)?;
+    let p = plan(&scenario, &args.scenario, &target, &settings).map_err(cli_error)?;
+    let written = match p.drive() {
+        Some((t_s, u_m)) => {
+            for (t, u) in t_s.iter().zip(u_m) {
+                writer.write_row(&[*t, *u])?;
+            }
+            writer.finish()?;
+            Some(args.out.as_path())
+        }
+        // No drive (the target's command reaches the end of the actuators): nothing is
+        // written; the temporary file goes with the writer.
+        None => None,
+    };
+    let summary = p.summary(written);
+    for warning in &summary.warnings {
+        eprintln!("warning: {warning}");
+    }
+    if args.json {
+        outln!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::to_value(&summary)?)?
+        );
+        return Ok(());
+    }
+    print_text(&summary)
+}
+
+/// The unit of a limit, from its name.
+fn unit(limit: &str) -> &'static str {
+    match limit.rsplit('_').next() {
+        Some("m") => "m",
+        Some("s") if limit.ends_with("_m_s") => "m/s",
+        Some("s2") => "m/s²",
+        Some("n") => "N",
+        Some("pa") => "Pa",
+        Some("s") => "m³/s",
+        _ => "",
+    }
+}
+
+/// `x` to 4 significant digits: fixed between 10⁻³ and 10⁶, else in exponent form.
+fn significant(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let e = x.abs().log10().floor() as i32;
+    if (-3..6).contains(&e) {
+        format!("{x:.*}", (3 - e).max(0) as usize)
+    } else {
+        format!("{x:.3e}")
+    }
+}
+
+fn print_text(s: &platen_plan::PlanSummary) -> Result<()> {
+    let t = &s.target;
+    outln!("{}: plan of `{}` on `{}`", s.name, t.file, s.scenario);
+    outln!(
+        "  target: {}, {} samples at {} Hz over {:.3} s (drive at {} Hz); peak {:.4} m/s² \
+         ({:.3} g), command peak {:.4} m",
+        t.kind,
+        t.samples,
+        t.sample_rate_hz,
+        t.duration_s,
+        t.drive_sample_rate_hz,
+        t.peak_a_m_s2,
+        t.peak_a_m_s2 / STANDARD_GRAVITY_M_S2,
+        t.peak_u_m
+    );
+    if let Some(d) = t.baseline_degree {
+        outln!(
+            "  baseline: end-matching polynomial of degree {d}; it removed {} m/s² RMS \
+             ({:.2} % of the target's), {} m/s² at most",
+            significant(t.baseline_correction_rms_m_s2),
+            100.0 * t.baseline_correction_rms_m_s2 / t.rms_a_m_s2.max(f64::MIN_POSITIVE),
+            significant(t.baseline_correction_peak_m_s2)
+        );
+    }
+    outln!(
+        "  feasible: {}",
+        if s.feasible {
+            "yes".to_owned()
+        } else {
+            let names: Vec<String> = s
+                .limiting
+                .iter()
+                .map(|l| format!("{} ({:.3}× at {:.3} s)", l.limit, l.ratio, l.t_s))
+                .collect();
+            format!("NO: {}", names.join(", "))
+        }
+    );
+    outln!(
+        "    {:<20} {:>12} {:>12} {:<5} {:>7} {:>10}",
+        "limit",
+        "peak",
+        "allowed",
+        "",
+        "use",
+        "at"
+    );
+    for l in &s.margins {
+        outln!(
+            "    {:<20} {:>12} {:>12} {:<5} {:>6.1}% {:>8.3} s",
+            l.limit,
+            significant(l.peak),
+            significant(l.allowed),
+            unit(l.limit),
+            100.0 * l.ratio,
+            l.t_s
+        );
+    }
+    if let Some(m) = &s.max_scale_search {
+        if m.at_upper_bound {
+            outln!(
+                "  largest scale that fits: at least {} (the search's bound)",
+                m.scale
+            );
+        } else {
+            outln!(
+                "  largest scale that fits: {:.4} (bracket {:.4}–{:.4}; beyond it: {}; {} runs)",
+                m.scale,
+                m.bracket[0],
+                m.bracket[1],
+                m.limiting.join(", "),
+                m.runs
+            );
+        }
+    }
+    if let Some(f) = &s.frf {
+        outln!(
+            "  iterations (gain {}, Ĥ {}, band {}–{} Hz):",
+            f.gain,
+            f.source,
+            f.band_hz[0],
+            f.band_hz[1]
+        );
+        outln!(
+            "    {:>3} {:>12} {:>12} {:>22}",
+            "k",
+            "accel NRMSE",
+            "disp NRMSE",
+            "spectrum error (5 %)"
+        );
+        for r in &s.iterations {
+            outln!(
+                "    {:>3} {:>11.2}% {:>11.2}% {:>11.2}% at {:.3} s",
+                r.iteration,
+                100.0 * r.acceleration_nrmse,
+                100.0 * r.displacement_nrmse,
+                100.0 * r.spectrum_error,
+                r.spectrum_error_period_s
+            );
+        }
+    }
+    outln!(
+        "  stop: {}{}",
+        s.stop,
+        s.stall_reason
+            .as_ref()
+            .map_or(String::new(), |r| format!(" ({r})"))
+    );
+    match &s.drive {
+        Some(d) => outln!(
+            "  drive: iteration {} ({:.2} % acceleration NRMSE), {} samples, peak {:.4} m, \
+             written to {}",
+            d.achieved.iteration,
+            100.0 * d.achieved.acceleration_nrmse,
+            d.samples,
+            d.peak_u_m,
+            d.out.as_deref().unwrap_or("(nothing)")
+        ),
+        None => outln!("  drive: none (nothing written)"),
+    }
+    Ok(())
+}

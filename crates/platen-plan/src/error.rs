@@ -1,0 +1,116 @@
+//! Errors of the `platen-plan` crate.
+//!
+//! An infeasible target is **not** an error: it is an answer ([`crate::Feasibility`]). Errors
+//! are inputs that cannot be planned (a target too short, not finite, not uniformly sampled
+//! or faster than the controller; a scenario without a `table_system`), settings out of
+//! range, and closed-loop runs that fail numerically.
+
+use std::path::PathBuf;
+
+use platen_integrate::IntegrateError;
+use platen_io::IoError;
+use platen_scenario::ScenarioError;
+use platen_signal::SignalError;
+
+/// Result type of this crate, defaulting to [`PlanError`].
+pub type Result<T, E = PlanError> = std::result::Result<T, E>;
+
+/// Why a plan could not be made.
+#[non_exhaustive]
+#[derive(Debug, thiserror::Error)]
+pub enum PlanError {
+    /// The scenario cannot be loaded or validated (its file, JSON path and value).
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+
+    /// A file cannot be read or written: the target CSV (with its line and column), the drive.
+    #[error(transparent)]
+    Io(#[from] IoError),
+
+    /// A target given in memory is unusable: `index` is the 0-based sample.
+    #[error("target `{origin}`: {message}")]
+    Target {
+        /// Where the target comes from (a file, or the caller that gave the arrays).
+        origin: String,
+        /// What is wrong, with the sample's index.
+        message: String,
+    },
+
+    /// The target is sampled faster than the controller reads its command.
+    #[error(
+        "`{}`: the target is sampled at {rate_hz} Hz, faster than the controller's \
+         {controller_hz} Hz: the controller reads the command once a period, so a drive at this \
+         rate cannot carry the target's content above {nyquist_hz} Hz (resample the target to \
+         at most {controller_hz} Hz)",
+        origin.display(),
+        nyquist_hz = 0.5 * controller_hz
+    )]
+    TargetRate {
+        /// The target's origin.
+        origin: PathBuf,
+        /// Its sample rate, Hz.
+        rate_hz: f64,
+        /// The controller's sample rate, Hz.
+        controller_hz: f64,
+    },
+
+    /// The scenario has no `table_system`: there is no loop to plan a drive for.
+    #[error(
+        "`{}`: no `table_system`: planning needs the loop around the platen (add \
+         \"table_system\": {{\"preset\": \"lhpost-2008\"}} or an explicit system)",
+        scenario.display()
+    )]
+    NoTableSystem {
+        /// The scenario.
+        scenario: PathBuf,
+    },
+
+    /// A planning setting is out of range.
+    #[error("setting `{name}` = {value} is invalid: expected {expected}")]
+    Setting {
+        /// The setting's name (SI unit in the name).
+        name: &'static str,
+        /// The rejected value.
+        value: f64,
+        /// What a valid value looks like.
+        expected: &'static str,
+    },
+
+    /// The white-noise measurement of the loop's response cannot be made (its band, RMS or
+    /// duration).
+    #[error("the white-noise measurement of the loop's response: {0}")]
+    Measurement(String),
+
+    /// A signal-processing plan was refused (a band or rate the tools cannot use).
+    #[error(transparent)]
+    Signal(#[from] SignalError),
+
+    /// A closed-loop run failed numerically (or its command was refused); the cause names
+    /// the time.
+    #[error("the closed-loop run of {what} failed")]
+    Run {
+        /// Which run (`the target`, `iteration 3`, `the white-noise measurement`).
+        what: String,
+        /// Why.
+        #[source]
+        source: IntegrateError,
+    },
+}
+
+/// `value` if it is finite and `ok`, else the setting's error.
+pub(crate) fn check_setting(
+    name: &'static str,
+    value: f64,
+    ok: bool,
+    expected: &'static str,
+) -> Result<f64> {
+    if value.is_finite() && ok {
+        Ok(value)
+    } else {
+        Err(PlanError::Setting {
+            name,
+            value,
+            expected,
+        })
+    }
+}

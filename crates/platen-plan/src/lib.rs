@@ -1,0 +1,73 @@
+//! Test planning on a simulated shake table: can the table run this target, what limits it
+//! and what scale fits, and which drive makes the table reproduce it. Physics-free: every
+//! answer comes from running a scenario's closed loop ([`platen_scenario`]: its model,
+//! `table_system` and specimen) with displacement commands.
+//!
+//! ```no_run
+//! use std::path::Path;
+//! use platen_plan::{load_scenario, plan, write_drive, PlanSettings, Target};
+//!
+//! let scenario_path = Path::new("scenarios/table-system/northridge-closed-loop.json");
+//! let scenario = load_scenario(scenario_path)?; // its excitation is ignored
+//! let target = Target::read_csv(Path::new("target.csv"))?; // t_s and a_m_s2 (or u_m)
+//! let p = plan(&scenario, scenario_path, &target, &PlanSettings::with_max_scale())?;
+//! println!("feasible: {}, max scale {:?}", p.feasibility.feasible,
+//!          p.feasibility.max_scale.as_ref().map(|m| m.scale));
+//! if let Some(it) = p.iteration() {
+//!     for r in &it.records {
+//!         println!("{}: acceleration NRMSE {:.3}", r.iteration, r.acceleration_nrmse);
+//!     }
+//! }
+//! if let Some((t_s, u_m)) = p.drive() {
+//!     write_drive(Path::new("drive.csv"), t_s, u_m)?;
+//! }
+//! # Ok::<(), platen_plan::PlanError>(())
+//! ```
+//!
+//! # What is here
+//!
+//! * [`Target`]: the target (acceleration or displacement, uniform time base), validated.
+//! * [`TargetMotion`] ([`baseline`]): the displacement command of a target, integrated from
+//!   an acceleration with a baseline treatment that starts and ends at rest and keeps the
+//!   displacement as small as a polynomial correction can.
+//! * [`Table`]: a scenario's closed loop driven by any command ([`Achieved`]).
+//! * [`feasibility()`](feasibility::feasibility), [`max_scale`] ([`feasibility`]): peaks and
+//!   margins of stroke, velocity, acceleration, actuator force, valve flow and supply
+//!   pressure; the limits that fail; the largest scale that fits, by bisection on the
+//!   simulated loop.
+//! * [`FrequencyResponse`] ([`frf`]): the loop's `Ĥ`, linearised or measured with white
+//!   noise.
+//! * [`iterate()`](fn@iterate), [`iterate_with`] ([`mod@iterate`]): offline drive iteration
+//!   `D_{k+1} = D_k + g·Ĥ⁻¹(T − R_k)` with a regularised inverse in a band, and its stop
+//!   criteria.
+//! * [`plan()`](plan::plan): all of it, with the summary `platen plan --json` prints.
+//!
+//! # Conventions
+//!
+//! SI units, unit in every name. The drive is a displacement command at the target's time
+//! stamps; its velocity and acceleration are derived exactly as `simulate` derives them from a
+//! `motion_csv` holding `t_s` and `u_m` ([`command_motion`]), so a drive written to CSV and
+//! replayed through `simulate` is the run the plan reports. Everything is deterministic: the
+//! same inputs give the same bytes.
+
+#![warn(missing_docs)]
+
+pub mod baseline;
+mod error;
+pub mod feasibility;
+pub mod frf;
+pub mod iterate;
+pub mod plan;
+mod table;
+mod target;
+
+pub use baseline::{command_motion, BaselineSettings, EndCorrection, TargetMotion};
+pub use error::{PlanError, Result};
+pub use feasibility::{max_scale, Feasibility, LimitUse, MaxScale, MaxScaleSettings};
+pub use frf::{FrequencyResponse, FrfSource, NoiseSettings};
+pub use iterate::{
+    iterate, iterate_with, Iteration, IterationRecord, IterationSettings, Response, Stop,
+};
+pub use plan::{load_scenario, plan, write_drive, Plan, PlanSettings, PlanSummary, PlannedDrive};
+pub use table::{Achieved, Table};
+pub use target::{Target, TargetKind, MIN_TARGET_SAMPLES};

@@ -1,0 +1,433 @@
+//! A whole plan: the target's motion, its feasibility and largest scale, the drive
+//! iteration, and the summary `platen plan --json` prints ([`plan`], [`PlanSummary`]).
+
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use platen_io::csv::write_csv_atomic;
+use platen_io::{IoAction, IoError};
+use platen_scenario::file::ExcitationSpec;
+use platen_scenario::{Arrays, LimitsSummary, Scenario};
+
+use crate::baseline::{peak, rms, BaselineSettings, TargetMotion};
+use crate::error::{PlanError, Result};
+use crate::feasibility::{
+    failing, feasibility, limit_uses, limits_summary, Feasibility, LimitUse, MaxScale,
+    MaxScaleSettings,
+};
+use crate::iterate::{iterate, IterationRecord, IterationSettings, Stop};
+use crate::table::{Achieved, Table};
+use crate::target::Target;
+use crate::Iteration;
+
+/// Everything a plan can be told.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PlanSettings {
+    /// How an acceleration target becomes a displacement command.
+    pub baseline: BaselineSettings,
+    /// The drive iteration.
+    pub iteration: IterationSettings,
+    /// The search of the largest scale (`None`: not searched).
+    pub max_scale: Option<MaxScaleSettings>,
+}
+
+impl PlanSettings {
+    /// The defaults with the largest scale searched.
+    pub fn with_max_scale() -> Self {
+        Self {
+            max_scale: Some(MaxScaleSettings::default()),
+            ..Self::default()
+        }
+    }
+}
+
+/// A finished plan.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    /// The scenario's file (for the summary).
+    pub scenario_path: PathBuf,
+    /// The scenario's name.
+    pub scenario_name: String,
+    /// The target's origin.
+    pub target_origin: PathBuf,
+    /// The target's own samples.
+    pub target_samples: usize,
+    /// The target's own sample rate, Hz.
+    pub target_rate_hz: f64,
+    /// The motion asked of the table (after the baseline treatment).
+    pub motion: TargetMotion,
+    /// The target's feasibility (its own command, iteration 0) and largest scale.
+    pub feasibility: Feasibility,
+    /// The drive iteration and what its best drive's run uses of every limit (`None` when
+    /// the target's own command drives the platen to the end of its actuators: there is no
+    /// run to iterate on).
+    pub drive: Option<PlannedDrive>,
+    /// What the planner wants its user to know.
+    pub warnings: Vec<String>,
+}
+
+/// The iterated drive of a plan.
+#[derive(Debug, Clone)]
+pub struct PlannedDrive {
+    /// The drive iteration.
+    pub iteration: Iteration<Achieved>,
+    /// Every limit against the best drive's run.
+    pub uses: Vec<LimitUse>,
+    /// The scenario's four limits against the best drive's run.
+    pub limits: LimitsSummary,
+    /// Where `Ĥ` came from, its measured band and mean coherence.
+    pub frf: FrfSummary,
+}
+
+impl Plan {
+    /// The drive: time stamps (the target's, on the controller's rate), s, and displacement
+    /// command, m (`None` when there is none: see [`Plan::drive`]).
+    pub fn drive(&self) -> Option<(&[f64], &[f64])> {
+        let d = self.drive.as_ref()?;
+        Some((&self.motion.t_s, &d.iteration.drive_u_m))
+    }
+
+    /// The drive iteration, if it ran.
+    pub fn iteration(&self) -> Option<&Iteration<Achieved>> {
+        self.drive.as_ref().map(|d| &d.iteration)
+    }
+}
+
+/// Loads a scenario file for planning: as [`Scenario::load`], but the `excitation` may be
+/// absent and is ignored when present (the target takes its place, so its records are not
+/// read), as is `duration_s`. The scenario's `run` is a placeholder (16 samples at rest);
+/// the planner runs the scenario's closed loop with its own commands.
+///
+/// # Errors
+/// Every error of [`Scenario::load`] but the excitation's; [`PlanError::NoTableSystem`].
+pub fn load_scenario(path: &Path) -> Result<Scenario> {
+    let text = std::fs::read_to_string(path).map_err(|source| IoError::Io {
+        path: path.to_owned(),
+        action: IoAction::Reading,
+        source,
+    })?;
+    // Syntax errors first, with their line; then add an empty excitation where there is none
+    // (on the first line, so that every later line keeps its number).
+    let value: serde_json::Value = platen_io::json::parse_json(path, &text)?;
+    let text = match value.as_object() {
+        Some(map) if !map.contains_key("excitation") => {
+            let at = text.find('{').map_or(0, |i| i + 1);
+            let insert = if map.is_empty() {
+                "\"excitation\": {}"
+            } else {
+                "\"excitation\": {}, "
+            };
+            format!("{}{insert}{}", &text[..at], &text[at..])
+        }
+        _ => text,
+    };
+    let mut file = platen_scenario::file::parse(path, &text)?;
+    file.excitation = ExcitationSpec::default();
+    file.duration_s = None;
+    if file.table_system.is_none() {
+        return Err(PlanError::NoTableSystem {
+            scenario: path.to_owned(),
+        });
+    }
+    let t_s: Vec<f64> = (0..16).map(|j| j as f64 / 1024.0).collect();
+    let arrays = Arrays::Motion {
+        u_m: vec![0.0; t_s.len()],
+        t_s,
+        v_m_s: None,
+        a_m_s2: None,
+    };
+    Ok(Scenario::from_arrays(path, file, arrays)?)
+}
+
+/// Plans `target` on `scenario` (read from `scenario_path`, for messages): the target's
+/// motion, its feasibility and largest scale, then the drive iteration.
+///
+/// # Errors
+/// [`PlanError::NoTableSystem`]; [`PlanError::TargetRate`] for a target sampled faster than
+/// the controller; bad settings; a closed-loop run that fails.
+pub fn plan(
+    scenario: &Scenario,
+    scenario_path: &Path,
+    target: &Target,
+    settings: &PlanSettings,
+) -> Result<Plan> {
+    let table = Table::new(scenario, scenario_path)?;
+    let controller_hz = table.controller_rate_hz();
+    if target.sample_rate_hz() > controller_hz * (1.0 + 1e-9) {
+        return Err(PlanError::TargetRate {
+            origin: target.origin().to_owned(),
+            rate_hz: target.sample_rate_hz(),
+            controller_hz,
+        });
+    }
+    let motion = TargetMotion::new(
+        target,
+        &settings.baseline,
+        scenario.limits.stroke_m,
+        controller_hz,
+    )?;
+    if rms(&motion.a_m_s2) == 0.0 {
+        return Err(PlanError::Target {
+            origin: target.origin().display().to_string(),
+            message: "the target's acceleration is zero everywhere: nothing to reproduce".into(),
+        });
+    }
+    let feasibility = feasibility(&table, &motion, settings.max_scale.as_ref())?;
+    let mut warnings = Vec::new();
+    let largest = feasibility.max_scale.as_ref().map_or(String::new(), |m| {
+        format!(" (largest scale that fits: {:.4})", m.scale)
+    });
+    if let Some(stop) = feasibility.achieved.end_stop {
+        warnings.push(format!(
+            "the target's command drives the platen to the end of its actuators at {:.3} s \
+             (u = {:.3} m): not iterated, no drive{largest}",
+            stop.t_s, stop.value
+        ));
+    } else if let Some(worst) = feasibility.limiting.first() {
+        warnings.push(format!(
+            "the target is not feasible: {} reaches {:.3} times its limit at {:.3} s{largest}; \
+             the drive reproduces it on the model, the table cannot run it",
+            worst.limit, worst.ratio, worst.t_s
+        ));
+    }
+    let drive = match feasibility.achieved.end_stop {
+        Some(_) => None,
+        None => {
+            let iteration = iterate(&table, &motion, &settings.iteration)?;
+            let uses = limit_uses(scenario, &iteration.achieved);
+            if feasibility.feasible {
+                if let Some(worst) = failing(&uses).first() {
+                    warnings.push(format!(
+                        "the target's own command fits, but the iterated drive's run exceeds \
+                         {} ({:.3} times its limit at {:.3} s)",
+                        worst.limit, worst.ratio, worst.t_s
+                    ));
+                }
+            }
+            if let Stop::Stalled { reason } = &iteration.stop {
+                warnings.push(format!("the drive iteration stalled: {reason}"));
+            }
+            if let Some(t) = iteration.achieved.cavitation_at_s() {
+                warnings.push(format!(
+                    "a chamber pressure reached the cavitation floor at {t:.4} s in the drive's \
+                     run"
+                ));
+            }
+            Some(PlannedDrive {
+                limits: limits_summary(scenario, &iteration.achieved),
+                frf: FrfSummary::new(&settings.iteration, &iteration),
+                uses,
+                iteration,
+            })
+        }
+    };
+    Ok(Plan {
+        scenario_path: scenario_path.to_owned(),
+        scenario_name: scenario.name.clone(),
+        target_origin: target.origin().to_owned(),
+        target_samples: target.len(),
+        target_rate_hz: target.sample_rate_hz(),
+        motion,
+        feasibility,
+        drive,
+        warnings,
+    })
+}
+
+/// Writes the drive CSV (`t_s`, `u_m`) atomically: nothing is left at `path` if it fails.
+///
+/// # Errors
+/// [`PlanError::Io`].
+pub fn write_drive(path: &Path, t_s: &[f64], u_m: &[f64]) -> Result<()> {
+    Ok(write_csv_atomic(path, &["t_s", "u_m"], &[t_s, u_m])?)
+}
+
+/// Where `Ĥ` came from, as the summary reports it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FrfSummary {
+    /// `linearised` or `measured`.
+    pub source: &'static str,
+    /// The correction band, Hz.
+    pub band_hz: [f64; 2],
+    /// The measured band, Hz (measured only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub measured_band_hz: Option<[f64; 2]>,
+    /// Mean coherence of the measurement over its band (measured only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub coherence: Option<f64>,
+    /// The gain `g`.
+    pub gain: f64,
+    /// `ε` of the regularised inverse.
+    pub regularisation: f64,
+    /// FFT length (record and padding), samples.
+    pub fft_len: usize,
+}
+
+impl FrfSummary {
+    fn new(settings: &IterationSettings, it: &Iteration<Achieved>) -> Self {
+        Self {
+            source: if it.measured.is_some() {
+                "measured"
+            } else {
+                "linearised"
+            },
+            band_hz: [it.band_hz.0, it.band_hz.1],
+            measured_band_hz: it.measured.map(|m| [m.0 .0, m.0 .1]),
+            coherence: it.measured.map(|m| m.1),
+            gain: settings.gain,
+            regularisation: settings.regularisation,
+            fft_len: it.fft_len,
+        }
+    }
+}
+
+/// The summary `platen plan --json` prints. Serialise it through [`serde_json::to_value`]
+/// for the keys in alphabetical order.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PlanSummary {
+    /// The scenario file.
+    pub scenario: String,
+    /// The scenario's name.
+    pub name: String,
+    /// The target.
+    pub target: TargetSummary,
+    /// Whether the target's own command respects every limit.
+    pub feasible: bool,
+    /// The scenario's four limits against the target command's run, as `simulate`'s.
+    pub limits: LimitsSummary,
+    /// The limits that fail, worst first.
+    pub limiting: Vec<LimitUse>,
+    /// Every limit with its peak, allowed value, ratio and time.
+    pub margins: Vec<LimitUse>,
+    /// The largest scale of the target that fits (absent when not searched).
+    pub max_scale: Option<f64>,
+    /// How it was found.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_scale_search: Option<MaxScale>,
+    /// Every iteration's figures, from 0 (the target's own command); empty when not iterated.
+    pub iterations: Vec<IterationRecord>,
+    /// The iteration whose drive is written (absent when not iterated).
+    pub best_iteration: Option<usize>,
+    /// `converged`, `max_iterations`, `stalled`, or `not_run` (the target's own command
+    /// reaches the end of the actuators).
+    pub stop: &'static str,
+    /// Why the iteration stalled (absent otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stall_reason: Option<String>,
+    /// `Ĥ` and the iteration's settings (absent when not iterated).
+    pub frf: Option<FrfSummary>,
+    /// The drive (absent when not iterated).
+    pub drive: Option<DriveSummary>,
+    /// What the planner wants its user to know.
+    pub warnings: Vec<String>,
+}
+
+/// The target, as the summary reports it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TargetSummary {
+    /// Its file (or origin).
+    pub file: String,
+    /// `acceleration` or `displacement`.
+    pub kind: &'static str,
+    /// Samples.
+    pub samples: usize,
+    /// Its sample rate, Hz.
+    pub sample_rate_hz: f64,
+    /// The rate of the drive (the controller's), Hz: a slower target is put on it.
+    pub drive_sample_rate_hz: f64,
+    /// Duration, s.
+    pub duration_s: f64,
+    /// Largest acceleration to reproduce (after the baseline treatment), m/s².
+    pub peak_a_m_s2: f64,
+    /// Largest displacement of its command, m.
+    pub peak_u_m: f64,
+    /// The end-correction degree (acceleration targets).
+    pub baseline_degree: Option<usize>,
+    /// RMS of the acceleration the baseline treatment removed, m/s².
+    pub baseline_correction_rms_m_s2: f64,
+    /// Its largest magnitude, m/s².
+    pub baseline_correction_peak_m_s2: f64,
+    /// RMS of the target's own acceleration, m/s².
+    pub rms_a_m_s2: f64,
+}
+
+/// The drive, as the summary reports it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DriveSummary {
+    /// The CSV written, if any.
+    pub out: Option<String>,
+    /// Samples.
+    pub samples: usize,
+    /// Largest displacement of the drive, m.
+    pub peak_u_m: f64,
+    /// What the drive achieves (the best iteration).
+    pub achieved: IterationRecord,
+    /// The run's signed peak displacement, m.
+    pub run_peak_u_m: f64,
+    /// The run's signed peak velocity, m/s.
+    pub run_peak_v_m_s: f64,
+    /// The run's signed peak actuator force, N.
+    pub run_peak_force_n: f64,
+    /// The scenario's four limits against the drive's run.
+    pub limits: LimitsSummary,
+    /// The limits the drive's run exceeds, worst first.
+    pub limiting: Vec<LimitUse>,
+}
+
+impl Plan {
+    /// The summary, with `out` the drive CSV written (if any).
+    pub fn summary(&self, out: Option<&Path>) -> PlanSummary {
+        let f = &self.feasibility;
+        let m = &self.motion;
+        let it = self.iteration();
+        PlanSummary {
+            scenario: self.scenario_path.display().to_string(),
+            name: self.scenario_name.clone(),
+            target: TargetSummary {
+                file: self.target_origin.display().to_string(),
+                kind: m.kind.name(),
+                samples: self.target_samples,
+                sample_rate_hz: self.target_rate_hz,
+                drive_sample_rate_hz: 1.0 / m.interval_s(),
+                duration_s: m.t_s[m.len() - 1] - m.t_s[0],
+                peak_a_m_s2: peak(&m.a_m_s2),
+                peak_u_m: m.peak_u_m(),
+                baseline_degree: m.end_degree,
+                baseline_correction_rms_m_s2: m.correction_rms_m_s2,
+                baseline_correction_peak_m_s2: m.correction_peak_m_s2,
+                rms_a_m_s2: m.target_rms_m_s2,
+            },
+            feasible: f.feasible,
+            limits: f.limits.clone(),
+            limiting: f.limiting.clone(),
+            margins: f.uses.clone(),
+            max_scale: f.max_scale.as_ref().map(|s| s.scale),
+            max_scale_search: f.max_scale.clone(),
+            iterations: it.map_or_else(Vec::new, |it| it.records.clone()),
+            best_iteration: it.map(|it| it.best),
+            stop: it.map_or("not_run", |it| it.stop.name()),
+            stall_reason: match it.map(|it| &it.stop) {
+                Some(Stop::Stalled { reason }) => Some(reason.clone()),
+                _ => None,
+            },
+            frf: self.drive.as_ref().map(|d| d.frf.clone()),
+            drive: self.drive.as_ref().map(|d| {
+                let it = &d.iteration;
+                let p = &it.achieved.output.peaks;
+                DriveSummary {
+                    out: out.map(|p| p.display().to_string()),
+                    samples: it.drive_u_m.len(),
+                    peak_u_m: peak(&it.drive_u_m),
+                    achieved: *it.best_record(),
+                    run_peak_u_m: p.u_m.value,
+                    run_peak_v_m_s: p.v_m_s.value,
+                    run_peak_force_n: p.force_n.value,
+                    limits: d.limits.clone(),
+                    limiting: failing(&d.uses),
+                }
+            }),
+            warnings: self.warnings.clone(),
+        }
+    }
+}

@@ -1,0 +1,196 @@
+//! The target: what the table should do, as an acceleration or a displacement record on a
+//! uniform time base ([`Target`]).
+
+use std::path::{Path, PathBuf};
+
+use platen_io::csv::read_table;
+use platen_io::IoError;
+
+use crate::error::{PlanError, Result};
+
+/// The fewest samples a target may have: the iteration works on its spectrum, and fewer
+/// samples than this carry no usable band.
+pub const MIN_TARGET_SAMPLES: usize = 16;
+
+/// What a target prescribes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TargetKind {
+    /// The table's acceleration (`a_m_s2`): the displacement command is integrated from it
+    /// with the baseline treatment of [`crate::baseline`].
+    Acceleration,
+    /// The table's displacement (`u_m`): the command as it is; the acceleration to reproduce
+    /// is its second derivative (second-order finite differences, as `simulate` derives it).
+    Displacement,
+}
+
+impl TargetKind {
+    /// `"acceleration"` or `"displacement"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            TargetKind::Acceleration => "acceleration",
+            TargetKind::Displacement => "displacement",
+        }
+    }
+}
+
+/// A validated target: at least [`MIN_TARGET_SAMPLES`] finite samples on a uniform,
+/// strictly increasing time base.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Target {
+    origin: PathBuf,
+    t_s: Vec<f64>,
+    values: Vec<f64>,
+    kind: TargetKind,
+    interval_s: f64,
+}
+
+impl Target {
+    /// A target acceleration `a_m_s2` (m/s²) at the times `t_s`; `origin` names it in
+    /// messages.
+    ///
+    /// # Errors
+    /// [`PlanError::Target`] naming the 0-based index of a non-finite value, a time that does
+    /// not increase or leaves the uniform grid, columns of different lengths, or fewer than
+    /// [`MIN_TARGET_SAMPLES`] samples.
+    pub fn acceleration(origin: &Path, t_s: Vec<f64>, a_m_s2: Vec<f64>) -> Result<Self> {
+        Self::new(origin, t_s, a_m_s2, TargetKind::Acceleration)
+    }
+
+    /// A target displacement `u_m` (m) at the times `t_s`.
+    ///
+    /// # Errors
+    /// As [`Target::acceleration`].
+    pub fn displacement(origin: &Path, t_s: Vec<f64>, u_m: Vec<f64>) -> Result<Self> {
+        Self::new(origin, t_s, u_m, TargetKind::Displacement)
+    }
+
+    fn new(origin: &Path, t_s: Vec<f64>, values: Vec<f64>, kind: TargetKind) -> Result<Self> {
+        let bad = |message: String| PlanError::Target {
+            origin: origin.display().to_string(),
+            message,
+        };
+        let name = match kind {
+            TargetKind::Acceleration => "a_m_s2",
+            TargetKind::Displacement => "u_m",
+        };
+        if values.len() != t_s.len() {
+            return Err(bad(format!(
+                "`{name}` has {} values but `t_s` has {}",
+                values.len(),
+                t_s.len()
+            )));
+        }
+        if t_s.len() < MIN_TARGET_SAMPLES {
+            return Err(bad(format!(
+                "{} samples: expected at least {MIN_TARGET_SAMPLES}",
+                t_s.len()
+            )));
+        }
+        for (column, data) in [("t_s", &t_s), (name, &values)] {
+            if let Some(i) = data.iter().position(|v| !v.is_finite()) {
+                return Err(bad(format!("{column}[{i}] = {} is not finite", data[i])));
+            }
+        }
+        let grid = platen_integrate::sampling_grid(&t_s).map_err(|e| bad(e.to_string()))?;
+        Ok(Self {
+            origin: origin.to_owned(),
+            t_s,
+            values,
+            kind,
+            interval_s: grid.interval_s,
+        })
+    }
+
+    /// Reads a target CSV: `t_s` and `a_m_s2` (an acceleration target) or, without
+    /// `a_m_s2`, `u_m` (a displacement target); other columns are ignored.
+    ///
+    /// # Errors
+    /// [`PlanError::Io`] naming the file and the line: unreadable, no `t_s` or neither
+    /// `a_m_s2` nor `u_m`, a non-numeric or non-finite cell, times that do not increase
+    /// strictly or are not uniformly sampled ([`platen_scenario::sampling::sampling_grid`]),
+    /// fewer than [`MIN_TARGET_SAMPLES`] rows.
+    pub fn read_csv(path: &Path) -> Result<Self> {
+        // The acceleration when the file has one (a displacement column beside it is not
+        // read, so it cannot fail the target); else the displacement.
+        let mut table = read_table(path, &["t_s"], &["a_m_s2"])?;
+        let (kind, values) = match table.take_column("a_m_s2") {
+            Some(a) => (TargetKind::Acceleration, a),
+            None => {
+                table = read_table(path, &["t_s", "u_m"], &[]).map_err(|e| match e {
+                    IoError::MissingColumn {
+                        path, available, ..
+                    } => IoError::MissingColumn {
+                        path,
+                        column: "a_m_s2` or `u_m".to_owned(),
+                        available,
+                    },
+                    other => other,
+                })?;
+                let u = table.take_column("u_m").unwrap_or_default();
+                (TargetKind::Displacement, u)
+            }
+        };
+        let t_s = table.take_column("t_s").unwrap_or_default();
+        if t_s.len() < MIN_TARGET_SAMPLES {
+            return Err(IoError::TooShort {
+                path: path.to_owned(),
+                rows: t_s.len(),
+                needed: MIN_TARGET_SAMPLES,
+            }
+            .into());
+        }
+        let grid = platen_scenario::sampling::sampling_grid(path, &t_s)?;
+        Ok(Self {
+            origin: path.to_owned(),
+            t_s,
+            values,
+            kind,
+            interval_s: grid.interval_s,
+        })
+    }
+
+    /// Where the target comes from.
+    pub fn origin(&self) -> &Path {
+        &self.origin
+    }
+
+    /// Acceleration or displacement.
+    pub fn kind(&self) -> TargetKind {
+        self.kind
+    }
+
+    /// The time stamps, s.
+    pub fn t_s(&self) -> &[f64] {
+        &self.t_s
+    }
+
+    /// The prescribed values: m/s² for an acceleration target, m for a displacement target.
+    pub fn values(&self) -> &[f64] {
+        &self.values
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.t_s.len()
+    }
+
+    /// Always false: a target has at least [`MIN_TARGET_SAMPLES`] samples.
+    pub fn is_empty(&self) -> bool {
+        self.t_s.is_empty()
+    }
+
+    /// The sample interval fitted over the whole record, s.
+    pub fn interval_s(&self) -> f64 {
+        self.interval_s
+    }
+
+    /// The sample rate, Hz.
+    pub fn sample_rate_hz(&self) -> f64 {
+        1.0 / self.interval_s
+    }
+
+    /// The time from the first to the last sample, s.
+    pub fn duration_s(&self) -> f64 {
+        self.t_s[self.t_s.len() - 1] - self.t_s[0]
+    }
+}

@@ -1,0 +1,329 @@
+//! `platen plan`: the drive it writes, replayed by `platen simulate`, is the run it reports; an
+//! infeasible target is an answer (exit 0) naming the limit; bad input is refused naming the
+//! file (and line), and nothing is written nor an existing drive touched.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use serde_json::{json, Value};
+
+mod common;
+use common::{platen, stderr};
+
+use platen::plan::iterate::nrmse;
+use platen::plan::{BaselineSettings, Target, TargetMotion};
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let path = dir.join(name);
+    fs::write(&path, text).unwrap();
+    path
+}
+
+/// The LHPOST preset's closed loop, no excitation (the target takes its place).
+fn lhpost_scenario(dir: &Path) -> PathBuf {
+    write(
+        dir,
+        "lhpost.json",
+        &json!({
+            "name": "LHPOST closed loop",
+            "model": {"preset": "lhpost-2008"},
+            "table_system": {"preset": "lhpost-2008"}
+        })
+        .to_string(),
+    )
+}
+
+/// A target CSV of `n` rows at `rate_hz` with column `column` given by `f(t)`.
+fn target_csv(
+    dir: &Path,
+    name: &str,
+    column: &str,
+    n: usize,
+    rate_hz: f64,
+    f: impl Fn(f64) -> f64,
+) -> PathBuf {
+    let mut s = format!("t_s,{column}\n");
+    for j in 0..n {
+        let t = j as f64 / rate_hz;
+        s.push_str(&format!("{t},{}\n", f(t)));
+    }
+    write(dir, name, &s)
+}
+
+/// An earthquake-like acceleration: a few sines under a rise–hold–decay envelope, 0.3 g peak.
+fn quake(t: f64) -> f64 {
+    let env = if t < 0.5 {
+        0.0
+    } else if t < 2.0 {
+        ((t - 0.5) / 1.5).powi(2)
+    } else {
+        (-(t - 2.0) / 2.0).exp()
+    };
+    let s: f64 = [
+        (0.7, 0.3, 0.0),
+        (1.9, 1.0, 1.1),
+        (3.3, 0.8, 2.3),
+        (6.1, 0.6, 0.4),
+        (11.0, 0.4, 5.0),
+    ]
+    .iter()
+    .map(|(f, a, p)| a * (std::f64::consts::TAU * f * t + p).sin())
+    .sum();
+    0.3 * 9.806_65 * env * s / 2.0
+}
+
+fn json_of(o: &std::process::Output) -> Value {
+    serde_json::from_slice(&o.stdout)
+        .unwrap_or_else(|e| panic!("{e}: {}\n{}", String::from_utf8_lossy(&o.stdout), stderr(o)))
+}
+
+#[test]
+fn the_drive_replayed_by_simulate_is_the_run_the_plan_reports() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scenario = lhpost_scenario(d);
+    let target = target_csv(d, "target.csv", "a_m_s2", 8 * 1024 + 1, 1024.0, quake);
+    let drive = d.join("drive.csv");
+    let o = platen(&[
+        "plan",
+        scenario.to_str().unwrap(),
+        "--target",
+        target.to_str().unwrap(),
+        "--out",
+        drive.to_str().unwrap(),
+        "--iterations",
+        "4",
+        "--json",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let p = json_of(&o);
+    // The contract's keys.
+    assert_eq!(p["feasible"], true);
+    assert_eq!(p["limiting"], json!([]));
+    for key in ["stroke_m", "velocity_m_s", "acceleration_m_s2", "force_n"] {
+        assert_eq!(p["limits"][key]["respected"], true, "{key}");
+        assert!(p["limits"][key]["limit"].as_f64().unwrap() > 0.0);
+    }
+    assert!(p["max_scale"].as_f64().unwrap() > 1.0, "{}", p["max_scale"]);
+    let iterations = p["iterations"].as_array().unwrap();
+    assert!(iterations.len() >= 2 && iterations.len() <= 5);
+    for it in iterations {
+        for key in ["acceleration_nrmse", "displacement_nrmse", "spectrum_error"] {
+            assert!(it[key].as_f64().unwrap() >= 0.0, "{key}: {it}");
+        }
+    }
+    let first = iterations[0]["acceleration_nrmse"].as_f64().unwrap();
+    let achieved = &p["drive"]["achieved"];
+    let best = achieved["acceleration_nrmse"].as_f64().unwrap();
+    assert!(best < 0.5 * first, "{first} → {best}");
+    assert_eq!(p["drive"]["out"], drive.to_str().unwrap());
+
+    // The drive: t_s, u_m at 1024 Hz.
+    let text = fs::read_to_string(&drive).unwrap();
+    assert!(text.starts_with("t_s,u_m\n"));
+    assert_eq!(text.lines().count(), 8 * 1024 + 2);
+
+    // Replayed through simulate as a motion_csv: the run the plan reports.
+    let replay = write(
+        d,
+        "replay.json",
+        &json!({
+            "model": {"preset": "lhpost-2008"},
+            "table_system": {"preset": "lhpost-2008"},
+            "excitation": {"motion_csv": "drive.csv"}
+        })
+        .to_string(),
+    );
+    let run = d.join("run.csv");
+    let o = platen(&[
+        "simulate",
+        replay.to_str().unwrap(),
+        "--out",
+        run.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let s = json_of(&o);
+    assert_eq!(s["limits"], p["drive"]["limits"]);
+    assert_eq!(s["peak_a_m_s2"], achieved["peak_a_m_s2"]);
+    assert_eq!(s["peak_u_m"], p["drive"]["run_peak_u_m"]);
+    assert_eq!(s["peak_force_n"], p["drive"]["run_peak_force_n"]);
+    // The achieved acceleration against the target's (after its baseline treatment).
+    let table = platen::io::csv::read_table(&run, &["a_m_s2", "u_m"], &[]).unwrap();
+    let t = Target::read_csv(&target).unwrap();
+    let motion = TargetMotion::new(&t, &BaselineSettings::default(), 0.75, 1024.0).unwrap();
+    assert_eq!(nrmse(table.column("a_m_s2").unwrap(), &motion.a_m_s2), best);
+    assert_eq!(
+        nrmse(table.column("u_m").unwrap(), &motion.u_m),
+        achieved["displacement_nrmse"].as_f64().unwrap()
+    );
+
+    // Deterministic: the same plan writes the same bytes.
+    let again = d.join("again.csv");
+    let o = platen(&[
+        "plan",
+        scenario.to_str().unwrap(),
+        "--target",
+        target.to_str().unwrap(),
+        "--out",
+        again.to_str().unwrap(),
+        "--iterations",
+        "4",
+        "--no-max-scale",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert_eq!(fs::read(&drive).unwrap(), fs::read(&again).unwrap());
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("feasible: yes") && out.contains("drive: iteration"),
+        "{out}"
+    );
+}
+
+#[test]
+fn an_infeasible_target_is_an_answer_naming_the_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scenario = lhpost_scenario(d);
+    // 0.6 m at 0.6 Hz: 2.3 m/s, beyond the 1.8 m/s velocity limit, inside the stroke.
+    let target = target_csv(d, "fast.csv", "u_m", 6 * 1024 + 1, 1024.0, |t| {
+        let ramp = |x: f64| 0.5 - 0.5 * (std::f64::consts::PI * x.clamp(0.0, 1.0)).cos();
+        0.6 * ramp(t / 1.5) * ramp((6.0 - t) / 1.5) * (std::f64::consts::TAU * 0.6 * t).sin()
+    });
+    let drive = d.join("drive.csv");
+    let o = platen(&[
+        "plan",
+        scenario.to_str().unwrap(),
+        "--target",
+        target.to_str().unwrap(),
+        "--out",
+        drive.to_str().unwrap(),
+        "--iterations",
+        "0",
+        "--json",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let p = json_of(&o);
+    assert_eq!(p["feasible"], false);
+    assert_eq!(p["limiting"][0]["limit"], "velocity_m_s");
+    assert!(p["limiting"][0]["ratio"].as_f64().unwrap() > 1.0);
+    assert_eq!(p["limits"]["velocity_m_s"]["respected"], false);
+    let scale = p["max_scale"].as_f64().unwrap();
+    assert!(scale > 0.6 && scale < 1.0, "{scale}");
+    assert!(stderr(&o).contains("not feasible"), "{}", stderr(&o));
+    assert_eq!(p["iterations"].as_array().unwrap().len(), 1);
+}
+
+/// The files in `dir`, sorted.
+fn listing(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn bad_input_is_refused_naming_the_file_and_nothing_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scenario = lhpost_scenario(d);
+    let good = |t: f64| (3.0 * t).sin();
+    let short = target_csv(d, "short.csv", "a_m_s2", 5, 1024.0, good);
+    let fast = target_csv(d, "fast.csv", "a_m_s2", 4096, 2048.0, good);
+    let mut text = fs::read_to_string(target_csv(d, "ok.csv", "a_m_s2", 64, 1024.0, good)).unwrap();
+    text = text.replacen(
+        &format!("{},{}\n", 20.0 / 1024.0, good(20.0 / 1024.0)),
+        "0.01953125,nan\n",
+        1,
+    );
+    let nan = write(d, "nan.csv", &text);
+    let unsorted = write(d, "unsorted.csv", "t_s,a_m_s2\n0,0\n0.001,1\n0.0005,2\n");
+    let open = write(d, "open.json", r#"{"model": {"preset": "lhpost-2008"}}"#);
+    // An existing drive must survive every failure untouched.
+    let drive = write(d, "drive.csv", "old drive\n");
+    let before = listing(d);
+    let cases: [(&Path, &Path, &[&str]); 5] = [
+        (&scenario, &short, &["short.csv", "at least 16"]),
+        (&scenario, &nan, &["nan.csv", "line 22"]),
+        (&scenario, &unsorted, &["unsorted.csv", "line 4"]),
+        (
+            &scenario,
+            &fast,
+            &["fast.csv", "faster than the controller"],
+        ),
+        (&open, &short, &["open.json", "table_system"]),
+    ];
+    for (s, t, needles) in cases {
+        for json in [false, true] {
+            let mut args = vec![
+                "plan",
+                s.to_str().unwrap(),
+                "--target",
+                t.to_str().unwrap(),
+                "--out",
+                drive.to_str().unwrap(),
+            ];
+            if json {
+                args.push("--json");
+            }
+            let o = platen(&args);
+            assert_eq!(o.status.code(), Some(3), "{needles:?}: {}", stderr(&o));
+            let e = stderr(&o);
+            for n in needles {
+                assert!(e.contains(n), "{n:?} not in: {e}");
+            }
+            if json {
+                let v: Value = serde_json::from_str(e.trim()).unwrap();
+                assert_eq!(v["error"]["kind"], "input");
+                assert!(v["error"]["file"].as_str().is_some(), "{v}");
+            }
+            assert!(o.stdout.is_empty());
+            assert_eq!(fs::read_to_string(&drive).unwrap(), "old drive\n");
+            assert_eq!(listing(d), before, "a file was left behind");
+        }
+    }
+    // The line of a bad cell in the JSON error object.
+    let o = platen(&[
+        "plan",
+        scenario.to_str().unwrap(),
+        "--target",
+        nan.to_str().unwrap(),
+        "--out",
+        drive.to_str().unwrap(),
+        "--json",
+    ]);
+    let v: Value = serde_json::from_str(stderr(&o).trim()).unwrap();
+    assert_eq!(v["error"]["line"], 22);
+    // An output folder that does not exist: an output error, before anything runs.
+    let o = platen(&[
+        "plan",
+        scenario.to_str().unwrap(),
+        "--target",
+        short.to_str().unwrap(),
+        "--out",
+        d.join("no-such-folder").join("drive.csv").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(5), "{}", stderr(&o));
+    // Usage errors.
+    for bad in [
+        ["--gain", "0"],
+        ["--gain", "2.5"],
+        ["--band-hz", "5,1"],
+        ["--iterations", "-1"],
+    ] {
+        let o = platen(&[
+            "plan",
+            scenario.to_str().unwrap(),
+            "--target",
+            short.to_str().unwrap(),
+            "--out",
+            drive.to_str().unwrap(),
+            bad[0],
+            bad[1],
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}: {}", stderr(&o));
+    }
+    assert_eq!(listing(d), before);
+}
