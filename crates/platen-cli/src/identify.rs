@@ -971,6 +971,7 @@ fn floor_factor(f: &FloorSpec) -> Result<f64> {
             name: Some(f.column.clone()),
             unit: f.unit.clone(),
             times_area_m2: None,
+            scale: None,
             offset: None,
             remove_mean: false,
             zero_at_start: false,
@@ -1337,4 +1338,148 @@ fn report_warnings(s: &mut String, id: &Identification) {
             let _ = writeln!(s, "  - {w}");
         }
     }
+}
+
+/// `platen identify --system FILE…`: the controller's gains from closed-loop records (see
+/// `platen_ident::system`). With two or more files, the last is held out and judged; the
+/// others are fitted. Prints the gains, the fit on each record, what cannot be identified and
+/// a runnable scenario (the `lhpost-2008` preset with the identified controller, commanded by
+/// the held-out record).
+pub fn run_system(files: &[PathBuf], columns: Option<&Path>, json: bool) -> Result<()> {
+    use platen_ident::system::{identify_system, SystemRecord, SystemSettings};
+    if files.is_empty() {
+        bail!("identify --system needs at least one recorded CSV file");
+    }
+    let map = match columns {
+        Some(path) => ColumnMap::load(path)?,
+        None => ColumnMap::default(),
+    };
+    let mut records = Vec::with_capacity(files.len());
+    for path in files {
+        let mut t = map
+            .read_table(
+                path,
+                &["t_s", "command_u_m", "u_m"],
+                &["drive", "delta_p_pa", "a_m_s2"],
+            )
+            .with_context(|| {
+                format!(
+                    "{}: identify --system needs the columns t_s, command_u_m and u_m \
+                     (drive, delta_p_pa, a_m_s2 where recorded)",
+                    path.display()
+                )
+            })?;
+        let mut take = |c: &str| t.take_column(c);
+        records.push(SystemRecord {
+            name: path.display().to_string(),
+            t_s: take("t_s").unwrap_or_default(),
+            command_u_m: take("command_u_m").unwrap_or_default(),
+            u_m: take("u_m").unwrap_or_default(),
+            drive: take("drive"),
+            delta_p_pa: take("delta_p_pa"),
+            a_m_s2: take("a_m_s2"),
+        });
+    }
+    let n = records.len();
+    let fit: Vec<bool> = (0..n).map(|i| n == 1 || i + 1 < n).collect();
+    let id = identify_system(&records, &fit, &SystemSettings::default())?;
+    let held = &records[n - 1];
+    let held_path = std::fs::canonicalize(&files[n - 1]).unwrap_or_else(|_| files[n - 1].clone());
+    let mut table_system = serde_json::json!({ "preset": "lhpost-2008" });
+    if let Some(g) = &id.gains {
+        table_system["controller"] = serde_json::json!({
+            "sample_rate_hz": g.sample_rate_hz,
+            "displacement_gain_per_m": g.displacement_gain_per_m,
+            "velocity_feedforward_s_per_m": g.velocity_feedforward_s_per_m,
+            "acceleration_feedforward_s2_per_m": g.acceleration_feedforward_s2_per_m,
+            "velocity_feedback_s_per_m": g.velocity_feedback_s_per_m,
+            "acceleration_feedback_s2_per_m": g.acceleration_feedback_s2_per_m,
+            "delta_p_gain_per_pa": g.delta_p_gain_per_pa,
+            "delta_p_highpass_hz": g.delta_p_highpass_hz,
+            "integral_gain_per_m_s": 0.0,
+        });
+    }
+    let span = held.t_s.last().copied().unwrap_or(0.0) - held.t_s.first().copied().unwrap_or(0.0);
+    let scenario = serde_json::json!({
+        "name": format!("identified controller, commanded by {}", held.name),
+        "model": { "preset": "lhpost-2008" },
+        "table_system": table_system,
+        "excitation": {
+            "motion_csv": held_path.display().to_string(),
+            "columns": { "u_m": { "name": map.header("command_u_m") } }
+        },
+        "duration_s": span,
+    });
+    let from_preset = [
+        "model (the platen: mass, friction, stiffness)",
+        "table_system: actuators, servo-valves, oil, supply, accumulator",
+        "table_system.controller.integral_gain_per_m_s (0: an integrator is not fitted)",
+    ];
+    if json {
+        let value = serde_json::json!({
+            "system_identification": id,
+            "scenario": scenario,
+            "scenario_from_preset": from_preset,
+        });
+        outln!("{}", serde_json::to_string_pretty(&value)?);
+        return Ok(());
+    }
+    let mut s = String::new();
+    match &id.gains {
+        Some(g) => {
+            let _ = writeln!(
+                s,
+                "controller at {:.6} Hz (fitted on {}):",
+                g.sample_rate_hz,
+                id.fitted_records.join(", ")
+            );
+            for (k, v) in [
+                ("K_p  displacement_gain_per_m", g.displacement_gain_per_m),
+                (
+                    "K_vf velocity_feedforward_s_per_m",
+                    g.velocity_feedforward_s_per_m,
+                ),
+                (
+                    "K_af acceleration_feedforward_s2_per_m",
+                    g.acceleration_feedforward_s2_per_m,
+                ),
+                (
+                    "K_vb velocity_feedback_s_per_m",
+                    g.velocity_feedback_s_per_m,
+                ),
+                (
+                    "K_ab acceleration_feedback_s2_per_m",
+                    g.acceleration_feedback_s2_per_m,
+                ),
+                ("K_dp delta_p_gain_per_pa", g.delta_p_gain_per_pa),
+                ("     delta_p_highpass_hz", g.delta_p_highpass_hz),
+            ] {
+                let _ = writeln!(s, "  {k:<40} {v:.6e}");
+            }
+            let _ = writeln!(s, "  saturated samples left out: {}", id.saturated_samples);
+        }
+        None => {
+            let _ = writeln!(s, "controller gains: not identified");
+        }
+    }
+    for r in &id.records {
+        let _ = writeln!(
+            s,
+            "{} {}: drive RMS error {:.3e} ({:.3} % of its RMS) over {} samples",
+            if r.fitted { "fitted  " } else { "held out" },
+            r.name,
+            r.drive_rms_error,
+            100.0 * r.drive_nrmse,
+            r.samples
+        );
+    }
+    for (what, why) in &id.not_identified {
+        let _ = writeln!(s, "not identified: {what}: {why}");
+    }
+    let _ = writeln!(
+        s,
+        "scenario (with --json): the lhpost-2008 preset with the identified controller"
+    );
+    outln!("{}", s.trim_end());
+    Ok(())
 }

@@ -337,6 +337,12 @@ enum Command {
         /// measured motion).
         #[arg(long)]
         no_output_error: bool,
+        /// Identify the table system's controller from closed-loop records instead (t_s,
+        /// command_u_m, u_m and, where recorded, drive, delta_p_pa, a_m_s2): the gains by
+        /// least squares on the drive; the last of two or more FILEs is held out and judged.
+        /// With --json, a runnable scenario with the identified controller.
+        #[arg(long, conflicts_with_all = ["manifest", "pressure_mpa", "plot", "report", "method"])]
+        system: bool,
         #[command(flatten)]
         size: plot::SizeArgs,
     },
@@ -544,6 +550,13 @@ fn run(command: Command) -> anyhow::Result<()> {
         ),
         Command::Identify {
             files,
+            columns,
+            json,
+            system: true,
+            ..
+        } => identify::run_system(&files, columns.as_deref(), json),
+        Command::Identify {
+            files,
             pressure_mpa,
             manifest,
             viscous_exponent,
@@ -554,6 +567,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             columns,
             method,
             no_output_error,
+            system: _,
             size,
         } => identify::run(&identify::Options {
             files: &files,

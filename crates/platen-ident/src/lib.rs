@@ -169,6 +169,7 @@ mod result;
 mod route;
 mod settings;
 pub mod summary;
+pub mod system;
 mod warning;
 mod work;
 

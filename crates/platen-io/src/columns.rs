@@ -23,6 +23,11 @@
 //! channel's mean over the file, `"zero_at_start": true` its first value (one or the other;
 //! the time column takes `offset` and `zero_at_start` only).
 //!
+//! The table system's channels: `command_u_m` (a displacement), `drive` (a fraction of full
+//! opening, no unit), `delta_p_pa` (a pressure), `storey{i}_a_m_s2` (accelerations, `i` ≥ 1).
+//! `"scale": 0.1` multiplies a channel after its unit's factor (a drive recorded in volts of a
+//! ±10 V servo amplifier).
+//!
 //! Units: time `s`, `ms`; displacement `m`, `mm`, `cm`, `in`; velocity `m/s`, `mm/s`, `cm/s`,
 //! `in/s`; acceleration `m/s2`, `mm/s2`, `cm/s2` (`gal`), `in/s2`, `g` (9.80665 m/s²); force `N`,
 //! `kN`, `MN`, `lbf`, `kip`; pressure (with `times_area_m2`) `Pa`, `kPa`, `MPa`, `bar`, `psi`.
@@ -48,6 +53,9 @@ pub struct ColumnSpec {
     pub unit: Option<String>,
     /// For a force given as a pressure: the area it acts on, m².
     pub times_area_m2: Option<f64>,
+    /// A factor applied after the unit's (default 1): `SI = (value − offset)·unit·scale`,
+    /// e.g. 0.1 for a drive recorded in volts of a ±10 V servo amplifier.
+    pub scale: Option<f64>,
     /// A constant subtracted from every value, in the file's unit (before the conversion to
     /// SI; default 0): a transducer's offset, e.g. `-0.13` for a pressure read in MPa.
     pub offset: Option<f64>,
@@ -99,14 +107,28 @@ impl Mapping {
     }
 }
 
-/// platen's column names and the kind of quantity each holds.
-const QUANTITIES: [(&str, Kind); 5] = [
+/// platen's column names and the kind of quantity each holds (besides the storeys'
+/// accelerations `storey{i}_a_m_s2`, `i` ≥ 1).
+const QUANTITIES: [(&str, Kind); 8] = [
     ("t_s", Kind::Time),
     ("u_m", Kind::Displacement),
     ("v_m_s", Kind::Velocity),
     ("a_m_s2", Kind::Acceleration),
     ("force_n", Kind::Force),
+    ("command_u_m", Kind::Displacement),
+    ("drive", Kind::Drive),
+    ("delta_p_pa", Kind::Pressure),
 ];
+
+/// The kind of platen's column `name`, if it is one.
+fn kind_of(name: &str) -> Option<Kind> {
+    if let Some(k) = QUANTITIES.iter().find(|(n, _)| *n == name).map(|(_, k)| *k) {
+        return Some(k);
+    }
+    let storey = name.strip_prefix("storey")?.strip_suffix("_a_m_s2")?;
+    let i: u32 = storey.parse().ok()?;
+    (i >= 1 && !storey.starts_with('0')).then_some(Kind::Acceleration)
+}
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Kind {
@@ -115,6 +137,10 @@ enum Kind {
     Velocity,
     Acceleration,
     Force,
+    /// A valve drive, a fraction of full opening (no unit; `scale` converts volts).
+    Drive,
+    /// A pressure difference, Pa.
+    Pressure,
 }
 
 /// A validated mapping: for each platen column, the header to read, the factor to SI, the
@@ -136,20 +162,16 @@ impl ColumnMap {
     ) -> Result<Self, (String, String, String)> {
         let mut entries = BTreeMap::new();
         for (ours, s) in spec {
-            let kind = QUANTITIES
-                .iter()
-                .find(|(n, _)| n == ours)
-                .map(|(_, k)| *k)
-                .ok_or_else(|| {
-                    (
-                        format!("{json_path}.{ours}"),
-                        format!("{ours:?}"),
-                        format!(
-                            "one of platen's columns: {}",
-                            QUANTITIES.map(|(n, _)| n).join(", ")
-                        ),
-                    )
-                })?;
+            let kind = kind_of(ours).ok_or_else(|| {
+                (
+                    format!("{json_path}.{ours}"),
+                    format!("{ours:?}"),
+                    format!(
+                        "one of platen's columns: {}, storey{{i}}_a_m_s2",
+                        QUANTITIES.map(|(n, _)| n).join(", ")
+                    ),
+                )
+            })?;
             let here = format!("{json_path}.{ours}");
             let factor = match (&s.unit, s.times_area_m2) {
                 (None, None) => 1.0,
@@ -179,6 +201,7 @@ impl ColumnMap {
                             }
                             f * a
                         }
+                        (UnitKind::Pressure, None) if kind == Kind::Pressure => f,
                         (UnitKind::Pressure, _) => {
                             return Err((
                                 format!("{here}.unit"),
@@ -202,6 +225,17 @@ impl ColumnMap {
                             ))
                         }
                     }
+                }
+            };
+            let factor = match s.scale {
+                None => factor,
+                Some(k) if k.is_finite() && k != 0.0 => factor * k,
+                Some(k) => {
+                    return Err((
+                        format!("{here}.scale"),
+                        k.to_string(),
+                        "a finite, non-zero factor".into(),
+                    ))
                 }
             };
             let header = s.name.clone().unwrap_or_else(|| ours.clone());
@@ -327,6 +361,8 @@ fn kind_name(k: Kind) -> &'static str {
         Kind::Force => {
             "force (N, kN, MN, lbf, kip) or a pressure (Pa, kPa, MPa, bar, psi) with times_area_m2"
         }
+        Kind::Drive => "none: a drive is a fraction of full opening (scale 0.1 maps ±10 V)",
+        Kind::Pressure => "pressure (Pa, kPa, MPa, bar, psi)",
     }
 }
 
@@ -403,6 +439,31 @@ mod tests {
         assert!((m.factor("force_n") - 0.33e6).abs() < 1e-6);
         assert_eq!(m.header("t_s"), "t_s");
         assert_eq!(m.factor("t_s"), 1.0);
+    }
+
+    #[test]
+    fn table_system_channels_map_with_units_and_a_scale() {
+        let m = map(r#"{"command_u_m": {"name": "Cmd", "unit": "mm"}, "drive": {"name": "Drive V", "scale": 0.1},
+                        "delta_p_pa": {"name": "dP", "unit": "MPa"}, "storey2_a_m_s2": {"unit": "g", "scale": 2}}"#)
+        .unwrap();
+        assert_eq!(
+            (m.header("command_u_m"), m.factor("command_u_m")),
+            ("Cmd", 1e-3)
+        );
+        assert_eq!((m.header("drive"), m.factor("drive")), ("Drive V", 0.1));
+        assert_eq!(m.factor("delta_p_pa"), 1e6);
+        assert_eq!(m.factor("storey2_a_m_s2"), 2.0 * 9.80665);
+        for (json, path) in [
+            (r#"{"drive": {"unit": "mm"}}"#, "c.drive.unit"),
+            (r#"{"delta_p_pa": {"unit": "kN"}}"#, "c.delta_p_pa.unit"),
+            (r#"{"u_m": {"scale": 0}}"#, "c.u_m.scale"),
+            (r#"{"storey0_a_m_s2": {}}"#, "c.storey0_a_m_s2"),
+            (r#"{"storey_a_m_s2": {}}"#, "c.storey_a_m_s2"),
+        ] {
+            let spec: BTreeMap<String, ColumnSpec> = serde_json::from_str(json).unwrap();
+            let e = ColumnMap::new(&spec, "c").unwrap_err();
+            assert_eq!(e.0, path, "{json}: {e:?}");
+        }
     }
 
     #[test]
