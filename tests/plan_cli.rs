@@ -327,3 +327,64 @@ fn bad_input_is_refused_naming_the_file_and_nothing_is_written() {
     }
     assert_eq!(listing(d), before);
 }
+
+#[test]
+fn plot_and_report_write_the_figures_and_list_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scenario = lhpost_scenario(d);
+    let target = target_csv(d, "target.csv", "a_m_s2", 6 * 1024 + 1, 1024.0, quake);
+    let figures = d.join("figures");
+    let report = d.join("plan.html");
+    let o = platen(&[
+        "plan",
+        scenario.to_str().unwrap(),
+        "--target",
+        target.to_str().unwrap(),
+        "--out",
+        d.join("drive.csv").to_str().unwrap(),
+        "--iterations",
+        "3",
+        "--no-max-scale",
+        "--plot",
+        figures.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+        "--width",
+        "800",
+        "--json",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let p = json_of(&o);
+    let listed: Vec<&str> = p["figures"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_str().unwrap())
+        .collect();
+    for stem in [
+        "plan-acceleration",
+        "plan-spectra",
+        "plan-convergence",
+        "plan-margins",
+    ] {
+        for ext in ["svg", "png"] {
+            let path = figures.join(format!("{stem}.{ext}"));
+            assert!(path.is_file(), "{}", path.display());
+            assert!(
+                listed.contains(&path.to_str().unwrap()),
+                "{} not in {listed:?}",
+                path.display()
+            );
+        }
+        let svg = fs::read_to_string(figures.join(format!("{stem}.svg"))).unwrap();
+        assert!(svg.contains("width=\"800\""), "{stem}: --width");
+    }
+    assert_eq!(listed.len(), 8);
+    assert_eq!(p["report"], report.to_str().unwrap());
+    let page = fs::read_to_string(&report).unwrap();
+    assert!(page.starts_with("<!DOCTYPE html>"));
+    assert_eq!(page.matches("<svg").count(), 4);
+    assert!(page.contains("Margins") && page.contains("stroke_m"));
+    assert!(!page.contains("src=\"http"), "self-contained");
+}

@@ -54,6 +54,7 @@ __all__ = [
     "compare",
     "identify",
     "sweep",
+    "plan",
     "schema",
     "PlatenError",
     "ScenarioError",
@@ -609,6 +610,91 @@ def sweep(
             raise ImportError("sweep(as_frame=True) needs pandas: pip install pandas") from None
         return rows
     return pd.DataFrame(rows, columns=header)
+
+
+def plan(
+    scenario: Scenario,
+    target_t_s: ArrayLike,
+    target_a_m_s2: Optional[ArrayLike] = None,
+    target_u_m: Optional[ArrayLike] = None,
+    iterations: int = 10,
+    gain: Optional[float] = None,
+    *,
+    target_nrmse: float = 0.02,
+    frf: str = "auto",
+    band_hz: Optional[Tuple[float, float]] = None,
+    max_scale: bool = True,
+) -> Dict[str, Any]:
+    """Plans a test as ``platen plan`` does: can the scenario's table run the target, what
+    limits it, the largest scale that fits, and the drive (displacement command) that makes
+    the simulated table reproduce it. See docs/planning.md.
+
+    ``scenario`` is a path or a dict in the scenario format with a ``table_system`` (its
+    excitation, if any, is ignored: the target takes its place). The target is
+    ``target_a_m_s2`` (an acceleration record, m/s²) or ``target_u_m`` (a displacement, m) at
+    the uniformly spaced time stamps ``target_t_s`` (s), at most at the controller's rate.
+    ``iterations`` is the most drive corrections (0: the target's own command only),
+    ``gain`` the iteration's gain in (0, 2) (None: the CLI's default, 0.7), ``target_nrmse``
+    the acceleration NRMSE (a fraction) that stops it, ``frf`` where the loop's response comes
+    from (``"auto"``, ``"linearised"`` or ``"measured"``), ``band_hz`` the correction band
+    ``(lo, hi)``, and ``max_scale=False`` skips the search of the largest scale that fits.
+
+    Returns a dict: ``drive_t_s`` and ``drive_u_m`` (float64 arrays: the drive at the
+    controller's rate, what ``--out`` writes; None when there is no drive, for a target whose
+    command reaches the end of the actuators) and ``summary`` (the object of
+    ``platen plan --json``: feasibility, margins, ``max_scale``, the iterations' errors, the
+    drive's; the target's ``file`` is ``"target"`` and the drive's ``out`` is None).
+    An infeasible target is an answer (``summary["feasible"]`` is False), not an error.
+
+    Raises ScenarioError (a ValueError) for bad input, with the CLI's message;
+    SimulationError if a closed-loop run fails.
+    """
+    path, text, origin = _scenario(scenario)
+    if (target_a_m_s2 is None) == (target_u_m is None):
+        raise ScenarioError("target: give exactly one of target_a_m_s2 and target_u_m")
+    t = _array(target_t_s, "target_t_s", "target")
+    a = None if target_a_m_s2 is None else _array(target_a_m_s2, "target_a_m_s2", "target")
+    u = None if target_u_m is None else _array(target_u_m, "target_u_m", "target")
+    values = a if a is not None else u
+    if len(values) != len(t):
+        raise ScenarioError(
+            f"`target`: target_t_s has {len(t)} samples, the target's values {len(values)}: "
+            "expected the same number"
+        )
+    if isinstance(iterations, bool) or not isinstance(iterations, numbers.Integral) or not (
+        0 <= int(iterations) <= 200
+    ):
+        raise ScenarioError(f"iterations = {iterations!r}: expected a whole number from 0 to 200")
+    if gain is None:
+        gain = 0.7
+    gain = float(gain)
+    if not (0.0 < gain < 2.0):
+        raise ScenarioError(f"gain = {gain}: expected a gain in (0, 2)")
+    target_nrmse = float(target_nrmse)
+    if not (math.isfinite(target_nrmse) and target_nrmse >= 0.0):
+        raise ScenarioError(f"target_nrmse = {target_nrmse}: expected an NRMSE >= 0 (a fraction)")
+    band = None
+    if band_hz is not None:
+        lo, hi = (float(x) for x in band_hz)
+        if not (math.isfinite(lo) and math.isfinite(hi) and 0.0 < lo < hi):
+            raise ScenarioError(f"band_hz = {band_hz!r}: expected (lo, hi) with 0 < lo < hi, Hz")
+        band = (lo, hi)
+    drive_t, drive_u, summary = _native(
+        _platen.plan,
+        path,
+        text,
+        origin,
+        t,
+        a,
+        u,
+        int(iterations),
+        gain,
+        target_nrmse,
+        str(frf),
+        band,
+        bool(max_scale),
+    )
+    return {"drive_t_s": drive_t, "drive_u_m": drive_u, "summary": json.loads(summary)}
 
 
 def schema() -> Dict[str, Any]:

@@ -18,6 +18,7 @@ use platen_plan::{
     load_scenario, plan, FrfSource, MaxScaleSettings, NoiseSettings, PlanError, PlanSettings,
     Target,
 };
+use platen_report::plan_figures;
 
 /// The arguments of `platen plan`.
 #[derive(clap::Args)]
@@ -57,6 +58,16 @@ pub struct Args {
     /// Print the plan as JSON on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Write the plan's figures to this folder as SVG and PNG: target against achieved
+    /// acceleration (iteration 0 and the drive's), their 5 %-damped response spectra, the
+    /// errors per iteration, the limits' margins.
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<PathBuf>,
+    /// Write a self-contained HTML report (margins, iterations, figures) to this file.
+    #[arg(long, value_name = "FILE.html")]
+    pub report: Option<PathBuf>,
+    #[command(flatten)]
+    pub size: crate::plot::SizeArgs,
 }
 
 /// `--frf`.
@@ -187,17 +198,47 @@ pub fn run(args: &Args) -> Result<()> {
         None => None,
     };
     let summary = p.summary(written);
+    let value = serde_json::to_value(&summary)?;
+    let figures = platen_report::write_outputs(
+        args.plot.as_deref(),
+        args.report.as_deref(),
+        &args.size.size(),
+        || plan_figures::figures(&p),
+        |figures, rendered| plan_figures::page(&p, value.clone(), figures, rendered),
+    )?;
     for warning in &summary.warnings {
         eprintln!("warning: {warning}");
     }
     if args.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&serde_json::to_value(&summary)?)?
-        );
+        let mut value = value;
+        if let serde_json::Value::Object(map) = &mut value {
+            if args.plot.is_some() {
+                map.insert(
+                    "figures".into(),
+                    crate::simulate::figure_list(&figures).into(),
+                );
+            }
+            if let Some(report) = &args.report {
+                map.insert("report".into(), report.display().to_string().into());
+            }
+        }
+        outln!("{}", serde_json::to_string_pretty(&value)?);
         return Ok(());
     }
-    print_text(&summary)
+    print_text(&summary)?;
+    if !figures.is_empty() {
+        outln!(
+            "  figures: {} files (SVG and PNG) in {}",
+            figures.len(),
+            args.plot
+                .as_deref()
+                .map_or(String::new(), |d| d.display().to_string())
+        );
+    }
+    if let Some(report) = &args.report {
+        outln!("  report: {}", report.display());
+    }
+    Ok(())
 }
 
 /// The unit of a limit, from its name.

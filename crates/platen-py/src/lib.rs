@@ -5,7 +5,8 @@
 //! to NumPy arrays and JSON text, and its errors to one exception,
 //! [`error::Failure`]`(kind, message)`, whose message is the CLI's. Everything is computed
 //! by the library crates ([`platen_scenario::Scenario::run`], [`platen_compare`],
-//! [`platen_ident`], [`platen_scenario::sweep`]), with the GIL released and panics caught.
+//! [`platen_ident`], [`platen_scenario::sweep`], [`platen_plan`]), with the GIL released and
+//! panics caught.
 //! The public API, its checks of Python values (dtypes, shapes, dicts) and its docstrings
 //! live in `python/platen/__init__.py`.
 //!
@@ -15,6 +16,7 @@
 
 pub mod error;
 mod identify;
+mod plan;
 
 use std::path::{Path, PathBuf};
 
@@ -341,6 +343,7 @@ fn _platen(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(compare, m)?)?;
     m.add_function(wrap_pyfunction!(identify::identify, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(plan::plan, m)?)?;
     m.add_function(wrap_pyfunction!(schema, m)?)?;
     Ok(())
 }

@@ -13,6 +13,8 @@
 //! * [`system_figures`] draws the Bode plots of a table system's linearised loop
 //!   (`platen model --system … --plot`), on a logarithmic frequency axis
 //!   ([`Panel::x_log`]).
+//! * [`plan_figures`] draws a test plan (`platen plan --plot`, `--report`): target against
+//!   achieved acceleration, response spectra, convergence and the limits' margins.
 //! * [`render`] writes them: SVG, PNG copies rendered by resvg with the embedded Noto Sans,
 //!   and the HTML page, every file atomically ([`write_outputs`]).
 //! * [`html`] builds self-contained pages; [`text`] the numbers, metric rows and terminal
@@ -60,6 +62,7 @@ mod error;
 pub mod figure;
 pub mod html;
 pub mod identify_figures;
+pub mod plan_figures;
 pub mod record_figures;
 pub mod render;
 pub mod run_figures;

@@ -1,0 +1,117 @@
+"""``platen.plan``: the drive and the summary of ``platen plan --json`` from arrays; bad input
+raises ScenarioError (a ValueError) with the CLI's message."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+import platen
+
+from conftest import read_csv
+
+RATE_HZ = 1024.0
+
+SCENARIO = {
+    "name": "LHPOST closed loop",
+    "model": {"preset": "lhpost-2008"},
+    "table_system": {"preset": "lhpost-2008"},
+}
+
+
+def quake(t: np.ndarray) -> np.ndarray:
+    """An earthquake-like acceleration: five sines under a rise–hold–decay envelope, 0.3 g."""
+    env = np.where(t < 0.5, 0.0, np.where(t < 2.0, ((t - 0.5) / 1.5) ** 2, np.exp(-(t - 2.0) / 2.0)))
+    s = sum(
+        a * np.sin(2 * math.pi * f * t + p)
+        for f, a, p in [(0.7, 0.3, 0.0), (1.9, 1.0, 1.1), (3.3, 0.8, 2.3), (6.1, 0.6, 0.4), (11.0, 0.4, 5.0)]
+    )
+    return 0.3 * 9.80665 * env * s / 2.0
+
+
+def target(seconds: float = 6.0):
+    t = np.arange(int(seconds * RATE_HZ) + 1) / RATE_HZ
+    return t, quake(t)
+
+
+def test_plan_returns_the_drive_and_the_summary():
+    t, a = target()
+    p = platen.plan(SCENARIO, t, target_a_m_s2=a, iterations=3, max_scale=False)
+    assert set(p) == {"drive_t_s", "drive_u_m", "summary"}
+    assert p["drive_t_s"].dtype == np.float64 and p["drive_u_m"].dtype == np.float64
+    assert len(p["drive_t_s"]) == len(t) == len(p["drive_u_m"])
+    s = p["summary"]
+    assert s["feasible"] is True
+    assert s["max_scale"] is None
+    records = s["iterations"]
+    assert 2 <= len(records) <= 4
+    assert s["drive"]["achieved"]["acceleration_nrmse"] < 0.5 * records[0]["acceleration_nrmse"]
+    assert s["drive"]["out"] is None
+
+
+def test_plan_agrees_with_the_cli(cli, tmp_path):
+    t, a = target()
+    scenario = tmp_path / "lhpost.json"
+    scenario.write_text(json.dumps(SCENARIO))
+    target_csv = tmp_path / "target.csv"
+    with open(target_csv, "w") as f:
+        f.write("t_s,a_m_s2\n")
+        for ti, ai in zip(t, a):
+            f.write(f"{float(ti)!r},{float(ai)!r}\n")
+    drive_csv = tmp_path / "drive.csv"
+    run = cli(
+        "plan", scenario, "--target", target_csv, "--out", drive_csv, "--iterations", "3", "--json"
+    )
+    expected = json.loads(run.stdout)
+    p = platen.plan(scenario, t, target_a_m_s2=a, iterations=3)
+    got = p["summary"]
+    for key in ("feasible", "max_scale", "iterations", "best_iteration", "stop", "margins", "limits"):
+        assert got[key] == expected[key], key
+    assert got["drive"]["achieved"] == expected["drive"]["achieved"]
+    written = read_csv(drive_csv)
+    np.testing.assert_array_equal(p["drive_t_s"], written["t_s"])
+    np.testing.assert_array_equal(p["drive_u_m"], written["u_m"])
+
+
+def test_a_displacement_target_and_no_iterations():
+    t = np.arange(2049) / RATE_HZ
+    u = 0.01 * np.sin(2 * math.pi * 1.0 * t) * np.sin(math.pi * t / t[-1]) ** 2
+    p = platen.plan(SCENARIO, t, target_u_m=u, iterations=0, max_scale=False)
+    s = p["summary"]
+    assert s["target"]["kind"] == "displacement"
+    assert len(s["iterations"]) == 1
+
+
+@pytest.mark.parametrize(
+    "kwargs, words",
+    [
+        ({}, "exactly one of"),
+        ({"target_a_m_s2": "x", "target_u_m": [0.0]}, "exactly one of"),
+        ({"target_a_m_s2": np.zeros(5)}, "samples"),
+        ({"target_a_m_s2": None, "target_u_m": None, "gain": 3.0}, "exactly one of"),
+    ],
+)
+def test_bad_targets_raise_scenario_error(kwargs, words):
+    t, _ = target(1.0)
+    with pytest.raises(platen.ScenarioError, match=words):
+        platen.plan(SCENARIO, t, **kwargs)
+
+
+def test_bad_settings_and_scenarios_raise_scenario_error():
+    t, a = target(1.0)
+    with pytest.raises(platen.ScenarioError, match="gain"):
+        platen.plan(SCENARIO, t, target_a_m_s2=a, gain=2.5)
+    with pytest.raises(platen.ScenarioError, match="iterations"):
+        platen.plan(SCENARIO, t, target_a_m_s2=a, iterations=-1)
+    with pytest.raises(platen.ScenarioError, match="frf"):
+        platen.plan(SCENARIO, t, target_a_m_s2=a, frf="guessed")
+    with pytest.raises(platen.ScenarioError, match="table_system"):
+        platen.plan({"name": "bare", "model": {"preset": "lhpost-2008"}}, t, target_a_m_s2=a)
+    with pytest.raises(ValueError, match="2048"):
+        fast = np.arange(1025) / 2048.0
+        platen.plan(SCENARIO, fast, target_a_m_s2=quake(fast))
+    with pytest.raises(platen.ScenarioError, match="zero"):
+        platen.plan(SCENARIO, t, target_a_m_s2=np.zeros_like(t))
