@@ -1,14 +1,27 @@
 #!/usr/bin/env python3
-"""Closed-loop records of a servo-hydraulic table for `platen identify --system`.
+"""Closed-loop records of a servo-hydraulic table carrying a specimen, for
+`platen identify --system`.
 
 An independent reference: numpy only, no platen code. It simulates the loop of
-docs/table-system.md (digital controller with zero-order hold, valve delay, second-order
-spool, four-way critically-centred valve with orifice flow, compressible single-ended
-actuator chambers with leakage, a platen with elastic, viscous and smoothed Coulomb forces)
-with parameters that are NOT the lhpost-2008 preset's, and writes what the controller read
-(with sensor noise) and the drive it sent:
+docs/table-system.md with parameters that are NOT the lhpost-2008 preset's:
 
-    t_s, command_u_m, u_m, drive, delta_p_pa, a_m_s2
+  digital controller (zero-order hold) -> valve delay -> second-order spool -> four-way
+  critically-centred valve (orifice flow per land, laminar below 1e-4 of the rated drop) ->
+  compressible single-ended actuator chambers with cross-port leakage -> a platen with
+  elastic, viscous and exact Coulomb friction (stick-slip: the platen sticks while
+  |F_A - K u - B| <= F_mu; the v = 0 crossing and the breakaway are located inside the
+  substep) -> a two-storey shear frame on the platen (base shear B = sum m_i * absolute
+  storey acceleration, B = -(k1 z1 + c1 z1') with z the storey displacements relative to
+  the platen).
+
+The hydraulics start as platen's closed loop starts them: centred spool, the null pressures
+(equal land drops, no net force), the platen and the specimen at rest at u = 0.
+
+It writes what the controller and the lab's sensors read (with sensor noise) and the drive
+the controller sent:
+
+    t_s, command_u_m, u_m, drive, delta_p_pa, cap_pressure_pa, rod_pressure_pa, a_m_s2,
+    storey1_a_m_s2, storey2_a_m_s2
 
 Conventions the controller uses (and `platen identify --system` assumes):
   v_ref, a_ref: central differences of the command (one-sided at the ends, as platen does);
@@ -34,7 +47,6 @@ P = {
     "stiffness_n_per_m": 2.0e5,
     "viscous_n_s_per_m": 5.0e3,
     "coulomb_n": 2000.0,
-    "coulomb_smoothing_m_s": 0.002,
     "cap_area_m2": 0.05,
     "rod_area_m2": 0.035,
     "cap_volume_m3": 0.03,
@@ -49,6 +61,11 @@ P = {
     "spool_damping_ratio": 0.7,
     "valve_delay_s": DELAY_SUB / (FS * SUB),
 }
+# Two storeys, bottom first: relative to the platen, storey i feels k_i, c_i to the one below.
+SPECIMEN = [
+    {"mass_kg": 3000.0, "stiffness_n_per_m": 3.0e6, "damping_n_s_per_m": 3000.0},
+    {"mass_kg": 2000.0, "stiffness_n_per_m": 3.0e6, "damping_n_s_per_m": 2500.0},
+]
 GAINS = {
     "sample_rate_hz": FS,
     "displacement_gain_per_m": 20.0,
@@ -59,47 +76,152 @@ GAINS = {
     "delta_p_gain_per_pa": 3e-8,
     "delta_p_highpass_hz": 0.5,
 }
-NOISE = {"u_m": 2e-6, "a_m_s2": 0.02, "delta_p_pa": 5e3, "drive_quantum": 1.0 / 32768}
+NOISE = {"u_m": 2e-6, "a_m_s2": 0.02, "storey_a_m_s2": 0.02, "pressure_pa": 5e3,
+         "drive_quantum": 1.0 / 32768}
+
+M1, M2 = SPECIMEN[0]["mass_kg"], SPECIMEN[1]["mass_kg"]
+K1, K2 = SPECIMEN[0]["stiffness_n_per_m"], SPECIMEN[1]["stiffness_n_per_m"]
+C1, C2 = SPECIMEN[0]["damping_n_s_per_m"], SPECIMEN[1]["damping_n_s_per_m"]
 
 
-def oil_column_hz(p):
-    """Free oil column at the chambers' initial volumes: (1/2pi) sqrt(b(Aa^2/Va + Ab^2/Vb)/M)."""
+def oil_column_hz(p, mass):
+    """Oil column at the chambers' initial volumes: (1/2pi) sqrt(b(Aa^2/Va + Ab^2/Vb)/M)."""
     k = p["bulk_modulus_pa"] * (p["cap_area_m2"] ** 2 / p["cap_volume_m3"]
                                 + p["rod_area_m2"] ** 2 / p["rod_volume_m3"])
-    return math.sqrt(k / p["mass_kg"]) / (2 * math.pi)
+    return math.sqrt(k / mass) / (2 * math.pi)
 
 
-def orifice(dp, k, lin):
-    """Flow through one land: k*sqrt(dp), linear below `lin` Pa so the slope stays finite."""
+def specimen_modes():
+    """Fixed-base modes of the specimen: (frequency Hz, damping ratio), lowest first."""
+    m = np.diag([M1, M2])
+    k = np.array([[K1 + K2, -K2], [-K2, K2]])
+    c = np.array([[C1 + C2, -C2], [-C2, C2]])
+    a = np.block([[np.zeros((2, 2)), np.eye(2)],
+                  [-np.linalg.solve(m, k), -np.linalg.solve(m, c)]])
+    ev = [e for e in np.linalg.eigvals(a) if e.imag > 0]
+    modes = sorted((abs(e) / (2 * math.pi), -e.real / abs(e)) for e in ev)
+    return [{"frequency_hz": f, "damping_ratio": z} for f, z in modes]
+
+
+K_LAND = P["rated_flow_m3_s"] / math.sqrt(P["rated_pressure_drop_pa"] / 2)
+LIN = 1e-4 * P["rated_pressure_drop_pa"]
+W_SPOOL = 2 * math.pi * P["spool_natural_frequency_hz"]
+
+
+def root(dp):
+    """sqrt(|dp|) with its sign; linear below LIN Pa (laminar) so the slope stays finite."""
     a = abs(dp)
-    return np.where(a >= lin, k * np.sign(dp) * np.sqrt(a), k * dp / math.sqrt(lin))
+    if a >= LIN:
+        return math.copysign(math.sqrt(a), dp)
+    return dp / math.sqrt(LIN)
 
 
-def rhs(s, d, p):
-    u, v, pa, pb, x, xd = s
-    k = p["rated_flow_m3_s"] / math.sqrt(p["rated_pressure_drop_pa"] / 2)
-    lin = 1e-4 * p["rated_pressure_drop_pa"]
+def parts(s, d, mode):
+    """Rates of the state s = [u, v, pa, pb, x, xd, z1, z1d, z2, z2d] with valve input d.
+
+    mode: +1 / -1 slipping with the friction's sign fixed, 0 stuck (v = 0, a = 0).
+    Returns (rates, platen acceleration, net force N = F_A - K u - B)."""
+    u, v, pa, pb, x, xd, z1, z1d, z2, z2d = s
+    p = P
+    pa_r, pb_r = max(pa, 0.0), max(pb, 0.0)
     ps, pr = p["supply_pressure_pa"], p["return_pressure_pa"]
     xo = min(max(x, -1.0), 1.0)
     if xo >= 0:
-        qa = xo * float(orifice(ps - pa, k, lin))
-        qb = xo * float(orifice(pb - pr, k, lin))
+        qa = K_LAND * xo * root(ps - pa_r)
+        qb = K_LAND * xo * root(pb_r - pr)
     else:
-        qa = xo * float(orifice(pa - pr, k, lin))
-        qb = xo * float(orifice(ps - pb, k, lin))
+        qa = K_LAND * xo * root(pa_r - pr)
+        qb = K_LAND * xo * root(ps - pb_r)
     aa, ab = p["cap_area_m2"], p["rod_area_m2"]
     va = p["cap_volume_m3"] + aa * u
     vb = p["rod_volume_m3"] - ab * u
     b, cl = p["bulk_modulus_pa"], p["leakage_m3_s_per_pa"]
-    dpa = b / va * (qa - aa * v - cl * (pa - pb))
-    dpb = b / vb * (-qb + ab * v + cl * (pa - pb))
-    f = (aa * pa - ab * pb - p["stiffness_n_per_m"] * u - p["viscous_n_s_per_m"] * v
-         - p["coulomb_n"] * math.tanh(v / p["coulomb_smoothing_m_s"]))
-    a = f / p["mass_kg"]
-    w = 2 * math.pi * p["spool_natural_frequency_hz"]
-    z = p["spool_damping_ratio"]
-    xdd = w * w * (d - x) - 2 * z * w * xd
-    return np.array([v, a, dpa, dpb, xd, xdd]), a
+    leak = cl * (pa_r - pb_r)
+    dpa = b / va * (qa - aa * v - leak)
+    dpb = b / vb * (-qb + ab * v + leak)
+    if pa <= 0 and dpa < 0:
+        dpa = 0.0
+    if pb <= 0 and dpb < 0:
+        dpb = 0.0
+    fa = aa * pa_r - ab * pb_r
+    shear = -(K1 * z1 + C1 * z1d)          # base shear B = sum m_i (a + z_i'')
+    net = fa - p["stiffness_n_per_m"] * u - shear
+    if mode == 0:
+        a = 0.0
+    else:
+        a = (net - p["viscous_n_s_per_m"] * v - p["coulomb_n"] * mode) / p["mass_kg"]
+    f1 = -K1 * z1 - C1 * z1d + K2 * (z2 - z1) + C2 * (z2d - z1d)
+    f2 = -K2 * (z2 - z1) - C2 * (z2d - z1d)
+    xdd = W_SPOOL * W_SPOOL * (d - x) - 2 * p["spool_damping_ratio"] * W_SPOOL * xd
+    rates = [v if mode != 0 else 0.0, a, dpa, dpb, xd, xdd,
+             z1d, f1 / M1 - a, z2d, f2 / M2 - a]
+    return rates, a, net
+
+
+def rk4(s, d, mode, dt):
+    k1, _, _ = parts(s, d, mode)
+    k2, _, _ = parts([a + 0.5 * dt * b for a, b in zip(s, k1)], d, mode)
+    k3, _, _ = parts([a + 0.5 * dt * b for a, b in zip(s, k2)], d, mode)
+    k4, _, _ = parts([a + dt * b for a, b in zip(s, k3)], d, mode)
+    out = [a + dt / 6 * (b + 2 * c + 2 * e + f) for a, b, c, e, f in zip(s, k1, k2, k3, k4)]
+    if mode == 0:
+        out[1] = 0.0
+    return out
+
+
+def locate(g, lo=0.0, hi=1.0):
+    """The root of g on (lo, hi) (g(lo) and g(hi) of opposite signs): Illinois."""
+    glo, ghi = g(lo), g(hi)
+    side = 0
+    for _ in range(60):
+        m = (lo * ghi - hi * glo) / (ghi - glo)
+        gm = g(m)
+        if gm == 0 or hi - lo < 1e-13:
+            return m
+        if (gm > 0) == (ghi > 0):
+            hi, ghi = m, gm
+            if side == -1:
+                glo *= 0.5
+            side = -1
+        else:
+            lo, glo = m, gm
+            if side == 1:
+                ghi *= 0.5
+            side = 1
+    return 0.5 * (lo + hi)
+
+
+def step(s, mode, d, dt):
+    """One substep of length dt with exact stick-slip; returns (state, mode)."""
+    fmu = P["coulomb_n"]
+    left = dt
+    for _ in range(8):
+        if left <= 0:
+            break
+        if mode == 0:
+            new = rk4(s, d, 0, left)
+            _, _, n_end = parts(new, d, 0)
+            if abs(n_end) <= fmu:
+                return new, 0
+            sign = 1.0 if n_end > 0 else -1.0
+            th = locate(lambda f: abs(parts(rk4(s, d, 0, f * left), d, 0)[2]) - fmu)
+            s = rk4(s, d, 0, th * left)
+            left -= th * left
+            mode = sign
+            continue
+        new = rk4(s, d, mode, left)
+        if new[1] * mode > 0:
+            return new, mode
+        th = locate(lambda f: rk4(s, d, mode, f * left)[1] * mode)
+        s = rk4(s, d, mode, th * left)
+        s[1] = 0.0
+        left -= th * left
+        _, _, n = parts(s, d, 0)
+        if abs(n) <= fmu:
+            mode = 0
+        else:
+            mode = 1.0 if n > 0 else -1.0
+    return s, mode
 
 
 def derivatives(u, h):
@@ -115,27 +237,38 @@ def derivatives(u, h):
     return v, a
 
 
-def simulate(cmd, p, g, rng):
+COLUMNS = ("u_m", "drive", "delta_p_pa", "cap_pressure_pa", "rod_pressure_pa", "a_m_s2",
+           "storey1_a_m_s2", "storey2_a_m_s2", "true_a_m_s2")
+
+
+def simulate(cmd, g, rng):
     n = len(cmd)
     h = 1.0 / FS
     dt = h / SUB
     vref, aref = derivatives(cmd, h)
-    # Initial state: at rest, pressures balancing the areas (p_a A_a = p_b A_b).
-    pb0 = 9e6
-    pa0 = pb0 * p["rod_area_m2"] / p["cap_area_m2"]
-    s = np.array([0.0, 0.0, pa0, pb0, 0.0, 0.0])
+    ps, pr = P["supply_pressure_pa"], P["return_pressure_pa"]
+    aa, ab = P["cap_area_m2"], P["rod_area_m2"]
+    # platen's null state: equal land drops (pa + pb = Ps + Pr), no net force (Aa pa = Ab pb).
+    pa0 = (ps + pr) * ab / (aa + ab)
+    pb0 = (ps + pr) * aa / (aa + ab)
+    s = [0.0, 0.0, pa0, pb0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    mode = 0
     w = 2 * math.pi * g["delta_p_highpass_hz"]
     c = 2.0 / h
-    out = {k: np.zeros(n) for k in ("u_m", "a_m_s2", "delta_p_pa", "drive")}
+    out = {k: np.zeros(n) for k in COLUMNS}
     d_old = 0.0
     hp = 0.0
     dp_prev = None
     u_prev = None
-    _, a_now = rhs(s, 0.0, p)
     for i in range(n):
+        rates, a_now, _ = parts(s, d_old, mode)
         um = s[0] + NOISE["u_m"] * rng.standard_normal()
         am = a_now + NOISE["a_m_s2"] * rng.standard_normal()
-        dpm = s[2] - s[3] + NOISE["delta_p_pa"] * rng.standard_normal()
+        pam = s[2] + NOISE["pressure_pa"] * rng.standard_normal()
+        pbm = s[3] + NOISE["pressure_pa"] * rng.standard_normal()
+        a1 = a_now + rates[7] + NOISE["storey_a_m_s2"] * rng.standard_normal()
+        a2 = a_now + rates[9] + NOISE["storey_a_m_s2"] * rng.standard_normal()
+        dpm = pam - pbm
         hp = 0.0 if dp_prev is None else (c * (dpm - dp_prev) + (c - w) * hp) / (c + w)
         dp_prev = dpm
         vm = 0.0 if u_prev is None else (um - u_prev) / h
@@ -148,17 +281,12 @@ def simulate(cmd, p, g, rng):
              - g["delta_p_gain_per_pa"] * hp)
         d = min(max(d, -1.0), 1.0)
         d = round(d / NOISE["drive_quantum"]) * NOISE["drive_quantum"]
-        out["u_m"][i], out["a_m_s2"][i], out["delta_p_pa"][i], out["drive"][i] = um, am, dpm, d
+        for k, x in zip(COLUMNS, (um, d, dpm, pam, pbm, am, a1, a2, a_now)):
+            out[k][i] = x
         for j in range(SUB):
-            dd = d_old if j < DELAY_SUB else d
-            k1, _ = rhs(s, dd, p)
-            k2, _ = rhs(s + 0.5 * dt * k1, dd, p)
-            k3, _ = rhs(s + 0.5 * dt * k2, dd, p)
-            k4, _ = rhs(s + dt * k3, dd, p)
-            s = s + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+            s, mode = step(s, mode, d_old if j < DELAY_SUB else d, dt)
         d_old = d
-        _, a_now = rhs(s, d, p)
-        if not np.all(np.isfinite(s)):
+        if not all(math.isfinite(x) for x in s):
             raise SystemExit("the reference loop diverged")
     return out
 
@@ -190,29 +318,49 @@ def main():
     os.makedirs(outdir, exist_ok=True)
     n = int(6 * FS)
     records = {
-        "wn-a.csv": white_noise(n, 11, 0.004, 0.2, 25.0),
+        "wn-a.csv": white_noise(n, 11, 0.0015, 0.2, 20.0),
         "chirp.csv": chirp(n, 0.5, 30.0, 4.0, 0.01),
-        "wn-b.csv": white_noise(n, 23, 0.004, 0.2, 25.0),
+        "wn-b.csv": white_noise(n, 23, 0.0015, 0.2, 20.0),
     }
     rng = np.random.default_rng(2026)
     summary = {}
+    header = ("t_s,command_u_m,u_m,drive,delta_p_pa,cap_pressure_pa,rod_pressure_pa,a_m_s2,"
+              "storey1_a_m_s2,storey2_a_m_s2\n")
     for name, cmd in records.items():
-        out = simulate(cmd, P, GAINS, rng)
+        out = simulate(cmd, GAINS, rng)
         t = np.arange(n) / FS
+        rows = []
+        for i in range(n):
+            rows.append(f"{t[i]:.9g},{cmd[i]:.9e},{out['u_m'][i]:.9e},{out['drive'][i]:.9e},"
+                        f"{out['delta_p_pa'][i]:.1f},{out['cap_pressure_pa'][i]:.1f},"
+                        f"{out['rod_pressure_pa'][i]:.1f},{out['a_m_s2'][i]:.6g},"
+                        f"{out['storey1_a_m_s2'][i]:.6g},{out['storey2_a_m_s2'][i]:.6g}\n")
         with open(os.path.join(outdir, name), "w") as fh:
-            fh.write("t_s,command_u_m,u_m,drive,delta_p_pa,a_m_s2\n")
-            for i in range(n):
-                fh.write(f"{t[i]:.9g},{cmd[i]:.9e},{out['u_m'][i]:.9e},{out['drive'][i]:.9e},"
-                         f"{out['delta_p_pa'][i]:.6f},{out['a_m_s2'][i]:.6e}\n")
+            fh.write(header)
+            fh.writelines(rows)
+        if name == "wn-a.csv":
+            with open(os.path.join(outdir, "missing-command.csv"), "w") as fh:
+                fh.write(header.replace("command_u_m,", ""))
+                for r in rows[:49]:
+                    cells = r.split(",")
+                    fh.write(",".join(cells[:1] + cells[2:]))
+        true_a = out["true_a_m_s2"]
         summary[name] = {
             "peak_drive": float(np.max(np.abs(out["drive"]))),
             "rms_tracking_error_m": float(np.sqrt(np.mean((cmd - out["u_m"]) ** 2))),
+            "rms_table_acceleration_m_s2": float(np.sqrt(np.mean(true_a ** 2))),
+            "peak_table_acceleration_m_s2": float(np.max(np.abs(true_a))),
+            "stuck_fraction": float(np.mean(true_a == 0.0)),
         }
+        print(name, summary[name], flush=True)
+    total = P["mass_kg"] + M1 + M2
     truth = {
         "made_by": "tools/reference/system_ident_records.py",
         "controller": GAINS,
         "plant": P,
-        "oil_column_frequency_hz": oil_column_hz(P),
+        "specimen": {"storeys": SPECIMEN, "modes": specimen_modes()},
+        "oil_column_frequency_hz": oil_column_hz(P, P["mass_kg"]),
+        "oil_column_frequency_with_specimen_hz": oil_column_hz(P, total),
         "noise": NOISE,
         "records": summary,
     }
