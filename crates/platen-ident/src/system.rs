@@ -27,6 +27,13 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::error::{IdentError, Result};
 
+mod plant;
+
+pub use plant::{
+    predict, IdentifiedHydraulics, IdentifiedMechanics, IdentifiedPlant, IdentifiedStorey, Mode,
+    Prediction, CONTINUITY_LOWPASS_HZ, DRIFT_HIGHPASS_HZ, JUDGE_STEPS_PER_PERIOD, SLIP_SPEED_M_S,
+};
+
 /// Corners tried for the `Δp` high-pass when none is given, Hz (0: `Δp` unfiltered).
 pub const HIGHPASS_GRID_HZ: [f64; 12] = [
     0.0, 0.02, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 1.0, 2.0, 5.0, 10.0,
@@ -52,6 +59,12 @@ pub struct SystemRecord {
     pub delta_p_pa: Option<Vec<f64>>,
     /// The platen's acceleration, m/s², if recorded.
     pub a_m_s2: Option<Vec<f64>>,
+    /// The cap-side chamber pressure (absolute), Pa, if recorded.
+    pub cap_pressure_pa: Option<Vec<f64>>,
+    /// The rod-side chamber pressure (absolute), Pa, if recorded.
+    pub rod_pressure_pa: Option<Vec<f64>>,
+    /// The storeys' absolute accelerations, m/s², bottom first (empty: none recorded).
+    pub storey_a_m_s2: Vec<Vec<f64>>,
 }
 
 impl SystemRecord {
@@ -78,10 +91,18 @@ impl SystemRecord {
             ("drive", &self.drive),
             ("delta_p_pa", &self.delta_p_pa),
             ("a_m_s2", &self.a_m_s2),
+            ("cap_pressure_pa", &self.cap_pressure_pa),
+            ("rod_pressure_pa", &self.rod_pressure_pa),
         ] {
             if let Some(c) = c {
                 channels.push((name, c));
             }
+        }
+        let storeys: Vec<String> = (1..=self.storey_a_m_s2.len())
+            .map(|i| format!("storey{i}_a_m_s2"))
+            .collect();
+        for (name, c) in storeys.iter().zip(&self.storey_a_m_s2) {
+            channels.push((name, c));
         }
         for (name, c) in channels {
             if c.len() != n {
@@ -157,6 +178,9 @@ pub struct SystemIdentification {
     pub records: Vec<HeldOut>,
     /// Samples left out as saturated (`|d| ≥ 0.999`) in the fit.
     pub saturated_samples: usize,
+    /// The plant (platen, specimen, valves, oil column) and the identified loop's
+    /// predictions, with a base geometry ([`SystemSettings::base`]).
+    pub plant: Option<IdentifiedPlant>,
     /// Quantities the records cannot show, with the reason.
     pub not_identified: Vec<(String, String)>,
 }
@@ -166,6 +190,15 @@ pub struct SystemIdentification {
 pub struct SystemSettings {
     /// The `Δp` high-pass corner, Hz, if known (otherwise chosen from [`HIGHPASS_GRID_HZ`]).
     pub delta_p_highpass_hz: Option<f64>,
+    /// The table's geometry from its drawings (actuator count and areas, valve count and
+    /// rated drop, supply and return pressures, bulk modulus): with it the plant is
+    /// identified; the rest of its values are replaced by the fitted ones. Without it only
+    /// the gains are (the motion is invariant to scaling every area, mass, force, flow and
+    /// volume together: see [`plant`](IdentifiedPlant)).
+    pub base: Option<platen_system::TableSystem>,
+    /// Whether to run the identified loop on every record's command and judge it
+    /// ([`IdentifiedPlant::predictions`]).
+    pub judge: bool,
 }
 
 /// Central differences (one-sided second order at the ends): velocity and acceleration.
@@ -330,21 +363,30 @@ pub fn identify_system(
             "no delta_p_pa recorded: taken as 0",
         ));
     }
-    for what in [
-        "servo-valve flow gain and dynamics",
-        "oil column, chamber volumes, bulk modulus",
-        "platen mass, friction, specimen",
-    ] {
-        not_identified.push(why(
-            what,
-            "not identified by this version of identify --system: taken from the preset",
-        ));
-    }
+    let plant = match &settings.base {
+        Some(base) => Some(plant::identify_plant(
+            records,
+            &periods,
+            &fitted,
+            base,
+            &mut not_identified,
+        )),
+        None => {
+            not_identified.push(why(
+                "servo-valves, oil column, platen, specimen",
+                "no base geometry (actuator count and areas, supply pressure): scaling every \
+                 area, mass, force, flow and volume together leaves the motion unchanged, \
+                 so the records alone show only ratios to the area",
+            ));
+            None
+        }
+    };
     let mut result = SystemIdentification {
         gains: None,
         fitted_records: fitted.iter().map(|&i| records[i].name.clone()).collect(),
         records: Vec::new(),
         saturated_samples: 0,
+        plant,
         not_identified,
     };
     if !has_drive {
@@ -436,5 +478,34 @@ pub fn identify_system(
         });
     }
     result.gains = Some(gains);
+    if let Some(plant) = result.plant.as_mut() {
+        if let Some(sys) = plant.system.as_mut() {
+            let c = &mut sys.controller;
+            c.sample_rate_hz = gains.sample_rate_hz;
+            c.displacement_gain_per_m = gains.displacement_gain_per_m;
+            c.integral_gain_per_m_s = 0.0;
+            c.velocity_feedforward_s_per_m = gains.velocity_feedforward_s_per_m;
+            c.acceleration_feedforward_s2_per_m = gains.acceleration_feedforward_s2_per_m;
+            c.velocity_feedback_s_per_m = gains.velocity_feedback_s_per_m;
+            c.acceleration_feedback_s2_per_m = gains.acceleration_feedback_s2_per_m;
+            c.delta_p_gain_per_pa = gains.delta_p_gain_per_pa;
+            c.delta_p_highpass_hz = gains.delta_p_highpass_hz;
+        }
+        if settings.judge {
+            if let (Some(sys), Some(model)) = (plant.system, plant.model) {
+                for (i, r) in records.iter().enumerate() {
+                    if let Some(p) = predict(
+                        r,
+                        fitted.contains(&i),
+                        &sys,
+                        &model,
+                        plant.specimen.as_ref(),
+                    ) {
+                        plant.predictions.push(p);
+                    }
+                }
+            }
+        }
+    }
     Ok(result)
 }
