@@ -340,9 +340,19 @@ enum Command {
         /// Identify the table system's controller from closed-loop records instead (t_s,
         /// command_u_m, u_m and, where recorded, drive, delta_p_pa, a_m_s2): the gains by
         /// least squares on the drive; the last of two or more FILEs is held out and judged.
-        /// With --json, a runnable scenario with the identified controller.
+        /// With --json, a runnable scenario with the identified controller. With --base, also
+        /// the plant (platen, storeys, valves, oil column) from cap_pressure_pa,
+        /// rod_pressure_pa, a_m_s2 and storey{i}_a_m_s2, judged by running the identified loop
+        /// on the held-out record's command.
         #[arg(long, conflicts_with_all = ["manifest", "pressure_mpa", "plot", "report", "method"])]
         system: bool,
+        /// With --system: the table's geometry from its drawings (actuator count and areas,
+        /// valve count and rated drop, supply and return pressures, bulk modulus), as a
+        /// scenario with a table_system or a table_system object (e.g. {"preset":
+        /// "lhpost-2008", "actuator": {…}}). Without it only the gains are identified: the
+        /// records show the plant only in ratios to the actuator area.
+        #[arg(long, value_name = "FILE.json", requires = "system")]
+        base: Option<PathBuf>,
         #[command(flatten)]
         size: plot::SizeArgs,
     },
@@ -553,8 +563,9 @@ fn run(command: Command) -> anyhow::Result<()> {
             columns,
             json,
             system: true,
+            base,
             ..
-        } => identify::run_system(&files, columns.as_deref(), json),
+        } => identify::run_system(&files, columns.as_deref(), base.as_deref(), json),
         Command::Identify {
             files,
             pressure_mpa,
@@ -568,6 +579,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             method,
             no_output_error,
             system: _,
+            base: _,
             size,
         } => identify::run(&identify::Options {
             files: &files,
