@@ -970,11 +970,7 @@ fn floor_factor(f: &FloorSpec) -> Result<f64> {
         ColumnSpec {
             name: Some(f.column.clone()),
             unit: f.unit.clone(),
-            times_area_m2: None,
-            scale: None,
-            offset: None,
-            remove_mean: false,
-            zero_at_start: false,
+            ..ColumnSpec::default()
         },
     );
     let map = ColumnMap::new(&spec, "floors")
@@ -1457,13 +1453,13 @@ pub fn run_system(
         "model": model,
         "table_system": table_system,
         // The record's own a_m_s2 is the table's, not the command's: the command's velocity
-        // and acceleration are derived from command_u_m (mapped to a header no record has).
+        // and acceleration are derived from command_u_m (the record's columns ignored).
         "excitation": {
             "motion_csv": held_path.display().to_string(),
             "columns": {
                 "u_m": { "name": map.header("command_u_m") },
-                "v_m_s": { "name": NOT_A_COLUMN },
-                "a_m_s2": { "name": NOT_A_COLUMN },
+                "v_m_s": { "ignore": true },
+                "a_m_s2": { "ignore": true },
             }
         },
         "duration_s": span,
@@ -1483,7 +1479,24 @@ pub fn run_system(
         let a = &sys.actuator;
         let room = (a.cap_volume_m3 / a.cap_area_m2).min(a.rod_volume_m3 / a.rod_area_m2);
         let stroke = base_stroke.filter(|s| *s < room).unwrap_or(0.9 * room);
-        scenario["limits"] = serde_json::json!({ "stroke_m": stroke });
+        // The other limits are this table's, not the preset's: its capacities by the closed
+        // forms in the weaker direction, and the acceleration that force gives the moving
+        // mass (platen and specimen).
+        let cap = sys.capacities();
+        let force = cap.push_force_n.min(cap.pull_force_n);
+        let velocity = cap.extend_velocity_m_s.min(cap.retract_velocity_m_s);
+        let mut limits = serde_json::json!({
+            "stroke_m": stroke,
+            "velocity_m_s": velocity,
+            "force_n": force,
+        });
+        if let Some(m) = plant.and_then(|p| p.model) {
+            let specimen_kg: f64 = plant
+                .and_then(|p| p.specimen.as_ref())
+                .map_or(0.0, |sp| sp.storeys().iter().map(|s| s.mass_kg).sum());
+            limits["acceleration_m_s2"] = (force / (m.effective_mass_kg + specimen_kg)).into();
+        }
+        scenario["limits"] = limits;
     }
     let mut from_preset: Vec<&str> = Vec::new();
     if plant.and_then(|p| p.model).is_none() {
@@ -1643,10 +1656,6 @@ pub fn run_system(
     outln!("{}", s.trim_end());
     Ok(())
 }
-
-/// A header no record has: the printed scenario's command takes its velocity and
-/// acceleration from `command_u_m`, not from the record's (the table's) `a_m_s2`.
-const NOT_A_COLUMN: &str = "(derived from command_u_m)";
 
 /// The `table_system` scenario object of `sys` (explicit: every key).
 fn table_system_json(sys: &platen_system::TableSystem) -> serde_json::Value {

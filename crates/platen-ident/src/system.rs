@@ -427,7 +427,7 @@ pub fn identify_system(
     let mut k = c.iter().copied();
     let mut next = || k.next().unwrap_or(0.0);
     let gains = IdentifiedGains {
-        sample_rate_hz: 1.0 / h,
+        sample_rate_hz: nominal_rate_hz(h),
         displacement_gain_per_m: next(),
         velocity_feedforward_s_per_m: next(),
         acceleration_feedforward_s2_per_m: next(),
@@ -508,4 +508,17 @@ pub fn identify_system(
         }
     }
     Ok(result)
+}
+
+/// The controller's rate from the records' mean period `h`: a whole number of hertz when the
+/// stamps agree with one within their rounding (1e-6 relative: stamps written with 9
+/// significant digits give 1023.9999996 Hz for 1024 Hz), else `1/h`.
+fn nominal_rate_hz(h: f64) -> f64 {
+    let rate = 1.0 / h;
+    let whole = rate.round();
+    if whole >= 1.0 && (rate - whole).abs() <= 1e-6 * whole {
+        whole
+    } else {
+        rate
+    }
 }

@@ -67,6 +67,12 @@ pub struct ColumnSpec {
     /// `remove_mean`.
     #[serde(default)]
     pub zero_at_start: bool,
+    /// Do not read this column even where the file has one of this name (default false):
+    /// platen then does without it as for a file that lacks it, e.g. a motion's `v_m_s` and
+    /// `a_m_s2` derived from its `u_m`. Alone: no other field with it; not for a column the
+    /// reading requires.
+    #[serde(default)]
+    pub ignore: bool,
 }
 
 /// How a channel is read: its header, the factor from the file's unit to SI, the offset
@@ -77,6 +83,8 @@ struct Mapping {
     factor: f64,
     offset: f64,
     zero: Zero,
+    /// Not read (`ignore`).
+    ignored: bool,
 }
 
 /// Where a channel's zero is.
@@ -173,6 +181,34 @@ impl ColumnMap {
                 )
             })?;
             let here = format!("{json_path}.{ours}");
+            if s.ignore {
+                let alone = ColumnSpec {
+                    ignore: true,
+                    ..ColumnSpec::default()
+                };
+                if kind == Kind::Time || *s != alone {
+                    return Err((
+                        format!("{here}.ignore"),
+                        "true".into(),
+                        if kind == Kind::Time {
+                            "no ignore on the time column t_s".into()
+                        } else {
+                            "ignore alone: no name, unit, scale, offset or zero with it".into()
+                        },
+                    ));
+                }
+                entries.insert(
+                    ours.clone(),
+                    Mapping {
+                        header: ours.clone(),
+                        factor: 1.0,
+                        offset: 0.0,
+                        zero: Zero::AsRecorded,
+                        ignored: true,
+                    },
+                );
+                continue;
+            }
             let factor = match (&s.unit, s.times_area_m2) {
                 (None, None) => 1.0,
                 (None, Some(_)) => {
@@ -274,6 +310,7 @@ impl ColumnMap {
                     factor,
                     offset,
                     zero,
+                    ignored: false,
                 },
             );
         }
@@ -318,16 +355,34 @@ impl ColumnMap {
     /// # Errors
     /// Every error of [`read_table`].
     pub fn read_table(&self, path: &Path, required: &[&str], optional: &[&str]) -> Result<Table> {
+        if let Some(ours) = required.iter().find(|c| self.ignored(c)) {
+            return Err(IoError::InvalidField {
+                path: path.to_owned(),
+                json_path: format!("columns.{ours}.ignore"),
+                value: "true".into(),
+                expected: format!("{ours} read: this reading needs it"),
+            });
+        }
+        let optional: Vec<&str> = optional
+            .iter()
+            .copied()
+            .filter(|c| !self.ignored(c))
+            .collect();
         let req: Vec<&str> = required.iter().map(|c| self.header(c)).collect();
         let opt: Vec<&str> = optional.iter().map(|c| self.header(c)).collect();
         let mut table = read_table(path, &req, &opt)?;
-        for &ours in required.iter().chain(optional) {
+        for &ours in required.iter().chain(&optional) {
             match self.entries.get(ours) {
                 Some(m) => table.rename_with(&m.header, ours, |c| m.apply(c)),
                 None => table.rename_with(ours, ours, |_| ()),
             }
         }
         Ok(table)
+    }
+
+    /// Whether platen's column `ours` is mapped with `ignore`: not read.
+    pub fn ignored(&self, ours: &str) -> bool {
+        self.entries.get(ours).is_some_and(|m| m.ignored)
     }
 
     /// The header to read for platen's column `ours`.
@@ -521,6 +576,32 @@ mod tests {
         let m = map(r#"{"u_m": {"name": "disp", "zero_at_start": true, "offset": 1}}"#).unwrap();
         let mut t = m.read_table(&path, &["u_m"], &[]).unwrap();
         assert_eq!(t.take_column("u_m").unwrap(), vec![0.0, 2.0, 7.0]);
+    }
+
+    #[test]
+    fn an_ignored_column_is_not_read_and_must_be_alone_and_optional() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("rec.csv");
+        std::fs::write(&path, "t_s,command_u_m,a_m_s2\n0,1,9\n1,2,9\n").unwrap();
+        let m = map(r#"{"u_m": {"name": "command_u_m"}, "a_m_s2": {"ignore": true}}"#).unwrap();
+        assert!(m.ignored("a_m_s2") && !m.ignored("u_m"));
+        let mut t = m
+            .read_table(&path, &["t_s", "u_m"], &["v_m_s", "a_m_s2"])
+            .unwrap();
+        assert_eq!(t.take_column("u_m").unwrap(), vec![1.0, 2.0]);
+        assert_eq!(t.take_column("a_m_s2"), None);
+        let e = m.read_table(&path, &["t_s", "a_m_s2"], &[]).unwrap_err();
+        assert!(e.to_string().contains("columns.a_m_s2.ignore"), "{e}");
+        for (json, at) in [
+            (
+                r#"{"a_m_s2": {"ignore": true, "unit": "g"}}"#,
+                "a_m_s2.ignore",
+            ),
+            (r#"{"t_s": {"ignore": true}}"#, "t_s.ignore"),
+        ] {
+            let e = map(json).unwrap_err();
+            assert_eq!(e.0, format!("excitation.columns.{at}"), "{json}: {e:?}");
+        }
     }
 
     #[test]

@@ -652,7 +652,7 @@ mod tests {
             "Northridge 1994 Tarzana at 120 % on the LHPOST with a two-storey frame: spectra";
         let (t, size) = fit_title(long, width);
         assert_eq!(t, long);
-        assert!(size < TITLE_SIZE && size >= 0.6 * TITLE_SIZE);
+        assert!((0.6 * TITLE_SIZE..TITLE_SIZE).contains(&size));
         assert!(TITLE_EM_PER_CHAR * size * long.chars().count() as f64 <= room + 1e-9);
         let longer = long.repeat(3);
         let (t, size) = fit_title(&longer, width);
