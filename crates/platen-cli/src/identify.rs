@@ -1416,7 +1416,7 @@ pub fn run_system(
     let plant = id.plant.as_ref();
     let identified_system = plant.and_then(|p| p.system);
     let mut table_system = match &identified_system {
-        Some(sys) => table_system_json(sys),
+        Some(sys) => crate::model::parameters(sys),
         None => serde_json::json!({ "preset": "lhpost-2008" }),
     };
     if let (Some(g), None) = (&id.gains, &identified_system) {
@@ -1655,54 +1655,6 @@ pub fn run_system(
     );
     outln!("{}", s.trim_end());
     Ok(())
-}
-
-/// The `table_system` scenario object of `sys` (explicit: every key).
-fn table_system_json(sys: &platen_system::TableSystem) -> serde_json::Value {
-    let a = &sys.actuator;
-    let v = &sys.servo_valve;
-    let c = &sys.controller;
-    let accumulator = match &sys.supply {
-        platen_system::Supply::Constant => serde_json::Value::Null,
-        platen_system::Supply::Accumulator(acc) => serde_json::json!({
-            "precharge_pressure_pa": acc.precharge_pressure_pa,
-            "volume_m3": acc.volume_m3,
-            "polytropic_exponent": acc.polytropic_exponent,
-            "pump_flow_m3_s": acc.pump_flow_m3_s,
-        }),
-    };
-    serde_json::json!({
-        "actuator": {
-            "count": a.count,
-            "cap_side_area_m2": a.cap_area_m2,
-            "rod_side_area_m2": a.rod_area_m2,
-            "chamber_volume_m3": [a.cap_volume_m3, a.rod_volume_m3],
-            "leakage_m3_s_per_pa": a.leakage_m3_s_per_pa,
-        },
-        "servo_valve": {
-            "count": v.count,
-            "rated_flow_m3_s": v.rated_flow_m3_s,
-            "rated_pressure_drop_pa": v.rated_pressure_drop_pa,
-            "natural_frequency_hz": v.natural_frequency_hz,
-            "damping_ratio": v.damping_ratio,
-            "delay_s": v.delay_s,
-        },
-        "oil_bulk_modulus_pa": sys.oil_bulk_modulus_pa,
-        "supply_pressure_pa": sys.supply_pressure_pa,
-        "return_pressure_pa": sys.return_pressure_pa,
-        "accumulator": accumulator,
-        "controller": {
-            "sample_rate_hz": c.sample_rate_hz,
-            "displacement_gain_per_m": c.displacement_gain_per_m,
-            "integral_gain_per_m_s": c.integral_gain_per_m_s,
-            "velocity_feedforward_s_per_m": c.velocity_feedforward_s_per_m,
-            "acceleration_feedforward_s2_per_m": c.acceleration_feedforward_s2_per_m,
-            "velocity_feedback_s_per_m": c.velocity_feedback_s_per_m,
-            "acceleration_feedback_s2_per_m": c.acceleration_feedback_s2_per_m,
-            "delta_p_gain_per_pa": c.delta_p_gain_per_pa,
-            "delta_p_highpass_hz": c.delta_p_highpass_hz,
-        },
-    })
 }
 
 /// `--base`: a scenario with a `table_system`, or a `table_system` object, validated as a

@@ -871,8 +871,9 @@ impl<'a> LoopDescription<'a> {
     }
 }
 
-/// The system's parameters, in the scenario format's `table_system` keys.
-fn parameters(sys: &TableSystem) -> Value {
+/// The system's parameters as the scenario format's `table_system` object, every key explicit
+/// (`platen model --json` and the scenario `identify --system` prints).
+pub(crate) fn parameters(sys: &TableSystem) -> Value {
     let a = &sys.actuator;
     let v = &sys.servo_valve;
     let c = &sys.controller;
