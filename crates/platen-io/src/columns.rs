@@ -23,10 +23,24 @@
 //! channel's mean over the file, `"zero_at_start": true` its first value (one or the other;
 //! the time column takes `offset` and `zero_at_start` only).
 //!
-//! The table system's channels: `command_u_m` (a displacement), `drive` (a fraction of full
-//! opening, no unit), `delta_p_pa` (a pressure), `storey{i}_a_m_s2` (accelerations, `i` ≥ 1).
+//! Every column a reader asks for can be mapped: `t_s`, `u_m`, `v_m_s`, `a_m_s2`, `force_n`,
+//! `base_shear_n`, the table system's `command_u_m` (a displacement), `drive` (a fraction of
+//! full opening, no unit), `delta_p_pa`, `cap_pressure_pa`, `rod_pressure_pa` (pressures), and
+//! the specimen's `storey{i}_u_m` and `storey{i}_a_m_s2` (`i` ≥ 1).
 //! `"scale": 0.1` multiplies a channel after its unit's factor (a drive recorded in volts of a
 //! ±10 V servo amplifier).
+//!
+//! Header names match with surrounding spaces trimmed, in the file and in the map (`" Table
+//! disp "` reads the file's `Table disp`, and a DAQ export's `" disp"` is read as `disp`). A
+//! channel the map names must be in the file, even one the reading could do without; an
+//! unknown column, an unknown unit or a header absent from the file is an error listing the
+//! accepted columns, the units of that quantity, or the file's headers. A file that lacks a
+//! required column, without a map entry for it, is reported with a one-line map that would
+//! read it.
+//!
+//! `"delay_s": 0.004` records a channel's known delay relative to the displacement `u_m`
+//! (finite, `|delay_s|` < [`MAX_DELAY_S`]; not on `t_s` or `u_m`). Reading does not apply it:
+//! [`ColumnMap::delay_s`] hands it to identification, which corrects the channel's skew.
 //!
 //! Units: time `s`, `ms`; displacement `m`, `mm`, `cm`, `in`; velocity `m/s`, `mm/s`, `cm/s`,
 //! `in/s`; acceleration `m/s2`, `mm/s2`, `cm/s2` (`gal`), `in/s2`, `g` (9.80665 m/s²); force `N`,
@@ -73,7 +87,17 @@ pub struct ColumnSpec {
     /// reading requires.
     #[serde(default)]
     pub ignore: bool,
+    /// The channel's known delay relative to the displacement `u_m`, s (default none): a
+    /// data system that samples a channel late by `delay_s` (positive) or early (negative).
+    /// Finite, `|delay_s|` < 1 s; not for `t_s` or `u_m` itself. Reading a file does not apply
+    /// it: identification uses it ([`ColumnMap::delay_s`]) to correct the channel's skew.
+    pub delay_s: Option<f64>,
 }
+
+/// The largest `|delay_s|` a column map accepts, s: a data system's channel skew is a few
+/// samples (milliseconds); a second or more is a wrong unit (ms given as s) or a wrong
+/// channel, not a skew.
+pub const MAX_DELAY_S: f64 = 1.0;
 
 /// How a channel is read: its header, the factor from the file's unit to SI, the offset
 /// subtracted first (file unit), and how its zero is set.
@@ -85,6 +109,10 @@ struct Mapping {
     zero: Zero,
     /// Not read (`ignore`).
     ignored: bool,
+    /// The header was given (`name`), rather than platen's own name.
+    named: bool,
+    /// The channel's delay relative to the displacement, s (`delay_s`).
+    delay_s: Option<f64>,
 }
 
 /// Where a channel's zero is.
@@ -116,26 +144,50 @@ impl Mapping {
 }
 
 /// platen's column names and the kind of quantity each holds (besides the storeys'
-/// accelerations `storey{i}_a_m_s2`, `i` ≥ 1).
-const QUANTITIES: [(&str, Kind); 8] = [
+/// displacements `storey{i}_u_m` and accelerations `storey{i}_a_m_s2`, `i` ≥ 1): every
+/// column a reader of records asks for.
+const QUANTITIES: [(&str, Kind); 11] = [
     ("t_s", Kind::Time),
     ("u_m", Kind::Displacement),
     ("v_m_s", Kind::Velocity),
     ("a_m_s2", Kind::Acceleration),
     ("force_n", Kind::Force),
+    ("base_shear_n", Kind::Force),
     ("command_u_m", Kind::Displacement),
     ("drive", Kind::Drive),
     ("delta_p_pa", Kind::Pressure),
+    ("cap_pressure_pa", Kind::Pressure),
+    ("rod_pressure_pa", Kind::Pressure),
 ];
+
+/// The per-storey columns: `storey{i}` followed by one of these suffixes, with their kind.
+const STOREY_QUANTITIES: [(&str, Kind); 2] = [
+    ("_u_m", Kind::Displacement),
+    ("_a_m_s2", Kind::Acceleration),
+];
+
+/// Every platen column a column map accepts, as a message lists them.
+pub fn canonical_columns() -> String {
+    let mut names: Vec<String> = QUANTITIES.iter().map(|(n, _)| (*n).to_owned()).collect();
+    names.extend(
+        STOREY_QUANTITIES
+            .iter()
+            .map(|(s, _)| format!("storey{{i}}{s} (i ≥ 1)")),
+    );
+    names.join(", ")
+}
 
 /// The kind of platen's column `name`, if it is one.
 fn kind_of(name: &str) -> Option<Kind> {
     if let Some(k) = QUANTITIES.iter().find(|(n, _)| *n == name).map(|(_, k)| *k) {
         return Some(k);
     }
-    let storey = name.strip_prefix("storey")?.strip_suffix("_a_m_s2")?;
-    let i: u32 = storey.parse().ok()?;
-    (i >= 1 && !storey.starts_with('0')).then_some(Kind::Acceleration)
+    let rest = name.strip_prefix("storey")?;
+    STOREY_QUANTITIES.iter().find_map(|(suffix, kind)| {
+        let storey = rest.strip_suffix(suffix)?;
+        let i: u32 = storey.parse().ok()?;
+        (i >= 1 && !storey.starts_with(['0', '+'])).then_some(*kind)
+    })
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -174,10 +226,7 @@ impl ColumnMap {
                 (
                     format!("{json_path}.{ours}"),
                     format!("{ours:?}"),
-                    format!(
-                        "one of platen's columns: {}, storey{{i}}_a_m_s2",
-                        QUANTITIES.map(|(n, _)| n).join(", ")
-                    ),
+                    format!("one of platen's columns: {}", canonical_columns()),
                 )
             })?;
             let here = format!("{json_path}.{ours}");
@@ -205,6 +254,8 @@ impl ColumnMap {
                         offset: 0.0,
                         zero: Zero::AsRecorded,
                         ignored: true,
+                        named: false,
+                        delay_s: None,
                     },
                 );
                 continue;
@@ -223,7 +274,7 @@ impl ColumnMap {
                         (
                             format!("{here}.unit"),
                             format!("{u:?}"),
-                            "a known unit (see the scenario documentation)".into(),
+                            expected_unit(kind),
                         )
                     })?;
                     match (unit_kind, area) {
@@ -257,7 +308,7 @@ impl ColumnMap {
                             return Err((
                                 format!("{here}.unit"),
                                 format!("{u:?}"),
-                                format!("a unit of {}", kind_name(kind)),
+                                expected_unit(kind),
                             ))
                         }
                     }
@@ -274,7 +325,40 @@ impl ColumnMap {
                     ))
                 }
             };
-            let header = s.name.clone().unwrap_or_else(|| ours.clone());
+            let header = match s.name.as_deref().map(str::trim) {
+                None => ours.clone(),
+                Some("") => {
+                    return Err((
+                        format!("{here}.name"),
+                        format!("{:?}", s.name.as_deref().unwrap_or_default()),
+                        "a header name of the file (not empty)".into(),
+                    ))
+                }
+                Some(name) => name.to_owned(),
+            };
+            let delay_s = match s.delay_s {
+                None => None,
+                Some(_) if matches!(kind, Kind::Time) || ours == "u_m" => {
+                    return Err((
+                        format!("{here}.delay_s"),
+                        s.delay_s.unwrap_or_default().to_string(),
+                        "no delay on t_s or u_m: a delay is a channel's skew relative to the \
+                         displacement u_m"
+                            .into(),
+                    ))
+                }
+                Some(d) if d.is_finite() && d.abs() < MAX_DELAY_S => Some(d),
+                Some(d) => {
+                    return Err((
+                        format!("{here}.delay_s"),
+                        d.to_string(),
+                        format!(
+                            "a finite delay in seconds, |delay_s| < {MAX_DELAY_S} s (a channel's \
+                             skew is milliseconds: 0.004, not 4)"
+                        ),
+                    ))
+                }
+            };
             let offset = s.offset.unwrap_or(0.0);
             if !offset.is_finite() {
                 return Err((
@@ -311,6 +395,8 @@ impl ColumnMap {
                     offset,
                     zero,
                     ignored: false,
+                    named: s.name.is_some(),
+                    delay_s,
                 },
             );
         }
@@ -368,9 +454,18 @@ impl ColumnMap {
             .copied()
             .filter(|c| !self.ignored(c))
             .collect();
-        let req: Vec<&str> = required.iter().map(|c| self.header(c)).collect();
-        let opt: Vec<&str> = optional.iter().map(|c| self.header(c)).collect();
-        let mut table = read_table(path, &req, &opt)?;
+        // A channel the map names must be in the file, even where the reading could do
+        // without it: a map that names a header the file lacks is a mistake, not a choice.
+        let (mapped, unmapped): (Vec<&str>, Vec<&str>) = optional
+            .iter()
+            .partition(|c| self.entries.contains_key(**c));
+        let req: Vec<&str> = required
+            .iter()
+            .chain(&mapped)
+            .map(|c| self.header(c))
+            .collect();
+        let opt: Vec<&str> = unmapped.iter().map(|c| self.header(c)).collect();
+        let mut table = read_table(path, &req, &opt).map_err(|e| self.missing(e, required))?;
         for &ours in required.iter().chain(&optional) {
             match self.entries.get(ours) {
                 Some(m) => table.rename_with(&m.header, ours, |c| m.apply(c)),
@@ -378,6 +473,57 @@ impl ColumnMap {
             }
         }
         Ok(table)
+    }
+
+    /// A missing column reported with what fixes it: the map's entry that names a header
+    /// the file lacks, or for a platen column the map does not name, how a map would.
+    fn missing(&self, e: IoError, required: &[&str]) -> IoError {
+        let IoError::MissingColumn {
+            path,
+            column,
+            available,
+        } = e
+        else {
+            return e;
+        };
+        if let Some((ours, m)) = self
+            .entries
+            .iter()
+            .find(|(_, m)| !m.ignored && m.header == column)
+        {
+            return IoError::MappedColumnMissing {
+                path,
+                column: ours.clone(),
+                header: if m.named {
+                    format!("the header `{}` (columns.{ours}.name)", m.header)
+                } else {
+                    format!("its own name `{ours}` (columns.{ours} gives no name)")
+                },
+                available,
+            };
+        }
+        match kind_of(&column) {
+            Some(kind) if required.contains(&column.as_str()) => {
+                let name = available.first().map_or("…", String::as_str);
+                let example = match example_unit(kind) {
+                    Some(unit) => {
+                        format!(r#"{{"{column}": {{"name": "{name}", "unit": "{unit}"}}}}"#)
+                    }
+                    None => format!(r#"{{"{column}": {{"name": "{name}"}}}}"#),
+                };
+                IoError::UnmappedColumn {
+                    path,
+                    column,
+                    available,
+                    example,
+                }
+            }
+            _ => IoError::MissingColumn {
+                path,
+                column,
+                available,
+            },
+        }
     }
 
     /// Whether platen's column `ours` is mapped with `ignore`: not read.
@@ -400,11 +546,40 @@ impl ColumnMap {
     pub fn offset(&self, ours: &str) -> f64 {
         self.entries.get(ours).map_or(0.0, |m| m.offset)
     }
+
+    /// The known delay of platen's column `ours` relative to the displacement `u_m`, s
+    /// (`delay_s` in the map; `None` when none is given). Validated (finite, below
+    /// [`MAX_DELAY_S`] in magnitude) but not applied by [`ColumnMap::read_table`]: the
+    /// channel is read as recorded, and identification corrects its skew.
+    pub fn delay_s(&self, ours: &str) -> Option<f64> {
+        self.entries.get(ours).and_then(|m| m.delay_s)
+    }
 }
 
 enum UnitKind {
     Of(Kind),
     Pressure,
+}
+
+/// A unit of kind `k` for an example map (none for a drive).
+fn example_unit(k: Kind) -> Option<&'static str> {
+    Some(match k {
+        Kind::Time => "s",
+        Kind::Displacement => "mm",
+        Kind::Velocity => "mm/s",
+        Kind::Acceleration => "g",
+        Kind::Force => "kN",
+        Kind::Pressure => "MPa",
+        Kind::Drive => return None,
+    })
+}
+
+/// What a map's `unit` for a column of kind `k` should be, listing the accepted units.
+fn expected_unit(k: Kind) -> String {
+    match k {
+        Kind::Drive => format!("no unit: {}", kind_name(k)),
+        _ => format!("a unit of {}", kind_name(k)),
+    }
 }
 
 fn kind_name(k: Kind) -> &'static str {
@@ -416,7 +591,7 @@ fn kind_name(k: Kind) -> &'static str {
         Kind::Force => {
             "force (N, kN, MN, lbf, kip) or a pressure (Pa, kPa, MPa, bar, psi) with times_area_m2"
         }
-        Kind::Drive => "none: a drive is a fraction of full opening (scale 0.1 maps ±10 V)",
+        Kind::Drive => "a drive is a fraction of full opening (scale 0.1 maps ±10 V)",
         Kind::Pressure => "pressure (Pa, kPa, MPa, bar, psi)",
     }
 }

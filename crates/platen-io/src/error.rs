@@ -69,6 +69,45 @@ pub enum IoError {
         available: Vec<String>,
     },
 
+    /// A required platen column is not in the header and no column map names it: the
+    /// message says how a column map (`--columns MAP.json`, a scenario's
+    /// `excitation.columns`) maps the file's own header to it.
+    #[error(
+        "`{}`, line 1: missing required column `{column}` (the header has: {}); a file that \
+         names it otherwise or records it in other units needs a column map \
+         (`--columns MAP.json`, or a scenario's `excitation.columns`), e.g. {example}",
+        path.display(),
+        format_names(available)
+    )]
+    UnmappedColumn {
+        /// CSV file.
+        path: PathBuf,
+        /// platen's name of the missing column.
+        column: String,
+        /// Column names found in the header (trimmed), in file order.
+        available: Vec<String>,
+        /// A one-line column map that would read it, with the file's first header.
+        example: String,
+    },
+
+    /// A column map reads a column from a header the file does not have.
+    #[error(
+        "`{}`, line 1: the column map reads `{column}` from {header}, which the file does not \
+         have (the header has: {})",
+        path.display(),
+        format_names(available)
+    )]
+    MappedColumnMissing {
+        /// CSV file.
+        path: PathBuf,
+        /// platen's name of the column.
+        column: String,
+        /// The header the map names, and where it names it.
+        header: String,
+        /// Column names found in the header (trimmed), in file order.
+        available: Vec<String>,
+    },
+
     /// A selected column name appears more than once in the header.
     #[error(
         "`{}`, line 1: column `{column}` appears more than once in the header \
@@ -323,6 +362,8 @@ impl IoError {
             | IoError::OutputFolderMissing { path, .. }
             | IoError::CsvSyntax { path, .. }
             | IoError::MissingColumn { path, .. }
+            | IoError::UnmappedColumn { path, .. }
+            | IoError::MappedColumnMissing { path, .. }
             | IoError::DuplicateColumn { path, .. }
             | IoError::NonNumeric { path, .. }
             | IoError::NonFinite { path, .. }
@@ -361,6 +402,8 @@ impl IoError {
     pub fn field(&self) -> Option<&str> {
         match self {
             IoError::MissingColumn { column, .. }
+            | IoError::UnmappedColumn { column, .. }
+            | IoError::MappedColumnMissing { column, .. }
             | IoError::DuplicateColumn { column, .. }
             | IoError::NonNumeric { column, .. }
             | IoError::NonFinite { column, .. }
