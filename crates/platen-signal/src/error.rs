@@ -61,6 +61,20 @@ pub enum SignalError {
         /// The smallest length that works.
         min: usize,
     },
+    /// Two channels share too little coherent content for a delay estimate
+    /// ([`crate::DelayEstimator`]).
+    #[error(
+        "only {bins} frequency bins have a coherence of at least {min_coherence}: a delay \
+         estimate needs {min_bins} (the channels do not hold the same motion, or it is too small)"
+    )]
+    Incoherent {
+        /// Coherent bins found.
+        bins: usize,
+        /// Bins needed.
+        min_bins: usize,
+        /// The coherence a bin needs.
+        min_coherence: f64,
+    },
 }
 
 /// Result alias of this crate.

@@ -40,6 +40,9 @@
 //! * [`differentiate`], [`cumulative_trapezoid`], [`MotionIntegrator`] (acceleration →
 //!   velocity → displacement with a [`Baseline`] correction), [`remove_polynomial`].
 //! * [`CrossoverVelocity`]: velocity from displacement and acceleration (paper §1.5, ref. \[14\]).
+//! * [`DelayEstimator`]: a channel's skew (delay) against a reference, to a fraction of a
+//!   sample with its standard error; [`advance`] shifts a channel by a non-integer number of
+//!   samples to remove it.
 //! * [`Resampler`]: band-limited change of sample rate.
 //! * [`AccelerogramMotion`]: the table motion of a ground-acceleration record as PEER
 //!   integrates it (straight lines between samples, exact integrals), with a [`Baseline`].
@@ -82,6 +85,7 @@ mod accelerogram;
 mod butterworth;
 mod calculus;
 mod crossover;
+mod delay;
 mod error;
 mod extend;
 mod fir;
@@ -99,6 +103,10 @@ pub use calculus::{
     MotionIntegrator, MAX_BASELINE_ORDER,
 };
 pub use crossover::{CrossoverVelocity, DEFAULT_CROSSOVER_HZ};
+pub use delay::{
+    advance, DelayEstimate, DelayEstimator, MAX_LAG_S, MAX_RELATIVE_FREQUENCY, MIN_BINS,
+    MIN_COHERENCE, MIN_DELAY_SAMPLES, SEGMENT_S,
+};
 pub use error::{Result, SignalError};
 pub use fir::{FirLowpass, MAX_FIR_ORDER};
 pub use resample::{Interpolation, Resampler};
