@@ -167,17 +167,14 @@ struct Input {
     generated_seed: Option<u64>,
 }
 
-/// Checks a `--pressure-mpa` value: finite and ≥ 0.
+/// Checks a `--pressure-mpa` value: finite, ≥ 0 and at most 100 MPa (a larger one is a
+/// pressure in another unit: [`platen_scenario::units::check_pressure_mpa`]).
 pub fn parse_pressure_mpa(s: &str) -> Result<f64, String> {
     let p: f64 = s
         .trim()
         .parse()
         .map_err(|_| format!("`{s}` is not a number"))?;
-    if p.is_finite() && p >= 0.0 {
-        Ok(p)
-    } else {
-        Err(format!("{p}: expected a pressure >= 0 MPa"))
-    }
+    platen_scenario::units::check_pressure_mpa(p)
 }
 
 /// Checks a `--viscous-exponent` value: in [0, 1].

@@ -42,14 +42,10 @@ pub fn parse_scale(s: &str) -> std::result::Result<f64, String> {
     parse_number(s)
 }
 
-/// `--pressure-mpa`: a finite pressure `>= 0`, MPa.
+/// `--pressure-mpa`: a finite pressure `>= 0`, MPa, at most 100 MPa (a larger one is a
+/// pressure in another unit: [`platen_scenario::units::check_pressure_mpa`]).
 pub fn parse_pressure_mpa(s: &str) -> std::result::Result<f64, String> {
-    let p = parse_number(s)?;
-    if p >= 0.0 {
-        Ok(p)
-    } else {
-        Err(format!("{p} MPa: expected a pressure >= 0"))
-    }
+    platen_scenario::units::check_pressure_mpa(parse_number(s)?)
 }
 
 /// `--set`: `identified.KEY=V1,V2,…` or `full.KEY=V1,V2,…` with a key the form has.

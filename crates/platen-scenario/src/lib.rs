@@ -28,6 +28,7 @@ pub mod scenario;
 mod summary;
 pub mod sweep;
 pub mod system;
+pub mod units;
 
 pub use arrays::Arrays;
 pub use describe::describe_model;

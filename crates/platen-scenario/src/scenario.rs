@@ -181,16 +181,26 @@ impl Scenario {
             )
         })?;
         let pressure_pa = match file.model.hold_down_pressure_mpa {
-            Some(p) if !(p.is_finite() && p >= 0.0) => {
-                return Err(ctx.invalid("model.hold_down_pressure_mpa", p, "a pressure >= 0 MPa"))
-            }
-            Some(p) => p * 1e6,
+            Some(p) => match crate::units::expected_pressure_mpa(p) {
+                Some(expected) => {
+                    return Err(ctx.invalid("model.hold_down_pressure_mpa", p, expected))
+                }
+                None => p * 1e6,
+            },
             None => preset.nominal_pressure_pa(),
         };
         let overrides = model_overrides(&ctx, &file.model)?;
         let model = build_model(&ctx, preset, pressure_pa, &overrides)?;
         let limits = table_limits(&ctx, preset, file.limits.as_ref())?;
         let (run, derived) = run(&ctx, file)?;
+        if let (Some(rel), Run::Inverse { motion }) = (&file.excitation.motion_csv, &run) {
+            crate::units::check_displacement_record(
+                &ctx.resolve(rel),
+                motion.t_s(),
+                motion.u_m(),
+                limits.stroke_m,
+            )?;
+        }
         let specimen = build_specimen(&ctx, file.specimen.as_ref(), &run)?;
         let closed_loop = match &file.table_system {
             None => None,

@@ -7,7 +7,7 @@ use std::path::Path;
 use serde::Serialize;
 
 use platen_integrate::{Exceedance, ForwardIntegrator, Peaks, RunStats, Trajectory};
-use platen_model::TableLimits;
+use platen_model::{PlatenModel, TableLimits};
 
 use crate::error::Result;
 use crate::scenario::{Derived, Run, Scenario};
@@ -345,6 +345,86 @@ impl RunSummary {
             }),
         }
         .with_loop(scenario, output)
+        .with_stuck_platen(scenario)
+    }
+}
+
+/// A force in kN, three decimals (a newton's resolution).
+fn kn(force_n: f64) -> String {
+    format!("{:.3} kN", force_n / 1e3)
+}
+
+impl RunSummary {
+    /// The summary with a warning for a forward run whose force never overcomes the static
+    /// friction at the initial displacement (`|F_A − F_E(u₀)| ≤ F_s(u₀)` throughout, from
+    /// rest), so the platen never moves: most likely a force in the wrong unit (kN read as N).
+    /// The run's own output is checked too: a platen that never left stick is reported even
+    /// where the force alone does not explain it.
+    fn with_stuck_platen(mut self, scenario: &Scenario) -> Self {
+        let Run::Forward {
+            record,
+            initial,
+            samples,
+            ..
+        } = &scenario.run
+        else {
+            return self;
+        };
+        if initial.v_m_s != 0.0 || self.forward.is_none() {
+            return self;
+        }
+        let never_moved = self.peak_v_m_s == 0.0;
+        let u0 = initial.u_m;
+        let (elastic_n, static_n) = match &scenario.model {
+            crate::Model::Identified(m) => (m.elastic_force_n(u0), m.static_threshold_n(u0)),
+            crate::Model::Full(m) => (m.elastic_force_n(u0), m.static_threshold_n(u0)),
+        };
+        let n = (*samples).min(record.len());
+        let (t, f) = (&record.t_s()[..n], &record.force_n()[..n]);
+        // The first sample of the largest magnitude.
+        let Some(i) = (0..n).reduce(|a, b| if f[b].abs() > f[a].abs() { b } else { a }) else {
+            return self;
+        };
+        let net_peak = f.iter().map(|x| (x - elastic_n).abs()).fold(0.0, f64::max);
+        let breakaway = if elastic_n == 0.0 {
+            format!(
+                "the breakaway force {} (the static friction F_s at v = 0)",
+                kn(static_n)
+            )
+        } else {
+            format!(
+                "the breakaway forces {} and {} (the elastic force F_E(u0) = {} at the initial \
+                 displacement {u0} m, ∓ the static friction F_s = {} at v = 0)",
+                kn(elastic_n - static_n),
+                kn(elastic_n + static_n),
+                kn(elastic_n),
+                kn(static_n)
+            )
+        };
+        if net_peak <= static_n {
+            self.warnings.push(format!(
+                "the force never reaches {breakaway}: its peak |force| is {} at {} s, so the \
+                 platen never leaves stick{}. A force given in kN where N is expected? (In N, \
+                 ×1000, it would peak at {}.) Map its unit with \
+                 \"columns\": {{\"force_n\": {{\"unit\": \"kN\"}}}}",
+                kn(f[i].abs()),
+                t[i],
+                if never_moved {
+                    " (the run confirms it: the velocity stayed 0)"
+                } else {
+                    ""
+                },
+                kn(f[i].abs() * 1e3),
+            ));
+        } else if never_moved {
+            self.warnings.push(format!(
+                "the platen never left stick: the velocity stayed 0 over the whole run (peak \
+                 |force| {} at {} s against {breakaway})",
+                kn(f[i].abs()),
+                t[i]
+            ));
+        }
+        self
     }
 }
 

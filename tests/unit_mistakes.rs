@@ -1,0 +1,278 @@
+//! Inputs whose magnitude betrays a unit mistake, through the built binary: a force record in
+//! kN read as N (runs, with a warning naming the peak and the breakaway force), a pressure in
+//! Pa where MPa is asked (refused), a displacement record far beyond the stroke (refused).
+//!
+//! The breakaway force is computed here from the paper's identified values, not by the code
+//! under test: `F_s = F_μ + a = 0.44 % × 5783 kN + 12.04 kN = 37.4852 kN` at 13.8 MPa
+//! (Eq. 22/23: the dissipative force at v → 0⁺ is `F_μ + a`).
+
+use std::path::{Path, PathBuf};
+
+mod common;
+use common::{platen, stderr};
+
+/// The paper's breakaway force of the LHPOST at 13.8 MPa, N.
+const PAPER_BREAKAWAY_N: f64 = 0.0044 * 5783e3 + 12.04e3;
+
+/// Writes `text` to `dir/name` and returns the path as a string.
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path.display().to_string()
+}
+
+/// A force record: `amplitude` × sin(2π·0.5 Hz·t) over 4 s at 100 Hz, under the header `F`.
+fn sine_force_csv(amplitude: f64) -> String {
+    let mut text = String::from("t_s,F\n");
+    for i in 0..=400 {
+        let t = i as f64 * 0.01;
+        let f = amplitude * (std::f64::consts::PI * t).sin();
+        text.push_str(&format!("{t},{f}\n"));
+    }
+    text
+}
+
+/// A number printed as `… {value} kN` right after `prefix` in `text`, in N.
+fn kn_after(text: &str, prefix: &str) -> f64 {
+    let rest = &text[text
+        .find(prefix)
+        .unwrap_or_else(|| panic!("{prefix:?} in {text}"))
+        + prefix.len()..];
+    let number = rest.split(" kN").next().unwrap();
+    number.trim().parse::<f64>().unwrap() * 1e3
+}
+
+/// The first row of `csv` (header first) whose second column is largest in magnitude:
+/// `(line, time text, value)`, read from the text written, not from platen.
+fn first_peak(csv: &str) -> (usize, String, f64) {
+    let mut best = (0, String::new(), 0.0_f64);
+    for (k, line) in csv.lines().enumerate().skip(1) {
+        let (t, x) = line.split_once(',').unwrap();
+        let x: f64 = x.parse().unwrap();
+        if x.abs() > best.2.abs() {
+            best = (k + 1, t.to_owned(), x);
+        }
+    }
+    best
+}
+
+fn json(o: &std::process::Output) -> serde_json::Value {
+    serde_json::from_slice(&o.stdout)
+        .unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&o.stdout)))
+}
+
+#[test]
+fn a_force_in_kn_read_as_n_warns_with_the_peak_and_the_breakaway_force() {
+    let dir = tempfile::tempdir().unwrap();
+    // 600 kN of a sine, written in kN, read as N: a 600 N peak.
+    let force = sine_force_csv(600.0);
+    write(dir.path(), "force.csv", &force);
+    let scenario = |unit: &str| {
+        format!(
+            r#"{{"model": {{"preset": "lhpost-2008"}},
+                 "excitation": {{"force_csv": "force.csv",
+                                 "columns": {{"force_n": {{"name": "F", "unit": "{unit}"}}}}}}}}"#
+        )
+    };
+    let sc = write(dir.path(), "n.json", &scenario("N"));
+    let out = dir.path().join("out.csv");
+    let o = platen(&["simulate", &sc, "--json", "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(err.contains("warning: the force never reaches"), "{err}");
+    let summary = json(&o);
+    let warnings = summary["warnings"].as_array().expect("a warnings list");
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    let w = warnings[0].as_str().unwrap();
+    assert!(err.contains(w), "stderr lacks the summary's warning: {err}");
+    // The breakaway force, printed to 1 N (three decimals of kN): the paper's within 0.5 N
+    // of printing, and 1 N of rounding in the preset's 0.44 % × 5783 kN.
+    let breakaway = kn_after(w, "the breakaway force ");
+    assert!(
+        (breakaway - PAPER_BREAKAWAY_N).abs() <= 1.0,
+        "breakaway {breakaway} N, paper {PAPER_BREAKAWAY_N} N: {w}"
+    );
+    // The peak: 600 N (sin(π/2), to the printed 1 N), at the first sample that reaches it.
+    let peak = kn_after(w, "its peak |force| is ");
+    assert!((peak - 600.0).abs() <= 0.5, "{w}");
+    let (_, t_peak, _) = first_peak(&force);
+    assert!(
+        w.contains(&format!("is 0.600 kN at {t_peak} s,")),
+        "{t_peak}: {w}"
+    );
+    assert!(w.contains("kN where N is expected"), "{w}");
+    assert!(w.contains("the run confirms it"), "{w}");
+    // The run's own output: the platen never moved (u and v stay exactly 0 in every row).
+    let text = std::fs::read_to_string(&out).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let (iu, iv) = (
+        header.iter().position(|c| *c == "u_m").unwrap(),
+        header.iter().position(|c| *c == "v_m_s").unwrap(),
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|c| c.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 401);
+    assert!(rows.iter().all(|r| r[iu] == 0.0 && r[iv] == 0.0));
+    // Stuck for the whole 4 s (a sum of 400 steps: 1e-9 s of rounding).
+    let stuck = summary["stick_time_s"].as_f64().unwrap();
+    assert!((stuck - 4.0).abs() < 1e-9, "{stuck}");
+
+    // The same file mapped in kN moves the platen (600 kN ≫ 37.5 kN): no warning.
+    let sc = write(dir.path(), "kn.json", &scenario("kN"));
+    let o = platen(&["simulate", &sc, "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(json(&o).get("warnings").is_none(), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
+}
+
+#[test]
+fn a_force_below_breakaway_at_a_displaced_start_names_both_breakaway_forces() {
+    let dir = tempfile::tempdir().unwrap();
+    // Starting at u0 = 0.1 m the springs pull with Kₑ·u0 = 126.6 kN (Kₑ = 1.266 MN/m): a
+    // constant 126.6 kN holds the platen, and so does anything within F_s = 37.485 kN of it.
+    let mut text = String::from("t_s,force_n\n");
+    for i in 0..=200 {
+        let t = i as f64 * 0.01;
+        let f = 126.6e3 + 30e3 * (std::f64::consts::PI * t).sin();
+        text.push_str(&format!("{t},{f}\n"));
+    }
+    write(dir.path(), "force.csv", &text);
+    let sc = write(
+        dir.path(),
+        "s.json",
+        r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"force_csv": "force.csv"},
+            "initial": {"u_m": 0.1, "v_m_s": 0.0}}"#,
+    );
+    let o = platen(&["simulate", &sc, "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let summary = json(&o);
+    let w = summary["warnings"][0].as_str().unwrap().to_owned();
+    let elastic = 1.266e6 * 0.1;
+    let low = kn_after(&w, "the breakaway forces ");
+    let high = kn_after(&w, &format!("{:.3} kN and ", low / 1e3));
+    assert!((low - (elastic - PAPER_BREAKAWAY_N)).abs() <= 1.0, "{w}");
+    assert!((high - (elastic + PAPER_BREAKAWAY_N)).abs() <= 1.0, "{w}");
+    assert_eq!(summary["peak_v_m_s"], 0.0);
+}
+
+#[test]
+fn a_pressure_in_pa_where_mpa_is_asked_is_refused_and_nothing_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let sr9 = root.join("scenarios/sr9-like-sine-force.json");
+    let cases = dir.path().join("cases.csv");
+    let report = dir.path().join("report.html");
+    let record = write(dir.path(), "rec.csv", "t_s,u_m,a_m_s2,force_n\n0,0,0,0\n");
+    for args in [
+        vec![
+            "sweep",
+            sr9.to_str().unwrap(),
+            "--pressure-mpa",
+            "13.8e6",
+            "--out",
+            cases.to_str().unwrap(),
+        ],
+        vec![
+            "identify",
+            &record,
+            "--pressure-mpa",
+            "13.8e6",
+            "--json",
+            "--report",
+            report.to_str().unwrap(),
+        ],
+    ] {
+        let o = platen(&args);
+        assert!(!o.status.success(), "{args:?}");
+        let err = stderr(&o);
+        assert!(err.contains("--pressure-mpa"), "{err}");
+        assert!(err.contains("MPa is expected"), "{err}");
+        assert!(err.contains("13.8e6 looks like Pa (13.8 MPa)"), "{err}");
+        assert!(o.stdout.is_empty(), "{args:?}");
+    }
+    assert!(!cases.exists() && !report.exists());
+    // In a scenario: refused with its JSON path, before anything runs or is written.
+    let text = std::fs::read_to_string(&sr9).unwrap().replace(
+        "\"hold_down_pressure_mpa\": 13.8",
+        "\"hold_down_pressure_mpa\": 13.8e6",
+    );
+    assert!(
+        text.contains("13.8e6"),
+        "the shipped scenario changed: {text}"
+    );
+    let sc = write(dir.path(), "p.json", &text);
+    let out = dir.path().join("out.csv");
+    let o = platen(&["simulate", &sc, "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(err.contains("model.hold_down_pressure_mpa"), "{err}");
+    assert!(err.contains("13.8e6 looks like Pa (13.8 MPa)"), "{err}");
+    assert!(!out.exists());
+    // 13.8 itself runs.
+    assert!(platen(&[
+        "sweep",
+        sr9.to_str().unwrap(),
+        "--pressure-mpa",
+        "13.8",
+        "--json"
+    ])
+    .status
+    .success());
+}
+
+/// A displacement sine of `amplitude_m` at 0.5 Hz over 2 s at 100 Hz.
+fn sine_motion_csv(amplitude_m: f64) -> String {
+    let mut text = String::from("t_s,u_m\n");
+    for i in 0..=200 {
+        let t = i as f64 * 0.01;
+        text.push_str(&format!(
+            "{t},{}\n",
+            amplitude_m * (std::f64::consts::PI * t).sin()
+        ));
+    }
+    text
+}
+
+#[test]
+fn a_displacement_record_a_hundred_strokes_long_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    // The LHPOST's stroke is ±0.75 m: 75 m is 100 strokes (a 75 mm record read as m would be
+    // 75 m too).
+    let far = sine_motion_csv(75.0);
+    write(dir.path(), "far.csv", &far);
+    let sc = write(
+        dir.path(),
+        "far.json",
+        r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"motion_csv": "far.csv"}}"#,
+    );
+    let out = dir.path().join("out.csv");
+    let o = platen(&["simulate", &sc, "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    let err = stderr(&o);
+    // The first sample of the largest |u| (75 m to rounding, near t = 0.5 s or 1.5 s).
+    let (line, t_peak, peak) = first_peak(&far);
+    assert!((peak.abs() - 75.0).abs() < 1e-9 && (line == 52 || line == 152));
+    for part in [
+        "far.csv",
+        &format!("line {line}, column u_m"),
+        &format!("reaches {peak} m at {t_peak} s"),
+        "100 times the table's stroke of ±0.75 m",
+        "mm read as m",
+        r#""u_m": {"unit": "mm"}"#,
+    ] {
+        assert!(err.contains(part), "{part:?} not in {err}");
+    }
+    assert!(!out.exists() && o.stdout.is_empty());
+    // Five strokes still run, the limit reported as exceeded (what would the table need).
+    write(dir.path(), "near.csv", &sine_motion_csv(3.75));
+    let sc = write(
+        dir.path(),
+        "near.json",
+        r#"{"model": {"preset": "lhpost-2008"}, "excitation": {"motion_csv": "near.csv"}}"#,
+    );
+    let o = platen(&["simulate", &sc, "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(json(&o)["limits"]["stroke_m"]["respected"], false);
+}
