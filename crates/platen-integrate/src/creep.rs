@@ -39,7 +39,7 @@
 
 use platen_model::PlatenModel;
 
-use crate::event::Direction;
+use crate::event::{just_past, Direction};
 use crate::run::Kin;
 
 /// Sub-steps of the reduced creep equation per span. `w_qs(t)` is smooth inside a span (the
@@ -50,6 +50,11 @@ const CREEP_SUBSTEPS: u32 = 2;
 /// and Illinois iterations inside that binade.
 const LOG_BISECTIONS: u32 = 12;
 const ROOT_ITERATIONS: u32 = 60;
+
+/// A pass of [`creep`] that ends this close to where it started (s) has not moved time in the
+/// callers' units (a fraction of a step, or seconds into a sample interval): it is stepped
+/// just past instead ([`just_past`], whose first increment is `4ε` s).
+const MIN_PROGRESS_S: f64 = 4.0 * f64::EPSILON;
 
 /// The lowest speed considered, m/s: below it the platen does not move in any double-precision
 /// sense over any time a record can last (1e-300 m/s × 1e9 s).
@@ -163,6 +168,10 @@ pub(crate) enum CreepEnd {
     Stops,
     /// The creep speed reached the stiff speed: slip resumes with the state's velocity.
     Slips,
+    /// `s·N` fell below `−F_s`: the platen is at rest (`v = 0`) with the net force beyond the
+    /// threshold against the motion, so it leaves rest the other way (a reversal). Without
+    /// static friction (`F_s = 0`) this is how creep passes through `v = 0`.
+    Reverses,
 }
 
 /// The result of [`creep`]: where it ended, in seconds from the start of the span, and the
@@ -206,6 +215,7 @@ pub(crate) fn creep<M: PlatenModel>(
     // At most a few passes: the first solves the end time at the start's displacement, the
     // next ones correct it for the creep displacement (which only moves a stop later).
     for _ in 0..4 {
+        let x_pass = run.at_s;
         let u = run.y.u;
         let elastic = model.elastic_force_n(u);
         let drive = |x: f64| s * (force(x) - elastic);
@@ -237,16 +247,36 @@ pub(crate) fn creep<M: PlatenModel>(
         run.at_s = x_end;
         match end {
             CreepEnd::Stops => {
-                let net = force(x_end) - model.elastic_force_n(run.y.u);
-                if net.abs() <= model.static_threshold_n(run.y.u) {
+                let u_end = run.y.u;
+                let net = force(x_end) - model.elastic_force_n(u_end);
+                let threshold_end = model.static_threshold_n(u_end);
+                if net.abs() <= threshold_end {
                     run.y.v = 0.0;
                     run.end = CreepEnd::Stops;
+                    return run;
+                }
+                if s * net < -threshold_end {
+                    // The net force is beyond the threshold against the motion: the platen
+                    // passed through rest (with no static friction, `F_s = 0`, the stop level
+                    // is `N = 0`, and rounding puts `N` on either side of it).
+                    run.y.v = 0.0;
+                    run.end = CreepEnd::Reverses;
                     return run;
                 }
                 // Rounding left |N| above the threshold at the new displacement: solve again
                 // from here (the stop can only be later).
                 if x_end >= span_s {
                     break;
+                }
+                if x_end - x_pass <= MIN_PROGRESS_S {
+                    // The crossing rounded onto the start of the pass, where the drive is a
+                    // hair above the stop level: step just past it, where it is not, so
+                    // every pass moves time forward by more than the callers' rounding.
+                    let elastic = model.elastic_force_n(u_end);
+                    let next =
+                        just_past(x_end, span_s, |x| s * (force(x) - elastic) <= threshold_end);
+                    run.y = advance(model, dir, run.y, run.at_s, next, &force, w_stiff, &mut run);
+                    run.at_s = next;
                 }
             }
             CreepEnd::Slips => {
@@ -257,7 +287,7 @@ pub(crate) fn creep<M: PlatenModel>(
                 run.end = CreepEnd::Slips;
                 return run;
             }
-            CreepEnd::Continues => break,
+            CreepEnd::Continues | CreepEnd::Reverses => break,
         }
     }
     // Still creeping at `at_s`: the end of the span, or (if rounding kept the stop test from

@@ -283,8 +283,9 @@ impl<M: PlatenModel> AdaptiveRun<'_, M> {
         };
         let elastic = self.model.elastic_force_n(self.y.u);
         let threshold = self.model.static_threshold_n(self.y.u);
+        let sign = b.direction.sign();
         let xb = just_past(x + b.fraction * (dt - x), dt, |t| {
-            (f0 + slope * t - elastic).abs() > threshold
+            sign * (f0 + slope * t - elastic) > threshold
         });
         self.stats.stick_time_s += xb - x;
         self.stats.record(EventKind::Breakaway);
@@ -339,6 +340,25 @@ impl<M: PlatenModel> AdaptiveRun<'_, M> {
             CreepEnd::Slips => {
                 self.mode = Mode::Slip(dir);
                 StepStop::Moved { at }
+            }
+            CreepEnd::Reverses => {
+                // Leave rest the other way from where the net force, as this segment
+                // evaluates it, is beyond the threshold that way (creep's own time rounds).
+                let (u, sign) = (self.y.u, dir.opposite().sign());
+                let (elastic, threshold) = (
+                    self.model.elastic_force_n(u),
+                    self.model.static_threshold_n(u),
+                );
+                let at = just_past(at, dt, |t| sign * (f0 + slope * t - elastic) > threshold);
+                let (mode, kind) = arrive_at_rest(self.model, u, f0 + slope * at, dir);
+                self.enter(mode, dt);
+                match kind {
+                    Some(kind) => {
+                        self.stats.record(kind);
+                        StepStop::Event { at, kind }
+                    }
+                    None => StepStop::Moved { at },
+                }
             }
         })
     }

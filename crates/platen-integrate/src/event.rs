@@ -85,6 +85,15 @@ impl Direction {
         }
     }
 
+    /// The other direction.
+    #[inline(always)]
+    pub(crate) fn opposite(self) -> Self {
+        match self {
+            Direction::Positive => Direction::Negative,
+            Direction::Negative => Direction::Positive,
+        }
+    }
+
     /// `+1.0` or `−1.0`.
     #[inline(always)]
     pub(crate) fn sign(self) -> f64 {

@@ -444,8 +444,9 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
             self.model.elastic_force_n(self.y.u),
             self.model.static_threshold_n(self.y.u),
         );
+        let sign = b.direction.sign();
         let tau_b = just_past(tau + b.fraction * (1.0 - tau), 1.0, |t| {
-            (self.grid.force(n, t) - elastic).abs() > threshold
+            sign * (self.grid.force(n, t) - elastic) > threshold
         });
         self.stats.stick_time_s += (tau_b - tau) * h;
         self.stats.record(EventKind::Breakaway);
@@ -498,6 +499,29 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
                 let f = self.grid.force(n, at);
                 self.enter(Mode::Slip(dir), f);
                 StepStop::Moved { at }
+            }
+            CreepEnd::Reverses => {
+                // Leave rest the other way from where the net force, as this step's grid
+                // evaluates it, is beyond the threshold that way (creep's own time rounds).
+                let back = dir.opposite();
+                let (u, sign) = (self.y.u, back.sign());
+                let (elastic, threshold) = (
+                    self.model.elastic_force_n(u),
+                    self.model.static_threshold_n(u),
+                );
+                let at = just_past(at, 1.0, |t| {
+                    sign * (self.grid.force(n, t) - elastic) > threshold
+                });
+                let f = self.grid.force(n, at);
+                let (mode, kind) = arrive_at_rest(self.model, u, f, dir);
+                self.enter(mode, f);
+                match kind {
+                    Some(kind) => {
+                        self.stats.record(kind);
+                        StepStop::Event { at, kind }
+                    }
+                    None => StepStop::Moved { at },
+                }
             }
         })
     }
