@@ -30,7 +30,11 @@
 //! * in a **stop**, where `s·N` falls to `F_s(u)` (then `w_qs = 0` and friction holds: `|N| ≤
 //!   F_s` is checked at the state reached, never assumed), or
 //! * in **slip**, where `w_qs` reaches `w_*`, with `v = s·w_qs` (the two descriptions agree
-//!   there to the bound above).
+//!   there to the bound above), or
+//! * in a **reversal**, where the net force at the stop is beyond the threshold against the
+//!   motion: without static friction (`F_s = 0`) the stop level is `N = 0` and the platen
+//!   creeps through `v = 0` into the other direction. A pass whose end rounds onto its start
+//!   is moved [`just_past`] it, so a creep never stalls in place.
 //!
 //! Both times are solved exactly for the force, which is linear inside the span, at the
 //! displacement of the start of the span, then corrected for the (sub-nanometre) creep
