@@ -89,6 +89,10 @@ pub fn run(options: &Options<'_>) -> Result<()> {
         |figures, rendered| html::compare_page(&comparison, figures, rendered),
     )?;
     if options.json {
+        // The text summary lists them; with --json they also go to stderr, as simulate's.
+        for warning in comparison.warnings() {
+            eprintln!("warning: {warning}");
+        }
         let summary = comparison.summary(&written, options.report);
         let summary = serde_json::to_value(&summary)?;
         outln!("{}", serde_json::to_string_pretty(&summary)?);

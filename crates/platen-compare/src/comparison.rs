@@ -13,7 +13,7 @@ use platen_signal::metrics::{interpolate_linear, ChannelMetrics, Comparator};
 use platen_signal::{differentiate, CrossoverVelocity, SampleRate, DEFAULT_CROSSOVER_HZ};
 
 use crate::error::{CompareError, Result};
-use crate::{Channel, Direction, Recording, Settings, Window};
+use crate::{Channel, Direction, RecordedLimitCheck, Recording, Settings, Window};
 
 /// One compared channel on the recorded time base.
 #[derive(Debug)]
@@ -88,7 +88,8 @@ pub struct Comparison {
     pub simulated_span_s: (f64, f64),
     /// The record's span, s.
     pub recorded_span_s: (f64, f64),
-    /// The metrics window, if any.
+    /// The metrics window, if any, clamped to the compared span (a bound given within half a
+    /// sample interval outside it is the span's end).
     pub window: Option<Window>,
     /// The lag search bound, s.
     pub max_lag_s: f64,
@@ -109,6 +110,10 @@ pub struct Comparison {
     pub law: Vec<(f64, f64)>,
     /// How the law is labelled.
     pub law_label: String,
+    /// The recording itself against the table's limits (the scenario's preset's with its
+    /// `limits` laid over), over the whole record: one check per limit whose column the file
+    /// has, in [`TableLimit::ALL`](crate::TableLimit::ALL) order.
+    pub recorded_limits: Vec<RecordedLimitCheck>,
 }
 
 impl Comparison {
@@ -152,7 +157,12 @@ impl Comparison {
     ) -> Result<Self> {
         let direction = Direction::of(scenario);
         let sim_span = scenario.run.time_span_s();
-        let range = recording.compared_range(scenario_path, sim_span, settings.window)?;
+        let settings_window_given = settings.window;
+        let (range, window) = recording.compared_range(scenario_path, sim_span, settings.window)?;
+        let settings = &Settings {
+            window,
+            ..*settings
+        };
         let specimen_channels = recording.specimen_channels(scenario.storeys())?;
         let sim = simulate(scenario, scenario_path)?;
         debug_assert_eq!((sim.t_s[0], sim.t_s[sim.len() - 1]), sim_span);
@@ -160,6 +170,22 @@ impl Comparison {
         let simulated = aligned(&sim, &t_s)?;
         let rate = SampleRate::new(1.0 / recording.step_s).map_err(CompareError::SampleRate)?;
         let mut recorded = recorded_quantities(&recording, &range, direction, &simulated, rate)?;
+        if let (Some(given), Some(used)) = (settings_window_given, window) {
+            if given != used {
+                recorded.sources.notes.push(format!(
+                    "--window {},{} s reaches past the compared span {} s to {} s by less than \
+                     half a sample interval ({} s): the metrics window is {},{} s.",
+                    given.start_s,
+                    given.end_s,
+                    t_s[0],
+                    t_s[t_s.len() - 1],
+                    0.5 * recording.step_s,
+                    used.start_s,
+                    used.end_s
+                ));
+            }
+        }
+        let recorded_limits = RecordedLimitCheck::of_recording(&recording, &scenario.limits);
         let mut series: Vec<(Channel, Vec<f64>, Vec<f64>)> = direction
             .channels()
             .iter()
@@ -252,6 +278,7 @@ impl Comparison {
             recorded_dissipative_n,
             law,
             law_label,
+            recorded_limits,
         })
     }
 

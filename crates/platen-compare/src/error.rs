@@ -66,7 +66,8 @@ pub enum CompareError {
     /// The metrics window is not inside the compared span.
     #[error(
         "--window {},{} s is not inside the compared span {} s to {} s (the recorded samples \
-         of `{}` within the scenario's span)",
+         of `{}` within the scenario's span; a bound within half its sample interval, \
+         {tolerance_s} s, outside the span is taken as the span's end)",
         window_s[0],
         window_s[1],
         compared_span_s.0,
@@ -80,6 +81,8 @@ pub enum CompareError {
         compared_span_s: (f64, f64),
         /// Recorded file.
         recorded: PathBuf,
+        /// Half the recorded sample interval, s: how far outside the span a bound may lie.
+        tolerance_s: f64,
     },
 
     /// The run produced fewer than two samples.

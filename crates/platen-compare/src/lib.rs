@@ -15,7 +15,11 @@
 //!   linearly onto the recorded samples that lie within the simulated span (exactly, where
 //!   the time stamps coincide).
 //! * Metrics are those of [`platen_signal::metrics`], over the whole compared span or the
-//!   [`Settings::window`].
+//!   [`Settings::window`] (a bound within half a recorded sample interval outside the
+//!   compared span is taken as the span's end).
+//! * The recording itself is checked against the table's limits (the scenario's preset's,
+//!   with its `limits` laid over): each of `u_m`, `v_m_s`, `a_m_s2`, `force_n` the file has,
+//!   over the whole record ([`RecordedLimitCheck`], [`Comparison::recorded_limits`]).
 //!
 //! No figure is drawn here: `platen-report` draws them from a [`Comparison`].
 //!
@@ -55,6 +59,7 @@
 mod channel;
 mod comparison;
 mod error;
+mod limits;
 mod recording;
 mod settings;
 mod summary;
@@ -62,6 +67,7 @@ mod summary;
 pub use channel::{Channel, Direction};
 pub use comparison::{ComparedChannel, Comparison, Quantities, Sources};
 pub use error::{CompareError, Result};
+pub use limits::{RecordedLimitCheck, TableLimit};
 pub use recording::Recording;
 pub use settings::{Settings, Window};
 pub use summary::{ChannelSummary, Summary};

@@ -62,17 +62,20 @@ impl Recording {
     }
 
     /// The indices of the recorded samples inside `simulated_span_s` (within half a sample
-    /// interval), checked to cover that span and to hold `window`.
+    /// interval), checked to cover that span and to hold `window`, and the window clamped to
+    /// the compared span: a bound within half a sample interval outside the span (a start
+    /// just before the first compared stamp, an end just after the last) is taken as the
+    /// span's end.
     ///
     /// # Errors
     /// [`CompareError::RecordTooShort`], [`CompareError::TooFewRecordedSamples`],
-    /// [`CompareError::WindowOutside`].
+    /// [`CompareError::WindowOutside`] (a bound further out).
     pub(crate) fn compared_range(
         &self,
         scenario_path: &Path,
         simulated_span_s: (f64, f64),
         window: Option<Window>,
-    ) -> Result<Range<usize>> {
+    ) -> Result<(Range<usize>, Option<Window>)> {
         let (rec_span, sim_span) = (self.span_s(), simulated_span_s);
         let tol = 0.5 * self.step_s;
         if rec_span.0 > sim_span.0 + tol || rec_span.1 < sim_span.1 - tol {
@@ -94,16 +97,31 @@ impl Recording {
             });
         }
         let compared_span = (self.t_s[first], self.t_s[end - 1]);
-        if let Some(w) = window {
-            if w.start_s < compared_span.0 - tol || w.end_s > compared_span.1 + tol {
+        let window = match window {
+            Some(w) if w.start_s < compared_span.0 - tol || w.end_s > compared_span.1 + tol => {
                 return Err(CompareError::WindowOutside {
                     window_s: [w.start_s, w.end_s],
                     compared_span_s: compared_span,
                     recorded: self.path.clone(),
+                    tolerance_s: tol,
                 });
             }
-        }
-        Ok(first..end)
+            // Within the tolerance: clamped (a NaN bound is left for the metrics to refuse).
+            Some(w) => Some(Window {
+                start_s: if w.start_s < compared_span.0 {
+                    compared_span.0
+                } else {
+                    w.start_s
+                },
+                end_s: if w.end_s > compared_span.1 {
+                    compared_span.1
+                } else {
+                    w.end_s
+                },
+            }),
+            None => None,
+        };
+        Ok((first..end, window))
     }
 
     /// The column `key` on `range`, if the record has it.

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use platen_signal::metrics::ChannelMetrics;
 use serde::Serialize;
 
-use crate::{Channel, Comparison};
+use crate::{Channel, Comparison, RecordedLimitCheck};
 
 /// The metrics of one channel, as the summary reports them (SI unit of the channel).
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -98,8 +98,15 @@ pub struct Summary {
     /// The metrics of each channel, keyed by its name.
     #[serde(flatten)]
     pub metrics: BTreeMap<&'static str, ChannelSummary>,
-    /// Substitutions made for columns the record lacks.
+    /// Substitutions made for columns the record lacks, and how the window was taken.
     pub notes: Vec<String>,
+    /// The recording itself against the table's limits, keyed by the limit's name
+    /// (`stroke_m`, `velocity_m_s`, `acceleration_m_s2`, `force_n`): only the limits whose
+    /// column (`u_m`, `v_m_s`, `a_m_s2`, `force_n`) the file has.
+    pub recorded_limits: BTreeMap<&'static str, RecordedLimitCheck>,
+    /// One sentence per table limit the recording exceeds
+    /// ([`RecordedLimitCheck::warning`]).
+    pub warnings: Vec<String>,
     /// Figure files written.
     pub figures: Vec<String>,
     /// Report written.
@@ -107,6 +114,15 @@ pub struct Summary {
 }
 
 impl Comparison {
+    /// One sentence per table limit the recording exceeds, in
+    /// [`TableLimit::ALL`](crate::TableLimit::ALL) order.
+    pub fn warnings(&self) -> Vec<String> {
+        self.recorded_limits
+            .iter()
+            .filter_map(RecordedLimitCheck::warning)
+            .collect()
+    }
+
     /// The summary, listing the figure files and the report written.
     pub fn summary(&self, figures: &[PathBuf], report: Option<&Path>) -> Summary {
         let (first, last) = self.compared_span_s();
@@ -131,6 +147,12 @@ impl Comparison {
                 })
                 .collect(),
             notes: self.recorded.sources.notes.clone(),
+            recorded_limits: self
+                .recorded_limits
+                .iter()
+                .map(|c| (c.kind.key(), c.clone()))
+                .collect(),
+            warnings: self.warnings(),
             figures: figures.iter().map(|p| p.display().to_string()).collect(),
             report: report.map(|p| p.display().to_string()),
         }

@@ -11,7 +11,7 @@ use serde_json::Value;
 use platen_compare::{Comparison, Direction};
 
 use crate::figure::Figure;
-use crate::text::{display_row, DISPLAY_HEADINGS};
+use crate::text::{display_row, recorded_limit_row, DISPLAY_HEADINGS, RECORDED_LIMIT_HEADINGS};
 
 const STYLE: &str = "\
 body{font-family:system-ui,-apple-system,'Segoe UI',Roboto,Helvetica,Arial,sans-serif;\
@@ -162,7 +162,7 @@ pub fn compare_page(c: &Comparison, figures: &[Figure], rendered: &[(String, Str
         title: format!("platen compare: {}", c.name),
         heading: c.name.clone(),
         items: compare_items(c),
-        sections: vec![metrics_section(c)],
+        sections: vec![metrics_section(c), recorded_limits_section(c)],
         figures,
         rendered,
         summary,
@@ -204,6 +204,37 @@ fn compare_items(c: &Comparison) -> Vec<(String, String)> {
         ),
         ("lag search".into(), format!("±{} s", c.max_lag_s)),
     ]
+}
+
+/// The recording itself against the table's limits, and a warning per limit it exceeds
+/// (empty for a recording with none of the limited columns).
+fn recorded_limits_section(c: &Comparison) -> String {
+    if c.recorded_limits.is_empty() {
+        return String::new();
+    }
+    let mut headings = vec!["recorded column"];
+    headings.extend(RECORDED_LIMIT_HEADINGS);
+    let rows: Vec<Vec<String>> = c
+        .recorded_limits
+        .iter()
+        .map(|check| {
+            let mut row = vec![format!("{} (against {})", check.column, check.kind.key())];
+            row.extend(recorded_limit_row(check));
+            row
+        })
+        .collect();
+    let mut h = heading("The recording against the table's limits");
+    h.push_str(&table(&headings, &rows, true));
+    h.push_str(&paragraph(
+        "Each limit (the scenario's preset's, with its `limits` laid over) against the \
+         recording's own column over the whole record; a column the file lacks is not checked. \
+         Time beyond = recorded samples beyond the limit × the sample interval.",
+        None,
+    ));
+    for warning in c.warnings() {
+        h.push_str(&paragraph(&format!("warning: {warning}"), Some("note")));
+    }
+    h
 }
 
 /// The metrics table, how to read it, and the notes on substituted columns.

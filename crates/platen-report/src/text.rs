@@ -5,7 +5,9 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use platen_compare::{Channel, ComparedChannel, Comparison, Direction};
+use platen_compare::{
+    Channel, ComparedChannel, Comparison, Direction, RecordedLimitCheck, TableLimit,
+};
 
 /// How a channel is shown: its unit in figures and tables, and that of its residual.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -131,6 +133,55 @@ pub fn display_row(ch: &ComparedChannel) -> [String; 7] {
     ]
 }
 
+/// Column headings of [`recorded_limit_row`].
+pub const RECORDED_LIMIT_HEADINGS: [&str; 6] = [
+    "limit",
+    "recorded peak",
+    "of the limit",
+    "respected",
+    "first beyond",
+    "time beyond",
+];
+
+/// A value of `kind`'s unit as display text (4 significant digits, or as given for a
+/// limit): kN for the force, SI otherwise.
+fn limit_value(kind: TableLimit, x: f64, as_given: bool) -> String {
+    let (x, unit) = match kind {
+        TableLimit::Force => (x / 1e3, "kN"),
+        _ => (x, kind.unit()),
+    };
+    if as_given {
+        format!("{x} {unit}")
+    } else {
+        format!("{} {unit}", significant(x, 4))
+    }
+}
+
+/// A recorded limit check as display strings: the limit, the recorded peak and its time, the
+/// peak as a percentage of the limit, whether it is respected, the first time beyond it and
+/// the time spent beyond it.
+pub fn recorded_limit_row(c: &RecordedLimitCheck) -> [String; 6] {
+    let peak = limit_value(c.kind, c.peak, false);
+    let peak = if c.peak < 0.0 {
+        peak.replacen('-', "−", 1)
+    } else {
+        format!("+{peak}")
+    };
+    [
+        limit_value(c.kind, c.limit, true),
+        format!("{peak} at {:.3} s", c.peak_t_s),
+        format!("{:.1} %", 100.0 * c.peak.abs() / c.limit),
+        if c.respected { "yes" } else { "no" }.into(),
+        c.first_exceeded_s
+            .map_or_else(|| "–".into(), |t| format!("{t:.3} s")),
+        if c.respected {
+            "–".into()
+        } else {
+            format!("{} s", significant(c.time_exceeded_s, 4))
+        },
+    ]
+}
+
 /// The terminal summary of a comparison (what `platen compare` prints without `--json`),
 /// listing the figure files and the report written; every line ends with a newline.
 pub fn compare_summary(c: &Comparison, figures: &[PathBuf], report: Option<&Path>) -> String {
@@ -171,6 +222,28 @@ pub fn compare_summary(c: &Comparison, figures: &[PathBuf], report: Option<&Path
     );
     for note in &c.recorded.sources.notes {
         let _ = writeln!(s, "  note: {note}");
+    }
+    if !c.recorded_limits.is_empty() {
+        let _ = writeln!(
+            s,
+            "  the recording against the table's limits (its own columns, whole record):"
+        );
+        for check in &c.recorded_limits {
+            let [limit, peak, share, _, first, beyond] = recorded_limit_row(check);
+            let verdict = if check.respected {
+                "respected".to_string()
+            } else {
+                format!("BEYOND from {first}, {beyond} in all")
+            };
+            let _ = writeln!(
+                s,
+                "    {:<28}peak {peak}, {share} of {limit}: {verdict}",
+                format!("{} ({})", check.kind.key(), check.column),
+            );
+        }
+    }
+    for warning in c.warnings() {
+        let _ = writeln!(s, "  warning: {warning}");
     }
     if !figures.is_empty() {
         let _ = writeln!(s, "  wrote {} figure files (SVG and PNG):", figures.len());
