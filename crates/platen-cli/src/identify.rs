@@ -386,6 +386,30 @@ struct RecordJsonOutput {
 }
 
 /// The text report of the any-record method.
+/// A record's channel delays for its report line: estimated (± one standard error) or
+/// given, in ms and samples, and whether the channel was corrected.
+fn delay_text(delays: &[platen_ident::anyrecord::ChannelDelay], sample_rate_hz: f64) -> String {
+    let mut s = String::new();
+    for d in delays {
+        let _ = write!(
+            s,
+            ", {} delay {:.2}{} ms = {:.2} samples ({}; {})",
+            d.column,
+            1e3 * d.delay_s,
+            d.std_error_s
+                .map_or(String::new(), |se| format!(" ± {:.2}", 1e3 * se)),
+            d.delay_s * sample_rate_hz,
+            if d.estimated() { "estimated" } else { "given" },
+            match (d.applied, d.estimated()) {
+                (true, _) => "corrected",
+                (false, true) => "too small to correct: used as recorded",
+                (false, false) => "used as recorded",
+            }
+        );
+    }
+    s
+}
+
 fn record_report(id: &RecordIdentification, inputs: &[&Input]) -> String {
     let mut s = String::new();
     let ee = &id.equation_error;
@@ -408,7 +432,7 @@ fn record_report(id: &RecordIdentification, inputs: &[&Input]) -> String {
     for (r, (rec, input)) in id.records.iter().zip(inputs).enumerate() {
         let _ = writeln!(
             s,
-            "  {}: {} samples at {} Hz, velocity {}, {} fitted over {:.1}–{:.0} mm/s, force offset {}{}",
+            "  {}: {} samples at {} Hz, velocity {}, {} fitted over {:.1}–{:.0} mm/s, force offset {}{}{}",
             input.label,
             rec.samples,
             rec.sample_rate_hz,
@@ -422,7 +446,8 @@ fn record_report(id: &RecordIdentification, inputs: &[&Input]) -> String {
                 f.masses_kg.len(),
                 f.masses_kg.iter().sum::<f64>(),
                 f.peak_base_shear_n / 1e3
-            ))
+            )),
+            delay_text(&rec.channel_delays, rec.sample_rate_hz)
         );
     }
     correlation_lines(&mut s, "equation error", &u.correlations);
@@ -992,6 +1017,7 @@ fn read_record(input: &Input) -> Result<TestRecord> {
     let f = take(&mut table, "force_n");
     let v = table.take_column("v_m_s");
     let context = || format!("`{}`", path.display());
+    let has_v = v.is_some();
     let mut rec =
         TestRecord::from_rate(input.name.clone(), 1.0 / dt, u, a, f).with_context(context)?;
     if let Some(v) = v {
@@ -1016,6 +1042,12 @@ fn read_record(input: &Input) -> Result<TestRecord> {
             floors.push((f.mass_kg, acc));
         }
         rec = rec.with_floors(&floors).with_context(context)?;
+    }
+    // A column map's known channel skew (`delay_s`), applied by identification as given.
+    for column in platen_ident::anyrecord::DELAYABLE_CHANNELS {
+        if let Some(d) = input.columns.delay_s(column).filter(|_| column != "v_m_s" || has_v) {
+            rec = rec.with_channel_delay_s(column, d).with_context(context)?;
+        }
     }
     Ok(rec)
 }

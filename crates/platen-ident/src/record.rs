@@ -1,5 +1,7 @@
 //! One periodic test's recorded channels, with what is known about the test.
 
+use std::collections::BTreeMap;
+
 use crate::error::{IdentError, Result};
 
 /// The waveform of a periodic test.
@@ -42,7 +44,12 @@ pub struct TestRecord {
     pressure_pa: Option<f64>,
     kind: Option<TestKind>,
     floors: Option<Floors>,
+    channel_delays_s: BTreeMap<&'static str, f64>,
 }
+
+/// The channels whose delay against the displacement may be given
+/// ([`TestRecord::with_channel_delay_s`]).
+pub const DELAYABLE_CHANNELS: [&str; 3] = ["a_m_s2", "force_n", "v_m_s"];
 
 /// The specimen floors of a record whose base shear was removed from its force
 /// ([`TestRecord::with_floors`]).
@@ -137,6 +144,7 @@ impl TestRecord {
             pressure_pa: None,
             kind: None,
             floors: None,
+            channel_delays_s: BTreeMap::new(),
         })
     }
 
@@ -234,6 +242,63 @@ impl TestRecord {
         Ok(self)
     }
 
+    /// Declares a known delay of channel `column` (one of [`DELAYABLE_CHANNELS`]) against the
+    /// displacement `u_m`, s: positive when the data system sampled it late (its sample at
+    /// `t` holds the value at `t − delay_s`). The any-record method advances the channel by
+    /// it before fitting instead of estimating the delay (a delay of 0 declares the channel
+    /// on time and turns the estimate off); see [`crate::anyrecord::ChannelDelay`]. The
+    /// periodic method does not use it.
+    ///
+    /// # Errors
+    /// [`IdentError::InvalidRecord`] for another column, or a delay that is not finite or
+    /// reaches a quarter of the record.
+    pub fn with_channel_delay_s(mut self, column: &str, delay_s: f64) -> Result<Self> {
+        let invalid = |message: String| IdentError::InvalidRecord {
+            test: self.name.clone(),
+            message,
+        };
+        let Some(&col) = DELAYABLE_CHANNELS.iter().find(|&&c| c == column) else {
+            return Err(invalid(format!(
+                "a delay for `{column}`: expected one of {} (delays are against `u_m`)",
+                DELAYABLE_CHANNELS.join(", ")
+            )));
+        };
+        let quarter_s = self.u_m.len() as f64 / (4.0 * self.sample_rate_hz);
+        if !(delay_s.is_finite() && delay_s.abs() < quarter_s) {
+            return Err(invalid(format!(
+                "`{column}` delay {delay_s} s: expected a finite delay shorter than a quarter \
+                 of the record ({quarter_s} s)"
+            )));
+        }
+        self.channel_delays_s.insert(col, delay_s);
+        Ok(self)
+    }
+
+    /// The delay given for `column` ([`TestRecord::with_channel_delay_s`]), s.
+    pub fn channel_delay_s(&self, column: &str) -> Option<f64> {
+        self.channel_delays_s.get(column).copied()
+    }
+
+    /// The record with channel `column` (one of [`DELAYABLE_CHANNELS`]) advanced by
+    /// `shift_samples` ([`platen_signal::advance`]); a missing velocity channel stays missing.
+    pub(crate) fn with_channel_advanced(
+        &self,
+        column: &str,
+        shift_samples: f64,
+    ) -> std::result::Result<Self, platen_signal::SignalError> {
+        let mut rec = self.clone();
+        match column {
+            "a_m_s2" => rec.a_m_s2 = platen_signal::advance(&self.a_m_s2, shift_samples)?,
+            "force_n" => rec.force_n = platen_signal::advance(&self.force_n, shift_samples)?,
+            _ => {
+                if let Some(v) = &self.v_m_s {
+                    rec.v_m_s = Some(platen_signal::advance(v, shift_samples)?);
+                }
+            }
+        }
+        Ok(rec)
+    }
+
     /// The floors whose base shear was removed, if any.
     pub fn floors(&self) -> Option<&Floors> {
         self.floors.as_ref()
@@ -320,5 +385,26 @@ mod tests {
         assert!(e.to_string().contains("storey 1 mass"), "{e}");
         let e = rec.with_floors(&[(1.0, vec![0.0; 3])]).unwrap_err();
         assert!(e.to_string().contains("storey 1 acceleration has 3"), "{e}");
+    }
+
+    #[test]
+    fn a_channel_delay_is_checked_and_kept() {
+        let n = 400;
+        let rec =
+            TestRecord::from_rate("r", 200.0, vec![0.0; n], vec![0.0; n], vec![0.0; n]).unwrap();
+        let e = rec.clone().with_channel_delay_s("u_m", 0.01).unwrap_err();
+        assert!(e.to_string().contains("a delay for `u_m`"), "{e}");
+        let e = rec.clone().with_channel_delay_s("a_m_s2", 0.5).unwrap_err();
+        assert!(
+            e.to_string().contains("quarter of the record (0.5 s)"),
+            "{e}"
+        );
+        assert!(rec
+            .clone()
+            .with_channel_delay_s("force_n", f64::NAN)
+            .is_err());
+        let rec = rec.with_channel_delay_s("a_m_s2", 0.0098).unwrap();
+        assert_eq!(rec.channel_delay_s("a_m_s2"), Some(0.0098));
+        assert_eq!(rec.channel_delay_s("force_n"), None);
     }
 }

@@ -10,7 +10,11 @@ mod output_error;
 pub(crate) mod result;
 mod separable;
 pub(crate) mod settings;
+mod skew;
 pub mod summary;
+
+pub use crate::record::DELAYABLE_CHANNELS;
+pub use skew::{ChannelDelay, MIN_APPLIED_SAMPLES, SIGNIFICANT};
 
 use std::cell::Cell;
 
@@ -89,6 +93,9 @@ pub fn identify_records(
     if records.is_empty() {
         return Err(IdentError::NoTests);
     }
+    // Channel skew (module `skew`): from here on the records are the corrected ones.
+    let corrected = skew::correct(records)?;
+    let records = corrected.records.as_slice();
     let prepared = prepare(records, settings)?;
     let data = Stacked::new(records, &prepared);
     let mut shape = Shape {
@@ -127,6 +134,7 @@ pub fn identify_records(
             hac = ee_covariance(&fit, &data);
         }
     }
+    skew_covariance(&mut hac, &fit, shape, &corrected, settings)?;
     let clamped = fit.clamped.clone();
     let fixed_reason = |key: IdentifiedKey| -> String {
         match key {
@@ -200,7 +208,10 @@ pub fn identify_records(
         speeds,
         settings.band_points,
     );
-    let reports = record_reports(records, &prepared, &fit, simulated);
+    let mut reports = record_reports(records, &prepared, &fit, simulated);
+    for (report, delays) in reports.iter_mut().zip(corrected.delays) {
+        report.channel_delays = delays;
+    }
     Ok(RecordIdentification {
         parameters: ee_params,
         equation_error,
@@ -210,6 +221,42 @@ pub fn identify_records(
         records: reports,
         warnings,
     })
+}
+
+/// Adds the variance of the estimated channel delays to the equation error's covariance
+/// (module `skew`): `g·gᵀ·MSE(τ)` per delay, `g` the central difference of the fitted
+/// vector over the delay. A perturbed fit that frees or clamps other parameters than `fit`
+/// says nothing about `g` along them and is skipped.
+fn skew_covariance(
+    hac: &mut Hac,
+    fit: &SeparableFit,
+    shape: Shape,
+    corrected: &skew::Corrected,
+    settings: &ValidRecordSettings,
+) -> Result<()> {
+    for p in skew::perturbations(corrected)? {
+        let refit = |records: &[TestRecord]| -> Result<SeparableFit> {
+            let prepared = prepare(records, settings)?;
+            Ok(Separable::new(&Stacked::new(records, &prepared), shape).fit())
+        };
+        let (minus, plus) = (refit(&p.minus)?, refit(&p.plus)?);
+        if minus.free != fit.free || plus.free != fit.free {
+            continue;
+        }
+        let g: Vec<f64> = fit
+            .free
+            .iter()
+            .map(|&i| (plus.full[i] - minus.full[i]) / (2.0 * p.h_s))
+            .collect();
+        for cov in [&mut hac.cov, &mut hac.cov_estimable] {
+            for (a, ga) in g.iter().enumerate() {
+                for (b, gb) in g.iter().enumerate() {
+                    cov[(a, b)] += ga * gb * p.mse_s2;
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 fn free_position(free: &[usize], full: usize) -> usize {
@@ -641,6 +688,7 @@ fn record_reports(
                 velocity_m_s: p.v_m_s.clone(),
                 u_m: rec.u_m().to_vec(),
                 simulated_u_m: sim,
+                channel_delays: Vec::new(),
             }
         })
         .collect()

@@ -154,6 +154,9 @@ pub struct RecordReport {
     pub u_m: Vec<f64>,
     /// The output error's simulated displacement (its mean offset added), m, if run.
     pub simulated_u_m: Option<Vec<f64>>,
+    /// The channels' delays against the displacement, given or estimated, and whether each
+    /// was corrected ([`crate::anyrecord::ChannelDelay`]).
+    pub channel_delays: Vec<crate::anyrecord::ChannelDelay>,
 }
 
 /// The result of [`crate::identify_records`].

@@ -229,6 +229,11 @@ pub struct RecordInfoSummary {
     pub floor_masses_kg: Option<Vec<f64>>,
     /// Largest base shear removed, N.
     pub peak_base_shear_n: Option<f64>,
+    /// Each channel's delay against the displacement, s (any-record method): the
+    /// acceleration's as estimated (corrected only when significant), and any given with the
+    /// record (corrected as given). Positive: the channel lags `u_m`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub channel_delay_s: Option<BTreeMap<&'static str, f64>>,
 }
 
 impl RecordInfoSummary {
@@ -252,6 +257,12 @@ impl RecordInfoSummary {
                 .map(EstimateSummary::new),
             floor_masses_kg: r.floors.as_ref().map(|f| f.masses_kg.clone()),
             peak_base_shear_n: r.floors.as_ref().map(|f| f.peak_base_shear_n),
+            channel_delay_s: Some(
+                r.channel_delays
+                    .iter()
+                    .map(|d| (d.column, d.delay_s))
+                    .collect(),
+            ),
         }
     }
 }
