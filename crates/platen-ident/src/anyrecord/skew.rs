@@ -17,7 +17,8 @@
 //!   reported and the channel is used as recorded.
 //! * **Intervals.** The delay used is itself uncertain: by the estimate's standard error when
 //!   applied, by the estimate itself (and its error) when not. The equation error is refitted
-//!   with the channel shifted by `±h` to get the estimates' derivative `g = ∂θ/∂τ`, and
+//!   with the channel shifted by `±h` (twice the delay's RMS error, at least a quarter
+//!   sample) to get the estimates' derivative `g = ∂θ/∂τ`, and
 //!   `g·gᵀ·MSE(τ)` is added to their covariance, `MSE = se² + (τ̂ − τ_used)²`.
 //! * **Given delays** (a column map's `delay_s`) are applied as given, exactly (no estimate,
 //!   no added variance); a given delay of 0 turns the estimate off.
@@ -34,6 +35,9 @@ pub const SIGNIFICANT: f64 = 3.0;
 /// a sample leaves is a small part of a two-sample lag's 2 %, and the variance added for it
 /// covers it).
 pub const MIN_APPLIED_SAMPLES: f64 = 0.1;
+
+/// Smallest step of the delay, samples, over which the estimates' derivative is taken.
+const STEP_SAMPLES: f64 = 0.25;
 
 /// A channel's delay against the displacement in one record (channel skew).
 ///
@@ -147,9 +151,11 @@ pub(crate) fn perturbations(corrected: &Corrected) -> Result<Vec<Perturbation>> 
             let fs = rec.sample_rate_hz();
             let used = if d.applied { d.delay_s } else { 0.0 };
             let mse_s2 = se * se + (d.delay_s - used).powi(2);
-            // A step of at least a tenth of a sample: the fit's dependence on the delay is
-            // smooth on that scale, and the step stays far above rounding.
-            let h_s = mse_s2.sqrt().max(MIN_APPLIED_SAMPLES / fs);
+            // The secant over ±2 root-mean-square errors, and over at least a quarter sample:
+            // the fit stops its (α, b) search within a tolerance, which makes its estimates
+            // jitter by a few kg of Mₑ between nearby delays; a shorter step would measure
+            // the jitter, not the slope (~100 kg per sample near the true delay).
+            let h_s = (2.0 * mse_s2.sqrt()).max(STEP_SAMPLES / fs);
             let shifted = |sign: f64| -> Result<Vec<TestRecord>> {
                 let mut set = corrected.records.clone();
                 set[r] = rec
