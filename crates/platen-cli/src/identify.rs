@@ -1045,7 +1045,8 @@ fn read_record(input: &Input) -> Result<TestRecord> {
     }
     // A column map's known channel skew (`delay_s`), applied by identification as given.
     for column in platen_ident::anyrecord::DELAYABLE_CHANNELS {
-        if let Some(d) = input.columns.delay_s(column).filter(|_| column != "v_m_s" || has_v) {
+        let delay = input.columns.delay_s(column);
+        if let Some(d) = delay.filter(|_| column != "v_m_s" || has_v) {
             rec = rec.with_channel_delay_s(column, d).with_context(context)?;
         }
     }
