@@ -84,6 +84,41 @@ fn signal_error(rec: &TestRecord) -> impl Fn(platen_signal::SignalError) -> Iden
     }
 }
 
+/// The delays of one record's channels: those given with it, and the acceleration's
+/// estimate unless given (none when the record has too little coherent motion to tell), each
+/// marked applied when the any-record method advances the channel by it.
+pub(crate) fn delays_of(rec: &TestRecord) -> Vec<ChannelDelay> {
+    let fs = rec.sample_rate_hz();
+    let mut delays = Vec::new();
+    for column in DELAYABLE_CHANNELS {
+        let delay = match rec.channel_delay_s(column) {
+            Some(d) => ChannelDelay {
+                column,
+                delay_s: d,
+                std_error_s: None,
+                applied: d != 0.0 && (column != "v_m_s" || rec.v_m_s().is_some()),
+            },
+            None if column == "a_m_s2" => {
+                let est = DelayEstimator::new(fs)
+                    .and_then(|e| e.acceleration_against_displacement(rec.a_m_s2(), rec.u_m()));
+                // A record without coherent motion (at rest, or too short) cannot say: its
+                // channel is used as recorded and no delay is reported.
+                let Ok(est) = est else { continue };
+                ChannelDelay {
+                    column,
+                    delay_s: est.delay_s,
+                    std_error_s: Some(est.std_error_s),
+                    applied: est.delay_s.abs() > SIGNIFICANT * est.std_error_s
+                        && est.delay_s.abs() * fs > MIN_APPLIED_SAMPLES,
+                }
+            }
+            None => continue,
+        };
+        delays.push(delay);
+    }
+    delays
+}
+
 /// Applies given delays and estimates (and, when significant, applies) the acceleration's.
 pub(crate) fn correct(records: &[TestRecord]) -> Result<Corrected> {
     let mut out = Corrected {
@@ -91,40 +126,12 @@ pub(crate) fn correct(records: &[TestRecord]) -> Result<Corrected> {
         delays: Vec::with_capacity(records.len()),
     };
     for rec in records {
-        let fs = rec.sample_rate_hz();
+        let delays = delays_of(rec);
         let mut fixed = rec.clone();
-        let mut delays = Vec::new();
-        for column in DELAYABLE_CHANNELS {
-            let given = rec.channel_delay_s(column);
-            let delay = match given {
-                Some(d) => ChannelDelay {
-                    column,
-                    delay_s: d,
-                    std_error_s: None,
-                    applied: d != 0.0 && (column != "v_m_s" || rec.v_m_s().is_some()),
-                },
-                None if column == "a_m_s2" => {
-                    let est = DelayEstimator::new(fs)
-                        .and_then(|e| e.acceleration_against_displacement(rec.a_m_s2(), rec.u_m()));
-                    // A record without coherent motion (at rest, or too short) cannot say:
-                    // its channel is used as recorded and no delay is reported.
-                    let Ok(est) = est else { continue };
-                    ChannelDelay {
-                        column,
-                        delay_s: est.delay_s,
-                        std_error_s: Some(est.std_error_s),
-                        applied: est.delay_s.abs() > SIGNIFICANT * est.std_error_s
-                            && est.delay_s.abs() * fs > MIN_APPLIED_SAMPLES,
-                    }
-                }
-                None => continue,
-            };
-            if delay.applied {
-                fixed = fixed
-                    .with_channel_advanced(column, delay.delay_s * fs)
-                    .map_err(signal_error(rec))?;
-            }
-            delays.push(delay);
+        for d in delays.iter().filter(|d| d.applied) {
+            fixed = fixed
+                .with_channel_advanced(d.column, d.delay_s * rec.sample_rate_hz())
+                .map_err(signal_error(rec))?;
         }
         out.records.push(fixed);
         out.delays.push(delays);
