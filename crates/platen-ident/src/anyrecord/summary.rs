@@ -229,9 +229,10 @@ pub struct RecordInfoSummary {
     pub floor_masses_kg: Option<Vec<f64>>,
     /// Largest base shear removed, N.
     pub peak_base_shear_n: Option<f64>,
-    /// Each channel's delay against the displacement, s (any-record method): the
-    /// acceleration's as estimated (corrected only when significant), and any given with the
-    /// record (corrected as given). Positive: the channel lags `u_m`.
+    /// Each channel's delay against the displacement, s: the acceleration's as estimated,
+    /// and any given with the record. Positive: the channel lags `u_m`. The any-record method
+    /// corrects a given delay, and an estimated one when significant; for a record it did not
+    /// fit (a periodic test) the delays are reported only.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub channel_delay_s: Option<BTreeMap<&'static str, f64>>,
 }
