@@ -269,21 +269,32 @@ fn bad_input_is_an_input_error_naming_the_file() {
         &["identify", p("nocol.csv").to_str().unwrap()],
         &["nocol.csv", "a_m_s2"],
     );
-    // Not periodic, with the paper's method forced (without it, a record that is not
-    // periodic goes to the any-record method: `identify_records.rs`).
+    // Not periodic, with the paper's method forced: it is not lost, it falls back to the
+    // any-record method, and its account says why.
     let mut text = String::from("t_s,u_m,a_m_s2,force_n\n");
     for i in 0..2000 {
         text.push_str(&format!("{},{},0,0\n", i as f64 / 512.0, i as f64 * 1e-4));
     }
     std::fs::write(p("ramp.csv"), text).unwrap();
-    fails_with(
-        &[
-            "identify",
-            p("ramp.csv").to_str().unwrap(),
-            "--method",
-            "periodic",
-        ],
-        &["ramp.csv", "not a periodic test"],
+    let o = platen(&[
+        "identify",
+        p("ramp.csv").to_str().unwrap(),
+        "--method",
+        "periodic",
+        "--no-output-error",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let r = &v["records"][0];
+    assert_eq!(r["method"], "record", "{r}");
+    assert_eq!(r["used"], true, "{r}");
+    assert!(
+        r["routing"]
+            .as_str()
+            .unwrap()
+            .starts_with("not a periodic test: the displacement crosses its mid-range 1 time(s)"),
+        "{r}"
     );
     // A file that does not exist.
     fails_with(

@@ -132,7 +132,7 @@ fn a_scenario_entry_is_the_csv_that_generate_recorded_writes() {
             m.to_str().unwrap(),
             "--json",
         ]));
-        for list in ["sine_tests", "triangle_tests"] {
+        for list in ["sine_tests", "triangle_tests", "records"] {
             for t in v[list].as_array_mut().unwrap() {
                 t.as_object_mut()
                     .unwrap()

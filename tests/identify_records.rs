@@ -95,7 +95,9 @@ fn a_manifest_with_floors_removes_the_specimens_base_shear() {
 }
 
 #[test]
-fn forcing_the_periodic_method_on_an_earthquake_is_the_old_error() {
+fn forcing_the_periodic_method_on_an_earthquake_falls_back_with_its_reason() {
+    // Issue 26: an earthquake is never lost to a forced periodic fit; it is identified by
+    // the any-record method, and its account says why.
     let dir = tempfile::tempdir().unwrap();
     let csv = exact_stamps(dir.path(), "eq-lab.csv");
     let columns = data().join("columns.json");
@@ -106,9 +108,25 @@ fn forcing_the_periodic_method_on_an_earthquake_is_the_old_error() {
         columns.to_str().unwrap(),
         "--method",
         "periodic",
+        "--no-output-error",
+        "--json",
     ]);
-    assert_eq!(o.status.code(), Some(3));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("not a periodic test"));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let records = v["records"].as_array().unwrap();
+    assert_eq!(records.len(), 1);
+    assert_eq!(records[0]["method"], "record");
+    assert_eq!(records[0]["used"], true);
+    assert!(records[0].get("reason").is_none());
+    assert!(
+        records[0]["routing"]
+            .as_str()
+            .unwrap()
+            .starts_with("not a periodic test: "),
+        "{}",
+        records[0]
+    );
+    assert!(v["effective_mass_kg"].as_f64().unwrap() > 0.0);
 }
 
 #[test]

@@ -40,10 +40,10 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
-use platen_ident::anyrecord::summary::RecordSummary;
+use platen_ident::anyrecord::summary::{record_entries, RecordInfoSummary, RecordSummary};
 use platen_ident::{
-    identify, identify_records, route, Estimate, Flag, Identification, IdentificationSummary,
-    IdentifiedKey, Method, Parameter, RecordIdentification, RecordSettings, RecordWarning, Route,
+    identify_any, Estimate, Flag, Identification, IdentificationSummary, Identified, IdentifiedKey,
+    Method, MethodRequest, Parameter, RecordIdentification, RecordSettings, RecordWarning,
     Settings, TestKind, TestRecord,
 };
 use platen_io::columns::{ColumnMap, ColumnSpec};
@@ -74,6 +74,8 @@ pub struct Options<'a> {
     pub method: Option<MethodChoice>,
     /// Skip the any-record method's output-error check.
     pub no_output_error: bool,
+    /// Hold the any-record method's stiffness at `Kₑ ≥ 0`.
+    pub nonnegative_stiffness: bool,
 }
 
 /// `--method`.
@@ -204,40 +206,63 @@ pub fn run(opts: &Options) -> Result<()> {
     }
     .build()
     .context("identification failed")?;
-    // Where each file goes: forced, declared `record`, or by its data.
-    let routes: Vec<Route> = records.iter().map(route).collect();
-    let periodic_only = match opts.method {
-        Some(MethodChoice::Periodic) => true,
-        Some(_) => false,
-        None => inputs
-            .iter()
-            .zip(&routes)
-            .all(|(i, r)| !i.record && r.method() == Method::Periodic),
-    };
-    if periodic_only {
-        return run_periodic(opts, &inputs, &records, &settings);
+    let record_settings = RecordSettings {
+        viscous_exponent: opts.viscous_exponent,
+        low_velocity_term: !opts.no_low_velocity_term,
+        output_error: !opts.no_output_error,
+        nonnegative_stiffness: opts.nonnegative_stiffness,
+        ..RecordSettings::default()
     }
-    run_records(opts, &inputs, records, &routes, &settings)
+    .build()
+    .context("identification failed")?;
+    // Where each file goes (forced, declared `record`, or by its data), the periodic method
+    // on the periodic tests it accepts, the any-record method on the rest: every file
+    // accounted for.
+    let declared: Vec<bool> = inputs.iter().map(|i| i.record).collect();
+    let request = match opts.method {
+        None => MethodRequest::Auto,
+        Some(MethodChoice::Periodic) => MethodRequest::Periodic,
+        Some(MethodChoice::Record) => MethodRequest::Record,
+        Some(MethodChoice::Both) => MethodRequest::Both,
+    };
+    let id = identify_any(&records, &declared, request, &settings, &record_settings)
+        .context("identification failed")?;
+    let files: Vec<String> = inputs
+        .iter()
+        .map(|i| i.path.display().to_string())
+        .collect();
+    let entries = record_entries(&id, &records, &files);
+    for (e, input) in entries.iter().zip(&inputs) {
+        if let Some(reason) = e.account.as_ref().and_then(|a| a.reason.as_ref()) {
+            eprintln!("warning: {} was not used: {reason}", input.name);
+        }
+    }
+    if id.periodic_only() {
+        let (periodic, _) = id.periodic.expect("periodic only");
+        return run_periodic(opts, &inputs, &periodic, entries);
+    }
+    run_records(opts, &inputs, id, entries)
 }
 
-/// The paper's method on every file: the output as it has always been.
+/// The paper's method on every file: the output as it has always been, with the records'
+/// accounts.
 fn run_periodic(
     opts: &Options,
     inputs: &[Input],
-    records: &[TestRecord],
-    settings: &platen_ident::ValidSettings,
+    id: &Identification,
+    entries: Vec<RecordInfoSummary>,
 ) -> Result<()> {
-    let id = identify(records, settings).context("identification failed")?;
     let written = platen_report::write_outputs(
         opts.plot,
         opts.report,
         &opts.size,
-        || identify_figures::figures(&id),
-        |figures, rendered| html_report(&id, inputs, figures, rendered),
+        || identify_figures::figures(id),
+        |figures, rendered| html_report(id, inputs, &entries, figures, rendered),
     )?;
     if opts.json {
         let output = JsonOutput {
-            summary: summary(&id, inputs),
+            summary: summary(id, inputs),
+            records: entries,
             figures: figure_list(opts, &written),
             report: opts.report.map(|path| path.display().to_string()),
         };
@@ -245,7 +270,8 @@ fn run_periodic(
         let value = serde_json::to_value(&output)?;
         outln!("{}", serde_json::to_string_pretty(&value)?);
     } else {
-        out!("{}", report(&id, inputs));
+        out!("{}", report(id, inputs));
+        out!("{}", accounts_report(&entries, inputs));
         print_written(&written, opts.report)?;
     }
     Ok(())
@@ -270,52 +296,36 @@ fn print_written(written: &[PathBuf], report: Option<&Path>) -> Result<()> {
     Ok(())
 }
 
-/// The any-record method on the records routed to it (every file with `--method record` or
-/// `both`), and the paper's method on the periodic tests when there are any and the method
-/// is not `record`.
+/// The any-record method on the records routed to it, and the paper's method on the
+/// periodic tests when there are any: [`identify_any`]'s result printed.
 fn run_records(
     opts: &Options,
     inputs: &[Input],
-    records: Vec<TestRecord>,
-    routes: &[Route],
-    settings: &platen_ident::ValidSettings,
+    identified: Identified,
+    entries: Vec<RecordInfoSummary>,
 ) -> Result<()> {
-    let method = opts.method;
-    let periodic_route = |k: usize| !inputs[k].record && routes[k].method() == Method::Periodic;
-    let periodic_idx: Vec<usize> = (0..inputs.len())
-        .filter(|&k| method != Some(MethodChoice::Record) && periodic_route(k))
-        .collect();
-    let record_idx: Vec<usize> = (0..inputs.len())
-        .filter(|&k| method.is_some() || !periodic_route(k))
-        .collect();
-    let periodic = if periodic_idx.is_empty() {
-        None
-    } else {
-        let recs: Vec<TestRecord> = periodic_idx.iter().map(|&k| records[k].clone()).collect();
-        Some(identify(&recs, settings).context("identification failed (periodic tests)")?)
-    };
-    let record_settings = RecordSettings {
-        viscous_exponent: opts.viscous_exponent,
-        low_velocity_term: !opts.no_low_velocity_term,
-        output_error: !opts.no_output_error,
-        ..RecordSettings::default()
-    }
-    .build()
-    .context("identification failed")?;
-    let recs: Vec<TestRecord> = record_idx.iter().map(|&k| records[k].clone()).collect();
-    let mut id =
-        identify_records(&recs, &record_settings).context("identification failed (records)")?;
+    let Identified {
+        periodic, records, ..
+    } = identified;
+    let (mut id, record_idx) = records.expect("the any-record method ran");
     for &k in &record_idx {
-        if let (Some(_), Route::Record { reason }) = (inputs[k].kind, &routes[k]) {
-            id.warnings.push(RecordWarning::DeclaredPeriodicButNot {
-                test: inputs[k].name.clone(),
-                reason: reason.clone(),
-            });
+        if let (Some(_), false) = (inputs[k].kind, inputs[k].record) {
+            if let Some(a) = entries[k].account.as_ref() {
+                if a.method == Method::Record {
+                    id.warnings.push(RecordWarning::DeclaredPeriodicButNot {
+                        test: inputs[k].name.clone(),
+                        reason: a.routing.clone(),
+                    });
+                }
+            }
         }
     }
+    let (periodic, periodic_idx) = match periodic {
+        Some((p, idx)) => (Some(p), idx),
+        None => (None, Vec::new()),
+    };
     let rec_inputs: Vec<&Input> = record_idx.iter().map(|&k| &inputs[k]).collect();
-    let per_inputs: Vec<&Input> = periodic_idx.iter().map(|&k| &inputs[k]).collect();
-    let per_owned: Vec<Input> = per_inputs.iter().map(|i| (*i).clone()).collect();
+    let per_owned: Vec<Input> = periodic_idx.iter().map(|&k| inputs[k].clone()).collect();
     let written = platen_report::write_outputs(
         opts.plot,
         opts.report,
@@ -333,12 +343,13 @@ fn run_records(
                 &rec_inputs,
                 periodic.as_ref(),
                 &per_owned,
+                (&entries, inputs),
                 figures,
                 rendered,
             )
         },
     )?;
-    let method_name = match method {
+    let method_name = match opts.method {
         Some(MethodChoice::Both) => "both",
         _ if periodic.is_some() => "mixed",
         _ => "record",
@@ -348,8 +359,10 @@ fn run_records(
             .iter()
             .map(|i| i.path.display().to_string())
             .collect();
+        let mut record_summary = RecordSummary::new(&id, &files);
+        record_summary.records = entries;
         let output = RecordJsonOutput {
-            summary: RecordSummary::new(&id, &files),
+            summary: record_summary,
             method: method_name,
             periodic: periodic.as_ref().map(|p| summary(p, &per_owned)),
             figures: figure_list(opts, &written),
@@ -363,9 +376,61 @@ fn run_records(
             outln!("\n== Periodic tests (hysteresis-loop method, §3) ==\n");
             out!("{}", report(p, &per_owned));
         }
+        out!("{}", accounts_report(&entries, inputs));
         print_written(&written, opts.report)?;
     }
     Ok(())
+}
+
+/// "Records": one line per input file, what identification did with it and why.
+fn accounts_report(entries: &[RecordInfoSummary], inputs: &[Input]) -> String {
+    let mut s = String::from("\nRecords (every file accounted for)\n");
+    let w = inputs
+        .iter()
+        .map(|i| i.label.chars().count())
+        .max()
+        .unwrap_or(0);
+    for (e, input) in entries.iter().zip(inputs) {
+        let Some(a) = &e.account else { continue };
+        let status = match &a.reason {
+            None => "used".to_owned(),
+            Some(r) => format!("NOT USED: {r}"),
+        };
+        let _ = writeln!(
+            s,
+            "  {:<w$}  {:<8}  {status}; {}",
+            input.label,
+            a.method.name(),
+            a.routing
+        );
+    }
+    s
+}
+
+/// The HTML table of [`accounts_report`].
+fn accounts_table(entries: &[RecordInfoSummary], inputs: &[Input]) -> Vec<String> {
+    let rows: Vec<Vec<String>> = entries
+        .iter()
+        .zip(inputs)
+        .filter_map(|(e, input)| {
+            let a = e.account.as_ref()?;
+            Some(vec![
+                input.label.clone(),
+                a.method.name().to_owned(),
+                if a.used { "yes" } else { "no" }.to_owned(),
+                a.reason.clone().unwrap_or_default(),
+                a.routing.clone(),
+            ])
+        })
+        .collect();
+    vec![
+        html::heading("Records"),
+        html::table(
+            &["file", "method", "used", "reason", "routing"],
+            &rows,
+            false,
+        ),
+    ]
 }
 
 /// What `--json` prints for the any-record method.
@@ -556,6 +621,7 @@ fn record_html_report(
     inputs: &[&Input],
     periodic: Option<&Identification>,
     periodic_inputs: &[Input],
+    (entries, all_inputs): (&[RecordInfoSummary], &[Input]),
     figures: &[Figure],
     rendered: &[(String, String)],
 ) -> String {
@@ -574,6 +640,7 @@ fn record_html_report(
         sections.push(html::heading("Periodic tests (hysteresis-loop method)"));
         sections.push(html::preformatted(&report(p, periodic_inputs)));
     }
+    sections.extend(accounts_table(entries, all_inputs));
     let files: Vec<String> = inputs
         .iter()
         .map(|i| i.path.display().to_string())
@@ -605,6 +672,8 @@ fn record_html_report(
 struct JsonOutput {
     #[serde(flatten)]
     summary: IdentificationSummary,
+    /// Every input file, with what identification did with it.
+    records: Vec<RecordInfoSummary>,
     #[serde(skip_serializing_if = "Option::is_none")]
     figures: Option<Vec<String>>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -625,6 +694,7 @@ fn summary(id: &Identification, inputs: &[Input]) -> IdentificationSummary {
 fn html_report(
     id: &Identification,
     inputs: &[Input],
+    entries: &[RecordInfoSummary],
     figures: &[Figure],
     rendered: &[(String, String)],
 ) -> String {
@@ -639,6 +709,7 @@ fn html_report(
     }
     sections.push(html::heading("Report"));
     sections.push(html::preformatted(&report(id, inputs)));
+    sections.extend(accounts_table(entries, inputs));
     html::page(&html::Page {
         title: "platen identify".into(),
         heading: "Identification from periodic tests (hysteresis-loop method)".into(),
@@ -838,9 +909,9 @@ impl<'a> ManifestReader<'a> {
         pressure_mpa: &[f64],
     ) -> Result<()> {
         if let Some(p) = entry.pressure_mpa {
-            if !(p.is_finite() && p >= 0.0) {
+            if let Err(e) = platen_scenario::units::check_pressure_mpa(p) {
                 bail!(
-                    "`{}`, at `tests[{k}].pressure_mpa`: {p}: expected a pressure >= 0 MPa",
+                    "`{}`, at `tests[{k}].pressure_mpa`: {e}",
                     self.path.display()
                 );
             }

@@ -327,16 +327,22 @@ enum Command {
         /// (a manifest's own `columns` win).
         #[arg(long, value_name = "MAP.json")]
         columns: Option<PathBuf>,
-        /// Force the method: `periodic` (the paper's, every file a periodic test), `record`
-        /// (the any-record method on every file, fitted jointly) or `both` (periodic tests
-        /// through both). Default: periodic tests to the paper's method, any other record
-        /// (earthquake, white noise) to the any-record method.
+        /// Force the method: `periodic` (the paper's wherever the data are periodic; a file
+        /// that is not, or that the paper's method rejects, falls back to the any-record
+        /// method with its reason), `record` (the any-record method on every file, fitted
+        /// jointly) or `both` (periodic tests through both). Default: periodic tests (regular
+        /// cycles of one shape) to the paper's method, any other record (earthquake, white
+        /// noise) to the any-record method. Every file is listed with what was done with it.
         #[arg(long, value_enum)]
         method: Option<identify::MethodChoice>,
         /// Skip the any-record method's output-error check (forward simulation fitted to the
         /// measured motion).
         #[arg(long)]
         no_output_error: bool,
+        /// Hold the any-record method's stiffness at Kₑ ≥ 0 (a table without a restoring
+        /// stiffness of its own); a warning says when the bound is active.
+        #[arg(long)]
+        nonnegative_stiffness: bool,
         /// Identify the table system's controller from closed-loop records instead (t_s,
         /// command_u_m, u_m and, where recorded, drive, delta_p_pa, a_m_s2): the gains by
         /// least squares on the drive; the last of two or more FILEs is held out and judged.
@@ -578,6 +584,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             columns,
             method,
             no_output_error,
+            nonnegative_stiffness,
             system: _,
             base: _,
             size,
@@ -593,6 +600,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             columns: columns.as_deref(),
             method,
             no_output_error,
+            nonnegative_stiffness,
             size: size.size(),
         }),
         Command::Plan(args) => plan::run(&args),

@@ -310,14 +310,90 @@ fn fundamental_hz(u: &[f64], rate: f64, errors: &Errors) -> Result<f64> {
     Ok(rate / rough_period)
 }
 
-/// Whether `rec` is a periodic test: its displacement crosses its mid-range at least three
-/// times, at regular intervals (the first check of [`analyse`]). `Err` says why not.
+/// Largest median mismatch of consecutive half-cycles for a record to count as periodic:
+/// `√(Σ(x₁ + x₂)² / Σ(x₁² + x₂²))` of the displacement about its mid-range over one half
+/// period `x₁` and the next `x₂` (0 for a sine or a triangle, whose second half-cycle is the
+/// first one inverted; about 1 for unrelated motion). A steady test with noise and rounded
+/// reversals stays below 0.02; an amplitude that grows by 30 % from one half-cycle to the
+/// next (a ramped start) gives 0.15, and the median over the half-cycles ignores a ramp at
+/// either end. Earthquake records whose few mid-range crossings happen to be regular give
+/// 0.4 and more.
+pub const HALF_CYCLE_MISMATCH: f64 = 0.15;
+
+/// Largest share of the displacement's energy (`Σ(u − mid)²`) outside the span of its regular
+/// cycles (first to last mid-range crossing, widened by a quarter period at each end) for a
+/// record to count as periodic. A test at rest before and after its cycles, or with a
+/// taper, has almost none there; an earthquake record whose regular crossings cover only part
+/// of it has most of its motion outside.
+pub const OUTSIDE_CYCLES_ENERGY: f64 = 0.25;
+
+/// Whether `rec` is a periodic test, by its data alone: its displacement crosses its
+/// mid-range at least three times at regular intervals (the first check of [`analyse`]),
+/// consecutive half-cycles have the same shape inverted (median mismatch below
+/// [`HALF_CYCLE_MISMATCH`]), and the cycles hold the motion (at most
+/// [`OUTSIDE_CYCLES_ENERGY`] of it outside them). Returns the fundamental frequency, Hz;
+/// `Err` says why the record is not periodic.
 pub(crate) fn periodicity(rec: &TestRecord) -> Result<f64> {
-    fundamental_hz(
-        rec.u_m(),
-        rec.sample_rate_hz(),
-        &Errors { test: rec.name() },
-    )
+    let errors = Errors { test: rec.name() };
+    let rate = rec.sample_rate_hz();
+    let f0 = fundamental_hz(rec.u_m(), rate, &errors)?;
+    periodic_shape(rec.u_m(), rate / f0, &errors)?;
+    Ok(f0)
+}
+
+/// The shape checks of [`periodicity`] on a displacement whose crossings are regular, with
+/// period `period` in samples.
+fn periodic_shape(u: &[f64], period: f64, errors: &Errors) -> Result<()> {
+    let (lo, hi) = min_max(u);
+    let mid = 0.5 * (hi + lo);
+    let c: Vec<f64> = u.iter().map(|x| x - mid).collect();
+    let cross = crossings(&c, CROSSING_HYSTERESIS * 0.5 * (hi - lo));
+    let (first, last) = (cross[0].0, cross[cross.len() - 1].0);
+    let (from, to) = (first - 0.25 * period, last + 0.25 * period);
+    let total: f64 = c.iter().map(|x| x * x).sum();
+    let outside: f64 = c
+        .iter()
+        .enumerate()
+        .filter(|&(i, _)| (i as f64) < from || (i as f64) > to)
+        .map(|(_, x)| x * x)
+        .sum();
+    if outside > OUTSIDE_CYCLES_ENERGY * total {
+        return Err(errors.not_periodic(format!(
+            "{:.0} % of its motion lies outside its {} regular zero crossings (at most {:.0} % in a periodic test)",
+            100.0 * outside / total,
+            cross.len(),
+            100.0 * OUTSIDE_CYCLES_ENERGY
+        )));
+    }
+    // Consecutive half-cycles from each crossing but the last two.
+    let half = 0.5 * period;
+    let points = half.ceil().max(1.0) as usize;
+    let mut mismatch: Vec<f64> = cross[..cross.len() - 2]
+        .iter()
+        .map(|&(s0, _)| {
+            let (mut num, mut den) = (0.0, 0.0);
+            for j in 0..points {
+                let s = s0 + half * j as f64 / points as f64;
+                let (x1, x2) = (interp(&c, s), interp(&c, s + half));
+                num += (x1 + x2).powi(2);
+                den += x1 * x1 + x2 * x2;
+            }
+            if den > 0.0 {
+                (num / den).sqrt()
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    mismatch.sort_by(f64::total_cmp);
+    let median = mismatch[(mismatch.len() - 1) / 2];
+    if median > HALF_CYCLE_MISMATCH {
+        return Err(errors.not_periodic(format!(
+            "its half-cycles do not repeat (median mismatch {:.2} between consecutive half-cycles, at most {HALF_CYCLE_MISMATCH} in a periodic test)",
+            median
+        )));
+    }
+    Ok(())
 }
 
 /// Every channel of a record through the two low-passes.

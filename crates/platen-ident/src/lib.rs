@@ -150,6 +150,7 @@
 
 #![warn(missing_docs)]
 
+mod account;
 pub mod anyrecord;
 mod cycle;
 mod dissipative;
@@ -173,6 +174,7 @@ pub mod system;
 mod warning;
 mod work;
 
+pub use account::{identify_any, Identified, MethodRequest, RecordAccount};
 pub use anyrecord::result::{
     BandPoint, Correlations, EquationErrorFit, FitKind, FitUncertainty, FloorsReport,
     OutputErrorFit, RecordIdentification, RecordReport, RecordWarning,
@@ -182,7 +184,10 @@ pub use anyrecord::{
     fit_agreement, identify_records, MAX_CORRELATION, MAX_RELATIVE_STD_ERROR,
     MIN_LOW_SPEED_FRACTION,
 };
-pub use cycle::{CycleInfo, PLATEAU_TOLERANCE, TRIANGLE_PLATEAU_FRACTION};
+pub use cycle::{
+    CycleInfo, HALF_CYCLE_MISMATCH, OUTSIDE_CYCLES_ENERGY, PLATEAU_TOLERANCE,
+    TRIANGLE_PLATEAU_FRACTION,
+};
 pub use dissipative::{LOW_SPEED_M_S, MIN_SPEED_SPREAD};
 pub use error::{IdentError, Result};
 pub use estimate::{student_t_975, Estimate, Parameter};

@@ -7,6 +7,7 @@
 mod data;
 mod hac;
 mod output_error;
+mod plausible;
 pub(crate) mod result;
 mod separable;
 pub(crate) mod settings;
@@ -33,7 +34,7 @@ use result::{
     BandPoint, Correlations, EquationErrorFit, FitKind, FitUncertainty, FloorsReport,
     OutputErrorFit, RecordIdentification, RecordReport, RecordWarning,
 };
-use separable::{Separable, SeparableFit, Shape, LOW_DECAY, LOW_FORCE, OFFSETS};
+use separable::{Separable, SeparableFit, Shape, LOW_DECAY, LOW_FORCE, OFFSETS, STIFFNESS};
 use settings::ValidRecordSettings;
 
 /// Estimates correlated beyond this (in absolute value) are reported as not separable
@@ -102,6 +103,7 @@ pub fn identify_records(
         alpha: settings.viscous_exponent,
         low: settings.low_velocity_term,
         records: records.len(),
+        nonneg_stiffness: settings.nonnegative_stiffness,
     };
     let needed = 10 * (shape.free().len() + 2);
     if data.len() < needed {
@@ -202,6 +204,14 @@ pub fn identify_records(
             Err(reason) => warnings.push(RecordWarning::OutputErrorNotUsed { reason }),
         }
     }
+    plausible::check(
+        &ee_params,
+        output_error.as_ref().map(|oe| &oe.parameters),
+        fit.clamped.contains(&STIFFNESS),
+        &fit.full,
+        records,
+        &mut warnings,
+    );
     let band = band(
         &fit.full,
         &(free.clone(), hac.cov_estimable.clone(), hac.critical_value),

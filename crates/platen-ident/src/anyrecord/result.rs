@@ -264,6 +264,41 @@ pub enum RecordWarning {
         /// Why it is not periodic.
         reason: String,
     },
+    /// A mass that is not positive, or a negative stiffness: no physical platen has one. A
+    /// table without a restoring stiffness of its own (bearings only) comes out with a small
+    /// negative `Kₑ` from noise or transducer drift; `nonnegative_stiffness` constrains it.
+    NegativeEstimate {
+        /// The fit.
+        fit: FitKind,
+        /// The parameter.
+        key: IdentifiedKey,
+        /// Its value.
+        value: f64,
+        /// Its 95 % interval, if estimated.
+        ci95: Option<[f64; 2]>,
+    },
+    /// `Kₑ ≥ 0` was imposed and is active: the unconstrained fit wanted a negative stiffness,
+    /// `Kₑ = 0` is reported.
+    StiffnessConstrained,
+    /// The static friction fitted (`F_μ + a`) exceeds the largest force in the records: the
+    /// platen could never have moved. Look for a force in the wrong unit or a wrong channel.
+    FrictionAbovePeakForce {
+        /// `F_μ + a`, N.
+        static_friction_n: f64,
+        /// Largest |force| the model explains (recorded, less the base shear), N.
+        peak_force_n: f64,
+    },
+    /// The output-error check came out physically implausible against the equation error
+    /// (a mass more than twice or less than half the equation error's, or not positive),
+    /// whatever its intervals: it is no check of the equation error.
+    OutputErrorImplausible {
+        /// The parameter.
+        key: IdentifiedKey,
+        /// The equation error's value.
+        equation_error: f64,
+        /// The output error's.
+        output_error: f64,
+    },
 }
 
 impl fmt::Display for RecordWarning {
@@ -358,7 +393,67 @@ impl fmt::Display for RecordWarning {
                 f,
                 "test `{test}` was declared periodic but is not ({reason}): identified by the any-record method"
             ),
+            RecordWarning::NegativeEstimate {
+                fit,
+                key,
+                value,
+                ci95,
+            } => {
+                write!(
+                    f,
+                    "implausible: {} = {value:.4e} {} ({}{}) is {} on a physical platen",
+                    symbol(*key),
+                    unit(*key),
+                    fit.name(),
+                    ci95.map_or(String::new(), |[lo, hi]| format!(
+                        ", 95 % interval {lo:.4e} to {hi:.4e}"
+                    )),
+                    if *key == IdentifiedKey::EffectiveMass {
+                        "impossible: a mass is positive"
+                    } else {
+                        "impossible: a stiffness is never negative"
+                    }
+                )?;
+                if *key == IdentifiedKey::Stiffness {
+                    f.write_str("; a table without a restoring stiffness of its own may use --nonnegative-stiffness")?;
+                }
+                Ok(())
+            }
+            RecordWarning::StiffnessConstrained => f.write_str(
+                "Kₑ ≥ 0 is active: the unconstrained fit wants a negative stiffness; Kₑ = 0 is reported (held at its bound)",
+            ),
+            RecordWarning::FrictionAbovePeakForce {
+                static_friction_n,
+                peak_force_n,
+            } => write!(
+                f,
+                "implausible: the static friction F_μ + a = {:.1} kN exceeds the largest force in the records ({:.1} kN), so the platen could never have moved: is the force in the wrong unit or the wrong channel?",
+                static_friction_n / 1e3,
+                peak_force_n / 1e3
+            ),
+            RecordWarning::OutputErrorImplausible {
+                key,
+                equation_error,
+                output_error,
+            } => write!(
+                f,
+                "implausible output-error check: {} = {output_error:.4e} {} against {equation_error:.4e} from the equation error; it does not check the equation error (the record may not excite the platen enough for a forward simulation to pin it)",
+                symbol(*key),
+                unit(*key)
+            ),
         }
+    }
+}
+
+/// The parameter's SI unit.
+fn unit(key: IdentifiedKey) -> &'static str {
+    match key {
+        IdentifiedKey::EffectiveMass => "kg",
+        IdentifiedKey::Stiffness => "N/m",
+        IdentifiedKey::CoulombForce | IdentifiedKey::LowVelocityForce => "N",
+        IdentifiedKey::ViscousCoefficient => "N/(m/s)^α",
+        IdentifiedKey::ViscousExponent => "",
+        IdentifiedKey::LowVelocityDecay => "s/m",
     }
 }
 

@@ -40,6 +40,8 @@ pub(crate) struct Shape {
     pub low: bool,
     /// Number of records (offsets).
     pub records: usize,
+    /// Whether `Kₑ ≥ 0` is imposed.
+    pub nonneg_stiffness: bool,
 }
 
 impl Shape {
@@ -339,7 +341,10 @@ impl<'a> Separable<'a> {
         self.shape
             .linear()
             .iter()
-            .map(|&i| matches!(i, COULOMB | VISCOUS | LOW_FORCE))
+            .map(|&i| {
+                matches!(i, COULOMB | VISCOUS | LOW_FORCE)
+                    || (i == STIFFNESS && self.shape.nonneg_stiffness)
+            })
             .collect()
     }
 
@@ -558,6 +563,7 @@ mod tests {
                 alpha: None,
                 low: true,
                 records: 1,
+                nonneg_stiffness: false,
             },
         )
         .fit();

@@ -42,6 +42,13 @@ pub struct RecordSettings {
     /// channel ([`crate::anyrecord`] docs) and `n·σ²` taken off `Σa²` and `Σu²`
     /// (corrected least squares, Fuller 1987 §2.2).
     pub noise_correction: bool,
+    /// Whether to hold the stiffness at `Kₑ ≥ 0` (default false). A table without a
+    /// restoring stiffness of its own (bearings only) can come out with a slightly negative
+    /// `Kₑ` from noise or a drifting displacement transducer; with this set the fit is
+    /// constrained, and [`crate::RecordWarning::StiffnessConstrained`] says when the bound is
+    /// active. Without it a negative estimate is kept and flagged
+    /// ([`crate::RecordWarning::NegativeEstimate`]).
+    pub nonnegative_stiffness: bool,
 }
 
 impl Default for RecordSettings {
@@ -57,6 +64,7 @@ impl Default for RecordSettings {
             output_error_iterations: 40,
             band_points: 41,
             noise_correction: true,
+            nonnegative_stiffness: false,
         }
     }
 }

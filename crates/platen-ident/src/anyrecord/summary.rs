@@ -6,6 +6,8 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
+use crate::account::{Identified, RecordAccount};
+use crate::record::TestRecord;
 use crate::result::ParameterEstimates;
 use crate::summary::{EstimateSummary, ParameterSummary};
 
@@ -206,7 +208,8 @@ impl BandSummary {
     }
 }
 
-/// One record.
+/// One record: what identification did with it (every input file has one, whichever method
+/// identified it) and, for the any-record method, what it fitted.
 #[derive(Debug, Clone, Serialize)]
 pub struct RecordInfoSummary {
     /// The file it was read from.
@@ -217,12 +220,19 @@ pub struct RecordInfoSummary {
     pub sample_rate_hz: f64,
     /// Samples.
     pub samples: usize,
-    /// `given` or `crossover`.
-    pub velocity: &'static str,
-    /// Samples fitted by the equation error.
-    pub used_samples: usize,
-    /// Speeds fitted, m/s.
-    pub speed_range_m_s: [f64; 2],
+    /// What identification did with it: `method`, `used`, `reason` (when not used) and
+    /// `routing` (why that method).
+    #[serde(flatten)]
+    pub account: Option<RecordAccount>,
+    /// `given` or `crossover` (any-record method).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub velocity: Option<&'static str>,
+    /// Samples fitted by the equation error (any-record method).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub used_samples: Option<usize>,
+    /// Speeds fitted, m/s (any-record method).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub speed_range_m_s: Option<[f64; 2]>,
     /// The force offset, N.
     pub offset_n: Option<EstimateSummary>,
     /// The storeys' masses whose base shear was removed, kg.
@@ -244,13 +254,14 @@ impl RecordInfoSummary {
             name: r.name.clone(),
             sample_rate_hz: r.sample_rate_hz,
             samples: r.samples,
-            velocity: if r.velocity_given {
+            account: None,
+            velocity: Some(if r.velocity_given {
                 "given"
             } else {
                 "crossover"
-            },
-            used_samples: r.used_samples,
-            speed_range_m_s: r.speed_range_m_s,
+            }),
+            used_samples: Some(r.used_samples),
+            speed_range_m_s: Some(r.speed_range_m_s),
             offset_n: id
                 .equation_error
                 .offsets_n
@@ -266,4 +277,67 @@ impl RecordInfoSummary {
             ),
         }
     }
+}
+
+impl RecordInfoSummary {
+    /// A record the any-record method did not fit (a periodic test, or one it could not
+    /// use): its file, name, rate and account.
+    fn accounted_only(rec: &TestRecord, file: &str, account: &RecordAccount) -> Self {
+        Self {
+            file: file.to_owned(),
+            name: rec.name().to_owned(),
+            sample_rate_hz: rec.sample_rate_hz(),
+            samples: rec.len(),
+            account: Some(account.clone()),
+            velocity: None,
+            used_samples: None,
+            speed_range_m_s: None,
+            offset_n: None,
+            floor_masses_kg: None,
+            peak_base_shear_n: None,
+            channel_delay_s: Some(
+                super::skew::delays_of(rec)
+                    .iter()
+                    .map(|d| (d.column, d.delay_s))
+                    .collect(),
+            ),
+        }
+    }
+}
+
+/// Every input record, in input order, with its account ([`crate::identify_any`]): the
+/// any-record method's entries carry its per-record figures too. `files[k]` is where
+/// `records[k]` was read from.
+pub fn record_entries(
+    id: &Identified,
+    records: &[TestRecord],
+    files: &[String],
+) -> Vec<RecordInfoSummary> {
+    let mut fitted: Vec<Option<RecordInfoSummary>> = vec![None; records.len()];
+    if let Some((rid, idx)) = &id.records {
+        let sub_files: Vec<String> = idx.iter().map(|&k| files[k].clone()).collect();
+        for (entry, &k) in RecordSummary::new(rid, &sub_files)
+            .records
+            .into_iter()
+            .zip(idx)
+        {
+            fitted[k] = Some(entry);
+        }
+    }
+    fitted
+        .into_iter()
+        .enumerate()
+        .map(|(k, entry)| {
+            let account = &id.accounts[k];
+            match entry {
+                // A periodic record that also entered the any-record fit (`both`) keeps the
+                // any-record figures under its periodic account.
+                Some(mut e) => {
+                    e.account = Some(account.clone());
+                    e
+                }
+                None => RecordInfoSummary::accounted_only(&records[k], &files[k], account),
+            }
+        })
+        .collect()
 }

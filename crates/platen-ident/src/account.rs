@@ -1,0 +1,216 @@
+//! Every record accounted for: which method identified each record, whether it was used, and
+//! why not. [`identify_any`] is what `platen identify` runs on a set of files: it routes each
+//! record ([`crate::route`]), tries the periodic records on the paper's method and sends
+//! those it rejects to the any-record method instead of losing them, runs both methods, and
+//! returns one [`RecordAccount`] per input record, in input order.
+
+use serde::Serialize;
+
+use crate::anyrecord::result::RecordIdentification;
+use crate::anyrecord::settings::ValidRecordSettings;
+use crate::cycle::{self, RatePlan};
+use crate::error::{IdentError, Result};
+use crate::record::TestRecord;
+use crate::result::Identification;
+use crate::route::{route, Method, Route};
+use crate::settings::ValidSettings;
+
+/// The method a front end asks for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum MethodRequest {
+    /// Each record by its data: periodic tests to the paper's method, the rest to the
+    /// any-record method.
+    #[default]
+    Auto,
+    /// The paper's method wherever the data allow it; a record that is not periodic, or that
+    /// the periodic method rejects, falls back to the any-record method (with its reason).
+    Periodic,
+    /// The any-record method on every record, fitted jointly.
+    Record,
+    /// Periodic records through both methods, every record through the any-record method.
+    Both,
+}
+
+/// What identification did with one record.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RecordAccount {
+    /// `"periodic"` or `"record"`: the method that identified it (with
+    /// [`MethodRequest::Both`], a periodic record's is `"periodic"`; it enters the
+    /// any-record fit too).
+    #[serde(serialize_with = "method_name")]
+    pub method: Method,
+    /// Whether it entered the identification.
+    pub used: bool,
+    /// Why it was not used (absent when used).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+    /// Why it went to its method: the periodic test's fundamental, why it is not a periodic
+    /// test, or why the periodic method rejected it.
+    pub routing: String,
+}
+
+fn method_name<S: serde::Serializer>(m: &Method, s: S) -> std::result::Result<S::Ok, S::Error> {
+    s.serialize_str(m.name())
+}
+
+/// The result of [`identify_any`].
+#[derive(Debug, Clone)]
+pub struct Identified {
+    /// The paper's method on the periodic records, if any went there, with their indices in
+    /// the input.
+    pub periodic: Option<(Identification, Vec<usize>)>,
+    /// The any-record method on the other records, if any went there (and it could run),
+    /// with their indices in the input.
+    pub records: Option<(RecordIdentification, Vec<usize>)>,
+    /// One per input record, in input order.
+    pub accounts: Vec<RecordAccount>,
+}
+
+impl Identified {
+    /// Whether only the paper's method ran (every record a periodic test): the output is the
+    /// periodic method's alone.
+    pub fn periodic_only(&self) -> bool {
+        self.records.is_none() && self.accounts.iter().all(|a| a.method == Method::Periodic)
+    }
+}
+
+/// Routes and identifies `records`: see the module docs. `declared_record[k]` says the user
+/// declared record `k` not a periodic test (a manifest's `"kind": "record"`).
+///
+/// # Errors
+/// [`IdentError::NoTests`] for no records; the periodic method's errors on the records it
+/// accepted; the any-record method's errors when it is the only method that could run (when
+/// the periodic method ran, records the any-record method cannot use are reported unused
+/// with its error as the reason).
+pub fn identify_any(
+    records: &[TestRecord],
+    declared_record: &[bool],
+    request: MethodRequest,
+    settings: &ValidSettings,
+    record_settings: &ValidRecordSettings,
+) -> Result<Identified> {
+    if records.is_empty() {
+        return Err(IdentError::NoTests);
+    }
+    let mut accounts = Vec::with_capacity(records.len());
+    let mut periodic_idx = Vec::new();
+    let mut record_idx = Vec::new();
+    let mut plans: Vec<RatePlan> = Vec::new();
+    for (k, rec) in records.iter().enumerate() {
+        let declared = declared_record.get(k).copied().unwrap_or(false);
+        let r = if declared {
+            Route::Record {
+                reason: "declared a record (kind \"record\")".to_owned(),
+            }
+        } else {
+            route(rec)
+        };
+        let mut account = RecordAccount {
+            method: Method::Record,
+            used: true,
+            reason: None,
+            routing: String::new(),
+        };
+        match (&r, request) {
+            (_, MethodRequest::Record) => {
+                account.routing = "the any-record method on every record (forced)".to_owned();
+            }
+            (Route::Record { reason }, _) => {
+                account.routing = format!("not a periodic test: {reason}");
+            }
+            (Route::Periodic { frequency_hz }, _) => {
+                match periodic_analysable(rec, settings, &mut plans) {
+                    Ok(()) => {
+                        account.method = Method::Periodic;
+                        account.routing =
+                            format!("a periodic test at {frequency_hz:.4} Hz (regular cycles)");
+                        periodic_idx.push(k);
+                    }
+                    Err(e) => {
+                        account.routing = format!(
+                            "the periodic method rejected it ({}): identified by the any-record method instead",
+                            cause(&e)
+                        );
+                    }
+                }
+            }
+        }
+        let to_record = account.method == Method::Record || request == MethodRequest::Both;
+        if to_record {
+            record_idx.push(k);
+        }
+        accounts.push(account);
+    }
+    let periodic = if periodic_idx.is_empty() {
+        None
+    } else {
+        let recs: Vec<TestRecord> = periodic_idx.iter().map(|&k| records[k].clone()).collect();
+        Some((crate::identify(&recs, settings)?, periodic_idx))
+    };
+    let records_id = if record_idx.is_empty() {
+        None
+    } else {
+        let recs: Vec<TestRecord> = record_idx.iter().map(|&k| records[k].clone()).collect();
+        match crate::identify_records(&recs, record_settings) {
+            Ok(id) => {
+                for (report, &k) in id.records.iter().zip(&record_idx) {
+                    if report.used_samples == 0 && accounts[k].method == Method::Record {
+                        accounts[k].used = false;
+                        accounts[k].reason = Some(format!(
+                            "no sample moves faster than {} m/s away from its ends: nothing to fit",
+                            record_settings.min_speed_m_s
+                        ));
+                    }
+                }
+                Some((id, record_idx))
+            }
+            Err(e) if periodic.is_some() => {
+                for &k in &record_idx {
+                    if accounts[k].method == Method::Record {
+                        accounts[k].used = false;
+                        accounts[k].reason = Some(format!(
+                            "the any-record method could not run on the records routed to it: {}",
+                            cause(&e)
+                        ));
+                    }
+                }
+                None
+            }
+            Err(e) => return Err(e),
+        }
+    };
+    Ok(Identified {
+        periodic,
+        records: records_id,
+        accounts,
+    })
+}
+
+/// Whether the paper's method can analyse `rec` alone (its cycle, filters and waveform).
+fn periodic_analysable(
+    rec: &TestRecord,
+    settings: &ValidSettings,
+    plans: &mut Vec<RatePlan>,
+) -> Result<()> {
+    let rate = rec.sample_rate_hz();
+    let plan = match plans
+        .iter()
+        .position(|p| (p.rate_hz - rate).abs() <= 1e-9 * rate)
+    {
+        Some(i) => i,
+        None => {
+            plans.push(RatePlan::new(rate, settings, rec.name())?);
+            plans.len() - 1
+        }
+    };
+    cycle::analyse(rec, &plans[plan], settings).map(|_| ())
+}
+
+/// The error's sentence without the record's name (the account belongs to the record).
+fn cause(e: &IdentError) -> String {
+    match e {
+        IdentError::NotPeriodic { reason, .. } => reason.clone(),
+        IdentError::InvalidRecord { message, .. } => message.clone(),
+        other => other.to_string(),
+    }
+}
