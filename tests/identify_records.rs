@@ -161,3 +161,58 @@ fn a_lab_file_with_rounded_stamps_is_identified_as_recorded() {
     let m = v["effective_mass_kg"].as_f64().unwrap();
     assert!((m / 118e3 - 1.0).abs() < 0.02, "{m}");
 }
+
+/// docs/identification.md's day of records: the lab's three records (one mislabelled a sine)
+/// and two of the paper's periodic tests, each routed by its data, every one listed with
+/// what was done with it.
+#[test]
+fn a_mixed_day_lists_every_record_with_its_method() {
+    let manifest = data().join("mixed-day-manifest.json");
+    let o = platen(&[
+        "identify",
+        "--manifest",
+        manifest.to_str().unwrap(),
+        "--no-output-error",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["method"], "mixed");
+    let got: Vec<(String, String, bool)> = v["records"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| {
+            (
+                r["name"].as_str().unwrap().to_owned(),
+                r["method"].as_str().unwrap().to_owned(),
+                r["used"].as_bool().unwrap(),
+            )
+        })
+        .collect();
+    let want = [
+        ("eq-lab", "record"),
+        ("wn-lab", "record"),
+        ("wn-low-lab", "record"),
+        ("S9@13.8MPa", "periodic"),
+        ("T4@13.8MPa", "periodic"),
+    ];
+    assert_eq!(got.len(), want.len());
+    for ((name, method, used), (n, m)) in got.iter().zip(want) {
+        assert_eq!((name.as_str(), method.as_str(), *used), (n, m, true));
+    }
+    for r in v["records"].as_array().unwrap() {
+        assert!(r["channel_delay_s"].is_object(), "{r}");
+        assert!(r.get("reason").is_none(), "{r}");
+    }
+    let warnings = v["warnings"].as_array().unwrap();
+    assert!(
+        warnings.iter().any(|w| w
+            .as_str()
+            .unwrap()
+            .contains("`wn-lab` was declared periodic but is not")),
+        "{warnings:?}"
+    );
+    assert_eq!(v["periodic"]["sine_tests"].as_array().unwrap().len(), 1);
+    assert_eq!(v["periodic"]["triangle_tests"].as_array().unwrap().len(), 1);
+}

@@ -396,9 +396,20 @@ fn accounts_report(entries: &[RecordInfoSummary], inputs: &[Input]) -> String {
             None => "used".to_owned(),
             Some(r) => format!("NOT USED: {r}"),
         };
+        let delays =
+            e.channel_delay_s
+                .as_ref()
+                .filter(|d| !d.is_empty())
+                .map_or(String::new(), |d| {
+                    let list: Vec<String> = d
+                        .iter()
+                        .map(|(c, s)| format!("{c} {:+.2} samples", s * e.sample_rate_hz))
+                        .collect();
+                    format!("; delay {}", list.join(", "))
+                });
         let _ = writeln!(
             s,
-            "  {:<w$}  {:<8}  {status}; {}",
+            "  {:<w$}  {:<8}  {status}{delays}; {}",
             input.label,
             a.method.name(),
             a.routing
@@ -419,6 +430,15 @@ fn accounts_table(entries: &[RecordInfoSummary], inputs: &[Input]) -> Vec<String
                 a.method.name().to_owned(),
                 if a.used { "yes" } else { "no" }.to_owned(),
                 a.reason.clone().unwrap_or_default(),
+                e.channel_delay_s
+                    .as_ref()
+                    .map(|d| {
+                        d.iter()
+                            .map(|(c, s)| format!("{c} {:.3} ms", 1e3 * s))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    })
+                    .unwrap_or_default(),
                 a.routing.clone(),
             ])
         })
