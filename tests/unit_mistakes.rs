@@ -183,6 +183,7 @@ fn a_pressure_in_pa_where_mpa_is_asked_is_refused_and_nothing_is_written() {
             "--report",
             report.to_str().unwrap(),
         ],
+        vec!["model", "--pressure-mpa", "13.8e6", "--json"],
     ] {
         let o = platen(&args);
         assert!(!o.status.success(), "{args:?}");
@@ -210,6 +211,21 @@ fn a_pressure_in_pa_where_mpa_is_asked_is_refused_and_nothing_is_written() {
     assert!(err.contains("model.hold_down_pressure_mpa"), "{err}");
     assert!(err.contains("13.8e6 looks like Pa (13.8 MPa)"), "{err}");
     assert!(!out.exists());
+    // In an identification manifest: refused naming the manifest and the entry.
+    let manifest = write(
+        dir.path(),
+        "m.json",
+        r#"{"tests": [{"file": "rec.csv", "pressure_mpa": 13.8e6}]}"#,
+    );
+    let o = platen(&["identify", "--manifest", &manifest, "--json"]);
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("m.json") && err.contains("tests[0].pressure_mpa"),
+        "{err}"
+    );
+    assert!(err.contains("13.8e6 looks like Pa (13.8 MPa)"), "{err}");
+    assert!(o.stdout.is_empty());
     // 13.8 itself runs.
     assert!(platen(&[
         "sweep",

@@ -153,6 +153,8 @@ def test_model_errors(cli):
     assert str(raised.value) == expected and code == 3
     with pytest.raises(platen.ScenarioError, match=r"pressure_mpa = -1: expected a pressure >= 0 MPa"):
         platen.model(pressure_mpa=-1)
+    with pytest.raises(platen.ScenarioError, match=r"13.8e6 looks like Pa \(13.8 MPa\)"):
+        platen.model(pressure_mpa=13.8e6)
     with pytest.raises(platen.ScenarioError, match="form = 'fll': expected 'identified' or 'full'"):
         platen.model(form="fll")
 

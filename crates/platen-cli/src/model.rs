@@ -135,8 +135,11 @@ fn run_preset(preset: &str, pressure_mpa: Option<f64>, form: Form, json_out: boo
 /// `--pressure-mpa` in Pa (default the preset's nominal pressure).
 fn pressure_pa(preset: Preset, pressure_mpa: Option<f64>) -> Result<f64> {
     Ok(match pressure_mpa {
-        Some(p) if !(p.is_finite() && p >= 0.0) => {
-            bail!("--pressure-mpa {p}: expected a pressure >= 0 MPa")
+        Some(p) if platen_scenario::units::expected_pressure_mpa(p).is_some() => {
+            bail!(
+                "--pressure-mpa {}",
+                platen_scenario::units::check_pressure_mpa(p).unwrap_err()
+            )
         }
         Some(p) => p * 1e6,
         None => preset.nominal_pressure_pa(),

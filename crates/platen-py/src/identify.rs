@@ -70,14 +70,12 @@ pub fn identify(
                 "internal error: one pressure per file expected",
             ));
         }
-        if let Some(p) = pressures_mpa
+        if let Some(e) = pressures_mpa
             .iter()
             .flatten()
-            .find(|p| !(p.is_finite() && **p >= 0.0))
+            .find_map(|&p| platen_scenario::units::check_pressure_mpa(p).err())
         {
-            return Err(Fail::input(format!(
-                "pressure_mpa = {p}: expected a pressure >= 0 MPa"
-            )));
+            return Err(Fail::input(format!("pressure_mpa = {e}")));
         }
         if let Some(a) = viscous_exponent.filter(|a| !(a.is_finite() && (0.0..=1.0).contains(a))) {
             return Err(Fail::input(format!(

@@ -208,10 +208,12 @@ fn inverse<'py>(
 fn model(preset: &str, pressure_mpa: Option<f64>, full: bool) -> PyResult<String> {
     let preset = Preset::from_name(preset).map_err(Fail::from)?;
     let pressure_pa = match pressure_mpa {
-        Some(p) if !(p.is_finite() && p >= 0.0) => {
-            return Err(
-                Fail::input(format!("pressure_mpa = {p}: expected a pressure >= 0 MPa")).into(),
-            )
+        Some(p) if platen_scenario::units::expected_pressure_mpa(p).is_some() => {
+            return Err(Fail::input(format!(
+                "pressure_mpa = {}",
+                platen_scenario::units::check_pressure_mpa(p).unwrap_err()
+            ))
+            .into())
         }
         Some(p) => p * 1e6,
         None => preset.nominal_pressure_pa(),
