@@ -25,7 +25,11 @@
 //!   platen velocity is slaved to `N`, the specimen is stepped as on a fixed base (the base
 //!   acceleration in creep is the rate of a velocity below the stiff speed, negligible), and
 //!   the end of creep (a stop where `s·N` falls to `F_s`, slip where the creep speed reaches the
-//!   stiff speed) is located by root finding on the RK4 map.
+//!   stiff speed) is located by root finding on the RK4 map. At a stop the net force at rest
+//!   decides: stick, a reversal (beyond the threshold against the motion: without static
+//!   friction, `F_s = 0`, creep passes through `v = 0` so), or creep on; a stop that rounds
+//!   onto the start of its advance with the net force still a hair along the motion is
+//!   stepped [`just_past`] it, so the event loop always moves time forward.
 //!
 //! A platen leaves rest into creep if its creep speed under the net force there is below the
 //! stiff speed (which it is at an exact breakaway), and creep hands over to slip where it
@@ -51,6 +55,10 @@ use crate::run::{check_run, sample_at, EnergyBalance, Kin, RunStats, State};
 use crate::stop::{Failure, StopReason};
 
 const NS: usize = Specimen::MAX_STOREYS;
+/// A creep stop located this close (fraction of a step) to where the advance started has not
+/// moved time: if the net force at rest still drives the creep on, it is stepped just past
+/// ([`just_past`], whose first increment is `4ε`) instead of creeping on in place.
+const MIN_PROGRESS: f64 = 4.0 * f64::EPSILON;
 /// Positions in the state vector: displacement, velocity, actuator work, platen dissipation,
 /// storey dissipation, then the `n` storey displacements from `Z` and the `n` storey
 /// velocities from `Z + n` (the stepper's `zd`): the live state is the prefix `5 + 2n` of the
@@ -577,8 +585,9 @@ impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
                 }
             }
             Mode::Creep(dir) => {
+                let start = self.y;
                 self.y = y_event;
-                let f = self.grid.force(n, at);
+                let mut f = self.grid.force(n, at);
                 let sn = dir.sign() * self.net(&self.y, f);
                 let fs = self.model.static_threshold_n(self.y[U]);
                 if sn - fs <= self.exit_level(dir, self.y[U]) - sn {
@@ -586,7 +595,17 @@ impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
                     // a reversal, as the net force at rest decides).
                     self.y[V] = 0.0;
                     let f_eff = f - self.base_shear(&self.y);
-                    match mode_at_rest(self.model, self.y[U], f_eff) {
+                    let mut mode = mode_at_rest(self.model, self.y[U], f_eff);
+                    if mode == Mode::Slip(dir) && x <= MIN_PROGRESS {
+                        // The stop rounded onto the start of the advance, where the net force
+                        // at rest is a hair along the motion: creeping on from here would
+                        // locate the same stop again without moving time. Step just past it,
+                        // to where the net force at rest no longer drives the creep on (see
+                        // `crate::creep`, whose passes do the same).
+                        (at, f) = self.creep_just_past(n, tau, x, start, dir);
+                        mode = mode_at_rest(self.model, self.y[U], f - self.base_shear(&self.y));
+                    }
+                    match mode {
                         Mode::Slip(d) if d == dir => {
                             self.enter(Mode::Creep(dir), f);
                             StepStop::Moved { at }
@@ -621,6 +640,39 @@ impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
                 }
             }
         }
+    }
+
+    /// A creep stop located `x ≤` [`MIN_PROGRESS`] past fraction `tau` of step `n` (from the
+    /// state `start`) where the net force at rest still drives the creep on in `dir`: creeps
+    /// from `start` to the first of `x + 4ε, x + 8ε, …` ([`just_past`]) where it does not,
+    /// or to the end of the step, and makes that the state (at rest, `v = 0`). Returns where
+    /// (fraction of the step) and the force there.
+    fn creep_just_past(
+        &mut self,
+        n: GridStep,
+        tau: f64,
+        x: f64,
+        start: Y<L>,
+        dir: Direction,
+    ) -> (f64, f64) {
+        let stopped = self.y;
+        self.y = start;
+        let x_b = just_past(x, 1.0 - tau, |x| {
+            let (y, _) = self.piece(n, tau, x, Grading::Single);
+            let f = self.grid.force(n, tau + x);
+            mode_at_rest(self.model, y[U], f - self.base_shear(&y)) != Mode::Slip(dir)
+        });
+        self.y = if x_b > x {
+            self.piece(n, tau, x_b, Grading::Single).0
+        } else {
+            stopped
+        };
+        self.y[V] = 0.0;
+        let mut at = tau + x_b;
+        if 1.0 - at < 1e-12 {
+            at = 1.0;
+        }
+        (at, self.grid.force(n, at))
     }
 
     /// The stuck state over a length `x` from fraction `tau` of step `n` (one RK4 step).

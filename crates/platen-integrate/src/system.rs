@@ -23,7 +23,10 @@
 //!   the same way (its rate `Ṅ = n(A_a·ṗ_a − A_b·ṗ_b) + k₁ż₁ + c₁z̈₁` is exact).
 //! * **creep±** (`α < 1`): the velocity slaved to the net force below the stiff speed; the
 //!   platen's acceleration is taken as zero there (it is the rate of a velocity below the
-//!   stiff speed, negligible next to the loop's).
+//!   stiff speed, negligible next to the loop's). A creep stop that rounds onto the start of
+//!   its advance with the net force at rest still a hair along the motion is stepped
+//!   [`just_past`] it (as in [`crate::forward_rk4_specimen`]), so a frictionless table
+//!   (`F_s = 0`) creeps through `v = 0` instead of stalling.
 //!
 //! The integrator of each piece is RK4 (one step, graded near rest as the force-driven RK4) or
 //! an adaptive Dormand–Prince 5(4) that meets `rtol`/`atol` over the piece.
@@ -56,6 +59,10 @@ use crate::run::{sample_at, EnergyBalance, Kin, RunStats, State};
 use crate::stop::{Failure, StopReason};
 
 const NS: usize = Specimen::MAX_STOREYS;
+/// A creep stop located this close (fraction of a step `h`) to where the advance started has
+/// not moved time: if the net force at rest still drives the creep on, it is stepped just
+/// past ([`just_past`]) instead of creeping on in place.
+const MIN_PROGRESS: f64 = 4.0 * f64::EPSILON;
 const U: usize = 0;
 const V: usize = 1;
 /// `∫F_A·v dt`, J.
@@ -788,13 +795,25 @@ impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
                 x_b
             }
             Mode::Creep(dir) => {
+                let start = (self.y, self.k);
                 self.commit(y_event, self.t + at);
                 let sn = dir.sign() * self.net(&self.y);
                 let fs = self.model.static_threshold_n(self.y[U]);
                 if sn - fs <= self.exit_level(dir, self.y[U]) - sn {
                     self.y[V] = 0.0;
                     let f_eff = self.force(&self.y) - self.base_shear(&self.y);
-                    match mode_at_rest(self.model, self.y[U], f_eff) {
+                    let mut mode = mode_at_rest(self.model, self.y[U], f_eff);
+                    if mode == Mode::Slip(dir) && x <= MIN_PROGRESS * self.h {
+                        // The stop rounded onto the start of the advance, where the net force
+                        // at rest is a hair along the motion: creeping on from here would
+                        // locate the same stop again without moving time. Step just past it,
+                        // to where the net force at rest no longer drives the creep on (see
+                        // `crate::creep`, whose passes do the same).
+                        at = self.creep_just_past(x, rest, start, dir);
+                        let f_eff = self.force(&self.y) - self.base_shear(&self.y);
+                        mode = mode_at_rest(self.model, self.y[U], f_eff);
+                    }
+                    match mode {
                         Mode::Slip(d) if d == dir => self.enter(Mode::Creep(dir)),
                         Mode::Stick => {
                             self.stats.run.record(EventKind::Stop);
@@ -817,6 +836,33 @@ impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
                 }
                 at
             }
+        }
+    }
+
+    /// A creep stop located `x ≤` [`MIN_PROGRESS`]`·h` seconds into the advance (from the
+    /// state and rates `start`) where the net force at rest still drives the creep on in
+    /// `dir`: creeps from `start` to the first of `x + 4ε, x + 8ε, …` s ([`just_past`]) where
+    /// it does not, or to `rest`, and commits that state at rest (`v = 0`). Returns where
+    /// (seconds into the advance).
+    fn creep_just_past(&mut self, x: f64, rest: f64, start: (Y<L>, Y<L>), dir: Direction) -> f64 {
+        let stopped = (self.y, self.k, self.a);
+        (self.y, self.k) = start;
+        let x_b = just_past(x, rest, |x| {
+            let (y, _) = self.piece(x, Grading::Single);
+            let f_eff = self.force(&y) - self.base_shear(&y);
+            mode_at_rest(self.model, y[U], f_eff) != Mode::Slip(dir)
+        });
+        if x_b > x {
+            let (y, _) = self.piece(x_b, Grading::Single);
+            self.commit(y, self.t + x_b);
+        } else {
+            (self.y, self.k, self.a) = stopped;
+        }
+        self.y[V] = 0.0;
+        if rest - x_b < 1e-12 * self.h {
+            rest
+        } else {
+            x_b
         }
     }
 
