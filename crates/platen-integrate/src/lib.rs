@@ -3,6 +3,8 @@
 //! * [`forward_rk4`]: a recorded or generated actuator force → displacement, velocity,
 //!   acceleration and the force decomposition, with fixed-step RK4 and exact stick-slip
 //!   (modes slip+, slip−, stick; `v = 0` located inside the step; breakaway solved exactly).
+//! * [`forward_rk4_ensemble`]: several such runs of the identified model (a sweep's cases)
+//!   advanced together in SIMD lanes, bit for bit the runs of [`forward_rk4`].
 //! * [`forward_dopri5`]: the same with the adaptive Dormand–Prince 5(4) of `ode_solvers`.
 //! * [`ForwardIntegrator`] and [`Method`]: one entry point for both, as a scenario selects it.
 //! * [`inverse`]: a prescribed motion → the actuator force it needs and its decomposition.
@@ -42,6 +44,7 @@
 
 mod creep;
 mod dopri5;
+mod ensemble;
 mod error;
 mod event;
 mod inverse;
@@ -55,6 +58,7 @@ mod stop;
 mod system;
 
 pub use dopri5::{forward_dopri5, Dopri5Settings};
+pub use ensemble::{forward_rk4_ensemble, forward_rk4_lanes, EnsembleCase, ENSEMBLE_LANES};
 pub use error::{IntegrateError, Result};
 pub use event::EventKind;
 pub use inverse::{inverse, inverse_specimen, INVERSE_SPECIMEN_SUBSTEPS};

@@ -332,17 +332,17 @@ impl Grading {
 /// the speed there is below what a piece that short can resolve).
 pub(crate) const MAX_HALVINGS: u32 = 60;
 
-/// The mutable state of a forward RK4 run.
-struct Stepper<'a, M> {
+/// The mutable state of a forward RK4 run (also one lane of [`crate::ensemble`]).
+pub(crate) struct Stepper<'a, M> {
     model: &'a M,
-    grid: Grid<'a>,
-    y: Kin,
-    mode: Mode,
+    pub(crate) grid: Grid<'a>,
+    pub(crate) y: Kin,
+    pub(crate) mode: Mode,
     /// Rates at the current state in the current mode (zero in stick and creep).
-    rates: SlipRates,
+    pub(crate) rates: SlipRates,
     /// The stiff speed of the current creep phase (see [`crate::creep`]), m/s.
     w_stiff: f64,
-    stats: RunStats,
+    pub(crate) stats: RunStats,
 }
 
 const AT_REST: SlipRates = SlipRates {
@@ -351,7 +351,7 @@ const AT_REST: SlipRates = SlipRates {
 };
 
 impl<'a, M: PlatenModel> Stepper<'a, M> {
-    fn new(model: &'a M, grid: Grid<'a>, initial: State) -> Self {
+    pub(crate) fn new(model: &'a M, grid: Grid<'a>, initial: State) -> Self {
         let mut s = Self {
             model,
             grid,
@@ -389,7 +389,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
     }
 
     /// The output sample at sample `j` of the record (grid point `j·k`, τ = 0).
-    fn sample(&self, j: usize, t_s: f64) -> Sample {
+    pub(crate) fn sample(&self, j: usize, t_s: f64) -> Sample {
         sample_at(
             self.model,
             j,
@@ -403,7 +403,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
 
     /// Advances from grid point `n` to `n + 1`, handling every event inside the step.
     #[inline]
-    fn step(&mut self, n: GridStep) -> Result<()> {
+    pub(crate) fn step(&mut self, n: GridStep) -> Result<()> {
         self.stats.steps += 1;
         let mut tau = 0.0;
         let mut events = 0u32;
@@ -736,7 +736,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
     }
 
     /// Closes the energy balance at the current state, the run having finished at `t_s`.
-    fn finish(&mut self, t_s: f64) -> RunStats {
+    pub(crate) fn finish(&mut self, t_s: f64) -> RunStats {
         self.stats.energy.close(
             self.model,
             self.y.u,
