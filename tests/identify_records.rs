@@ -168,12 +168,16 @@ fn a_lab_file_with_rounded_stamps_is_identified_as_recorded() {
 #[test]
 fn a_mixed_day_lists_every_record_with_its_method() {
     let manifest = data().join("mixed-day-manifest.json");
+    let dir = tempfile::tempdir().unwrap();
+    let page = dir.path().join("day.html");
     let o = platen(&[
         "identify",
         "--manifest",
         manifest.to_str().unwrap(),
         "--no-output-error",
         "--json",
+        "--report",
+        page.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: Value = serde_json::from_slice(&o.stdout).unwrap();
@@ -213,6 +217,20 @@ fn a_mixed_day_lists_every_record_with_its_method() {
             .contains("`wn-lab` was declared periodic but is not")),
         "{warnings:?}"
     );
+    // The HTML report's table: one row per file, with the columns of the JSON.
+    let html = std::fs::read_to_string(&page).unwrap();
+    let table = &html[html.find("<h2>Records</h2>").expect("a Records section")..];
+    let table = &table[..table.find("</table>").unwrap()];
+    assert!(table.contains(
+        "<th>file</th><th>method</th><th>used</th><th>reason</th><th>channel delay</th><th>routing</th>"
+    ));
+    assert_eq!(table.matches("<tr>").count(), 1 + want.len());
+    for (n, _) in want {
+        assert!(
+            table.contains(&format!("<td><code>{n}</code></td>")) || table.contains(n),
+            "{n}"
+        );
+    }
     assert_eq!(v["periodic"]["sine_tests"].as_array().unwrap().len(), 1);
     assert_eq!(v["periodic"]["triangle_tests"].as_array().unwrap().len(), 1);
 }

@@ -446,7 +446,14 @@ fn accounts_table(entries: &[RecordInfoSummary], inputs: &[Input]) -> Vec<String
     vec![
         html::heading("Records"),
         html::table(
-            &["file", "method", "used", "reason", "routing"],
+            &[
+                "file",
+                "method",
+                "used",
+                "reason",
+                "channel delay",
+                "routing",
+            ],
             &rows,
             false,
         ),
