@@ -192,17 +192,7 @@ fn periodic_analysable(
     settings: &ValidSettings,
     plans: &mut Vec<RatePlan>,
 ) -> Result<()> {
-    let rate = rec.sample_rate_hz();
-    let plan = match plans
-        .iter()
-        .position(|p| (p.rate_hz - rate).abs() <= 1e-9 * rate)
-    {
-        Some(i) => i,
-        None => {
-            plans.push(RatePlan::new(rate, settings, rec.name())?);
-            plans.len() - 1
-        }
-    };
+    let plan = RatePlan::for_record(plans, rec, settings)?;
     cycle::analyse(rec, &plans[plan], settings).map(|_| ())
 }
 

@@ -93,6 +93,24 @@ pub(crate) struct RatePlan {
 }
 
 impl RatePlan {
+    /// The index in `plans` of the plan at `rec`'s sample rate, made and added if there is
+    /// none yet (one filter design per rate, however many records share it).
+    pub(crate) fn for_record(
+        plans: &mut Vec<RatePlan>,
+        rec: &TestRecord,
+        settings: &ValidSettings,
+    ) -> Result<usize> {
+        let rate = rec.sample_rate_hz();
+        if let Some(i) = plans
+            .iter()
+            .position(|p| (p.rate_hz - rate).abs() <= 1e-9 * rate)
+        {
+            return Ok(i);
+        }
+        plans.push(RatePlan::new(rate, settings, rec.name())?);
+        Ok(plans.len() - 1)
+    }
+
     pub(crate) fn new(rate_hz: f64, settings: &ValidSettings, test: &str) -> Result<Self> {
         let signal = |source| IdentError::Signal {
             test: test.to_owned(),

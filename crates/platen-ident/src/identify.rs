@@ -105,17 +105,7 @@ fn analyse_records(
     let mut plans: Vec<RatePlan> = Vec::new();
     let mut work = Vec::with_capacity(records.len());
     for rec in records {
-        let rate = rec.sample_rate_hz();
-        let plan_idx = match plans
-            .iter()
-            .position(|p| (p.rate_hz - rate).abs() <= 1e-9 * rate)
-        {
-            Some(i) => i,
-            None => {
-                plans.push(RatePlan::new(rate, settings, rec.name())?);
-                plans.len() - 1
-            }
-        };
+        let plan_idx = RatePlan::for_record(&mut plans, rec, settings)?;
         let an = cycle::analyse(rec, &plans[plan_idx], settings)?;
         work.push(Work::new(rec, an, settings));
     }

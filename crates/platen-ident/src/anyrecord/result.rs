@@ -403,7 +403,7 @@ impl fmt::Display for RecordWarning {
                     f,
                     "implausible: {} = {value:.4e} {} ({}{}) is {} on a physical platen",
                     symbol(*key),
-                    unit(*key),
+                    key.unit(),
                     fit.name(),
                     ci95.map_or(String::new(), |[lo, hi]| format!(
                         ", 95 % interval {lo:.4e} to {hi:.4e}"
@@ -439,21 +439,9 @@ impl fmt::Display for RecordWarning {
                 f,
                 "implausible output-error check: {} = {output_error:.4e} {} against {equation_error:.4e} from the equation error; it does not check the equation error (the record may not excite the platen enough for a forward simulation to pin it)",
                 symbol(*key),
-                unit(*key)
+                key.unit()
             ),
         }
-    }
-}
-
-/// The parameter's SI unit.
-fn unit(key: IdentifiedKey) -> &'static str {
-    match key {
-        IdentifiedKey::EffectiveMass => "kg",
-        IdentifiedKey::Stiffness => "N/m",
-        IdentifiedKey::CoulombForce | IdentifiedKey::LowVelocityForce => "N",
-        IdentifiedKey::ViscousCoefficient => "N/(m/s)^α",
-        IdentifiedKey::ViscousExponent => "",
-        IdentifiedKey::LowVelocityDecay => "s/m",
     }
 }
 
