@@ -20,6 +20,9 @@ fn bench_json_reports_every_figure_as_a_positive_number() {
         "rk4_full_ratio_to_baseline",
         "rk4_steps_per_s",
         "rk4_simulated_s_per_wall_s",
+        "ensemble_ns_per_step_per_trajectory",
+        "ensemble_scalar_ns_per_step",
+        "ensemble_ratio_to_scalar",
     ] {
         let v = b[key]
             .as_f64()

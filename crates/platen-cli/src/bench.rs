@@ -25,7 +25,12 @@
 //! * `table_system`: the closed loop ([`forward_closed_loop`]) of the `lhpost-2008` table
 //!   system (controller at 1024 Hz, valves, single-ended actuators, accumulator) on the
 //!   identified model, commanded with that S9 motion, at its default step (7 RK4 steps per
-//!   controller period, resolving the 246 Hz spool), timed per integration step.
+//!   controller period, resolving the 246 Hz spool), timed per integration step;
+//! * `ensemble` and `ensemble_scalar`: [`ENSEMBLE_LANES`] sweep-like cases (the identified
+//!   model at 6.9 and 13.8 MPa under the forward force scaled by 0.9 and 1.1, more cases to
+//!   fill the lanes) run by [`forward_rk4_ensemble`] in SIMD lanes, and the same cases run one
+//!   after the other by the scalar [`forward_rk4`] (bit for bit the same runs), each case's
+//!   peaks only; timed per step per trajectory, so their ratio is the ensemble's gain.
 //!
 //! The workloads are data ([`workloads`]): one timing loop ([`time_round_robin`]) runs them
 //! round-robin `repeats` times and the median wall time of each is reported, so that a slow
@@ -40,8 +45,9 @@ use anyhow::{ensure, Context, Result};
 use serde_json::{json, Map, Value};
 
 use platen_integrate::{
-    forward_closed_loop, forward_rk4_specimen, inverse, Dopri5Settings, ForceRecord,
-    ForwardIntegrator, LoopMethod, LoopRun, Method, Motion, Rk4, State, Trajectory,
+    forward_closed_loop, forward_rk4, forward_rk4_ensemble, forward_rk4_specimen, inverse,
+    Dopri5Settings, EnsembleCase, ForceRecord, ForwardIntegrator, LoopMethod, LoopRun, Method,
+    Motion, Peaks, Rk4, State, Trajectory, ENSEMBLE_LANES,
 };
 use platen_model::{preset, FullModel, IdentifiedModel, IdentifiedParams, Specimen, Storey};
 use platen_system::TableSystem;
@@ -90,6 +96,10 @@ enum Job {
     /// [`forward_closed_loop`] of the preset's table system commanded with the motion; one
     /// unit per integration step.
     TableSystem,
+    /// [`forward_rk4_ensemble`] of the ensemble cases; one unit per step per trajectory.
+    Ensemble(Rk4),
+    /// [`forward_rk4`] of each ensemble case in turn; one unit per step per trajectory.
+    EnsembleScalar(Rk4),
 }
 
 /// One timed workload.
@@ -194,6 +204,18 @@ fn workloads() -> Result<Vec<Workload>> {
             "step",
             Job::TableSystem,
         ),
+        Workload::new(
+            "ensemble_scalar",
+            "ensemble_scalar: sweep-like cases one by one, peaks",
+            "step",
+            Job::EnsembleScalar(Rk4::with_steps_per_sample(1)?),
+        ),
+        Workload::new(
+            "ensemble",
+            "ensemble: the same cases in SIMD lanes, peaks",
+            "step",
+            Job::Ensemble(Rk4::with_steps_per_sample(1)?),
+        ),
     ])
 }
 
@@ -209,6 +231,9 @@ struct Inputs {
     full: FullModel,
     specimen: Specimen,
     system: TableSystem,
+    /// The models and force records of the ensemble cases.
+    ensemble_models: Vec<IdentifiedModel>,
+    ensemble_records: Vec<ForceRecord>,
 }
 
 /// The 3-storey specimen of the `rk4_specimen` workload: 20 t floors, storey stiffnesses 40,
@@ -252,6 +277,15 @@ impl Inputs {
         )
         .context("bench motion")?;
         let identified_params = preset::lhpost_2008_identified(PRESSURE_PA);
+        let (mut ensemble_models, mut ensemble_records) = (Vec::new(), Vec::new());
+        for case in 0..ENSEMBLE_LANES {
+            let scale = [0.9, 1.1][case / 2 % 2] + 0.05 * (case / 4) as f64;
+            let pressure_pa = [6.9e6, PRESSURE_PA][case % 2];
+            ensemble_models.push(preset::lhpost_2008_identified(pressure_pa).build()?);
+            let scaled = force.iter().map(|f| f * scale).collect();
+            ensemble_records
+                .push(ForceRecord::from_rate(RATE_HZ, scaled).context("bench ensemble record")?);
+        }
         Ok(Self {
             samples,
             force,
@@ -262,7 +296,24 @@ impl Inputs {
             full: preset::lhpost_2008_physical(PRESSURE_PA).build()?,
             specimen: bench_specimen()?,
             system: platen_system::preset::lhpost_2008(),
+            ensemble_models,
+            ensemble_records,
         })
+    }
+}
+
+impl Inputs {
+    /// The ensemble cases, from rest.
+    fn ensemble_cases(&self) -> Vec<EnsembleCase<'_>> {
+        self.ensemble_models
+            .iter()
+            .zip(&self.ensemble_records)
+            .map(|(model, record)| EnsembleCase {
+                model,
+                record,
+                initial: State::default(),
+            })
+            .collect()
     }
 }
 
@@ -346,6 +397,33 @@ impl Job {
                 let stats = stats.context("bench closed-loop run")?;
                 black_box(&*out);
                 Ok((s, stats.run.steps, None))
+            }
+            Job::Ensemble(rk4) => {
+                let cases = inputs.ensemble_cases();
+                let mut peaks = vec![Peaks::default(); cases.len()];
+                let (s, results) =
+                    time(|| forward_rk4_ensemble(black_box(&cases), rk4, samples, &mut peaks));
+                for r in results {
+                    r.context("bench ensemble run")?;
+                }
+                black_box(&peaks);
+                Ok((s, ((samples - 1) * cases.len()) as u64, None))
+            }
+            Job::EnsembleScalar(rk4) => {
+                let cases = inputs.ensemble_cases();
+                let mut peaks = vec![Peaks::default(); cases.len()];
+                let (s, results) = time(|| {
+                    black_box(&cases)
+                        .iter()
+                        .zip(peaks.iter_mut())
+                        .map(|(c, p)| forward_rk4(c.model, c.record, rk4, c.initial, samples, p))
+                        .collect::<Vec<_>>()
+                });
+                for r in results {
+                    r.context("bench ensemble case, scalar")?;
+                }
+                black_box(&peaks);
+                Ok((s, ((samples - 1) * cases.len()) as u64, None))
             }
             Job::Inverse => {
                 clear(out);
@@ -473,6 +551,20 @@ impl Report<'_> {
             json!(rk4_full.ns_per_unit() / base),
         );
         m.insert("rk4_steps_per_s".into(), json!(1e9 / rk4.ns_per_unit()));
+        let (ensemble, ensemble_scalar) = (self.get("ensemble"), self.get("ensemble_scalar"));
+        m.insert("ensemble_lanes".into(), json!(ENSEMBLE_LANES));
+        m.insert(
+            "ensemble_ns_per_step_per_trajectory".into(),
+            json!(ensemble.ns_per_unit()),
+        );
+        m.insert(
+            "ensemble_scalar_ns_per_step".into(),
+            json!(ensemble_scalar.ns_per_unit()),
+        );
+        m.insert(
+            "ensemble_ratio_to_scalar".into(),
+            json!(ensemble.ns_per_unit() / ensemble_scalar.ns_per_unit()),
+        );
         m.insert(
             "rk4_simulated_s_per_wall_s".into(),
             json!(simulated_s / rk4.median_s()),
