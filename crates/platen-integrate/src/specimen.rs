@@ -132,9 +132,82 @@ impl<M: PlatenModel, const L: usize> GridStepper for Stepper<'_, M, L> {
     }
 }
 
+/// The storeys' masses, stiffnesses and dampings (bottom first) in fixed-size arrays; the
+/// first `n` are the specimen's.
+struct StoreyConstants {
+    m: [f64; NS],
+    k: [f64; NS],
+    c: [f64; NS],
+}
+
+impl StoreyConstants {
+    fn of(spec: &Specimen) -> Self {
+        let mut st = Self {
+            m: [0.0; NS],
+            k: [0.0; NS],
+            c: [0.0; NS],
+        };
+        for (i, s) in spec.storeys().iter().enumerate() {
+            (st.m[i], st.k[i], st.c[i]) = (s.mass_kg, s.stiffness_n_per_m, s.damping_n_s_per_m);
+        }
+        st
+    }
+}
+
+/// The part of the storeys' rates that does not depend on the platen's acceleration `a`
+/// ([`Stepper::storey_part`]).
+struct StoreyPart {
+    /// The storey accelerations at `a = 0`: `z̈ᵢ = qᵢ − a`.
+    q: [f64; NS],
+    /// The power dissipated by the storey dampers, W.
+    power: f64,
+    /// The bottom storey's shear `k₁z₁ + c₁ż₁ = −B`, N.
+    shear0: f64,
+}
+
+/// The friction direction of slip as a number: `+1.0` for `POSITIVE`, `−1.0` otherwise (as
+/// in the bare RK4: the slip path is compiled per direction, and `±x` is exact).
+#[inline(always)]
+const fn direction<const POSITIVE: bool>() -> f64 {
+    if POSITIVE {
+        1.0
+    } else {
+        -1.0
+    }
+}
+
+/// [`Stepper::storey_part`] for a state of length `L` (`(L − 5)/2` storeys).
+#[inline(always)]
+fn storey_part<const L: usize>(st: &StoreyConstants, y: &Y<L>) -> StoreyPart {
+    let (n, zd0) = ((L - Z) / 2, Z + (L - Z) / 2);
+    let mut part = StoreyPart {
+        q: [0.0; NS],
+        power: 0.0,
+        shear0: 0.0,
+    };
+    let (mut z_prev, mut zd_prev, mut shear_prev) = (0.0, 0.0, 0.0);
+    for i in 0..n {
+        let (z, zd) = (y[Z + i], y[zd0 + i]);
+        let (d, dd) = (z - z_prev, zd - zd_prev);
+        let shear = st.k[i] * d + st.c[i] * dd;
+        part.power += st.c[i] * dd * dd;
+        if i == 0 {
+            part.shear0 = shear;
+        } else {
+            part.q[i - 1] = (shear - shear_prev) / st.m[i - 1];
+        }
+        (z_prev, zd_prev, shear_prev) = (z, zd, shear);
+    }
+    part.q[n - 1] = -shear_prev / st.m[n - 1];
+    part
+}
+
 struct Stepper<'a, M, const L: usize> {
     model: &'a M,
     spec: &'a Specimen,
+    /// The storeys' constants in fixed-size arrays (the first `N` are live), so that the
+    /// storey loops run over compile-time bounds without indexing the specimen's `Vec`.
+    storeys: StoreyConstants,
     grid: Grid<'a>,
     y: Y<L>,
     mode: Mode,
@@ -162,6 +235,7 @@ impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
         let mut s = Self {
             model,
             spec,
+            storeys: StoreyConstants::of(spec),
             grid,
             y,
             mode: Mode::Stick,
@@ -200,20 +274,60 @@ impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
         self.spec.energy_j(y[V], &y[Z..Z + n], &y[zd..zd + n])
     }
 
+    /// The storeys' part of the rates that does not depend on the platen's acceleration `a`
+    /// (the storey accelerations are `qᵢ − a`), computed once per stage before the platen's.
+    ///
+    /// The same operations, in the same order, as [`Specimen::storey_accelerations`] (whose
+    /// `(shearᵢ₊₁ − shearᵢ)/mᵢ − a` is `qᵢ − a` here, and whose bottom storey's shear
+    /// `k₁(z₁ − 0) + c₁(ż₁ − 0)` is `−B` bit for bit), so the results are identical; the
+    /// unit test `storey_part_is_the_model_s` checks it.
+    #[inline(always)]
+    fn storey_part(&self, y: &Y<L>) -> StoreyPart {
+        storey_part(&self.storeys, y)
+    }
+
+    /// Writes the storeys' rates into `dy` from their linear part under platen acceleration
+    /// `a`.
+    #[inline(always)]
+    fn storey_rates(part: &StoreyPart, a: f64, y: &Y<L>, dy: &mut Y<L>) {
+        for i in 0..Self::N {
+            dy[Z + i] = y[Self::ZD + i];
+            dy[Self::ZD + i] = part.q[i] - a;
+        }
+        dy[SD] = part.power;
+    }
+
+    /// The rates of the full state in slip with direction `direction::<POSITIVE>()` under
+    /// actuator force `f`, into `dy`; returns the platen acceleration. The slip case of
+    /// [`Stepper::rates`], compiled per direction so that `±v` and `±D` fold (exact for ±1).
+    #[inline(always)]
+    fn slip_rates<const POSITIVE: bool>(&self, f: f64, y: &Y<L>, dy: &mut Y<L>) -> f64 {
+        let part = self.storey_part(y);
+        let bs = -part.shear0;
+        let r = self
+            .model
+            .slip_rates(f - bs, y[U], y[V], direction::<POSITIVE>());
+        dy[U] = y[V];
+        dy[V] = r.a_m_s2;
+        dy[W] = f * y[V];
+        dy[DI] = r.dissipated_power_w;
+        Self::storey_rates(&part, r.a_m_s2, y, dy);
+        r.a_m_s2
+    }
+
     /// The rates of the full state in `mode` under actuator force `f`, into `dy`; returns the
     /// platen acceleration.
     #[inline(always)]
     fn rates(&self, mode: Mode, f: f64, y: &Y<L>, dy: &mut Y<L>) -> f64 {
-        let bs = self.base_shear(y);
+        match mode {
+            Mode::Slip(Direction::Positive) => return self.slip_rates::<true>(f, y, dy),
+            Mode::Slip(Direction::Negative) => return self.slip_rates::<false>(f, y, dy),
+            _ => {}
+        }
+        let part = self.storey_part(y);
+        let bs = -part.shear0;
         let a = match mode {
-            Mode::Slip(dir) => {
-                let r = self.model.slip_rates(f - bs, y[U], y[V], dir.sign());
-                dy[U] = y[V];
-                dy[V] = r.a_m_s2;
-                dy[W] = f * y[V];
-                dy[DI] = r.dissipated_power_w;
-                r.a_m_s2
-            }
+            Mode::Slip(_) => unreachable!("slip returned above"),
             Mode::Stick => {
                 dy[U] = 0.0;
                 dy[V] = 0.0;
@@ -236,12 +350,7 @@ impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
                 }
             }
         };
-        let (n, zd) = (Self::N, Self::ZD);
-        dy[Z..Z + n].copy_from_slice(&y[zd..zd + n]);
-        let (zs, zds) = (&y[Z..Z + n], &y[zd..zd + n]);
-        dy[SD] = self
-            .spec
-            .storey_accelerations(a, zs, zds, &mut dy[zd..zd + n]);
+        Self::storey_rates(&part, a, y, dy);
         a
     }
 
@@ -434,8 +543,76 @@ impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
     }
 
     /// Advances from grid point `n` to `n + 1`, handling every event inside the step.
+    ///
+    /// A step in slip away from rest first tries [`Stepper::slip_fast`] (compiled per
+    /// direction); anything it does not commit, and every other mode, goes through the
+    /// generic [`Stepper::advance`].
+    #[inline(always)]
     fn step(&mut self, n: GridStep) -> Result<()> {
         self.stats.steps += 1;
+        let committed = match self.mode {
+            Mode::Slip(Direction::Positive) if self.y[V] != 0.0 => self.slip_fast::<true>(n),
+            Mode::Slip(Direction::Negative) if self.y[V] != 0.0 => self.slip_fast::<false>(n),
+            _ => false,
+        };
+        if committed {
+            return Ok(());
+        }
+        self.step_with_events(n)
+    }
+
+    /// One RK4 step over the whole grid step `n` in slip with direction
+    /// `direction::<POSITIVE>()` (the platen moving, `v ≠ 0`), committed when it is safe:
+    /// exactly the first try of [`Stepper::advance`] (`τ = 0`, a single piece of length 1),
+    /// the same operations in the same order, so what it commits is bit for bit what
+    /// [`Stepper::advance`] would. Returns whether it committed; if not, nothing has changed
+    /// (statistics included) and the step is taken again by [`Stepper::step_with_events`].
+    #[inline(always)]
+    fn slip_fast<const POSITIVE: bool>(&mut self, n: GridStep) -> bool {
+        let dir = direction::<POSITIVE>();
+        // The piece is the whole step: `len = 1 − 0`, `len·h = h`.
+        let h = self.grid.h;
+        let (f_mid, f_end) = (self.grid.force(n, 0.5), self.grid.force(n, 1.0));
+        let (y, k1) = (&self.y, &self.k);
+        let hh = 0.5 * h;
+        let (mut k2, mut k3, mut k4) = ([0.0; L], [0.0; L], [0.0; L]);
+        let mut y2 = *y;
+        for i in 0..L {
+            y2[i] += hh * k1[i];
+        }
+        self.slip_rates::<POSITIVE>(f_mid, &y2, &mut k2);
+        let mut y3 = *y;
+        for i in 0..L {
+            y3[i] += hh * k2[i];
+        }
+        self.slip_rates::<POSITIVE>(f_mid, &y3, &mut k3);
+        let mut y4 = *y;
+        for i in 0..L {
+            y4[i] += h * k3[i];
+        }
+        self.slip_rates::<POSITIVE>(f_end, &y4, &mut k4);
+        let h6 = h / 6.0;
+        let mut y1 = *y;
+        for i in 0..L {
+            y1[i] += h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
+        }
+        let stage_min = (dir * y2[V]).min(dir * y3[V]).min(dir * y4[V]);
+        if !(dir * y1[V] > 0.0 && stage_min > 0.0 && y1.iter().all(|x| x.is_finite())) {
+            return false;
+        }
+        let mut k_end = [0.0; L];
+        let a1 = self.slip_rates::<POSITIVE>(f_end, &y1, &mut k_end);
+        let (d0, d1) = (dir * self.a * h, dir * a1 * h);
+        if dip_to_zero(dir * self.y[V], dir * y1[V], d0, d1).is_some() || !a1.is_finite() {
+            return false;
+        }
+        self.stats.rhs_evaluations += 4;
+        (self.y, self.k, self.a) = (y1, k_end, a1);
+        true
+    }
+
+    /// [`Stepper::step`] through the generic [`Stepper::advance`]: every mode and event.
+    fn step_with_events(&mut self, n: GridStep) -> Result<()> {
         self.f_rate = self.force_rate(n.j);
         let mut tau = 0.0;
         let mut events = 0u32;
@@ -740,5 +917,55 @@ impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
         self.stats.accepted_steps = self.stats.steps;
         self.stats.stop = StopReason::Finished { t_s };
         self.stats
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use platen_model::Storey;
+
+    /// The stepper's split of the storey rates (linear part first, then `− a`) gives the
+    /// model's storey accelerations, damper power and base shear bit for bit.
+    #[test]
+    fn storey_part_is_the_model_s() {
+        let storey = |m: f64, k: f64, c: f64| Storey {
+            mass_kg: m,
+            stiffness_n_per_m: k,
+            damping_n_s_per_m: c,
+        };
+        let spec = Specimen::new(vec![
+            storey(30e3, 27.08e6, 86.2e3),
+            storey(25e3, 19.35e6, 61.6e3),
+            storey(21e3, 13.1e6, 0.0),
+        ])
+        .unwrap();
+        let st = StoreyConstants::of(&spec);
+        // A deterministic spread of states, signs and magnitudes (-0.0 included).
+        let mut x = 0.123_456_789_f64;
+        let mut next = || {
+            x = (x * 3.987_654_321 + 0.314_159).fract();
+            (x - 0.5) * 10f64.powi((x * 12.0) as i32 - 8)
+        };
+        for case in 0..2000 {
+            let mut y = [0.0; 11];
+            for v in &mut y {
+                *v = next();
+            }
+            if case == 0 {
+                y[Z] = -0.0;
+                y[Z + 3] = -0.0;
+            }
+            let a = next();
+            let part = storey_part(&st, &y);
+            let mut zdd = [0.0; 3];
+            let power = spec.storey_accelerations(a, &y[Z..Z + 3], &y[Z + 3..Z + 6], &mut zdd);
+            assert_eq!(power.to_bits(), part.power.to_bits(), "case {case}");
+            for (i, (zdd, q)) in zdd.iter().zip(part.q).enumerate() {
+                assert_eq!(zdd.to_bits(), (q - a).to_bits(), "case {case} storey {i}");
+            }
+            let bs = spec.base_shear_n(y[Z], y[Z + 3]);
+            assert_eq!(bs.to_bits(), (-part.shear0).to_bits(), "case {case}");
+        }
     }
 }
