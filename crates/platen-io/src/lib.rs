@@ -26,6 +26,7 @@ pub mod columns;
 pub mod csv;
 pub mod error;
 pub mod json;
+pub mod number;
 pub mod peer;
 
 pub use atomic::{write_bytes_atomic, AtomicFile};
