@@ -2,6 +2,11 @@
 //! parameter values over one scenario, run in parallel on every core (rayon), one row of
 //! peaks and counters per case. The rows are in case order, so the output has the same bytes
 //! whatever the number of threads.
+//!
+//! Forward RK4 sweeps run their identified-model cases in groups of up to
+//! [`ENSEMBLE_LANES`] consecutive cases, each group one ensemble
+//! ([`forward_rk4_ensemble`]: the cases in SIMD lanes, bit for bit the scalar runs), so the
+//! results, and the output's bytes, are those of one scalar run per case.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -9,7 +14,10 @@ use std::path::Path;
 use rayon::prelude::*;
 use serde_json::{json, Map, Value};
 
-use platen_integrate::{IntegrateError, Peaks, RunStats};
+use platen_integrate::{
+    forward_rk4_ensemble, EnsembleCase, IntegrateError, Method, Peaks, Rk4, RunStats,
+    ENSEMBLE_LANES,
+};
 use platen_io::csv::write_number;
 use platen_model::ModelError;
 
@@ -108,6 +116,25 @@ impl Sweep {
     /// Runs every case in parallel under `run` (the scenario's excitation), calling
     /// `progress` after each; the outcomes are in case order.
     pub fn run(&self, run: &Run, progress: impl Fn() + Sync) -> Vec<Outcome> {
+        if let Run::Forward {
+            integrator: Method::Rk4(rk4),
+            samples,
+            ..
+        } = run
+        {
+            // Groups as large as the lanes allow while every thread still gets one.
+            let threads = rayon::current_num_threads().max(1);
+            let lanes = self.cases.len().div_ceil(threads).clamp(1, ENSEMBLE_LANES);
+            let groups: Vec<&[Case]> = self.cases.chunks(lanes).collect();
+            return groups
+                .par_iter()
+                .flat_map_iter(|group| {
+                    let outcomes = run_group(group, run, *rk4, *samples);
+                    group.iter().for_each(|_| progress());
+                    outcomes
+                })
+                .collect();
+        }
         self.cases
             .par_iter()
             .map(|case| {
@@ -185,6 +212,47 @@ fn run_case(case: &Case, run: &Run) -> Outcome {
         },
         Err(e) => failed(e),
     }
+}
+
+/// Runs consecutive cases of a forward RK4 sweep: the identified-model cases together as one
+/// ensemble, the others as [`run_case`] runs them; the outcomes in case order, each that of
+/// [`run_case`] on its case.
+fn run_group(cases: &[Case], run: &Run, rk4: Rk4, samples: usize) -> Vec<Outcome> {
+    let scaled: Vec<_> = cases.iter().map(|c| run.scaled(c.scale)).collect();
+    let mut outcomes: Vec<Option<Outcome>> = vec![None; cases.len()];
+    let mut lanes: Vec<(usize, EnsembleCase<'_>)> = Vec::new();
+    for (i, (case, scaled)) in cases.iter().zip(&scaled).enumerate() {
+        match (&case.model, scaled.as_deref()) {
+            (
+                Model::Identified(model),
+                Ok(Run::Forward {
+                    record, initial, ..
+                }),
+            ) => lanes.push((
+                i,
+                EnsembleCase {
+                    model,
+                    record,
+                    initial: *initial,
+                },
+            )),
+            _ => outcomes[i] = Some(run_case(case, run)),
+        }
+    }
+    let ensemble: Vec<EnsembleCase<'_>> = lanes.iter().map(|&(_, c)| c).collect();
+    let mut peaks = vec![Peaks::default(); ensemble.len()];
+    let results = forward_rk4_ensemble(&ensemble, rk4, samples, &mut peaks);
+    for ((i, _), (result, peaks)) in lanes.iter().zip(results.into_iter().zip(peaks)) {
+        outcomes[*i] = Some(match result {
+            Ok(stats) => Outcome {
+                peaks,
+                stats: Some(stats),
+                error: None,
+            },
+            Err(e) => failed(e),
+        });
+    }
+    outcomes.into_iter().flatten().collect()
 }
 
 fn failed(e: IntegrateError) -> Outcome {
