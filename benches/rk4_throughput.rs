@@ -14,7 +14,16 @@
 //! Each runs the identified model (Eq. 22/23) and the full Lagrangian model (Eq. 1–8) with a
 //! [`Peaks`] sink (the integrator's own cost; `platen bench` keeps the whole trajectory), and
 //! the baseline on the same force samples. After each group the medians and the ratios are
-//! printed. Run: `cargo bench --bench rk4_throughput -- --warm-up-time 1 --measurement-time 3`.
+//! printed.
+//!
+//! A third group, `forward_rk4_specimen`, runs the `no_stick` force with a specimen on the
+//! identified model ([`forward_rk4_specimen`]): the 3-storey, 60 t frame of `platen bench`
+//! (`bench_specimen` in `crates/platen-cli/src/bench.rs`: 20 t floors, 40, 32 and 24 MN/m,
+//! dampers 3 ms times each stiffness) and a 2-storey, 55 t frame (the one of
+//! `scenarios/specimen/frame-forward.json`), next to the bare identified run and the baseline
+//! of the same run (the target: a specimen step at most 1.6 × the baseline).
+//!
+//! Run: `cargo bench --bench rk4_throughput -- --warm-up-time 1 --measurement-time 3`.
 
 // criterion's macros generate undocumented items.
 #![allow(missing_docs)]
@@ -24,8 +33,8 @@ mod common;
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use platen::integrate::{forward_rk4, ForceRecord, Peaks, Rk4, State};
-use platen::model::preset;
+use platen::integrate::{forward_rk4, forward_rk4_specimen, ForceRecord, Peaks, Rk4, State};
+use platen::model::{preset, Specimen, Storey};
 
 use common::baseline::baseline_rk4;
 use common::{report_ratios, sine_force, timed, PRESSURE_PA, RATE_HZ};
@@ -120,5 +129,99 @@ fn stick(c: &mut Criterion) {
     bench_record(c, "forward_rk4_stick", 45e3);
 }
 
-criterion_group!(benches, no_stick, stick);
+/// A storey of `mass_kg`, stiffness `k` and damping `c`.
+fn storey(mass_kg: f64, k: f64, c: f64) -> Storey {
+    Storey {
+        mass_kg,
+        stiffness_n_per_m: k,
+        damping_n_s_per_m: c,
+    }
+}
+
+fn specimen(c: &mut Criterion) {
+    let group_name = "forward_rk4_specimen";
+    let params = preset::lhpost_2008_identified(PRESSURE_PA);
+    let identified = params.build().unwrap();
+    let rk4 = Rk4::with_steps_per_sample(1).unwrap();
+    // `platen bench`'s frame and the shipped 2-storey frame.
+    let three = Specimen::new(vec![
+        storey(20e3, 40e6, 3e-3 * 40e6),
+        storey(20e3, 32e6, 3e-3 * 32e6),
+        storey(20e3, 24e6, 3e-3 * 24e6),
+    ])
+    .unwrap();
+    let two = Specimen::new(vec![
+        storey(30e3, 27_083_177.88, 86_208.43),
+        storey(25e3, 19_345_127.06, 61_577.45),
+    ])
+    .unwrap();
+    let seconds = 60;
+    let force = sine_force(100e3, seconds);
+    let steps = (force.len() - 1) as u64;
+    let record = ForceRecord::from_rate(RATE_HZ, force.clone()).unwrap();
+    let key = |what: &str| format!("{group_name}/{what}/{seconds}");
+    let mut group = c.benchmark_group(group_name);
+    group.sample_size(SAMPLE_SIZE);
+    group.throughput(Throughput::Elements(steps));
+    group.bench_with_input(
+        BenchmarkId::new("plain_loop_baseline", seconds),
+        &force,
+        |b, f| {
+            timed(b, &key("plain_loop_baseline"), || {
+                baseline_rk4(&params, black_box(f), 1.0 / RATE_HZ, State::default())
+            })
+        },
+    );
+    group.bench_with_input(
+        BenchmarkId::new("identified_stick_slip", seconds),
+        &record,
+        |b, r| {
+            timed(b, &key("identified_stick_slip"), || {
+                let mut peaks = Peaks::default();
+                forward_rk4(
+                    &identified,
+                    black_box(r),
+                    rk4,
+                    State::default(),
+                    r.len(),
+                    &mut peaks,
+                )
+                .unwrap();
+                peaks
+            })
+        },
+    );
+    for (name, spec) in [("two_storeys", &two), ("three_storeys", &three)] {
+        group.bench_with_input(BenchmarkId::new(name, seconds), &record, |b, r| {
+            timed(b, &key(name), || {
+                let mut peaks = Peaks::default();
+                forward_rk4_specimen(
+                    &identified,
+                    black_box(spec),
+                    black_box(r),
+                    rk4,
+                    State::default(),
+                    r.len(),
+                    &mut peaks,
+                )
+                .unwrap();
+                peaks
+            })
+        });
+    }
+    group.finish();
+    report_ratios(
+        &format!("{group_name}, {seconds} s record"),
+        SAMPLE_SIZE,
+        (&key("plain_loop_baseline"), steps),
+        &[
+            (&key("identified_stick_slip"), steps),
+            (&key("two_storeys"), steps),
+            (&key("three_storeys"), steps),
+        ],
+        "step",
+    );
+}
+
+criterion_group!(benches, no_stick, stick, specimen);
 criterion_main!(benches);
