@@ -74,7 +74,8 @@ enum Command {
         scenario: PathBuf,
         /// Write the time series (t_s, u_m, v_m_s, a_m_s2, force_n, inertial_force_n,
         /// elastic_force_n, dissipative_force_n; then a specimen's and a closed loop's
-        /// columns) to this CSV file.
+        /// columns) to this CSV file; a name ending in .parquet writes Parquet instead (the
+        /// same columns, float64, one row per sample).
         #[arg(long)]
         out: Option<PathBuf>,
         /// Print a machine-readable summary on stdout.

@@ -95,6 +95,23 @@ impl AtomicFile {
     }
 }
 
+/// Writes go to the buffered temporary file ([`AtomicFile::writer`]), so that a writer that
+/// takes ownership of its sink (the Parquet writer) can hand the file back for
+/// [`AtomicFile::commit`].
+impl Write for AtomicFile {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        self.out.write(buf)
+    }
+
+    fn write_all(&mut self, buf: &[u8]) -> io::Result<()> {
+        self.out.write_all(buf)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.out.flush()
+    }
+}
+
 /// Writes `bytes` to `path` atomically (JSON, SVG, PNG and HTML outputs).
 ///
 /// # Errors

@@ -27,7 +27,9 @@ pub mod csv;
 pub mod error;
 pub mod json;
 pub mod number;
+pub mod parquet;
 pub mod peer;
+pub mod series;
 
 pub use atomic::{write_bytes_atomic, AtomicFile};
 pub use error::{IoAction, IoError, Result};

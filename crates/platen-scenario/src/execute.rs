@@ -7,7 +7,7 @@ use platen_integrate::{
     IntegrateError, LoopRun, LoopStats, Method, Motion, Peak, Peaks, RunStats, Sample, SampleSink,
     SystemColumns, Trajectory,
 };
-use platen_io::csv::CsvWriter;
+use platen_io::series::SeriesWriter;
 use platen_io::IoError;
 use platen_model::{PlatenModel, Specimen};
 
@@ -245,11 +245,13 @@ fn run_model<M: PlatenModel, S: SampleSink>(
 }
 
 /// A [`SampleSink`] that streams the contract's columns ([`Trajectory::COLUMN_NAMES`]) to a
-/// CSV file as the run produces them, atomically ([`CsvWriter`]): a one-hour 1024 Hz run
-/// holds no trajectory in memory, and a failed run leaves no partial file.
+/// CSV file as the run produces them, atomically ([`SeriesWriter`]): a one-hour 1024 Hz run
+/// holds no trajectory in memory, and a failed run leaves no partial file. A destination
+/// ending in `.parquet` gets the same columns as a Parquet file (`float64`, one row per
+/// sample) instead.
 #[derive(Debug)]
 pub struct CsvSink {
-    writer: CsvWriter,
+    writer: SeriesWriter,
     error: Option<IoError>,
     /// The row being written (allocated once).
     row: Vec<f64>,
@@ -294,7 +296,7 @@ impl CsvSink {
             names.extend(SystemColumns::NAMES.iter().map(|&n| n.to_owned()));
         }
         Ok(Self {
-            writer: CsvWriter::create(path, &names)?,
+            writer: SeriesWriter::create(path, &names)?,
             error: None,
             row: Vec::with_capacity(names.len()),
         })
