@@ -506,17 +506,17 @@ def identify(
     viscous_exponent: Optional[float] = None,
     low_velocity_term: bool = True,
 ) -> Dict[str, Any]:
-    """Identifies the platen's parameters from recorded periodic tests (the paper's
-    hysteresis-loop method, §3), as ``platen identify FILE… --method periodic --json``.
-    The any-record method (earthquake and white-noise records) is not reachable from
-    Python yet; use the CLI for it.
+    """Identifies the platen's parameters from recorded tests, as ``platen identify FILE…
+    --json``: periodic tests by the paper's hysteresis-loop method (§3), any other record
+    (earthquake, white noise) by the any-record method, each file by its data; ``records``
+    lists every file with the method that took it, whether it was used and why.
 
     ``files``: recorded CSVs with ``t_s``, ``u_m``, ``a_m_s2``, ``force_n`` and optionally
     ``v_m_s`` (``columns`` maps a lab's own names and units, as for :func:`compare`).
     ``pressure_mpa``: the hold-down pressure, MPa, for every file or one per file.
     ``viscous_exponent`` holds α instead of fitting it; ``low_velocity_term=False`` drops
     a·e^(−b|v|). Returns the seven identified keys at the top level, with the per-test
-    tables, standard errors and warnings.
+    tables (or the any-record fits), standard errors, the records' accounts and warnings.
     """
     if isinstance(files, (str, os.PathLike)):
         files = [files]

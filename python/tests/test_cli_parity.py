@@ -177,6 +177,18 @@ def test_identify_gives_the_clis_json(cli, cli_json, tmp_path):
     assert result == expected
     assert abs(result["effective_mass_kg"] / 144e3 - 1) < 0.01
     assert abs(result["stiffness_n_per_m"] / 1.266e6 - 1) < 0.01
+    assert [r["method"] for r in result["records"]] == ["periodic"] * 4
+
+
+def test_identify_routes_an_earthquake_record_as_the_cli_does(cli_json):
+    """A lab's earthquake record goes to the any-record method, in Python as in the CLI."""
+    data = SCENARIOS.parent / "tests" / "data" / "any-record"
+    record, columns = data / "eq-lab.csv", data / "columns.json"
+    expected = cli_json("identify", record, "--columns", columns)
+    result = platen.identify(record, columns=columns)
+    assert result == expected
+    assert result["method"] == "record"
+    assert [(r["method"], r["used"]) for r in result["records"]] == [("record", True)]
 
 
 def test_forward_and_inverse_with_a_specimen_give_the_scenarios_run():

@@ -43,8 +43,8 @@ use serde::{Deserialize, Serialize};
 use platen_ident::anyrecord::summary::{record_entries, RecordInfoSummary, RecordSummary};
 use platen_ident::{
     identify_any, Estimate, Flag, Identification, IdentificationSummary, Identified, IdentifiedKey,
-    Method, MethodRequest, Parameter, RecordIdentification, RecordSettings, RecordWarning,
-    Settings, TestKind, TestRecord,
+    IdentifyOutput, MethodRequest, Parameter, RecordIdentification, RecordSettings, Settings,
+    TestKind, TestRecord,
 };
 use platen_io::columns::{ColumnMap, ColumnSpec};
 use platen_io::json::parse_json_file;
@@ -237,11 +237,47 @@ pub fn run(opts: &Options) -> Result<()> {
             eprintln!("warning: {} was not used: {reason}", input.name);
         }
     }
-    if id.periodic_only() {
-        let (periodic, _) = id.periodic.expect("periodic only");
-        return run_periodic(opts, &inputs, &periodic, entries);
+    let output = id.output(&records, &files, request);
+    match id {
+        Identified {
+            records: Some((rid, record_idx)),
+            periodic,
+            ..
+        } => run_records(
+            opts,
+            &inputs,
+            (&rid, &record_idx),
+            periodic,
+            &entries,
+            output,
+        ),
+        Identified {
+            periodic: Some((periodic, _)),
+            ..
+        } => run_periodic(opts, &inputs, &periodic, &entries, output),
+        Identified { .. } => unreachable!("identify_any runs at least one method"),
     }
-    run_records(opts, &inputs, id, entries)
+}
+
+/// What `--json` prints: the identification's output ([`Identified::output`]) and the files
+/// written.
+#[derive(Serialize)]
+struct JsonOutput {
+    #[serde(flatten)]
+    output: IdentifyOutput,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    figures: Option<Vec<String>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    report: Option<String>,
+}
+
+impl JsonOutput {
+    fn print(self) -> Result<()> {
+        // Through a `Value`, whose maps sort their keys at every level.
+        let value = serde_json::to_value(&self)?;
+        outln!("{}", serde_json::to_string_pretty(&value)?);
+        Ok(())
+    }
 }
 
 /// The paper's method on every file: the output as it has always been, with the records'
@@ -250,28 +286,26 @@ fn run_periodic(
     opts: &Options,
     inputs: &[Input],
     id: &Identification,
-    entries: Vec<RecordInfoSummary>,
+    entries: &[RecordInfoSummary],
+    output: IdentifyOutput,
 ) -> Result<()> {
     let written = platen_report::write_outputs(
         opts.plot,
         opts.report,
         &opts.size,
         || identify_figures::figures(id),
-        |figures, rendered| html_report(id, inputs, &entries, figures, rendered),
+        |figures, rendered| html_report(id, inputs, entries, figures, rendered),
     )?;
     if opts.json {
-        let output = JsonOutput {
-            summary: summary(id, inputs),
-            records: entries,
+        JsonOutput {
+            output,
             figures: figure_list(opts, &written),
             report: opts.report.map(|path| path.display().to_string()),
-        };
-        // Through a `Value`, whose maps sort their keys at every level.
-        let value = serde_json::to_value(&output)?;
-        outln!("{}", serde_json::to_string_pretty(&value)?);
+        }
+        .print()?;
     } else {
         out!("{}", report(id, inputs));
-        out!("{}", accounts_report(&entries, inputs));
+        out!("{}", accounts_report(entries, inputs));
         print_written(&written, opts.report)?;
     }
     Ok(())
@@ -301,25 +335,11 @@ fn print_written(written: &[PathBuf], report: Option<&Path>) -> Result<()> {
 fn run_records(
     opts: &Options,
     inputs: &[Input],
-    identified: Identified,
-    entries: Vec<RecordInfoSummary>,
+    (id, record_idx): (&RecordIdentification, &[usize]),
+    periodic: Option<(Identification, Vec<usize>)>,
+    entries: &[RecordInfoSummary],
+    output: IdentifyOutput,
 ) -> Result<()> {
-    let Identified {
-        periodic, records, ..
-    } = identified;
-    let (mut id, record_idx) = records.expect("the any-record method ran");
-    for &k in &record_idx {
-        if let (Some(_), false) = (inputs[k].kind, inputs[k].record) {
-            if let Some(a) = entries[k].account.as_ref() {
-                if a.method == Method::Record {
-                    id.warnings.push(RecordWarning::DeclaredPeriodicButNot {
-                        test: inputs[k].name.clone(),
-                        reason: a.routing.clone(),
-                    });
-                }
-            }
-        }
-    }
     let (periodic, periodic_idx) = match periodic {
         Some((p, idx)) => (Some(p), idx),
         None => (None, Vec::new()),
@@ -331,7 +351,7 @@ fn run_records(
         opts.report,
         &opts.size,
         || {
-            let mut f = record_figures::figures(&id);
+            let mut f = record_figures::figures(id);
             if let Some(p) = &periodic {
                 f.extend(identify_figures::figures(p));
             }
@@ -339,44 +359,30 @@ fn run_records(
         },
         |figures, rendered| {
             record_html_report(
-                &id,
+                id,
                 &rec_inputs,
                 periodic.as_ref(),
                 &per_owned,
-                (&entries, inputs),
+                (entries, inputs),
                 figures,
                 rendered,
             )
         },
     )?;
-    let method_name = match opts.method {
-        Some(MethodChoice::Both) => "both",
-        _ if periodic.is_some() => "mixed",
-        _ => "record",
-    };
     if opts.json {
-        let files: Vec<String> = rec_inputs
-            .iter()
-            .map(|i| i.path.display().to_string())
-            .collect();
-        let mut record_summary = RecordSummary::new(&id, &files);
-        record_summary.records = entries;
-        let output = RecordJsonOutput {
-            summary: record_summary,
-            method: method_name,
-            periodic: periodic.as_ref().map(|p| summary(p, &per_owned)),
+        JsonOutput {
+            output,
             figures: figure_list(opts, &written),
             report: opts.report.map(|path| path.display().to_string()),
-        };
-        let value = serde_json::to_value(&output)?;
-        outln!("{}", serde_json::to_string_pretty(&value)?);
+        }
+        .print()?;
     } else {
-        out!("{}", record_report(&id, &rec_inputs));
+        out!("{}", record_report(id, &rec_inputs));
         if let Some(p) = &periodic {
             outln!("\n== Periodic tests (hysteresis-loop method, §3) ==\n");
             out!("{}", report(p, &per_owned));
         }
-        out!("{}", accounts_report(&entries, inputs));
+        out!("{}", accounts_report(entries, inputs));
         print_written(&written, opts.report)?;
     }
     Ok(())
@@ -458,23 +464,6 @@ fn accounts_table(entries: &[RecordInfoSummary], inputs: &[Input]) -> Vec<String
             false,
         ),
     ]
-}
-
-/// What `--json` prints for the any-record method.
-#[derive(Serialize)]
-struct RecordJsonOutput {
-    #[serde(flatten)]
-    summary: RecordSummary,
-    /// `record` (any-record method only), `mixed` (periodic tests by the paper's method
-    /// too), `both` (forced).
-    method: &'static str,
-    /// The paper's method on the periodic tests, when run.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    periodic: Option<IdentificationSummary>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    figures: Option<Vec<String>>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    report: Option<String>,
 }
 
 /// The text report of the any-record method.
@@ -692,19 +681,6 @@ fn record_html_report(
         summary: serde_json::to_value(RecordSummary::new(id, &files))
             .expect("a summary of numbers, strings and string-keyed maps serialises"),
     })
-}
-
-/// What `--json` prints: the identification's summary, and the files written.
-#[derive(Serialize)]
-struct JsonOutput {
-    #[serde(flatten)]
-    summary: IdentificationSummary,
-    /// Every input file, with what identification did with it.
-    records: Vec<RecordInfoSummary>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    figures: Option<Vec<String>>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    report: Option<String>,
 }
 
 /// The summary of `id`, whose tests come from `inputs`.

@@ -6,14 +6,16 @@
 
 use serde::Serialize;
 
-use crate::anyrecord::result::RecordIdentification;
+use crate::anyrecord::result::{RecordIdentification, RecordWarning};
 use crate::anyrecord::settings::ValidRecordSettings;
+use crate::anyrecord::summary::{record_entries, RecordInfoSummary, RecordSummary};
 use crate::cycle::{self, RatePlan};
 use crate::error::{IdentError, Result};
 use crate::record::TestRecord;
 use crate::result::Identification;
 use crate::route::{route, Method, Route};
 use crate::settings::ValidSettings;
+use crate::summary::IdentificationSummary;
 
 /// The method a front end asks for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -152,7 +154,19 @@ pub fn identify_any(
     } else {
         let recs: Vec<TestRecord> = record_idx.iter().map(|&k| records[k].clone()).collect();
         match crate::identify_records(&recs, record_settings) {
-            Ok(id) => {
+            Ok(mut id) => {
+                for &k in &record_idx {
+                    let declared = declared_record.get(k).copied().unwrap_or(false);
+                    if records[k].kind().is_some()
+                        && !declared
+                        && accounts[k].method == Method::Record
+                    {
+                        id.warnings.push(RecordWarning::DeclaredPeriodicButNot {
+                            test: records[k].name().to_owned(),
+                            reason: accounts[k].routing.clone(),
+                        });
+                    }
+                }
                 for (report, &k) in id.records.iter().zip(&record_idx) {
                     if report.used_samples == 0 && accounts[k].method == Method::Record {
                         accounts[k].used = false;
@@ -202,5 +216,77 @@ fn cause(e: &IdentError) -> String {
         IdentError::NotPeriodic { reason, .. } => reason.clone(),
         IdentError::InvalidRecord { message, .. } => message.clone(),
         other => other.to_string(),
+    }
+}
+
+/// The machine-readable result of [`identify_any`]: what `platen identify --json` prints (less
+/// the files it wrote) and `platen.identify` returns. Serialises as one flat object.
+#[derive(Debug, Clone, Serialize)]
+#[serde(untagged)]
+pub enum IdentifyOutput {
+    /// Every record a periodic test: the paper's method's summary, with the records' accounts.
+    Periodic {
+        /// The paper's method.
+        #[serde(flatten)]
+        summary: IdentificationSummary,
+        /// Every input record, with what was done with it.
+        records: Vec<RecordInfoSummary>,
+    },
+    /// The any-record method's summary (its `records` list every input record), with the
+    /// paper's method on the periodic tests under `periodic`.
+    Records {
+        /// The any-record method.
+        #[serde(flatten)]
+        summary: RecordSummary,
+        /// `record` (any-record method only), `mixed` (periodic tests by the paper's method
+        /// too) or `both` (forced).
+        method: &'static str,
+        /// The paper's method on the periodic tests, when run.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        periodic: Option<IdentificationSummary>,
+    },
+}
+
+impl Identified {
+    /// The output of this identification of `records`, read from `files` (same order);
+    /// `request` as given to [`identify_any`].
+    pub fn output(
+        &self,
+        records: &[TestRecord],
+        files: &[String],
+        request: MethodRequest,
+    ) -> IdentifyOutput {
+        let entries = record_entries(self, records, files);
+        let subset =
+            |idx: &[usize]| -> Vec<String> { idx.iter().map(|&k| files[k].clone()).collect() };
+        let periodic = self
+            .periodic
+            .as_ref()
+            .map(|(p, idx)| IdentificationSummary::new(p, &subset(idx)));
+        match (&self.records, periodic) {
+            (None, Some(summary)) if self.periodic_only() => IdentifyOutput::Periodic {
+                summary,
+                records: entries,
+            },
+            (Some((rid, idx)), periodic) => {
+                let mut summary = RecordSummary::new(rid, &subset(idx));
+                summary.records = entries;
+                IdentifyOutput::Records {
+                    summary,
+                    method: match request {
+                        MethodRequest::Both => "both",
+                        _ if periodic.is_some() => "mixed",
+                        _ => "record",
+                    },
+                    periodic,
+                }
+            }
+            // The periodic method ran and the any-record method could not (its records are
+            // accounted for as not used).
+            (None, periodic) => IdentifyOutput::Periodic {
+                summary: periodic.expect("identify_any ran at least one method"),
+                records: entries,
+            },
+        }
     }
 }

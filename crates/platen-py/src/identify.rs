@@ -1,10 +1,11 @@
-//! `platen.identify`: the paper's hysteresis-loop method on recorded periodic test files.
+//! `platen.identify`: `platen identify FILE… --json` on recorded test files: periodic tests
+//! by the paper's hysteresis-loop method, any other record by the any-record method.
 
 use std::path::{Path, PathBuf};
 
 use pyo3::prelude::*;
 
-use platen_ident::{IdentificationSummary, TestRecord};
+use platen_ident::TestRecord;
 use platen_io::columns::ColumnMap;
 use platen_scenario::sampling::uniform_step_s;
 
@@ -101,8 +102,20 @@ pub fn identify(
         }
         .build()
         .map_err(failed)?;
-        let id = platen_ident::identify(&records, &settings).map_err(failed)?;
+        let record_settings = platen_ident::RecordSettings {
+            viscous_exponent,
+            low_velocity_term,
+            ..platen_ident::RecordSettings::default()
+        }
+        .build()
+        .map_err(failed)?;
+        // As `platen identify FILE… --json`: each file by its data, every file accounted for.
+        let request = platen_ident::MethodRequest::Auto;
+        let declared = vec![false; records.len()];
+        let id =
+            platen_ident::identify_any(&records, &declared, request, &settings, &record_settings)
+                .map_err(failed)?;
         let names: Vec<String> = files.iter().map(|p| p.display().to_string()).collect();
-        json_text(&IdentificationSummary::new(&id, &names))
+        json_text(&id.output(&records, &names, request))
     })?)
 }
