@@ -228,7 +228,7 @@ pub enum IdentifyOutput {
     Periodic {
         /// The paper's method.
         #[serde(flatten)]
-        summary: IdentificationSummary,
+        summary: Box<IdentificationSummary>,
         /// Every input record, with what was done with it.
         records: Vec<RecordInfoSummary>,
     },
@@ -237,13 +237,13 @@ pub enum IdentifyOutput {
     Records {
         /// The any-record method.
         #[serde(flatten)]
-        summary: RecordSummary,
+        summary: Box<RecordSummary>,
         /// `record` (any-record method only), `mixed` (periodic tests by the paper's method
         /// too) or `both` (forced).
         method: &'static str,
         /// The paper's method on the periodic tests, when run.
         #[serde(skip_serializing_if = "Option::is_none")]
-        periodic: Option<IdentificationSummary>,
+        periodic: Option<Box<IdentificationSummary>>,
     },
 }
 
@@ -262,7 +262,7 @@ impl Identified {
         let periodic = self
             .periodic
             .as_ref()
-            .map(|(p, idx)| IdentificationSummary::new(p, &subset(idx)));
+            .map(|(p, idx)| Box::new(IdentificationSummary::new(p, &subset(idx))));
         match (&self.records, periodic) {
             (None, Some(summary)) if self.periodic_only() => IdentifyOutput::Periodic {
                 summary,
@@ -272,7 +272,7 @@ impl Identified {
                 let mut summary = RecordSummary::new(rid, &subset(idx));
                 summary.records = entries;
                 IdentifyOutput::Records {
-                    summary,
+                    summary: Box::new(summary),
                     method: match request {
                         MethodRequest::Both => "both",
                         _ if periodic.is_some() => "mixed",

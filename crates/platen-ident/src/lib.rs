@@ -174,7 +174,7 @@ pub mod system;
 mod warning;
 mod work;
 
-pub use account::{identify_any, IdentifyOutput, Identified, MethodRequest, RecordAccount};
+pub use account::{identify_any, Identified, IdentifyOutput, MethodRequest, RecordAccount};
 pub use anyrecord::result::{
     BandPoint, Correlations, EquationErrorFit, FitKind, FitUncertainty, FloorsReport,
     OutputErrorFit, RecordIdentification, RecordReport, RecordWarning,
