@@ -11,7 +11,9 @@
 //! * `format_ryu`: the same bytes with [`platen::io::number`] (Ryū, the writer's formatter
 //!   since issue 28), into a `Vec<u8>`;
 //! * `write_csv_file`: [`write_csv_atomic`] to a file in a temporary folder (formatting, the
-//!   writes, sync and rename: the whole writer).
+//!   writes, sync and rename: the whole writer);
+//! * `write_parquet_file`: [`write_parquet_atomic`], the same columns to a Parquet file
+//!   (float64, uncompressed), the same way (its MB/s are of the CSV's text, for comparison).
 //!
 //! Criterion reports each in bytes/s; after the group the medians and the ratios to the
 //! baseline are printed, with MB/s. Run:
@@ -29,6 +31,7 @@ use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use platen::integrate::{forward_rk4, ForceRecord, Rk4, State, Trajectory};
 use platen::io::csv::write_csv_atomic;
 use platen::io::number::{format_number, NumberBuffer};
+use platen::io::parquet::write_parquet_atomic;
 use platen::model::preset;
 
 use common::{median_ns, sine_force, timed, PRESSURE_PA, RATE_HZ};
@@ -117,6 +120,12 @@ fn writer(c: &mut Criterion) {
             write_csv_atomic(&path, &Trajectory::COLUMN_NAMES, black_box(&columns)).unwrap()
         })
     });
+    let parquet = dir.path().join("writer.parquet");
+    group.bench_function("write_parquet_file", |b| {
+        timed(b, &key("write_parquet_file"), || {
+            write_parquet_atomic(&parquet, &Trajectory::COLUMN_NAMES, black_box(&columns)).unwrap()
+        })
+    });
     group.finish();
 
     let Some(base) = median_ns(&key("format_baseline"), SAMPLE_SIZE) else {
@@ -127,7 +136,12 @@ fn writer(c: &mut Criterion) {
         columns[0].len(),
         bytes as f64 / 1e6
     );
-    for what in ["format_baseline", "format_ryu", "write_csv_file"] {
+    for what in [
+        "format_baseline",
+        "format_ryu",
+        "write_csv_file",
+        "write_parquet_file",
+    ] {
         if let Some(t) = median_ns(&key(what), SAMPLE_SIZE) {
             println!(
                 "  {:<32} {:>8.1} ms {:>8.0} MB/s {:>6.2}",
