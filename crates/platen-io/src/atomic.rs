@@ -2,7 +2,8 @@
 //! folder, which is flushed, synced and renamed over the destination only when complete.
 //! A failed or interrupted write removes the temporary file and leaves an existing
 //! destination untouched. This is the one implementation every writer uses (CSV, streamed
-//! CSV, JSON, SVG, PNG, HTML).
+//! CSV, Parquet, JSON, SVG, PNG, HTML). The file gets the mode of any new file (`0o666` less
+//! the umask), not the temporary file's private `0600`.
 
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
@@ -46,9 +47,18 @@ impl AtomicFile {
                 folder: folder.to_path_buf(),
             });
         }
-        let temp = tempfile::Builder::new()
-            .prefix(&format!(".{}.", file_name.to_string_lossy()))
-            .suffix(".tmp")
+        let prefix = format!(".{}.", file_name.to_string_lossy());
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(&prefix).suffix(".tmp");
+        // The file platen writes is an ordinary output: created with the mode any program's
+        // `File::create` gives (0o666 less the umask: 0644 under the usual 022) so that others
+        // on the lab's machine can read it, not the temporary file's private 0600.
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            builder.permissions(std::fs::Permissions::from_mode(0o666));
+        }
+        let temp = builder
             .tempfile_in(directory_of(path))
             .map_err(|source| IoError::Io {
                 path: path.to_path_buf(),
