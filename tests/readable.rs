@@ -127,8 +127,17 @@ fn model_json_is_unchanged_by_the_text_form() {
 }
 
 /// The verbs of the contract.
-const VERBS: [&str; 9] = [
-    "simulate", "compare", "identify", "model", "generate", "bench", "schema", "sweep", "plan",
+const VERBS: [&str; 10] = [
+    "simulate",
+    "compare",
+    "identify",
+    "model",
+    "generate",
+    "bench",
+    "schema",
+    "sweep",
+    "plan",
+    "completions",
 ];
 
 /// `platen --help` lists each verb on one line of at most 100 characters, and no line of the

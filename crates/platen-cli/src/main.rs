@@ -213,6 +213,19 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Print a shell completion script for platen's verbs and options.
+    ///
+    /// Load it in the shell's startup file, e.g. for bash
+    /// `source <(platen completions bash)`, or save it where the shell looks for completions.
+    #[command(after_help = "Examples:\n  \
+        platen completions bash > ~/.local/share/bash-completion/completions/platen\n  \
+        platen completions zsh > ~/.zfunc/_platen\n  \
+        platen completions fish > ~/.config/fish/completions/platen.fish")]
+    Completions {
+        /// The shell: bash, zsh, fish, elvish or powershell.
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
     /// Write a scenario's excitation, or recorded-like data for a motion scenario.
     #[command(after_help = "Examples:\n  \
         platen generate excitation scenarios/s9-sine-motion.json --out s9-motion.csv\n  \
@@ -436,7 +449,7 @@ impl Command {
             | Command::Sweep { json, .. }
             | Command::Identify { json, .. } => *json,
             Command::Plan(args) => args.json,
-            Command::Schema { .. } => false,
+            Command::Schema { .. } | Command::Completions { .. } => false,
         }
     }
 }
@@ -532,6 +545,13 @@ fn run(command: Command) -> anyhow::Result<()> {
             size: size.size(),
         }),
         Command::Schema { out } => schema::run(out.as_deref()),
+        Command::Completions { shell } => {
+            let mut command = <Cli as clap::CommandFactory>::command();
+            let mut script = Vec::new();
+            clap_complete::generate(shell, &mut command, "platen", &mut script);
+            out!("{}", String::from_utf8_lossy(&script));
+            Ok(())
+        }
         Command::Generate {
             what,
             scenario,
