@@ -127,7 +127,7 @@ fn model_json_is_unchanged_by_the_text_form() {
 }
 
 /// The verbs of the contract.
-const VERBS: [&str; 10] = [
+const VERBS: [&str; 11] = [
     "simulate",
     "compare",
     "identify",
@@ -138,6 +138,7 @@ const VERBS: [&str; 10] = [
     "sweep",
     "plan",
     "completions",
+    "scenarios",
 ];
 
 /// `platen --help` lists each verb on one line of at most 100 characters, and no line of the

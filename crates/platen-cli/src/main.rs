@@ -213,6 +213,21 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// List the shipped scenarios: path, what each runs, its name.
+    ///
+    /// Reads the `scenarios` folder of the current directory (a clone of the repository), else
+    /// the one platen was built from, or DIR. Scenarios that need a PEER record say so.
+    #[command(after_help = "Examples:\n  \
+        platen scenarios\n  \
+        platen scenarios --json\n  \
+        platen scenarios my-lab/scenarios")]
+    Scenarios {
+        /// The folder to list (default: ./scenarios, else the one platen was built from).
+        dir: Option<PathBuf>,
+        /// Print the list as JSON: [{path, name, kind, needs_record, specimen}, …].
+        #[arg(long)]
+        json: bool,
+    },
     /// Print a shell completion script for platen's verbs and options.
     ///
     /// Load it in the shell's startup file, e.g. for bash
@@ -447,7 +462,8 @@ impl Command {
             | Command::Bench { json, .. }
             | Command::Generate { json, .. }
             | Command::Sweep { json, .. }
-            | Command::Identify { json, .. } => *json,
+            | Command::Identify { json, .. }
+            | Command::Scenarios { json, .. } => *json,
             Command::Plan(args) => args.json,
             Command::Schema { .. } | Command::Completions { .. } => false,
         }
@@ -545,6 +561,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             size: size.size(),
         }),
         Command::Schema { out } => schema::run(out.as_deref()),
+        Command::Scenarios { dir, json } => scenarios(dir, json),
         Command::Completions { shell } => {
             let mut command = <Cli as clap::CommandFactory>::command();
             let mut script = Vec::new();
@@ -678,4 +695,69 @@ fn integrate_exit_code(e: &IntegrateError) -> u8 {
         IntegrateError::NonFiniteState { .. } | IntegrateError::EventLoopStalled { .. } => 4,
         _ => 3,
     }
+}
+
+/// `platen scenarios`: the shipped scenarios ([`platen_scenario::catalog`]).
+fn scenarios(dir: Option<PathBuf>, json: bool) -> anyhow::Result<()> {
+    use platen_scenario::catalog::{shipped, RunKind};
+    let dir = match dir {
+        Some(d) => d,
+        None => {
+            let here = PathBuf::from("scenarios");
+            let built = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+            if here.is_dir() {
+                here
+            } else if built.is_dir() {
+                built
+            } else {
+                anyhow::bail!(
+                    "no scenarios folder here (./scenarios) nor where platen was built ({}): give one, `platen scenarios DIR`, or run from a clone of the repository",
+                    built.display()
+                )
+            }
+        }
+    };
+    if !dir.is_dir() {
+        anyhow::bail!(
+            "`{}` is not a folder: expected a folder of scenario files",
+            dir.display()
+        );
+    }
+    let list = shipped(&dir)?;
+    if json {
+        outln!("{}", serde_json::to_string_pretty(&list)?);
+        return Ok(());
+    }
+    outln!("Scenarios in {}:", dir.display());
+    let w = list
+        .iter()
+        .map(|s| s.path.chars().count())
+        .max()
+        .unwrap_or(0);
+    for s in &list {
+        let kind = match s.kind {
+            RunKind::Forward => "forward",
+            RunKind::Inverse => "inverse",
+            RunKind::ClosedLoop => "closed loop",
+            RunKind::Group => "folder",
+        };
+        let mut notes = Vec::new();
+        if s.specimen {
+            notes.push("specimen");
+        }
+        if s.needs_record {
+            notes.push("needs a PEER record");
+        }
+        let notes = if notes.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", notes.join(", "))
+        };
+        outln!("  {:<w$}  {:<11}  {}{notes}", s.path, kind, s.name);
+    }
+    outln!(
+        "Run one: platen simulate {}/<path> --out out/run.csv",
+        dir.display()
+    );
+    Ok(())
 }

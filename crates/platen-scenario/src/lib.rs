@@ -15,6 +15,7 @@
 #![warn(missing_docs)]
 
 mod arrays;
+pub mod catalog;
 mod ctx;
 mod describe;
 pub mod error;
