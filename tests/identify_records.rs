@@ -234,3 +234,19 @@ fn a_mixed_day_lists_every_record_with_its_method() {
     assert_eq!(v["periodic"]["sine_tests"].as_array().unwrap().len(), 1);
     assert_eq!(v["periodic"]["triangle_tests"].as_array().unwrap().len(), 1);
 }
+
+/// The text report prints the record's rate as a person writes it, not the float the rounded
+/// stamps give (204.79999998958843).
+#[test]
+fn the_report_prints_a_rounded_sample_rate() {
+    let o = platen(&[
+        "identify",
+        data().join("eq-lab.csv").to_str().unwrap(),
+        "--columns",
+        data().join("columns.json").to_str().unwrap(),
+        "--no-output-error",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8(o.stdout).unwrap();
+    assert!(text.contains("6145 samples at 204.8 Hz,"), "{text}");
+}

@@ -516,7 +516,7 @@ fn record_report(id: &RecordIdentification, inputs: &[&Input]) -> String {
             "  {}: {} samples at {} Hz, velocity {}, {} fitted over {:.1}–{:.0} mm/s, force offset {}{}{}",
             input.label,
             rec.samples,
-            rec.sample_rate_hz,
+            platen_report::text::rounded(rec.sample_rate_hz, 9),
             if rec.velocity_given { "given" } else { "from the crossover estimate" },
             rec.used_samples,
             1e3 * rec.speed_range_m_s[0],

@@ -275,9 +275,9 @@ fn print_text(s: &platen_plan::PlanSummary) -> Result<()> {
          ({:.3} g), command peak {:.4} m",
         t.kind,
         t.samples,
-        t.sample_rate_hz,
+        platen_report::text::rounded(t.sample_rate_hz, 9),
         t.duration_s,
-        t.drive_sample_rate_hz,
+        platen_report::text::rounded(t.drive_sample_rate_hz, 9),
         t.peak_a_m_s2,
         t.peak_a_m_s2 / STANDARD_GRAVITY_M_S2,
         t.peak_u_m

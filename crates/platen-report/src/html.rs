@@ -188,7 +188,7 @@ fn compare_items(c: &Comparison) -> Vec<(String, String)> {
             format!(
                 "{} recorded samples at {} Hz, {first:.3}–{last:.3} s (simulated {:.3}–{:.3} s, record {:.3}–{:.3} s)",
                 c.t_s.len(),
-                c.sample_rate_hz,
+                crate::text::rounded(c.sample_rate_hz, 9),
                 c.simulated_span_s.0,
                 c.simulated_span_s.1,
                 c.recorded_span_s.0,

@@ -73,6 +73,16 @@ pub fn significant(x: f64, digits: usize) -> String {
     }
 }
 
+/// `x` to `digits` significant digits without trailing zeros: a sample rate measured from
+/// rounded stamps, 204.79999998958843 Hz, reads 204.8 (at 9 digits), and 1024 reads 1024.
+pub fn rounded(x: f64, digits: usize) -> String {
+    let text = significant(x, digits);
+    if text.contains('e') || !text.contains('.') {
+        return text;
+    }
+    text.trim_end_matches('0').trim_end_matches('.').to_owned()
+}
+
 /// `text` with an explicit sign.
 fn signed(text: String) -> String {
     if text.starts_with('-') {
@@ -197,7 +207,7 @@ pub fn compare_summary(c: &Comparison, figures: &[PathBuf], report: Option<&Path
         "  compared with {}: {} samples at {} Hz over {first:.3}–{last:.3} s",
         c.recorded_path.display(),
         c.t_s.len(),
-        c.sample_rate_hz,
+        rounded(c.sample_rate_hz, 9),
     );
     if let Some(w) = c.window {
         let _ = writeln!(s, "  metrics over the window {}–{} s", w.start_s, w.end_s);
@@ -255,4 +265,18 @@ pub fn compare_summary(c: &Comparison, figures: &[PathBuf], report: Option<&Path
         let _ = writeln!(s, "  wrote report {}", r.display());
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rounded_reads_as_a_person_writes_it() {
+        assert_eq!(rounded(204.79999998958843, 9), "204.8");
+        assert_eq!(rounded(1024.0, 9), "1024");
+        assert_eq!(rounded(1023.9999996, 9), "1024");
+        assert_eq!(rounded(0.5, 9), "0.5");
+        assert_eq!(rounded(2.5e7, 3), "2.50e7");
+    }
 }
