@@ -90,6 +90,10 @@ enum Command {
         plot: Option<PathBuf>,
         #[command(flatten)]
         size: plot::SizeArgs,
+        /// Run at this hold-down pressure, MPa, instead of the scenario's (the model rebuilt
+        /// from its preset at P with the scenario's overrides, as `sweep --pressure-mpa`).
+        #[arg(long, value_name = "P", allow_negative_numbers = true, value_parser = sweep::parse_pressure_mpa)]
+        pressure_mpa: Option<f64>,
     },
     /// Run a scenario and compare it with a recorded test, channel by channel.
     ///
@@ -513,12 +517,14 @@ fn run(command: Command) -> anyhow::Result<()> {
             json,
             plot,
             size,
+            pressure_mpa,
         } => simulate::run(&simulate::Options {
             scenario: &scenario,
             out: out.as_deref(),
             json,
             plot: plot.as_deref(),
             size: size.size(),
+            pressure_mpa,
         }),
         Command::Compare {
             scenario,

@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 
 use platen_integrate::{ForwardIntegrator, Peaks, RunStats, Sample, SampleSink};
 use platen_model::STANDARD_GRAVITY_M_S2;
@@ -25,11 +25,18 @@ pub struct Options<'a> {
     pub plot: Option<&'a Path>,
     /// Size of the figures.
     pub size: FigureSize,
+    /// The hold-down pressure to run at, MPa, instead of the scenario's.
+    pub pressure_mpa: Option<f64>,
 }
 
 pub fn run(opts: &Options<'_>) -> Result<()> {
     let (path, out) = (opts.scenario, opts.out);
-    let scenario = Scenario::load(path)?;
+    let mut scenario = Scenario::load(path)?;
+    if let Some(p) = opts.pressure_mpa {
+        scenario = scenario
+            .at_pressure(p * 1e6)
+            .with_context(|| format!("`{}`: the model at --pressure-mpa {p}", path.display()))?;
+    }
     // Create the temporary output first, so that an unwritable path fails before the run.
     let storeys = scenario.storeys();
     let mut stream = out

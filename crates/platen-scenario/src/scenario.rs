@@ -133,6 +133,18 @@ impl Scenario {
         })
     }
 
+    /// The scenario at another hold-down pressure: its model rebuilt from its preset at
+    /// `pressure_pa` with the scenario's own overrides (what `platen simulate --pressure-mpa`
+    /// runs).
+    ///
+    /// # Errors
+    /// As [`ModelOverrides::build`].
+    pub fn at_pressure(mut self, pressure_pa: f64) -> std::result::Result<Scenario, ModelError> {
+        self.model = self.model_at(pressure_pa, &[])?;
+        self.hold_down_pressure_pa = pressure_pa;
+        Ok(self)
+    }
+
     /// The scenario's model rebuilt from its preset at `pressure_pa`, with the scenario's own
     /// overrides and then `extra` laid over it (what a sweep varies).
     ///
