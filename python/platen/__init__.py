@@ -700,3 +700,9 @@ def plan(
 def schema() -> Dict[str, Any]:
     """The JSON Schema of the scenario format (``platen schema``)."""
     return json.loads(_platen.schema())
+
+
+def __dir__() -> List[str]:
+    """``dir(platen)``: the public API (``__all__``) and ``__version__``, not the modules and
+    typing names this file imports for its own use (PEP 562)."""
+    return sorted(__all__ + ["__version__"])
