@@ -422,6 +422,20 @@ fn csv_error(path: &Path, error: csv::Error, line: u64) -> IoError {
 /// synced and renamed over `path`. On any error the temporary file is removed and an existing
 /// file at `path` is left untouched.
 pub fn write_csv_atomic(path: &Path, header: &[&str], columns: &[&[f64]]) -> Result<()> {
+    let rows = checked_rows(path, header, columns)?;
+    let mut writer = CsvWriter::create(path, header)?;
+    for_each_row(columns, rows, |row| writer.write_row(row))?;
+    writer.finish()
+}
+
+/// Checks columns about to be written to `path` (one valid name per column, all of one
+/// length) and returns their length: the checks of [`write_csv_atomic`], shared by the
+/// Parquet writer.
+///
+/// # Errors
+/// [`HeaderMismatch`](IoError::HeaderMismatch), [`InvalidColumnName`](IoError::InvalidColumnName),
+/// [`ColumnLengthMismatch`](IoError::ColumnLengthMismatch), in that order.
+pub(crate) fn checked_rows(path: &Path, header: &[&str], columns: &[&[f64]]) -> Result<usize> {
     if header.len() != columns.len() {
         return Err(IoError::HeaderMismatch {
             path: path.to_path_buf(),
@@ -446,16 +460,23 @@ pub fn write_csv_atomic(path: &Path, header: &[&str], columns: &[&[f64]]) -> Res
             });
         }
     }
+    Ok(rows)
+}
 
-    let mut writer = CsvWriter::create(path, header)?;
+/// Calls `write` with each of the first `rows` rows of `columns`, in order, in one buffer.
+pub(crate) fn for_each_row(
+    columns: &[&[f64]],
+    rows: usize,
+    mut write: impl FnMut(&[f64]) -> Result<()>,
+) -> Result<()> {
     let mut row = vec![0.0; columns.len()];
     for i in 0..rows {
         for (value, column) in row.iter_mut().zip(columns) {
             *value = column[i];
         }
-        writer.write_row(&row)?;
+        write(&row)?;
     }
-    writer.finish()
+    Ok(())
 }
 
 /// A time-series CSV written row by row as a run produces it, atomically (see

@@ -153,40 +153,17 @@ impl ParquetWriter {
     }
 }
 
-/// Writes columns to a Parquet file atomically: `header[j]` names `columns[j]`; every
-/// value must be finite and all columns of one length, as for
-/// [`write_csv_atomic`](crate::csv::write_csv_atomic).
+/// Writes columns to a Parquet file atomically: `header[j]` names `columns[j]`; names, lengths
+/// and values are checked as for [`write_csv_atomic`](crate::csv::write_csv_atomic).
 ///
 /// # Errors
-/// [`HeaderMismatch`](IoError::HeaderMismatch), [`ColumnLengthMismatch`](IoError::ColumnLengthMismatch),
+/// [`HeaderMismatch`](IoError::HeaderMismatch), [`InvalidColumnName`](IoError::InvalidColumnName),
+/// [`ColumnLengthMismatch`](IoError::ColumnLengthMismatch),
 /// [`NonFinite`](IoError::NonFinite), or as [`ParquetWriter`]; nothing is left at `path`.
 pub fn write_parquet_atomic(path: &Path, header: &[&str], columns: &[&[f64]]) -> Result<()> {
-    if header.len() != columns.len() {
-        return Err(IoError::HeaderMismatch {
-            path: path.to_path_buf(),
-            names: header.len(),
-            columns: columns.len(),
-        });
-    }
-    let rows = columns.first().map_or(0, |c| c.len());
-    for (name, column) in header.iter().zip(columns) {
-        if column.len() != rows {
-            return Err(IoError::ColumnLengthMismatch {
-                path: path.to_path_buf(),
-                column: (*name).to_owned(),
-                expected: rows,
-                found: column.len(),
-            });
-        }
-    }
+    let rows = crate::csv::checked_rows(path, header, columns)?;
     let mut writer = ParquetWriter::create(path, header)?;
-    let mut row = vec![0.0; columns.len()];
-    for i in 0..rows {
-        for (value, column) in row.iter_mut().zip(columns) {
-            *value = column[i];
-        }
-        writer.write_row(&row)?;
-    }
+    crate::csv::for_each_row(columns, rows, |row| writer.write_row(row))?;
     writer.finish()
 }
 
