@@ -48,7 +48,7 @@ fn bash_completes_the_verbs_and_their_options() {
         eprintln!("skipped: no bash on this machine");
         return;
     };
-    assert_eq!(verbs, ["simulate", "schema", "sweep"]);
+    assert_eq!(verbs, ["simulate", "schema", "scenarios", "sweep"]);
     let options = bash_completes(&["platen", "identify", "--no"]).unwrap();
     assert_eq!(
         options,
