@@ -148,7 +148,7 @@ impl<'a> Grid<'a> {
 /// (exact for ±1, so the results are bit for bit those of a run-time direction) and two
 /// multiplications leave the dependency chain of every stage.
 #[inline(always)]
-const fn direction<const POSITIVE: bool>() -> f64 {
+pub(crate) const fn direction<const POSITIVE: bool>() -> f64 {
     if POSITIVE {
         1.0
     } else {

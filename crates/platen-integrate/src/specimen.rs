@@ -50,7 +50,7 @@ use crate::event::{
 };
 use crate::output::{Sample, SampleSink, SpecimenSample};
 use crate::record::ForceRecord;
-use crate::rk4::{drive, Grading, Grid, GridStep, GridStepper, Rk4, MAX_HALVINGS};
+use crate::rk4::{direction, drive, Grading, Grid, GridStep, GridStepper, Rk4, MAX_HALVINGS};
 use crate::run::{check_run, sample_at, EnergyBalance, Kin, RunStats, State};
 use crate::stop::{Failure, StopReason};
 
@@ -163,17 +163,6 @@ struct StoreyPart {
     power: f64,
     /// The bottom storey's shear `k₁z₁ + c₁ż₁ = −B`, N.
     shear0: f64,
-}
-
-/// The friction direction of slip as a number: `+1.0` for `POSITIVE`, `−1.0` otherwise (as
-/// in the bare RK4: the slip path is compiled per direction, and `±x` is exact).
-#[inline(always)]
-const fn direction<const POSITIVE: bool>() -> f64 {
-    if POSITIVE {
-        1.0
-    } else {
-        -1.0
-    }
 }
 
 /// [`Stepper::storey_part`] for a state of length `L` (`(L − 5)/2` storeys).
