@@ -12,11 +12,11 @@
 //! exact stick-slip can approach but not beat.
 //!
 //! The criterion benches (`benches/rk4_throughput.rs`, `benches/dopri5_throughput.rs`, through
-//! `benches/common/mod.rs`) and `platen bench` (`crates/platen-cli/src/bench.rs`, through
+//! `benches/common/mod.rs`) and `platen bench` (`src/bin/platen/bench.rs`, through
 //! `#[path]`) all compile this one file, time it in the same run as the real integrators and
 //! report their ratio to it; `benches/c/rk4_baseline.c` is the same loop in C.
 //!
-//! Its test (that it computes the model it claims to) is in `crates/platen-cli/src/bench.rs`,
+//! Its test (that it computes the model it claims to) is in `src/bin/platen/bench.rs`,
 //! where it runs as a unit test of the `platen` binary.
 //!
 //! Do not use it to simulate anything: with `sign(v)` friction it is off by ~4e-4 m on the
