@@ -84,6 +84,30 @@ run sweep_plot sweep scenarios/sr9-like-sine-force.json --scale 0.5,1,1.5 --pres
 run simulate_plot simulate scenarios/paper-forward-force.json --json --plot "$out/simulate-figures" \
   --png-scale 0.5
 
+# The closed loop, planning and the model's loop description (issue 27's refactor moves their
+# printing into the libraries).
+for s in scenarios/table-system/wn10g-closed-loop.json; do
+  name=$(basename "$s" .json)
+  run "simulate_${name}_csv" simulate "$s" --out "$out/${name}.csv"
+  run "simulate_${name}_json" simulate "$s" --json
+  run "simulate_${name}_text" simulate "$s"
+  run "model_scenario_${name}_json" model --scenario "$s" --json
+  run "model_scenario_${name}_text" model --scenario "$s" --plot "$out/${name}-bode"
+done
+run model_system_json model --system lhpost-2008 --json
+run model_system_text model --system lhpost-2008
+run generate_wn10g_target generate excitation scenarios/table-system/wn10g-closed-loop.json --out "$out/wn10g-target.csv"
+run plan_wn10g_text plan scenarios/table-system/wn10g-closed-loop.json --target "$out/wn10g-target.csv" \
+  --out "$out/wn10g-drive.csv" --iterations 3 --plot "$out/wn10g-plan" --report "$out/wn10g-plan.html"
+run plan_wn10g_json plan scenarios/table-system/wn10g-closed-loop.json --target "$out/wn10g-target.csv" \
+  --out "$out/wn10g-drive2.csv" --iterations 3 --json
+# Any-record identification: a mixed day of records (its manifest's paths are relative to it).
+run identify_mixed_json identify --manifest tests/data/any-record/mixed-day-manifest.json --json
+run identify_mixed_text identify --manifest tests/data/any-record/mixed-day-manifest.json \
+  --report "$out/mixed.html"
+run identify_records_json identify tests/data/any-record/eq-lab.csv tests/data/any-record/wn-lab.csv \
+  --columns tests/data/any-record/columns.json --json
+
 # Model and schema.
 for form in identified full; do
   for p in 0 6.9 13.8; do
