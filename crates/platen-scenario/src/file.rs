@@ -41,7 +41,7 @@ pub struct ScenarioFile {
     /// The loop around the platen (controller, valves, actuators, supply): with one, a motion
     /// excitation is the displacement command of a closed-loop forward run
     /// ([`crate::system`]).
-    pub table_system: Option<crate::system::TableSystemSpec>,
+    pub table_system: Option<crate::system_file::TableSystemSpec>,
 }
 
 /// `specimen`: a linear shear building fixed on the platen.

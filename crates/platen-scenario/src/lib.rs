@@ -29,6 +29,7 @@ pub mod scenario;
 mod summary;
 pub mod sweep;
 pub mod system;
+mod system_file;
 pub mod units;
 
 pub use arrays::Arrays;
