@@ -1,6 +1,7 @@
 //! Differentiation and integration of uniformly sampled records, with baseline correction.
 
 use crate::error::{Result, SignalError};
+use crate::motion::{check_finite, Motion};
 use crate::SampleRate;
 
 /// Derivative of a uniformly sampled record by second-order finite differences.
@@ -96,15 +97,6 @@ pub struct InitialMotion {
     pub v_m_s: f64,
 }
 
-/// Velocity and displacement integrated from an acceleration record, one value per sample.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct Motion {
-    /// Velocity, m/s.
-    pub v_m_s: Vec<f64>,
-    /// Displacement, m.
-    pub u_m: Vec<f64>,
-}
-
 /// Integrates acceleration to velocity and displacement (trapezoidal rule) with an optional
 /// [`Baseline`] correction. Plan once with [`new`](Self::new), integrate many records.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -145,21 +137,44 @@ impl MotionIntegrator {
         self.baseline
     }
 
-    /// Integrates `a_m_s2` from `initial`. An empty record gives empty results.
-    pub fn integrate(&self, a_m_s2: &[f64], initial: InitialMotion) -> Motion {
-        let mut v_m_s = match self.baseline {
-            Baseline::Acceleration { order } => {
-                let mut a = a_m_s2.to_vec();
-                remove_polynomial(&mut a, order);
-                cumulative_trapezoid(&a, self.rate, initial.v_m_s)
+    /// The motion of the acceleration record `a_m_s2` from `initial`: sample `i` at
+    /// `t_s = i/sample_rate_hz`, the velocity the cumulative trapezoid of the acceleration
+    /// and the displacement that of the velocity, after the [`Baseline`] correction.
+    ///
+    /// The motion's acceleration is the one whose integral its velocity is: the record as
+    /// given ([`Baseline::None`]), the record less its polynomial
+    /// ([`Baseline::Acceleration`]), or the record less the derivative of the polynomial
+    /// taken out of the velocity ([`Baseline::Velocity`]), so the three channels stay one
+    /// motion.
+    ///
+    /// # Errors
+    /// [`SignalError::TooFewSamples`] for fewer than two samples,
+    /// [`SignalError::NonFiniteInput`] for a sample that is not finite (as [`Motion::new`]).
+    pub fn integrate(&self, a_m_s2: &[f64], initial: InitialMotion) -> Result<Motion> {
+        if a_m_s2.len() < 2 {
+            return Err(SignalError::TooFewSamples {
+                found: a_m_s2.len(),
+                needed: 2,
+            });
+        }
+        check_finite("a_m_s2", a_m_s2)?;
+        let rate_hz = self.rate.hz();
+        let t_s: Vec<f64> = (0..a_m_s2.len()).map(|i| i as f64 / rate_hz).collect();
+        let mut a_m_s2 = a_m_s2.to_vec();
+        if let Baseline::Acceleration { order } = self.baseline {
+            remove_polynomial(&mut a_m_s2, order);
+        }
+        let mut v_m_s = cumulative_trapezoid(&a_m_s2, self.rate, initial.v_m_s);
+        if let (Baseline::Velocity { order }, n @ 2..) = (self.baseline, v_m_s.len()) {
+            // The polynomial's slope per sample, into m/s².
+            let mut slope = vec![0.0; n];
+            fit_and_remove(&mut v_m_s, order, Some(&mut slope));
+            for (a, s) in a_m_s2.iter_mut().zip(&slope) {
+                *a -= s * rate_hz;
             }
-            _ => cumulative_trapezoid(a_m_s2, self.rate, initial.v_m_s),
-        };
-        if let Baseline::Velocity { order } = self.baseline {
-            remove_polynomial(&mut v_m_s, order);
         }
         let u_m = cumulative_trapezoid(&v_m_s, self.rate, initial.u_m);
-        Motion { v_m_s, u_m }
+        Motion::new(t_s, u_m, v_m_s, a_m_s2)
     }
 }
 
@@ -170,6 +185,14 @@ impl MotionIntegrator {
 /// Gram–Schmidt), with three work vectors. A degree at or above the number of samples removes
 /// everything (the fit interpolates).
 pub fn remove_polynomial(x: &mut [f64], order: usize) {
+    fit_and_remove(x, order, None);
+}
+
+/// [`remove_polynomial`], and where `slope` is given (as long as `x`, at least two samples)
+/// the derivative of the removed polynomial per sample index added to it, carried through
+/// the same recurrence (`p′ₖ₊₁ = pₖ + (s − α)·p′ₖ − β·p′ₖ₋₁`). `x` comes out the same to the
+/// bit either way.
+fn fit_and_remove(x: &mut [f64], order: usize, mut slope: Option<&mut [f64]>) {
     let n = x.len();
     if n == 0 {
         return;
@@ -183,6 +206,11 @@ pub fn remove_polynomial(x: &mut [f64], order: usize) {
     let mut p_prev = vec![0.0; n];
     let mut p = vec![1.0; n];
     let mut p_next = vec![0.0; n];
+    // Derivatives of the three polynomials in the mapped abscissa (only with `slope`).
+    let derivatives = if slope.is_some() { n } else { 0 };
+    let mut dp_prev = vec![0.0; derivatives];
+    let mut dp = vec![0.0; derivatives];
+    let mut dp_next = vec![0.0; derivatives];
     let mut norm_prev = 1.0;
     // Polynomials whose norm falls to this fraction of the first one are numerically zero
     // (the degree has reached the number of points).
@@ -196,6 +224,11 @@ pub fn remove_polynomial(x: &mut [f64], order: usize) {
         for (xi, pi) in x.iter_mut().zip(&p) {
             *xi -= c * pi;
         }
+        if let Some(slope) = slope.as_deref_mut() {
+            for (si, dpi) in slope.iter_mut().zip(&dp) {
+                *si += c * dpi;
+            }
+        }
         if degree == order {
             break;
         }
@@ -204,9 +237,21 @@ pub fn remove_polynomial(x: &mut [f64], order: usize) {
         for i in 0..n {
             p_next[i] = (t[i] - alpha) * p[i] - beta * p_prev[i];
         }
+        for i in 0..derivatives {
+            dp_next[i] = p[i] + (t[i] - alpha) * dp[i] - beta * dp_prev[i];
+        }
         std::mem::swap(&mut p_prev, &mut p);
         std::mem::swap(&mut p, &mut p_next);
+        std::mem::swap(&mut dp_prev, &mut dp);
+        std::mem::swap(&mut dp, &mut dp_next);
         norm_prev = norm;
+    }
+    // From the mapped abscissa (−1 … 1 over the record) to the sample index.
+    if let Some(slope) = slope {
+        let per_index = 2.0 / (n.max(2) - 1) as f64;
+        for si in slope.iter_mut() {
+            *si *= per_index;
+        }
     }
 }
 
@@ -242,6 +287,41 @@ mod tests {
         let mut y: Vec<f64> = (0..100).map(|i| (i as f64 * 0.37).sin()).collect();
         remove_polynomial(&mut y, 2);
         assert!(y.iter().sum::<f64>().abs() < 1e-12);
+    }
+
+    /// The slope of the removed polynomial is its exact derivative per sample: for a
+    /// polynomial of the fitted degree, the derivative of what was there.
+    #[test]
+    fn the_slope_of_the_removed_polynomial_is_its_derivative() {
+        let n = 301;
+        for order in 0..=MAX_BASELINE_ORDER {
+            let p = |i: f64| -> f64 {
+                (0..=order)
+                    .map(|k| (k as f64 - 1.5) * (i / 300.0).powi(k as i32))
+                    .sum()
+            };
+            let mut x: Vec<f64> = (0..n).map(|i| p(i as f64)).collect();
+            let exact: Vec<f64> = (0..n)
+                .map(|i| {
+                    let s = i as f64 / 300.0;
+                    (1..=order)
+                        .map(|k| (k as f64 - 1.5) * k as f64 * s.powi(k as i32 - 1) / 300.0)
+                        .sum()
+                })
+                .collect();
+            let before = x.clone();
+            let mut plain = x.clone();
+            remove_polynomial(&mut plain, order);
+            let mut slope = vec![0.0; n];
+            fit_and_remove(&mut x, order, Some(&mut slope));
+            assert_eq!(x, plain, "order {order}: x must not depend on the slope");
+            let worst = slope
+                .iter()
+                .zip(&exact)
+                .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+            assert!(worst < 1e-11, "order {order}: slope off by {worst}");
+            assert_ne!(before, x);
+        }
     }
 
     #[test]

@@ -61,6 +61,51 @@ pub enum SignalError {
         /// The smallest length that works.
         min: usize,
     },
+    /// The columns of a record (a [`Motion`](crate::Motion)) do not have the same length.
+    #[error("record columns differ in length: {what} has {found} values, expected {expected}")]
+    ColumnLengthMismatch {
+        /// Which column.
+        what: &'static str,
+        /// Its length.
+        found: usize,
+        /// The length of the time column.
+        expected: usize,
+    },
+    /// A record with a time column (a [`Motion`](crate::Motion)) has too few samples.
+    #[error("record has {found} samples; at least {needed} are needed")]
+    TooFewSamples {
+        /// Samples present.
+        found: usize,
+        /// Samples needed.
+        needed: usize,
+    },
+    /// A value in a record is NaN or infinite.
+    #[error("{what}[{index}] = {value} is not finite")]
+    NonFiniteInput {
+        /// Which column.
+        what: &'static str,
+        /// Zero-based sample index.
+        index: usize,
+        /// The value.
+        value: f64,
+    },
+    /// A time column does not increase strictly.
+    #[error("time is not strictly increasing at sample {index}: {previous_s} s then {value_s} s")]
+    TimeNotIncreasing {
+        /// Zero-based sample index.
+        index: usize,
+        /// The previous time, s.
+        previous_s: f64,
+        /// The offending time, s.
+        value_s: f64,
+    },
+    /// A velocity dead band ([`Motion::with_rest_velocity`](crate::Motion::with_rest_velocity))
+    /// that is not a finite positive number.
+    #[error("rest_velocity_m_s = {value} is invalid: expected a finite velocity > 0 m/s")]
+    InvalidRestVelocity {
+        /// The value given, m/s.
+        value: f64,
+    },
     /// Two channels share too little coherent content for a delay estimate
     /// ([`crate::DelayEstimator`]).
     #[error(

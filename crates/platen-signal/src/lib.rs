@@ -39,6 +39,9 @@
 //!   [`trim_to_whole_periods`]).
 //! * [`differentiate`], [`cumulative_trapezoid`], [`MotionIntegrator`] (acceleration →
 //!   velocity → displacement with a [`Baseline`] correction), [`remove_polynomial`].
+//! * [`Motion`]: a table motion (displacement, velocity, acceleration at checked sample
+//!   times), what [`MotionIntegrator`] returns and an inverse run of `platen_integrate`
+//!   takes; [`derivative`] and [`second_derivative`] on a non-uniform time grid.
 //! * [`CrossoverVelocity`]: velocity from displacement and acceleration (paper §1.5, ref. \[14\]).
 //! * [`DelayEstimator`]: a channel's skew (delay) against a reference, to a fraction of a
 //!   sample with its standard error; [`advance`] shifts a channel by a non-integer number of
@@ -55,7 +58,8 @@
 //! * **Units.** SI throughout, and the unit is part of every name: `sample_rate_hz`,
 //!   `cutoff_hz`, `frequency_hz`, `t_s`, `u_m`, `v_m_s`, `a_m_s2`, `phase_rad`.
 //! * **Sampling.** Records are uniformly sampled; sample `i` is at `t_s = i/sample_rate_hz`
-//!   from the record's start. Nothing here reads time columns: check uniformity first.
+//!   from the record's start. Only [`Motion`] and the derivatives on a time grid take time
+//!   columns (and [`Motion`] checks only that time increases): check uniformity first.
 //! * **Zero phase, not causal.** Every low-pass here is zero-phase (non-causal): output sample
 //!   `i` depends on inputs before and after it, and a pass-band sine comes out in phase with the
 //!   input, with no delay. Their response is a real *amplitude* `A(f)`
@@ -90,6 +94,7 @@ mod error;
 mod extend;
 mod fir;
 pub mod metrics;
+mod motion;
 mod resample;
 mod response_spectrum;
 mod spectral;
@@ -99,7 +104,7 @@ mod window;
 pub use accelerogram::{AccelerogramMotion, Kinematics};
 pub use butterworth::{ButterworthLowpass, MAX_BUTTERWORTH_ORDER};
 pub use calculus::{
-    cumulative_trapezoid, differentiate, remove_polynomial, Baseline, InitialMotion, Motion,
+    cumulative_trapezoid, differentiate, remove_polynomial, Baseline, InitialMotion,
     MotionIntegrator, MAX_BASELINE_ORDER,
 };
 pub use crossover::{CrossoverVelocity, DEFAULT_CROSSOVER_HZ};
@@ -109,6 +114,7 @@ pub use delay::{
 };
 pub use error::{Result, SignalError};
 pub use fir::{FirLowpass, MAX_FIR_ORDER};
+pub use motion::{derivative, second_derivative, Motion};
 pub use resample::{Interpolation, Resampler};
 pub use response_spectrum::{ResponseSpectrum, SdofOscillator};
 pub use spectral::{trim_to_whole_periods, whole_periods, SpectralLowpass, WholePeriods};

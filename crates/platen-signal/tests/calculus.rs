@@ -78,14 +78,15 @@ fn integration_of_a_sine_acceleration_is_within_the_trapezoid_error_bound() {
             .collect();
         let m = MotionIntegrator::new(fs, Baseline::None)
             .unwrap()
-            .integrate(&a, InitialMotion { u_m: u0, v_m_s: v0 });
-        assert_eq!(m.v_m_s[0], v0);
-        assert_eq!(m.u_m[0], u0);
+            .integrate(&a, InitialMotion { u_m: u0, v_m_s: v0 })
+            .unwrap();
+        assert_eq!(m.v_m_s()[0], v0);
+        assert_eq!(m.u_m()[0], u0);
         let dt = 1.0 / fs;
         let bound_v = duration_s * dt * dt * amp * w * w / 12.0;
         let bound_u =
             dt * dt * amp * (w * w * duration_s * duration_s / 24.0 + w * duration_s / 12.0);
-        let (ev, eu) = (max_abs_diff(&m.v_m_s, &v), max_abs_diff(&m.u_m, &u));
+        let (ev, eu) = (max_abs_diff(m.v_m_s(), &v), max_abs_diff(m.u_m(), &u));
         assert!(
             ev <= bound_v,
             "{fs} Hz: velocity error {ev} > bound {bound_v}"
@@ -133,24 +134,85 @@ fn baseline_correction_removes_an_accelerometer_bias() {
 
     let plain = MotionIntegrator::new(fs, Baseline::None)
         .unwrap()
-        .integrate(&biased, InitialMotion::default());
-    let drift = max_abs_diff(&plain.v_m_s, &v_true);
+        .integrate(&biased, InitialMotion::default())
+        .unwrap();
+    let drift = max_abs_diff(plain.v_m_s(), &v_true);
     assert!((drift - 0.2).abs() < 0.01, "plain drift {drift}");
 
     let corrected = MotionIntegrator::new(fs, Baseline::Acceleration { order: 0 })
         .unwrap()
-        .integrate(&biased, InitialMotion::default());
-    let ev = max_abs_diff(&corrected.v_m_s, &v_true);
+        .integrate(&biased, InitialMotion::default())
+        .unwrap();
+    let ev = max_abs_diff(corrected.v_m_s(), &v_true);
     assert!(ev < 2e-4, "acceleration baseline: velocity error {ev}");
-    let eu = max_abs_diff(&corrected.u_m, &u_true);
+    let eu = max_abs_diff(corrected.u_m(), &u_true);
     assert!(eu < 1e-3, "acceleration baseline: displacement error {eu}");
 
     let by_velocity = MotionIntegrator::new(fs, Baseline::Velocity { order: 1 })
         .unwrap()
-        .integrate(&biased, InitialMotion::default());
+        .integrate(&biased, InitialMotion::default())
+        .unwrap();
     let centred: Vec<f64> = v_true.iter().map(|v| v - 1.0 / w).collect();
-    let ev = max_abs_diff(&by_velocity.v_m_s, &centred);
+    let ev = max_abs_diff(by_velocity.v_m_s(), &centred);
     assert!(ev < 1e-3, "velocity baseline: velocity error {ev}");
+    // The velocity line's slope (the bias, 0.02 m/s², and what the line fit takes of the
+    // oscillation) is gone from the acceleration too: the velocity's derivative is the
+    // motion's acceleration to the trapezoid's `Δt²·ω²/12·|a| ≈ 4e-5` plus the differences'
+    // own error, at every sample; the raw acceleration is off by the bias.
+    let rate = SampleRate::new(fs).unwrap();
+    let dv = differentiate(by_velocity.v_m_s(), rate);
+    let interior = 1..n - 1;
+    let ea = max_abs_diff(
+        &dv[interior.clone()],
+        &by_velocity.a_m_s2()[interior.clone()],
+    );
+    assert!(
+        ea < 1e-4,
+        "velocity baseline: acceleration off the velocity by {ea}"
+    );
+    let raw = max_abs_diff(&dv[interior.clone()], &biased[interior]);
+    assert!((raw - 0.02).abs() < 1e-3, "raw acceleration off by {raw}");
+}
+
+/// The motion of an acceleration record: sample `i` at `i/f_s`, the velocity and displacement
+/// the cumulative trapezoids from the initial values, and the acceleration the record itself
+/// (no baseline) or the record less its polynomial (an acceleration baseline): bit for bit.
+#[test]
+fn the_integrated_motion_is_the_record_and_its_trapezoids() {
+    let fs = 200.0;
+    let rate = SampleRate::new(fs).unwrap();
+    let a: Vec<f64> = (0..401).map(|i| (i as f64 * 0.05).sin() + 0.3).collect();
+    let initial = InitialMotion {
+        u_m: 0.01,
+        v_m_s: -0.2,
+    };
+    let m = MotionIntegrator::new(fs, Baseline::None)
+        .unwrap()
+        .integrate(&a, initial)
+        .unwrap();
+    assert_eq!(m.t_s(), times(a.len(), fs));
+    assert_eq!(m.a_m_s2(), a);
+    let v = cumulative_trapezoid(&a, rate, -0.2);
+    assert_eq!(m.v_m_s(), v);
+    assert_eq!(m.u_m(), cumulative_trapezoid(&v, rate, 0.01));
+    assert_eq!(m.rest_velocity_m_s(), None);
+
+    let m = MotionIntegrator::new(fs, Baseline::Acceleration { order: 2 })
+        .unwrap()
+        .integrate(&a, initial)
+        .unwrap();
+    let mut corrected = a.clone();
+    platen_signal::remove_polynomial(&mut corrected, 2);
+    assert_eq!(m.a_m_s2(), corrected);
+    assert_eq!(m.v_m_s(), cumulative_trapezoid(&corrected, rate, -0.2));
+
+    let mut bad = a;
+    bad[7] = f64::NAN;
+    let e = MotionIntegrator::new(fs, Baseline::None)
+        .unwrap()
+        .integrate(&bad, initial)
+        .unwrap_err();
+    assert_eq!(e.to_string(), "a_m_s2[7] = NaN is not finite");
 }
 
 #[test]
@@ -162,6 +224,11 @@ fn baseline_orders_above_the_maximum_are_rejected() {
     assert!(MotionIntegrator::new(-1.0, Baseline::None).is_err());
     let m = MotionIntegrator::new(100.0, Baseline::Acceleration { order: 8 }).unwrap();
     assert_eq!(m.baseline(), Baseline::Acceleration { order: 8 });
-    let empty = m.integrate(&[], InitialMotion::default());
-    assert!(empty.v_m_s.is_empty() && empty.u_m.is_empty());
+    assert_eq!(
+        m.integrate(&[1.0], InitialMotion::default()),
+        Err(SignalError::TooFewSamples {
+            found: 1,
+            needed: 2
+        })
+    );
 }

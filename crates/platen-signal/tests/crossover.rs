@@ -119,9 +119,9 @@ fn crossover_beats_either_source_alone_on_noisy_biased_records() {
         v_m_s: v_true[0],
     };
     let plain = MotionIntegrator::new(FS_HZ, Baseline::None).unwrap();
-    let e_a_raw = rms_diff(&plain.integrate(&a, v0).v_m_s, &v_true);
+    let e_a_raw = rms_diff(plain.integrate(&a, v0).unwrap().v_m_s(), &v_true);
     let corrected = MotionIntegrator::new(FS_HZ, Baseline::Acceleration { order: 0 }).unwrap();
-    let e_a = rms_diff(&corrected.integrate(&a, v0).v_m_s, &v_true);
+    let e_a = rms_diff(corrected.integrate(&a, v0).unwrap().v_m_s(), &v_true);
 
     let best_single = e_d_raw.min(e_d).min(e_a_raw).min(e_a);
     let report = format!(
