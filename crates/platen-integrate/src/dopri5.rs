@@ -596,7 +596,7 @@ impl<M: PlatenModel> AdaptiveRun<'_, M> {
         let found = locate_zero_velocity(span, dir * ya[1], (yb, dir * yb[1]), tolerance, |len| {
             self.stats.root_iterations += 1;
             let y = self.integrate_plain(dir, f0, slope, xa, ya, xa + len, t0)?;
-            Ok((y, dir * y[1]))
+            Ok::<_, IntegrateError>((y, dir * y[1]))
         })?;
         Ok(found.map_or((xa, ya), |(len, y)| (xa + len, y)))
     }

@@ -1,5 +1,7 @@
 //! Errors of the integrators.
 
+use platen_signal::SignalError;
+
 use crate::stop::{AdaptiveFailure, Failure, StopReason};
 
 /// Why a run could not be set up or did not finish.
@@ -86,7 +88,8 @@ pub enum IntegrateError {
         /// The record's sample interval, s.
         sample_interval_s: f64,
     },
-    /// A velocity dead band that is not a finite positive number.
+    /// A velocity dead band ([`crate::Motion::with_rest_velocity`]) that is not a finite
+    /// positive number.
     #[error("rest_velocity_m_s = {value} is invalid: expected a finite velocity > 0 m/s")]
     InvalidRestVelocity {
         /// The value given, m/s.
@@ -150,6 +153,10 @@ pub enum IntegrateError {
         /// Displacement, m.
         u_m: f64,
     },
+    /// Any other error of `platen_signal` converted with `From` (a [`crate::Motion`]'s
+    /// checks convert to the variants above that have the same message).
+    #[error(transparent)]
+    Signal(SignalError),
     /// The stick-slip event loop stopped advancing inside one step.
     #[error("numerical failure at t = {t_s} s: {events} stick-slip events inside one step; the event loop does not advance")]
     EventLoopStalled {
@@ -193,6 +200,44 @@ impl IntegrateError {
             _ => return None,
         };
         Some(StopReason::Failed { t_s, cause })
+    }
+}
+
+/// The checks of a [`crate::Motion`] (a `platen_signal` type) as the same checks of this
+/// crate's records raise them: the same variant and message, so a motion and a
+/// [`crate::ForceRecord`] report a bad record alike.
+impl From<SignalError> for IntegrateError {
+    fn from(e: SignalError) -> Self {
+        match e {
+            SignalError::ColumnLengthMismatch {
+                what,
+                found,
+                expected,
+            } => IntegrateError::LengthMismatch {
+                what,
+                found,
+                expected,
+            },
+            SignalError::TooFewSamples { found, needed } => {
+                IntegrateError::TooShort { found, needed }
+            }
+            SignalError::NonFiniteInput { what, index, value } => {
+                IntegrateError::NonFiniteInput { what, index, value }
+            }
+            SignalError::TimeNotIncreasing {
+                index,
+                previous_s,
+                value_s,
+            } => IntegrateError::TimeNotIncreasing {
+                index,
+                previous_s,
+                value_s,
+            },
+            SignalError::InvalidRestVelocity { value } => {
+                IntegrateError::InvalidRestVelocity { value }
+            }
+            other => IntegrateError::Signal(other),
+        }
     }
 }
 

@@ -3,7 +3,7 @@
 use platen_model::{force_terms, ForceTerms, PlatenModel, Specimen};
 
 use crate::output::{Sample, SampleSink, SpecimenSample};
-use crate::record::Motion;
+use crate::Motion;
 
 /// Computes, at every sample of `motion`, the actuator force and its decomposition and
 /// delivers it to `sink`.

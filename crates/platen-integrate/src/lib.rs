@@ -67,9 +67,12 @@ pub use output::{
     Exceedance, Peak, Peaks, Sample, SampleSink, SpecimenColumns, SpecimenSample, SystemColumns,
     SystemSample, Trajectory,
 };
+/// The prescribed motion of inverse and closed-loop runs, and the derivatives its
+/// constructors use, are `platen_signal`'s, re-exported here; their errors convert into
+/// [`IntegrateError`] with `?`.
+pub use platen_signal::{derivative, second_derivative, Motion};
 pub use record::{
-    derivative, sampling_grid, second_derivative, uniform_interval_s, ForceRecord, Motion,
-    SamplingGrid, UNIFORM_RELATIVE_TOLERANCE,
+    sampling_grid, uniform_interval_s, ForceRecord, SamplingGrid, UNIFORM_RELATIVE_TOLERANCE,
 };
 pub use rk4::{forward_rk4, Rk4};
 pub use run::{EnergyBalance, RunStats, State};

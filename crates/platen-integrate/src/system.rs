@@ -53,10 +53,10 @@ use crate::event::{
     EventKind, Mode, MAX_EVENTS_PER_STEP,
 };
 use crate::output::{SampleSink, SpecimenSample, SystemSample};
-use crate::record::Motion;
 use crate::rk4::{Grading, MAX_HALVINGS};
 use crate::run::{sample_at, EnergyBalance, Kin, RunStats, State};
 use crate::stop::{Failure, StopReason};
+use crate::Motion;
 
 const NS: usize = Specimen::MAX_STOREYS;
 /// A creep stop located this close (fraction of a step `h`) to where the advance started has

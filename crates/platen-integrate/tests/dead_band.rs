@@ -118,7 +118,7 @@ fn the_dead_band_changes_only_the_samples_inside_it() {
 #[test]
 fn a_dead_band_that_is_not_a_positive_velocity_is_rejected() {
     for bad in [0.0, -1e-3, f64::NAN, f64::INFINITY] {
-        let e = standing_still(0.0).with_rest_velocity(bad).unwrap_err();
+        let e = IntegrateError::from(standing_still(0.0).with_rest_velocity(bad).unwrap_err());
         assert!(
             matches!(e, IntegrateError::InvalidRestVelocity { .. }),
             "{bad}: {e:?}"

@@ -196,14 +196,14 @@ pub fn command_motion(t_s: &[f64], u_m: &[f64]) -> Result<Motion> {
     let on_grid: Vec<f64> = (0..t_s.len())
         .map(|i| grid.start_s + i as f64 * grid.interval_s)
         .collect();
-    let m = Motion::from_displacement(on_grid, u_m.to_vec()).map_err(wrap)?;
+    let m = Motion::from_displacement(on_grid, u_m.to_vec()).map_err(|e| wrap(e.into()))?;
     Motion::new(
         t_s.to_vec(),
         m.u_m().to_vec(),
         m.v_m_s().to_vec(),
         m.a_m_s2().to_vec(),
     )
-    .map_err(wrap)
+    .map_err(|e| wrap(e.into()))
 }
 
 fn acceleration_motion(

@@ -494,7 +494,7 @@ fn crossover_note() -> String {
 }
 
 /// `m` at the time stamps `t_s` (same length) instead of its own times.
-fn restamp(t_s: Vec<f64>, m: &Motion) -> std::result::Result<Motion, IntegrateError> {
+fn restamp(t_s: Vec<f64>, m: &Motion) -> std::result::Result<Motion, platen_signal::SignalError> {
     Motion::new(
         t_s,
         m.u_m().to_vec(),
@@ -522,10 +522,10 @@ fn white_noise(gen: &Generated, g: &WhiteNoiseMotion) -> Result<Run> {
 }
 
 /// A record the integrator's checks reject.
-pub(crate) fn rejected(path: &Path, cause: IntegrateError) -> ScenarioError {
+pub(crate) fn rejected(path: &Path, cause: impl Into<IntegrateError>) -> ScenarioError {
     ScenarioError::RecordRejected {
         path: path.to_owned(),
-        cause,
+        cause: cause.into(),
     }
 }
 
