@@ -48,5 +48,5 @@ pub mod preset;
 pub use controller::{ControllerInput, ControllerState};
 pub use error::{Result, SystemError};
 pub use hydraulics::{HydraulicConstants, HydraulicRates, HydraulicState, LAMINAR_FRACTION};
-pub use linear::{Capacities, Linearisation, Margins, Mechanics, SECANT_SPEED_M_S};
+pub use linear::{Capacities, Linearisation, Margins, Mechanics, Passband, SECANT_SPEED_M_S};
 pub use params::{Accumulator, Actuator, Controller, ServoValve, Supply, TableSystem};

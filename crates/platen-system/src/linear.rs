@@ -100,6 +100,21 @@ pub struct Margins {
     pub peak_gain_hz: f64,
 }
 
+/// How flat the closed loop's gain command → displacement is: its −3 dB bandwidth and its
+/// lowest gain below it ([`TableSystem::passband`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Passband {
+    /// The frequency above which `|U/R|` stays below `1/√2` (−3 dB) up to the controller's
+    /// Nyquist frequency, Hz (`None`: it ends above `1/√2`, or never reaches it).
+    pub bandwidth_hz: Option<f64>,
+    /// The lowest `|U/R|` from 0.001 Hz to its largest below the bandwidth (below the
+    /// Nyquist frequency without one): a dip inside the band the table tracks, before the
+    /// resonance peak and the roll-off.
+    pub min_gain: f64,
+    /// Where it is, Hz.
+    pub min_gain_hz: f64,
+}
+
 /// The table's capacities by the closed forms.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Capacities {
@@ -331,6 +346,43 @@ impl TableSystem {
         let windings = (2.0 * total - std::f64::consts::PI * integrators) / std::f64::consts::TAU;
         out.stable = windings.round() == 0.0;
         out
+    }
+
+    /// The [`Passband`] of the closed loop of `lin`, on a logarithmic grid of 4000
+    /// frequencies from 0.001 Hz to the controller's Nyquist frequency, the bandwidth refined
+    /// by bisection.
+    pub fn passband(&self, lin: &Linearisation) -> Passband {
+        let level = std::f64::consts::FRAC_1_SQRT_2;
+        let gain = |f: f64| self.closed_loop_response(lin, f).norm();
+        let (f_min, f_max, n) = (0.001_f64, 0.5 * self.controller.sample_rate_hz, 4000);
+        let at = |i: usize| f_min * (f_max / f_min).powf(i as f64 / n as f64);
+        let g: Vec<f64> = (0..=n).map(|i| gain(at(i))).collect();
+        // The last fall through the level, if the gain stays below it after.
+        let last_fall = (1..=n)
+            .rev()
+            .take_while(|&i| g[i] < level)
+            .last()
+            .filter(|&i| g[i - 1] >= level);
+        let bandwidth_hz = last_fall.map(|i| {
+            let (mut a, mut b) = (at(i - 1), at(i));
+            for _ in 0..60 {
+                let m = (a * b).sqrt();
+                if gain(m) < level {
+                    b = m;
+                } else {
+                    a = m;
+                }
+            }
+            (a * b).sqrt()
+        });
+        let below = last_fall.unwrap_or(n);
+        let argmax = (0..=below).fold(0, |best, i| if g[i] > g[best] { i } else { best });
+        let i_min = (0..=argmax).fold(0, |best, i| if g[i] < g[best] { i } else { best });
+        Passband {
+            bandwidth_hz,
+            min_gain: g[i_min],
+            min_gain_hz: at(i_min),
+        }
     }
 
     /// The fastest rate of the loop, rad/s: the larger of the spool's natural frequency and
