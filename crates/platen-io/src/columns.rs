@@ -407,8 +407,8 @@ impl ColumnMap {
     /// as a scenario's `excitation.columns`), for recorded files named on the command line.
     ///
     /// # Errors
-    /// [`IoError::Io`] if the file cannot be read, [`IoError::Json`] (with the
-    /// JSON path) if it is not such an object, [`IoError::InvalidField`] for an unknown
+    /// [`IoError::Io`] if the file cannot be read, [`IoError::JsonSyntax`] if it is not
+    /// JSON, [`IoError::Json`] (with the JSON path) if it is not such an object, [`IoError::InvalidField`] for an unknown
     /// column or unit.
     pub fn load(path: &Path) -> Result<Self> {
         let spec: BTreeMap<String, ColumnSpec> = parse_json_file(path)?;

@@ -303,6 +303,20 @@ pub enum IoError {
         message: String,
     },
 
+    /// A JSON input (scenario, column map, manifest) is not valid JSON: a comma, bracket,
+    /// brace or quote out of place.
+    #[error("`{}`: JSON syntax error at line {line} column {column}: {message}", path.display())]
+    JsonSyntax {
+        /// The JSON file.
+        path: PathBuf,
+        /// 1-based line of the error, as a text editor shows it.
+        line: u64,
+        /// 1-based column of the error.
+        column: u64,
+        /// What is wrong (`trailing comma`, `expected value`, …).
+        message: String,
+    },
+
     /// A scenario field has a value that cannot be used.
     #[error("`{}`: {json_path} = {value}: expected {expected}", path.display())]
     InvalidField {
@@ -377,12 +391,14 @@ impl IoError {
             | IoError::ColumnLengthMismatch { path, .. }
             | IoError::InvalidColumnName { path, .. }
             | IoError::Json { path, .. }
+            | IoError::JsonSyntax { path, .. }
             | IoError::InvalidField { path, .. }
             | IoError::Record { path, .. } => path,
         }
     }
 
-    /// The 1-based line of the file the error is about, where it is known (CSV rows).
+    /// The 1-based line of the file the error is about, where it is known (CSV rows, a JSON
+    /// syntax error).
     pub fn line(&self) -> Option<u64> {
         match self {
             IoError::CsvSyntax { line, .. }
@@ -392,6 +408,7 @@ impl IoError {
             | IoError::RaggedRow { line, .. }
             | IoError::NonUniform { line, .. }
             | IoError::OffGrid { line, .. } => Some(*line),
+            IoError::JsonSyntax { line, .. } => Some(*line),
             _ => None,
         }
     }

@@ -28,6 +28,7 @@ pub fn parse_json_file<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T>
 /// is named. A file that ends early (empty, or cut off) says so with the line it ends on.
 ///
 /// # Errors
+/// [`IoError::JsonSyntax`] for text that is not JSON (with the line and column), else
 /// [`IoError::Json`].
 pub fn parse_json<T: serde::de::DeserializeOwned>(path: &Path, text: &str) -> Result<T> {
     let de = &mut serde_json::Deserializer::from_str(text);
@@ -51,6 +52,16 @@ pub fn parse_json<T: serde::de::DeserializeOwned>(path: &Path, text: &str) -> Re
         let mut message = inner.to_string();
         if let Some(pos) = message.rfind(" at line ") {
             message.truncate(pos);
+        }
+        // A syntax error has no field to name: serde_path_to_error's path there is where it
+        // was reading (`?` for a key still to come), which means nothing to the reader.
+        if inner.is_syntax() {
+            return IoError::JsonSyntax {
+                path: path.to_owned(),
+                line: line as u64,
+                column: column as u64,
+                message,
+            };
         }
         if let Some(rest) = message.strip_suffix(", expected f64") {
             message = format!("{rest}, expected a number");
@@ -148,5 +159,58 @@ fn matching_fields(node: &serde_json::Value, here: String, quoted: &str, found: 
     };
     if described == quoted {
         found.push(here);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_syntax_error_names_the_line_and_column_and_no_path() {
+        let text = "{\"model\": {\"preset\": \"lhpost-2008\"},\n\"duration_s\": 1\n\n,}";
+        let e = parse_json::<serde_json::Value>(Path::new("s.json"), text).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                IoError::JsonSyntax {
+                    line: 4,
+                    column: 2,
+                    ..
+                }
+            ),
+            "{e:?}"
+        );
+        let message = e.to_string();
+        assert_eq!(
+            message,
+            "`s.json`: JSON syntax error at line 4 column 2: trailing comma"
+        );
+        assert_eq!(e.line(), Some(4));
+        assert_eq!(e.field(), None);
+    }
+
+    #[test]
+    fn a_trailing_comma_inside_an_object_shows_no_question_mark() {
+        let text = "{\"model\": {\"preset\": \"lhpost-2008\",}}";
+        let e = parse_json::<serde_json::Value>(Path::new("s.json"), text).unwrap_err();
+        let message = e.to_string();
+        assert!(!message.contains('?'), "{message}");
+        assert!(
+            message.contains("JSON syntax error at line 1 column"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn a_type_error_keeps_its_json_path() {
+        #[derive(serde::Deserialize, Debug)]
+        #[allow(dead_code)]
+        struct S {
+            duration_s: f64,
+        }
+        let e = parse_json::<S>(Path::new("s.json"), "{\"duration_s\": \"long\"}").unwrap_err();
+        assert!(matches!(e, IoError::Json { .. }), "{e:?}");
+        assert!(e.to_string().contains("duration_s (line 1"), "{e}");
     }
 }

@@ -371,7 +371,8 @@ pub struct InitialSpec {
 /// Parses scenario JSON, reporting the JSON path (or line and column) of any error.
 ///
 /// # Errors
-/// [`crate::ScenarioError::Io`] ([`platen_io::IoError::Json`]).
+/// [`crate::ScenarioError::Io`] ([`platen_io::IoError::JsonSyntax`] for text that is not
+/// JSON, [`platen_io::IoError::Json`] for JSON that is not a scenario).
 pub fn parse(path: &Path, text: &str) -> Result<ScenarioFile> {
     Ok(parse_json(path, text)?)
 }

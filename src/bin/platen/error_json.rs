@@ -13,9 +13,9 @@
 //! - `exit_code`: the process's exit code (the same with or without `--json`);
 //! - `message`: the text the plain form prints after `error: `;
 //! - `file`: the file the error is about, where one is known, else null;
-//! - `field`: the JSON path of a scenario field (with the line and column of a syntax or type
-//!   error) or the name of a CSV column, else null;
-//! - `line`: the 1-based line of a CSV file, else null.
+//! - `field`: the JSON path of a scenario field (with the line and column of a type error) or
+//!   the name of a CSV column, else null (a JSON syntax error has no field);
+//! - `line`: the 1-based line of a CSV file or of a JSON syntax error, else null.
 
 use serde_json::{json, Value};
 
