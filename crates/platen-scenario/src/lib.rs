@@ -17,7 +17,8 @@
 mod arrays;
 pub mod catalog;
 mod ctx;
-mod describe;
+pub mod describe;
+mod describe_system;
 pub mod error;
 mod excitation;
 mod execute;
