@@ -36,6 +36,7 @@ mod plot;
 mod schema;
 mod simulate;
 mod sweep;
+mod usage;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -76,7 +77,7 @@ enum Command {
         /// elastic_force_n, dissipative_force_n; then a specimen's and a closed loop's
         /// columns) to this CSV file; a name ending in .parquet writes Parquet instead (the
         /// same columns, float64, one row per sample).
-        #[arg(long)]
+        #[arg(long, value_parser = usage::OutFile("run.csv"))]
         out: Option<PathBuf>,
         /// Print a machine-readable summary on stdout.
         #[arg(long)]
@@ -124,7 +125,7 @@ enum Command {
         #[arg(long, value_name = "T0,T1", allow_hyphen_values = true, value_parser = compare::parse_window)]
         window: Option<compare::Window>,
         /// Write a self-contained HTML report (metrics table and figures) to this file.
-        #[arg(long, value_name = "FILE.html")]
+        #[arg(long, value_name = "FILE.html", value_parser = usage::OutFile("report.html"))]
         report: Option<PathBuf>,
         /// JSON file mapping the record's channel names and units to platen's columns, as a
         /// scenario's excitation.columns: {"u_m": {"name": "Table disp", "unit": "mm"}, …}.
@@ -214,7 +215,7 @@ enum Command {
         platen schema --out scenario.schema.json")]
     Schema {
         /// Write the schema to this file instead of standard output.
-        #[arg(long)]
+        #[arg(long, value_parser = usage::OutFile("scenario.schema.json"))]
         out: Option<PathBuf>,
     },
     /// List the shipped scenarios: path, what each runs, its name.
@@ -256,7 +257,7 @@ enum Command {
         /// Scenario JSON file.
         scenario: PathBuf,
         /// Output CSV file.
-        #[arg(long)]
+        #[arg(long, value_parser = usage::OutFile("excitation.csv"))]
         out: PathBuf,
         /// Seed of the noise of recorded-like data.
         #[arg(long, default_value_t = 1)]
@@ -293,7 +294,7 @@ enum Command {
         #[arg(long = "set", value_name = "FORM.NAME=V1,V2,…", value_parser = sweep::parse_set)]
         set: Vec<sweep::SetAxis>,
         /// Write one row per case to this CSV file (written atomically when all cases are done).
-        #[arg(long)]
+        #[arg(long, value_parser = usage::OutFile("cases.csv"))]
         out: Option<PathBuf>,
         /// Print a machine-readable summary of every case on stdout.
         #[arg(long)]
@@ -353,7 +354,7 @@ enum Command {
         plot: Option<PathBuf>,
         /// Write a self-contained HTML report (parameters, per-test tables, figures) to this
         /// file.
-        #[arg(long, value_name = "FILE.html")]
+        #[arg(long, value_name = "FILE.html", value_parser = usage::OutFile("report.html"))]
         report: Option<PathBuf>,
         /// JSON file mapping the files' channel names and units to platen's columns, as a
         /// scenario's excitation.columns: {"u_m": {"name": "Table disp", "unit": "mm"}, …}
@@ -420,7 +421,7 @@ pub(crate) enum Form {
 }
 
 fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    let cli = match Cli::try_parse().map_err(usage::spaced_list) {
         Ok(cli) => cli,
         // With --json a usage error is a JSON error object too; help and version print as
         // usual.

@@ -33,7 +33,7 @@ pub struct Args {
     pub target: PathBuf,
     /// Write the drive (`t_s`, `u_m`: the displacement command, at the controller's rate) to
     /// this CSV file.
-    #[arg(long, value_name = "DRIVE.csv")]
+    #[arg(long, value_name = "DRIVE.csv", value_parser = crate::usage::OutFile("drive.csv"))]
     pub out: PathBuf,
     /// Most drive corrections (0: run the target's own command only).
     #[arg(long, value_name = "N", default_value_t = 10, value_parser = clap::value_parser!(u16).range(0..=200))]
@@ -64,7 +64,7 @@ pub struct Args {
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
     /// Write a self-contained HTML report (margins, iterations, figures) to this file.
-    #[arg(long, value_name = "FILE.html")]
+    #[arg(long, value_name = "FILE.html", value_parser = crate::usage::OutFile("report.html"))]
     pub report: Option<PathBuf>,
     #[command(flatten)]
     pub size: crate::plot::SizeArgs,
