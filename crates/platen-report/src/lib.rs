@@ -62,6 +62,7 @@ mod error;
 pub mod figure;
 pub mod html;
 pub mod identify_figures;
+pub mod model_text;
 pub mod plan_figures;
 pub mod record_figures;
 pub mod render;

@@ -10,6 +10,7 @@
 
 use plotters::style::RGBColor;
 
+use platen_scenario::describe::SystemAnalysis;
 use platen_system::{Linearisation, Margins, TableSystem};
 
 use crate::figure::{Dash, Figure, Panel, Series, MODEL, RESIDUAL, SIMULATED};
@@ -460,4 +461,29 @@ mod tests {
             assert!(svg.contains(&format!("\n{label}\n")), "no tick {label}");
         }
     }
+}
+
+/// The Bode figures of a table system's [`SystemAnalysis`] (`platen model --plot`): the loop
+/// with the specimen as a rigid payload first (the one the titles' numbers describe), then
+/// the bare table; `name` heads the titles.
+pub fn analysis_figures(name: &str, analysis: &SystemAnalysis) -> Vec<Figure> {
+    let mut curves = Vec::new();
+    if let (Some(lin), Some(kg)) = (analysis.loaded, analysis.specimen_mass_kg) {
+        curves.push(LoopCurve {
+            label: format!(
+                "with the specimen (rigid, {} t)",
+                crate::model_text::significant(kg / 1e3, crate::model_text::SIGNIFICANT_DIGITS)
+            ),
+            linearisation: lin,
+        });
+    }
+    curves.push(LoopCurve {
+        label: if curves.is_empty() {
+            String::new()
+        } else {
+            "bare table".into()
+        },
+        linearisation: analysis.bare,
+    });
+    figures(name, &analysis.system, &curves, &analysis.margins)
 }
