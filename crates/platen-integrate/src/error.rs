@@ -243,3 +243,58 @@ impl From<SignalError> for IntegrateError {
 
 /// Result alias of this crate.
 pub type Result<T, E = IntegrateError> = std::result::Result<T, E>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Motion;
+
+    /// A bad motion reports through `?` exactly as a bad force record does: the variant of
+    /// this crate with the same message.
+    #[test]
+    fn a_motions_errors_convert_to_the_same_variant_and_message() {
+        let t = || vec![0.0, 1.0, 2.0];
+        let cases = [
+            Motion::from_displacement(vec![0.0, 1.0], vec![0.0; 2]).unwrap_err(),
+            Motion::new(t(), vec![0.0; 2], vec![0.0; 3], vec![0.0; 3]).unwrap_err(),
+            Motion::new(
+                t(),
+                vec![0.0; 3],
+                vec![0.0, f64::INFINITY, 0.0],
+                vec![0.0; 3],
+            )
+            .unwrap_err(),
+            Motion::from_displacement(vec![0.0, 2.0, 1.0], vec![0.0; 3]).unwrap_err(),
+            Motion::from_displacement(t(), vec![0.0; 3])
+                .unwrap()
+                .with_rest_velocity(-1.0)
+                .unwrap_err(),
+        ];
+        let converted: Vec<IntegrateError> = cases.iter().cloned().map(Into::into).collect();
+        assert!(matches!(
+            converted[..],
+            [
+                IntegrateError::TooShort {
+                    found: 2,
+                    needed: 3
+                },
+                IntegrateError::LengthMismatch { what: "u_m", .. },
+                IntegrateError::NonFiniteInput {
+                    what: "v_m_s",
+                    index: 1,
+                    ..
+                },
+                IntegrateError::TimeNotIncreasing { index: 2, .. },
+                IntegrateError::InvalidRestVelocity { .. },
+            ]
+        ));
+        for (signal, integrate) in cases.iter().zip(&converted) {
+            assert_eq!(signal.to_string(), integrate.to_string());
+        }
+        let other = platen_signal::SampleRate::new(0.0).unwrap_err();
+        assert_eq!(
+            IntegrateError::from(other.clone()),
+            IntegrateError::Signal(other)
+        );
+    }
+}

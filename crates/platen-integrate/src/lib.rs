@@ -7,7 +7,10 @@
 //!   advanced together in SIMD lanes, bit for bit the runs of [`forward_rk4`].
 //! * [`forward_dopri5`]: the same with the adaptive Dormand–Prince 5(4) of `ode_solvers`.
 //! * [`ForwardIntegrator`] and [`Method`]: one entry point for both, as a scenario selects it.
-//! * [`inverse`]: a prescribed motion → the actuator force it needs and its decomposition.
+//! * [`inverse`]: a prescribed [`Motion`] → the actuator force it needs and its
+//!   decomposition. The motion is `platen_signal`'s (re-exported here), so an acceleration
+//!   record integrated there runs as it is; its checks' errors convert into
+//!   [`IntegrateError`] with `?`.
 //! * [`forward_closed_loop`]: a displacement command → the table system's controller, valves
 //!   and actuators ([`platen_system::TableSystem`]) → the platen, in closed loop.
 //!
@@ -67,9 +70,8 @@ pub use output::{
     Exceedance, Peak, Peaks, Sample, SampleSink, SpecimenColumns, SpecimenSample, SystemColumns,
     SystemSample, Trajectory,
 };
-/// The prescribed motion of inverse and closed-loop runs, and the derivatives its
-/// constructors use, are `platen_signal`'s, re-exported here; their errors convert into
-/// [`IntegrateError`] with `?`.
+// The prescribed motion of inverse and closed-loop runs, and the derivatives its
+// constructors use, are platen-signal's; their errors convert into IntegrateError with `?`.
 pub use platen_signal::{derivative, second_derivative, Motion};
 pub use record::{
     sampling_grid, uniform_interval_s, ForceRecord, SamplingGrid, UNIFORM_RELATIVE_TOLERANCE,
