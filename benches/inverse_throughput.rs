@@ -21,15 +21,9 @@ use common::{median_ns, timed, PRESSURE_PA, RATE_HZ};
 
 const SAMPLE_SIZE: usize = 20;
 
+/// `platen bench`'s S9 motion over `seconds` s.
 fn s9_motion(seconds: usize) -> Motion {
-    let w = 2.0 * std::f64::consts::PI * 0.6;
-    let t: Vec<f64> = (0..=seconds * RATE_HZ as usize)
-        .map(|j| j as f64 / RATE_HZ)
-        .collect();
-    let u = t.iter().map(|&t| 0.2 * (w * t).sin()).collect();
-    let v = t.iter().map(|&t| 0.2 * w * (w * t).cos()).collect();
-    let a = t.iter().map(|&t| -0.2 * w * w * (w * t).sin()).collect();
-    Motion::new(t, u, v, a).unwrap()
+    platen::bench::s9_motion(seconds * RATE_HZ as usize + 1).unwrap()
 }
 
 fn bench(c: &mut Criterion) {

@@ -144,12 +144,7 @@ fn specimen(c: &mut Criterion) {
     let identified = params.build().unwrap();
     let rk4 = Rk4::with_steps_per_sample(1).unwrap();
     // `platen bench`'s frame and the shipped 2-storey frame.
-    let three = Specimen::new(vec![
-        storey(20e3, 40e6, 3e-3 * 40e6),
-        storey(20e3, 32e6, 3e-3 * 32e6),
-        storey(20e3, 24e6, 3e-3 * 24e6),
-    ])
-    .unwrap();
+    let three = platen::bench::bench_specimen().unwrap();
     let two = Specimen::new(vec![
         storey(30e3, 27_083_177.88, 86_208.43),
         storey(25e3, 19_345_127.06, 61_577.45),

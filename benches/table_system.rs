@@ -28,15 +28,9 @@ use common::{report_ratios, sine_force, timed, PRESSURE_PA, RATE_HZ};
 const SAMPLE_SIZE: usize = 20;
 const SECONDS: usize = 60;
 
+/// `platen bench`'s S9 motion over [`SECONDS`] s.
 fn s9_command() -> Motion {
-    let (amp, w) = (0.2, std::f64::consts::TAU * 0.6);
-    let t: Vec<f64> = (0..=SECONDS * RATE_HZ as usize)
-        .map(|j| j as f64 / RATE_HZ)
-        .collect();
-    let u = t.iter().map(|&t| amp * (w * t).sin()).collect();
-    let v = t.iter().map(|&t| amp * w * (w * t).cos()).collect();
-    let a = t.iter().map(|&t| -amp * w * w * (w * t).sin()).collect();
-    Motion::new(t, u, v, a).unwrap()
+    platen::bench::s9_motion(SECONDS * RATE_HZ as usize + 1).unwrap()
 }
 
 fn bench(c: &mut Criterion) {

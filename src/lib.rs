@@ -12,6 +12,8 @@ pub use platen_scenario as scenario;
 pub use platen_signal as signal;
 pub use platen_system as system;
 
+pub mod bench;
+
 /// Loads and runs a scenario file, keeping every column in memory.
 pub use platen_scenario::simulate;
 /// A finished run in memory: columns by name and the summary ([`simulate`]).

@@ -7,9 +7,10 @@
 //! the median of the last `sample_size` samples (criterion's own sample set after warm-up)
 //! of each benchmark next to the baseline's.
 
-#![allow(dead_code)]
+#![allow(dead_code, unused_imports)]
 
-pub mod baseline;
+/// The plain-loop measuring stick, the one copy `platen bench` times too.
+pub use platen::bench::baseline;
 
 use std::collections::BTreeMap;
 use std::hint::black_box;
@@ -18,11 +19,9 @@ use std::time::Instant;
 
 use criterion::Bencher;
 
-/// Sample rate of every workload, Hz; the RK4 steps once per sample (h = 1/1024 s).
-pub const RATE_HZ: f64 = 1024.0;
-
-/// Hold-down pressure of every workload, Pa.
-pub const PRESSURE_PA: f64 = 13.8e6;
+/// Sample rate of every workload, Hz; the RK4 steps once per sample (h = 1/1024 s); and
+/// hold-down pressure of every workload, Pa: `platen bench`'s.
+pub use platen::bench::{PRESSURE_PA, RATE_HZ};
 
 /// A sine force of `amplitude_n` at 0.5 Hz, sampled at 1024 Hz for `seconds`, from `t = 0`.
 ///
@@ -33,9 +32,7 @@ pub const PRESSURE_PA: f64 = 13.8e6;
 /// * 45 kN, just above the 37.5 kN static threshold: two stick phases per period (≈ 22 % of
 ///   the time stuck), each with a stop and a breakaway to locate.
 pub fn sine_force(amplitude_n: f64, seconds: usize) -> Vec<f64> {
-    (0..=seconds * RATE_HZ as usize)
-        .map(|j| amplitude_n * (2.0 * std::f64::consts::PI * 0.5 * j as f64 / RATE_HZ).sin())
-        .collect()
+    platen::bench::sine_force_n(amplitude_n, seconds * RATE_HZ as usize + 1)
 }
 
 /// Time per iteration (ns) of every call criterion made of each routine, by benchmark name.

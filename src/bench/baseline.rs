@@ -1,5 +1,5 @@
 //! A plain-loop RK4 used as a **measuring stick** for the speed of
-//! [`platen_integrate::forward_rk4`]: not a physics integrator, and not part of any library.
+//! [`platen_integrate::forward_rk4`]: not a physics integrator.
 //!
 //! [`baseline_rk4`] is the loop one would write for the purpose of timing the arithmetic of
 //! the identified model (Eq. 22/23) and nothing else: classical RK4 at the force record's
@@ -12,12 +12,11 @@
 //! exact stick-slip can approach but not beat.
 //!
 //! The criterion benches (`benches/rk4_throughput.rs`, `benches/dopri5_throughput.rs`, through
-//! `benches/common/mod.rs`) and `platen bench` (`src/bin/platen/bench.rs`, through
-//! `#[path]`) all compile this one file, time it in the same run as the real integrators and
-//! report their ratio to it; `benches/c/rk4_baseline.c` is the same loop in C.
+//! `benches/common/mod.rs`) and `platen bench` (through [`crate::bench`]) all use this one
+//! loop, time it in the same run as the real integrators and report their ratio to it;
+//! `benches/c/rk4_baseline.c` is the same loop in C.
 //!
-//! Its test (that it computes the model it claims to) is in `src/bin/platen/bench.rs`,
-//! where it runs as a unit test of the `platen` binary.
+//! Its test (that it computes the model it claims to) is in [`crate::bench`]'s tests.
 //!
 //! Do not use it to simulate anything: with `sign(v)` friction it is off by ~4e-4 m on the
 //! paper's reference record and never sits still (see the crate's stick-slip tests).
