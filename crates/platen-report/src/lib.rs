@@ -17,6 +17,8 @@
 //!   achieved acceleration, response spectra, convergence and the limits' margins.
 //! * [`render`] writes them: SVG, PNG copies rendered by resvg with the embedded Noto Sans,
 //!   and the HTML page, every file atomically ([`write_outputs`]).
+//! * [`simulate_report`], [`plan_report`] and [`sweep_report`] write the text summaries of
+//!   `platen simulate`, `plan`, `sweep` and `generate` (and `generate`'s JSON report).
 //! * [`html`] builds self-contained pages; [`text`] the numbers, metric rows and terminal
 //!   summary.
 //!
@@ -64,12 +66,15 @@ pub mod html;
 pub mod identify_figures;
 pub mod model_text;
 pub mod plan_figures;
+pub mod plan_report;
 pub mod record_figures;
 pub mod render;
 pub mod run_figures;
 pub mod series;
+pub mod simulate_report;
 mod svg;
 pub mod sweep_figures;
+pub mod sweep_report;
 pub mod system_figures;
 pub mod text;
 

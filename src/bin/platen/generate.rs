@@ -4,11 +4,11 @@
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
-use serde_json::json;
 
 use platen_integrate::{inverse, Peaks, Trajectory};
 use platen_io::csv::write_csv_atomic;
 use platen_model::PlatenModel;
+use platen_report::sweep_report::GenerateReport;
 use platen_scenario::recorded::{recorded_like, ArtefactSettings, Recorded};
 use platen_scenario::{Model, Run, Scenario};
 
@@ -39,7 +39,7 @@ pub fn run(what: What, scenario_path: &Path, out: &Path, seed: u64, json_out: bo
                     &["t_s", "force_n"],
                     &[&record.t_s()[..n], &record.force_n()[..n]],
                 )?;
-                report(json_out, out, n, json!({"kind": "force"}))?;
+                report(json_out, out, n, "force", None)?;
             }
             Run::Inverse { motion } => {
                 write_csv_atomic(
@@ -47,18 +47,13 @@ pub fn run(what: What, scenario_path: &Path, out: &Path, seed: u64, json_out: bo
                     &["t_s", "u_m", "v_m_s", "a_m_s2"],
                     &[motion.t_s(), motion.u_m(), motion.v_m_s(), motion.a_m_s2()],
                 )?;
-                report(json_out, out, motion.len(), json!({"kind": "motion"}))?;
+                report(json_out, out, motion.len(), "motion", None)?;
             }
         },
         What::Recorded => {
             let rec = recorded_of(&scenario, scenario_path, seed)?;
             write_csv_atomic(out, &Recorded::COLUMN_NAMES, &rec.columns())?;
-            report(
-                json_out,
-                out,
-                rec.t_s.len(),
-                json!({"kind": "recorded", "seed": seed}),
-            )?;
+            report(json_out, out, rec.t_s.len(), "recorded", Some(seed))?;
         }
     }
     Ok(())
@@ -102,20 +97,24 @@ fn recorded<M: PlatenModel>(
     .context("recorded-like data could not be made")
 }
 
+/// Prints what was written: [`GenerateReport`] as JSON or as its text line.
 fn report(
     json_out: bool,
     out: &Path,
     samples: usize,
-    extra: serde_json::Value,
-) -> anyhow::Result<()> {
+    kind: &'static str,
+    seed: Option<u64>,
+) -> Result<()> {
+    let report = GenerateReport {
+        kind,
+        out: out.display().to_string(),
+        samples,
+        seed,
+    };
     if json_out {
-        let mut v = json!({"out": out.display().to_string(), "samples": samples});
-        if let (Some(m), serde_json::Value::Object(e)) = (v.as_object_mut(), extra) {
-            m.extend(e);
-        }
-        outln!("{v}");
+        outln!("{}", serde_json::to_string(&report)?);
     } else {
-        outln!("wrote {} ({samples} samples)", out.display());
+        out!("{}", report.text());
     }
     Ok(())
 }

@@ -13,7 +13,6 @@ use clap::ValueEnum;
 
 use platen_io::csv::CsvWriter;
 use platen_io::IoError;
-use platen_model::STANDARD_GRAVITY_M_S2;
 use platen_plan::{
     load_scenario, plan, FrfSource, MaxScaleSettings, NoiseSettings, PlanError, PlanSettings,
     Target,
@@ -225,166 +224,14 @@ pub fn run(args: &Args) -> Result<()> {
         outln!("{}", serde_json::to_string_pretty(&value)?);
         return Ok(());
     }
-    print_text(&summary)?;
-    if !figures.is_empty() {
-        outln!(
-            "  figures: {} files (SVG and PNG) in {}",
-            figures.len(),
-            args.plot
-                .as_deref()
-                .map_or(String::new(), |d| d.display().to_string())
-        );
-    }
-    if let Some(report) = &args.report {
-        outln!("  report: {}", report.display());
-    }
-    Ok(())
-}
-
-/// The unit of a limit, from its name.
-fn unit(limit: &str) -> &'static str {
-    match limit.rsplit('_').next() {
-        Some("m") => "m",
-        Some("s") if limit.ends_with("_m_s") => "m/s",
-        Some("s2") => "m/s²",
-        Some("n") => "N",
-        Some("pa") => "Pa",
-        Some("s") => "m³/s",
-        _ => "",
-    }
-}
-
-/// `x` to 4 significant digits: fixed between 10⁻³ and 10⁶, else in exponent form.
-fn significant(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return format!("{x}");
-    }
-    let e = x.abs().log10().floor() as i32;
-    if (-3..6).contains(&e) {
-        format!("{x:.*}", (3 - e).max(0) as usize)
-    } else {
-        format!("{x:.3e}")
-    }
-}
-
-fn print_text(s: &platen_plan::PlanSummary) -> Result<()> {
-    let t = &s.target;
-    outln!("{}: plan of `{}` on `{}`", s.name, t.file, s.scenario);
-    outln!(
-        "  target: {}, {} samples at {} Hz over {:.3} s (drive at {} Hz); peak {:.4} m/s² \
-         ({:.3} g), command peak {:.4} m",
-        t.kind,
-        t.samples,
-        platen_report::text::rounded(t.sample_rate_hz, 9),
-        t.duration_s,
-        platen_report::text::rounded(t.drive_sample_rate_hz, 9),
-        t.peak_a_m_s2,
-        t.peak_a_m_s2 / STANDARD_GRAVITY_M_S2,
-        t.peak_u_m
+    out!(
+        "{}",
+        platen_report::plan_report::text(
+            &summary,
+            &figures,
+            args.plot.as_deref(),
+            args.report.as_deref()
+        )
     );
-    if let Some(d) = t.baseline_degree {
-        outln!(
-            "  baseline: end-matching polynomial of degree {d}; it removed {} m/s² RMS \
-             ({:.2} % of the target's), {} m/s² at most",
-            significant(t.baseline_correction_rms_m_s2),
-            100.0 * t.baseline_correction_rms_m_s2 / t.rms_a_m_s2.max(f64::MIN_POSITIVE),
-            significant(t.baseline_correction_peak_m_s2)
-        );
-    }
-    outln!(
-        "  feasible: {}",
-        if s.feasible {
-            "yes".to_owned()
-        } else {
-            let names: Vec<String> = s
-                .limiting
-                .iter()
-                .map(|l| format!("{} ({:.3}× at {:.3} s)", l.limit, l.ratio, l.t_s))
-                .collect();
-            format!("NO: {}", names.join(", "))
-        }
-    );
-    outln!(
-        "    {:<20} {:>12} {:>12} {:<5} {:>7} {:>10}",
-        "limit",
-        "peak",
-        "allowed",
-        "",
-        "use",
-        "at"
-    );
-    for l in &s.margins {
-        outln!(
-            "    {:<20} {:>12} {:>12} {:<5} {:>6.1}% {:>8.3} s",
-            l.limit,
-            significant(l.peak),
-            significant(l.allowed),
-            unit(l.limit),
-            100.0 * l.ratio,
-            l.t_s
-        );
-    }
-    if let Some(m) = &s.max_scale_search {
-        if m.at_upper_bound {
-            outln!(
-                "  largest scale that fits: at least {} (the search's bound)",
-                m.scale
-            );
-        } else {
-            outln!(
-                "  largest scale that fits: {:.4} (bracket {:.4}–{:.4}; beyond it: {}; {} runs)",
-                m.scale,
-                m.bracket[0],
-                m.bracket[1],
-                m.limiting.join(", "),
-                m.runs
-            );
-        }
-    }
-    if let Some(f) = &s.frf {
-        outln!(
-            "  iterations (gain {}, Ĥ {}, band {}–{} Hz):",
-            f.gain,
-            f.source,
-            f.band_hz[0],
-            f.band_hz[1]
-        );
-        outln!(
-            "    {:>3} {:>12} {:>12} {:>22}",
-            "k",
-            "accel NRMSE",
-            "disp NRMSE",
-            "spectrum error (5 %)"
-        );
-        for r in &s.iterations {
-            outln!(
-                "    {:>3} {:>11.2}% {:>11.2}% {:>11.2}% at {:.3} s",
-                r.iteration,
-                100.0 * r.acceleration_nrmse,
-                100.0 * r.displacement_nrmse,
-                100.0 * r.spectrum_error,
-                r.spectrum_error_period_s
-            );
-        }
-    }
-    outln!(
-        "  stop: {}{}",
-        s.stop,
-        s.stall_reason
-            .as_ref()
-            .map_or(String::new(), |r| format!(" ({r})"))
-    );
-    match &s.drive {
-        Some(d) => outln!(
-            "  drive: iteration {} ({:.2} % acceleration NRMSE), {} samples, peak {:.4} m, \
-             written to {}",
-            d.achieved.iteration,
-            100.0 * d.achieved.acceleration_nrmse,
-            d.samples,
-            d.peak_u_m,
-            d.out.as_deref().unwrap_or("(nothing)")
-        ),
-        None => outln!("  drive: none (nothing written)"),
-    }
     Ok(())
 }

@@ -14,7 +14,6 @@
 //! * A case that fails numerically is reported in its row's `status`; the other cases still
 //!   run, the output is written, and the command exits with code 4.
 
-use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::path::Path;
 use std::time::Instant;
@@ -25,7 +24,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use platen_integrate::IntegrateError;
 use platen_io::write_bytes_atomic;
 use platen_model::{IdentifiedKey, PhysicalKey};
-use platen_scenario::sweep::{self, Case, Outcome, Sweep};
+use platen_scenario::sweep::{self, Outcome, Sweep};
 use platen_scenario::{ModelKey, Scenario};
 
 pub use platen_scenario::sweep::SetAxis;
@@ -155,15 +154,17 @@ pub fn run(
         }
         outln!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
-        print_summary(&scenario, set_names, cases, &outcomes, out, wall_s)?;
-        if plot.dir.is_some() {
-            if written.is_empty() {
-                outln!("  no figures: every axis holds one value (give two or more to plot peaks against it)");
-            }
-            for path in &written {
-                outln!("  wrote {}", path.display());
-            }
-        }
+        let run = platen_report::sweep_report::SweepRun {
+            scenario: &scenario,
+            set_names,
+            cases,
+            outcomes: &outcomes,
+            out,
+            wall_s,
+            threads: rayon::current_num_threads(),
+        };
+        let figures = plot.dir.map(|_| written.as_slice());
+        out!("{}", platen_report::sweep_report::sweep_text(&run, figures));
     }
     failures(&outcomes, out.is_some())
 }
@@ -223,61 +224,4 @@ fn progress_bar(cases: usize) -> ProgressBar {
         bar.set_style(style);
     }
     bar
-}
-
-fn print_summary(
-    scenario: &Scenario,
-    set_names: &[String],
-    cases: &[Case],
-    outs: &[Outcome],
-    out: Option<&Path>,
-    wall_s: f64,
-) -> anyhow::Result<()> {
-    outln!(
-        "{}: {} cases ({} model, {}) in {wall_s:.2} s on {} threads",
-        scenario.name,
-        cases.len(),
-        scenario.model.form(),
-        scenario.preset.name(),
-        rayon::current_num_threads()
-    );
-    let mut head = format!("  {:>5} {:>8} {:>8}", "case", "scale", "MPa");
-    for n in set_names {
-        let _ = write!(head, " {n:>14}");
-    }
-    let _ = write!(
-        head,
-        " {:>9} {:>9} {:>8} {:>10} {:>8} {:>6}  limits exceeded",
-        "u (m)", "v (m/s)", "a (g)", "F (kN)", "stick s", "events"
-    );
-    outln!("{head}");
-    for (i, (case, o)) in cases.iter().zip(outs).enumerate() {
-        let mut line = format!("  {i:>5} {:>8} {:>8}", case.scale, case.pressure_mpa);
-        for v in &case.sets {
-            let _ = write!(line, " {v:>14}");
-        }
-        if let Some(e) = &o.error {
-            let _ = write!(line, "  FAILED: {e}");
-            outln!("{line}");
-            continue;
-        }
-        let (stick, events) = match &o.stats {
-            Some(s) => (format!("{:.3}", s.stick_time_s), s.events().to_string()),
-            None => ("-".to_owned(), "-".to_owned()),
-        };
-        let _ = write!(
-            line,
-            " {:>+9.4} {:>+9.4} {:>+8.3} {:>+10.1} {stick:>8} {events:>6}  {}",
-            o.peaks.u_m.value,
-            o.peaks.v_m_s.value,
-            o.peaks.a_m_s2.value / platen_model::STANDARD_GRAVITY_M_S2,
-            o.peaks.force_n.value / 1e3,
-            sweep::exceeded(scenario, &o.peaks),
-        );
-        outln!("{line}");
-    }
-    if let Some(out) = out {
-        outln!("  wrote {}", out.display());
-    }
-    Ok(())
 }

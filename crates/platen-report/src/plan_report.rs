@@ -1,0 +1,188 @@
+//! The text summary of a test plan (`platen plan`): the target, feasibility and the limits'
+//! margins, the largest scale that fits, the drive iterations and the drive.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use platen_model::STANDARD_GRAVITY_M_S2;
+use platen_plan::PlanSummary;
+
+use crate::text::{rounded, significant};
+
+/// The unit of a limit, from its name.
+fn unit(limit: &str) -> &'static str {
+    match limit.rsplit('_').next() {
+        Some("m") => "m",
+        Some("s") if limit.ends_with("_m_s") => "m/s",
+        Some("s2") => "m/s²",
+        Some("n") => "N",
+        Some("pa") => "Pa",
+        Some("s") => "m³/s",
+        _ => "",
+    }
+}
+
+/// The text summary of the plan `s`, then the figure files `figures` written to `plot_dir`
+/// and the HTML `report` written, if any.
+pub fn text(
+    s: &PlanSummary,
+    figures: &[PathBuf],
+    plot_dir: Option<&Path>,
+    report: Option<&Path>,
+) -> String {
+    let mut o = String::new();
+    summary_lines(&mut o, s);
+    if !figures.is_empty() {
+        let _ = writeln!(
+            o,
+            "  figures: {} files (SVG and PNG) in {}",
+            figures.len(),
+            plot_dir.map_or(String::new(), |d| d.display().to_string())
+        );
+    }
+    if let Some(report) = report {
+        let _ = writeln!(o, "  report: {}", report.display());
+    }
+    o
+}
+
+/// The target, the margins, the scale and the feasibility.
+fn summary_lines(o: &mut String, s: &PlanSummary) {
+    let t = &s.target;
+    let _ = writeln!(o, "{}: plan of `{}` on `{}`", s.name, t.file, s.scenario);
+    let _ = writeln!(
+        o,
+        "  target: {}, {} samples at {} Hz over {:.3} s (drive at {} Hz); peak {:.4} m/s² \
+         ({:.3} g), command peak {:.4} m",
+        t.kind,
+        t.samples,
+        rounded(t.sample_rate_hz, 9),
+        t.duration_s,
+        rounded(t.drive_sample_rate_hz, 9),
+        t.peak_a_m_s2,
+        t.peak_a_m_s2 / STANDARD_GRAVITY_M_S2,
+        t.peak_u_m
+    );
+    if let Some(d) = t.baseline_degree {
+        let _ = writeln!(
+            o,
+            "  baseline: end-matching polynomial of degree {d}; it removed {} m/s² RMS \
+             ({:.2} % of the target's), {} m/s² at most",
+            significant(t.baseline_correction_rms_m_s2, 4),
+            100.0 * t.baseline_correction_rms_m_s2 / t.rms_a_m_s2.max(f64::MIN_POSITIVE),
+            significant(t.baseline_correction_peak_m_s2, 4)
+        );
+    }
+    let feasible = if s.feasible {
+        "yes".to_owned()
+    } else {
+        let names: Vec<String> = s
+            .limiting
+            .iter()
+            .map(|l| format!("{} ({:.3}× at {:.3} s)", l.limit, l.ratio, l.t_s))
+            .collect();
+        format!("NO: {}", names.join(", "))
+    };
+    let _ = writeln!(o, "  feasible: {feasible}");
+    let _ = writeln!(
+        o,
+        "    {:<20} {:>12} {:>12} {:<5} {:>7} {:>10}",
+        "limit", "peak", "allowed", "", "use", "at"
+    );
+    for l in &s.margins {
+        let _ = writeln!(
+            o,
+            "    {:<20} {:>12} {:>12} {:<5} {:>6.1}% {:>8.3} s",
+            l.limit,
+            significant(l.peak, 4),
+            significant(l.allowed, 4),
+            unit(l.limit),
+            100.0 * l.ratio,
+            l.t_s
+        );
+    }
+    if let Some(m) = &s.max_scale_search {
+        if m.at_upper_bound {
+            let _ = writeln!(
+                o,
+                "  largest scale that fits: at least {} (the search's bound)",
+                m.scale
+            );
+        } else {
+            let _ = writeln!(
+                o,
+                "  largest scale that fits: {:.4} (bracket {:.4}–{:.4}; beyond it: {}; {} runs)",
+                m.scale,
+                m.bracket[0],
+                m.bracket[1],
+                m.limiting.join(", "),
+                m.runs
+            );
+        }
+    }
+    iteration_lines(o, s);
+}
+
+/// The iterations, the stop and the drive.
+fn iteration_lines(o: &mut String, s: &PlanSummary) {
+    if let Some(f) = &s.frf {
+        let _ = writeln!(
+            o,
+            "  iterations (gain {}, Ĥ {}, band {}–{} Hz):",
+            f.gain, f.source, f.band_hz[0], f.band_hz[1]
+        );
+        let _ = writeln!(
+            o,
+            "    {:>3} {:>12} {:>12} {:>22}",
+            "k", "accel NRMSE", "disp NRMSE", "spectrum error (5 %)"
+        );
+        for r in &s.iterations {
+            let _ = writeln!(
+                o,
+                "    {:>3} {:>11.2}% {:>11.2}% {:>11.2}% at {:.3} s",
+                r.iteration,
+                100.0 * r.acceleration_nrmse,
+                100.0 * r.displacement_nrmse,
+                100.0 * r.spectrum_error,
+                r.spectrum_error_period_s
+            );
+        }
+    }
+    let _ = writeln!(
+        o,
+        "  stop: {}{}",
+        s.stop,
+        s.stall_reason
+            .as_ref()
+            .map_or(String::new(), |r| format!(" ({r})"))
+    );
+    let _ = match &s.drive {
+        Some(d) => writeln!(
+            o,
+            "  drive: iteration {} ({:.2} % acceleration NRMSE), {} samples, peak {:.4} m, \
+             written to {}",
+            d.achieved.iteration,
+            100.0 * d.achieved.acceleration_nrmse,
+            d.samples,
+            d.peak_u_m,
+            d.out.as_deref().unwrap_or("(nothing)")
+        ),
+        None => writeln!(o, "  drive: none (nothing written)"),
+    };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::unit;
+
+    /// Every limit's unit follows from the end of its name.
+    #[test]
+    fn a_limit_s_unit_follows_from_its_name() {
+        assert_eq!(unit("stroke_m"), "m");
+        assert_eq!(unit("velocity_m_s"), "m/s");
+        assert_eq!(unit("acceleration_m_s2"), "m/s²");
+        assert_eq!(unit("force_n"), "N");
+        assert_eq!(unit("supply_pressure_pa"), "Pa");
+        assert_eq!(unit("flow_m3_s"), "m³/s");
+    }
+}

@@ -1,0 +1,245 @@
+//! The text summary of a run (`platen simulate`): what ran, its peaks, a forward run's
+//! solver, stick and energy figures, a specimen's base shear and storey drifts, the table's
+//! limits, and a closed loop's tracking, valves, supply and margins.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use platen_integrate::{ForwardIntegrator as _, Peaks};
+use platen_model::STANDARD_GRAVITY_M_S2;
+use platen_scenario::{Run, RunOutput, RunSummary, Scenario};
+
+/// The text summary of `scenario`'s run `output` (summarised as `summary`), its CSV written
+/// to `out` if any, and the figure files `figures` written for it (none: no figure lines).
+///
+/// ```no_run
+/// use std::path::Path;
+/// use platen_scenario::{RunSummary, Scenario};
+/// # struct Nothing;
+/// # impl platen_integrate::SampleSink for Nothing {
+/// #     fn accept(&mut self, _: &platen_integrate::Sample) {}
+/// # }
+///
+/// let path = Path::new("scenarios/specimen/frame-forward.json");
+/// let scenario = Scenario::load(path)?;
+/// let output = scenario.run(&mut Nothing)?;
+/// let summary = RunSummary::new(path, &scenario, &output, None);
+/// print!("{}", platen_report::simulate_report::text(&scenario, &output, &summary, None, &[]));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn text(
+    scenario: &Scenario,
+    output: &RunOutput,
+    summary: &RunSummary,
+    out: Option<&Path>,
+    figures: &[PathBuf],
+) -> String {
+    let mut s = String::new();
+    run_lines(&mut s, scenario, output, out);
+    loop_lines(&mut s, summary);
+    if !figures.is_empty() {
+        let _ = writeln!(s, "  wrote {} figure files (SVG and PNG):", figures.len());
+        for path in figures {
+            let _ = writeln!(s, "    {}", path.display());
+        }
+    }
+    s
+}
+
+/// `", overridden: name = value, …"` when the scenario lays values over its preset's.
+fn overridden(s: &Scenario) -> String {
+    let values = s.overrides.values();
+    if values.is_empty() {
+        return String::new();
+    }
+    let listed: Vec<String> = values
+        .iter()
+        .map(|(key, value)| format!("{} = {value}", key.name()))
+        .collect();
+    format!(", overridden: {}", listed.join(", "))
+}
+
+/// `x` to 3 decimals without trailing zeros (4.2 g, 6.8 MN, 2.25 g).
+fn trimmed(x: f64) -> String {
+    let s = format!("{x:.3}");
+    s.trim_end_matches('0').trim_end_matches('.').to_owned()
+}
+
+/// The specimen's lines: the peak base shear, kN, and each storey's peak drift, mm, with
+/// their times (nothing without a specimen). The scenario format gives no storey heights, so
+/// the drifts are lengths, not ratios.
+fn specimen_lines(s: &mut String, peaks: &Peaks) {
+    if peaks.storeys == 0 {
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "  peak base shear   {:>+10.1} kN    at {:.3} s",
+        peaks.base_shear_n.value / 1e3,
+        peaks.base_shear_n.t_s
+    );
+    for (i, drift) in peaks.drift_m[..peaks.storeys].iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "  peak storey {} drift {:>+8.3} mm    at {:.3} s",
+            i + 1,
+            drift.value * 1e3,
+            drift.t_s
+        );
+    }
+}
+
+/// What ran, its peaks, a forward run's figures and the table's limits.
+fn run_lines(s: &mut String, sc: &Scenario, output: &RunOutput, out: Option<&Path>) {
+    let (peaks, stats) = (&output.peaks, output.stats.as_ref());
+    let dir = if sc.closed_loop.is_some() {
+        "closed loop (command → controller → valves → platen)"
+    } else if stats.is_some() {
+        "forward (force → motion)"
+    } else {
+        "inverse (motion → force)"
+    };
+    let _ = writeln!(
+        s,
+        "{}: {dir}, {} model, {} at {:.2} MPa{}",
+        sc.name,
+        sc.model.form(),
+        sc.preset.name(),
+        sc.hold_down_pressure_pa / 1e6,
+        overridden(sc)
+    );
+    let _ = writeln!(
+        s,
+        "  {} samples over {:.3} s",
+        peaks.samples,
+        peaks.span_s.1 - peaks.span_s.0
+    );
+    for (channel, how) in &sc.derived {
+        let _ = writeln!(s, "  derived {channel}: {how}");
+    }
+    let _ = writeln!(
+        s,
+        "  peak displacement {:>+10.4} m     at {:.3} s",
+        peaks.u_m.value, peaks.u_m.t_s
+    );
+    let _ = writeln!(
+        s,
+        "  peak velocity     {:>+10.4} m/s   at {:.3} s",
+        peaks.v_m_s.value, peaks.v_m_s.t_s
+    );
+    let _ = writeln!(
+        s,
+        "  peak acceleration {:>+10.4} m/s²  at {:.3} s ({:.3} g)",
+        peaks.a_m_s2.value,
+        peaks.a_m_s2.t_s,
+        peaks.a_m_s2.value / STANDARD_GRAVITY_M_S2
+    );
+    let _ = writeln!(
+        s,
+        "  peak force        {:>+10.1} kN    at {:.3} s",
+        peaks.force_n.value / 1e3,
+        peaks.force_n.t_s
+    );
+    specimen_lines(s, peaks);
+    if let (Some(st), Run::Forward { integrator, .. }) = (stats, &sc.run) {
+        let _ = writeln!(
+            s,
+            "  stick: {:.3} s in all, {} stops, {} breakaways, {} reversals",
+            st.stick_time_s, st.stick_events, st.breakaways, st.reversals
+        );
+        let _ = writeln!(
+            s,
+            "  solver: {}, {} steps ({} rejected), {} right-hand-side evaluations, {} events located",
+            integrator.name(),
+            st.steps,
+            st.rejected_steps,
+            st.rhs_evaluations,
+            st.events()
+        );
+        let _ = writeln!(
+            s,
+            "  energy: actuator work {:.4e} J = ΔE_kin + ΔE_el + dissipated {:.4e} J; residual {:.2e} J ({:.1e} relative)",
+            st.energy.actuator_work_j,
+            st.energy.dissipated_j,
+            st.energy.residual_j(),
+            st.energy.relative_residual()
+        );
+    }
+    let ex = peaks.exceedances(&sc.limits);
+    if ex.is_empty() {
+        let l = &sc.limits;
+        let _ = writeln!(
+            s,
+            "  within the table's limits (stroke ±{} m, {} m/s, {} g, {} MN)",
+            l.stroke_m,
+            l.velocity_m_s,
+            trimmed(l.acceleration_m_s2 / STANDARD_GRAVITY_M_S2),
+            trimmed(l.force_n / 1e6)
+        );
+    }
+    for e in ex {
+        let _ = writeln!(
+            s,
+            "  EXCEEDS {} limit: peak {:+.4} vs limit {:.4} (SI units) at {:.3} s",
+            e.quantity, e.peak, e.limit, e.t_s
+        );
+    }
+    if let Some(out) = out {
+        let _ = writeln!(s, "  wrote {}", out.display());
+    }
+}
+
+/// The closed loop's lines (nothing for the other runs).
+fn loop_lines(s: &mut String, summary: &RunSummary) {
+    let (Some(ts), Some(f)) = (&summary.table_system, summary.oil_column_frequency_hz) else {
+        return;
+    };
+    let _ = writeln!(
+        s,
+        "  closed loop: oil column {f:.2} Hz at mid-stroke; {} controller samples, {} steps each",
+        ts.controller_samples, ts.steps_per_controller_period
+    );
+    let _ = writeln!(
+        s,
+        "  tracking: displacement error {:.3} mm RMS, {:+.3} mm peak at {:.3} s",
+        ts.tracking_displacement_rms_m * 1e3,
+        ts.tracking_displacement_peak_m * 1e3,
+        ts.tracking_displacement_peak_t_s
+    );
+    let _ = writeln!(
+        s,
+        "            acceleration error {:.4} m/s² RMS, {:+.4} m/s² peak at {:.3} s",
+        ts.tracking_acceleration_rms_m_s2,
+        ts.tracking_acceleration_peak_m_s2,
+        ts.tracking_acceleration_peak_t_s
+    );
+    let _ = writeln!(
+        s,
+        "  valves: peak flow {:+.4} m³/s of {:.4} m³/s capacity ({:.0} %), saturated {:.3} s",
+        ts.peak_flow_m3_s,
+        ts.valve_flow_capacity_m3_s,
+        100.0 * ts.peak_flow_m3_s.abs() / ts.valve_flow_capacity_m3_s,
+        ts.valve_saturated_time_s
+    );
+    let _ = writeln!(
+        s,
+        "  supply: lowest {:.2} MPa{}",
+        ts.min_supply_pressure_pa / 1e6,
+        ts.cavitation_at_s
+            .map_or(String::new(), |t| format!("; CAVITATION at {t:.4} s"))
+    );
+    let m = &ts.loop_margins;
+    let _ = writeln!(
+        s,
+        "  loop (linearised): {}, gain margin {}, phase margin {}",
+        if m.stable { "stable" } else { "UNSTABLE" },
+        m.gain_margin_db.map_or("none".into(), |g| format!(
+            "{g:.1} dB at {:.1} Hz",
+            m.phase_crossover_hz.unwrap_or(0.0)
+        )),
+        m.phase_margin_deg.map_or("none".into(), |p| format!(
+            "{p:.1}° at {:.2} Hz",
+            m.gain_crossover_hz.unwrap_or(0.0)
+        ))
+    );
+}
