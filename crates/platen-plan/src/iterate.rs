@@ -583,6 +583,20 @@ pub fn iterate(
     motion: &TargetMotion,
     settings: &IterationSettings,
 ) -> Result<Iteration<Achieved>> {
+    iterate_observed(table, motion, settings, &mut |_| {})
+}
+
+/// [`iterate`], calling `on_run(k)` when the closed-loop run of iteration `k` is done (0: the
+/// target's own command; at most `settings.max_iterations`): a hook for progress reports.
+///
+/// # Errors
+/// As [`iterate`].
+pub fn iterate_observed(
+    table: &Table<'_>,
+    motion: &TargetMotion,
+    settings: &IterationSettings,
+    on_run: &mut dyn FnMut(usize),
+) -> Result<Iteration<Achieved>> {
     let fs = 1.0 / motion.interval_s();
     let with_specimen = table.scenario().specimen.is_some();
     let frf = match &settings.frf.resolve(with_specimen) {
@@ -593,7 +607,9 @@ pub fn iterate(
         }
     };
     let mut it = iterate_with(motion, &|f| frf.at(f), settings, |drive, k| {
-        table.run_or_end_stop(&motion.t_s, drive, &format!("iteration {k}"))
+        let r = table.run_or_end_stop(&motion.t_s, drive, &format!("iteration {k}"));
+        on_run(k);
+        r
     })?;
     it.measured = frf.measured_band();
     Ok(it)

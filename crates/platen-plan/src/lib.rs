@@ -66,8 +66,11 @@ pub use error::{PlanError, Result};
 pub use feasibility::{max_scale, Feasibility, LimitUse, MaxScale, MaxScaleSettings};
 pub use frf::{FrequencyResponse, FrfSource, NoiseSettings};
 pub use iterate::{
-    iterate, iterate_with, Iteration, IterationRecord, IterationSettings, Response, Stop,
+    iterate, iterate_observed, iterate_with, Iteration, IterationRecord, IterationSettings,
+    Response, Stop,
 };
-pub use plan::{load_scenario, plan, write_drive, Plan, PlanSettings, PlanSummary, PlannedDrive};
+pub use plan::{
+    load_scenario, plan, plan_observed, write_drive, Plan, PlanSettings, PlanSummary, PlannedDrive,
+};
 pub use table::{Achieved, Table};
 pub use target::{Target, TargetKind, MIN_TARGET_SAMPLES};

@@ -16,7 +16,7 @@ use crate::feasibility::{
     failing, feasibility, limit_uses, limits_summary, Feasibility, LimitUse, MaxScale,
     MaxScaleSettings,
 };
-use crate::iterate::{iterate, IterationRecord, IterationSettings, Stop};
+use crate::iterate::{iterate_observed, IterationRecord, IterationSettings, Stop};
 use crate::table::{Achieved, Table};
 use crate::target::Target;
 use crate::Iteration;
@@ -152,6 +152,22 @@ pub fn plan(
     target: &Target,
     settings: &PlanSettings,
 ) -> Result<Plan> {
+    plan_observed(scenario, scenario_path, target, settings, &mut |_| {})
+}
+
+/// [`plan`], calling `on_run(k)` when the closed-loop run of drive iteration `k` is done (0:
+/// the target's own command; at most `settings.iteration.max_iterations`): a hook for
+/// progress reports ([`iterate_observed`](crate::iterate::iterate_observed)).
+///
+/// # Errors
+/// As [`plan`].
+pub fn plan_observed(
+    scenario: &Scenario,
+    scenario_path: &Path,
+    target: &Target,
+    settings: &PlanSettings,
+    on_run: &mut dyn FnMut(usize),
+) -> Result<Plan> {
     let table = Table::new(scenario, scenario_path)?;
     let controller_hz = table.controller_rate_hz();
     if target.sample_rate_hz() > controller_hz * (1.0 + 1e-9) {
@@ -194,7 +210,7 @@ pub fn plan(
     let drive = match feasibility.achieved.end_stop {
         Some(_) => None,
         None => {
-            let iteration = iterate(&table, &motion, &settings.iteration)?;
+            let iteration = iterate_observed(&table, &motion, &settings.iteration, on_run)?;
             let uses = limit_uses(scenario, &iteration.achieved);
             if feasibility.feasible {
                 if let Some(worst) = failing(&uses).first() {

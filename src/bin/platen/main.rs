@@ -33,6 +33,7 @@ mod identify;
 mod model;
 mod plan;
 mod plot;
+mod progress;
 mod schema;
 mod simulate;
 mod sweep;

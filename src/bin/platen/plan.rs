@@ -14,10 +14,12 @@ use clap::ValueEnum;
 use platen_io::csv::CsvWriter;
 use platen_io::IoError;
 use platen_plan::{
-    load_scenario, plan, FrfSource, MaxScaleSettings, NoiseSettings, PlanError, PlanSettings,
-    Target,
+    load_scenario, plan_observed, FrfSource, MaxScaleSettings, NoiseSettings, PlanError,
+    PlanSettings, Target,
 };
 use platen_report::plan_figures;
+
+use crate::progress::Progress;
 
 /// The arguments of `platen plan`.
 #[derive(clap::Args)]
@@ -183,7 +185,15 @@ pub fn run(args: &Args) -> Result<()> {
     let mut writer = CsvWriter::create(&args.out, &["t_s", "u_m"])?;
     let scenario = load_scenario(&args.scenario).map_err(cli_error)?;
     let target = Target::read_csv(&args.target).map_err(cli_error)?;
-    let p = plan(&scenario, &args.scenario, &target, &settings).map_err(cli_error)?;
+    // A bar of the drive iterations (on a terminal, after a second).
+    let progress = Progress::new(
+        u64::from(args.iterations) + 1,
+        "{bar:30} {pos}/{len} runs of the drive iteration, {elapsed_precise} elapsed",
+    );
+    let on_run = &mut |k: usize| progress.set_position(k as u64 + 1);
+    let p = plan_observed(&scenario, &args.scenario, &target, &settings, on_run);
+    progress.finish();
+    let p = p.map_err(cli_error)?;
     let written = match p.drive() {
         Some((t_s, u_m)) => {
             for (t, u) in t_s.iter().zip(u_m) {

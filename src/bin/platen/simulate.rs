@@ -8,9 +8,10 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 
-use platen_integrate::{Sample, SampleSink};
 use platen_report::{run_figures, run_figures::RunRecorder, FigureSize};
-use platen_scenario::{CsvSink, RunSummary, Scenario};
+use platen_scenario::{CsvSink, Run, RunSummary, Scenario};
+
+use crate::progress::{Progress, Ticker};
 
 /// The options of `platen simulate`.
 pub struct Options<'a> {
@@ -43,12 +44,26 @@ pub fn run(opts: &Options<'_>) -> Result<()> {
         .transpose()?;
     // The figures' points are collected as the run goes, in memory that does not grow with it.
     let mut recorder = opts.plot.map(|_| RunRecorder::new(&scenario.run));
-    let output = match (stream.as_mut(), recorder.as_mut()) {
-        (Some(sink), Some(rec)) => scenario.run(&mut (sink, rec))?,
-        (Some(sink), None) => scenario.run(sink)?,
-        (None, Some(rec)) => scenario.run(rec)?,
-        (None, None) => scenario.run(&mut NoOutput)?,
+    // A bar of the samples written (on a terminal, after a second).
+    let expected = match &scenario.run {
+        Run::Forward { samples, .. } => *samples,
+        Run::Inverse { motion } => motion.len(),
     };
+    let progress = Progress::new(
+        expected as u64,
+        "{bar:30} {percent:>3}% of {human_len} samples, {eta} left",
+    );
+    let tick = Ticker {
+        progress: &progress,
+        samples: 0,
+    };
+    let output = match (stream.as_mut(), recorder.as_mut()) {
+        (Some(sink), Some(rec)) => scenario.run(&mut ((sink, rec), tick))?,
+        (Some(sink), None) => scenario.run(&mut (sink, tick))?,
+        (None, Some(rec)) => scenario.run(&mut (rec, tick))?,
+        (None, None) => scenario.run(&mut { tick })?,
+    };
+    progress.finish();
     if let Some(stream) = stream {
         stream.finish()?;
     }
@@ -84,12 +99,4 @@ pub fn run(opts: &Options<'_>) -> Result<()> {
 /// The figure files written, as the `figures` list of `--json`.
 pub fn figure_list(written: &[std::path::PathBuf]) -> Vec<String> {
     written.iter().map(|p| p.display().to_string()).collect()
-}
-
-/// A sink that keeps nothing (the summary's peaks are collected alongside).
-struct NoOutput;
-
-impl SampleSink for NoOutput {
-    #[inline]
-    fn accept(&mut self, _: &Sample) {}
 }

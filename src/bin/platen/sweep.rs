@@ -14,12 +14,10 @@
 //! * A case that fails numerically is reported in its row's `status`; the other cases still
 //!   run, the output is written, and the command exits with code 4.
 
-use std::io::IsTerminal;
 use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{anyhow, Result};
-use indicatif::{ProgressBar, ProgressStyle};
 
 use platen_integrate::IntegrateError;
 use platen_io::write_bytes_atomic;
@@ -126,10 +124,13 @@ pub fn run(
         ));
     }
     let grid = Sweep::new(&scenario, scales, pressures_mpa, sets)?;
-    let progress = progress_bar(grid.cases.len());
+    let progress = crate::progress::Progress::new(
+        grid.cases.len() as u64,
+        "{bar:40} {pos}/{len} cases  {elapsed_precise} elapsed, {eta} left",
+    );
     let start = Instant::now();
-    let outcomes = grid.run(&scenario.run, || progress.inc(1));
-    progress.finish_and_clear();
+    let outcomes = grid.run(&scenario.run, || progress.inc());
+    progress.finish();
     let wall_s = start.elapsed().as_secs_f64();
 
     let (cases, set_names) = (&grid.cases, &grid.set_names);
@@ -210,18 +211,4 @@ fn failures(outcomes: &[Outcome], wrote: bool) -> Result<()> {
 /// Reports a bad command line the way clap does (exit code 2) and exits.
 fn usage_error(message: String) -> ! {
     clap::Error::raw(clap::error::ErrorKind::ArgumentConflict, message + "\n").exit()
-}
-
-/// A progress bar on stderr when it is a terminal and `CI` is not set; hidden otherwise.
-fn progress_bar(cases: usize) -> ProgressBar {
-    if !std::io::stderr().is_terminal() || std::env::var_os("CI").is_some() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(cases as u64);
-    if let Ok(style) = ProgressStyle::with_template(
-        "{bar:40} {pos}/{len} cases  {elapsed_precise} elapsed, {eta} left",
-    ) {
-        bar.set_style(style);
-    }
-    bar
 }
