@@ -130,6 +130,13 @@
 //!    the simulated motion (1 kN of slow force noise moves a 0.95 MN/m table by 1 mm), so on
 //!    the test records its standard errors are 1.5–6 times the equation error's.
 //!
+//! # Reading records
+//!
+//! [`read_records`] reads what `platen identify` and Python's `platen.identify` identify:
+//! recorded CSV files through a column map, an identification manifest that lists files
+//! (with kinds, pressures, column maps and a specimen's floors) or motion scenarios whose
+//! recorded-like data are made in memory ([`inputs`]).
+//!
 //! # Conventions
 //!
 //! * SI units throughout; the unit is part of every public name (`sample_rate_hz`,
@@ -161,6 +168,7 @@ mod global;
 mod groups;
 mod identify;
 mod inertial;
+pub mod inputs;
 mod law;
 mod lm;
 mod paper_fit;
@@ -192,6 +200,7 @@ pub use dissipative::{LOW_SPEED_M_S, MIN_SPEED_SPREAD};
 pub use error::{IdentError, Result};
 pub use estimate::{student_t_975, Estimate, Parameter};
 pub use identify::identify;
+pub use inputs::{read_records, InputError, RecordInputs, RecordRequest, RecordSource};
 pub use inertial::{MAX_MASS_RELATIVE_STD_ERROR, MIN_INERTIAL_TO_DISSIPATIVE};
 pub use platen_model::{DissipativeLaw, IdentifiedKey};
 pub use record::{Floors, TestKind, TestRecord, MIN_SAMPLES};
