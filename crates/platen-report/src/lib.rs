@@ -17,6 +17,7 @@
 //!   achieved acceleration, response spectra, convergence and the limits' margins.
 //! * [`render`] writes them: SVG, PNG copies rendered by resvg with the embedded Noto Sans,
 //!   and the HTML page, every file atomically ([`write_outputs`]).
+//! * [`identify_report`] writes `platen identify`'s text report and HTML page.
 //! * [`simulate_report`], [`plan_report`] and [`sweep_report`] write the text summaries of
 //!   `platen simulate`, `plan`, `sweep` and `generate` (and `generate`'s JSON report).
 //! * [`html`] builds self-contained pages; [`text`] the numbers, metric rows and terminal
@@ -64,6 +65,7 @@ mod error;
 pub mod figure;
 pub mod html;
 pub mod identify_figures;
+pub mod identify_report;
 pub mod model_text;
 pub mod plan_figures;
 pub mod plan_report;
