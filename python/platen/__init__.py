@@ -499,30 +499,39 @@ def compare(
 
 
 def identify(
-    files: Union[PathLike, Sequence[PathLike]],
+    files: Union[PathLike, Sequence[PathLike]] = (),
     columns: Union[None, PathLike, Mapping] = None,
     *,
+    manifest: Optional[PathLike] = None,
     pressure_mpa: Union[None, float, Sequence[Optional[float]]] = None,
     viscous_exponent: Optional[float] = None,
     low_velocity_term: bool = True,
 ) -> Dict[str, Any]:
     """Identifies the platen's parameters from recorded tests, as ``platen identify FILE…
-    --json``: periodic tests by the paper's hysteresis-loop method (§3), any other record
-    (earthquake, white noise) by the any-record method, each file by its data; ``records``
-    lists every file with the method that took it, whether it was used and why.
+    [--manifest M] --json``: periodic tests by the paper's hysteresis-loop method (§3), any
+    other record (earthquake, white noise) by the any-record method, each file by its data;
+    ``records`` lists every file with the method that took it, whether it was used and why.
 
     ``files``: recorded CSVs with ``t_s``, ``u_m``, ``a_m_s2``, ``force_n`` and optionally
-    ``v_m_s`` (``columns`` maps a lab's own names and units, as for :func:`compare`).
-    ``pressure_mpa``: the hold-down pressure, MPa, for every file or one per file.
-    ``viscous_exponent`` holds α instead of fitting it; ``low_velocity_term=False`` drops
-    a·e^(−b|v|). Returns the seven identified keys at the top level, with the per-test
-    tables (or the any-record fits), standard errors, the records' accounts and warnings.
+    ``v_m_s`` (``columns`` maps a lab's own names and units, as for :func:`compare`,
+    including a channel's known ``delay_s``). ``manifest``: an identification manifest
+    (``{"tests": [{"file": …, "kind": …, "pressure_mpa": …}], "columns": …, "floors": …}``,
+    see docs/identification.md) whose entries are read after ``files``, as the CLI reads it:
+    per-entry kinds, pressures and column maps, a specimen's ``floors`` (their base shear is
+    taken off the force) and ``scenario`` entries (recorded-like data made in memory).
+    ``pressure_mpa``: the hold-down pressure, MPa, for every file (and every manifest entry
+    without one) or one per file. ``viscous_exponent`` holds α instead of fitting it;
+    ``low_velocity_term=False`` drops a·e^(−b|v|). Returns the seven identified keys at the
+    top level, with the per-test tables (or the any-record fits), standard errors, the
+    records' accounts and warnings.
     """
     if isinstance(files, (str, os.PathLike)):
         files = [files]
     paths = [_path(f, "files") for f in files]
-    if pressure_mpa is None or isinstance(pressure_mpa, numbers.Real):
-        pressures = [None if pressure_mpa is None else float(pressure_mpa)] * len(paths)
+    if pressure_mpa is None:
+        pressures: List[Optional[float]] = []
+    elif isinstance(pressure_mpa, numbers.Real):
+        pressures = [float(pressure_mpa)]
     else:
         pressures = [None if p is None else float(p) for p in pressure_mpa]
         if len(pressures) != len(paths):
@@ -532,8 +541,18 @@ def identify(
             )
     exponent = None if viscous_exponent is None else float(viscous_exponent)
     cpath, ctext = _columns(columns)
+    manifest_path = None if manifest is None else _path(manifest, "manifest")
     return json.loads(
-        _native(_platen.identify, paths, pressures, cpath, ctext, exponent, bool(low_velocity_term))
+        _native(
+            _platen.identify,
+            paths,
+            pressures,
+            cpath,
+            ctext,
+            exponent,
+            bool(low_velocity_term),
+            manifest_path,
+        )
     )
 
 

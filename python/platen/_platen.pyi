@@ -48,6 +48,7 @@ def identify(
     columns_text: Optional[str],
     viscous_exponent: Optional[float],
     low_velocity_term: bool,
+    manifest: Optional[str] = None,
 ) -> str: ...
 def sweep(
     path: Optional[str],
