@@ -243,3 +243,44 @@ fn loop_lines(s: &mut String, summary: &RunSummary) {
         ))
     );
 }
+
+/// A verb's `--json` object with the outputs written beside it: `figures`, the files written
+/// (when figures were asked for: `Some`, even if empty), and `report`, the HTML page (if any).
+/// The keys stay in alphabetical order (a `serde_json` map); a value that is not an object is
+/// returned as it is.
+pub fn with_outputs(
+    mut value: serde_json::Value,
+    figures: Option<&[PathBuf]>,
+    report: Option<&Path>,
+) -> serde_json::Value {
+    if let serde_json::Value::Object(map) = &mut value {
+        if let Some(figures) = figures {
+            let list: Vec<String> = figures.iter().map(|p| p.display().to_string()).collect();
+            map.insert("figures".into(), list.into());
+        }
+        if let Some(report) = report {
+            map.insert("report".into(), report.display().to_string().into());
+        }
+    }
+    value
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::{Path, PathBuf};
+
+    use super::with_outputs;
+
+    /// The outputs go in as sorted keys; without them the value is unchanged.
+    #[test]
+    fn with_outputs_adds_the_figures_and_report_written() {
+        let v = serde_json::json!({"name": "x", "samples": 3});
+        assert_eq!(with_outputs(v.clone(), None, None), v);
+        let figures = [PathBuf::from("d/a.svg"), PathBuf::from("d/a.png")];
+        let w = with_outputs(v, Some(&figures), Some(Path::new("r.html")));
+        assert_eq!(
+            serde_json::to_string(&w).unwrap(),
+            r#"{"figures":["d/a.svg","d/a.png"],"name":"x","report":"r.html","samples":3}"#
+        );
+    }
+}

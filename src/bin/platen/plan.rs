@@ -18,6 +18,7 @@ use platen_plan::{
     PlanSettings, Target,
 };
 use platen_report::plan_figures;
+use platen_report::simulate_report::with_outputs;
 
 use crate::progress::Progress;
 
@@ -94,24 +95,20 @@ fn parse_number(s: &str) -> std::result::Result<f64, String> {
     }
 }
 
+/// A finite number for which `ok` holds, else `"{v}: expected {what}"`.
+fn parse_checked(s: &str, ok: fn(f64) -> bool, what: &str) -> std::result::Result<f64, String> {
+    let v = parse_number(s)?;
+    ok(v).then_some(v).ok_or(format!("{v}: expected {what}"))
+}
+
 /// `--gain`: in (0, 2).
 fn parse_gain(s: &str) -> std::result::Result<f64, String> {
-    let g = parse_number(s)?;
-    if g > 0.0 && g < 2.0 {
-        Ok(g)
-    } else {
-        Err(format!("{g}: expected a gain in (0, 2)"))
-    }
+    parse_checked(s, |g| g > 0.0 && g < 2.0, "a gain in (0, 2)")
 }
 
 /// `--target-nrmse`: a fraction >= 0.
 fn parse_nrmse(s: &str) -> std::result::Result<f64, String> {
-    let e = parse_number(s)?;
-    if e >= 0.0 {
-        Ok(e)
-    } else {
-        Err(format!("{e}: expected an NRMSE >= 0 (a fraction)"))
-    }
+    parse_checked(s, |e| e >= 0.0, "an NRMSE >= 0 (a fraction)")
 }
 
 /// `--band-hz LO,HI` with `0 < LO < HI`.
@@ -219,18 +216,8 @@ pub fn run(args: &Args) -> Result<()> {
         eprintln!("warning: {warning}");
     }
     if args.json {
-        let mut value = value;
-        if let serde_json::Value::Object(map) = &mut value {
-            if args.plot.is_some() {
-                map.insert(
-                    "figures".into(),
-                    crate::simulate::figure_list(&figures).into(),
-                );
-            }
-            if let Some(report) = &args.report {
-                map.insert("report".into(), report.display().to_string().into());
-            }
-        }
+        let figures = args.plot.as_ref().map(|_| figures.as_slice());
+        let value = with_outputs(value, figures, args.report.as_deref());
         outln!("{}", serde_json::to_string_pretty(&value)?);
         return Ok(());
     }

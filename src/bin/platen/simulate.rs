@@ -8,6 +8,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 
+use platen_report::simulate_report::with_outputs;
 use platen_report::{run_figures, run_figures::RunRecorder, FigureSize};
 use platen_scenario::{CsvSink, Run, RunSummary, Scenario};
 
@@ -83,10 +84,8 @@ pub fn run(opts: &Options<'_>) -> Result<()> {
     }
     if opts.json {
         // Through a Value, so the keys come out in alphabetical order.
-        let mut value = serde_json::to_value(&summary)?;
-        if let (Some(_), Some(map)) = (opts.plot, value.as_object_mut()) {
-            map.insert("figures".into(), figure_list(&written).into());
-        }
+        let figures = opts.plot.map(|_| written.as_slice());
+        let value = with_outputs(serde_json::to_value(&summary)?, figures, None);
         outln!("{}", serde_json::to_string_pretty(&value)?);
     } else {
         let text =
@@ -94,9 +93,4 @@ pub fn run(opts: &Options<'_>) -> Result<()> {
         out!("{text}");
     }
     Ok(())
-}
-
-/// The figure files written, as the `figures` list of `--json`.
-pub fn figure_list(written: &[std::path::PathBuf]) -> Vec<String> {
-    written.iter().map(|p| p.display().to_string()).collect()
 }

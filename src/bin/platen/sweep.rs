@@ -22,6 +22,7 @@ use anyhow::{anyhow, Result};
 use platen_integrate::IntegrateError;
 use platen_io::write_bytes_atomic;
 use platen_model::{IdentifiedKey, PhysicalKey};
+use platen_report::simulate_report::with_outputs;
 use platen_scenario::sweep::{self, Outcome, Sweep};
 use platen_scenario::{ModelKey, Scenario};
 
@@ -146,13 +147,9 @@ pub fn run(
         |_, _| String::new(),
     )?;
     if json_out {
-        let mut summary = sweep::json_summary(path, &scenario, set_names, cases, &outcomes, out);
-        if let (Some(_), Some(map)) = (plot.dir, summary.as_object_mut()) {
-            map.insert(
-                "figures".into(),
-                crate::simulate::figure_list(&written).into(),
-            );
-        }
+        let summary = sweep::json_summary(path, &scenario, set_names, cases, &outcomes, out);
+        let figures = plot.dir.map(|_| written.as_slice());
+        let summary = with_outputs(summary, figures, None);
         outln!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
         let run = platen_report::sweep_report::SweepRun {
