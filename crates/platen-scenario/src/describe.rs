@@ -246,6 +246,23 @@ impl ModelDescription {
     }
 }
 
+/// The model `preset` at the hold-down pressure `pressure_pa`: its identified model or,
+/// when `full`, its full model (the model [`ModelDescription::of_preset`] describes).
+///
+/// # Errors
+/// [`ModelError::InvalidParameter`] for a pressure the preset rejects.
+pub fn preset_model(
+    preset: Preset,
+    pressure_pa: f64,
+    full: bool,
+) -> std::result::Result<Model, ModelError> {
+    Ok(if full {
+        Model::Full(Box::new(preset.physical(pressure_pa)?.build()?))
+    } else {
+        Model::Identified(preset.identified(pressure_pa)?.build()?)
+    })
+}
+
 /// The description of `preset` at the hold-down pressure `pressure_pa`
 /// ([`ModelDescription::of_preset`]) as a JSON object, its keys in alphabetical order.
 ///

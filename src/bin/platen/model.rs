@@ -13,7 +13,6 @@ use anyhow::{bail, Context, Result};
 use platen_model::Preset;
 use platen_report::{model_text, system_figures, FigureSize};
 use platen_scenario::describe::{self, ModelDescription, SystemAnalysis, SystemParameters};
-use platen_scenario::Model;
 use platen_system::TableSystem;
 
 use crate::Form;
@@ -46,62 +45,38 @@ pub fn run(o: &Options<'_>) -> Result<()> {
              ({names}) or a --scenario with a `table_system`"
         );
     }
-    // The description, the table system's loop and what the figures' titles name.
+    // The description, the model, its stroke and specimen, the scenario's table system and
+    // what the figures' titles name.
     let mut header = String::new();
-    let (mut description, analysis, name) = match o.scenario {
+    let (mut description, model, stroke_m, specimen_kg, given, name) = match o.scenario {
         Some(path) => {
             let loaded = describe::load_for_description(path)?;
-            let s = &loaded.scenario;
-            let stroke_m = s.limits.stroke_m;
-            let system = match o.system {
-                Some(name) => Some((Some(name.to_owned()), system_preset(name, stroke_m)?)),
-                None => s
-                    .closed_loop
-                    .as_ref()
-                    .map(|cl| (loaded.table_system_preset.clone(), cl.system)),
-            };
+            let s = loaded.scenario;
+            header = model_text::scenario_header(path, &s);
+            let given = s
+                .closed_loop
+                .as_ref()
+                .map(|cl| (loaded.table_system_preset, cl.system));
             let specimen_kg = s.specimen.as_ref().map(|sp| sp.total_mass_kg());
-            header = model_text::scenario_header(path, s);
-            let analysis = system.map(|(preset, system)| {
-                SystemAnalysis::new(preset, system, &s.model, stroke_m, specimen_kg)
-            });
-            (
-                ModelDescription::of_scenario(path, s)?,
-                analysis,
-                s.name.clone(),
-            )
+            let d = ModelDescription::of_scenario(path, &s)?;
+            (d, s.model, s.limits.stroke_m, specimen_kg, given, s.name)
         }
         None => {
             let preset = Preset::from_name(o.preset)?;
             let pressure_pa = pressure_pa(preset, o.pressure_mpa)?;
             let full = matches!(o.form, Form::Full);
-            let description = ModelDescription::of_preset(preset, pressure_pa, full)?;
-            let model = if full {
-                Model::Full(Box::new(preset.physical(pressure_pa)?.build()?))
-            } else {
-                Model::Identified(preset.identified(pressure_pa)?.build()?)
-            };
-            let stroke_m = preset.limits().stroke_m;
-            let analysis = match o.system {
-                Some(name) => {
-                    let system = system_preset(name, stroke_m)?;
-                    Some(SystemAnalysis::new(
-                        Some(name.to_owned()),
-                        system,
-                        &model,
-                        stroke_m,
-                        None,
-                    ))
-                }
-                None => None,
-            };
-            (
-                description,
-                analysis,
-                o.system.unwrap_or(preset.name()).to_owned(),
-            )
+            let d = ModelDescription::of_preset(preset, pressure_pa, full)?;
+            let model = describe::preset_model(preset, pressure_pa, full)?;
+            let name = o.system.unwrap_or(preset.name()).to_owned();
+            (d, model, preset.limits().stroke_m, None, None, name)
         }
     };
+    let system = match o.system {
+        Some(name) => Some((Some(name.to_owned()), system_preset(name, stroke_m)?)),
+        None => given,
+    };
+    let analysis = system
+        .map(|(preset, system)| SystemAnalysis::new(preset, system, &model, stroke_m, specimen_kg));
     description.table_system = analysis.as_ref().map(SystemAnalysis::description);
     let written = match (&analysis, o.plot) {
         (None, Some(_)) => bail!(
