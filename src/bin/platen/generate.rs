@@ -3,14 +3,13 @@
 
 use std::path::Path;
 
-use anyhow::{bail, Context, Result};
+use anyhow::Result;
 
-use platen_integrate::{inverse, Peaks, Trajectory};
+use platen_ident::inputs::recorded_of;
 use platen_io::csv::write_csv_atomic;
-use platen_model::PlatenModel;
 use platen_report::sweep_report::GenerateReport;
-use platen_scenario::recorded::{recorded_like, ArtefactSettings, Recorded};
-use platen_scenario::{Model, Run, Scenario};
+use platen_scenario::recorded::Recorded;
+use platen_scenario::{Run, Scenario};
 
 /// What to generate.
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -57,44 +56,6 @@ pub fn run(what: What, scenario_path: &Path, out: &Path, seed: u64, json_out: bo
         }
     }
     Ok(())
-}
-
-/// The recorded-like data of a loaded motion scenario (`scenario_path` names it in
-/// messages): what `platen generate recorded` writes, and what `platen identify` makes of a
-/// manifest entry that names a scenario.
-pub(crate) fn recorded_of(
-    scenario: &Scenario,
-    scenario_path: &Path,
-    seed: u64,
-) -> Result<Recorded> {
-    let Run::Inverse { motion } = &scenario.run else {
-        bail!(
-            "`{}`: recorded-like data needs a motion scenario (motion_csv, sine_motion, triangle_motion, \
-             white_noise_motion or ground_motion); this one is force-driven",
-            scenario_path.display()
-        );
-    };
-    match &scenario.model {
-        Model::Identified(m) => recorded(m, motion, seed),
-        Model::Full(m) => recorded(&**m, motion, seed),
-    }
-}
-
-fn recorded<M: PlatenModel>(
-    model: &M,
-    motion: &platen_integrate::Motion,
-    seed: u64,
-) -> Result<Recorded> {
-    let mut truth = (Trajectory::with_capacity(motion.len()), Peaks::default());
-    inverse(model, motion, &mut truth);
-    recorded_like(
-        &truth.0,
-        model.static_threshold_n(0.0),
-        &ArtefactSettings::default(),
-        seed,
-    )
-    .map_err(anyhow::Error::msg)
-    .context("recorded-like data could not be made")
 }
 
 /// Prints what was written: [`GenerateReport`] as JSON or as its text line.
