@@ -191,6 +191,46 @@ def test_identify_routes_an_earthquake_record_as_the_cli_does(cli_json):
     assert [(r["method"], r["used"]) for r in result["records"]] == [("record", True)]
 
 
+def test_identify_applies_a_column_maps_delay_as_the_cli_does(cli_json, tmp_path):
+    """A column map's ``delay_s`` (a channel's known skew) reaches identification through the
+    reading the CLI uses: the same object, with the delay given."""
+    data = SCENARIOS.parent / "tests" / "data" / "any-record"
+    columns = json.loads((data / "columns.json").read_text())
+    columns["a_m_s2"]["delay_s"] = 0.004
+    path = tmp_path / "columns-delay.json"
+    path.write_text(json.dumps(columns))
+    record = data / "eq-lab.csv"
+    expected = cli_json("identify", record, "--columns", path)
+    assert platen.identify(record, columns=path) == expected
+    result = platen.identify(record, columns=columns)
+    assert result == expected
+    assert result["records"][0]["channel_delay_s"] == {"a_m_s2": 0.004}
+
+
+def test_identify_reads_a_manifest_with_floors_as_the_cli_does(cli_json):
+    """``manifest=`` with a specimen's floors (their base shear taken off the force) gives
+    ``platen identify --manifest … --json``."""
+    manifest = SCENARIOS.parent / "tests" / "data" / "any-record" / "two-storey-manifest.json"
+    expected = cli_json("identify", "--manifest", manifest)
+    result = platen.identify(manifest=manifest)
+    assert result == expected
+    (entry,) = result["records"]
+    assert entry["floor_masses_kg"] == [14000.0, 11000.0]
+    assert entry["peak_base_shear_n"] > 0
+
+
+def test_identify_reads_a_mixed_days_manifest_as_the_cli_does(cli_json):
+    """A manifest with a column map, a declared kind and scenario entries (recorded-like
+    data made in memory): the CLI's object, every record accounted for."""
+    manifest = SCENARIOS.parent / "tests" / "data" / "any-record" / "mixed-day-manifest.json"
+    expected = cli_json("identify", "--manifest", manifest)
+    result = platen.identify(manifest=manifest)
+    assert result == expected
+    assert [r["name"] for r in result["records"]] == [
+        "eq-lab", "wn-lab", "wn-low-lab", "S9@13.8MPa", "T4@13.8MPa"
+    ]
+
+
 def test_forward_and_inverse_with_a_specimen_give_the_scenarios_run():
     """``specimen=`` on arrays runs exactly as the shipped specimen scenarios, with the
     specimen's columns after the contract's."""

@@ -191,6 +191,14 @@ def test_identify_errors(cli, tmp_path):
         platen.identify([record], pressure_mpa=[13.8, 6.9])
     with pytest.raises(platen.ScenarioError, match="no test files"):
         platen.identify([])
+    # A manifest's mistake: the CLI's message, naming the manifest and the JSON path.
+    manifest = tmp_path / "manifest.json"
+    manifest.write_text(json.dumps({"floors": [{"column": "Acc", "mass_kg": -1}], "tests": [{"file": "at-rest.csv"}]}))
+    p = cli("identify", "--manifest", manifest, check=False)
+    with pytest.raises(platen.ScenarioError) as raised:
+        platen.identify(manifest=manifest)
+    assert "error: " + str(raised.value) == p.stderr.rstrip("\n") and p.returncode == 3
+    assert "at `floors[0].mass_kg` (tests[0]): -1: expected a mass > 0 kg" in str(raised.value)
 
 
 def test_sweep_errors():
