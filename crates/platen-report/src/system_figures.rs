@@ -218,6 +218,31 @@ pub fn figures(
     ]
 }
 
+/// The Bode figures of a table system's [`SystemAnalysis`] (`platen model --plot`): the loop
+/// with the specimen as a rigid payload first (the one the titles' numbers describe), then
+/// the bare table; `name` heads the titles.
+pub fn analysis_figures(name: &str, analysis: &SystemAnalysis) -> Vec<Figure> {
+    let mut curves = Vec::new();
+    if let (Some(lin), Some(kg)) = (analysis.loaded, analysis.specimen_mass_kg) {
+        curves.push(LoopCurve {
+            label: format!(
+                "with the specimen (rigid, {} t)",
+                crate::model_text::significant(kg / 1e3, crate::model_text::SIGNIFICANT_DIGITS)
+            ),
+            linearisation: lin,
+        });
+    }
+    curves.push(LoopCurve {
+        label: if curves.is_empty() {
+            String::new()
+        } else {
+            "bare table".into()
+        },
+        linearisation: analysis.bare,
+    });
+    figures(name, &analysis.system, &curves, &analysis.margins)
+}
+
 /// The curves of one quantity (magnitude or phase) of every configuration.
 fn curve_series(curves: &[LoopCurve], quantity: impl Fn(usize) -> Points) -> Vec<Series> {
     curves
@@ -461,29 +486,4 @@ mod tests {
             assert!(svg.contains(&format!("\n{label}\n")), "no tick {label}");
         }
     }
-}
-
-/// The Bode figures of a table system's [`SystemAnalysis`] (`platen model --plot`): the loop
-/// with the specimen as a rigid payload first (the one the titles' numbers describe), then
-/// the bare table; `name` heads the titles.
-pub fn analysis_figures(name: &str, analysis: &SystemAnalysis) -> Vec<Figure> {
-    let mut curves = Vec::new();
-    if let (Some(lin), Some(kg)) = (analysis.loaded, analysis.specimen_mass_kg) {
-        curves.push(LoopCurve {
-            label: format!(
-                "with the specimen (rigid, {} t)",
-                crate::model_text::significant(kg / 1e3, crate::model_text::SIGNIFICANT_DIGITS)
-            ),
-            linearisation: lin,
-        });
-    }
-    curves.push(LoopCurve {
-        label: if curves.is_empty() {
-            String::new()
-        } else {
-            "bare table".into()
-        },
-        linearisation: analysis.bare,
-    });
-    figures(name, &analysis.system, &curves, &analysis.margins)
 }
