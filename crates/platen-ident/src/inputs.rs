@@ -51,6 +51,9 @@ use platen_model::PlatenModel;
 use platen_scenario::recorded::{recorded_like, ArtefactSettings, Recorded};
 use platen_scenario::sampling::uniform_step_s;
 use platen_scenario::{Model, Run, Scenario, ScenarioError};
+use platen_system::TableSystem;
+
+use crate::system::SystemRecord;
 
 use crate::{IdentError, TestKind, TestRecord};
 
@@ -314,6 +317,50 @@ pub enum InputError {
     RecordedLike {
         /// Why.
         message: String,
+    },
+    /// A closed-loop record that cannot be read or lacks a required column.
+    #[error(
+        "{}: identify --system needs the columns t_s, command_u_m and u_m (drive, delta_p_pa, \
+         cap_pressure_pa, rod_pressure_pa, a_m_s2, storey{{i}}_a_m_s2 where recorded)",
+        source.file().display()
+    )]
+    SystemColumns {
+        /// The file's error (with its path).
+        #[source]
+        source: IoError,
+    },
+    /// A table system's base (`--base`) that cannot be read.
+    #[error("--base {}: cannot read it", path.display())]
+    BaseUnreadable {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A table system's base that is not JSON.
+    #[error("--base {}: not JSON", path.display())]
+    BaseNotJson {
+        /// The file.
+        path: PathBuf,
+        /// Where and why.
+        #[source]
+        source: serde_json::Error,
+    },
+    /// A table system's base that is not a valid table system.
+    #[error("--base {}: not a table system", path.display())]
+    BaseNotSystem {
+        /// The file (boxed: the scenario error is large).
+        path: Box<Path>,
+        /// The scenario format's error.
+        #[source]
+        source: ScenarioError,
+    },
+    /// A base without a table system.
+    #[error("--base {}: no table_system in it", path.display())]
+    NoTableSystem {
+        /// The file.
+        path: PathBuf,
     },
     /// The recorded-like data of a scenario entry do not make a test record.
     #[error("`{}` (recorded-like, seed {seed})", path.display())]
@@ -811,5 +858,288 @@ pub fn recorded_of(scenario: &Scenario, path: &Path, seed: u64) -> Result<Record
     match &scenario.model {
         Model::Identified(m) => recorded(m, motion, seed),
         Model::Full(m) => recorded(&**m, motion, seed),
+    }
+}
+
+/// Reads the closed-loop records of a table-system identification
+/// ([`crate::system::identify_system`]): `t_s`, `command_u_m` and `u_m`, and where recorded
+/// `drive`, `delta_p_pa`, `cap_pressure_pa`, `rod_pressure_pa`, `a_m_s2` and the storeys'
+/// `storey{i}_a_m_s2`, through `columns`; each named by its path.
+///
+/// # Errors
+/// [`InputError::SystemColumns`] (with the file's error) for a file that cannot be read or
+/// lacks a required column.
+pub fn read_system_records(
+    files: &[PathBuf],
+    columns: &ColumnMap,
+) -> Result<Vec<SystemRecord>, InputError> {
+    let storey_names: Vec<String> = (1..=platen_model::Specimen::MAX_STOREYS)
+        .map(|i| format!("storey{i}_a_m_s2"))
+        .collect();
+    let mut optional = vec![
+        "drive",
+        "delta_p_pa",
+        "a_m_s2",
+        "cap_pressure_pa",
+        "rod_pressure_pa",
+    ];
+    optional.extend(storey_names.iter().map(String::as_str));
+    let mut records = Vec::with_capacity(files.len());
+    for path in files {
+        let mut t = columns
+            .read_table(path, &["t_s", "command_u_m", "u_m"], &optional)
+            .map_err(|source| InputError::SystemColumns { source })?;
+        let storeys = storey_names
+            .iter()
+            .map_while(|c| t.take_column(c))
+            .collect();
+        let mut take = |c: &str| t.take_column(c);
+        records.push(SystemRecord {
+            name: path.display().to_string(),
+            t_s: take("t_s").unwrap_or_default(),
+            command_u_m: take("command_u_m").unwrap_or_default(),
+            u_m: take("u_m").unwrap_or_default(),
+            drive: take("drive"),
+            delta_p_pa: take("delta_p_pa"),
+            a_m_s2: take("a_m_s2"),
+            cap_pressure_pa: take("cap_pressure_pa"),
+            rod_pressure_pa: take("rod_pressure_pa"),
+            storey_a_m_s2: storeys,
+        });
+    }
+    Ok(records)
+}
+
+/// Reads the base of a table-system identification (`--base`): a scenario with a
+/// `table_system`, or a `table_system` object, validated as a scenario would validate it
+/// (commanded by `record`'s `command_u_m` through `columns`), with its stroke limit if it
+/// gives one.
+///
+/// # Errors
+/// [`InputError::BaseUnreadable`], [`InputError::BaseNotJson`], [`InputError::BaseNotSystem`]
+/// (each with its cause) and [`InputError::NoTableSystem`].
+pub fn read_base_system(
+    path: &Path,
+    record: &Path,
+    columns: &ColumnMap,
+) -> Result<(TableSystem, Option<f64>), InputError> {
+    let text = std::fs::read_to_string(path).map_err(|source| InputError::BaseUnreadable {
+        path: path.to_owned(),
+        source,
+    })?;
+    let value: serde_json::Value =
+        serde_json::from_str(&text).map_err(|source| InputError::BaseNotJson {
+            path: path.to_owned(),
+            source,
+        })?;
+    let (spec, stroke) = match value.get("table_system") {
+        Some(ts) => (
+            ts.clone(),
+            value.pointer("/limits/stroke_m").and_then(|v| v.as_f64()),
+        ),
+        None => (value.clone(), None),
+    };
+    let record = std::fs::canonicalize(record).unwrap_or_else(|_| record.to_path_buf());
+    // Validated with a tiny stroke: the base's volumes are replaced by the fitted ones.
+    let scenario = serde_json::json!({
+        "model": { "preset": "lhpost-2008" },
+        "table_system": spec,
+        "limits": { "stroke_m": stroke.unwrap_or(1e-3) },
+        "excitation": {
+            "motion_csv": record.display().to_string(),
+            "columns": { "u_m": { "name": columns.header("command_u_m") } }
+        },
+    });
+    let not_system = |source| InputError::BaseNotSystem {
+        path: path.into(),
+        source,
+    };
+    let file = platen_scenario::file::parse(path, &scenario.to_string()).map_err(not_system)?;
+    let s = Scenario::from_file(path, file).map_err(not_system)?;
+    let Some(cl) = s.closed_loop else {
+        return Err(InputError::NoTableSystem {
+            path: path.to_owned(),
+        });
+    };
+    Ok((cl.system, stroke))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The repository's any-record test data.
+    fn data() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/any-record")
+    }
+
+    /// A fresh folder for this test's files.
+    fn folder(name: &str) -> PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("platen-ident-inputs-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    fn lab_columns() -> ColumnMap {
+        ColumnMap::load(&data().join("columns.json")).unwrap()
+    }
+
+    #[test]
+    fn a_manifest_with_floors_removes_their_base_shear() {
+        let request = RecordRequest {
+            manifest: Some(data().join("two-storey-manifest.json")),
+            ..RecordRequest::default()
+        };
+        let inputs = read_records(&request).unwrap();
+        assert_eq!(inputs.sources.len(), 1);
+        let floors = inputs.records[0].floors().expect("floors removed");
+        assert_eq!(floors.masses_kg, [14000.0, 11000.0]);
+        // Independently: the largest |Σ mᵢ·aᵢ| of the file's floor columns, mm/s² to m/s².
+        let text = std::fs::read_to_string(data().join("eq-two-storey-lab.csv")).unwrap();
+        let peak = text
+            .lines()
+            .skip(1)
+            .map(|l| {
+                let c: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+                (14000.0 * c[4] + 11000.0 * c[5]) * 1e-3
+            })
+            .fold(0.0_f64, |m, x| m.max(x.abs()));
+        assert!((floors.peak_base_shear_n / peak - 1.0).abs() < 1e-12);
+        assert_eq!(
+            inputs.files(),
+            [data().join("eq-two-storey-lab.csv").display().to_string()]
+        );
+    }
+
+    #[test]
+    fn a_column_maps_delay_is_given_to_the_record() {
+        let dir = folder("delay");
+        let map = r#"{"t_s": {"name": "Time", "unit": "s"}, "u_m": {"name": "Table Disp", "unit": "mm"},
+            "a_m_s2": {"name": "Table Acc", "unit": "mm/s2", "delay_s": 0.004},
+            "force_n": {"name": "dP", "unit": "MPa", "times_area_m2": 0.15}}"#;
+        let request = RecordRequest {
+            files: vec![data().join("eq-lab.csv")],
+            pressures_mpa: vec![Some(13.8)],
+            columns: ColumnMap::from_json(&dir.join("map.json"), map).unwrap(),
+            ..RecordRequest::default()
+        };
+        let inputs = read_records(&request).unwrap();
+        let rec = &inputs.records[0];
+        assert_eq!(rec.channel_delay_s("a_m_s2"), Some(0.004));
+        assert_eq!(rec.pressure_pa(), Some(13.8e6));
+        assert_eq!(rec.name(), data().join("eq-lab.csv").display().to_string());
+        assert_eq!(inputs.sources[0].label, "eq-lab.csv");
+        assert_eq!(inputs.declared_record(), [false]);
+    }
+
+    #[test]
+    fn manifest_entries_lay_over_the_files_and_scenarios_are_made_in_memory() {
+        let dir = folder("overlay");
+        let scenario = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../scenarios/paper-tests/13.8MPa/S9.json")
+            .canonicalize()
+            .unwrap();
+        let manifest = dir.join("m.json");
+        let eq = data().join("eq-lab.csv");
+        std::fs::write(
+            &manifest,
+            serde_json::json!({
+                "tests": [
+                    { "file": eq, "kind": "record", "name": "eq" },
+                    { "scenario": scenario, "seed": 9, "kind": "sine" },
+                ]
+            })
+            .to_string(),
+        )
+        .unwrap();
+        let request = RecordRequest {
+            files: vec![eq.clone()],
+            manifest: Some(manifest),
+            columns: lab_columns(),
+            ..RecordRequest::default()
+        };
+        let sources = request.sources().unwrap();
+        assert_eq!(sources.len(), 2, "the file given and listed is one record");
+        assert_eq!(
+            (sources[0].name.as_str(), sources[0].label.as_str()),
+            ("eq", "eq")
+        );
+        assert!(sources[0].declared_record && sources[0].kind.is_none());
+        assert_eq!(sources[1].generated_seed, Some(9));
+        assert_eq!(sources[1].kind, Some(TestKind::Sine));
+        let rec = sources[1].read().unwrap();
+        assert_eq!(rec.pressure_pa(), Some(13.8e6));
+        assert_eq!(rec.kind(), Some(TestKind::Sine));
+        // The numbers `platen generate recorded --seed 9` writes.
+        let made = recorded_of(&Scenario::load(&scenario).unwrap(), &scenario, 9).unwrap();
+        assert_eq!(rec.u_m(), made.u_m.as_slice());
+        assert_eq!(rec.force_n(), made.force_n.as_slice());
+        assert_eq!(rec.v_m_s(), Some(made.v_m_s.as_slice()));
+    }
+
+    #[test]
+    fn mistakes_are_named_with_the_file_and_json_path() {
+        let dir = folder("mistakes");
+        let manifest = dir.join("m.json");
+        let message = |json: serde_json::Value, request: RecordRequest| {
+            std::fs::write(&manifest, json.to_string()).unwrap();
+            let request = RecordRequest {
+                manifest: Some(manifest.clone()),
+                ..request
+            };
+            request.sources().unwrap_err().to_string()
+        };
+        let m = manifest.display();
+        assert_eq!(
+            message(
+                serde_json::json!({"tests": [{"file": "a.csv", "scenario": "b.json"}]}),
+                RecordRequest::default()
+            ),
+            format!("`{m}`, at `tests[0]`: expected `file` or `scenario`, not both")
+        );
+        assert_eq!(
+            message(
+                serde_json::json!({"floors": [{"column": "F1", "mass_kg": 0}], "tests": [{"file": "a.csv"}]}),
+                RecordRequest::default()
+            ),
+            format!("`{m}`, at `floors[0].mass_kg` (tests[0]): 0: expected a mass > 0 kg")
+        );
+        // A file given with one pressure and listed with another.
+        let a = dir.join("a.csv");
+        std::fs::write(&a, "t_s\n").unwrap();
+        assert_eq!(
+            message(
+                serde_json::json!({"tests": [{"file": "a.csv", "pressure_mpa": 6.9}]}),
+                RecordRequest {
+                    files: vec![a.clone()],
+                    pressures_mpa: vec![Some(13.8)],
+                    ..RecordRequest::default()
+                }
+            ),
+            format!(
+                "`{}`: hold-down pressure 13.8 MPa from --pressure-mpa but 6.9 MPa in the manifest `{m}`",
+                a.display()
+            )
+        );
+        let err = RecordRequest {
+            files: vec!["a.csv".into()],
+            pressures_mpa: vec![Some(13.8), Some(6.9)],
+            ..RecordRequest::default()
+        }
+        .sources()
+        .unwrap_err();
+        assert!(matches!(
+            err,
+            InputError::PressureCount { given: 2, files: 1 }
+        ));
+        let err = RecordRequest::default().sources().unwrap_err();
+        assert!(matches!(err, InputError::NoFiles));
+        let err = message(
+            serde_json::json!({"tests": [{"file": 3}]}),
+            RecordRequest::default(),
+        );
+        assert!(err.starts_with("reading the identification manifest (expected {\"tests\": "));
     }
 }

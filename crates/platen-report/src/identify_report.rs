@@ -1,13 +1,16 @@
 //! The reports of `platen identify`: the text a terminal shows and the HTML page of
 //! `--report`, for the paper's hysteresis-loop method ([`Identification`]), the any-record
 //! method ([`RecordIdentification`]) or both ([`Identified`]), with one line per input record
-//! saying what identification did with it and why.
+//! saying what identification did with it and why; and for `identify --system`, the text
+//! report of a table-system identification and the scenario it makes runnable
+//! ([`system_text`], [`system_scenario`]).
 //!
 //! Parameters are shown in a reader's units ([`display_unit`]: t, MN/m, kN), each estimate as
 //! `value ± one standard error` with enough decimals to show the standard error's first
 //! significant digit ([`plus_minus`]).
 
 use std::fmt::Write as _;
+use std::path::Path;
 
 use platen_ident::anyrecord::summary::{record_entries, RecordInfoSummary, RecordSummary};
 use platen_ident::anyrecord::ChannelDelay;
@@ -15,6 +18,10 @@ use platen_ident::{
     Correlations, Estimate, Flag, Identification, IdentificationSummary, Identified, IdentifiedKey,
     Parameter, ParameterEstimates, RecordIdentification, RecordSource, TestKind, TestRecord,
 };
+
+use platen_ident::system::{SystemIdentification, SystemRecord};
+use platen_io::columns::ColumnMap;
+use platen_scenario::describe::SystemParameters;
 
 use crate::figure::Figure;
 use crate::{html, identify_figures, record_figures};
@@ -797,4 +804,269 @@ fn report_warnings(s: &mut String, id: &Identification) {
             let _ = writeln!(s, "  - {w}");
         }
     }
+}
+
+/// A table-system identification as a runnable scenario (`platen identify --system --json`).
+pub struct SystemScenario {
+    /// The scenario: the identified model, table system and specimen where identified, else
+    /// the `lhpost-2008` preset with the identified controller, commanded by the held-out
+    /// record.
+    pub scenario: serde_json::Value,
+    /// What the scenario takes from the preset (or the base) rather than the records.
+    pub from_preset: Vec<&'static str>,
+}
+
+/// The scenario of a table-system identification, commanded by the held-out record `held`
+/// (read from `held_path` through `columns`); `base_stroke` is the base's stroke limit, if
+/// it gives one.
+pub fn system_scenario(
+    id: &SystemIdentification,
+    held: &SystemRecord,
+    held_path: &Path,
+    columns: &ColumnMap,
+    base_stroke: Option<f64>,
+) -> SystemScenario {
+    let plant = id.plant.as_ref();
+    let identified_system = plant.and_then(|p| p.system);
+    let mut table_system = match &identified_system {
+        Some(sys) => serde_json::to_value(SystemParameters::from(sys)).unwrap_or_default(),
+        None => serde_json::json!({ "preset": "lhpost-2008" }),
+    };
+    if let (Some(g), None) = (&id.gains, &identified_system) {
+        table_system["controller"] = serde_json::json!({
+            "sample_rate_hz": g.sample_rate_hz,
+            "displacement_gain_per_m": g.displacement_gain_per_m,
+            "velocity_feedforward_s_per_m": g.velocity_feedforward_s_per_m,
+            "acceleration_feedforward_s2_per_m": g.acceleration_feedforward_s2_per_m,
+            "velocity_feedback_s_per_m": g.velocity_feedback_s_per_m,
+            "acceleration_feedback_s2_per_m": g.acceleration_feedback_s2_per_m,
+            "delta_p_gain_per_pa": g.delta_p_gain_per_pa,
+            "delta_p_highpass_hz": g.delta_p_highpass_hz,
+            "integral_gain_per_m_s": 0.0,
+        });
+    }
+    let model = match plant.and_then(|p| p.model) {
+        Some(m) => serde_json::json!({
+            "preset": "lhpost-2008",
+            "identified": {
+                "effective_mass_kg": m.effective_mass_kg,
+                "stiffness_n_per_m": m.stiffness_n_per_m,
+                "coulomb_force_n": m.coulomb_force_n,
+                "viscous_coefficient": m.viscous_coefficient,
+                "viscous_exponent": m.viscous_exponent,
+                "low_velocity_force_n": m.low_velocity_force_n,
+                "low_velocity_decay_s_per_m": m.low_velocity_decay_s_per_m,
+            }
+        }),
+        None => serde_json::json!({ "preset": "lhpost-2008" }),
+    };
+    let span = held.t_s.last().copied().unwrap_or(0.0) - held.t_s.first().copied().unwrap_or(0.0);
+    let mut scenario = serde_json::json!({
+        "name": format!("identified table system, commanded by {}", held.name),
+        "model": model,
+        "table_system": table_system,
+        // The record's own a_m_s2 is the table's, not the command's: the command's velocity
+        // and acceleration are derived from command_u_m (the record's columns ignored).
+        "excitation": {
+            "motion_csv": held_path.display().to_string(),
+            "columns": {
+                "u_m": { "name": columns.header("command_u_m") },
+                "v_m_s": { "ignore": true },
+                "a_m_s2": { "ignore": true },
+            }
+        },
+        "duration_s": span,
+    });
+    if let Some(sp) = plant.and_then(|p| p.specimen.as_ref()) {
+        scenario["specimen"] = serde_json::json!({
+            "storeys": sp.storeys().iter().map(|s| serde_json::json!({
+                "mass_kg": s.mass_kg,
+                "stiffness_n_per_m": s.stiffness_n_per_m,
+                "damping_n_s_per_m": s.damping_n_s_per_m,
+            })).collect::<Vec<_>>()
+        });
+    }
+    if let Some(sys) = &identified_system {
+        // The chambers must keep oil over the stroke: the base's, else 90 % of what the
+        // identified volumes allow.
+        let a = &sys.actuator;
+        let room = (a.cap_volume_m3 / a.cap_area_m2).min(a.rod_volume_m3 / a.rod_area_m2);
+        let stroke = base_stroke.filter(|s| *s < room).unwrap_or(0.9 * room);
+        // The other limits are this table's, not the preset's: its capacities by the closed
+        // forms in the weaker direction, and the acceleration that force gives the moving
+        // mass (platen and specimen).
+        let cap = sys.capacities();
+        let force = cap.push_force_n.min(cap.pull_force_n);
+        let velocity = cap.extend_velocity_m_s.min(cap.retract_velocity_m_s);
+        let mut limits = serde_json::json!({
+            "stroke_m": stroke,
+            "velocity_m_s": velocity,
+            "force_n": force,
+        });
+        if let Some(m) = plant.and_then(|p| p.model) {
+            let specimen_kg: f64 = plant
+                .and_then(|p| p.specimen.as_ref())
+                .map_or(0.0, |sp| sp.storeys().iter().map(|s| s.mass_kg).sum());
+            limits["acceleration_m_s2"] = (force / (m.effective_mass_kg + specimen_kg)).into();
+        }
+        scenario["limits"] = limits;
+    }
+    let mut from_preset: Vec<&str> = Vec::new();
+    if plant.and_then(|p| p.model).is_none() {
+        from_preset.push("model (the platen: mass, friction, stiffness)");
+    }
+    if identified_system.is_none() {
+        from_preset.push("table_system: actuators, servo-valves, oil, supply, accumulator");
+    } else {
+        from_preset.push(
+            "table_system: actuator count and areas, valve count and rated drop, supply and \
+             return pressures, bulk modulus, accumulator (from --base)",
+        );
+    }
+    from_preset
+        .push("table_system.controller.integral_gain_per_m_s (0: an integrator is not fitted)");
+    SystemScenario {
+        scenario,
+        from_preset,
+    }
+}
+
+/// The text report of a table-system identification: the controller's gains, the fit on
+/// each record, the plant, what could not be identified and what the scenario holds.
+pub fn system_text(id: &SystemIdentification) -> String {
+    let plant = id.plant.as_ref();
+    let identified_system = plant.and_then(|p| p.system);
+    let mut s = String::new();
+    match &id.gains {
+        Some(g) => {
+            let _ = writeln!(
+                s,
+                "controller at {:.6} Hz (fitted on {}):",
+                g.sample_rate_hz,
+                id.fitted_records.join(", ")
+            );
+            for (k, v) in [
+                ("K_p  displacement_gain_per_m", g.displacement_gain_per_m),
+                (
+                    "K_vf velocity_feedforward_s_per_m",
+                    g.velocity_feedforward_s_per_m,
+                ),
+                (
+                    "K_af acceleration_feedforward_s2_per_m",
+                    g.acceleration_feedforward_s2_per_m,
+                ),
+                (
+                    "K_vb velocity_feedback_s_per_m",
+                    g.velocity_feedback_s_per_m,
+                ),
+                (
+                    "K_ab acceleration_feedback_s2_per_m",
+                    g.acceleration_feedback_s2_per_m,
+                ),
+                ("K_dp delta_p_gain_per_pa", g.delta_p_gain_per_pa),
+                ("     delta_p_highpass_hz", g.delta_p_highpass_hz),
+            ] {
+                let _ = writeln!(s, "  {k:<40} {v:.6e}");
+            }
+            let _ = writeln!(s, "  saturated samples left out: {}", id.saturated_samples);
+        }
+        None => {
+            let _ = writeln!(s, "controller gains: not identified");
+        }
+    }
+    for r in &id.records {
+        let _ = writeln!(
+            s,
+            "{} {}: drive RMS error {:.3e} ({:.3} % of its RMS) over {} samples",
+            if r.fitted { "fitted  " } else { "held out" },
+            r.name,
+            r.drive_rms_error,
+            100.0 * r.drive_nrmse,
+            r.samples
+        );
+    }
+    if let Some(p) = plant {
+        if let Some(m) = &p.mechanics {
+            let _ = writeln!(
+                s,
+                "platen: mass {:.1} kg, stiffness {:.1} N/m, viscous {:.1} N·s/m, Coulomb \
+                 {:.1} N (force residual {:.3} % over {} samples)",
+                m.effective_mass_kg,
+                m.stiffness_n_per_m,
+                m.viscous_coefficient,
+                m.coulomb_force_n,
+                100.0 * m.force_nrmse,
+                m.samples
+            );
+        }
+        for (i, st) in p.storeys.iter().enumerate() {
+            let _ = writeln!(
+                s,
+                "storey {}: mass {:.1} kg, stiffness {:.4e} N/m, damping {:.1} N·s/m",
+                i + 1,
+                st.mass_kg,
+                st.stiffness_n_per_m,
+                st.damping_n_s_per_m
+            );
+        }
+        for (i, m) in p.specimen_modes.iter().enumerate() {
+            let _ = writeln!(
+                s,
+                "specimen mode {}: {:.4} Hz, damping {:.2} %",
+                i + 1,
+                m.frequency_hz,
+                100.0 * m.damping_ratio
+            );
+        }
+        if let Some(h) = &p.hydraulics {
+            let _ = writeln!(
+                s,
+                "valves: rated flow {:.5e} m³/s each, leakage {:.3e} m³/s/Pa, spool {} Hz ζ {} \
+                 delay {:.3e} s (equivalent lag {:.4e} s)",
+                h.rated_flow_m3_s,
+                h.leakage_m3_s_per_pa,
+                h.spool_natural_frequency_hz,
+                h.spool_damping_ratio,
+                h.valve_delay_s,
+                h.equivalent_lag_s
+            );
+            let _ = writeln!(
+                s,
+                "oil column: chambers {:.5e} / {:.5e} m³ at β {:.4e} Pa; {:.4} Hz bare, {:.4} \
+                 Hz with the specimen",
+                h.cap_volume_m3,
+                h.rod_volume_m3,
+                h.oil_bulk_modulus_pa,
+                h.oil_column_frequency_hz,
+                h.oil_column_frequency_with_specimen_hz
+            );
+        }
+        for pr in &p.predictions {
+            let _ = writeln!(
+                s,
+                "{} {}: the identified loop on its command: table acceleration RMS error \
+                 {:.4} m/s² of {:.4} (noise ≈ {:.4}), displacement {:.3e} m of {:.3e}",
+                if pr.fitted { "fitted  " } else { "held out" },
+                pr.name,
+                pr.acceleration_rms_error_m_s2,
+                pr.acceleration_rms_m_s2,
+                pr.acceleration_noise_m_s2,
+                pr.displacement_rms_error_m,
+                pr.displacement_rms_m
+            );
+        }
+    }
+    for (what, why) in &id.not_identified {
+        let _ = writeln!(s, "not identified: {what}: {why}");
+    }
+    let _ = writeln!(
+        s,
+        "scenario (with --json): {}",
+        if identified_system.is_some() {
+            "the identified model, table system and specimen"
+        } else {
+            "the lhpost-2008 preset with the identified controller"
+        }
+    );
+    s
 }

@@ -12,7 +12,7 @@ use anyhow::{bail, Context, Result};
 
 use platen_model::Preset;
 use platen_report::{model_text, system_figures, FigureSize};
-use platen_scenario::describe::{self, ModelDescription, SystemAnalysis, SystemParameters};
+use platen_scenario::describe::{self, ModelDescription, SystemAnalysis};
 use platen_system::TableSystem;
 
 use crate::Form;
@@ -135,10 +135,4 @@ fn system_preset(name: &str, stroke_m: f64) -> Result<TableSystem> {
         .validate(stroke_m)
         .with_context(|| format!("--system {name} over the stroke ±{stroke_m} m"))?;
     Ok(system)
-}
-
-/// The system's parameters as the scenario format's `table_system` object, every key explicit
-/// (the scenario `identify --system` prints).
-pub(crate) fn parameters(sys: &TableSystem) -> serde_json::Value {
-    serde_json::to_value(SystemParameters::from(sys)).unwrap_or_default()
 }
