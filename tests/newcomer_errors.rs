@@ -161,6 +161,10 @@ fn a_comma_list_written_with_spaces_shows_the_list_with_commas() {
             assert_eq!(v["error"]["kind"], "usage", "{e}");
         }
     }
+    // Where the option takes one value (simulate's --pressure-mpa), clap's own message.
+    let o = platen(&["simulate", &forward, "--pressure-mpa", "6.9", "13.8"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(!stderr(&o).contains("comma-separated"), "{}", stderr(&o));
     // Another unexpected argument keeps clap's own message.
     let o = platen(&["sweep", &forward, "--scale", "0.5", "fast"]);
     assert_eq!(o.status.code(), Some(2));

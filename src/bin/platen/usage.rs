@@ -50,13 +50,14 @@ impl clap::builder::TypedValueParser for OutFile {
     }
 }
 
-/// The options that take one comma-separated list of numbers (`--scale 0.5,1,1.5`).
-const COMMA_LISTS: [&str; 5] = [
-    "--scale",
-    "--pressure-mpa",
-    "--set",
-    "--window",
-    "--band-hz",
+/// The verbs' options that take one comma-separated list of numbers (`sweep --scale
+/// 0.5,1,1.5`); elsewhere `--pressure-mpa` takes one value.
+const COMMA_LISTS: [(&str, &str); 5] = [
+    ("sweep", "--scale"),
+    ("sweep", "--pressure-mpa"),
+    ("sweep", "--set"),
+    ("compare", "--window"),
+    ("plan", "--band-hz"),
 ];
 
 /// `e` restated when it is an "unexpected argument" that is the second value of a comma list
@@ -83,7 +84,8 @@ pub(crate) fn spaced_list(e: clap::Error) -> clap::Error {
         Some((name, value)) => (name, Some(value)),
         None => (args[at].as_str(), None),
     };
-    if !COMMA_LISTS.contains(&option) {
+    let verb = args.get(1).map_or("", String::as_str);
+    if !COMMA_LISTS.contains(&(verb, option)) {
         return e;
     }
     let number = |v: &&str| v.split(',').all(|x| x.trim().parse::<f64>().is_ok());
@@ -108,12 +110,8 @@ pub(crate) fn spaced_list(e: clap::Error) -> clap::Error {
         cmd = cmd.bin_name(name.to_string_lossy().into_owned());
     }
     cmd.build();
-    let verb = args[1..at]
-        .iter()
-        .find(|a| !a.starts_with('-'))
-        .and_then(|v| cmd.find_subcommand_mut(v))
-        .cloned();
-    let mut cmd = verb.unwrap_or(cmd);
+    let sub = cmd.find_subcommand_mut(verb).cloned();
+    let mut cmd = sub.unwrap_or(cmd);
     cmd.error(
         ErrorKind::UnknownArgument,
         format!(
