@@ -97,6 +97,42 @@ pub enum PlanError {
     },
 }
 
+impl PlanError {
+    /// The error as a file error when it is one, so that callers that report errors by file,
+    /// line and field (the CLI's exit codes and JSON error object) see it as such: a file that
+    /// cannot be read or written, a target sampled faster than the controller (a bad record,
+    /// [`IoError::Record`]) and a scenario without a `table_system` (a missing field,
+    /// [`IoError::InvalidField`]). Any other error is returned as it is.
+    pub fn into_io(self) -> std::result::Result<IoError, Self> {
+        match self {
+            PlanError::Io(io) => Ok(io),
+            PlanError::TargetRate {
+                origin,
+                rate_hz,
+                controller_hz,
+            } => Ok(IoError::Record {
+                path: origin,
+                message: format!(
+                    "sampled at {rate_hz} Hz, faster than the controller's {controller_hz} Hz: \
+                     the controller reads its command once a period, so the drive is at its \
+                     rate and cannot carry the target's content above {} Hz (resample the \
+                     target to at most {controller_hz} Hz)",
+                    0.5 * controller_hz
+                ),
+            }),
+            PlanError::NoTableSystem { scenario } => Ok(IoError::InvalidField {
+                path: scenario,
+                json_path: "table_system".to_owned(),
+                value: "(missing)".to_owned(),
+                expected: "the loop around the platen, {\"preset\": \"lhpost-2008\"} or an \
+                           explicit system: planning runs the closed loop"
+                    .to_owned(),
+            }),
+            other => Err(other),
+        }
+    }
+}
+
 /// `value` if it is finite and `ok`, else the setting's error.
 pub(crate) fn check_setting(
     name: &'static str,
@@ -112,5 +148,48 @@ pub(crate) fn check_setting(
             value,
             expected,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::{Path, PathBuf};
+
+    use platen_io::IoError;
+
+    use super::PlanError;
+
+    /// A fast target is a bad record of its file, a scenario without a loop a missing field;
+    /// other errors stay plan errors.
+    #[test]
+    fn file_errors_become_io_errors_and_the_others_stay() {
+        let fast = PlanError::TargetRate {
+            origin: PathBuf::from("t.csv"),
+            rate_hz: 2048.0,
+            controller_hz: 1024.0,
+        };
+        match fast.into_io() {
+            Ok(IoError::Record { path, message }) => {
+                assert_eq!(path, Path::new("t.csv"));
+                assert!(message.contains("above 512 Hz"), "{message}");
+            }
+            other => panic!("{other:?}"),
+        }
+        let bare = PlanError::NoTableSystem {
+            scenario: PathBuf::from("s.json"),
+        };
+        assert!(matches!(
+            bare.into_io(),
+            Ok(IoError::InvalidField { json_path, .. }) if json_path == "table_system"
+        ));
+        let setting = PlanError::Setting {
+            name: "gain",
+            value: 3.0,
+            expected: "(0, 2)",
+        };
+        assert!(matches!(
+            setting.into_io(),
+            Err(PlanError::Setting { name: "gain", .. })
+        ));
     }
 }

@@ -12,7 +12,6 @@ use anyhow::Result;
 use clap::ValueEnum;
 
 use platen_io::csv::CsvWriter;
-use platen_io::IoError;
 use platen_plan::{
     load_scenario, plan_observed, FrfSource, MaxScaleSettings, NoiseSettings, PlanError,
     PlanSettings, Target,
@@ -127,37 +126,13 @@ fn parse_band(s: &str) -> std::result::Result<(f64, f64), String> {
 /// The error of the plan, unwrapped so that the exit code and the JSON error object see the
 /// file and line errors it holds (as for every verb).
 fn cli_error(e: PlanError) -> anyhow::Error {
-    match e {
-        PlanError::Scenario(se) => se.into(),
-        PlanError::Io(io) => io.into(),
-        PlanError::Run { what, source } => {
+    match e.into_io() {
+        Ok(io) => io.into(),
+        Err(PlanError::Scenario(se)) => se.into(),
+        Err(PlanError::Run { what, source }) => {
             anyhow::Error::new(source).context(format!("the closed-loop run of {what} failed"))
         }
-        PlanError::TargetRate {
-            origin,
-            rate_hz,
-            controller_hz,
-        } => IoError::Record {
-            path: origin,
-            message: format!(
-                "sampled at {rate_hz} Hz, faster than the controller's {controller_hz} Hz: the \
-                 controller reads its command once a period, so the drive is at its rate and \
-                 cannot carry the target's content above {} Hz (resample the target to at most \
-                 {controller_hz} Hz)",
-                0.5 * controller_hz
-            ),
-        }
-        .into(),
-        PlanError::NoTableSystem { scenario } => IoError::InvalidField {
-            path: scenario,
-            json_path: "table_system".to_owned(),
-            value: "(missing)".to_owned(),
-            expected: "the loop around the platen, {\"preset\": \"lhpost-2008\"} or an explicit \
-                       system: planning runs the closed loop"
-                .to_owned(),
-        }
-        .into(),
-        other => other.into(),
+        Err(other) => other.into(),
     }
 }
 
