@@ -1,7 +1,7 @@
 """How much a Python call costs over the Rust integrator: platen.forward on the standard
 workload of `platen bench` against the integration time `platen bench` reports for it.
 
-The workload (src/bin/platen/bench.rs): a 100 kN, 0.5 Hz sine force sampled at
+The workload (platen::bench, src/bench.rs): a 100 kN, 0.5 Hz sine force sampled at
 1024 Hz for 600 s (614 401 samples), the lhpost-2008 identified model at 13.8 MPa, RK4 at
 1/1024 s from rest, every output sample kept in memory. `platen bench --json` times that
 run in Rust (`rk4_ns_per_step`, median of its round-robin runs); this script times

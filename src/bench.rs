@@ -849,7 +849,7 @@ mod tests {
         assert_eq!(stats.stick_events, 0);
     }
 
-    /// The baseline (`benches/common/baseline.rs`) computes the model it claims to: under a
+    /// The baseline ([`baseline`]) computes the model it claims to: under a
     /// force well above the friction threshold the platen slips in one direction
     /// from the first step, so the plain loop (no stick logic) and the exact integrator take
     /// the same path.

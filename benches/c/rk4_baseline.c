@@ -2,7 +2,7 @@
  * The plain-loop RK4 baseline in C: an independent check of the limit that `platen bench`
  * and `cargo bench --bench rk4_throughput` compare the Rust integrator with.
  *
- * Same loop as crates/platen-integrate/src/baseline.rs: classical RK4 on the identified
+ * Same loop as src/bench/baseline.rs (platen::bench::baseline): classical RK4 on the identified
  * LHPOST model at 13.8 MPa (Eq. 22/23: Me = 144 t, Ke = 1.266 MN/m, Fmu = 0.44 % x 5783 kN,
  * Ce = 44.58 kN/(m/s)^0.5 with alpha = 0.5 as a square root, a = 12.04 kN, b = 78.5 s/m),
  * one exp per stage, copysign friction, force linearly interpolated, no stick logic, no
