@@ -157,7 +157,7 @@ pub fn plan(
 
 /// [`plan`], calling `on_run(k)` when the closed-loop run of drive iteration `k` is done (0:
 /// the target's own command; at most `settings.iteration.max_iterations`): a hook for
-/// progress reports ([`iterate_observed`](crate::iterate::iterate_observed)).
+/// progress reports ([`iterate_observed`]).
 ///
 /// # Errors
 /// As [`plan`].
