@@ -10,7 +10,7 @@
 //! significant digit ([`plus_minus`]).
 
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use platen_ident::anyrecord::summary::{record_entries, RecordInfoSummary, RecordSummary};
 use platen_ident::anyrecord::ChannelDelay;
@@ -1068,5 +1068,38 @@ pub fn system_text(id: &SystemIdentification) -> String {
             "the lhpost-2008 preset with the identified controller"
         }
     );
+    s
+}
+
+/// What `platen identify --system --json` prints: the identification, the scenario it makes
+/// runnable ([`system_scenario`]) and what that scenario takes from the preset, every map's
+/// keys sorted.
+pub fn system_json(
+    id: &SystemIdentification,
+    held: &SystemRecord,
+    held_path: &Path,
+    columns: &ColumnMap,
+    base_stroke: Option<f64>,
+) -> serde_json::Value {
+    let s = system_scenario(id, held, held_path, columns, base_stroke);
+    serde_json::json!({
+        "system_identification": id,
+        "scenario": s.scenario,
+        "scenario_from_preset": s.from_preset,
+    })
+}
+
+/// The lines naming the files written: the figures (absent when none) and the HTML report.
+pub fn written_text(figures: &[PathBuf], report: Option<&Path>) -> String {
+    let mut s = String::new();
+    if !figures.is_empty() {
+        let _ = writeln!(s, "\nWrote {} figure files (SVG and PNG):", figures.len());
+        for path in figures {
+            let _ = writeln!(s, "  {}", path.display());
+        }
+    }
+    if let Some(path) = report {
+        let _ = writeln!(s, "Wrote report {}", path.display());
+    }
     s
 }

@@ -24,7 +24,7 @@ use platen_ident::inputs::{
 };
 use platen_ident::{identify_any, IdentifyOutput, MethodRequest, RecordSettings, Settings};
 use platen_io::columns::ColumnMap;
-use platen_report::identify_report::{system_scenario, system_text, IdentifyReport};
+use platen_report::identify_report::{system_json, system_text, written_text, IdentifyReport};
 
 /// Options of `platen identify`.
 pub struct Options<'a> {
@@ -165,16 +165,7 @@ pub fn run(opts: &Options) -> Result<()> {
         }
         .print()
     } else {
-        out!("{}", report.text());
-        if !written.is_empty() {
-            outln!("\nWrote {} figure files (SVG and PNG):", written.len());
-            for path in &written {
-                outln!("  {}", path.display());
-            }
-        }
-        if let Some(path) = opts.report {
-            outln!("Wrote report {}", path.display());
-        }
+        out!("{}{}", report.text(), written_text(&written, opts.report));
         Ok(())
     }
 }
@@ -272,12 +263,7 @@ pub fn run_system(
     if json {
         let held_path =
             std::fs::canonicalize(&files[n - 1]).unwrap_or_else(|_| files[n - 1].clone());
-        let s = system_scenario(&id, &records[n - 1], &held_path, &map, base_stroke);
-        let value = serde_json::json!({
-            "system_identification": id,
-            "scenario": s.scenario,
-            "scenario_from_preset": s.from_preset,
-        });
+        let value = system_json(&id, &records[n - 1], &held_path, &map, base_stroke);
         outln!("{}", serde_json::to_string_pretty(&value)?);
     } else {
         outln!("{}", system_text(&id).trim_end());
