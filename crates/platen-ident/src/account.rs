@@ -8,11 +8,12 @@ use serde::Serialize;
 
 use crate::anyrecord::result::{RecordIdentification, RecordWarning};
 use crate::anyrecord::settings::ValidRecordSettings;
-use crate::anyrecord::summary::{record_entries, RecordInfoSummary, RecordSummary};
+use crate::anyrecord::summary::{RecordInfoSummary, RecordSummary};
 use crate::cycle::{self, RatePlan};
 use crate::error::{IdentError, Result};
 use crate::record::TestRecord;
 use crate::result::Identification;
+pub use crate::route::RecordAccount;
 use crate::route::{route, Method, Route};
 use crate::settings::ValidSettings;
 use crate::summary::IdentificationSummary;
@@ -31,28 +32,6 @@ pub enum MethodRequest {
     Record,
     /// Periodic records through both methods, every record through the any-record method.
     Both,
-}
-
-/// What identification did with one record.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct RecordAccount {
-    /// `"periodic"` or `"record"`: the method that identified it (with
-    /// [`MethodRequest::Both`], a periodic record's is `"periodic"`; it enters the
-    /// any-record fit too).
-    #[serde(serialize_with = "method_name")]
-    pub method: Method,
-    /// Whether it entered the identification.
-    pub used: bool,
-    /// Why it was not used (absent when used).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub reason: Option<String>,
-    /// Why it went to its method: the periodic test's fundamental, why it is not a periodic
-    /// test, or why the periodic method rejected it.
-    pub routing: String,
-}
-
-fn method_name<S: serde::Serializer>(m: &Method, s: S) -> std::result::Result<S::Ok, S::Error> {
-    s.serialize_str(m.name())
 }
 
 /// The result of [`identify_any`].
@@ -256,7 +235,7 @@ impl Identified {
         files: &[String],
         request: MethodRequest,
     ) -> IdentifyOutput {
-        let entries = record_entries(self, records, files);
+        let entries = self.record_entries(records, files);
         let subset =
             |idx: &[usize]| -> Vec<String> { idx.iter().map(|&k| files[k].clone()).collect() };
         let periodic = self
@@ -288,5 +267,45 @@ impl Identified {
                 records: entries,
             },
         }
+    }
+}
+
+impl Identified {
+    /// Every input record, in input order, with its account ([`identify_any`]): the
+    /// any-record method's entries carry its per-record figures too. `files[k]` is where
+    /// `records[k]` was read from.
+    pub fn record_entries(
+        &self,
+        records: &[TestRecord],
+        files: &[String],
+    ) -> Vec<RecordInfoSummary> {
+        let id = self;
+        let mut fitted: Vec<Option<RecordInfoSummary>> = vec![None; records.len()];
+        if let Some((rid, idx)) = &id.records {
+            let sub_files: Vec<String> = idx.iter().map(|&k| files[k].clone()).collect();
+            for (entry, &k) in RecordSummary::new(rid, &sub_files)
+                .records
+                .into_iter()
+                .zip(idx)
+            {
+                fitted[k] = Some(entry);
+            }
+        }
+        fitted
+            .into_iter()
+            .enumerate()
+            .map(|(k, entry)| {
+                let account = &id.accounts[k];
+                match entry {
+                    // A periodic record that also entered the any-record fit (`both`) keeps the
+                    // any-record figures under its periodic account.
+                    Some(mut e) => {
+                        e.account = Some(account.clone());
+                        e
+                    }
+                    None => RecordInfoSummary::accounted_only(&records[k], &files[k], account),
+                }
+            })
+            .collect()
     }
 }

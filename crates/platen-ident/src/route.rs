@@ -1,6 +1,8 @@
 //! Which method identifies a record: periodic tests go to the paper's hysteresis-loop method,
 //! any other record to the any-record method.
 
+use serde::Serialize;
+
 use crate::error::IdentError;
 use crate::record::TestRecord;
 
@@ -91,4 +93,26 @@ mod tests {
         let r = route(&record(chirp));
         assert_eq!(r.method(), Method::Record, "{r:?}");
     }
+}
+
+/// What identification did with one record.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RecordAccount {
+    /// `"periodic"` or `"record"`: the method that identified it (with
+    /// [`crate::MethodRequest::Both`], a periodic record's is `"periodic"`; it enters the
+    /// any-record fit too).
+    #[serde(serialize_with = "method_name")]
+    pub method: Method,
+    /// Whether it entered the identification.
+    pub used: bool,
+    /// Why it was not used (absent when used).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+    /// Why it went to its method: the periodic test's fundamental, why it is not a periodic
+    /// test, or why the periodic method rejected it.
+    pub routing: String,
+}
+
+fn method_name<S: serde::Serializer>(m: &Method, s: S) -> std::result::Result<S::Ok, S::Error> {
+    s.serialize_str(m.name())
 }

@@ -12,7 +12,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use platen_ident::anyrecord::summary::{record_entries, RecordInfoSummary, RecordSummary};
+use platen_ident::anyrecord::summary::{RecordInfoSummary, RecordSummary};
 use platen_ident::anyrecord::ChannelDelay;
 use platen_ident::{
     Correlations, Estimate, Flag, Identification, IdentificationSummary, Identified, IdentifiedKey,
@@ -108,11 +108,8 @@ impl IdentifyReport<'_> {
     }
 
     fn entries(&self) -> Vec<RecordInfoSummary> {
-        record_entries(
-            self.identified,
-            self.records,
-            &platen_ident::inputs::files(self.sources),
-        )
+        self.identified
+            .record_entries(self.records, &platen_ident::inputs::files(self.sources))
     }
 
     fn subset(&self, idx: &[usize]) -> Vec<&RecordSource> {

@@ -6,9 +6,9 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use crate::account::{Identified, RecordAccount};
 use crate::record::TestRecord;
 use crate::result::ParameterEstimates;
+use crate::route::RecordAccount;
 use crate::summary::{EstimateSummary, ParameterSummary};
 
 use super::result::{
@@ -282,7 +282,7 @@ impl RecordInfoSummary {
 impl RecordInfoSummary {
     /// A record the any-record method did not fit (a periodic test, or one it could not
     /// use): its file, name, rate and account.
-    fn accounted_only(rec: &TestRecord, file: &str, account: &RecordAccount) -> Self {
+    pub(crate) fn accounted_only(rec: &TestRecord, file: &str, account: &RecordAccount) -> Self {
         Self {
             file: file.to_owned(),
             name: rec.name().to_owned(),
@@ -303,41 +303,4 @@ impl RecordInfoSummary {
             ),
         }
     }
-}
-
-/// Every input record, in input order, with its account ([`crate::identify_any`]): the
-/// any-record method's entries carry its per-record figures too. `files[k]` is where
-/// `records[k]` was read from.
-pub fn record_entries(
-    id: &Identified,
-    records: &[TestRecord],
-    files: &[String],
-) -> Vec<RecordInfoSummary> {
-    let mut fitted: Vec<Option<RecordInfoSummary>> = vec![None; records.len()];
-    if let Some((rid, idx)) = &id.records {
-        let sub_files: Vec<String> = idx.iter().map(|&k| files[k].clone()).collect();
-        for (entry, &k) in RecordSummary::new(rid, &sub_files)
-            .records
-            .into_iter()
-            .zip(idx)
-        {
-            fitted[k] = Some(entry);
-        }
-    }
-    fitted
-        .into_iter()
-        .enumerate()
-        .map(|(k, entry)| {
-            let account = &id.accounts[k];
-            match entry {
-                // A periodic record that also entered the any-record fit (`both`) keeps the
-                // any-record figures under its periodic account.
-                Some(mut e) => {
-                    e.account = Some(account.clone());
-                    e
-                }
-                None => RecordInfoSummary::accounted_only(&records[k], &files[k], account),
-            }
-        })
-        .collect()
 }
