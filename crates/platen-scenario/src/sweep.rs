@@ -8,11 +8,13 @@
 //! ([`forward_rk4_ensemble`]: the cases in SIMD lanes, bit for bit the scalar runs), so the
 //! results, and the output's bytes, are those of one scalar run per case.
 
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
 use rayon::prelude::*;
-use serde_json::{json, Map, Value};
+use serde::Serialize;
+use serde_json::Value;
 
 use platen_integrate::{
     forward_rk4_ensemble, EnsembleCase, IntegrateError, Method, Peaks, Rk4, RunStats,
@@ -22,6 +24,7 @@ use platen_io::csv::write_number;
 use platen_model::ModelError;
 
 use crate::scenario::{Model, ModelKey, Run, Scenario};
+use crate::summary::ExceedanceSummary;
 
 /// One parameter axis: `FORM.KEY` and its values.
 #[derive(Debug, Clone, PartialEq)]
@@ -374,7 +377,146 @@ pub fn csv_text(
     text
 }
 
-/// The `--json` summary of a sweep: the scenario, counts, and one object per case.
+/// The `--json` summary of a sweep ([`json_summary`]): the scenario, counts, and one row per
+/// case. Serialised by serde; the JSON object's keys print sorted, as every `--json` of the
+/// CLI does.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SweepSummary {
+    /// The scenario file, as given.
+    pub scenario: String,
+    /// The scenario's `name`.
+    pub name: String,
+    /// `"forward"` or `"inverse"`.
+    pub direction: &'static str,
+    /// `"identified"` or `"full"`.
+    pub model_form: &'static str,
+    /// The model preset's name.
+    pub preset: &'static str,
+    /// How many cases ran.
+    pub cases: usize,
+    /// How many failed numerically.
+    pub failed: usize,
+    /// How many ran and exceeded at least one of the table's limits.
+    pub exceeding_a_limit: usize,
+    /// The CSV written, if any.
+    pub out: Option<String>,
+    /// One row per case, in case order.
+    pub results: Vec<CaseSummary>,
+}
+
+/// One case's row of a [`SweepSummary`]: its axes, status, and (when it ran) its peaks with
+/// their times, stick time, events and the limits it exceeds.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CaseSummary {
+    /// The case's index (input order).
+    pub case: usize,
+    /// The excitation scale.
+    pub scale: f64,
+    /// The hold-down pressure, MPa.
+    pub hold_down_pressure_mpa: f64,
+    /// The `--set` values, by key.
+    pub set: BTreeMap<String, f64>,
+    /// `"ok"` or `"failed: …"`.
+    pub status: String,
+    /// The peaks, stick time, events and exceedances (absent for a failed case).
+    #[serde(flatten)]
+    pub run: Option<CaseRun>,
+}
+
+/// What a case that ran reports ([`CaseSummary::run`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CaseRun {
+    /// Peak |u|, m (signed), and its time.
+    pub peak_u_m: f64,
+    /// When `peak_u_m` occurred, s.
+    pub peak_u_m_t_s: f64,
+    /// Peak velocity, m/s (signed).
+    pub peak_v_m_s: f64,
+    /// When `peak_v_m_s` occurred, s.
+    pub peak_v_m_s_t_s: f64,
+    /// Peak acceleration, m/s² (signed).
+    pub peak_a_m_s2: f64,
+    /// When `peak_a_m_s2` occurred, s.
+    pub peak_a_m_s2_t_s: f64,
+    /// Peak actuator force, N (signed).
+    pub peak_force_n: f64,
+    /// When `peak_force_n` occurred, s.
+    pub peak_force_n_t_s: f64,
+    /// Time spent in stick, s (absent from runs without statistics: `null`).
+    pub stick_time_s: Option<f64>,
+    /// Events located (`null` as `stick_time_s`).
+    pub events: Option<u64>,
+    /// The table's limits the case exceeds.
+    pub limit_exceedances: Vec<ExceedanceSummary>,
+}
+
+impl SweepSummary {
+    /// The summary of `outs`, the outcomes of `cases` over `scenario` (read from `path`),
+    /// `set_names` naming the `--set` axes and `out` the CSV written.
+    pub fn new(
+        path: &Path,
+        scenario: &Scenario,
+        set_names: &[String],
+        cases: &[Case],
+        outs: &[Outcome],
+        out: Option<&Path>,
+    ) -> Self {
+        let results = cases
+            .iter()
+            .zip(outs)
+            .enumerate()
+            .map(|(i, (case, o))| CaseSummary {
+                case: i,
+                scale: case.scale,
+                hold_down_pressure_mpa: case.pressure_mpa,
+                set: set_names
+                    .iter()
+                    .cloned()
+                    .zip(case.sets.iter().copied())
+                    .collect(),
+                status: status(o),
+                run: o.error.is_none().then(|| CaseRun {
+                    peak_u_m: o.peaks.u_m.value,
+                    peak_u_m_t_s: o.peaks.u_m.t_s,
+                    peak_v_m_s: o.peaks.v_m_s.value,
+                    peak_v_m_s_t_s: o.peaks.v_m_s.t_s,
+                    peak_a_m_s2: o.peaks.a_m_s2.value,
+                    peak_a_m_s2_t_s: o.peaks.a_m_s2.t_s,
+                    peak_force_n: o.peaks.force_n.value,
+                    peak_force_n_t_s: o.peaks.force_n.t_s,
+                    stick_time_s: o.stats.map(|s| s.stick_time_s),
+                    events: o.stats.map(|s| s.events()),
+                    limit_exceedances: o
+                        .peaks
+                        .exceedances(&scenario.limits)
+                        .iter()
+                        .map(ExceedanceSummary::from)
+                        .collect(),
+                }),
+            })
+            .collect();
+        SweepSummary {
+            scenario: path.display().to_string(),
+            name: scenario.name.clone(),
+            direction: match scenario.run {
+                Run::Forward { .. } => "forward",
+                Run::Inverse { .. } => "inverse",
+            },
+            model_form: scenario.model.form(),
+            preset: scenario.preset.name(),
+            cases: cases.len(),
+            failed: outs.iter().filter(|o| o.error.is_some()).count(),
+            exceeding_a_limit: outs
+                .iter()
+                .filter(|o| o.error.is_none() && !o.peaks.exceedances(&scenario.limits).is_empty())
+                .count(),
+            out: out.map(|p| p.display().to_string()),
+            results,
+        }
+    }
+}
+
+/// The `--json` summary of a sweep as a JSON value ([`SweepSummary`]).
 pub fn json_summary(
     path: &Path,
     scenario: &Scenario,
@@ -383,62 +525,8 @@ pub fn json_summary(
     outs: &[Outcome],
     out: Option<&Path>,
 ) -> Value {
-    let rows: Vec<Value> = cases
-        .iter()
-        .zip(outs)
-        .enumerate()
-        .map(|(i, (case, o))| {
-            let mut m = Map::new();
-            m.insert("case".into(), json!(i));
-            m.insert("scale".into(), json!(case.scale));
-            m.insert("hold_down_pressure_mpa".into(), json!(case.pressure_mpa));
-            let set: Map<String, Value> = set_names
-                .iter()
-                .zip(&case.sets)
-                .map(|(n, v)| (n.clone(), json!(v)))
-                .collect();
-            m.insert("set".into(), Value::Object(set));
-            m.insert("status".into(), json!(status(o)));
-            if o.error.is_some() {
-                return Value::Object(m);
-            }
-            for (key, peak) in [
-                ("peak_u_m", o.peaks.u_m),
-                ("peak_v_m_s", o.peaks.v_m_s),
-                ("peak_a_m_s2", o.peaks.a_m_s2),
-                ("peak_force_n", o.peaks.force_n),
-            ] {
-                m.insert(key.into(), json!(peak.value));
-                m.insert(format!("{key}_t_s"), json!(peak.t_s));
-            }
-            m.insert(
-                "stick_time_s".into(),
-                json!(o.stats.map(|s| s.stick_time_s)),
-            );
-            m.insert("events".into(), json!(o.stats.map(|s| s.events())));
-            let exceed: Vec<Value> = o
-                .peaks
-                .exceedances(&scenario.limits)
-                .iter()
-                .map(|e| json!({"quantity": e.quantity, "peak": e.peak, "limit": e.limit, "t_s": e.t_s}))
-                .collect();
-            m.insert("limit_exceedances".into(), Value::Array(exceed));
-            Value::Object(m)
-        })
-        .collect();
-    json!({
-        "scenario": path.display().to_string(),
-        "name": scenario.name,
-        "direction": match scenario.run { Run::Forward { .. } => "forward", Run::Inverse { .. } => "inverse" },
-        "model_form": scenario.model.form(),
-        "preset": scenario.preset.name(),
-        "cases": cases.len(),
-        "failed": outs.iter().filter(|o| o.error.is_some()).count(),
-        "exceeding_a_limit": outs
-            .iter()
-            .filter(|o| o.error.is_none() && !o.peaks.exceedances(&scenario.limits).is_empty())
-            .count(),
-        "out": out.map(|p| p.display().to_string()),
-        "results": rows,
-    })
+    serde_json::to_value(SweepSummary::new(
+        path, scenario, set_names, cases, outs, out,
+    ))
+    .expect("a sweep summary is plain data (strings, finite or null numbers)")
 }
