@@ -17,12 +17,38 @@
 //!   the name of a CSV column, else null (a JSON syntax error has no field);
 //! - `line`: the 1-based line of a CSV file or of a JSON syntax error, else null.
 
-use serde_json::{json, Value};
+use std::fmt;
+
+use serde::Serialize;
 
 use platen_compare::CompareError;
 use platen_io::IoError;
 use platen_report::ReportError;
 use platen_scenario::ScenarioError;
+
+/// The object printed: `{"error": {…}}`.
+#[derive(Serialize)]
+pub(crate) struct ErrorObject {
+    error: ErrorDetail,
+}
+
+/// The error's fields, declared in the order they print (sorted, as every `--json` object).
+#[derive(Serialize)]
+struct ErrorDetail {
+    exit_code: u8,
+    field: Option<String>,
+    file: Option<String>,
+    kind: &'static str,
+    line: Option<u64>,
+    message: String,
+}
+
+impl fmt::Display for ErrorObject {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let text = serde_json::to_string(self).map_err(|_| fmt::Error)?;
+        f.write_str(&text)
+    }
+}
 
 /// The `kind` of an exit code.
 fn kind(code: u8) -> &'static str {
@@ -35,19 +61,21 @@ fn kind(code: u8) -> &'static str {
 }
 
 /// The error object of a usage error (the command line itself), exit code 2.
-pub(crate) fn usage(message: &str) -> Value {
-    json!({"error": {
-        "kind": kind(2),
-        "exit_code": 2,
-        "message": message,
-        "file": null,
-        "field": null,
-        "line": null,
-    }})
+pub(crate) fn usage(message: &str) -> ErrorObject {
+    ErrorObject {
+        error: ErrorDetail {
+            exit_code: 2,
+            field: None,
+            file: None,
+            kind: kind(2),
+            line: None,
+            message: message.to_owned(),
+        },
+    }
 }
 
 /// The error object of `e`, which exits with `code`.
-pub(crate) fn object(e: &anyhow::Error, code: u8) -> Value {
+pub(crate) fn object(e: &anyhow::Error, code: u8) -> ErrorObject {
     let (file, field, line) = match io_error(e) {
         Some(io) => (
             Some(io.file().display().to_string()),
@@ -56,14 +84,16 @@ pub(crate) fn object(e: &anyhow::Error, code: u8) -> Value {
         ),
         None => (scenario_file(e), None, None),
     };
-    json!({"error": {
-        "kind": kind(code),
-        "exit_code": code,
-        "message": format!("{e:#}"),
-        "file": file,
-        "field": field,
-        "line": line,
-    }})
+    ErrorObject {
+        error: ErrorDetail {
+            exit_code: code,
+            field,
+            file,
+            kind: kind(code),
+            line,
+            message: format!("{e:#}"),
+        },
+    }
 }
 
 /// The file I/O error in `e`'s chain, looking through the transparent wrappers that hide it
