@@ -1100,3 +1100,73 @@ pub fn written_text(figures: &[PathBuf], report: Option<&Path>) -> String {
     }
     s
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use platen_ident::inputs::{read_records, RecordRequest};
+    use platen_ident::{identify_any, MethodRequest, RecordSettings, Settings};
+
+    /// Two of the paper's tests at 13.8 MPa, made in memory from their scenarios through a
+    /// manifest that names them.
+    fn paper_pair() -> (Vec<RecordSource>, Vec<TestRecord>, Identified) {
+        let root =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/paper-tests/13.8MPa");
+        let dir =
+            std::env::temp_dir().join(format!("platen-report-identify-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let manifest = dir.join("m.json");
+        let entry = |name: &str, seed: u64| serde_json::json!({"scenario": root.join(format!("{name}.json")), "seed": seed, "name": name});
+        let tests = serde_json::json!({"tests": [entry("S9", 9), entry("T4", 16)]});
+        std::fs::write(&manifest, tests.to_string()).unwrap();
+        let inputs = read_records(&RecordRequest {
+            manifest: Some(manifest),
+            ..RecordRequest::default()
+        })
+        .unwrap();
+        let id = identify_any(
+            &inputs.records,
+            &inputs.declared_record(),
+            MethodRequest::Auto,
+            &Settings::default().build().unwrap(),
+            &RecordSettings::default().build().unwrap(),
+        )
+        .unwrap();
+        (inputs.sources, inputs.records, id)
+    }
+
+    #[test]
+    fn the_text_and_page_name_every_record_by_its_label() {
+        let (sources, records, id) = paper_pair();
+        let report = IdentifyReport {
+            identified: &id,
+            sources: &sources,
+            records: &records,
+        };
+        assert!(report.unused().is_empty());
+        let text = report.text();
+        assert!(text.starts_with(
+            "Identified parameters (2 tests; reference hold-down pressure 13.8 MPa; ± one standard error)\n"
+        ));
+        let accounts = &text[text.find("\nRecords (every file accounted for)\n").unwrap()..];
+        assert_eq!(accounts.lines().count(), 4, "{accounts}");
+        assert!(accounts.contains("\n  S9  periodic  used; "));
+        assert!(accounts.contains("\n  T4  periodic  used; "));
+        // The sine's mass row and the triangle's stiffness row, each under its own label.
+        assert!(text.contains("\n  S9    13.8 "));
+        assert!(text.contains("\n  T4    13.8 "));
+        let page = report.html(&[], &[]);
+        assert!(page.contains("<h2>Records</h2>"));
+        assert!(page.contains("S9, T4"), "the files item lists the names");
+    }
+
+    #[test]
+    fn written_files_are_listed_after_the_report() {
+        assert_eq!(written_text(&[], None), "");
+        let figures = [PathBuf::from("f/a.svg"), PathBuf::from("f/a.png")];
+        assert_eq!(
+            written_text(&figures, Some(Path::new("r.html"))),
+            "\nWrote 2 figure files (SVG and PNG):\n  f/a.svg\n  f/a.png\nWrote report r.html\n"
+        );
+    }
+}
