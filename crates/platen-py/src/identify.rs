@@ -26,6 +26,7 @@ fn input_fail(e: InputError) -> Fail {
 /// --json`.
 #[pyfunction]
 #[pyo3(signature = (files, pressures_mpa, columns_path, columns_text, viscous_exponent, low_velocity_term, manifest=None))]
+#[allow(clippy::too_many_arguments)]
 pub fn identify(
     py: Python<'_>,
     files: Vec<PathBuf>,
