@@ -106,7 +106,10 @@ pub fn run(opts: &Options) -> Result<()> {
     let progress = progress_bar(sources.len());
     let mut records = Vec::with_capacity(sources.len());
     for source in &sources {
-        records.push(source.read().map_err(input_error)?);
+        records.push(source.read().map_err(|e| {
+            progress.finish_and_clear();
+            input_error(e)
+        })?);
         progress.inc(1);
     }
     let settings = Settings {
