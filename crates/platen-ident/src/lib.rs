@@ -200,8 +200,8 @@ pub use dissipative::{LOW_SPEED_M_S, MIN_SPEED_SPREAD};
 pub use error::{IdentError, Result};
 pub use estimate::{student_t_975, Estimate, Parameter};
 pub use identify::identify;
-pub use inputs::{read_records, InputError, RecordInputs, RecordRequest, RecordSource};
 pub use inertial::{MAX_MASS_RELATIVE_STD_ERROR, MIN_INERTIAL_TO_DISSIPATIVE};
+pub use inputs::{read_records, InputError, RecordInputs, RecordRequest, RecordSource};
 pub use platen_model::{DissipativeLaw, IdentifiedKey};
 pub use record::{Floors, TestKind, TestRecord, MIN_SAMPLES};
 pub use result::{
