@@ -3,6 +3,11 @@
 
 use crate::error::{IntegrateError, Result};
 
+// The column checks a [`platen_signal::Motion`] passes; their errors convert into this
+// crate's variants (`TooShort`, `NonFiniteInput`, `TimeNotIncreasing`, `LengthMismatch`) with
+// the same messages.
+use platen_signal::{check_len, check_times};
+
 /// Largest deviation of a time stamp from the record's fitted sampling grid, as a fraction of
 /// the fitted interval: 10 %.
 ///
@@ -63,48 +68,6 @@ impl SamplingGrid {
         }
         Ok(k as u32)
     }
-}
-
-fn check_finite(what: &'static str, values: &[f64]) -> Result<()> {
-    match values.iter().position(|x| !x.is_finite()) {
-        Some(index) => Err(IntegrateError::NonFiniteInput {
-            what,
-            index,
-            value: values[index],
-        }),
-        None => Ok(()),
-    }
-}
-
-fn check_times(t_s: &[f64], needed: usize) -> Result<()> {
-    if t_s.len() < needed {
-        return Err(IntegrateError::TooShort {
-            found: t_s.len(),
-            needed,
-        });
-    }
-    check_finite("t_s", t_s)?;
-    for i in 1..t_s.len() {
-        if t_s[i] <= t_s[i - 1] {
-            return Err(IntegrateError::TimeNotIncreasing {
-                index: i,
-                previous_s: t_s[i - 1],
-                value_s: t_s[i],
-            });
-        }
-    }
-    Ok(())
-}
-
-fn check_len(what: &'static str, column: &[f64], expected: usize) -> Result<()> {
-    if column.len() != expected {
-        return Err(IntegrateError::LengthMismatch {
-            what,
-            found: column.len(),
-            expected,
-        });
-    }
-    check_finite(what, column)
 }
 
 /// The sample interval of a uniformly sampled, strictly increasing time column: the interval

@@ -114,7 +114,7 @@ pub use delay::{
 };
 pub use error::{Result, SignalError};
 pub use fir::{FirLowpass, MAX_FIR_ORDER};
-pub use motion::{derivative, second_derivative, Motion};
+pub use motion::{check_len, check_times, derivative, second_derivative, Motion};
 pub use resample::{Interpolation, Resampler};
 pub use response_spectrum::{ResponseSpectrum, SdofOscillator};
 pub use spectral::{trim_to_whole_periods, whole_periods, SpectralLowpass, WholePeriods};

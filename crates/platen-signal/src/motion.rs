@@ -156,7 +156,14 @@ pub(crate) fn check_finite(what: &'static str, values: &[f64]) -> Result<()> {
     }
 }
 
-fn check_times(t_s: &[f64], needed: usize) -> Result<()> {
+/// Checks a time column: at least `needed` samples, finite, strictly increasing. A
+/// [`Motion`]'s times pass it; a record of another kind (a force record) checks its times
+/// the same way.
+///
+/// # Errors
+/// [`SignalError::TooFewSamples`], [`SignalError::NonFiniteInput`] naming `t_s` and the
+/// index, [`SignalError::TimeNotIncreasing`].
+pub fn check_times(t_s: &[f64], needed: usize) -> Result<()> {
     if t_s.len() < needed {
         return Err(SignalError::TooFewSamples {
             found: t_s.len(),
@@ -176,7 +183,12 @@ fn check_times(t_s: &[f64], needed: usize) -> Result<()> {
     Ok(())
 }
 
-fn check_len(what: &'static str, column: &[f64], expected: usize) -> Result<()> {
+/// Checks a data column `what` against its time column's length `expected`: the same length,
+/// every value finite.
+///
+/// # Errors
+/// [`SignalError::ColumnLengthMismatch`], [`SignalError::NonFiniteInput`] naming `what`.
+pub fn check_len(what: &'static str, column: &[f64], expected: usize) -> Result<()> {
     if column.len() != expected {
         return Err(SignalError::ColumnLengthMismatch {
             what,
