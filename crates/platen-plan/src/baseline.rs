@@ -214,20 +214,22 @@ fn acceleration_motion(
     rate_hz: f64,
 ) -> Result<TargetMotion> {
     let fs = target.sample_rate_hz();
-    let mut k = AccelerogramMotion::new(fs, rate_hz, settings.pre)?.process(target.values())?;
+    let n = t_s.len();
+    let (_, mut u, mut v, mut a) = AccelerogramMotion::new(fs, rate_hz, settings.pre)?
+        .process(target.values())?
+        .truncated(n)?
+        .into_columns();
     // The target's straight lines at the drive's samples, before any correction: what the
     // treatment's correction is measured against.
-    let mut raw = if settings.pre == Baseline::None {
-        k.a_m_s2.clone()
+    let raw = if settings.pre == Baseline::None {
+        a.clone()
     } else {
-        AccelerogramMotion::new(fs, rate_hz, Baseline::None)?
+        let (_, _, _, raw) = AccelerogramMotion::new(fs, rate_hz, Baseline::None)?
             .process(target.values())?
-            .a_m_s2
+            .truncated(n)?
+            .into_columns();
+        raw
     };
-    let n = t_s.len();
-    for c in [&mut k.a_m_s2, &mut k.v_m_s, &mut k.u_m, &mut raw] {
-        c.truncate(n);
-    }
     let span_s = (n - 1) as f64 / rate_hz;
     let degrees: Vec<usize> = match settings.end {
         EndCorrection::Degree(d) => {
@@ -248,11 +250,11 @@ fn acceleration_motion(
     let target_rms = rms(&raw);
     let mut chosen: Option<(usize, EndPolynomial, f64)> = None;
     for d in degrees {
-        let p = EndPolynomial::fit(&k.u_m, &k.v_m_s, span_s, d);
+        let p = EndPolynomial::fit(&u, &v, span_s, d);
         let (mut peak_u, mut sum2) = (0.0_f64, 0.0);
-        for i in 0..n {
+        for (i, &ui) in u.iter().enumerate() {
             let (pv, _, pdd) = p.all(i as f64 / (n - 1) as f64);
-            peak_u = peak_u.max((k.u_m[i] - pv).abs());
+            peak_u = peak_u.max((ui - pv).abs());
             sum2 += pdd * pdd;
         }
         let small = (sum2 / n as f64).sqrt() <= AUTO_MAX_CORRECTION * target_rms;
@@ -276,9 +278,6 @@ fn acceleration_motion(
     let Some((degree, p, _)) = chosen else {
         unreachable!("at least one degree is tried")
     };
-    let mut u = k.u_m;
-    let mut v = k.v_m_s;
-    let mut a = k.a_m_s2;
     let (mut sum2, mut peak_c) = (0.0, 0.0_f64);
     for i in 0..n {
         let s = i as f64 / (n - 1) as f64;

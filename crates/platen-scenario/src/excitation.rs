@@ -677,12 +677,13 @@ fn ground_motion(ctx: &Ctx, g: &GroundMotion, duration_s: Option<f64>) -> Result
         }
     };
     let a: Vec<f64> = acc[..record_samples].iter().map(|x| x * scale).collect();
-    let mut m = plan.process(&a).map_err(|e| signal("record", e))?;
-    for column in [&mut m.a_m_s2, &mut m.v_m_s, &mut m.u_m] {
-        column.truncate(samples);
-    }
-    let t = (0..m.a_m_s2.len()).map(|j| j as f64 / rate).collect();
-    Motion::new(t, m.u_m, m.v_m_s, m.a_m_s2).map_err(|cause| rejected(&path, cause))
+    // The record's own faults (too short, a filter's) are the record's; a motion that cannot
+    // be (non-finite) is rejected as a motion file's would be.
+    let m = plan.process(&a).map_err(|e| match e {
+        platen_signal::SignalError::NonFiniteInput { .. } => rejected(&path, e),
+        other => signal("record", other),
+    })?;
+    m.truncated(samples).map_err(|cause| rejected(&path, cause))
 }
 
 /// The ground acceleration of a `ground_motion` record (m/s²) and its sample interval (s):

@@ -3,20 +3,9 @@
 
 use crate::calculus::{remove_polynomial, Baseline, MAX_BASELINE_ORDER};
 use crate::error::{Result, SignalError};
+use crate::motion::{check_len, Motion};
 use crate::resample::{Interpolation, Resampler};
 use crate::{SampleRate, ZeroPhaseFilter};
-
-/// Acceleration, velocity and displacement of a table motion, one value per output sample
-/// (sample `j` at `j/to_hz` from the record's first sample).
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct Kinematics {
-    /// Acceleration, m/s².
-    pub a_m_s2: Vec<f64>,
-    /// Velocity, m/s.
-    pub v_m_s: Vec<f64>,
-    /// Displacement, m.
-    pub u_m: Vec<f64>,
-}
 
 /// The table motion of an acceleration record sampled at `from_hz`, at the table rate `to_hz`:
 /// plan once ([`new`](Self::new)), process many records ([`process`](Self::process)).
@@ -108,11 +97,14 @@ impl AccelerogramMotion {
         self.resampler.output_len(input_len)
     }
 
-    /// The table motion of the acceleration record `a_m_s2`, from rest at 0.
+    /// The table motion of the acceleration record `a_m_s2`, from rest at 0: a [`Motion`]
+    /// whose sample `j` is at `j/to_hz` s from the record's first sample.
     ///
     /// # Errors
-    /// [`SignalError::RecordTooShort`] for a record of fewer than 2 samples.
-    pub fn process(&self, a_m_s2: &[f64]) -> Result<Kinematics> {
+    /// [`SignalError::RecordTooShort`] for a record of fewer than 2 samples,
+    /// [`SignalError::NonFiniteInput`] for a non-finite acceleration (or a motion that
+    /// overflows).
+    pub fn process(&self, a_m_s2: &[f64]) -> Result<Motion> {
         if a_m_s2.len() < 2 {
             return Err(SignalError::RecordTooShort {
                 what: "acceleration record",
@@ -120,6 +112,7 @@ impl AccelerogramMotion {
                 min: 2,
             });
         }
+        check_len("a_m_s2", a_m_s2, a_m_s2.len())?;
         let mut a = match self.resampler.anti_alias() {
             Some(filter) => filter.apply(a_m_s2)?,
             None => a_m_s2.to_vec(),
@@ -143,11 +136,9 @@ impl AccelerogramMotion {
         };
         let m = self.output_len(n);
         let step = self.from.hz() / self.to.hz();
-        let mut out = Kinematics {
-            a_m_s2: Vec::with_capacity(m),
-            v_m_s: Vec::with_capacity(m),
-            u_m: Vec::with_capacity(m),
-        };
+        let mut out_a = Vec::with_capacity(m);
+        let mut out_v = Vec::with_capacity(m);
+        let mut out_u = Vec::with_capacity(m);
         for j in 0..m {
             let pos = (j as f64 * step).min((n - 1) as f64);
             let k = (pos.floor() as usize).min(n - 2);
@@ -162,11 +153,12 @@ impl AccelerogramMotion {
                 vj -= p.value(t);
                 uj -= p.integral(t);
             }
-            out.a_m_s2.push(aj);
-            out.v_m_s.push(vj);
-            out.u_m.push(uj);
+            out_a.push(aj);
+            out_v.push(vj);
+            out_u.push(uj);
         }
-        Ok(out)
+        let t_s = (0..m).map(|j| j as f64 / self.to.hz()).collect();
+        Motion::new(t_s, out_u, out_v, out_a)
     }
 }
 

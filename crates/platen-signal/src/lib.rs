@@ -101,7 +101,7 @@ mod spectral;
 mod welch;
 mod window;
 
-pub use accelerogram::{AccelerogramMotion, Kinematics};
+pub use accelerogram::AccelerogramMotion;
 pub use butterworth::{ButterworthLowpass, MAX_BUTTERWORTH_ORDER};
 pub use calculus::{
     cumulative_trapezoid, differentiate, remove_polynomial, Baseline, InitialMotion,

@@ -143,6 +143,34 @@ impl Motion {
     pub fn is_empty(&self) -> bool {
         self.t_s.is_empty()
     }
+
+    /// The first `samples` samples (all of them when there are fewer), with the same rest
+    /// velocity.
+    ///
+    /// # Errors
+    /// [`SignalError::TooFewSamples`] for `samples < 2`.
+    pub fn truncated(mut self, samples: usize) -> Result<Self> {
+        if samples < 2 {
+            return Err(SignalError::TooFewSamples {
+                found: samples,
+                needed: 2,
+            });
+        }
+        for c in [
+            &mut self.t_s,
+            &mut self.u_m,
+            &mut self.v_m_s,
+            &mut self.a_m_s2,
+        ] {
+            c.truncate(samples);
+        }
+        Ok(self)
+    }
+
+    /// The columns `(t_s, u_m, v_m_s, a_m_s2)`, taken out of the motion.
+    pub fn into_columns(self) -> (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
+        (self.t_s, self.u_m, self.v_m_s, self.a_m_s2)
+    }
 }
 
 pub(crate) fn check_finite(what: &'static str, values: &[f64]) -> Result<()> {

@@ -19,19 +19,19 @@ fn a_ramp_acceleration_gives_its_closed_form_velocity_and_displacement() {
         .unwrap()
         .process(&a)
         .unwrap();
-    assert_eq!(m.a_m_s2.len(), 10241);
-    for j in 0..m.a_m_s2.len() {
+    assert_eq!(m.a_m_s2().len(), 10241);
+    for j in 0..m.a_m_s2().len() {
         let t = j as f64 / 1024.0;
-        assert!((m.a_m_s2[j] - (c + b * t)).abs() < 1e-12, "a at {t}");
+        assert!((m.a_m_s2()[j] - (c + b * t)).abs() < 1e-12, "a at {t}");
         assert!(
-            (m.v_m_s[j] - (c * t + b * t * t / 2.0)).abs() < 1e-11,
+            (m.v_m_s()[j] - (c * t + b * t * t / 2.0)).abs() < 1e-11,
             "v at {t}"
         );
         let u = c * t * t / 2.0 + b * t * t * t / 6.0;
         assert!(
-            (m.u_m[j] - u).abs() < 1e-10,
+            (m.u_m()[j] - u).abs() < 1e-10,
             "u at {t}: {} vs {u}",
-            m.u_m[j]
+            m.u_m()[j]
         );
     }
 }
@@ -49,8 +49,8 @@ fn at_the_records_samples_the_velocity_is_the_trapezoid_of_the_acceleration() {
         .unwrap();
     let trapezoid = cumulative_trapezoid(&a, SampleRate::new(50.0).unwrap(), 0.0);
     for (k, v) in trapezoid.iter().enumerate() {
-        assert!((m.v_m_s[20 * k] - v).abs() < 1e-12, "sample {k}");
-        assert_eq!(m.a_m_s2[20 * k], a[k]);
+        assert!((m.v_m_s()[20 * k] - v).abs() < 1e-12, "sample {k}");
+        assert_eq!(m.a_m_s2()[20 * k], a[k]);
     }
 }
 
@@ -64,7 +64,7 @@ fn the_upsampled_acceleration_never_leaves_the_range_of_its_neighbouring_samples
         .unwrap()
         .process(&a)
         .unwrap();
-    for (j, &y) in m.a_m_s2.iter().enumerate() {
+    for (j, &y) in m.a_m_s2().iter().enumerate() {
         let pos = j as f64 * 50.0 / 1024.0;
         let k = (pos.floor() as usize).min(a.len() - 2);
         let (lo, hi) = (a[k].min(a[k + 1]), a[k].max(a[k + 1]));
@@ -102,18 +102,24 @@ fn every_baseline_correction_keeps_acceleration_velocity_and_displacement_consis
             .unwrap()
             .process(&a)
             .unwrap();
-        let dv = differentiate(&m.v_m_s, rate);
-        let du = differentiate(&m.u_m, rate);
+        let dv = differentiate(m.v_m_s(), rate);
+        let du = differentiate(m.u_m(), rate);
         let peak = |x: &[f64]| x.iter().fold(0.0f64, |p, y| p.max(y.abs()));
-        let inner = 2..m.v_m_s.len() - 2;
+        let inner = 2..m.v_m_s().len() - 2;
         let ea = (inner.clone())
-            .map(|j| (dv[j] - m.a_m_s2[j]).abs())
+            .map(|j| (dv[j] - m.a_m_s2()[j]).abs())
             .fold(0.0, f64::max);
         let ev = inner
-            .map(|j| (du[j] - m.v_m_s[j]).abs())
+            .map(|j| (du[j] - m.v_m_s()[j]).abs())
             .fold(0.0, f64::max);
-        assert!(ea < 2e-4 * peak(&m.a_m_s2), "{baseline:?}: a vs dv/dt {ea}");
-        assert!(ev < 2e-4 * peak(&m.v_m_s), "{baseline:?}: v vs du/dt {ev}");
+        assert!(
+            ea < 2e-4 * peak(m.a_m_s2()),
+            "{baseline:?}: a vs dv/dt {ea}"
+        );
+        assert!(
+            ev < 2e-4 * peak(m.v_m_s()),
+            "{baseline:?}: v vs du/dt {ev}"
+        );
         if let Baseline::Velocity { order } = baseline {
             // The corrected velocity at the record's samples has no component along
             // 1, t, …, t^order (its least-squares fit of that order is zero).
@@ -122,7 +128,7 @@ fn every_baseline_correction_keeps_acceleration_velocity_and_displacement_consis
                     let j = (k as f64 * 1024.0 / 50.0).round() as usize;
                     // Only the record samples that are table samples (every 25th: 0.5 s).
                     if k % 25 == 0 {
-                        m.v_m_s[j]
+                        m.v_m_s()[j]
                     } else {
                         f64::NAN
                     }
@@ -143,7 +149,7 @@ fn every_baseline_correction_keeps_acceleration_velocity_and_displacement_consis
                 // Sampled every 0.5 s only, so the projection is small, not zero: 2 % of the
                 // velocity's peak bounds it (uncorrected, the trend alone is 0.01·20²/2 = 2 m/s).
                 assert!(
-                    projection.abs() < 0.02 * peak(&m.v_m_s),
+                    projection.abs() < 0.02 * peak(m.v_m_s()),
                     "{baseline:?}: projection on t^{power} {projection}"
                 );
             }
@@ -163,4 +169,30 @@ fn records_too_short_and_orders_too_high_are_rejected() {
         Err(SignalError::InvalidCount { value: 9, .. })
     ));
     assert!(AccelerogramMotion::new(0.0, 1024.0, Baseline::None).is_err());
+    // A non-finite sample is named, not carried into the motion.
+    assert!(matches!(
+        plan.process(&[0.0, 1.0, f64::NAN, 0.0]),
+        Err(SignalError::NonFiniteInput {
+            what: "a_m_s2",
+            index: 2,
+            ..
+        })
+    ));
+}
+
+#[test]
+fn the_motion_is_stamped_at_the_table_rate_and_can_be_cut() {
+    let a: Vec<f64> = (0..101).map(|k| (k as f64 * 0.1).sin()).collect();
+    let m = AccelerogramMotion::new(50.0, 200.0, Baseline::None)
+        .unwrap()
+        .process(&a)
+        .unwrap();
+    assert_eq!(m.len(), 401, "⌊(n − 1)·to/from⌋ + 1");
+    for (j, &t) in m.t_s().iter().enumerate() {
+        assert_eq!(t, j as f64 / 200.0);
+    }
+    let cut = m.clone().truncated(10).unwrap();
+    assert_eq!(cut.len(), 10);
+    assert_eq!(cut.u_m(), &m.u_m()[..10]);
+    assert!(m.truncated(1).is_err());
 }
