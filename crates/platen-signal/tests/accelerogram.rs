@@ -116,10 +116,7 @@ fn every_baseline_correction_keeps_acceleration_velocity_and_displacement_consis
             ea < 2e-4 * peak(m.a_m_s2()),
             "{baseline:?}: a vs dv/dt {ea}"
         );
-        assert!(
-            ev < 2e-4 * peak(m.v_m_s()),
-            "{baseline:?}: v vs du/dt {ev}"
-        );
+        assert!(ev < 2e-4 * peak(m.v_m_s()), "{baseline:?}: v vs du/dt {ev}");
         if let Baseline::Velocity { order } = baseline {
             // The corrected velocity at the record's samples has no component along
             // 1, t, …, t^order (its least-squares fit of that order is zero).
