@@ -247,3 +247,30 @@ fn bad_sweep_arguments_fail_with_a_clear_message_and_no_output() {
         assert!(!out.exists(), "{extra:?}: output written despite the error");
     }
 }
+
+#[test]
+fn the_text_summary_has_the_same_bytes_on_every_run_and_thread_count() {
+    // Determinism: the summary on stdout holds no wall time and no thread count (those go to
+    // stderr as a diagnostic), so two runs on 1 and 2 threads print the same bytes.
+    let sr9 = scenario("sr9-like-sine-force.json");
+    let args = [
+        "sweep",
+        &sr9,
+        "--scale",
+        "0.5,1,1.5",
+        "--pressure-mpa",
+        "6.9,13.8",
+    ];
+    let one = platen_on(1, &args);
+    let two = platen_on(2, &args);
+    assert!(
+        one.status.success() && two.status.success(),
+        "{}",
+        stderr(&one)
+    );
+    assert_eq!(one.stdout, two.stdout);
+    let text = String::from_utf8(one.stdout.clone()).unwrap();
+    assert!(text.starts_with("SR9-like 100 kN, 0.5 Hz sine force (forward): 6 cases (identified model, lhpost-2008)\n"), "{text}");
+    assert!(stderr(&one).contains("6 cases in ") && stderr(&one).contains(" s on 1 threads"));
+    assert!(stderr(&two).contains(" s on 2 threads"));
+}

@@ -22,28 +22,23 @@ pub struct SweepRun<'a> {
     pub outcomes: &'a [Outcome],
     /// The CSV written, if any.
     pub out: Option<&'a Path>,
-    /// Wall time of the whole grid, s.
-    pub wall_s: f64,
-    /// Threads the cases ran on.
-    pub threads: usize,
 }
 
 /// The text summary of a sweep: a heading, one row per case (its axes' values, then its peaks,
 /// stick time and events, and the limits it exceeded, or its failure), the CSV written; then,
 /// with `figures` (`Some`: figures were asked for), the figure files written or why none
-/// were.
+/// were. It holds nothing that changes from run to run (no wall time, no thread count): the
+/// same sweep prints the same bytes.
 pub fn sweep_text(run: &SweepRun<'_>, figures: Option<&[PathBuf]>) -> String {
     let mut s = String::new();
     let scenario = run.scenario;
     let _ = writeln!(
         s,
-        "{}: {} cases ({} model, {}) in {:.2} s on {} threads",
+        "{}: {} cases ({} model, {})",
         scenario.name,
         run.cases.len(),
         scenario.model.form(),
         scenario.preset.name(),
-        run.wall_s,
-        run.threads
     );
     let mut head = format!("  {:>5} {:>8} {:>8}", "case", "scale", "MPa");
     for n in run.set_names {

@@ -158,11 +158,16 @@ pub fn run(
             cases,
             outcomes: &outcomes,
             out,
-            wall_s,
-            threads: rayon::current_num_threads(),
         };
         let figures = plot.dir.map(|_| written.as_slice());
         out!("{}", platen_report::sweep_report::sweep_text(&run, figures));
+        // How long it took is a diagnostic (stderr), so the summary's bytes are the same on
+        // every run and every machine.
+        eprintln!(
+            "{} cases in {wall_s:.2} s on {} threads",
+            cases.len(),
+            rayon::current_num_threads()
+        );
     }
     failures(&outcomes, out.is_some())
 }
