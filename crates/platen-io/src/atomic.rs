@@ -160,3 +160,14 @@ fn sync_directory(dir: &Path) {
     #[cfg(not(unix))]
     let _ = dir;
 }
+
+/// The temporary files ([`AtomicFile`]'s `.NAME.XXXXXX.tmp`) left in `dir`: the writers' tests
+/// check that none remains after a write, failed or not.
+#[cfg(test)]
+pub(crate) fn temp_files_in(dir: &std::path::Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.') && n.ends_with(".tmp"))
+        .collect()
+}

@@ -591,6 +591,7 @@ pub fn write_number<W: Write>(out: &mut W, value: f64) -> io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::atomic::temp_files_in;
     use crate::atomic::write_bytes_atomic;
     use std::fs;
     use tempfile::TempDir;
@@ -615,14 +616,6 @@ mod tests {
         let message = error.to_string();
         assert!(message.contains(name), "no file name in: {message}");
         (error, message)
-    }
-
-    fn temp_files_in(dir: &Path) -> Vec<String> {
-        fs::read_dir(dir)
-            .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .filter(|n| n.starts_with('.') && n.ends_with(".tmp"))
-            .collect()
     }
 
     #[test]

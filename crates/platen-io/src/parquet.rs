@@ -221,15 +221,8 @@ fn parquet_error(path: &Path, error: parquet::errors::ParquetError) -> IoError {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::atomic::temp_files_in;
     use std::fs;
-
-    fn temp_files_in(dir: &Path) -> Vec<String> {
-        fs::read_dir(dir)
-            .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .filter(|n| n.starts_with('.') && n.ends_with(".tmp"))
-            .collect()
-    }
 
     #[test]
     fn columns_round_trip_bit_for_bit_across_batches() {
