@@ -32,9 +32,12 @@ mod common;
 
 use std::hint::black_box;
 
-use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use criterion::measurement::WallTime;
+use criterion::{
+    criterion_group, criterion_main, BenchmarkGroup, BenchmarkId, Criterion, Throughput,
+};
 use platen::integrate::{forward_rk4, forward_rk4_specimen, ForceRecord, Peaks, Rk4, State};
-use platen::model::{preset, Specimen, Storey};
+use platen::model::{preset, IdentifiedParams, PlatenModel, Specimen, Storey};
 
 use common::baseline::baseline_rk4;
 use common::{report_ratios, sine_force, timed, PRESSURE_PA, RATE_HZ};
@@ -42,11 +45,59 @@ use common::{report_ratios, sine_force, timed, PRESSURE_PA, RATE_HZ};
 const SAMPLE_SIZE: usize = 20;
 const LENGTHS_S: [usize; 2] = [60, 600];
 
+/// The criterion group the benches register in.
+type Group<'a> = BenchmarkGroup<'a, WallTime>;
+
+/// Registers `plain_loop_baseline`: the plain RK4 loop of `params` on the `force` samples.
+fn bench_baseline(
+    group: &mut Group<'_>,
+    key: &str,
+    seconds: usize,
+    params: &IdentifiedParams,
+    force: &[f64],
+) {
+    group.bench_with_input(
+        BenchmarkId::new("plain_loop_baseline", seconds),
+        force,
+        |b, f| {
+            timed(b, &format!("{key}/plain_loop_baseline/{seconds}"), || {
+                baseline_rk4(params, black_box(f), 1.0 / RATE_HZ, State::default())
+            })
+        },
+    );
+}
+
+/// Registers `name`: the forward RK4 of `model` over `record` into a [`Peaks`] sink.
+fn bench_forward<M: PlatenModel>(
+    group: &mut Group<'_>,
+    key: &str,
+    name: &str,
+    seconds: usize,
+    model: &M,
+    record: &ForceRecord,
+) {
+    let rk4 = Rk4::with_steps_per_sample(1).unwrap();
+    group.bench_with_input(BenchmarkId::new(name, seconds), record, |b, r| {
+        timed(b, &format!("{key}/{name}/{seconds}"), || {
+            let mut peaks = Peaks::default();
+            forward_rk4(
+                model,
+                black_box(r),
+                rk4,
+                State::default(),
+                r.len(),
+                &mut peaks,
+            )
+            .unwrap();
+            peaks
+        })
+    });
+}
+
 fn bench_record(c: &mut Criterion, group_name: &str, amplitude_n: f64) {
     let params = preset::lhpost_2008_identified(PRESSURE_PA);
     let identified = params.build().unwrap();
     let full = preset::lhpost_2008_physical(PRESSURE_PA).build().unwrap();
-    let rk4 = Rk4::with_steps_per_sample(1).unwrap();
     let mut group = c.benchmark_group(group_name);
     group.sample_size(SAMPLE_SIZE);
     let mut names = Vec::new();
@@ -55,53 +106,22 @@ fn bench_record(c: &mut Criterion, group_name: &str, amplitude_n: f64) {
         let steps = (force.len() - 1) as u64;
         group.throughput(Throughput::Elements(steps));
         let record = ForceRecord::from_rate(RATE_HZ, force.clone()).unwrap();
-        let key = |what: &str| format!("{group_name}/{what}/{seconds}");
-        group.bench_with_input(
-            BenchmarkId::new("plain_loop_baseline", seconds),
-            &force,
-            |b, f| {
-                timed(b, &key("plain_loop_baseline"), || {
-                    baseline_rk4(&params, black_box(f), 1.0 / RATE_HZ, State::default())
-                })
-            },
-        );
-        group.bench_with_input(
-            BenchmarkId::new("identified_stick_slip", seconds),
+        bench_baseline(&mut group, group_name, seconds, &params, &force);
+        bench_forward(
+            &mut group,
+            group_name,
+            "identified_stick_slip",
+            seconds,
+            &identified,
             &record,
-            |b, r| {
-                timed(b, &key("identified_stick_slip"), || {
-                    let mut peaks = Peaks::default();
-                    forward_rk4(
-                        &identified,
-                        black_box(r),
-                        rk4,
-                        State::default(),
-                        r.len(),
-                        &mut peaks,
-                    )
-                    .unwrap();
-                    peaks
-                })
-            },
         );
-        group.bench_with_input(
-            BenchmarkId::new("full_stick_slip", seconds),
+        bench_forward(
+            &mut group,
+            group_name,
+            "full_stick_slip",
+            seconds,
+            &full,
             &record,
-            |b, r| {
-                timed(b, &key("full_stick_slip"), || {
-                    let mut peaks = Peaks::default();
-                    forward_rk4(
-                        &full,
-                        black_box(r),
-                        rk4,
-                        State::default(),
-                        r.len(),
-                        &mut peaks,
-                    )
-                    .unwrap();
-                    peaks
-                })
-            },
         );
         names.push((seconds, steps));
     }
@@ -158,33 +178,14 @@ fn specimen(c: &mut Criterion) {
     let mut group = c.benchmark_group(group_name);
     group.sample_size(SAMPLE_SIZE);
     group.throughput(Throughput::Elements(steps));
-    group.bench_with_input(
-        BenchmarkId::new("plain_loop_baseline", seconds),
-        &force,
-        |b, f| {
-            timed(b, &key("plain_loop_baseline"), || {
-                baseline_rk4(&params, black_box(f), 1.0 / RATE_HZ, State::default())
-            })
-        },
-    );
-    group.bench_with_input(
-        BenchmarkId::new("identified_stick_slip", seconds),
+    bench_baseline(&mut group, group_name, seconds, &params, &force);
+    bench_forward(
+        &mut group,
+        group_name,
+        "identified_stick_slip",
+        seconds,
+        &identified,
         &record,
-        |b, r| {
-            timed(b, &key("identified_stick_slip"), || {
-                let mut peaks = Peaks::default();
-                forward_rk4(
-                    &identified,
-                    black_box(r),
-                    rk4,
-                    State::default(),
-                    r.len(),
-                    &mut peaks,
-                )
-                .unwrap();
-                peaks
-            })
-        },
     );
     for (name, spec) in [("two_storeys", &two), ("three_storeys", &three)] {
         group.bench_with_input(BenchmarkId::new(name, seconds), &record, |b, r| {
