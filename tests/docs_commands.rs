@@ -28,112 +28,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
+mod common;
 
-/// One step of a page: a command line, or a file the page asks to save.
-#[derive(Debug, PartialEq)]
-enum Step {
-    Run(String),
-    Save { path: String, text: String },
-}
-
-/// The steps of a Markdown page in order: the lines of its shell blocks (continuations
-/// joined, comments and blank lines left out, only the `$ ` lines of a console block) and the
-/// JSON blocks introduced by “Save as `out/…`”.
-fn steps(markdown: &str) -> Vec<Step> {
-    let mut steps = Vec::new();
-    let mut block: Option<(String, Option<String>)> = None;
-    let mut body = String::new();
-    let mut pending = String::new();
-    // The text paragraph before a block (blank lines between them allowed).
-    let mut paragraph = String::new();
-    let mut after_blank = false;
-    for line in markdown.lines() {
-        if let Some(fence) = line.trim_start().strip_prefix("```") {
-            match block.take() {
-                Some((lang, save)) => {
-                    if lang == "json" {
-                        if let Some(path) = save {
-                            steps.push(Step::Save {
-                                path,
-                                text: std::mem::take(&mut body),
-                            });
-                        }
-                    }
-                    body.clear();
-                }
-                None => {
-                    let lang = fence.trim().to_owned();
-                    let save = paragraph
-                        .rsplit_once("Save as `")
-                        .and_then(|(_, rest)| rest.split_once('`'))
-                        .map(|(path, _)| path.to_owned())
-                        .filter(|p| p.starts_with("out/"));
-                    block = Some((lang, save));
-                    paragraph.clear();
-                }
-            }
-            continue;
-        }
-        let Some((lang, _)) = &block else {
-            if line.trim().is_empty() {
-                after_blank = true;
-            } else {
-                if after_blank {
-                    paragraph.clear();
-                    after_blank = false;
-                }
-                paragraph.push_str(line);
-                paragraph.push(' ');
-            }
-            continue;
-        };
-        if lang == "json" {
-            body.push_str(line);
-            body.push('\n');
-            continue;
-        }
-        if !matches!(lang.as_str(), "sh" | "bash" | "console" | "shell") {
-            continue;
-        }
-        let line = if lang == "console" {
-            match line.trim_start().strip_prefix("$ ") {
-                Some(command) => command,
-                None if !pending.is_empty() => line,
-                None => continue,
-            }
-        } else {
-            line
-        };
-        let line = match line.find(" # ") {
-            Some(i) if !in_quotes(&line[..i]) => &line[..i],
-            _ => line,
-        };
-        let line = line.trim();
-        if pending.is_empty() && (line.is_empty() || line.starts_with('#')) {
-            continue;
-        }
-        match line.strip_suffix('\\') {
-            Some(head) => {
-                pending.push_str(head.trim_end());
-                pending.push(' ');
-            }
-            None => {
-                pending.push_str(line);
-                steps.push(Step::Run(std::mem::take(&mut pending)));
-            }
-        }
-    }
-    steps
-}
-
-/// Whether `text` leaves a quote open (so a `#` after it is inside a string).
-fn in_quotes(text: &str) -> bool {
-    text.chars().filter(|&c| c == '"').count() % 2 == 1
-        || text.chars().filter(|&c| c == '\'').count() % 2 == 1
-}
+use common::docs::{copy_tree, pages, root, steps, written_paths, Step};
 
 /// Why a command is not run here, or None to run it.
 fn not_run(command: &str) -> Option<String> {
@@ -178,30 +75,6 @@ fn not_run(command: &str) -> Option<String> {
 fn on_path(program: &str) -> bool {
     std::env::var_os("PATH")
         .is_some_and(|paths| std::env::split_paths(&paths).any(|dir| dir.join(program).is_file()))
-}
-
-/// The arguments that name something a command writes: the values of `--out`, `--plot`,
-/// `--report`, `-o` and a redirection's target.
-fn written_paths(command: &str) -> Vec<String> {
-    let words: Vec<&str> = command.split_whitespace().collect();
-    words
-        .windows(2)
-        .filter(|w| matches!(w[0], "--out" | "--plot" | "--report" | "-o" | ">" | ">>"))
-        .map(|w| w[1].to_owned())
-        .collect()
-}
-
-fn copy_tree(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for e in std::fs::read_dir(from).unwrap() {
-        let p = e.unwrap().path();
-        let target = to.join(p.file_name().unwrap());
-        if p.is_dir() {
-            copy_tree(&p, &target);
-        } else {
-            std::fs::copy(&p, &target).unwrap();
-        }
-    }
 }
 
 /// A temporary clone of what the commands read, with `platen` on a PATH of its own.
@@ -351,18 +224,6 @@ fn run_page(page: &Path, done: &mut BTreeSet<String>) -> (usize, Vec<String>) {
         ran += 1;
     }
     (ran, skipped)
-}
-
-/// The Markdown pages the check covers: the README and every page under `docs/`.
-fn pages() -> Vec<PathBuf> {
-    let mut docs: Vec<PathBuf> = std::fs::read_dir(root().join("docs"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "md"))
-        .collect();
-    docs.sort();
-    docs.insert(0, root().join("README.md"));
-    docs
 }
 
 #[test]

@@ -6,73 +6,16 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::SystemTime;
 
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
+mod common;
 
-/// The command lines of every ```sh block of a Markdown text, continuation lines joined,
-/// comments and blank lines left out.
-fn sh_commands(markdown: &str) -> Vec<String> {
-    let mut commands = Vec::new();
-    let mut in_sh = false;
-    let mut pending = String::new();
-    for line in markdown.lines() {
-        if line.starts_with("```") {
-            in_sh = !in_sh && line.trim() == "```sh";
-            continue;
-        }
-        if !in_sh {
-            continue;
-        }
-        let line = line.split(" # ").next().unwrap().trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        match line.strip_suffix('\\') {
-            Some(head) => pending.push_str(head),
-            None => {
-                pending.push_str(line);
-                commands.push(std::mem::take(&mut pending));
-            }
-        }
-    }
-    commands
-}
-
-/// The arguments that name something a command writes: the values of `--out`, `--plot`,
-/// `--report` and `-o`, a virtual environment's folder and a redirection's target.
-fn written_paths(command: &str) -> Vec<String> {
-    let words: Vec<&str> = command.split_whitespace().collect();
-    let mut paths = Vec::new();
-    for (i, w) in words.iter().enumerate() {
-        let names_output = matches!(*w, "--out" | "--plot" | "--report" | "-o" | ">" | ">>")
-            || (*w == "venv" && i > 0 && words[i - 1] == "-m");
-        if names_output {
-            let value = words.get(i + 1).copied().unwrap_or("");
-            paths.push(value.to_owned());
-        }
-    }
-    paths
-}
-
-/// The Markdown files the check covers: the README and every page under `docs/`.
-fn documents() -> Vec<PathBuf> {
-    let mut docs: Vec<PathBuf> = std::fs::read_dir(root().join("docs"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "md"))
-        .collect();
-    docs.sort();
-    docs.insert(0, root().join("README.md"));
-    docs
-}
+use common::docs::{commands, copy_tree, pages, root, written_paths};
 
 #[test]
 fn every_command_of_the_readme_and_docs_writes_under_out() {
     let mut checked = 0;
-    for doc in documents() {
+    for doc in pages() {
         let text = std::fs::read_to_string(&doc).unwrap();
-        for command in sh_commands(&text) {
+        for command in commands(&text) {
             for path in written_paths(&command) {
                 assert!(
                     path.starts_with("out/") && !path.contains(".."),
@@ -96,7 +39,7 @@ fn every_command_of_the_readme_and_docs_writes_under_out() {
 
 #[test]
 fn the_output_check_sees_a_command_that_writes_elsewhere() {
-    let cmds = sh_commands(
+    let cmds = commands(
         "```sh\nplaten simulate s.json --out sr9.csv\nplaten compare a.json \\\n    --plot figs\n```\n",
     );
     assert_eq!(cmds.len(), 2);
@@ -120,19 +63,6 @@ fn snapshot(dir: &Path, into: &mut BTreeMap<PathBuf, SystemTime>) {
     }
 }
 
-fn copy_tree(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for e in std::fs::read_dir(from).unwrap() {
-        let p = e.unwrap().path();
-        let target = to.join(p.file_name().unwrap());
-        if p.is_dir() {
-            copy_tree(&p, &target);
-        } else {
-            std::fs::copy(&p, &target).unwrap();
-        }
-    }
-}
-
 /// The quick start's `platen` commands, in order, in a copy of the clone's `scenarios/` and
 /// `out/`: each succeeds, and nothing outside `out/` is created or changed. (Its Python line
 /// is what `.ci/run` does in its own virtual environment.)
@@ -144,7 +74,7 @@ fn the_readme_quick_start_runs_top_to_bottom_and_writes_only_under_out() {
         .expect("a Quick start section");
     let section = &readme[start + 1..];
     let section = &section[..section[3..].find("\n## ").map_or(section.len(), |i| i + 3)];
-    let commands: Vec<String> = sh_commands(section)
+    let commands: Vec<String> = commands(section)
         .into_iter()
         .filter(|c| c.starts_with("platen "))
         .collect();
