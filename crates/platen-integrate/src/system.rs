@@ -323,7 +323,12 @@ impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
     /// The net force on the platen less its elastic force: `N = F_A − F_E(u) − B`.
     #[inline(always)]
     fn net(&self, y: &Y<L>) -> f64 {
-        self.force(y) - self.model.elastic_force_n(y[U]) - self.base_shear(y)
+        // The same arithmetic as `mode_at_rest(…, f_eff)` (the actuator force less the base
+        // shear, then less the elastic force): a net force that rounds differently in the
+        // two would let the breakaway test and the mode at rest disagree by an ulp at the
+        // threshold, and the event loop toggle between them without time moving.
+        let f_eff = self.force(y) - self.base_shear(y);
+        f_eff - self.model.elastic_force_n(y[U])
     }
 
     /// The rates of the state in `mode`, into `dy`; returns the platen acceleration and the
