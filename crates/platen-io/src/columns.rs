@@ -58,39 +58,45 @@ use crate::json::{parse_json, parse_json_file};
 use crate::STANDARD_GRAVITY_M_S2;
 
 /// How one of platen's columns is found in a file.
-#[derive(Debug, Clone, Default, Deserialize, PartialEq, schemars::JsonSchema)]
+#[derive(Debug, Clone, Default, Deserialize, serde::Serialize, PartialEq, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ColumnSpec {
     /// The header in the file (default: platen's own column name).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
     /// The unit of the values in the file (default: platen's SI unit).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub unit: Option<String>,
     /// For a force given as a pressure: the area it acts on, m².
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub times_area_m2: Option<f64>,
     /// A factor applied after the unit's (default 1): `SI = (value − offset)·unit·scale`,
     /// e.g. 0.1 for a drive recorded in volts of a ±10 V servo amplifier.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub scale: Option<f64>,
     /// A constant subtracted from every value, in the file's unit (before the conversion to
     /// SI; default 0): a transducer's offset, e.g. `-0.13` for a pressure read in MPa.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub offset: Option<f64>,
     /// Subtract the channel's mean over the file (after the offset; default false). Not for
     /// `t_s`.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub remove_mean: bool,
     /// Subtract the channel's first value, so it starts at zero (default false); not with
     /// `remove_mean`.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub zero_at_start: bool,
     /// Do not read this column even where the file has one of this name (default false):
     /// platen then does without it as for a file that lacks it, e.g. a motion's `v_m_s` and
     /// `a_m_s2` derived from its `u_m`. Alone: no other field with it; not for a column the
     /// reading requires.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub ignore: bool,
     /// The channel's known delay relative to the displacement `u_m`, s (default none): a
     /// data system that samples a channel late by `delay_s` (positive) or early (negative).
     /// Finite, `|delay_s|` < 1 s; not for `t_s` or `u_m` itself. Reading a file does not apply
     /// it: identification uses it ([`ColumnMap::delay_s`]) to correct the channel's skew.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub delay_s: Option<f64>,
 }
 
@@ -314,6 +320,18 @@ impl ColumnMap {
                     }
                 }
             };
+            if kind == Kind::Drive
+                && s.unit.as_deref().map(str::trim) == Some("V")
+                && s.scale.is_none()
+            {
+                return Err((
+                    format!("{here}.scale"),
+                    "(missing)".into(),
+                    "a drive in volts needs scale = 1/(full-scale volts) to be a fraction of full \
+                     opening, e.g. 0.1 for a ±10 V servo amplifier"
+                        .into(),
+                ));
+            }
             let factor = match s.scale {
                 None => factor,
                 Some(k) if k.is_finite() && k != 0.0 => factor * k,
@@ -536,6 +554,29 @@ impl ColumnMap {
         self.entries.get(ours).map_or(ours, |m| m.header.as_str())
     }
 
+    /// A column spec that reads platen's column `ours` exactly as this map reads it (its
+    /// header, its whole factor to SI as `scale`, its offset and zero; not its delay), for a
+    /// scenario that must read the same file the same way.
+    pub fn reading_spec(&self, ours: &str) -> ColumnSpec {
+        let Some(m) = self.entries.get(ours) else {
+            return ColumnSpec::default();
+        };
+        if m.ignored {
+            return ColumnSpec {
+                ignore: true,
+                ..ColumnSpec::default()
+            };
+        }
+        ColumnSpec {
+            name: Some(m.header.clone()),
+            scale: (m.factor != 1.0).then_some(m.factor),
+            offset: (m.offset != 0.0).then_some(m.offset),
+            remove_mean: m.zero == Zero::Mean,
+            zero_at_start: m.zero == Zero::Start,
+            ..ColumnSpec::default()
+        }
+    }
+
     /// The factor from the file's unit to SI for platen's column `ours`.
     pub fn factor(&self, ours: &str) -> f64 {
         self.entries.get(ours).map_or(1.0, |m| m.factor)
@@ -570,14 +611,14 @@ fn example_unit(k: Kind) -> Option<&'static str> {
         Kind::Acceleration => "g",
         Kind::Force => "kN",
         Kind::Pressure => "MPa",
-        Kind::Drive => return None,
+        Kind::Drive => "V",
     })
 }
 
 /// What a map's `unit` for a column of kind `k` should be, listing the accepted units.
 fn expected_unit(k: Kind) -> String {
     match k {
-        Kind::Drive => format!("no unit: {}", kind_name(k)),
+        Kind::Drive => format!("no unit or V: {}", kind_name(k)),
         _ => format!("a unit of {}", kind_name(k)),
     }
 }
@@ -591,7 +632,10 @@ fn kind_name(k: Kind) -> &'static str {
         Kind::Force => {
             "force (N, kN, MN, lbf, kip) or a pressure (Pa, kPa, MPa, bar, psi) with times_area_m2"
         }
-        Kind::Drive => "a drive is a fraction of full opening (scale 0.1 maps ±10 V)",
+        Kind::Drive => {
+            "a drive is a fraction of full opening; in volts, unit V with scale 1/(full-scale \
+             volts), e.g. 0.1 for ±10 V"
+        }
         Kind::Pressure => "pressure (Pa, kPa, MPa, bar, psi)",
     }
 }
@@ -625,6 +669,9 @@ fn unit_factor(unit: &str) -> Option<(UnitKind, f64)> {
         "MPa" => (UnitKind::Pressure, 1e6),
         "bar" => (UnitKind::Pressure, 1e5),
         "psi" => (UnitKind::Pressure, 6_894.757_293_168),
+        // A drive recorded in volts: its `scale` (1 over the full-scale voltage) makes it the
+        // fraction of full opening.
+        "V" => (UnitKind::Of(Drive), 1.0),
         _ => return None,
     })
 }
