@@ -53,6 +53,15 @@ pub enum IdentError {
         /// What a valid value looks like.
         expected: &'static str,
     },
+    /// Closed-loop records that cannot show the loop (`identify --system`): no drive, or a
+    /// command that does not move the table.
+    #[error("the table's loop cannot be identified from `{record}`: {reason}")]
+    LoopNotIdentifiable {
+        /// The record's name (the file it came from).
+        record: String,
+        /// Why, and what would make it identifiable.
+        reason: String,
+    },
     /// Nothing to identify from.
     #[error("no test records given: identification needs periodic sine and/or triangle tests")]
     NoTests,

@@ -22,17 +22,41 @@
 //! marked for fitting; the others are held out and the drive the fitted gains predict is
 //! compared with theirs ([`HeldOut`]). A quantity the records cannot show is listed in
 //! [`SystemIdentification::not_identified`] with the reason.
-
-use nalgebra::{DMatrix, DVector};
+//!
+//! The gains are constrained to the range a scenario accepts (every gain `≥ 0`): a gain the
+//! unconstrained fit would make negative is held at 0 and said so
+//! ([`SystemIdentification::not_identified`]); the others are refitted without it
+//! ([`fit`](self) has the exact non-negative least squares and the standard errors).
+//!
+//! Before any fit the channels' skew is measured and corrected ([`skew`]): the table's
+//! acceleration against the second derivative of the displacement (the storeys' accelerometers
+//! are taken to share the table's data path), the pressures by the platen's force balance.
+//!
+//! A loop that cannot be identified is an error with the reason
+//! ([`IdentError::LoopNotIdentifiable`]): a fitted record without the drive, or a command
+//! that does not move the table.
 
 use crate::error::{IdentError, Result};
 
+mod fit;
+mod judge;
 mod plant;
+mod provenance;
+pub mod skew;
 
-pub use plant::{
-    predict, IdentifiedHydraulics, IdentifiedMechanics, IdentifiedPlant, IdentifiedStorey, Mode,
-    Prediction, CONTINUITY_LOWPASS_HZ, DRIFT_HIGHPASS_HZ, JUDGE_STEPS_PER_PERIOD, SLIP_SPEED_M_S,
+pub use judge::{
+    fir_black_box, Baseline, BlackBox, HeldOutMedians, Judgement, Prediction, PredictionSeries,
+    BLACK_BOX_LENGTH_S, JUDGE_LOWPASS_HZ, MAX_BLACK_BOX_TAPS,
 };
+pub use plant::stroke_limit_m;
+pub use plant::{
+    Geometry, IdentifiedHydraulics, IdentifiedMechanics, IdentifiedPlant, IdentifiedStorey, Mode,
+    CONTINUITY_LOWPASS_HZ, DRIFT_HIGHPASS_HZ, MECHANICS_LOWPASS_FRACTION, NOMINAL_AREA_M2,
+    NOMINAL_BULK_MODULUS_PA, NOMINAL_RATED_DROP_PA, NOMINAL_RETURN_PRESSURE_PA,
+    NOMINAL_SUPPLY_PRESSURE_PA, SLIP_SPEED_M_S, STROKE_FRACTION_OF_ROOM,
+};
+pub use provenance::{Source, ValueProvenance};
+pub use skew::ChannelSkew;
 
 /// Corners tried for the `Δp` high-pass when none is given, Hz (0: `Δp` unfiltered).
 pub const HIGHPASS_GRID_HZ: [f64; 12] = [
@@ -152,6 +176,22 @@ pub struct IdentifiedGains {
     pub delta_p_highpass_hz: f64,
 }
 
+/// One gain's estimate.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct GainEstimate {
+    /// Its scenario key (`displacement_gain_per_m`, …).
+    pub key: &'static str,
+    /// The value (0 when held there).
+    pub value: f64,
+    /// Its standard error (batch means over the fit's residuals); absent when held at 0 or
+    /// not fitted.
+    pub std_error: Option<f64>,
+    /// Whether the sign constraint held it at 0 (the unconstrained fit made it negative).
+    pub held_at_zero: bool,
+    /// What the unconstrained fit gave, when it was held at 0.
+    pub unconstrained: Option<f64>,
+}
+
 /// How well the gains reproduce one record's drive.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct HeldOut {
@@ -178,9 +218,19 @@ pub struct SystemIdentification {
     pub records: Vec<HeldOut>,
     /// Samples left out as saturated (`|d| ≥ 0.999`) in the fit.
     pub saturated_samples: usize,
-    /// The plant (platen, specimen, valves, oil column) and the identified loop's
-    /// predictions, with a base geometry ([`SystemSettings::base`]).
+    /// Each gain with its standard error and whether it was held at 0.
+    pub gain_estimates: Vec<GainEstimate>,
+    /// The channels' skew measured on the records and corrected before the fits.
+    pub channel_skew: Vec<ChannelSkew>,
+    /// The plant (platen, specimen, valves, oil column), in the base's geometry
+    /// ([`SystemSettings::base`]) or, without one, in ratios to a nominal actuator area.
     pub plant: Option<IdentifiedPlant>,
+    /// The identified loop run on each record's command, against a linear black box and
+    /// perfect tracking ([`SystemSettings::judge`]).
+    pub judgement: Option<Judgement>,
+    /// Where each value of the identified table's scenario comes from: `identified` (with
+    /// its standard error where it has one), `given` (the base) or `assumed` (with why).
+    pub provenance: Vec<ValueProvenance>,
     /// Quantities the records cannot show, with the reason.
     pub not_identified: Vec<(String, String)>,
 }
@@ -191,13 +241,17 @@ pub struct SystemSettings {
     /// The `Δp` high-pass corner, Hz, if known (otherwise chosen from [`HIGHPASS_GRID_HZ`]).
     pub delta_p_highpass_hz: Option<f64>,
     /// The table's geometry from its drawings (actuator count and areas, valve count and
-    /// rated drop, supply and return pressures, bulk modulus): with it the plant is
-    /// identified; the rest of its values are replaced by the fitted ones. Without it only
-    /// the gains are (the motion is invariant to scaling every area, mass, force, flow and
-    /// volume together: see [`plant`](IdentifiedPlant)).
+    /// rated drop, supply and return pressures, bulk modulus): with it the plant comes out in
+    /// absolute units. Without it the plant is identified in ratios to the actuator area
+    /// (the motion is invariant to scaling every area, mass, force, flow and volume
+    /// together: see [`plant`](IdentifiedPlant)), laid on [`SystemSettings::area_m2`] or
+    /// [`NOMINAL_AREA_M2`] and the other nominal values, each listed as `assumed`.
     pub base: Option<platen_system::TableSystem>,
+    /// The actuator's area, m², when known without the rest of the drawings (used without a
+    /// base: the plant's absolute scale).
+    pub area_m2: Option<f64>,
     /// Whether to run the identified loop on every record's command and judge it
-    /// ([`IdentifiedPlant::predictions`]).
+    /// ([`SystemIdentification::judgement`]).
     pub judge: bool,
 }
 
@@ -238,82 +292,125 @@ struct Columns {
     delta_p: bool,
 }
 
-/// The regressor rows `[e, v_ref, a_ref, −v, (−a), (−HP Δp)]` and drives of a record's
-/// unsaturated samples (ends left out); the count of saturated samples.
-fn rows(
+/// The gains' keys in the order of the regressor columns.
+const GAIN_KEYS: [&str; 6] = [
+    "displacement_gain_per_m",
+    "velocity_feedforward_s_per_m",
+    "acceleration_feedforward_s2_per_m",
+    "velocity_feedback_s_per_m",
+    "acceleration_feedback_s2_per_m",
+    "delta_p_gain_per_pa",
+];
+
+/// The regressor row `[e, v_ref, a_ref, −v, −a, −HP Δp]` (absent channels 0) of every
+/// unsaturated sample of a record (ends left out), pushed into `design`; the count of
+/// saturated samples.
+fn push_rows(
+    design: &mut fit::Design,
+    index: usize,
     r: &SystemRecord,
     h: f64,
     cols: Columns,
     corner_hz: f64,
-) -> (Vec<Vec<f64>>, Vec<f64>, usize) {
+) -> usize {
     let n = r.t_s.len();
+    let Some(drive) = r.drive.as_ref() else {
+        return 0;
+    };
     let (vref, aref) = central(&r.command_u_m, h);
     let hp = r
         .delta_p_pa
         .as_ref()
         .filter(|_| cols.delta_p)
         .map(|dp| highpass(dp, h, corner_hz));
-    let mut x = Vec::with_capacity(n);
-    let mut y = Vec::with_capacity(n);
     let mut saturated = 0;
-    let Some(drive) = r.drive.as_ref() else {
-        return (x, y, 0);
-    };
     for i in 2..n - 2 {
         if drive[i].abs() >= SATURATED_DRIVE {
             saturated += 1;
             continue;
         }
         let v = (r.u_m[i] - r.u_m[i - 1]) / h;
-        let mut row = vec![r.command_u_m[i] - r.u_m[i], vref[i], aref[i], -v];
-        if cols.acceleration {
-            row.push(-r.a_m_s2.as_ref().map_or(0.0, |a| a[i]));
-        }
-        if let Some(hp) = &hp {
-            row.push(-hp[i]);
-        }
-        x.push(row);
-        y.push(drive[i]);
+        let a = match (&r.a_m_s2, cols.acceleration) {
+            (Some(a), true) => a[i],
+            _ => 0.0,
+        };
+        let row = [
+            r.command_u_m[i] - r.u_m[i],
+            vref[i],
+            aref[i],
+            -v,
+            -a,
+            hp.as_ref().map_or(0.0, |hp| -hp[i]),
+        ];
+        design.push(&row, drive[i], index, i);
     }
-    (x, y, saturated)
+    saturated
 }
 
-/// Least squares with each column scaled to unit RMS; the coefficients and the residual's
-/// sum of squares.
-fn solve(x: &[Vec<f64>], y: &[f64]) -> Option<(Vec<f64>, f64)> {
-    let m = x.first()?.len();
-    let n = x.len();
-    if n <= m {
-        return None;
+/// The command's motion in a record, against the displacement sensor's noise: a loop whose
+/// command does not move the table shows nothing of it. The RMS of the command's deviation
+/// from its mean must exceed this many times the RMS of the displacement's second
+/// difference over √6 (the sensor's noise, an upper bound).
+pub const MIN_COMMAND_TO_NOISE: f64 = 10.0;
+
+/// Why `records` (the fitted ones) cannot show the loop, if they cannot.
+fn not_identifiable(records: &[SystemRecord], fitted: &[usize]) -> Option<IdentError> {
+    for &i in fitted {
+        let r = &records[i];
+        let fail = |reason: String| {
+            Some(IdentError::LoopNotIdentifiable {
+                record: r.name.clone(),
+                reason,
+            })
+        };
+        if r.drive.is_none() {
+            return fail(
+                "no drive recorded: the controller's gains act on the table only through the \
+                 drive, which the valves, the oil column and the platen filter; without it \
+                 neither the gains nor the valves can be separated (map the drive channel, \
+                 e.g. {\"drive\": {\"name\": \"Voltage command\", \"unit\": \"V\", \"scale\": \
+                 0.1}} for a ±10 V drive)"
+                    .into(),
+            );
+        }
+        let n = r.command_u_m.len() as f64;
+        let mean = r.command_u_m.iter().sum::<f64>() / n;
+        let motion = (r
+            .command_u_m
+            .iter()
+            .map(|c| (c - mean).powi(2))
+            .sum::<f64>()
+            / n)
+            .sqrt();
+        let noise = (r
+            .u_m
+            .windows(3)
+            .map(|w| (w[2] - 2.0 * w[1] + w[0]).powi(2))
+            .sum::<f64>()
+            / (n - 2.0).max(1.0))
+        .sqrt()
+            / 6f64.sqrt();
+        if motion <= MIN_COMMAND_TO_NOISE * noise {
+            return fail(format!(
+                "the command does not move the table (RMS {motion:.3e} m about its mean, \
+                 against the displacement's noise {noise:.3e} m): a record at rest shows \
+                 nothing of the loop; give records with a moving command (white noise, \
+                 sweeps, earthquakes)"
+            ));
+        }
     }
-    let scale: Vec<f64> = (0..m)
-        .map(|j| {
-            let s = (x.iter().map(|r| r[j] * r[j]).sum::<f64>() / n as f64).sqrt();
-            if s > 0.0 {
-                s
-            } else {
-                1.0
-            }
-        })
-        .collect();
-    let a = DMatrix::from_fn(n, m, |i, j| x[i][j] / scale[j]);
-    let b = DVector::from_column_slice(y);
-    let svd = a.clone().svd(true, true);
-    let c = svd.solve(&b, 1e-12).ok()?;
-    let res = &b - &a * &c;
-    Some((
-        (0..m).map(|j| c[j] / scale[j]).collect(),
-        res.norm_squared(),
-    ))
+    None
 }
 
-/// Identifies the controller from `records`; those with `fit[i]` true are fitted, the others
-/// held out and judged.
+/// Identifies the controller and the plant from `records`; those with `fit[i]` true are
+/// fitted, the others held out and judged.
 ///
 /// # Errors
 /// [`IdentError::NoTests`] without records, [`IdentError::InvalidRecord`] for a record whose
 /// channels do not fit together, or when no record is marked for the fit, or the fit is
-/// singular (a command too poor to separate the gains).
+/// singular (a command too poor to separate the gains);
+/// [`IdentError::LoopNotIdentifiable`] for a fitted record without the drive or whose
+/// command does not move the table.
 pub fn identify_system(
     records: &[SystemRecord],
     fit: &[bool],
@@ -335,22 +432,29 @@ pub fn identify_system(
             message: "no record is marked for the fit".into(),
         });
     }
+    if let Some(e) = not_identifiable(records, &fitted) {
+        return Err(e);
+    }
+    if let Some(a) = settings.area_m2 {
+        if !(a.is_finite() && a > 0.0) {
+            return Err(IdentError::InvalidSetting {
+                name: "area_m2",
+                value: a,
+                expected: "a finite actuator area > 0, m²",
+            });
+        }
+    }
+    // Skew: the acceleration channels first (against the displacement), then the pressures
+    // (by the force balance, inside the plant's fit).
+    let mut channel_skew = Vec::new();
+    let mut corrected = skew::correct_accelerations(records, &periods, &fitted, &mut channel_skew)?;
     let all = |f: fn(&SystemRecord) -> bool| fitted.iter().all(|&i| f(&records[i]));
     let mut not_identified = Vec::new();
-    let has_drive = all(|r| r.drive.is_some());
     let cols = Columns {
         acceleration: all(|r| r.a_m_s2.is_some()),
         delta_p: all(|r| r.delta_p_pa.is_some()),
     };
     let why = |what: &str, reason: &str| (what.to_owned(), reason.to_owned());
-    if !has_drive {
-        not_identified.push(why(
-            "controller gains",
-            "no drive recorded in every fitted record: the gains act only through the drive, \
-             which the valves, oil column and platen filter; without it they cannot be \
-             separated from the plant",
-        ));
-    }
     if !cols.acceleration {
         not_identified.push(why(
             "acceleration_feedback_s2_per_m",
@@ -363,150 +467,150 @@ pub fn identify_system(
             "no delta_p_pa recorded: taken as 0",
         ));
     }
-    let plant = match &settings.base {
-        Some(base) => Some(plant::identify_plant(
-            records,
-            &periods,
-            &fitted,
-            base,
-            &mut not_identified,
-        )),
-        None => {
-            not_identified.push(why(
-                "servo-valves, oil column, platen, specimen",
-                "no base geometry (actuator count and areas, supply pressure): scaling every \
-                 area, mass, force, flow and volume together leaves the motion unchanged, \
-                 so the records alone show only ratios to the area",
-            ));
-            None
-        }
-    };
-    let mut result = SystemIdentification {
-        gains: None,
-        fitted_records: fitted.iter().map(|&i| records[i].name.clone()).collect(),
-        records: Vec::new(),
-        saturated_samples: 0,
-        plant,
-        not_identified,
-    };
-    if !has_drive {
-        return Ok(result);
-    }
+    let plant_input = plant::PlantInput::new(settings, &corrected[0]);
+    let mut plant = plant::identify_plant(
+        &mut corrected,
+        &periods,
+        &fitted,
+        &plant_input,
+        &mut channel_skew,
+        &mut not_identified,
+    )?;
+    let records_c = corrected.as_slice();
     let h = periods[fitted[0]];
     let corners: Vec<f64> = match (cols.delta_p, settings.delta_p_highpass_hz) {
         (false, _) => vec![0.0],
         (true, Some(c)) => vec![c],
         (true, None) => HIGHPASS_GRID_HZ.to_vec(),
     };
-    let mut best: Option<(f64, Vec<f64>, f64, usize)> = None;
+    // Every gain ≥ 0 (a scenario refuses a negative one); the columns the records lack are
+    // held at 0.
+    let nonneg = [true; 6];
+    let absent = [
+        false,
+        false,
+        false,
+        false,
+        !cols.acceleration,
+        !cols.delta_p,
+    ];
+    let mut best: Option<(f64, fit::LinearFit, usize)> = None;
     for &corner in &corners {
-        let mut x = Vec::new();
-        let mut y = Vec::new();
+        let mut design = fit::Design::new(6);
         let mut sat = 0;
         for &i in &fitted {
-            let (xi, yi, si) = rows(&records[i], periods[i], cols, corner);
-            x.extend(xi);
-            y.extend(yi);
-            sat += si;
+            sat += push_rows(&mut design, i, &records_c[i], periods[i], cols, corner);
         }
-        let Some((c, ss)) = solve(&x, &y) else {
+        let Some(f) = design.fit(&nonneg, &absent) else {
             continue;
         };
-        if best.as_ref().is_none_or(|b| ss < b.2) {
-            best = Some((corner, c, ss, sat));
+        if best.as_ref().is_none_or(|b| f.rss < b.1.rss) {
+            best = Some((corner, f, sat));
         }
     }
-    let Some((corner, c, _, sat)) = best else {
+    let Some((corner, gfit, sat)) = best else {
         return Err(IdentError::InvalidRecord {
-            test: result.fitted_records.join(", "),
+            test: fitted
+                .iter()
+                .map(|&i| records[i].name.clone())
+                .collect::<Vec<_>>()
+                .join(", "),
             message: "the drive cannot be fitted: too few unsaturated samples or a command \
                       too poor to separate the gains"
                 .into(),
         });
     };
-    let mut k = c.iter().copied();
-    let mut next = || k.next().unwrap_or(0.0);
+    // What the unconstrained fit gives for a gain held at 0 (reported, not used).
+    let unconstrained = {
+        let mut design = fit::Design::new(6);
+        for &i in &fitted {
+            push_rows(&mut design, i, &records_c[i], periods[i], cols, corner);
+        }
+        design.fit(&[false; 6], &absent)
+    };
+    let c = &gfit.coef;
     let gains = IdentifiedGains {
         sample_rate_hz: nominal_rate_hz(h),
-        displacement_gain_per_m: next(),
-        velocity_feedforward_s_per_m: next(),
-        acceleration_feedforward_s2_per_m: next(),
-        velocity_feedback_s_per_m: next(),
-        acceleration_feedback_s2_per_m: if cols.acceleration { next() } else { 0.0 },
-        delta_p_gain_per_pa: if cols.delta_p { next() } else { 0.0 },
+        displacement_gain_per_m: c[0],
+        velocity_feedforward_s_per_m: c[1],
+        acceleration_feedforward_s2_per_m: c[2],
+        velocity_feedback_s_per_m: c[3],
+        acceleration_feedback_s2_per_m: c[4],
+        delta_p_gain_per_pa: c[5],
         delta_p_highpass_hz: corner,
     };
-    result.saturated_samples = sat;
-    for (i, r) in records.iter().enumerate() {
-        if r.drive.is_none() {
-            continue;
-        }
+    let gain_estimates: Vec<GainEstimate> = (0..6)
+        .filter(|&j| !absent[j])
+        .map(|j| GainEstimate {
+            key: GAIN_KEYS[j],
+            value: c[j],
+            std_error: Some(gfit.estimates[j].std_error).filter(|s| s.is_finite()),
+            held_at_zero: gfit.clamped[j],
+            unconstrained: gfit.clamped[j]
+                .then(|| unconstrained.as_ref().map(|u| u.coef[j]))
+                .flatten(),
+        })
+        .collect();
+    for g in gain_estimates.iter().filter(|g| g.held_at_zero) {
+        not_identified.push((
+            g.key.to_owned(),
+            format!(
+                "held at 0: the unconstrained fit gives {} (a scenario takes only gains ≥ 0; a \
+                 negative value is the fit absorbing noise, skew or what the law does not \
+                 hold, not the controller)",
+                g.unconstrained
+                    .map_or("no value".to_owned(), |u| format!("{u:.4e}"))
+            ),
+        ));
+    }
+    let mut result = SystemIdentification {
+        gains: Some(gains),
+        fitted_records: fitted.iter().map(|&i| records[i].name.clone()).collect(),
+        records: Vec::new(),
+        saturated_samples: sat,
+        gain_estimates,
+        channel_skew,
+        plant: None,
+        judgement: None,
+        provenance: Vec::new(),
+        not_identified,
+    };
+    for (i, r) in records_c.iter().enumerate() {
         let usable = Columns {
             acceleration: cols.acceleration && r.a_m_s2.is_some(),
             delta_p: cols.delta_p && r.delta_p_pa.is_some(),
         };
-        let (x, y, _) = rows(r, periods[i], usable, corner);
-        let mut coef = vec![
-            gains.displacement_gain_per_m,
-            gains.velocity_feedforward_s_per_m,
-            gains.acceleration_feedforward_s2_per_m,
-            gains.velocity_feedback_s_per_m,
-        ];
-        if usable.acceleration {
-            coef.push(gains.acceleration_feedback_s2_per_m);
-        }
-        if usable.delta_p {
-            coef.push(gains.delta_p_gain_per_pa);
-        }
-        let n = y.len().max(1) as f64;
-        let err2: f64 = x
-            .iter()
-            .zip(&y)
-            .map(|(row, d)| {
-                let p: f64 = row.iter().zip(&coef).map(|(a, b)| a * b).sum();
-                (d - p) * (d - p)
-            })
-            .sum();
-        let rms_d = (y.iter().map(|d| d * d).sum::<f64>() / n).sqrt();
+        let mut design = fit::Design::new(6);
+        push_rows(&mut design, i, r, periods[i], usable, corner);
+        let n = design.len().max(1) as f64;
+        let (err2, dd) = design.residual_and_rhs(c);
+        let rms_d = (dd / n).sqrt();
         let rms_e = (err2 / n).sqrt();
         result.records.push(HeldOut {
-            name: r.name.clone(),
+            name: records[i].name.clone(),
             fitted: fitted.contains(&i),
-            samples: y.len(),
+            samples: design.len(),
             drive_rms_error: rms_e,
             drive_nrmse: if rms_d > 0.0 { rms_e / rms_d } else { f64::NAN },
         });
     }
-    result.gains = Some(gains);
-    if let Some(plant) = result.plant.as_mut() {
-        if let Some(sys) = plant.system.as_mut() {
-            let c = &mut sys.controller;
-            c.sample_rate_hz = gains.sample_rate_hz;
-            c.displacement_gain_per_m = gains.displacement_gain_per_m;
-            c.integral_gain_per_m_s = 0.0;
-            c.velocity_feedforward_s_per_m = gains.velocity_feedforward_s_per_m;
-            c.acceleration_feedforward_s2_per_m = gains.acceleration_feedforward_s2_per_m;
-            c.velocity_feedback_s_per_m = gains.velocity_feedback_s_per_m;
-            c.acceleration_feedback_s2_per_m = gains.acceleration_feedback_s2_per_m;
-            c.delta_p_gain_per_pa = gains.delta_p_gain_per_pa;
-            c.delta_p_highpass_hz = gains.delta_p_highpass_hz;
-        }
-        if settings.judge {
-            if let (Some(sys), Some(model)) = (plant.system, plant.model) {
-                for (i, r) in records.iter().enumerate() {
-                    if let Some(p) = predict(
-                        r,
-                        fitted.contains(&i),
-                        &sys,
-                        &model,
-                        plant.specimen.as_ref(),
-                    ) {
-                        plant.predictions.push(p);
-                    }
-                }
-            }
-        }
+    if let Some(sys) = plant.system.as_mut() {
+        let ctl = &mut sys.controller;
+        ctl.sample_rate_hz = gains.sample_rate_hz;
+        ctl.displacement_gain_per_m = gains.displacement_gain_per_m;
+        ctl.integral_gain_per_m_s = 0.0;
+        ctl.velocity_feedforward_s_per_m = gains.velocity_feedforward_s_per_m;
+        ctl.acceleration_feedforward_s2_per_m = gains.acceleration_feedforward_s2_per_m;
+        ctl.velocity_feedback_s_per_m = gains.velocity_feedback_s_per_m;
+        ctl.acceleration_feedback_s2_per_m = gains.acceleration_feedback_s2_per_m;
+        ctl.delta_p_gain_per_pa = gains.delta_p_gain_per_pa;
+        ctl.delta_p_highpass_hz = gains.delta_p_highpass_hz;
     }
+    if settings.judge {
+        result.judgement = judge::judge(records_c, &periods, &fitted, &plant);
+    }
+    result.provenance = provenance::of(&result, &plant, &plant_input);
+    result.plant = Some(plant);
     Ok(result)
 }
 

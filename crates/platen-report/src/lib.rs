@@ -78,6 +78,7 @@ mod svg;
 pub mod sweep_figures;
 pub mod sweep_report;
 pub mod system_figures;
+pub mod system_identify_report;
 pub mod text;
 
 pub use error::{ReportError, Result};

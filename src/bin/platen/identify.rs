@@ -24,7 +24,7 @@ use platen_ident::inputs::{
 };
 use platen_ident::{identify_any, IdentifyOutput, MethodRequest, RecordSettings, Settings};
 use platen_io::columns::ColumnMap;
-use platen_report::identify_report::{system_json, system_text, written_text, IdentifyReport};
+use platen_report::identify_report::{written_text, IdentifyReport};
 
 /// Options of `platen identify`.
 pub struct Options<'a> {
@@ -228,27 +228,38 @@ impl JsonOutput {
     }
 }
 
-/// `platen identify --system FILE…`: the controller's gains from closed-loop records (see
-/// `platen_ident::system`). With two or more files, the last is held out and judged; the
-/// others are fitted. Prints the gains, the fit on each record, what cannot be identified and
-/// a runnable scenario (the `lhpost-2008` preset with the identified controller, commanded by
-/// the held-out record).
-pub fn run_system(
-    files: &[PathBuf],
-    columns: Option<&Path>,
-    base: Option<&Path>,
-    json: bool,
-) -> Result<()> {
+/// The options of `platen identify --system`.
+pub struct SystemOptions<'a> {
+    /// The column map.
+    pub columns: Option<&'a Path>,
+    /// The base geometry (`--base`).
+    pub base: Option<&'a Path>,
+    /// The actuator area alone (`--area-m2`).
+    pub area_m2: Option<f64>,
+    /// `--json`.
+    pub json: bool,
+    /// `--plot DIR`.
+    pub plot: Option<&'a Path>,
+    /// The figures' size.
+    pub size: platen_report::render::FigureSize,
+}
+
+/// `platen identify --system FILE…`: the table's loop from closed-loop records (see
+/// `platen_ident::system`). With two or more files, the last is held out; the identified loop
+/// is judged on every record. Prints the identification and, with `--json`, a runnable
+/// scenario that is the identified table with each value's provenance.
+pub fn run_system(files: &[PathBuf], o: &SystemOptions<'_>) -> Result<()> {
     use platen_ident::system::{identify_system, SystemSettings};
+    use platen_report::system_identify_report::{prediction_figures, system_json, system_text};
     if files.is_empty() {
         bail!("identify --system needs at least one recorded CSV file");
     }
-    let map = match columns {
+    let map = match o.columns {
         Some(path) => ColumnMap::load(path)?,
         None => ColumnMap::default(),
     };
     let records = read_system_records(files, &map).map_err(input_error)?;
-    let (base_system, base_stroke) = match base {
+    let (base_system, base_stroke) = match o.base {
         Some(path) => {
             let (s, stroke) = read_base_system(path, &files[0], &map).map_err(input_error)?;
             (Some(s), stroke)
@@ -259,17 +270,36 @@ pub fn run_system(
     let fit: Vec<bool> = (0..n).map(|i| n == 1 || i + 1 < n).collect();
     let settings = SystemSettings {
         base: base_system,
+        area_m2: o.area_m2,
         judge: true,
         ..SystemSettings::default()
     };
     let id = identify_system(&records, &fit, &settings)?;
-    if json {
+    let written = platen_report::render::write_outputs(
+        o.plot,
+        None,
+        &o.size,
+        || prediction_figures(&id),
+        |_, _| String::new(),
+    )?;
+    if o.json {
         let held_path =
             std::fs::canonicalize(&files[n - 1]).unwrap_or_else(|_| files[n - 1].clone());
-        let value = system_json(&id, &records[n - 1], &held_path, &map, base_stroke);
+        let mut value = system_json(&id, &records[n - 1], &held_path, &map, base_stroke);
+        if o.plot.is_some() {
+            value["figures"] = written
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .into();
+        }
         outln!("{}", serde_json::to_string_pretty(&value)?);
     } else {
         outln!("{}", system_text(&id).trim_end());
+        let w = written_text(&written, None);
+        if !w.is_empty() {
+            outln!("{}", w.trim_end());
+        }
     }
     Ok(())
 }

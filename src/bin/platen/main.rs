@@ -378,22 +378,26 @@ enum Command {
         /// stiffness of its own); a warning says when the bound is active.
         #[arg(long)]
         nonnegative_stiffness: bool,
-        /// Identify the table system's controller from closed-loop records instead (t_s,
-        /// command_u_m, u_m and, where recorded, drive, delta_p_pa, a_m_s2): the gains by
-        /// least squares on the drive; the last of two or more FILEs is held out and judged.
-        /// With --json, a runnable scenario with the identified controller. With --base, also
-        /// the plant (platen, storeys, valves, oil column) from cap_pressure_pa,
-        /// rod_pressure_pa, a_m_s2 and storey{i}_a_m_s2, judged by running the identified loop
-        /// on the held-out record's command.
-        #[arg(long, conflicts_with_all = ["manifest", "pressure_mpa", "plot", "report", "method"])]
+        /// Identify the table's whole loop from closed-loop records instead (t_s,
+        /// command_u_m, u_m, drive and, as tables record them, delta_p_pa or
+        /// cap_pressure_pa and rod_pressure_pa, a_m_s2, storey{i}_a_m_s2): the controller's
+        /// gains, the platen, the specimen, the valves and the oil column. The last of two or
+        /// more FILEs is held out: the identified loop runs on every record's command and is
+        /// judged against a linear black box and perfect tracking (--plot draws it). With
+        /// --json, a runnable scenario that is the identified table, each value's provenance.
+        #[arg(long, conflicts_with_all = ["manifest", "pressure_mpa", "report", "method"])]
         system: bool,
         /// With --system: the table's geometry from its drawings (actuator count and areas,
         /// valve count and rated drop, supply and return pressures, bulk modulus), as a
         /// scenario with a table_system or a table_system object (e.g. {"preset":
-        /// "lhpost-2008", "actuator": {…}}). Without it only the gains are identified: the
-        /// records show the plant only in ratios to the actuator area.
+        /// "lhpost-2008", "actuator": {…}}). Without it the plant is identified in ratios to
+        /// the actuator area, laid on --area-m2 or a nominal area (listed as assumed).
         #[arg(long, value_name = "FILE.json", requires = "system")]
         base: Option<PathBuf>,
+        /// With --system and without --base: the actuator's area, m², when it is known
+        /// without the rest of the drawings (the plant's absolute scale).
+        #[arg(long, value_name = "M2", requires = "system", conflicts_with = "base")]
+        area_m2: Option<f64>,
         #[command(flatten)]
         size: plot::SizeArgs,
     },
@@ -616,8 +620,21 @@ fn run(command: Command) -> anyhow::Result<()> {
             json,
             system: true,
             base,
+            area_m2,
+            plot,
+            size,
             ..
-        } => identify::run_system(&files, columns.as_deref(), base.as_deref(), json),
+        } => identify::run_system(
+            &files,
+            &identify::SystemOptions {
+                columns: columns.as_deref(),
+                base: base.as_deref(),
+                area_m2,
+                json,
+                plot: plot.as_deref(),
+                size: size.size(),
+            },
+        ),
         Command::Identify {
             files,
             pressure_mpa,
@@ -633,6 +650,7 @@ fn run(command: Command) -> anyhow::Result<()> {
             nonnegative_stiffness,
             system: _,
             base: _,
+            area_m2: _,
             size,
         } => identify::run(&identify::Options {
             files: &files,

@@ -1,65 +1,117 @@
-//! The plant of the loop (platen, specimen, valves, oil column) identified from records that
-//! carry the chamber pressures and the accelerations, and the identified loop judged by
-//! running it on a held-out record's command.
+//! The plant of the loop (platen, specimen, valves, oil column) identified from what tables
+//! record: the command, the displacement, the drive, the pressure difference `Δp` *or* the
+//! two chamber pressures, and the accelerations of the table and, where recorded, of the
+//! storeys.
 //!
-//! # What the records can show, and what is taken from the drawings
+//! # What the records can show, and what is taken from the drawings or assumed
 //!
 //! Scaling every area by `s` and the masses, forces, valve flows, chamber volumes and leakage
 //! by `s` as well leaves the motion unchanged: without the actuator geometry only ratios to
 //! the area are visible. The geometry a lab knows from its drawings (actuator count, cap and
 //! rod areas, valve count, rated pressure drop, supply and return pressures, the oil's bulk
-//! modulus) comes from a *base* table system ([`super::SystemSettings::base`]); everything
-//! else is fitted:
+//! modulus) comes from a *base* table system ([`super::SystemSettings::base`]) when given.
+//! Without it the plant is laid on a nominal geometry, every value of which is listed as
+//! `assumed` ([`super::ValueProvenance`]): one double-ended actuator of
+//! [`NOMINAL_AREA_M2`] (or the area given alone, [`super::SystemSettings::area_m2`]), one
+//! valve rated at [`NOMINAL_RATED_DROP_PA`], supply [`NOMINAL_SUPPLY_PRESSURE_PA`], return
+//! [`NOMINAL_RETURN_PRESSURE_PA`], bulk modulus [`NOMINAL_BULK_MODULUS_PA`]. The masses,
+//! forces, flows and volumes then scale with the area; the motion, the oil column, the loop's
+//! response and every prediction do not. With both chamber pressures and no base the rod
+//! side's share of the area is identified (a regressor of the force balance); with `Δp`
+//! alone the actuator is double-ended (`Δp` gives the force only then).
 //!
 //! * **Platen and specimen masses, stiffness, viscous and Coulomb friction**: linear least
-//!   squares of `F_A = M·a + C·v + K·u + F_μ·sgn(v) + Σ mᵢ·aᵢ` with
-//!   `F_A = n(A_a·p_a − A_b·p_b)` from the recorded pressures, `v` the central difference of
-//!   `u`, `a`, `aᵢ` the recorded accelerations, over the samples with `|v| ≥`
-//!   [`SLIP_SPEED_M_S`] (where the friction is surely `±F_μ`, not a stick reaction).
+//!   squares of `F_A = M·a + C·v + K·u + F_μ·sgn(v) + Σ mᵢ·aᵢ`, `F_A = n·A·Δp` or
+//!   `n(A_a·p_a − A_b·p_b)`, `v` the central difference of `u`, over the samples with
+//!   `|v| ≥` [`SLIP_SPEED_M_S`] (where the friction is surely `±F_μ`, not a stick reaction),
+//!   every term through the same zero-phase low-pass at [`MECHANICS_LOWPASS_FRACTION`] of the
+//!   sample rate (fourth-order Butterworth, forward and backward): content the command does
+//!   not drive (hydraulic noise, pumps, an accelerometer's own resonances) lies above it, and
+//!   in a regressor it would bias the masses low (errors in variables). `C`, `F_μ` and `K`
+//!   are constrained `≥ 0`.
 //! * **Storeys' stiffness and damping**: storey `j`'s equation
 //!   `Σ_{i≥j} mᵢ·aᵢ = −k_j·δ_j − c_j·δ̇_j` (`δ_j` the drift, the double integral of
 //!   `a_j − a_{j−1}`, `a₀` the table's) with both sides passed through the same filter
 //!   `s²/(s + ω₀)²` (Tustin, `ω₀ = 2π·`[`DRIFT_HIGHPASS_HZ`]): the drift side becomes
 //!   `(a_j − a_{j−1})/(s + ω₀)²`, a stable filter of the record, so no drift is integrated
 //!   open loop. The records start at rest, so the causal filters start exact.
-//! * **Valves and oil column**: each chamber's continuity,
-//!   `A_a·v + A_a·u·ṗ_a/β = K·x_v·√drop_a − C_L·Δp − (V_a0/β)·ṗ_a` (and the rod side's),
-//!   linear in the land coefficient `K`, the leakage `C_L` and the compliances `V/β`, with
-//!   every term passed through the same low-pass `ω_c²/(s² + 2ζω_c s + ω_c²)`
-//!   (`ω_c = 2π·`[`CONTINUITY_LOWPASS_HZ`], Tustin) so that `ṗ` and `v` come out of the
-//!   filter's own state instead of differentiated noise. `x_v` is the recorded drive through
-//!   the spool (pure delay, then second order), its delay, natural frequency and damping
-//!   chosen from a grid by the least residual. Only `V/β` is visible (the `u·ṗ/β` term is a
-//!   fraction of a percent at these strokes): `β` is the base's and the volumes follow.
+//! * **Valves and oil column**: with both pressures, each chamber's continuity
+//!   `A_a·v + A_a·u·ṗ_a/β = K·x_v·√drop_a − C_L·Δp − (V_a0/β)·ṗ_a` (and the rod side's); with
+//!   `Δp` alone, the load flow of the double-ended actuator
+//!   `A·v = K·x_v·√((P_s − P_R − sgn(x_v)·Δp)/2) − C_L·Δp − (V₀/2β)·Δṗ` (the chambers' sum of
+//!   pressures stays `P_s + P_R`). Both are linear in the land coefficient `K`, the leakage
+//!   `C_L` and the compliances `V/β`, every term through the same low-pass
+//!   `ω_c²/(s² + 2ζω_c s + ω_c²)` (`ω_c = 2π·min(`[`CONTINUITY_LOWPASS_HZ`]`, f_s/5)`,
+//!   Tustin) so that `ṗ` and `v` come out of the filter's own state instead of differentiated
+//!   noise. `x_v` is the recorded drive through the spool (pure delay, then second order),
+//!   its delay, natural frequency and damping chosen from a grid by the least residual. Only
+//!   `V/β` is visible (the `u·ṗ/β` term is a fraction of a percent at these strokes): `β` is
+//!   the base's (or the nominal) and the volumes follow.
 //!
-//! The identified loop is judged by running it ([`platen_integrate::forward_closed_loop`]) on
-//! each held-out record's command and comparing the achieved table acceleration and
-//! displacement with the record's.
+//! Every linear fit carries standard errors from its residuals' own correlation
+//! ([`super::fit`]); they are listed per scenario value in [`IdentifiedPlant::std_errors`].
+
+use std::collections::BTreeMap;
 
 use nalgebra::{DMatrix, SymmetricEigen};
-use platen_integrate::{
-    forward_closed_loop, LoopMethod, LoopRun, Motion, Sample, SampleSink, State,
-};
 use platen_model::{IdentifiedParams, Specimen, Storey};
-use platen_system::TableSystem;
+use platen_signal::{ButterworthLowpass, ZeroPhaseFilter};
+use platen_system::{Actuator, Controller, ServoValve, Supply, TableSystem};
 
-use super::{solve, SystemRecord};
+use super::fit::{Design, LinearFit};
+use super::skew::{self, ChannelSkew, MIN_APPLIED_SAMPLES, PRESSURE_SHIFT_GRID};
+use super::{SystemRecord, SystemSettings};
+use crate::error::{IdentError, Result};
 
 /// Samples slower than this are left out of the mechanics fit (the friction there may be a
 /// stick reaction, not `±F_μ`), m/s.
 pub const SLIP_SPEED_M_S: f64 = 0.01;
-/// Corner of the `s²/(s + ω₀)²` filter on the storey equations, Hz.
-pub const DRIFT_HIGHPASS_HZ: f64 = 0.3;
-/// Corner of the low-pass on the continuity equations, Hz.
+/// Corner of the `s²/(s + ω₀)²` filter on the storey equations, Hz. The drift regressor is
+/// the relative acceleration through `1/(s + ω₀)²`, whose gain is flat below `ω₀`: the
+/// accelerometers' noise there, integrated twice, would be in the regressor and bias the
+/// stiffness low (errors in variables). The noise's share of the regressor is least for `ω₀`
+/// near the specimen's modes; 2 Hz is below the first mode of the specimens shake tables
+/// carry and keeps that share small (on the small table's records, where the frame's first
+/// mode is at 6.5 Hz, a 0.3 Hz corner gave its stiffness 33 % low).
+pub const DRIFT_HIGHPASS_HZ: f64 = 2.0;
+/// Highest corner of the low-pass on the continuity equations, Hz (a fifth of the sample
+/// rate below 500 Hz).
 pub const CONTINUITY_LOWPASS_HZ: f64 = 100.0;
-/// Integration steps per controller period in the judging runs.
-pub const JUDGE_STEPS_PER_PERIOD: u32 = 16;
+/// Corner of the zero-phase low-pass on the force balance, as a fraction of the sample rate
+/// (20.5 Hz at 204.8 Hz, 102 Hz at 1024 Hz): below the content a command does not drive,
+/// above the platen's motion.
+pub const MECHANICS_LOWPASS_FRACTION: f64 = 0.1;
 /// Spool natural frequencies tried, Hz.
 pub const SPOOL_FREQUENCY_GRID_HZ: [f64; 6] = [60.0, 100.0, 150.0, 200.0, 300.0, 500.0];
 /// Spool damping ratios tried.
 pub const SPOOL_DAMPING_GRID: [f64; 3] = [0.5, 0.7, 0.9];
 /// Valve delays tried, in sixteenths of the controller period.
 pub const DELAY_GRID_SIXTEENTHS: [u32; 5] = [0, 4, 8, 12, 16];
+/// The actuator area the plant is laid on without drawings, m² (assumed: the records show
+/// only ratios to it).
+pub const NOMINAL_AREA_M2: f64 = 0.01;
+/// The supply pressure assumed without drawings, Pa (a usual lab supply; its effect on the
+/// motion is through `√(P_s − P_R ∓ Δp)` only, small while `Δp ≪ P_s`).
+pub const NOMINAL_SUPPLY_PRESSURE_PA: f64 = 21e6;
+/// The return pressure assumed without drawings, Pa.
+pub const NOMINAL_RETURN_PRESSURE_PA: f64 = 0.3e6;
+/// The oil's bulk modulus assumed without drawings, Pa (mineral oil with some air; only
+/// `V/β` is identified, the volumes follow from it).
+pub const NOMINAL_BULK_MODULUS_PA: f64 = 1.5e9;
+/// The valves' rated pressure drop assumed without drawings, Pa (the usual rating: the rated
+/// flow is quoted at it).
+pub const NOMINAL_RATED_DROP_PA: f64 = 7e6;
+
+/// The stroke limit of an identified table without drawings: this share of the stroke its
+/// identified chamber volumes allow (the chambers must keep oil at the ends).
+pub const STROKE_FRACTION_OF_ROOM: f64 = 0.9;
+
+/// The stroke limit of an identified table system: [`STROKE_FRACTION_OF_ROOM`] of the
+/// stroke its chambers allow (`min(V_a0/A_a, V_b0/A_b)`), m.
+pub fn stroke_limit_m(system: &TableSystem) -> f64 {
+    let a = &system.actuator;
+    STROKE_FRACTION_OF_ROOM * (a.cap_volume_m3 / a.cap_area_m2).min(a.rod_volume_m3 / a.rod_area_m2)
+}
 
 /// The platen's mechanics found by least squares.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -78,6 +130,8 @@ pub struct IdentifiedMechanics {
     pub force_rms_residual_n: f64,
     /// That RMS relative to the actuator force's RMS.
     pub force_nrmse: f64,
+    /// The rod side's area over the cap side's, when identified (both pressures, no base).
+    pub rod_to_cap_area_ratio: Option<f64>,
 }
 
 /// One identified storey, with its fit.
@@ -139,26 +193,21 @@ pub struct IdentifiedHydraulics {
     /// Oil-column frequency with the specimen as a rigid payload (what `platen simulate`
     /// reports), Hz.
     pub oil_column_frequency_with_specimen_hz: f64,
+    /// The pressure channels the continuity used: `"chamber pressures"` or `"delta_p"`.
+    pub from: &'static str,
 }
 
-/// The identified loop run on one record's command.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct Prediction {
-    /// The record's name.
-    pub name: String,
-    /// Whether the record was used in the fit.
-    pub fitted: bool,
-    /// RMS of the recorded table acceleration, m/s².
-    pub acceleration_rms_m_s2: f64,
-    /// RMS of recorded less predicted table acceleration, m/s².
-    pub acceleration_rms_error_m_s2: f64,
-    /// The accelerometer's noise estimated from the record (RMS of the second difference
-    /// over √6: an upper bound, the signal's own curvature included), m/s².
-    pub acceleration_noise_m_s2: f64,
-    /// RMS of the recorded displacement, m.
-    pub displacement_rms_m: f64,
-    /// RMS of recorded less predicted displacement, m.
-    pub displacement_rms_error_m: f64,
+/// Where the plant's absolute scale comes from.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Geometry {
+    /// The cap-side area the plant is laid on, m².
+    pub area_m2: f64,
+    /// `"given"` (the base, or the area alone) or `"assumed"` (nominal: the masses, forces,
+    /// flows and volumes scale with it; the motion does not).
+    pub area_source: &'static str,
+    /// Whether the rest of the geometry (counts, rated drop, supply and return pressures,
+    /// bulk modulus) comes from a base (else nominal, assumed).
+    pub base_given: bool,
 }
 
 /// What the plant fit found (see the module docs).
@@ -172,9 +221,14 @@ pub struct IdentifiedPlant {
     pub specimen_modes: Vec<Mode>,
     /// Valves and oil column.
     pub hydraulics: Option<IdentifiedHydraulics>,
-    /// The identified loop on each record's command.
-    pub predictions: Vec<Prediction>,
-    /// The identified table system (the base's geometry, the fitted rest).
+    /// The absolute scale.
+    pub geometry: Geometry,
+    /// Standard errors of the identified values, by their path in the printed scenario
+    /// (`model.identified.effective_mass_kg`, `specimen.storeys[0].stiffness_n_per_m`,
+    /// `table_system.servo_valve.rated_flow_m3_s`, …).
+    pub std_errors: BTreeMap<String, f64>,
+    /// The identified table system (the base's or nominal geometry, the fitted rest), when
+    /// the valves were identified.
     #[serde(skip)]
     pub system: Option<TableSystem>,
     /// The identified platen model.
@@ -185,23 +239,129 @@ pub struct IdentifiedPlant {
     pub specimen: Option<Specimen>,
 }
 
-/// The recorded actuator force `n(A_a·p_a − A_b·p_b)` (or `n·A·Δp` for a double-ended
-/// actuator with only `Δp`), N.
-fn actuator_force(r: &SystemRecord, base: &TableSystem) -> Option<Vec<f64>> {
-    let a = &base.actuator;
-    let n = f64::from(a.count);
-    match (&r.cap_pressure_pa, &r.rod_pressure_pa, &r.delta_p_pa) {
-        (Some(pa), Some(pb), _) => Some(
-            pa.iter()
-                .zip(pb)
-                .map(|(pa, pb)| n * (a.cap_area_m2 * pa - a.rod_area_m2 * pb))
-                .collect(),
-        ),
-        (_, _, Some(dp)) if a.cap_area_m2 == a.rod_area_m2 => {
-            Some(dp.iter().map(|dp| n * a.cap_area_m2 * dp).collect())
+/// The geometry the plant is laid on ([`super::SystemSettings`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct PlantInput {
+    /// The base (given, or nominal).
+    pub base: TableSystem,
+    /// Whether `base` is the lab's (else nominal).
+    pub base_given: bool,
+    /// Whether the area was given (with the base, or alone).
+    pub area_given: bool,
+}
+
+impl PlantInput {
+    /// The base of `settings`, else a nominal one of one double-ended actuator.
+    pub fn new(settings: &SystemSettings, first: &SystemRecord) -> Self {
+        if let Some(base) = settings.base {
+            return Self {
+                base,
+                base_given: true,
+                area_given: true,
+            };
         }
-        _ => None,
+        let area = settings.area_m2.unwrap_or(NOMINAL_AREA_M2);
+        let h = first.period_s().unwrap_or(1e-3);
+        let base = TableSystem {
+            actuator: Actuator {
+                count: 1,
+                cap_area_m2: area,
+                rod_area_m2: area,
+                // Replaced by the fitted ones; placeholders for a valid system.
+                cap_volume_m3: area,
+                rod_volume_m3: area,
+                leakage_m3_s_per_pa: 0.0,
+            },
+            servo_valve: ServoValve {
+                count: 1,
+                rated_flow_m3_s: 1e-3,
+                rated_pressure_drop_pa: NOMINAL_RATED_DROP_PA,
+                natural_frequency_hz: 100.0,
+                damping_ratio: 0.7,
+                delay_s: 0.0,
+            },
+            oil_bulk_modulus_pa: NOMINAL_BULK_MODULUS_PA,
+            supply_pressure_pa: NOMINAL_SUPPLY_PRESSURE_PA,
+            return_pressure_pa: NOMINAL_RETURN_PRESSURE_PA,
+            supply: Supply::Constant,
+            controller: Controller {
+                sample_rate_hz: 1.0 / h,
+                displacement_gain_per_m: 0.0,
+                integral_gain_per_m_s: 0.0,
+                velocity_feedforward_s_per_m: 0.0,
+                acceleration_feedforward_s2_per_m: 0.0,
+                velocity_feedback_s_per_m: 0.0,
+                acceleration_feedback_s2_per_m: 0.0,
+                delta_p_gain_per_pa: 0.0,
+                delta_p_highpass_hz: 0.0,
+            },
+        };
+        Self {
+            base,
+            base_given: false,
+            area_given: settings.area_m2.is_some(),
+        }
     }
+}
+
+/// How the actuator force comes from a record's pressures.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum ForceFrom {
+    /// `n(A_a·p_a − A_b·p_b)` with the base's areas.
+    Chambers,
+    /// `n·A·(p_a − r·p_b)` with `r` fitted (both pressures, no base).
+    ChambersRatioFree,
+    /// `n·A·Δp` (a double-ended actuator).
+    DeltaP,
+}
+
+/// How the fitted records give the force, or why they cannot.
+fn force_from(
+    records: &[SystemRecord],
+    fitted: &[usize],
+    input: &PlantInput,
+) -> std::result::Result<ForceFrom, &'static str> {
+    let a = &input.base.actuator;
+    let chambers = fitted
+        .iter()
+        .all(|&i| records[i].cap_pressure_pa.is_some() && records[i].rod_pressure_pa.is_some());
+    let dp = fitted.iter().all(|&i| records[i].delta_p_pa.is_some());
+    if chambers {
+        Ok(if input.base_given {
+            ForceFrom::Chambers
+        } else {
+            ForceFrom::ChambersRatioFree
+        })
+    } else if dp && a.cap_area_m2 == a.rod_area_m2 {
+        Ok(ForceFrom::DeltaP)
+    } else if dp {
+        Err(
+            "the base's actuator is single-ended (cap and rod areas differ): delta_p_pa alone \
+             does not give its force; record cap_pressure_pa and rod_pressure_pa",
+        )
+    } else {
+        Err(
+            "no pressure recorded in every fitted record: the actuator force needs \
+             delta_p_pa (a double-ended actuator) or cap_pressure_pa and rod_pressure_pa",
+        )
+    }
+}
+
+/// The zero-phase low-pass of the force balance at `h`.
+fn mechanics_filter(r: &SystemRecord, h: f64) -> Result<ButterworthLowpass> {
+    ButterworthLowpass::new(4, MECHANICS_LOWPASS_FRACTION / h, 1.0 / h).map_err(|source| {
+        IdentError::Signal {
+            test: r.name.clone(),
+            source,
+        }
+    })
+}
+
+fn filtered(f: &ButterworthLowpass, r: &SystemRecord, x: &[f64]) -> Result<Vec<f64>> {
+    f.apply(x).map_err(|source| IdentError::Signal {
+        test: r.name.clone(),
+        source,
+    })
 }
 
 fn central_velocity(u: &[f64], h: f64) -> Vec<f64> {
@@ -213,44 +373,150 @@ fn central_velocity(u: &[f64], h: f64) -> Vec<f64> {
     v
 }
 
-/// The mechanics fit over `recs`; returns the mechanics and the storeys' masses.
-fn fit_mechanics(
-    recs: &[(&SystemRecord, f64, Vec<f64>)],
+/// The force balance's design over the fitted records, the pressures shifted earlier by
+/// `shift_s`. Columns: `[M, C, K, F_μ, m₁ … m_s, (r)]`.
+fn mechanics_design(
+    records: &[SystemRecord],
+    periods: &[f64],
+    fitted: &[usize],
+    input: &PlantInput,
+    from: ForceFrom,
     storeys: usize,
-) -> Option<(IdentifiedMechanics, Vec<f64>)> {
-    let mut x = Vec::new();
-    let mut y = Vec::new();
-    for (r, h, force) in recs {
-        let a = r.a_m_s2.as_ref()?;
-        let v = central_velocity(&r.u_m, *h);
-        for i in 2..r.u_m.len() - 2 {
+    shift_s: f64,
+) -> Result<Design> {
+    let act = &input.base.actuator;
+    let n_act = f64::from(act.count);
+    let ratio = from == ForceFrom::ChambersRatioFree;
+    let m = 4 + storeys + usize::from(ratio);
+    let mut design = Design::new(m);
+    for &k in fitted {
+        let r = &records[k];
+        let h = periods[k];
+        let lp = mechanics_filter(r, h)?;
+        let s = shift_s / h;
+        let sh = |x: &Option<Vec<f64>>| -> Result<Vec<f64>> {
+            skew::shift(r, x.as_deref().unwrap_or(&[]), s)
+        };
+        let (force, extra): (Vec<f64>, Option<Vec<f64>>) = match from {
+            ForceFrom::DeltaP => (
+                sh(&r.delta_p_pa)?
+                    .iter()
+                    .map(|dp| n_act * act.cap_area_m2 * dp)
+                    .collect(),
+                None,
+            ),
+            ForceFrom::Chambers => {
+                let (pa, pb) = (sh(&r.cap_pressure_pa)?, sh(&r.rod_pressure_pa)?);
+                (
+                    pa.iter()
+                        .zip(&pb)
+                        .map(|(pa, pb)| n_act * (act.cap_area_m2 * pa - act.rod_area_m2 * pb))
+                        .collect(),
+                    None,
+                )
+            }
+            ForceFrom::ChambersRatioFree => {
+                let (pa, pb) = (sh(&r.cap_pressure_pa)?, sh(&r.rod_pressure_pa)?);
+                let f = |p: &[f64]| -> Vec<f64> {
+                    p.iter().map(|p| n_act * act.cap_area_m2 * p).collect()
+                };
+                (f(&pa), Some(f(&pb)))
+            }
+        };
+        let Some(a) = &r.a_m_s2 else { continue };
+        let v = central_velocity(&r.u_m, h);
+        let sgn: Vec<f64> = v.iter().map(|v| v.signum()).collect();
+        let y = filtered(&lp, r, &force)?;
+        let mut cols = vec![
+            filtered(&lp, r, a)?,
+            filtered(&lp, r, &v)?,
+            filtered(&lp, r, &r.u_m)?,
+            filtered(&lp, r, &sgn)?,
+        ];
+        for st in r.storey_a_m_s2.iter().take(storeys) {
+            cols.push(filtered(&lp, r, st)?);
+        }
+        if let Some(e) = &extra {
+            // F = n·A·(p_a − r·p_b): the rod-side term moves to the regressors.
+            cols.push(filtered(&lp, r, e)?.iter().map(|x| -x).collect());
+        }
+        let n = r.u_m.len();
+        let edge = ((0.5 / h) as usize).min(n / 4);
+        let mut row = vec![0.0; m];
+        for i in edge..n - edge {
             if v[i].abs() < SLIP_SPEED_M_S {
                 continue;
             }
-            let mut row = vec![a[i], v[i], r.u_m[i], v[i].signum()];
-            for s in r.storey_a_m_s2.iter().take(storeys) {
-                row.push(s[i]);
+            for (c, col) in row.iter_mut().zip(&cols) {
+                *c = col[i];
             }
-            x.push(row);
-            y.push(force[i]);
+            design.push(&row, y[i], k, i);
         }
     }
-    let (c, ss) = solve(&x, &y)?;
-    let n = y.len() as f64;
-    let rms_f = (y.iter().map(|f| f * f).sum::<f64>() / n).sqrt();
-    let rms_e = (ss / n).sqrt();
-    Some((
-        IdentifiedMechanics {
-            effective_mass_kg: c[0],
-            viscous_coefficient: c[1],
-            stiffness_n_per_m: c[2],
-            coulomb_force_n: c[3],
-            samples: y.len(),
-            force_rms_residual_n: rms_e,
-            force_nrmse: rms_e / rms_f,
-        },
-        c[4..].to_vec(),
-    ))
+    Ok(design)
+}
+
+/// The constraints of the force balance: `C, K, F_μ ≥ 0`.
+fn mechanics_signs(m: usize) -> Vec<bool> {
+    (0..m).map(|j| (1..=3).contains(&j)).collect()
+}
+
+/// The mechanics fit, the pressures' skew found by the force balance and corrected in
+/// `records` (and reported).
+#[allow(clippy::too_many_arguments)]
+fn fit_mechanics(
+    records: &mut [SystemRecord],
+    periods: &[f64],
+    fitted: &[usize],
+    input: &PlantInput,
+    from: ForceFrom,
+    storeys: usize,
+    skew_report: &mut Vec<ChannelSkew>,
+) -> Result<Option<LinearFit>> {
+    let m = 4 + storeys + usize::from(from == ForceFrom::ChambersRatioFree);
+    let signs = mechanics_signs(m);
+    let none = vec![false; m];
+    let h0 = periods[fitted[0]];
+    let mut grid = Vec::with_capacity(PRESSURE_SHIFT_GRID.len());
+    for &s in &PRESSURE_SHIFT_GRID {
+        let d = mechanics_design(records, periods, fitted, input, from, storeys, s * h0)?;
+        grid.push(d.fit(&signs, &none).map(|f| f.rss));
+    }
+    let best = grid
+        .iter()
+        .enumerate()
+        .filter_map(|(i, r)| r.map(|r| (i, r)))
+        .min_by(|a, b| a.1.total_cmp(&b.1));
+    let Some((ib, rb)) = best else {
+        return Ok(None);
+    };
+    let step = PRESSURE_SHIFT_GRID[1] - PRESSURE_SHIFT_GRID[0];
+    let samples = match (
+        ib.checked_sub(1).and_then(|i| grid[i]),
+        grid.get(ib + 1).copied().flatten(),
+    ) {
+        (Some(ym), Some(yp)) => skew::parabola_vertex(PRESSURE_SHIFT_GRID[ib], step, ym, rb, yp),
+        _ => PRESSURE_SHIFT_GRID[ib],
+    };
+    let applied = samples.abs() > MIN_APPLIED_SAMPLES;
+    let column = match from {
+        ForceFrom::DeltaP => "delta_p_pa",
+        _ => "cap_pressure_pa, rod_pressure_pa",
+    };
+    skew_report.push(ChannelSkew {
+        column: column.into(),
+        delay_s: samples * h0,
+        std_error_s: None,
+        delay_samples: samples,
+        applied,
+        method: "the shift that fits the platen's force balance best (a grid of half samples, \
+                 then a parabola through the best three)",
+    });
+    if applied {
+        skew::correct_pressures(records, periods, samples * h0)?;
+    }
+    let design = mechanics_design(records, periods, fitted, input, from, storeys, 0.0)?;
+    Ok(design.fit(&signs, &none))
 }
 
 /// The second-order filter `1/(s² + 2ζω s + ω²)` of `x` by the trapezoidal rule, started at
@@ -281,18 +547,42 @@ fn second_order(x: &[f64], h: f64, w: f64, zeta: f64) -> [Vec<f64>; 3] {
     [q, qd, qdd]
 }
 
-/// The storeys' stiffness and damping (masses given), bottom first.
+/// The storey fit's filters run at this many times the records' rate: the trapezoid rule's
+/// frequency warping, `(ωh)²/6` relative on a double integral (0.66 % at 6.5 Hz on 204.8 Hz
+/// records, which showed as a stiffness 0.7 % high), falls with the square of the step.
+const UPSAMPLE: usize = 4;
+
+/// `x` at `UPSAMPLE` times its rate: band-limited interpolation
+/// ([`platen_signal::advance`] by each fraction of a sample, interleaved).
+fn upsampled(x: &[f64]) -> Option<Vec<f64>> {
+    let shifted: Vec<Vec<f64>> = (1..UPSAMPLE)
+        .map(|k| platen_signal::advance(x, k as f64 / UPSAMPLE as f64).ok())
+        .collect::<Option<_>>()?;
+    let mut out = Vec::with_capacity(UPSAMPLE * x.len());
+    for i in 0..x.len() {
+        out.push(x[i]);
+        for s in &shifted {
+            out.push(s[i]);
+        }
+    }
+    Some(out)
+}
+
+/// The storeys' stiffness and damping (masses given), bottom first, with the standard errors
+/// of stiffness and damping.
 fn fit_storeys(
-    recs: &[(&SystemRecord, f64, Vec<f64>)],
+    records: &[SystemRecord],
+    periods: &[f64],
+    fitted: &[usize],
     masses: &[f64],
-) -> Option<Vec<IdentifiedStorey>> {
+) -> Option<Vec<(IdentifiedStorey, [f64; 2])>> {
     let w0 = std::f64::consts::TAU * DRIFT_HIGHPASS_HZ;
     let ns = masses.len();
     let mut out = Vec::with_capacity(ns);
     for j in 0..ns {
-        let mut x = Vec::new();
-        let mut y = Vec::new();
-        for (r, h, _) in recs {
+        let mut design = Design::new(2);
+        for &k in fitted {
+            let (r, h) = (&records[k], periods[k]);
             let below = if j == 0 {
                 r.a_m_s2.as_ref()?
             } else {
@@ -304,26 +594,36 @@ fn fit_storeys(
                 .map(|(a, b)| a - b)
                 .collect();
             let shear: Vec<f64> = (0..r.u_m.len())
-                .map(|i| (j..ns).map(|k| masses[k] * r.storey_a_m_s2[k][i]).sum())
+                .map(|i| (j..ns).map(|s| masses[s] * r.storey_a_m_s2[s][i]).sum())
                 .collect();
-            // 1/(s+ω₀)²: ζ = 1.
-            let [d0, d1, _] = second_order(&rel, *h, w0, 1.0);
-            let [_, _, s2] = second_order(&shear, *h, w0, 1.0);
-            let skip = (2.0 / (DRIFT_HIGHPASS_HZ * *h)) as usize / 10;
-            for i in skip.min(r.u_m.len() / 4)..r.u_m.len() {
-                x.push(vec![-d0[i], -d1[i]]);
-                y.push(s2[i]);
+            // Both sides through the force balance's low-pass: what the command does not
+            // drive is left out, as there.
+            let lp = mechanics_filter(r, h).ok()?;
+            let (rel, shear) = (lp.apply(&rel).ok()?, lp.apply(&shear).ok()?);
+            // 1/(s+ω₀)²: ζ = 1, run at UPSAMPLE times the rate on the band-limited
+            // interpolation of both sides, then taken at the samples.
+            let (rel, shear) = (upsampled(&rel)?, upsampled(&shear)?);
+            let hu = h / UPSAMPLE as f64;
+            let [d0, d1, _] = second_order(&rel, hu, w0, 1.0);
+            let [_, _, s2] = second_order(&shear, hu, w0, 1.0);
+            let skip = (2.0 / (DRIFT_HIGHPASS_HZ * h)) as usize / 10;
+            let n = r.u_m.len();
+            // The last samples' interpolation reaches past the record: left out.
+            for i in skip.min(n / 4)..n - UPSAMPLE {
+                let j = UPSAMPLE * i;
+                design.push(&[-d0[j], -d1[j]], s2[j], k, i);
             }
         }
-        let (c, ss) = solve(&x, &y)?;
-        let n = y.len() as f64;
-        let rms = (y.iter().map(|v| v * v).sum::<f64>() / n).sqrt();
-        out.push(IdentifiedStorey {
-            mass_kg: masses[j],
-            stiffness_n_per_m: c[0],
-            damping_n_s_per_m: c[1],
-            shear_nrmse: (ss / n).sqrt() / rms,
-        });
+        let f = design.fit(&[true, true], &[false, false])?;
+        out.push((
+            IdentifiedStorey {
+                mass_kg: masses[j],
+                stiffness_n_per_m: f.coef[0],
+                damping_n_s_per_m: f.coef[1],
+                shear_nrmse: f.nrmse(),
+            },
+            [f.estimates[0].std_error, f.estimates[1].std_error],
+        ));
     }
     Some(out)
 }
@@ -401,32 +701,55 @@ fn root(dp: f64, laminar: f64) -> f64 {
     }
 }
 
-/// The filtered continuity rows of one record for one spool: `(rows, rhs)`.
+/// The spool-independent filtered terms of one record's continuity.
 struct Continuity {
-    /// Filtered `x_v·√drop` regressors need the spool; the rest is fixed per record.
+    /// `LP(Δp)`.
     lp_dp: Vec<f64>,
+    /// Chambers: `LP(ṗ_a)`, `LP(ṗ_b)`; `Δp` alone: `LP(Δṗ)/2` (twice).
     lp_dpa: Vec<f64>,
     lp_dpb: Vec<f64>,
+    /// Chambers: `A_a·(LP(v) + LP(u·ṗ_a)/β)` and the rod side's; `Δp` alone: `A·LP(v)`.
     rhs_a: Vec<f64>,
     rhs_b: Vec<f64>,
+    /// Whether the record's chambers are used (else its `Δp`).
+    chambers: bool,
+}
+
+/// The continuity's low-pass corner at period `h`, Hz.
+fn continuity_corner_hz(h: f64) -> f64 {
+    CONTINUITY_LOWPASS_HZ.min(0.2 / h)
 }
 
 fn lowpass(x: &[f64], h: f64) -> [Vec<f64>; 3] {
-    let w = std::f64::consts::TAU * CONTINUITY_LOWPASS_HZ;
+    let w = std::f64::consts::TAU * continuity_corner_hz(h);
     let [q, qd, qdd] = second_order(x, h, w, std::f64::consts::FRAC_1_SQRT_2);
     let s = |v: Vec<f64>| v.into_iter().map(|z| z * w * w).collect::<Vec<f64>>();
     [s(q), s(qd), s(qdd)]
 }
 
-fn continuity(r: &SystemRecord, h: f64, base: &TableSystem) -> Option<Continuity> {
-    let (pa, pb) = (r.cap_pressure_pa.as_ref()?, r.rod_pressure_pa.as_ref()?);
+fn continuity(r: &SystemRecord, h: f64, base: &TableSystem, chambers: bool) -> Option<Continuity> {
     let a = &base.actuator;
+    let [_, lp_v, _] = lowpass(&r.u_m, h);
+    if !chambers {
+        let dp = r.delta_p_pa.as_ref()?;
+        let [lp_dp, lp_ddp, _] = lowpass(dp, h);
+        let half: Vec<f64> = lp_ddp.iter().map(|x| 0.5 * x).collect();
+        let rhs: Vec<f64> = lp_v.iter().map(|v| a.cap_area_m2 * v).collect();
+        return Some(Continuity {
+            lp_dp,
+            lp_dpa: half.clone(),
+            lp_dpb: half,
+            rhs_a: rhs.clone(),
+            rhs_b: rhs,
+            chambers,
+        });
+    }
+    let (pa, pb) = (r.cap_pressure_pa.as_ref()?, r.rod_pressure_pa.as_ref()?);
     let beta = base.oil_bulk_modulus_pa;
     let dp: Vec<f64> = pa.iter().zip(pb).map(|(a, b)| a - b).collect();
     let [lp_dp, _, _] = lowpass(&dp, h);
     let [_, lp_dpa, _] = lowpass(pa, h);
     let [_, lp_dpb, _] = lowpass(pb, h);
-    let [_, lp_v, _] = lowpass(&r.u_m, h);
     // The small u·ṗ/β terms, with ṗ from the filtered pressure (unfiltered is noise).
     let upa: Vec<f64> = r.u_m.iter().zip(&lp_dpa).map(|(u, p)| u * p).collect();
     let upb: Vec<f64> = r.u_m.iter().zip(&lp_dpb).map(|(u, p)| u * p).collect();
@@ -444,196 +767,178 @@ fn continuity(r: &SystemRecord, h: f64, base: &TableSystem) -> Option<Continuity
         lp_dpb,
         rhs_a,
         rhs_b,
+        chambers,
     })
 }
 
-/// `(coefficients [K, C_L, V_a0/β, V_b0/β], residual², rhs², samples)` for one spool.
+/// The continuity fit for one spool: coefficients `[K, C_L, V_a0/β, V_b0/β]` (`Δp` alone:
+/// `[K, C_L, V₀/β]`), every one `≥ 0`.
 fn fit_continuity(
-    recs: &[(&SystemRecord, f64, Continuity)],
+    recs: &[(usize, &SystemRecord, f64, Continuity)],
     base: &TableSystem,
     spool_of: &dyn Fn(&[f64], f64) -> Vec<f64>,
-) -> Option<(Vec<f64>, f64, f64)> {
+) -> Option<LinearFit> {
     let laminar = platen_system::LAMINAR_FRACTION * base.servo_valve.rated_pressure_drop_pa;
     let (ps, pr) = (base.supply_pressure_pa, base.return_pressure_pa);
-    let mut x = Vec::new();
-    let mut y = Vec::new();
-    for (r, h, c) in recs {
-        let (pa, pb) = (r.cap_pressure_pa.as_ref()?, r.rod_pressure_pa.as_ref()?);
+    let chambers = recs.first()?.3.chambers;
+    let m = if chambers { 4 } else { 3 };
+    let mut design = Design::new(m);
+    for (k, r, h, c) in recs {
         let xv = spool_of(r.drive.as_ref()?, *h);
         let (mut qa, mut qb) = (vec![0.0; xv.len()], vec![0.0; xv.len()]);
-        for i in 0..xv.len() {
-            let (pa, pb) = (pa[i].max(0.0), pb[i].max(0.0));
-            (qa[i], qb[i]) = if xv[i] >= 0.0 {
-                (
-                    xv[i] * root(ps - pa, laminar),
-                    xv[i] * root(pb - pr, laminar),
-                )
-            } else {
-                (
-                    xv[i] * root(pa - pr, laminar),
-                    xv[i] * root(ps - pb, laminar),
-                )
-            };
+        if chambers {
+            let (pa, pb) = (r.cap_pressure_pa.as_ref()?, r.rod_pressure_pa.as_ref()?);
+            for i in 0..xv.len() {
+                let (pa, pb) = (pa[i].max(0.0), pb[i].max(0.0));
+                (qa[i], qb[i]) = if xv[i] >= 0.0 {
+                    (
+                        xv[i] * root(ps - pa, laminar),
+                        xv[i] * root(pb - pr, laminar),
+                    )
+                } else {
+                    (
+                        xv[i] * root(pa - pr, laminar),
+                        xv[i] * root(ps - pb, laminar),
+                    )
+                };
+            }
+        } else {
+            let dp = r.delta_p_pa.as_ref()?;
+            for i in 0..xv.len() {
+                let drop = 0.5 * (ps - pr - xv[i].signum() * dp[i]);
+                qa[i] = xv[i] * root(drop, laminar);
+            }
         }
         let [lqa, _, _] = lowpass(&qa, *h);
-        let [lqb, _, _] = lowpass(&qb, *h);
+        let [lqb, _, _] = if chambers {
+            lowpass(&qb, *h)
+        } else {
+            [Vec::new(), Vec::new(), Vec::new()]
+        };
         let skip = (0.05 / *h) as usize;
         for i in skip..xv.len() {
-            x.push(vec![lqa[i], -c.lp_dp[i], -c.lp_dpa[i], 0.0]);
-            y.push(c.rhs_a[i]);
-            x.push(vec![lqb[i], -c.lp_dp[i], 0.0, c.lp_dpb[i]]);
-            y.push(c.rhs_b[i]);
-        }
-    }
-    let (c, ss) = normal_equations(&x, &y)?;
-    let yy = y.iter().map(|v| v * v).sum::<f64>();
-    Some((c, ss, yy))
-}
-
-/// Least squares by the column-scaled normal equations (small, well-conditioned problems
-/// solved many times: the grid search); the coefficients and the residual's sum of squares.
-fn normal_equations(x: &[Vec<f64>], y: &[f64]) -> Option<(Vec<f64>, f64)> {
-    let m = x.first()?.len();
-    let mut scale = vec![0.0; m];
-    for row in x {
-        for (s, v) in scale.iter_mut().zip(row) {
-            *s += v * v;
-        }
-    }
-    let scale: Vec<f64> = scale
-        .iter()
-        .map(|s| if *s > 0.0 { s.sqrt() } else { 1.0 })
-        .collect();
-    let mut ata = DMatrix::<f64>::zeros(m, m);
-    let mut atb = nalgebra::DVector::<f64>::zeros(m);
-    for (row, yi) in x.iter().zip(y) {
-        for i in 0..m {
-            let xi = row[i] / scale[i];
-            atb[i] += xi * yi;
-            for j in 0..m {
-                ata[(i, j)] += xi * row[j] / scale[j];
+            if chambers {
+                design.push(&[lqa[i], -c.lp_dp[i], -c.lp_dpa[i], 0.0], c.rhs_a[i], *k, i);
+                design.push(&[lqb[i], -c.lp_dp[i], 0.0, c.lp_dpb[i]], c.rhs_b[i], *k, i);
+            } else {
+                design.push(&[lqa[i], -c.lp_dp[i], -c.lp_dpa[i]], c.rhs_a[i], *k, i);
             }
         }
     }
-    let c = ata.cholesky()?.solve(&atb);
-    let coef: Vec<f64> = (0..m).map(|j| c[j] / scale[j]).collect();
-    let ss = x
-        .iter()
-        .zip(y)
-        .map(|(row, yi)| {
-            let p: f64 = row.iter().zip(&coef).map(|(a, b)| a * b).sum();
-            (yi - p) * (yi - p)
-        })
-        .sum();
-    Some((coef, ss))
+    design.fit(&vec![true; m], &vec![false; m])
 }
 
-/// Collects the table's displacement and acceleration of a run.
-#[derive(Default)]
-struct Collect {
-    u: Vec<f64>,
-    a: Vec<f64>,
-}
-
-impl SampleSink for Collect {
-    fn accept(&mut self, s: &Sample) {
-        self.u.push(s.u_m);
-        self.a.push(s.a_m_s2);
-    }
-}
-
-fn rms(x: impl Iterator<Item = f64>) -> f64 {
-    let (mut s, mut n) = (0.0, 0usize);
-    for v in x {
-        s += v * v;
-        n += 1;
-    }
-    (s / n.max(1) as f64).sqrt()
-}
-
-/// Runs the identified loop on `r`'s command and compares it with the record.
-pub fn predict(
-    r: &SystemRecord,
-    fitted: bool,
-    system: &TableSystem,
-    model: &IdentifiedParams,
-    specimen: Option<&Specimen>,
-) -> Option<Prediction> {
-    let a_rec = r.a_m_s2.as_ref()?;
-    let model = model.build().ok()?;
-    let command = Motion::from_displacement(r.t_s.clone(), r.command_u_m.clone()).ok()?;
-    let run = LoopRun {
-        system,
-        specimen,
-        command: &command,
-        method: LoopMethod::Rk4 {
-            steps_per_period: JUDGE_STEPS_PER_PERIOD,
-        },
-        initial: State {
-            u_m: r.command_u_m[0],
-            v_m_s: 0.0,
-        },
-    };
-    let mut sink = Collect::default();
-    forward_closed_loop(&model, &run, r.t_s.len(), &mut sink).ok()?;
-    if sink.a.len() != a_rec.len() {
-        return None;
-    }
-    let n = a_rec.len();
-    let noise = rms((1..n - 1).map(|i| a_rec[i + 1] - 2.0 * a_rec[i] + a_rec[i - 1])) / 6f64.sqrt();
-    Some(Prediction {
-        name: r.name.clone(),
-        fitted,
-        acceleration_rms_m_s2: rms(a_rec.iter().copied()),
-        acceleration_rms_error_m_s2: rms(a_rec.iter().zip(&sink.a).map(|(x, y)| x - y)),
-        acceleration_noise_m_s2: noise,
-        displacement_rms_m: rms(r.u_m.iter().copied()),
-        displacement_rms_error_m: rms(r.u_m.iter().zip(&sink.u).map(|(x, y)| x - y)),
-    })
-}
-
-/// Fits the plant on `fitted` records with the `base` geometry; `not_identified` gets what
-/// cannot be seen.
-pub(super) fn identify_plant(
-    records: &[SystemRecord],
+/// Fits the plant on the `fitted` records in `input`'s geometry; corrects the pressures'
+/// skew in `records` (reported in `skew_report`); `not_identified` gets what cannot be seen.
+///
+/// # Errors
+/// [`IdentError::Signal`] when a filter cannot be made for a record's rate.
+pub(crate) fn identify_plant(
+    records: &mut [SystemRecord],
     periods: &[f64],
     fitted: &[usize],
-    base: &TableSystem,
+    input: &PlantInput,
+    skew_report: &mut Vec<ChannelSkew>,
     not_identified: &mut Vec<(String, String)>,
-) -> IdentifiedPlant {
+) -> Result<IdentifiedPlant> {
     let why = |what: &str, reason: &str| (what.to_owned(), reason.to_owned());
+    let mut base = input.base;
     let mut plant = IdentifiedPlant {
         mechanics: None,
         storeys: Vec::new(),
         specimen_modes: Vec::new(),
         hydraulics: None,
-        predictions: Vec::new(),
+        geometry: Geometry {
+            area_m2: base.actuator.cap_area_m2,
+            area_source: if input.area_given { "given" } else { "assumed" },
+            base_given: input.base_given,
+        },
+        std_errors: BTreeMap::new(),
         system: None,
         model: None,
         specimen: None,
     };
-    let forces: Option<Vec<(&SystemRecord, f64, Vec<f64>)>> = fitted
-        .iter()
-        .map(|&i| Some((&records[i], periods[i], actuator_force(&records[i], base)?)))
-        .collect();
+    if !input.base_given {
+        not_identified.push(why(
+            "the plant's absolute scale (actuator area; with it every mass, force, flow and volume)",
+            "scaling every area, mass, force, flow and volume together leaves the motion \
+             unchanged, so the records show only ratios to the area: the plant is laid on the \
+             area given or a nominal one (listed as assumed); the motion, the oil column and \
+             every prediction do not depend on it",
+        ));
+    }
     let storeys = fitted
         .iter()
         .map(|&i| records[i].storey_a_m_s2.len())
         .min()
         .unwrap_or(0);
     let has_a = fitted.iter().all(|&i| records[i].a_m_s2.is_some());
-    match (&forces, has_a) {
-        (None, _) => not_identified.push(why(
-            "platen mass, stiffness, friction; specimen",
-            "the actuator force needs cap_pressure_pa and rod_pressure_pa in every fitted \
-             record (delta_p_pa alone gives it only for a double-ended actuator)",
+    let from = force_from(records, fitted, input);
+    match (&from, has_a) {
+        (Err(reason), _) => not_identified.push(why(
+            "platen mass, stiffness, friction; specimen; servo-valves and oil column",
+            reason,
         )),
-        (Some(_), false) => not_identified.push(why(
+        (Ok(_), false) => not_identified.push(why(
             "platen mass, stiffness, friction; specimen",
             "no a_m_s2 in every fitted record: the inertia cannot be separated",
         )),
-        (Some(recs), true) => {
-            if let Some((mech, masses)) = fit_mechanics(recs, storeys) {
+        (Ok(from), true) => {
+            let from = *from;
+            if let Some(f) =
+                fit_mechanics(records, periods, fitted, input, from, storeys, skew_report)?
+            {
+                let c = &f.coef;
+                let se = |j: usize| f.estimates[j].std_error;
+                let ratio = (from == ForceFrom::ChambersRatioFree).then(|| c[4 + storeys]);
+                if let Some(r) = ratio {
+                    base.actuator.rod_area_m2 = r * base.actuator.cap_area_m2;
+                    plant.std_errors.insert(
+                        "table_system.actuator.rod_side_area_m2".into(),
+                        se(4 + storeys) * base.actuator.cap_area_m2,
+                    );
+                }
+                let mech = IdentifiedMechanics {
+                    effective_mass_kg: c[0],
+                    viscous_coefficient: c[1],
+                    stiffness_n_per_m: c[2],
+                    coulomb_force_n: c[3],
+                    samples: f.rows,
+                    force_rms_residual_n: f.rms_residual(),
+                    force_nrmse: f.nrmse(),
+                    rod_to_cap_area_ratio: ratio,
+                };
+                for (j, key) in [
+                    (0, "effective_mass_kg"),
+                    (1, "viscous_coefficient"),
+                    (2, "stiffness_n_per_m"),
+                    (3, "coulomb_force_n"),
+                ] {
+                    if se(j).is_finite() {
+                        plant
+                            .std_errors
+                            .insert(format!("model.identified.{key}"), se(j));
+                    }
+                }
+                for (name, j) in [
+                    ("viscous_coefficient", 1),
+                    ("stiffness_n_per_m", 2),
+                    ("coulomb_force_n", 3),
+                ] {
+                    if f.clamped[j] {
+                        not_identified.push(why(
+                            name,
+                            "held at 0: the unconstrained force balance makes it negative, \
+                             which no platen has",
+                        ));
+                    }
+                }
+                let masses: Vec<f64> = c[4..4 + storeys].to_vec();
+                for (j, _) in masses.iter().enumerate() {
+                    plant
+                        .std_errors
+                        .insert(format!("specimen.storeys[{j}].mass_kg"), se(4 + j));
+                }
                 plant.mechanics = Some(mech);
                 if storeys == 0 {
                     not_identified.push(why(
@@ -641,97 +946,50 @@ pub(super) fn identify_plant(
                         "no storey{i}_a_m_s2 recorded: a specimen's base shear, if any, is \
                          in the platen's mass, stiffness and damping",
                     ));
-                } else if let Some(st) = fit_storeys(recs, &masses) {
-                    plant.specimen_modes = modes(&st);
-                    plant.storeys = st;
+                } else if let Some(st) = fit_storeys(records, periods, fitted, &masses) {
+                    for (j, (_, e)) in st.iter().enumerate() {
+                        plant
+                            .std_errors
+                            .insert(format!("specimen.storeys[{j}].stiffness_n_per_m"), e[0]);
+                        plant
+                            .std_errors
+                            .insert(format!("specimen.storeys[{j}].damping_n_s_per_m"), e[1]);
+                    }
+                    plant.storeys = st.into_iter().map(|(s, _)| s).collect();
+                    plant.specimen_modes = modes(&plant.storeys);
                 }
             }
         }
     }
+    plant.std_errors.retain(|_, v| v.is_finite());
     let drive = fitted.iter().all(|&i| records[i].drive.is_some());
-    let cont: Option<Vec<(&SystemRecord, f64, Continuity)>> = fitted
-        .iter()
-        .map(|&i| {
-            Some((
-                &records[i],
-                periods[i],
-                continuity(&records[i], periods[i], base)?,
-            ))
-        })
-        .collect();
+    let chambers = matches!(from, Ok(ForceFrom::Chambers | ForceFrom::ChambersRatioFree));
+    let cont: Option<Vec<(usize, &SystemRecord, f64, Continuity)>> = match from {
+        Ok(_) => fitted
+            .iter()
+            .map(|&i| {
+                Some((
+                    i,
+                    &records[i],
+                    periods[i],
+                    continuity(&records[i], periods[i], &base, chambers)?,
+                ))
+            })
+            .collect(),
+        Err(_) => None,
+    };
     match (cont, drive) {
         (Some(recs), true) => {
-            let mut grid: Vec<(f64, f64, u32, Vec<f64>, f64, f64)> = Vec::new();
-            for &f in &SPOOL_FREQUENCY_GRID_HZ {
-                for &z in &SPOOL_DAMPING_GRID {
-                    for &d in &DELAY_GRID_SIXTEENTHS {
-                        let of = |dr: &[f64], h: f64| spool(dr, h, f, z, d);
-                        if let Some((c, ss, yy)) = fit_continuity(&recs, base, &of) {
-                            grid.push((f, z, d, c, ss, yy));
-                        }
-                    }
-                }
-            }
-            grid.sort_by(|a, b| a.4.total_cmp(&b.4));
-            if let Some((f, z, d, c, ss, yy)) = grid.first().cloned() {
-                let h = recs[0].1;
-                let lag = |f: f64, z: f64, d: u32| {
-                    f64::from(d) * h / 16.0 + 2.0 * z / (std::f64::consts::TAU * f)
-                };
-                let best_lag = lag(f, z, d);
-                // Flat ridge: another grid point of about the same lag, a spool at least
-                // 1.5× faster or slower, fits within 5 % of the best residual.
-                let lag_only = grid.iter().any(|g| {
-                    (lag(g.0, g.1, g.2) / best_lag - 1.0).abs() < 0.1
-                        && (g.0 / f >= 1.5 || f / g.0 >= 1.5)
-                        && g.4 < 1.05 * ss
-                });
-                let beta = base.oil_bulk_modulus_pa;
-                let k = c[0];
-                let valves = f64::from(base.servo_valve.count);
-                let rated = k * (0.5 * base.servo_valve.rated_pressure_drop_pa).sqrt() / valves;
-                let mut hyd = IdentifiedHydraulics {
-                    land_coefficient: k,
-                    rated_flow_m3_s: rated,
-                    leakage_m3_s_per_pa: c[1],
-                    cap_compliance_m3_per_pa: c[2],
-                    rod_compliance_m3_per_pa: c[3],
-                    cap_volume_m3: c[2] * beta,
-                    rod_volume_m3: c[3] * beta,
-                    oil_bulk_modulus_pa: beta,
-                    spool_natural_frequency_hz: f,
-                    spool_damping_ratio: z,
-                    valve_delay_s: f64::from(d) * h / 16.0,
-                    equivalent_lag_s: best_lag,
-                    lag_only,
-                    flow_nrmse: (ss / yy).sqrt(),
-                    oil_column_frequency_hz: f64::NAN,
-                    oil_column_frequency_with_specimen_hz: f64::NAN,
-                };
-                if lag_only {
-                    not_identified.push(why(
-                        "servo_valve.natural_frequency_hz, damping_ratio, delay_s separately",
-                        "the spool is faster than the records' band: only its equivalent lag \
-                         τ + 2ζ/ω_n is visible (the printed values are the grid's best, one \
-                         of many that fit as well)",
-                    ));
-                }
-                not_identified.push(why(
-                    "oil_bulk_modulus_pa separately from the chamber volumes",
-                    "only V/β is visible at these strokes: β is the base's, the volumes \
-                     follow from it",
-                ));
-                if hyd.leakage_m3_s_per_pa < 0.0 {
-                    hyd.leakage_m3_s_per_pa = 0.0;
-                }
-                let mut sys = *base;
+            if let Some(hyd) = fit_valves(&recs, &base, &mut plant, not_identified) {
+                let mut sys = base;
                 sys.actuator.cap_volume_m3 = hyd.cap_volume_m3;
                 sys.actuator.rod_volume_m3 = hyd.rod_volume_m3;
                 sys.actuator.leakage_m3_s_per_pa = hyd.leakage_m3_s_per_pa;
-                sys.servo_valve.rated_flow_m3_s = rated;
-                sys.servo_valve.natural_frequency_hz = f;
-                sys.servo_valve.damping_ratio = z;
+                sys.servo_valve.rated_flow_m3_s = hyd.rated_flow_m3_s;
+                sys.servo_valve.natural_frequency_hz = hyd.spool_natural_frequency_hz;
+                sys.servo_valve.damping_ratio = hyd.spool_damping_ratio;
                 sys.servo_valve.delay_s = hyd.valve_delay_s;
+                let mut hyd = hyd;
                 if let Some(m) = &plant.mechanics {
                     let payload: f64 = plant.storeys.iter().map(|s| s.mass_kg).sum();
                     hyd.oil_column_frequency_hz =
@@ -743,11 +1001,14 @@ pub(super) fn identify_plant(
                 plant.hydraulics = Some(hyd);
             }
         }
-        (None, _) => not_identified.push(why(
-            "servo-valve flow gain and dynamics, oil column, leakage",
-            "the chambers' continuity needs cap_pressure_pa and rod_pressure_pa in every \
-             fitted record",
-        )),
+        (None, _) => {
+            if from.is_ok() {
+                not_identified.push(why(
+                    "servo-valve flow gain and dynamics, oil column, leakage",
+                    "the continuity needs the pressures in every fitted record",
+                ));
+            }
+        }
         (Some(_), false) => not_identified.push(why(
             "servo-valve flow gain and dynamics, oil column, leakage",
             "no drive recorded in every fitted record: the spool's input is unknown",
@@ -782,5 +1043,103 @@ pub(super) fn identify_plant(
         )
         .ok();
     }
-    plant
+    Ok(plant)
+}
+
+/// The spool grid's best continuity fit, as the valves and oil column.
+fn fit_valves(
+    recs: &[(usize, &SystemRecord, f64, Continuity)],
+    base: &TableSystem,
+    plant: &mut IdentifiedPlant,
+    not_identified: &mut Vec<(String, String)>,
+) -> Option<IdentifiedHydraulics> {
+    let why = |what: &str, reason: &str| (what.to_owned(), reason.to_owned());
+    let mut grid: Vec<(f64, f64, u32, LinearFit)> = Vec::new();
+    for &f in &SPOOL_FREQUENCY_GRID_HZ {
+        for &z in &SPOOL_DAMPING_GRID {
+            for &d in &DELAY_GRID_SIXTEENTHS {
+                let of = |dr: &[f64], h: f64| spool(dr, h, f, z, d);
+                if let Some(fit) = fit_continuity(recs, base, &of) {
+                    grid.push((f, z, d, fit));
+                }
+            }
+        }
+    }
+    grid.sort_by(|a, b| a.3.rss.total_cmp(&b.3.rss));
+    let (f, z, d, fit) = grid.first()?.clone();
+    let chambers = recs[0].3.chambers;
+    let h = recs[0].2;
+    let lag =
+        |f: f64, z: f64, d: u32| f64::from(d) * h / 16.0 + 2.0 * z / (std::f64::consts::TAU * f);
+    let best_lag = lag(f, z, d);
+    // Flat ridge: another grid point of about the same lag, a spool at least 1.5× faster or
+    // slower, fits within 5 % of the best residual.
+    let lag_only = grid.iter().any(|g| {
+        (lag(g.0, g.1, g.2) / best_lag - 1.0).abs() < 0.1
+            && (g.0 / f >= 1.5 || f / g.0 >= 1.5)
+            && g.3.rss < 1.05 * fit.rss
+    });
+    let beta = base.oil_bulk_modulus_pa;
+    let c = &fit.coef;
+    let se = |j: usize| fit.estimates[j].std_error;
+    let k = c[0];
+    let valves = f64::from(base.servo_valve.count);
+    let to_rated = (0.5 * base.servo_valve.rated_pressure_drop_pa).sqrt() / valves;
+    let (ca, cb, se_a, se_b) = if chambers {
+        (c[2], c[3], se(2), se(3))
+    } else {
+        (c[2], c[2], se(2), se(2))
+    };
+    for (key, value) in [
+        ("table_system.servo_valve.rated_flow_m3_s", se(0) * to_rated),
+        ("table_system.actuator.leakage_m3_s_per_pa", se(1)),
+        ("table_system.actuator.chamber_volume_m3[0]", se_a * beta),
+        ("table_system.actuator.chamber_volume_m3[1]", se_b * beta),
+    ] {
+        if value.is_finite() {
+            plant.std_errors.insert(key.into(), value);
+        }
+    }
+    if lag_only {
+        not_identified.push(why(
+            "servo_valve.natural_frequency_hz, damping_ratio, delay_s separately",
+            "the spool is faster than the records' band: only its equivalent lag τ + 2ζ/ω_n \
+             is visible (the printed values are the grid's best, one of many that fit as well)",
+        ));
+    }
+    not_identified.push(why(
+        "oil_bulk_modulus_pa separately from the chamber volumes",
+        "only V/β is visible at these strokes: β is the base's (or the nominal), the volumes \
+         follow from it",
+    ));
+    if !chambers {
+        not_identified.push(why(
+            "the two chamber volumes apart",
+            "Δp alone shows the load flow of a double-ended actuator, whose chambers are then \
+             taken alike (V_a0 = V_b0)",
+        ));
+    }
+    Some(IdentifiedHydraulics {
+        land_coefficient: k,
+        rated_flow_m3_s: k * to_rated,
+        leakage_m3_s_per_pa: c[1].max(0.0),
+        cap_compliance_m3_per_pa: ca,
+        rod_compliance_m3_per_pa: cb,
+        cap_volume_m3: ca * beta,
+        rod_volume_m3: cb * beta,
+        oil_bulk_modulus_pa: beta,
+        spool_natural_frequency_hz: f,
+        spool_damping_ratio: z,
+        valve_delay_s: f64::from(d) * h / 16.0,
+        equivalent_lag_s: best_lag,
+        lag_only,
+        flow_nrmse: fit.nrmse(),
+        oil_column_frequency_hz: f64::NAN,
+        oil_column_frequency_with_specimen_hz: f64::NAN,
+        from: if chambers {
+            "chamber pressures"
+        } else {
+            "delta_p"
+        },
+    })
 }

@@ -1,0 +1,172 @@
+//! Channel skew in closed-loop records: a data system that samples or filters a channel
+//! later than another (a few samples is common) biases every fit that puts the two in one
+//! equation. Measured and corrected before the fits, one delay per channel for the whole set
+//! of records (they come from one data system):
+//!
+//! * **Table acceleration** `a_m_s2`: its delay against the second derivative of the
+//!   displacement ([`platen_signal::DelayEstimator::acceleration_against_displacement`]) in
+//!   each fitted record, pooled by inverse variance. The storeys' accelerations are taken to
+//!   share it (the same data path; nothing in the records holds their motion independently
+//!   of their own dynamics). Applied when beyond [`SIGNIFICANT`] standard errors and
+//!   [`MIN_APPLIED_SAMPLES`] of a sample, as the any-record method applies it.
+//! * **Pressures** (`delta_p_pa`, or the two chamber pressures together): their delay is the
+//!   one that makes the platen's force balance fit best, a grid of
+//!   [`PRESSURE_SHIFT_GRID`] then a parabola through the best three (the force's relation
+//!   to the motion is the very model being fitted, so no spectral estimate is unbiased for
+//!   it).
+//!
+//! Every channel is shifted with [`platen_signal::advance`] (band-limited, to a fraction of a
+//! sample), and every estimate is reported ([`ChannelSkew`]), applied or not.
+
+use platen_signal::{advance, DelayEstimator};
+
+use super::SystemRecord;
+use crate::error::{IdentError, Result};
+
+/// An estimated acceleration delay is applied only beyond this many standard errors.
+pub const SIGNIFICANT: f64 = 3.0;
+/// An estimated delay is applied only beyond this fraction of a sample.
+pub const MIN_APPLIED_SAMPLES: f64 = 0.1;
+/// The pressure shifts tried, samples (then refined by a parabola).
+pub const PRESSURE_SHIFT_GRID: [f64; 13] = [
+    -3.0, -2.5, -2.0, -1.5, -1.0, -0.5, 0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0,
+];
+
+/// A channel's delay against the displacement, measured on the records.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ChannelSkew {
+    /// The channel (`a_m_s2`, `delta_p_pa`, …).
+    pub column: String,
+    /// The delay, s (positive: the channel lags `u_m`).
+    pub delay_s: f64,
+    /// Its standard error, s (absent for the force-balance estimate of the pressures).
+    pub std_error_s: Option<f64>,
+    /// The delay in samples.
+    pub delay_samples: f64,
+    /// Whether the channels were corrected by it.
+    pub applied: bool,
+    /// How it was found.
+    pub method: &'static str,
+}
+
+fn signal_error(r: &SystemRecord, source: platen_signal::SignalError) -> IdentError {
+    IdentError::Signal {
+        test: r.name.clone(),
+        source,
+    }
+}
+
+/// Shifts `x` earlier by `samples` (corrects a channel recorded that many samples late).
+pub(crate) fn shift(r: &SystemRecord, x: &[f64], samples: f64) -> Result<Vec<f64>> {
+    if samples == 0.0 {
+        return Ok(x.to_vec());
+    }
+    advance(x, samples).map_err(|e| signal_error(r, e))
+}
+
+/// Estimates the table acceleration's delay on the fitted records and returns the records
+/// with `a_m_s2` and the storeys' accelerations corrected (when significant); the estimate
+/// goes to `report`.
+pub(crate) fn correct_accelerations(
+    records: &[SystemRecord],
+    periods: &[f64],
+    fitted: &[usize],
+    report: &mut Vec<ChannelSkew>,
+) -> Result<Vec<SystemRecord>> {
+    let mut out = records.to_vec();
+    let (mut wsum, mut dsum) = (0.0, 0.0);
+    for &i in fitted {
+        let r = &records[i];
+        let Some(a) = &r.a_m_s2 else {
+            return Ok(out);
+        };
+        let est = DelayEstimator::new(1.0 / periods[i])
+            .and_then(|d| d.acceleration_against_displacement(a, &r.u_m));
+        // A record too short or too still for a spectral estimate adds nothing.
+        if let Ok(e) = est {
+            if e.std_error_s > 0.0 && e.std_error_s.is_finite() {
+                let w = 1.0 / (e.std_error_s * e.std_error_s);
+                wsum += w;
+                dsum += w * e.delay_s;
+            }
+        }
+    }
+    if wsum <= 0.0 {
+        return Ok(out);
+    }
+    let delay_s = dsum / wsum;
+    let se = 1.0 / wsum.sqrt();
+    let h = periods[fitted[0]];
+    let samples = delay_s / h;
+    let applied = delay_s.abs() > SIGNIFICANT * se && samples.abs() > MIN_APPLIED_SAMPLES;
+    report.push(ChannelSkew {
+        column: "a_m_s2".into(),
+        delay_s,
+        std_error_s: Some(se),
+        delay_samples: samples,
+        applied,
+        method: "acceleration against the displacement's second derivative (cross-spectrum \
+                 phase), pooled over the fitted records; the storeys' accelerations share it",
+    });
+    if applied {
+        for (r, (c, &hp)) in records.iter().zip(out.iter_mut().zip(periods)) {
+            let k = delay_s / hp;
+            if let Some(a) = &r.a_m_s2 {
+                c.a_m_s2 = Some(shift(r, a, k)?);
+            }
+            c.storey_a_m_s2 = r
+                .storey_a_m_s2
+                .iter()
+                .map(|s| shift(r, s, k))
+                .collect::<Result<_>>()?;
+        }
+    }
+    Ok(out)
+}
+
+/// Corrects the pressure channels of every record by `samples` (at the first fitted
+/// record's rate: converted to each record's own).
+pub(crate) fn correct_pressures(
+    records: &mut [SystemRecord],
+    periods: &[f64],
+    delay_s: f64,
+) -> Result<()> {
+    for (r, &h) in records.iter_mut().zip(periods) {
+        let k = delay_s / h;
+        let original = r.clone();
+        for c in [
+            &mut r.delta_p_pa,
+            &mut r.cap_pressure_pa,
+            &mut r.rod_pressure_pa,
+        ] {
+            if let Some(x) = c.as_ref() {
+                *c = Some(shift(&original, x, k)?);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The vertex of the parabola through three equally spaced points `(x₀ − d, y₋)`,
+/// `(x₀, y₀)`, `(x₀ + d, y₊)`, within `[x₀ − d, x₀ + d]`.
+pub(crate) fn parabola_vertex(x0: f64, d: f64, ym: f64, y0: f64, yp: f64) -> f64 {
+    let curv = ym - 2.0 * y0 + yp;
+    if curv <= 0.0 {
+        return x0;
+    }
+    (x0 + 0.5 * d * (ym - yp) / curv).clamp(x0 - d, x0 + d)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_vertex_of_a_parabola() {
+        let f = |x: f64| 3.0 * (x - 0.37).powi(2) + 1.0;
+        let v = parabola_vertex(0.5, 0.5, f(0.0), f(0.5), f(1.0));
+        assert!((v - 0.37).abs() < 1e-12, "{v}");
+        // Flat or concave: the middle point.
+        assert_eq!(parabola_vertex(1.0, 0.5, 1.0, 1.0, 1.0), 1.0);
+    }
+}
