@@ -207,8 +207,7 @@ impl Design {
         let mut current = DVector::zeros(p);
         let mut count = 0usize;
         let mut last_record = None;
-        for i in 0..n {
-            let record = self.at[i].0;
+        for (i, (&(record, _), &e)) in self.at.iter().zip(resid).enumerate() {
             if count >= block || last_record.is_some_and(|r| r != record) {
                 sums.push(std::mem::replace(&mut current, DVector::zeros(p)));
                 count = 0;
@@ -216,7 +215,7 @@ impl Design {
             last_record = Some(record);
             let r = self.row(i);
             for (a, &j) in free.iter().enumerate() {
-                current[a] += r[j] * resid[i];
+                current[a] += r[j] * e;
             }
             count += 1;
         }
