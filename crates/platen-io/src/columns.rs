@@ -705,6 +705,50 @@ mod tests {
         );
     }
 
+    /// A drive recorded in volts maps with its scale; without one it is refused at
+    /// `….drive.scale`, with the fix (issue 33).
+    #[test]
+    fn a_drive_in_volts_needs_its_scale() {
+        let m =
+            map(r#"{"drive": {"name": "Voltage command", "unit": "V", "scale": 0.1}}"#).unwrap();
+        assert_eq!(
+            (m.header("drive"), m.factor("drive")),
+            ("Voltage command", 0.1)
+        );
+        let (path, _, expected) =
+            map(r#"{"drive": {"name": "Voltage command", "unit": "V"}}"#).unwrap_err();
+        assert_eq!(path, "excitation.columns.drive.scale");
+        assert!(expected.contains("0.1 for a ±10 V"), "{expected}");
+        // Volts are a drive's unit only.
+        let (path, _, _) = map(r#"{"u_m": {"unit": "V"}}"#).unwrap_err();
+        assert_eq!(path, "excitation.columns.u_m.unit");
+    }
+
+    /// A reading spec reads a channel as the map does: the header, the whole factor as
+    /// `scale`, the offset and the zero.
+    #[test]
+    fn a_reading_spec_reads_as_the_map_does() {
+        let m = map(
+            r#"{"command_u_m": {"name": "Cmd", "unit": "mm", "offset": 0.5, "zero_at_start": true},
+                        "a_m_s2": {"ignore": true}}"#,
+        )
+        .unwrap();
+        let spec = m.reading_spec("command_u_m");
+        assert_eq!(spec.name.as_deref(), Some("Cmd"));
+        assert_eq!(spec.scale, Some(1e-3));
+        assert_eq!(spec.offset, Some(0.5));
+        assert!(spec.zero_at_start && !spec.remove_mean && spec.unit.is_none());
+        let again = map(&format!(
+            r#"{{"u_m": {}}}"#,
+            serde_json::to_string(&spec).unwrap()
+        ))
+        .unwrap();
+        assert_eq!(again.factor("u_m"), m.factor("command_u_m"));
+        assert_eq!(again.offset("u_m"), m.offset("command_u_m"));
+        assert!(m.reading_spec("a_m_s2").ignore);
+        assert_eq!(m.reading_spec("t_s"), ColumnSpec::default());
+    }
+
     #[test]
     fn lab_channels_map_to_si_columns() {
         let m = map(r#"{"u_m": {"name": "Table disp", "unit": "mm"}, "a_m_s2": {"name": "acc (g)", "unit": "g"},
