@@ -555,11 +555,15 @@ impl ColumnMap {
     }
 
     /// A column spec that reads platen's column `ours` exactly as this map reads it (its
-    /// header, its whole factor to SI as `scale`, its offset and zero; not its delay), for a
-    /// scenario that must read the same file the same way.
+    /// header, its whole factor to SI as `scale`, its offset and zero; not its delay; platen's
+    /// own name for a channel the map leaves alone), for a scenario that must read the same
+    /// file under another column's name (a command read as a motion's `u_m`).
     pub fn reading_spec(&self, ours: &str) -> ColumnSpec {
         let Some(m) = self.entries.get(ours) else {
-            return ColumnSpec::default();
+            return ColumnSpec {
+                name: Some(ours.to_owned()),
+                ..ColumnSpec::default()
+            };
         };
         if m.ignored {
             return ColumnSpec {
@@ -746,7 +750,8 @@ mod tests {
         assert_eq!(again.factor("u_m"), m.factor("command_u_m"));
         assert_eq!(again.offset("u_m"), m.offset("command_u_m"));
         assert!(m.reading_spec("a_m_s2").ignore);
-        assert_eq!(m.reading_spec("t_s"), ColumnSpec::default());
+        // A channel the map leaves alone is read by platen's own name.
+        assert_eq!(m.reading_spec("t_s").name.as_deref(), Some("t_s"));
     }
 
     #[test]

@@ -223,10 +223,13 @@ pub fn system_text(id: &SystemIdentification) -> String {
     for c in &id.channel_skew {
         let _ = writeln!(
             s,
-            "channel skew {}: {:+.3} samples ({:+.3e} s){}",
+            "channel skew {}: {:+.3} samples ({:+.3e} s){}{}",
             c.column,
             c.delay_samples,
             c.delay_s,
+            c.residual_ratio.map_or(String::new(), |r| format!(
+                ", force-balance residual {r:.3} of the unshifted"
+            )),
             if c.applied {
                 ", corrected"
             } else {
@@ -263,7 +266,7 @@ pub fn system_text(id: &SystemIdentification) -> String {
             let _ = writeln!(
                 s,
                 "platen: mass {} kg, stiffness {} N/m, viscous {} N·s/m, Coulomb {} N (force \
-                 residual {:.3} % over {} samples)",
+                 residual {:.3} % over {} samples){}",
                 plus_minus(
                     m.effective_mass_kg,
                     se("model.identified.effective_mass_kg")
@@ -278,7 +281,10 @@ pub fn system_text(id: &SystemIdentification) -> String {
                 ),
                 plus_minus(m.coulomb_force_n, se("model.identified.coulomb_force_n")),
                 100.0 * m.force_nrmse,
-                m.samples
+                m.samples,
+                m.rod_to_cap_area_ratio.map_or(String::new(), |r| format!(
+                    "; rod side {r:.5} of the cap side's area (from both pressures)"
+                ))
             );
         }
         for (i, st) in p.storeys.iter().enumerate() {

@@ -437,8 +437,9 @@ fn mechanics_design(
             cols.push(filtered(&lp, r, st)?);
         }
         if let Some(e) = &extra {
-            // F = n·A·(p_a − r·p_b): the rod-side term moves to the regressors.
-            cols.push(filtered(&lp, r, e)?.iter().map(|x| -x).collect());
+            // n·A·(p_a − r·p_b) = M·a + …: the rod side's term moves to the regressors,
+            // n·A·p_a = M·a + … + r·(n·A·p_b).
+            cols.push(filtered(&lp, r, e)?);
         }
         let n = r.u_m.len();
         let edge = ((0.5 / h) as usize).min(n / 4);
@@ -498,7 +499,19 @@ fn fit_mechanics(
         (Some(ym), Some(yp)) => skew::parabola_vertex(PRESSURE_SHIFT_GRID[ib], step, ym, rb, yp),
         _ => PRESSURE_SHIFT_GRID[ib],
     };
-    let applied = samples.abs() > MIN_APPLIED_SAMPLES;
+    let zero = PRESSURE_SHIFT_GRID
+        .iter()
+        .position(|&x| x == 0.0)
+        .and_then(|i| grid[i]);
+    let final_rss = mechanics_design(records, periods, fitted, input, from, storeys, samples * h0)?
+        .fit(&signs, &none)
+        .map(|f| f.rss);
+    let residual_ratio = match (final_rss, zero) {
+        (Some(a), Some(b)) if b > 0.0 => Some(a / b),
+        _ => None,
+    };
+    let applied = samples.abs() > MIN_APPLIED_SAMPLES
+        && residual_ratio.is_some_and(|r| r <= skew::PRESSURE_SKEW_MAX_RESIDUAL_RATIO);
     let column = match from {
         ForceFrom::DeltaP => "delta_p_pa",
         _ => "cap_pressure_pa, rod_pressure_pa",
@@ -509,6 +522,7 @@ fn fit_mechanics(
         std_error_s: None,
         delay_samples: samples,
         applied,
+        residual_ratio,
         method: "the shift that fits the platen's force balance best (a grid of half samples, \
                  then a parabola through the best three)",
     });
@@ -997,7 +1011,17 @@ pub(crate) fn identify_plant(
                     hyd.oil_column_frequency_with_specimen_hz =
                         sys.oil_column_frequency_hz(m.effective_mass_kg + payload, 0.0);
                 }
-                plant.system = Some(sys);
+                // Only a system a scenario takes is printed and run.
+                match sys.validate(stroke_limit_m(&sys)) {
+                    Ok(()) => plant.system = Some(sys),
+                    Err(e) => not_identified.push(why(
+                        "the table system as a whole",
+                        &format!(
+                            "the identified values are not a table system a scenario takes \
+                             ({e}); the records do not determine the valves and chambers"
+                        ),
+                    )),
+                }
                 plant.hydraulics = Some(hyd);
             }
         }
