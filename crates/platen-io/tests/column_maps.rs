@@ -136,11 +136,12 @@ fn an_unknown_column_or_unit_lists_what_is_accepted() {
     assert!(e.2.contains("m/s2, mm/s2, cm/s2, gal, in/s2, g"), "{e:?}");
     let e = map(r#"{"delta_p_pa": {"unit": "atm"}}"#).unwrap_err();
     assert!(e.2.contains("Pa, kPa, MPa, bar, psi"), "{e:?}");
+    // A drive in volts needs the scale that makes it a fraction of full opening.
     let e = map(r#"{"drive": {"unit": "V"}}"#).unwrap_err();
-    assert!(
-        e.2.starts_with("no unit") && e.2.contains("scale 0.1"),
-        "{e:?}"
-    );
+    assert_eq!(e.0, "columns.drive.scale", "{e:?}");
+    assert!(e.2.contains("0.1 for a ±10 V"), "{e:?}");
+    let e = map(r#"{"drive": {"unit": "mm"}}"#).unwrap_err();
+    assert!(e.2.starts_with("no unit or V"), "{e:?}");
 }
 
 #[test]
