@@ -15,14 +15,13 @@
 //! dissipative terms would absorb. (The hysteresis-loop method is immune to it: its symmetric
 //! combinations cancel that part.)
 
-use nalgebra::DMatrix;
 use platen_model::{DissipativeLaw, Exponent, IdentifiedKey};
 
 use crate::cycle::RatePlan;
 use crate::estimate::{Estimate, Parameter};
 use crate::groups::Groups;
 use crate::law::{self, LawFit};
-use crate::lm::{self, covariance, Covariance, LmSettings, Problem};
+use crate::lm::{self, covariance, Covariance, Jacobian, LmSettings, Problem};
 use crate::result::{GlobalFit, ParameterEstimates, PressureGroup};
 use crate::warning::Warning;
 use crate::work::Work;
@@ -104,7 +103,7 @@ impl Problem for GlobalProblem {
             *r = q[M] * s.a + q[k_index(s.group)] * s.u + sign(s.v) * d - s.f;
         }
     }
-    fn jacobian(&self, p: &[f64], j: &mut DMatrix<f64>) {
+    fn jacobian(&self, p: &[f64], _r: &[f64], j: &mut Jacobian) {
         let q = self.full(p);
         let laws = self.laws(&q);
         for (i, s) in self.samples.iter().enumerate() {
@@ -112,7 +111,7 @@ impl Problem for GlobalProblem {
             let sign = sign(s.v);
             let grad = laws[s.group].gradient(w, w.ln());
             for (k, &which) in self.free.iter().enumerate() {
-                j[(i, k)] = match which {
+                j.shared[(i, k)] = match which {
                     M => s.a,
                     C => sign * grad[law::VISCOUS],
                     ALPHA => sign * grad[law::EXPONENT],
@@ -241,7 +240,7 @@ fn fit(
     };
     let start: Vec<f64> = free.iter().map(|&i| problem.base[i]).collect();
     let res = lm::minimize(&problem, &start, &lower, &upper, LmSettings::default());
-    let cov = covariance(&res.jacobian, res.ssr, correlation);
+    let cov = covariance(res.jacobian.as_dense(), res.ssr, correlation);
     let solution = Solution {
         q: problem.full(&res.params),
         free: &free,

@@ -4,7 +4,7 @@
 use nalgebra::{DMatrix, DVector};
 use platen_model::{DissipativeLaw, Exponent};
 
-use crate::lm::{self, covariance, LmSettings, Problem};
+use crate::lm::{self, covariance, Jacobian, LmSettings, Problem};
 
 /// The law from its parameters in the order of the index constants below.
 pub(crate) fn law_from(p: [f64; 5]) -> DissipativeLaw {
@@ -148,13 +148,13 @@ impl Problem for LawProblem<'_> {
             *r = self.sqrt_w[i] * (d - self.pts.force[i]);
         }
     }
-    fn jacobian(&self, p: &[f64], j: &mut DMatrix<f64>) {
+    fn jacobian(&self, p: &[f64], _r: &[f64], j: &mut Jacobian) {
         let law = law_from(self.full(p));
         for i in 0..self.pts.len() {
             let grad = law.gradient(self.pts.speed[i], self.ln_v[i]);
             let sw = self.sqrt_w[i];
             for (k, &which) in self.free.iter().enumerate() {
-                j[(i, k)] = sw * grad[which];
+                j.shared[(i, k)] = sw * grad[which];
             }
         }
     }
@@ -281,7 +281,7 @@ pub(crate) fn fit(
     let lower: Vec<f64> = free_idx.iter().map(|&i| LOWER[i]).collect();
     let upper: Vec<f64> = free_idx.iter().map(|&i| UPPER[i]).collect();
     let res = lm::minimize(&problem, &start, &lower, &upper, LmSettings::default());
-    let cov = covariance(&res.jacobian, res.ssr, correlation_samples);
+    let cov = covariance(res.jacobian.as_dense(), res.ssr, correlation_samples);
     let full = problem.full(&res.params);
     let mut std_errors = [f64::NAN; 5];
     let mut singular = [false; 5];

@@ -1,12 +1,212 @@
 //! Levenberg–Marquardt nonlinear least squares on nalgebra, with box bounds by projection,
 //! and the covariance of the estimate from the Jacobian at the optimum.
 //!
-//! The problems here are small (at most a dozen parameters) and tall (up to ~10⁵ residuals),
-//! so the normal equations `JᵀJ` are formed explicitly and solved by Cholesky; the damping is
-//! Marquardt's, proportional to the diagonal of `JᵀJ`, which makes the iteration invariant to
-//! the parameters' units (newtons next to exponents).
+//! The problems here are tall (up to ~10⁶ residuals) with few parameters, or with parameters
+//! that each touch one group of residuals only (a record's offset or initial state), so the
+//! normal equations `JᵀJ` are formed explicitly, from a Jacobian stored by blocks
+//! ([`Jacobian`]), and solved by Cholesky; the damping is Marquardt's, proportional to the
+//! diagonal of `JᵀJ`, which makes the iteration invariant to the parameters' units (newtons
+//! next to exponents).
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
+
+/// A Jacobian `∂rᵢ/∂pⱼ` stored by blocks. The first `shared` parameters may move any
+/// residual; the rest come in groups of `width`, one group per group of residuals (group `g`
+/// at positions `shared + g·width …`), and move only the residuals of their group: a
+/// record's force offset, or its initial state. Only the non-zero blocks are stored, so its
+/// size and the cost of `JᵀJ` grow with the residuals, not with residuals × groups. A dense
+/// Jacobian is the case `width = 0`.
+#[derive(Debug, Clone)]
+pub(crate) struct Jacobian {
+    /// The shared parameters' columns, `residuals × shared`.
+    pub shared: DMatrix<f64>,
+    /// Each residual's derivatives by its own group's parameters, `residuals × width`.
+    pub local: DMatrix<f64>,
+    /// The group of each residual (empty when `width = 0`).
+    pub group: Vec<usize>,
+    /// Number of groups.
+    pub groups: usize,
+}
+
+impl Jacobian {
+    /// A dense `rows × cols` Jacobian (zeros).
+    pub(crate) fn dense(rows: usize, cols: usize) -> Self {
+        Self {
+            shared: DMatrix::zeros(rows, cols),
+            local: DMatrix::zeros(rows, 0),
+            group: Vec::new(),
+            groups: 0,
+        }
+    }
+
+    /// A Jacobian (zeros) with `shared` shared columns and `width` local ones for each of
+    /// `groups` groups; `group[i]` is residual `i`'s.
+    pub(crate) fn blocked(
+        rows: usize,
+        shared: usize,
+        width: usize,
+        group: Vec<usize>,
+        groups: usize,
+    ) -> Self {
+        debug_assert_eq!(group.len(), rows);
+        debug_assert!(group.iter().all(|&g| g < groups));
+        Self {
+            shared: DMatrix::zeros(rows, shared),
+            local: DMatrix::zeros(rows, width),
+            group,
+            groups,
+        }
+    }
+
+    /// Residuals (rows).
+    pub(crate) fn rows(&self) -> usize {
+        self.shared.nrows()
+    }
+
+    /// Parameters (columns): the shared ones and every group's.
+    pub(crate) fn cols(&self) -> usize {
+        self.shared.ncols() + self.width() * self.groups
+    }
+
+    /// Local parameters per group.
+    pub(crate) fn width(&self) -> usize {
+        self.local.ncols()
+    }
+
+    /// Column of local parameter `k` of group `g`.
+    pub(crate) fn local_column(&self, g: usize, k: usize) -> usize {
+        self.shared.ncols() + g * self.width() + k
+    }
+
+    /// The dense Jacobian of a problem without local parameters.
+    ///
+    /// # Panics
+    /// If it has local parameters.
+    pub(crate) fn as_dense(&self) -> &DMatrix<f64> {
+        assert_eq!(self.width(), 0, "a Jacobian with local parameters");
+        &self.shared
+    }
+
+    /// `JᵀJ`, dense (`cols × cols`), each entry summed as nalgebra sums the dense
+    /// Jacobian's (`Jᵀ·J` by [`Dot8`]), so the result is the dense product's, bit for bit.
+    pub(crate) fn gram(&self) -> DMatrix<f64> {
+        let m0 = self.shared.ncols();
+        let w = self.width();
+        if w == 0 {
+            return self.shared.tr_mul(&self.shared);
+        }
+        let n = self.rows();
+        let mut out = DMatrix::zeros(self.cols(), self.cols());
+        out.view_mut((0, 0), (m0, m0))
+            .copy_from(&self.shared.tr_mul(&self.shared));
+        // Per group: (shared a, local k) at a·w + k, then (local k, local l) at m0·w + k·w + l.
+        let per = (m0 + w) * w;
+        let mut acc = vec![Dot8::default(); self.groups * per];
+        let lanes = Dot8::lane_rows(n);
+        for (i, &g) in self.group.iter().enumerate().take(lanes) {
+            let acc = &mut acc[g * per..(g + 1) * per];
+            for k in 0..w {
+                let l = self.local[(i, k)];
+                for a in 0..m0 {
+                    acc[a * w + k].add(i, self.shared[(i, a)] * l);
+                }
+                for k2 in 0..w {
+                    acc[m0 * w + k * w + k2].add(i, self.local[(i, k)] * self.local[(i, k2)]);
+                }
+            }
+        }
+        let mut values: Vec<f64> = acc.iter().map(Dot8::finish).collect();
+        for i in lanes..n {
+            let g = self.group[i];
+            let v = &mut values[g * per..(g + 1) * per];
+            for k in 0..w {
+                let l = self.local[(i, k)];
+                for a in 0..m0 {
+                    v[a * w + k] += self.shared[(i, a)] * l;
+                }
+                for k2 in 0..w {
+                    v[m0 * w + k * w + k2] += self.local[(i, k)] * self.local[(i, k2)];
+                }
+            }
+        }
+        for g in 0..self.groups {
+            let v = &values[g * per..(g + 1) * per];
+            for k in 0..w {
+                let c = self.local_column(g, k);
+                for a in 0..m0 {
+                    out[(a, c)] = v[a * w + k];
+                    out[(c, a)] = v[a * w + k];
+                }
+                for k2 in 0..w {
+                    out[(self.local_column(g, k2), c)] = v[m0 * w + k * w + k2];
+                }
+            }
+        }
+        out
+    }
+
+    /// `Jᵀv`, summed as the dense product's (see [`Jacobian::gram`]).
+    pub(crate) fn tr_mul(&self, v: &[f64]) -> DVector<f64> {
+        let top = self.shared.tr_mul(&DVector::from_column_slice(v));
+        let w = self.width();
+        if w == 0 {
+            return top;
+        }
+        let m0 = self.shared.ncols();
+        let n = self.rows();
+        let mut acc = vec![Dot8::default(); self.groups * w];
+        let lanes = Dot8::lane_rows(n);
+        for (i, &g) in self.group.iter().enumerate().take(lanes) {
+            for k in 0..w {
+                acc[g * w + k].add(i, self.local[(i, k)] * v[i]);
+            }
+        }
+        let mut out = DVector::zeros(self.cols());
+        out.rows_mut(0, m0).copy_from(&top);
+        for (x, a) in acc.iter().enumerate() {
+            out[m0 + x] = a.finish();
+        }
+        for i in lanes..n {
+            for k in 0..w {
+                out[m0 + self.group[i] * w + k] += self.local[(i, k)] * v[i];
+            }
+        }
+        out
+    }
+}
+
+/// A dot product `Σ xᵢ·yᵢ` over `n` rows summed as nalgebra's `dot` sums it, so that a sum
+/// over some of the rows (the others being zero) equals the dense one bit for bit: eight
+/// running sums by row index mod 8 over the first [`Dot8::lane_rows`] rows, combined
+/// (`0 + (s₀+s₄) + (s₁+s₅) + (s₂+s₆) + (s₃+s₇)`), then the last rows added in order.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Dot8 {
+    lanes: [f64; 8],
+}
+
+impl Dot8 {
+    /// Rows summed in lanes out of `n` (the rest are added after [`Dot8::finish`], in order).
+    pub(crate) fn lane_rows(n: usize) -> usize {
+        n - n % 8
+    }
+
+    /// Adds the product of row `i` (below [`Dot8::lane_rows`]).
+    #[inline(always)]
+    pub(crate) fn add(&mut self, i: usize, product: f64) {
+        self.lanes[i & 7] += product;
+    }
+
+    /// The lanes combined.
+    pub(crate) fn finish(&self) -> f64 {
+        let l = &self.lanes;
+        let mut res = 0.0;
+        res += l[0] + l[4];
+        res += l[1] + l[5];
+        res += l[2] + l[6];
+        res += l[3] + l[7];
+        res
+    }
+}
 
 /// A least-squares problem: minimise `½·Σ rᵢ(p)²`.
 pub(crate) trait Problem {
@@ -16,8 +216,13 @@ pub(crate) trait Problem {
     fn parameter_count(&self) -> usize;
     /// Residuals `r(p)` (model − data, weighted) into `r`.
     fn residuals(&self, p: &[f64], r: &mut [f64]);
-    /// Jacobian `∂rᵢ/∂pⱼ` into `j` (`residual_count × parameter_count`).
-    fn jacobian(&self, p: &[f64], j: &mut DMatrix<f64>);
+    /// Jacobian `∂rᵢ/∂pⱼ` into `j` (shaped by [`Problem::new_jacobian`]), given the
+    /// residuals `r = r(p)` already computed (a difference quotient needs not rerun them).
+    fn jacobian(&self, p: &[f64], r: &[f64], j: &mut Jacobian);
+    /// A Jacobian of the problem's shape: dense unless the problem has local parameters.
+    fn new_jacobian(&self) -> Jacobian {
+        Jacobian::dense(self.residual_count(), self.parameter_count())
+    }
 }
 
 /// Stopping rules.
@@ -50,7 +255,9 @@ pub(crate) struct LmResult {
     /// Sum of squared residuals at the optimum.
     pub ssr: f64,
     /// Jacobian at the optimum.
-    pub jacobian: DMatrix<f64>,
+    pub jacobian: Jacobian,
+    /// Residuals at the optimum.
+    pub residuals: Vec<f64>,
     /// Outer iterations done.
     pub iterations: usize,
     /// Whether a stopping rule (not the iteration limit) ended the run.
@@ -83,15 +290,10 @@ struct Search<'a> {
 impl Search<'_> {
     /// One outer iteration at the Jacobian `jac`: raises the damping until a step lowers the
     /// cost, and takes it. Returns true when a stopping rule says the minimum is reached.
-    fn iterate<P: Problem>(
-        &mut self,
-        problem: &P,
-        jac: &DMatrix<f64>,
-        settings: &LmSettings,
-    ) -> bool {
+    fn iterate<P: Problem>(&mut self, problem: &P, jac: &Jacobian, settings: &LmSettings) -> bool {
         let m = self.p.len();
-        let jtj = jac.tr_mul(jac);
-        let g = jac.tr_mul(&DVector::from_column_slice(&self.r));
+        let jtj = jac.gram();
+        let g = jac.tr_mul(&self.r);
         let diag: Vec<f64> = (0..m)
             .map(|i| jtj[(i, i)].max(1e-300 + 1e-12 * jtj.diagonal().max()))
             .collect();
@@ -167,22 +369,24 @@ pub(crate) fn minimize<P: Problem>(
         lower,
         upper,
     };
-    let mut jac = DMatrix::zeros(n, m);
+    let mut jac = problem.new_jacobian();
+    debug_assert_eq!((jac.rows(), jac.cols()), (n, m));
     let mut iterations = 0;
     let mut converged = false;
     while iterations < settings.max_iterations {
         iterations += 1;
-        problem.jacobian(&search.p, &mut jac);
+        problem.jacobian(&search.p, &search.r, &mut jac);
         if search.iterate(problem, &jac, &settings) {
             converged = true;
             break;
         }
     }
-    problem.jacobian(&search.p, &mut jac);
+    problem.jacobian(&search.p, &search.r, &mut jac);
     LmResult {
         params: search.p,
         ssr: search.cost,
         jacobian: jac,
+        residuals: search.r,
         iterations,
         converged,
     }
@@ -314,11 +518,11 @@ mod tests {
                 *r = p[0] * (-p[1] * x).exp() - y;
             }
         }
-        fn jacobian(&self, p: &[f64], j: &mut DMatrix<f64>) {
+        fn jacobian(&self, p: &[f64], _r: &[f64], j: &mut Jacobian) {
             for (i, x) in self.x.iter().enumerate() {
                 let e = (-p[1] * x).exp();
-                j[(i, 0)] = e;
-                j[(i, 1)] = -p[0] * x * e;
+                j.shared[(i, 0)] = e;
+                j.shared[(i, 1)] = -p[0] * x * e;
             }
         }
     }
@@ -354,6 +558,45 @@ mod tests {
         );
         assert_eq!(fit.params[1], 0.5);
         assert!(fit.ssr > 0.0);
+    }
+
+    /// A blocked Jacobian's `JᵀJ` and `Jᵀr` are the dense product's, bit for bit, whatever
+    /// the number of rows modulo 8 and however the groups' rows fall.
+    #[test]
+    fn a_blocked_jacobians_normal_equations_are_the_dense_products_bit_for_bit() {
+        let mut x = 0x1234_5678_9abc_def0_u64;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for rows in [5, 8, 61, 203] {
+            let groups = 3;
+            let group: Vec<usize> = (0..rows).map(|i| (i * groups) / rows).collect();
+            let mut j = Jacobian::blocked(rows, 3, 2, group.clone(), groups);
+            j.shared = DMatrix::from_fn(rows, 3, |_, _| next() * 1e3);
+            j.local = DMatrix::from_fn(rows, 2, |_, _| next());
+            let r: Vec<f64> = (0..rows).map(|_| next()).collect();
+            let dense = DMatrix::from_fn(rows, j.cols(), |i, c| {
+                if c < 3 {
+                    j.shared[(i, c)]
+                } else {
+                    let (g, k) = ((c - 3) / 2, (c - 3) % 2);
+                    if group[i] == g {
+                        j.local[(i, k)]
+                    } else {
+                        0.0
+                    }
+                }
+            });
+            assert_eq!(j.gram(), dense.tr_mul(&dense), "{rows} rows");
+            assert_eq!(
+                j.tr_mul(&r),
+                dense.tr_mul(&DVector::from_column_slice(&r)),
+                "{rows} rows"
+            );
+        }
     }
 
     #[test]

@@ -22,6 +22,7 @@
 use nalgebra::{DMatrix, SymmetricEigen};
 
 use crate::estimate::student_t_975;
+use crate::lm::Jacobian;
 
 /// Scaled `JᵀJ` eigenvalues below this fraction of the largest are singular directions (as
 /// [`crate::lm::SINGULAR_RELATIVE_EIGENVALUE`]).
@@ -63,47 +64,19 @@ pub(crate) struct Hac {
     pub effective_samples: f64,
 }
 
-/// The scores summed per (group, time): one `T × m` matrix per group, over its time span.
-fn score_series(
-    jac: &DMatrix<f64>,
-    resid: &[f64],
-    time: &[usize],
-    group: &[usize],
-    scale: &[f64],
-) -> Vec<DMatrix<f64>> {
-    let m = jac.ncols();
-    let groups = group.iter().copied().max().map_or(0, |g| g + 1);
-    let mut span = vec![(usize::MAX, 0usize); groups];
-    for (&t, &g) in time.iter().zip(group) {
-        span[g].0 = span[g].0.min(t);
-        span[g].1 = span[g].1.max(t);
-    }
-    let mut series: Vec<DMatrix<f64>> = span
-        .iter()
-        .map(|&(lo, hi)| DMatrix::zeros(if lo > hi { 0 } else { hi - lo + 1 }, m))
-        .collect();
-    for i in 0..resid.len() {
-        let (g, t) = (group[i], time[i]);
-        let row = t - span[g].0;
-        for k in 0..m {
-            series[g][(row, k)] += jac[(i, k)] / scale[k] * resid[i];
-        }
-    }
-    series
-}
-
 /// The sandwich covariance of the parameters of a fit with Jacobian `jac` (rows: residuals)
-/// and residuals `resid`; residual `i` belongs to record `group[i]` at sample `time[i]`.
-pub(crate) fn covariance(
-    jac: &DMatrix<f64>,
-    resid: &[f64],
-    time: &[usize],
-    group: &[usize],
-) -> Hac {
-    let n_res = jac.nrows();
-    let m = jac.ncols();
+/// and residuals `resid`; residual `i` belongs to record `group[i]` at sample `time[i]` (a
+/// Jacobian with local parameters has them by the same groups).
+///
+/// Each record's scores touch the shared parameters and its own local ones only, so the
+/// cost grows with the residuals and not with residuals × records.
+pub(crate) fn covariance(jac: &Jacobian, resid: &[f64], time: &[usize], group: &[usize]) -> Hac {
+    let n_res = jac.rows();
+    let m = jac.cols();
+    let (m0, width) = (jac.shared.ncols(), jac.width());
     debug_assert_eq!(resid.len(), n_res);
-    let jtj = jac.tr_mul(jac);
+    debug_assert!(width == 0 || jac.group == group);
+    let jtj = jac.gram();
     let scale: Vec<f64> = (0..m)
         .map(|k| {
             let d = jtj[(k, k)].sqrt();
@@ -134,32 +107,71 @@ pub(crate) fn covariance(
         inv += (vec * vec.transpose()) / ev;
     }
 
-    let series = score_series(jac, resid, time, group, &scale);
-    let n_time: usize = series.iter().map(DMatrix::nrows).sum();
+    // Each group's scores summed per sample index over its time span (the residuals that
+    // share a time, in order), then cut into blocks of `block` consecutive sample indices.
+    // The sums run in the order of the dense `residuals × parameters` form (each block's
+    // column sums in time order, blocks in group order), so the result is its, bit for bit;
+    // the columns of other groups' local parameters, zero there, are left out.
+    let groups = group.iter().copied().max().map_or(0, |g| g + 1);
+    let mut span = vec![(usize::MAX, 0usize); groups];
+    let mut members: Vec<Vec<usize>> = vec![Vec::new(); groups];
+    for (i, (&t, &g)) in time.iter().zip(group).enumerate() {
+        span[g].0 = span[g].0.min(t);
+        span[g].1 = span[g].1.max(t);
+        members[g].push(i);
+    }
+    let rows: Vec<usize> = span
+        .iter()
+        .map(|&(lo, hi)| if lo > hi { 0 } else { hi - lo + 1 })
+        .collect();
+    let n_time: usize = rows.iter().sum();
     let blocks_wanted = (n_time / BLOCK_SAMPLES).clamp(MIN_BLOCKS, MAX_BLOCKS);
     let block = n_time.div_ceil(blocks_wanted).max(1);
     let mut meat = DMatrix::<f64>::zeros(m, m);
     let mut blocks = 0usize;
-    for s in &series {
-        let rows = s.nrows();
+    let mut white = 0.0;
+    let cols = m0 + width;
+    for g in 0..groups {
+        // The group's columns: the shared ones, then its own local ones.
+        let index: Vec<usize> = (0..m0)
+            .chain((0..width).map(|k| jac.local_column(g, k)))
+            .collect();
+        let mut series = DMatrix::<f64>::zeros(rows[g], cols);
+        for &i in &members[g] {
+            let row = time[i] - span[g].0;
+            for k in 0..m0 {
+                series[(row, k)] += jac.shared[(i, k)] / scale[k] * resid[i];
+            }
+            for k in 0..width {
+                series[(row, m0 + k)] += jac.local[(i, k)] / scale[index[m0 + k]] * resid[i];
+            }
+        }
         let mut start = 0;
-        while start < rows {
-            let len = block.min(rows - start);
-            let sum = s.rows(start, len).row_sum();
-            meat += sum.transpose() * &sum;
+        while start < rows[g] {
+            let len = block.min(rows[g] - start);
+            let sum = series.rows(start, len).row_sum();
+            for (x, &i) in index.iter().enumerate() {
+                for (y, &j) in index.iter().enumerate() {
+                    meat[(i, j)] += sum[x] * sum[y];
+                }
+            }
             blocks += 1;
             start += len;
+        }
+        // The first parameter's column (another group's local one is zero here).
+        if let Some(x) = index.iter().position(|&i| i == 0) {
+            white += series.column(x).norm_squared();
         }
     }
     let k = blocks.max(2) as f64;
     meat *= k / (k - 1.0);
     let bandwidth = block;
-    let white: f64 = series
-        .iter()
-        .map(|s| s.column(0).norm_squared())
-        .sum::<f64>()
-        .max(f64::MIN_POSITIVE);
-    let effective_samples = n_time as f64 * white / meat[(0, 0)].max(f64::MIN_POSITIVE);
+    let white = white.max(f64::MIN_POSITIVE);
+    let effective_samples = if m > 0 {
+        n_time as f64 * white / meat[(0, 0)].max(f64::MIN_POSITIVE)
+    } else {
+        n_time as f64
+    };
     let scaled = &inv * meat * &inv;
     let cov = DMatrix::from_fn(m, m, |i, j| {
         if singular[i] || singular[j] {
@@ -220,7 +232,8 @@ mod tests {
             }
             let mean = x.iter().sum::<f64>() / n as f64;
             let resid: Vec<f64> = x.iter().map(|v| mean - v).collect();
-            let jac = DMatrix::from_element(n, 1, 1.0);
+            let mut jac = Jacobian::dense(n, 1);
+            jac.shared.fill(1.0);
             let time: Vec<usize> = (0..n).collect();
             let hac = covariance(&jac, &resid, &time, &vec![0; n]);
             let truth = 1.0 / (1.0 - rho) / (n as f64).sqrt();

@@ -17,8 +17,6 @@ pub mod summary;
 pub use crate::record::DELAYABLE_CHANNELS;
 pub use skew::{ChannelDelay, MIN_APPLIED_SAMPLES, SIGNIFICANT};
 
-use std::cell::Cell;
-
 use nalgebra::DMatrix;
 use platen_model::{DissipativeLaw, Exponent, IdentifiedKey};
 
@@ -463,31 +461,6 @@ struct OeOutcome {
     simulated: Vec<Option<Vec<f64>>>,
 }
 
-/// Counts the simulations of an output-error problem.
-struct Counted<'a> {
-    inner: &'a OutputError,
-    count: Cell<usize>,
-}
-
-impl crate::lm::Problem for Counted<'_> {
-    fn residual_count(&self) -> usize {
-        self.inner.residual_count()
-    }
-    fn parameter_count(&self) -> usize {
-        self.inner.parameter_count()
-    }
-    fn residuals(&self, p: &[f64], r: &mut [f64]) {
-        self.count.set(self.count.get() + 1);
-        self.inner.residuals(p, r);
-    }
-    fn jacobian(&self, p: &[f64], j: &mut DMatrix<f64>) {
-        self.count.set(self.count.get() + p.len() + 1);
-        self.inner.jacobian(p, j);
-    }
-}
-
-use crate::lm::Problem as _;
-
 fn run_output_error(
     records: &[TestRecord],
     velocities: &[Vec<f64>],
@@ -507,27 +480,20 @@ fn run_output_error(
         "the equation error's parameters give no valid model to simulate, or the simulation failed"
             .to_owned()
     })?;
-    let counted = Counted {
-        inner: &problem,
-        count: Cell::new(0),
-    };
-    let rms_start = problem.rms(&start);
+    let (lower, upper) = problem.bounds();
     let res = crate::lm::minimize(
-        &counted,
+        &problem,
         &start,
-        &problem.bounds().0,
-        &problem.bounds().1,
+        &lower,
+        &upper,
         crate::lm::LmSettings {
             max_iterations: settings.output_error_iterations,
             cost_tolerance: 1e-6,
             step_tolerance: 1e-6,
         },
     );
-    let rms_end = problem.rms(&res.params);
-    let mut resid = vec![0.0; problem.residual_count()];
-    problem.residuals(&res.params, &mut resid);
     let (time, group) = problem.residual_layout();
-    let hac = hac::covariance(&res.jacobian, &resid, &time, &group);
+    let hac = hac::covariance(&res.jacobian, &res.residuals, &time, &group);
     let q = problem.model_vector(&res.params);
     let mut full = q.to_vec();
     full.extend(std::iter::repeat_n(0.0, records.len()));
@@ -535,9 +501,8 @@ fn run_output_error(
     let mut free_full: Vec<usize> = model_free.to_vec();
     free_full.extend((0..2 * records.len()).map(|k| 1000 + k));
     let (params, corr) = parameters(&full, &free_full, &hac, fixed_reason);
-    let simulated = (0..records.len())
-        .map(|r| problem.simulate(&res.params, r).map(|(u, _)| u))
-        .collect();
+    let (simulated, rms_end): (Vec<_>, Vec<_>) = problem.finish(&res.params).into_iter().unzip();
+    let rms_start = problem.start_rms();
     Ok(OeOutcome {
         fit: OutputErrorFit {
             parameters: params,
@@ -554,7 +519,7 @@ fn run_output_error(
                 .collect(),
             iterations: res.iterations,
             converged: res.converged,
-            simulations: counted.count.get(),
+            simulations: problem.runs(),
         },
         simulated,
     })

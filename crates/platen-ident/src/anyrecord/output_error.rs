@@ -14,12 +14,12 @@
 //! stops depend on `F_s = F_μ + a` exactly, so the low-velocity behaviour that the equation
 //! error leaves out (samples below its minimum speed) enters here.
 
-use nalgebra::DMatrix;
+use std::cell::Cell;
 
 use platen_integrate::{forward_rk4, ForceRecord, Rk4, Sample, SampleSink, State};
 use platen_model::IdentifiedParams;
 
-use crate::lm::Problem;
+use crate::lm::{Jacobian, Problem};
 use crate::record::TestRecord;
 
 use super::separable::{
@@ -58,6 +58,10 @@ pub(crate) struct OutputError {
     /// The full model vector (held parameters at their values).
     base: [f64; 7],
     rk4: Rk4,
+    /// Unweighted RMS of each record's displacement and acceleration residuals at the start.
+    start_rms: Vec<(f64, f64)>,
+    /// Forward runs of a record so far.
+    runs: Cell<usize>,
 }
 
 /// Lower and upper bounds of the model parameters, in full-vector order (`Mₑ > 0`, the
@@ -121,18 +125,30 @@ impl OutputError {
             model_free,
             base,
             rk4: Rk4::with_steps_per_sample(steps_per_sample).ok()?,
+            start_rms: Vec::with_capacity(records.len()),
+            runs: Cell::new(0),
         };
         // Channel weights from the start's residuals.
         let q = problem.full(&start);
         for r in 0..problem.records.len() {
             let (ru, ra) = problem.raw_residuals(&q, &start, r)?;
-            let rms = |x: &[f64]| (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt();
             let (su, sa) = (rms(&ru), rms(&ra));
+            problem.start_rms.push((su, sa));
             let rec = &mut problem.records[r];
             rec.weight_u = if su > 0.0 { 1.0 / su } else { 1.0 };
             rec.weight_a = if sa > 0.0 { 1.0 / sa } else { 1.0 };
         }
         Some((problem, start))
+    }
+
+    /// Forward runs of a record so far (a run of every record counts one per record).
+    pub(crate) fn runs(&self) -> usize {
+        self.runs.get()
+    }
+
+    /// Unweighted RMS of each record's displacement and acceleration residuals at the start.
+    pub(crate) fn start_rms(&self) -> &[(f64, f64)] {
+        &self.start_rms
     }
 
     /// The model vector at `p`.
@@ -159,6 +175,7 @@ impl OutputError {
     /// Simulated − measured displacement and acceleration of record `r`, each with its
     /// mean removed; `None` if the model is invalid or the run fails.
     fn raw_residuals(&self, q: &[f64; 7], p: &[f64], r: usize) -> Option<(Vec<f64>, Vec<f64>)> {
+        self.runs.set(self.runs.get() + 1);
         let model = Self::params(q).build().ok()?;
         let rec = &self.records[r];
         let n = rec.u.len();
@@ -212,32 +229,48 @@ impl OutputError {
         (time, group)
     }
 
-    /// Unweighted RMS of the displacement and acceleration residuals of every record at `p`.
-    pub(crate) fn rms(&self, p: &[f64]) -> Vec<(f64, f64)> {
+    /// Each record at `p`: its simulated displacement (`None` if the model is invalid or the
+    /// run fails), and the unweighted RMS of its displacement and acceleration residuals
+    /// (NaN if so).
+    pub(crate) fn finish(&self, p: &[f64]) -> Vec<(Option<Vec<f64>>, (f64, f64))> {
         let q = self.full(p);
         (0..self.records.len())
             .map(|r| match self.raw_residuals(&q, p, r) {
-                Some((u, a)) => {
-                    let rms =
-                        |x: &[f64]| (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt();
-                    (rms(&u), rms(&a))
+                Some((ru, ra)) => {
+                    let rms = (rms(&ru), rms(&ra));
+                    // Back from the de-meaned residual to the simulation: add the measured
+                    // channel and the mean offset (a constant, shown as fitted).
+                    let u = ru.iter().zip(&self.records[r].u).map(|(x, m)| x + m);
+                    (Some(u.collect()), rms)
                 }
-                None => (f64::NAN, f64::NAN),
+                None => (None, (f64::NAN, f64::NAN)),
             })
             .collect()
     }
 
-    /// The simulated displacement and acceleration of record `r` at `p`.
-    pub(crate) fn simulate(&self, p: &[f64], r: usize) -> Option<(Vec<f64>, Vec<f64>)> {
-        let q = self.full(p);
-        let (ru, ra) = self.raw_residuals(&q, p, r)?;
+    /// Weighted residuals of record `r` at `p` (model vector `q`) into `out` (its `2n`
+    /// rows: displacement, then acceleration), `+∞` if the run fails.
+    fn record_residuals(&self, q: &[f64; 7], p: &[f64], r: usize, out: &mut [f64]) {
         let rec = &self.records[r];
-        // Back from de-meaned residuals to the simulation: add the measured channels and
-        // the mean offsets (a constant per channel, shown as fitted).
-        Some((
-            ru.iter().zip(&rec.u).map(|(x, m)| x + m).collect(),
-            ra.iter().zip(&rec.a).map(|(x, m)| x + m).collect(),
-        ))
+        let n = rec.u.len();
+        match self.raw_residuals(q, p, r) {
+            Some((u, a)) => {
+                for i in 0..n {
+                    out[i] = rec.weight_u * u[i];
+                    out[n + i] = rec.weight_a * a[i];
+                }
+            }
+            None => out.fill(f64::INFINITY),
+        }
+    }
+
+    /// The first row of each record's residuals, and the end.
+    fn row_starts(&self) -> Vec<usize> {
+        let mut at = vec![0];
+        for rec in &self.records {
+            at.push(at[at.len() - 1] + 2 * rec.u.len());
+        }
+        at
     }
 
     /// The model parameters at `p`, full vector.
@@ -271,36 +304,63 @@ impl Problem for OutputError {
     }
     fn residuals(&self, p: &[f64], out: &mut [f64]) {
         let q = self.full(p);
-        let mut at = 0;
-        for (r, rec) in self.records.iter().enumerate() {
-            let n = rec.u.len();
-            match self.raw_residuals(&q, p, r) {
-                Some((u, a)) => {
-                    for i in 0..n {
-                        out[at + i] = rec.weight_u * u[i];
-                        out[at + n + i] = rec.weight_a * a[i];
-                    }
-                }
-                None => out[at..at + 2 * n].fill(f64::INFINITY),
-            }
-            at += 2 * n;
+        let rows = self.row_starts();
+        for r in 0..self.records.len() {
+            self.record_residuals(&q, p, r, &mut out[rows[r]..rows[r + 1]]);
         }
     }
-    fn jacobian(&self, p: &[f64], j: &mut DMatrix<f64>) {
-        let m = self.residual_count();
-        let mut base = vec![0.0; m];
-        self.residuals(p, &mut base);
+    /// Forward differences: every record rerun for a model parameter, only its own record
+    /// for a record's initial state; `base` is the residuals at `p`.
+    fn jacobian(&self, p: &[f64], base: &[f64], j: &mut Jacobian) {
+        let quotient = |r: f64, b: f64, h: f64| {
+            let d = (r - b) / h;
+            if d.is_finite() {
+                d
+            } else {
+                0.0
+            }
+        };
+        let nm = self.model_free.len();
         let mut trial = p.to_vec();
-        let mut r = vec![0.0; m];
-        for k in 0..p.len() {
+        let mut r = vec![0.0; self.residual_count()];
+        for k in 0..nm {
             let h = self.step(p, k);
             trial[k] = p[k] + h;
             self.residuals(&trial, &mut r);
             trial[k] = p[k];
-            for i in 0..m {
-                let d = (r[i] - base[i]) / h;
-                j[(i, k)] = if d.is_finite() { d } else { 0.0 };
+            for (i, (&x, &b)) in r.iter().zip(base).enumerate() {
+                j.shared[(i, k)] = quotient(x, b, h);
+            }
+        }
+        let q = self.full(p);
+        let rows = self.row_starts();
+        for rec in 0..self.records.len() {
+            let span = rows[rec]..rows[rec + 1];
+            for state in 0..2 {
+                let k = nm + 2 * rec + state;
+                let h = self.step(p, k);
+                trial[k] = p[k] + h;
+                self.record_residuals(&q, &trial, rec, &mut r[span.clone()]);
+                trial[k] = p[k];
+                for i in span.clone() {
+                    j.local[(i, state)] = quotient(r[i], base[i], h);
+                }
             }
         }
     }
+    fn new_jacobian(&self) -> Jacobian {
+        let (_, group) = self.residual_layout();
+        Jacobian::blocked(
+            self.residual_count(),
+            self.model_free.len(),
+            2,
+            group,
+            self.records.len(),
+        )
+    }
+}
+
+/// Root mean square.
+fn rms(x: &[f64]) -> f64 {
+    (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt()
 }

@@ -97,7 +97,9 @@ pub struct OutputErrorFit {
     pub iterations: usize,
     /// Whether it met its tolerance.
     pub converged: bool,
-    /// Forward simulations run.
+    /// Forward runs of a record (a run of every record counts one per record), including
+    /// the difference quotients of the Jacobian: a model parameter's column reruns every
+    /// record, a record's initial state only that record.
     pub simulations: usize,
 }
 

@@ -10,7 +10,7 @@
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
-use crate::lm::{self, LmSettings, Problem};
+use crate::lm::{self, Jacobian, LmSettings, Problem};
 
 use super::data::Stacked;
 
@@ -455,14 +455,16 @@ impl<'a> Separable<'a> {
     }
 
     /// `∂r/∂θ` for the parameters `free` (full-vector indices) at `full`.
-    fn full_jacobian(&self, full: &[f64], free: &[usize]) -> DMatrix<f64> {
+    fn full_jacobian(&self, full: &[f64], free: &[usize]) -> Jacobian {
         let (alpha, b) = (full[EXPONENT], full[LOW_DECAY]);
         let d = self.data;
-        DMatrix::from_fn(d.len(), free.len(), |i, c| match free[c] {
+        let mut j = Jacobian::dense(d.len(), free.len());
+        j.shared = DMatrix::from_fn(d.len(), free.len(), |i, c| match free[c] {
             EXPONENT => full[VISCOUS] * d.s[i] * (alpha * d.ln_w[i]).exp() * d.ln_w[i],
             LOW_DECAY => -full[LOW_FORCE] * d.s[i] * d.w[i] * (-b * d.w[i]).exp(),
             other => column(d, other, i, alpha, b),
-        })
+        });
+        j
     }
 }
 
@@ -483,7 +485,8 @@ impl Problem for Separable<'_> {
         }
     }
     /// Kaufman's Jacobian: `∂r/∂q_k ≈ P⊥·(∂X/∂q_k)·θ̂`.
-    fn jacobian(&self, q: &[f64], j: &mut DMatrix<f64>) {
+    fn jacobian(&self, q: &[f64], _r: &[f64], j: &mut Jacobian) {
+        let j = &mut j.shared;
         let (alpha, b) = alpha_b(&self.shape, q);
         let x = self.design(alpha, b);
         let sol = self.solve_design(&x);
@@ -511,7 +514,7 @@ pub(crate) struct SeparableFit {
     /// Residuals (model − data) of the stacked samples.
     pub residual: Vec<f64>,
     /// `∂r/∂θ` of the parameters `free` at the optimum.
-    pub jacobian: DMatrix<f64>,
+    pub jacobian: Jacobian,
     /// The fitted parameters not held at a bound ([`Shape::free`] less `clamped`).
     pub free: Vec<usize>,
     /// Linear parameters held at zero by their bound (full-vector indices).

@@ -168,7 +168,7 @@ pub struct OutputErrorSummary {
     pub iterations: usize,
     /// Whether it converged.
     pub converged: bool,
-    /// Forward simulations run.
+    /// Forward runs of a record (a run of every record counts one per record).
     pub simulations: usize,
 }
 
