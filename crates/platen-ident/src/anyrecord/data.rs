@@ -1,11 +1,16 @@
 //! The channels of each record as the fits use them: the velocity (given, or the crossover
-//! estimate), the samples fast enough for the equation error, and those samples stacked.
+//! estimate), the samples fast enough for the equation error, and those samples stacked,
+//! one block per record (a refit that changes one record shares the others' blocks).
+
+use std::cell::{OnceCell, RefCell};
+use std::rc::Rc;
 
 use platen_signal::CrossoverVelocity;
 
 use crate::error::{IdentError, Result};
 use crate::record::TestRecord;
 
+use super::separable::{FixedSums, GridSums};
 use super::settings::ValidRecordSettings;
 
 /// One record, ready for the fits.
@@ -92,9 +97,11 @@ pub(crate) fn prepare(
         .collect()
 }
 
-/// The samples of the equation error, stacked over the records.
-#[derive(Debug, Clone, Default)]
-pub(crate) struct Stacked {
+/// One record's samples used by the equation error (those of [`Prepared::used`]), in order.
+#[derive(Debug, Default)]
+pub(crate) struct Block {
+    /// Index of the record.
+    pub record: usize,
     pub a: Vec<f64>,
     pub u: Vec<f64>,
     /// `sign(v)`.
@@ -105,10 +112,50 @@ pub(crate) struct Stacked {
     pub ln_w: Vec<f64>,
     /// Force, N.
     pub f: Vec<f64>,
-    /// Record of each sample.
-    pub record: Vec<usize>,
     /// Index of each sample in its record.
     pub time: Vec<usize>,
+    /// Noise variances of the accelerometer, (m/s²)², and of the displacement, m²
+    /// ([`Prepared::a_noise_var`], [`Prepared::u_noise_var`]).
+    pub noise_var: [f64; 2],
+    /// The equation error's sums over this block of the columns that do not depend on
+    /// `(α, b)`, and at the nodes of its start grid: computed once and shared by every fit
+    /// that uses the block (module `separable`).
+    pub(crate) fixed: OnceCell<FixedSums>,
+    pub(crate) grid: RefCell<Vec<Rc<GridSums>>>,
+}
+
+impl Block {
+    /// The used samples of record `record`.
+    pub(crate) fn new(record: usize, rec: &TestRecord, p: &Prepared) -> Self {
+        let mut b = Block {
+            record,
+            noise_var: [p.a_noise_var, p.u_noise_var],
+            ..Block::default()
+        };
+        for i in (0..rec.len()).filter(|&i| p.used[i]) {
+            let v = p.v_m_s[i];
+            b.a.push(rec.a_m_s2()[i]);
+            b.u.push(rec.u_m()[i]);
+            b.s.push(v.signum());
+            b.w.push(v.abs());
+            b.ln_w.push(v.abs().ln());
+            b.f.push(rec.force_n()[i]);
+            b.time.push(i);
+        }
+        b
+    }
+
+    pub(crate) fn len(&self) -> usize {
+        self.f.len()
+    }
+}
+
+/// The samples of the equation error, stacked over the records: one [`Block`] per record, in
+/// record order (a record with no sample fast enough has an empty block). The residuals and
+/// the Jacobian's rows of a fit follow the same order.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Stacked {
+    pub blocks: Vec<Rc<Block>>,
     /// `Σ σ²_a` and `Σ σ²_u` over the samples: the part of `Σa²` and `Σu²` that is sensor
     /// noise, removed from the normal equations (corrected least squares).
     pub noise_sums: [f64; 2],
@@ -116,26 +163,60 @@ pub(crate) struct Stacked {
 
 impl Stacked {
     pub(crate) fn new(records: &[TestRecord], prepared: &[Prepared]) -> Self {
-        let mut s = Stacked::default();
-        for (r, (rec, p)) in records.iter().zip(prepared).enumerate() {
-            for i in (0..rec.len()).filter(|&i| p.used[i]) {
-                let v = p.v_m_s[i];
-                s.a.push(rec.a_m_s2()[i]);
-                s.u.push(rec.u_m()[i]);
-                s.s.push(v.signum());
-                s.w.push(v.abs());
-                s.ln_w.push(v.abs().ln());
-                s.f.push(rec.force_n()[i]);
-                s.record.push(r);
-                s.time.push(i);
-                s.noise_sums[0] += p.a_noise_var;
-                s.noise_sums[1] += p.u_noise_var;
+        Self::from_blocks(
+            records
+                .iter()
+                .zip(prepared)
+                .enumerate()
+                .map(|(r, (rec, p))| Rc::new(Block::new(r, rec, p)))
+                .collect(),
+        )
+    }
+
+    pub(crate) fn from_blocks(blocks: Vec<Rc<Block>>) -> Self {
+        let mut noise_sums = [0.0; 2];
+        // Sample by sample, in order, as the sums were always formed.
+        for b in &blocks {
+            for _ in 0..b.len() {
+                noise_sums[0] += b.noise_var[0];
+                noise_sums[1] += b.noise_var[1];
             }
         }
-        s
+        Self { blocks, noise_sums }
+    }
+
+    /// The same samples with record `record`'s block replaced (the others are shared).
+    pub(crate) fn with_block(&self, record: usize, block: Block) -> Self {
+        let mut blocks = self.blocks.clone();
+        blocks[record] = Rc::new(block);
+        Self::from_blocks(blocks)
     }
 
     pub(crate) fn len(&self) -> usize {
-        self.f.len()
+        self.blocks.iter().map(|b| b.len()).sum()
+    }
+
+    /// `|v|` of every sample.
+    pub(crate) fn speeds(&self) -> impl Iterator<Item = f64> + '_ {
+        self.blocks.iter().flat_map(|b| b.w.iter().copied())
+    }
+
+    /// The record of every sample.
+    pub(crate) fn groups(&self) -> Vec<usize> {
+        self.blocks
+            .iter()
+            .flat_map(|b| std::iter::repeat_n(b.record, b.len()))
+            .collect()
+    }
+
+    /// Record and sample index of every sample (the residuals' layout).
+    pub(crate) fn layout(&self) -> (Vec<usize>, Vec<usize>) {
+        let mut time = Vec::with_capacity(self.len());
+        let mut group = Vec::with_capacity(self.len());
+        for b in &self.blocks {
+            time.extend_from_slice(&b.time);
+            group.extend(std::iter::repeat_n(b.record, b.len()));
+        }
+        (time, group)
     }
 }

@@ -25,7 +25,7 @@ use crate::estimate::{Estimate, Parameter};
 use crate::record::TestRecord;
 use crate::result::ParameterEstimates;
 
-use data::{prepare, Prepared, Stacked};
+use data::{prepare, Block, Prepared, Stacked};
 use hac::Hac;
 use output_error::OutputError;
 use result::{
@@ -134,7 +134,7 @@ pub fn identify_records(
             hac = ee_covariance(&fit, &data);
         }
     }
-    skew_covariance(&mut hac, &fit, shape, &corrected, settings)?;
+    skew_covariance(&mut hac, &fit, shape, &data, &corrected, settings)?;
     let clamped = fit.clamped.clone();
     let fixed_reason = |key: IdentifiedKey| -> String {
         match key {
@@ -234,18 +234,21 @@ pub fn identify_records(
 /// Adds the variance of the estimated channel delays to the equation error's covariance
 /// (module `skew`): `g·gᵀ·MSE(τ)` per delay, `g` the central difference of the fitted
 /// vector over the delay. A perturbed fit that frees or clamps other parameters than `fit`
-/// says nothing about `g` along them and is skipped.
+/// says nothing about `g` along them and is skipped. Each refit prepares the one record whose
+/// channel moved and shares every other record's samples and sums with `data`.
 fn skew_covariance(
     hac: &mut Hac,
     fit: &SeparableFit,
     shape: Shape,
+    data: &Stacked,
     corrected: &skew::Corrected,
     settings: &ValidRecordSettings,
 ) -> Result<()> {
     for p in skew::perturbations(corrected)? {
-        let refit = |records: &[TestRecord]| -> Result<SeparableFit> {
-            let prepared = prepare(records, settings)?;
-            Ok(Separable::new(&Stacked::new(records, &prepared), shape).fit())
+        let refit = |rec: &TestRecord| -> Result<SeparableFit> {
+            let prepared = prepare(std::slice::from_ref(rec), settings)?;
+            let block = Block::new(p.record, rec, &prepared[0]);
+            Ok(Separable::new(&data.with_block(p.record, block), shape).fit())
         };
         let (minus, plus) = (refit(&p.minus)?, refit(&p.plus)?);
         if minus.free != fit.free || plus.free != fit.free {
@@ -274,7 +277,8 @@ fn free_position(free: &[usize], full: usize) -> usize {
 }
 
 fn ee_covariance(fit: &SeparableFit, data: &Stacked) -> Hac {
-    hac::covariance(&fit.jacobian, &fit.residual, &data.time, &data.record)
+    let (time, group) = data.layout();
+    hac::covariance(&fit.jacobian, &fit.residual, &time, &group)
 }
 
 /// An estimate with the sandwich's variance and the fixed-b critical value; the degrees of
@@ -361,9 +365,8 @@ fn uncertainty(hac: &Hac, correlations: Correlations) -> FitUncertainty {
 
 /// Smallest and largest speed of the fitted samples, m/s.
 fn speed_range(data: &Stacked) -> [f64; 2] {
-    data.w
-        .iter()
-        .fold([f64::INFINITY, 0.0], |[lo, hi], &w| [lo.min(w), hi.max(w)])
+    data.speeds()
+        .fold([f64::INFINITY, 0.0], |[lo, hi], w| [lo.min(w), hi.max(w)])
 }
 
 /// The equation error's identifiability warnings.
@@ -398,7 +401,7 @@ fn ee_warnings(
     correlation_warnings(FitKind::EquationError, params, corr, speeds, b, warnings);
     if params.low_velocity_force_n.estimate().is_some() && b > 0.0 {
         let reach = 3.0 / b;
-        let below = data.w.iter().filter(|&&w| w < reach).count() as f64 / data.len() as f64;
+        let below = data.speeds().filter(|&w| w < reach).count() as f64 / data.len() as f64;
         if below < MIN_LOW_SPEED_FRACTION {
             warnings.push(RecordWarning::FewLowSpeedSamples {
                 below_m_s: reach,

@@ -7,12 +7,30 @@
 //! `(α, b)`. For each `(α, b)` the linear parameters are solved exactly, so the search is over
 //! two numbers only: a grid over `α ∈ {0.1…1}` and `b ∈ {2.5…5120} s/m` (doubling) for the
 //! start, then Levenberg–Marquardt on the projected residual `r(α, b) = −P⊥(α, b)·F`.
+//!
+//! **Cost.** Nothing of size samples × parameters is formed. An offset's column is the
+//! indicator of its record's samples, so the normal equations are an arrowhead: the model's
+//! columns (at most five), dense, bordered by one diagonal entry per record.
+//!
+//! * The start grid's nodes work from sums formed record by record ([`Block`]), once per
+//!   record and grid (kept with the block, so a refit that changes one record, the
+//!   channel-skew variance of module `skew`, forms them for that record only), and solve the
+//!   arrowhead by eliminating the offsets (a Schur complement); where that reduced system is
+//!   near singular, the dense pseudo-inverse of the whole system decides. Only the best
+//!   node is used from the grid.
+//! * The search's evaluations and the final solve sum the normal equations in one pass
+//!   over the samples, exactly as the dense design's `XᵀX` and `Xᵀy` were summed
+//!   ([`Dot8`]), and solve the whole system as before: the fit is the dense formulation's,
+//!   bit for bit, at `O(samples)` plus a `(5 + records)²` eigen-decomposition.
+
+use std::cell::RefCell;
+use std::rc::Rc;
 
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
-use crate::lm::{self, Jacobian, LmSettings, Problem};
+use crate::lm::{self, Dot8, Jacobian, LmSettings, Problem};
 
-use super::data::Stacked;
+use super::data::{Block, Stacked};
 
 /// Index of each parameter in the full vector `[Mₑ, Kₑ, F_μ, Cₑ, α, a, b, c_1…c_R]`.
 pub(crate) const MASS: usize = 0;
@@ -30,6 +48,18 @@ pub(crate) const OFFSETS: usize = 7;
 /// below any speed a fit can use).
 const ALPHA_BOUNDS: [f64; 2] = [0.0, 1.0];
 const DECAY_BOUNDS: [f64; 2] = [0.1, 1e4];
+
+/// The reduced (offsets eliminated) system, scaled by the whole system's diagonal, is solved
+/// directly when its smallest eigenvalue exceeds this times the number of columns. Then the
+/// whole scaled system's eigenvalues are all above ~10⁻⁹ of its largest, far above the
+/// pseudo-inverse's singular threshold (10⁻¹²), so both give the same solution: the whole
+/// system `[[Â, B̂], [B̂ᵀ, I]] = L·diag(S, I)·Lᵀ` with `L = [[I, B̂], [0, I]]`,
+/// `‖B̂‖² ≤ λ_max(Â) ≤ 5`, has `λ_min ≥ λ_min(S)/(1 + √5)²` and `λ_max ≤` its trace.
+const SCHUR_MIN_EIGENVALUE: f64 = 1e-8;
+
+/// Singular directions of the whole system's pseudo-inverse: scaled eigenvalues below this
+/// fraction of the largest.
+const PSEUDO_INVERSE_SINGULAR: f64 = 1e-12;
 
 /// Which parameters are fitted.
 #[derive(Debug, Clone, Copy)]
@@ -94,23 +124,288 @@ fn alpha_b(shape: &Shape, q: &[f64]) -> (f64, f64) {
     (alpha, b)
 }
 
-/// The value of column `full` (a linear parameter's index) at sample `i`.
-#[inline]
-fn column(data: &Stacked, full: usize, i: usize, alpha: f64, b: f64) -> f64 {
-    match full {
-        MASS => data.a[i],
-        STIFFNESS => data.u[i],
-        COULOMB => data.s[i],
-        VISCOUS => data.s[i] * (alpha * data.ln_w[i]).exp(),
-        LOW_FORCE => data.s[i] * (-b * data.w[i]).exp(),
-        r => {
-            if data.record[i] == r - OFFSETS {
-                1.0
-            } else {
-                0.0
+/// Sums over one block of the columns that do not depend on `(α, b)`: `x = (a, u, s)`, the
+/// offset (`1`) and the force `y`.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct FixedSums {
+    /// `Σ xⱼ·xₖ`.
+    xx: [[f64; 3]; 3],
+    /// `Σ xⱼ`.
+    x: [f64; 3],
+    /// The number of samples.
+    n: f64,
+    /// `Σ xⱼ·y`.
+    xy: [f64; 3],
+    /// `Σ y`.
+    y: f64,
+    /// `Σ y²`.
+    yy: f64,
+}
+
+impl FixedSums {
+    fn of(b: &Block) -> Self {
+        let mut s = Self::default();
+        for i in 0..b.len() {
+            let x = [b.a[i], b.u[i], b.s[i]];
+            let y = b.f[i];
+            for j in 0..3 {
+                for k in 0..3 {
+                    s.xx[j][k] += x[j] * x[k];
+                }
+                s.x[j] += x[j];
+                s.xy[j] += x[j] * y;
             }
+            s.n += 1.0;
+            s.y += y;
+            s.yy += y * y;
+        }
+        s
+    }
+
+    /// The block's, computed on first use.
+    fn cached(b: &Block) -> Self {
+        *b.fixed.get_or_init(|| Self::of(b))
+    }
+}
+
+/// Sums over one block of a column `z` that depends on `(α, b)` (`c = s·|v|^α` or
+/// `e = s·e^(−b|v|)`) against the others.
+#[derive(Debug, Clone, Copy, Default)]
+struct ColumnSums {
+    /// `Σ z·a`, `Σ z·u`, `Σ z·s`.
+    zx: [f64; 3],
+    /// `Σ z` (against the block's offset).
+    z: f64,
+    /// `Σ z²`.
+    zz: f64,
+    /// `Σ z·y`.
+    zy: f64,
+}
+
+impl ColumnSums {
+    #[inline(always)]
+    fn add(&mut self, z: f64, b: &Block, i: usize) {
+        self.zx[0] += z * b.a[i];
+        self.zx[1] += z * b.u[i];
+        self.zx[2] += z * b.s[i];
+        self.z += z;
+        self.zz += z * z;
+        self.zy += z * b.f[i];
+    }
+}
+
+/// A block's sums at one `(α, b)`.
+#[derive(Debug, Clone, Copy, Default)]
+struct NodeSums {
+    c: ColumnSums,
+    e: ColumnSums,
+    /// `Σ c·e`.
+    ce: f64,
+}
+
+/// A block's sums at every node of a start grid (`alphas × decays`).
+#[derive(Debug)]
+pub(crate) struct GridSums {
+    alphas: Vec<f64>,
+    decays: Vec<f64>,
+    /// Per `α`.
+    c: Vec<ColumnSums>,
+    /// Per `b` (zero without the low-velocity term).
+    e: Vec<ColumnSums>,
+    /// Per `(α, b)`, `α` major.
+    ce: Vec<f64>,
+}
+
+impl GridSums {
+    /// Samples handled together: each node's column is computed once per sample (one
+    /// exponential per `α` and per `b`, not per pair) and kept for the cross sums.
+    const CHUNK: usize = 256;
+
+    fn of(block: &Block, alphas: &[f64], decays: &[f64], low: bool) -> Self {
+        let (na, nb) = (alphas.len(), decays.len());
+        let mut g = GridSums {
+            alphas: alphas.to_vec(),
+            decays: decays.to_vec(),
+            c: vec![ColumnSums::default(); na],
+            e: vec![ColumnSums::default(); nb],
+            ce: vec![0.0; na * nb],
+        };
+        let chunk = Self::CHUNK;
+        let mut cbuf = vec![0.0; na * chunk];
+        let mut ebuf = vec![0.0; nb * chunk];
+        let n = block.len();
+        let mut start = 0;
+        while start < n {
+            let len = chunk.min(n - start);
+            for (k, &alpha) in alphas.iter().enumerate() {
+                let sums = &mut g.c[k];
+                for (j, slot) in cbuf[k * chunk..k * chunk + len].iter_mut().enumerate() {
+                    let i = start + j;
+                    let c = block.s[i] * (alpha * block.ln_w[i]).exp();
+                    *slot = c;
+                    sums.add(c, block, i);
+                }
+            }
+            if low {
+                for (k, &b) in decays.iter().enumerate() {
+                    let sums = &mut g.e[k];
+                    for (j, slot) in ebuf[k * chunk..k * chunk + len].iter_mut().enumerate() {
+                        let i = start + j;
+                        let e = block.s[i] * (-b * block.w[i]).exp();
+                        *slot = e;
+                        sums.add(e, block, i);
+                    }
+                }
+                for ka in 0..na {
+                    let c = &cbuf[ka * chunk..ka * chunk + len];
+                    for kb in 0..nb {
+                        let e = &ebuf[kb * chunk..kb * chunk + len];
+                        let acc = &mut g.ce[ka * nb + kb];
+                        for (x, y) in c.iter().zip(e) {
+                            *acc += x * y;
+                        }
+                    }
+                }
+            }
+            start += len;
+        }
+        g
+    }
+
+    /// The block's sums at this grid, computed on first use and kept with the block.
+    fn cached(block: &Block, alphas: &[f64], decays: &[f64], low: bool) -> Rc<Self> {
+        let mut cache = block.grid.borrow_mut();
+        if let Some(g) = cache
+            .iter()
+            .find(|g| g.alphas == alphas && g.decays == decays)
+        {
+            return Rc::clone(g);
+        }
+        let g = Rc::new(Self::of(block, alphas, decays, low));
+        cache.push(Rc::clone(&g));
+        g
+    }
+
+    fn node(&self, ka: usize, kb: usize) -> NodeSums {
+        NodeSums {
+            c: self.c[ka],
+            e: self.e[kb],
+            ce: self.ce[ka * self.decays.len() + kb],
         }
     }
+}
+
+/// The normal equations `G·θ = Xᵀy` of the linear parameters at one `(α, b)` in their
+/// arrowhead shape: the model's columns (Mₑ, Kₑ, F_μ, Cₑ and, with the low-velocity term,
+/// a: [`Shape::linear`] order), dense, and one offset per record, whose columns are
+/// indicators of disjoint sets of samples. `G` holds the noise correction.
+struct Normal {
+    /// `G` among the model's columns, `k × k`.
+    a: DMatrix<f64>,
+    /// `G` between the model's columns and each offset, `k × R`.
+    b: DMatrix<f64>,
+    /// `G` of each offset with itself: its record's samples.
+    d: Vec<f64>,
+    /// `Xᵀy` of the model's columns.
+    xm: Vec<f64>,
+    /// `Xᵀy` of the offsets.
+    xo: Vec<f64>,
+    /// `yᵀy`.
+    yy: f64,
+}
+
+impl Normal {
+    /// From each block's sums, in record order.
+    fn new<'a>(
+        parts: impl ExactSizeIterator<Item = (&'a FixedSums, NodeSums)>,
+        low: bool,
+        noise_sums: [f64; 2],
+    ) -> Self {
+        let k = if low { 5 } else { 4 };
+        let records = parts.len();
+        let mut n = Normal {
+            a: DMatrix::zeros(k, k),
+            b: DMatrix::zeros(k, records),
+            d: vec![0.0; records],
+            xm: vec![0.0; k],
+            xo: vec![0.0; records],
+            yy: 0.0,
+        };
+        for (r, (fx, node)) in parts.enumerate() {
+            let (c, e) = (&node.c, &node.e);
+            for j in 0..3 {
+                for l in 0..3 {
+                    n.a[(j, l)] += fx.xx[j][l];
+                }
+                n.a[(3, j)] += c.zx[j];
+                n.b[(j, r)] = fx.x[j];
+                n.xm[j] += fx.xy[j];
+            }
+            n.a[(3, 3)] += c.zz;
+            n.b[(3, r)] = c.z;
+            n.xm[3] += c.zy;
+            if low {
+                for j in 0..3 {
+                    n.a[(4, j)] += e.zx[j];
+                }
+                n.a[(4, 3)] += node.ce;
+                n.a[(4, 4)] += e.zz;
+                n.b[(4, r)] = e.z;
+                n.xm[4] += e.zy;
+            }
+            n.d[r] = fx.n;
+            n.xo[r] = fx.y;
+            n.yy += fx.yy;
+        }
+        for j in 0..k {
+            for l in j + 1..k {
+                n.a[(j, l)] = n.a[(l, j)];
+            }
+        }
+        // Corrected least squares: the sensors' noise is not motion.
+        n.a[(0, 0)] -= noise_sums[0];
+        n.a[(1, 1)] -= noise_sums[1];
+        n
+    }
+
+    fn model_columns(&self) -> usize {
+        self.a.nrows()
+    }
+
+    /// The whole `G` (model's columns, then the offsets).
+    fn dense(&self) -> DMatrix<f64> {
+        let (k, r) = (self.model_columns(), self.d.len());
+        let mut g = DMatrix::zeros(k + r, k + r);
+        g.view_mut((0, 0), (k, k)).copy_from(&self.a);
+        g.view_mut((0, k), (k, r)).copy_from(&self.b);
+        g.view_mut((k, 0), (r, k)).copy_from(&self.b.transpose());
+        for (i, &d) in self.d.iter().enumerate() {
+            g[(k + i, k + i)] = d;
+        }
+        g
+    }
+
+    fn xty(&self) -> DVector<f64> {
+        DVector::from_iterator(
+            self.xm.len() + self.xo.len(),
+            self.xm.iter().chain(&self.xo).copied(),
+        )
+    }
+}
+
+/// How [`Solve::apply`] applies the inverse of the normal equations (restricted to the
+/// columns not held at zero).
+enum Inverse {
+    /// The offsets eliminated: the inverse of the reduced system of the kept model columns
+    /// `keep` (model indices), with the border `b` and diagonal `d` of the offsets.
+    Schur {
+        keep: Vec<usize>,
+        reduced_inv: DMatrix<f64>,
+        b: DMatrix<f64>,
+        d: Vec<f64>,
+    },
+    /// The dense pseudo-inverse of the whole system (zero in the clamped columns).
+    Dense(DMatrix<f64>),
 }
 
 /// A least-squares solve of the normal equations `G·θ = Xᵀy` with `θ_k ≥ 0` for the
@@ -121,13 +416,121 @@ fn column(data: &Stacked, full: usize, i: usize, alpha: f64, b: f64) -> f64 {
 /// with the least residual kept. Each solve is scaled to unit diagonal and drops singular
 /// directions (collinear columns).
 struct Solve {
+    /// In [`Shape::linear`] order.
     theta: Vec<f64>,
-    /// Pseudo-inverse of `G` restricted to the columns not held at zero (zero elsewhere).
-    g_inv: DMatrix<f64>,
     /// Sum of squared residuals.
     ssr: f64,
     /// Columns held at their bound (zero).
     clamped: Vec<bool>,
+    inverse: Inverse,
+}
+
+impl Inverse {
+    /// `G⁺·v` for `v` in [`Shape::linear`] order, zero in the clamped columns.
+    fn apply(&self, v: &[f64]) -> Vec<f64> {
+        match self {
+            Inverse::Dense(g_inv) => (g_inv * DVector::from_column_slice(v))
+                .iter()
+                .copied()
+                .collect(),
+            Inverse::Schur {
+                keep,
+                reduced_inv,
+                b,
+                d,
+            } => {
+                let k = b.nrows();
+                let (vm, vo) = v.split_at(k);
+                let rhs = DVector::from_iterator(
+                    keep.len(),
+                    keep.iter().map(|&i| {
+                        vm[i] - (0..d.len()).map(|r| b[(i, r)] * vo[r] / d[r]).sum::<f64>()
+                    }),
+                );
+                let zk = reduced_inv * rhs;
+                let mut z = vec![0.0; v.len()];
+                for (x, &i) in keep.iter().enumerate() {
+                    z[i] = zk[x];
+                }
+                for r in 0..d.len() {
+                    let mut t = vo[r];
+                    for (x, &i) in keep.iter().enumerate() {
+                        t -= b[(i, r)] * zk[x];
+                    }
+                    z[k + r] = t / d[r];
+                }
+                z
+            }
+        }
+    }
+}
+
+impl Solve {
+    /// `G⁺·v` for `v` in [`Shape::linear`] order, zero in the clamped columns.
+    fn apply(&self, v: &[f64]) -> Vec<f64> {
+        self.inverse.apply(v)
+    }
+}
+
+/// The solve with the model columns `keep` (the offsets always kept) by eliminating the
+/// offsets, or `None` when the reduced system is too near singular to be sure the
+/// pseudo-inverse of the whole system would keep every direction
+/// ([`SCHUR_MIN_EIGENVALUE`]), or a record has no samples.
+fn schur(n: &Normal, keep: &[bool]) -> Option<(Vec<f64>, Inverse)> {
+    let (k, records) = (n.model_columns(), n.d.len());
+    let idx: Vec<usize> = (0..k).filter(|&i| keep[i]).collect();
+    let p = idx.len();
+    if p == 0 || n.d.iter().any(|&d| d <= 0.0) {
+        return None;
+    }
+    // Scaled by the whole system's diagonal, as its pseudo-inverse is.
+    let scale: Vec<f64> = idx.iter().map(|&i| n.a[(i, i)].sqrt()).collect();
+    if scale.iter().any(|&x| !(x > 0.0 && x.is_finite())) {
+        return None;
+    }
+    let reduced = DMatrix::from_fn(p, p, |x, y| {
+        let (i, j) = (idx[x], idx[y]);
+        let border: f64 = (0..records)
+            .map(|r| n.b[(i, r)] * n.b[(j, r)] / n.d[r])
+            .sum();
+        (n.a[(i, j)] - border) / (scale[x] * scale[y])
+    });
+    let eig = SymmetricEigen::new(reduced);
+    if !(eig.eigenvalues.min() > SCHUR_MIN_EIGENVALUE * (p + records) as f64) {
+        return None;
+    }
+    let mut inv = DMatrix::zeros(p, p);
+    for e in 0..p {
+        let v = eig.eigenvectors.column(e);
+        inv += (v * v.transpose()) / eig.eigenvalues[e];
+    }
+    let reduced_inv = DMatrix::from_fn(p, p, |x, y| inv[(x, y)] / (scale[x] * scale[y]));
+    let inverse = Inverse::Schur {
+        keep: idx,
+        reduced_inv,
+        b: n.b.clone(),
+        d: n.d.clone(),
+    };
+    let xty: Vec<f64> = n.xm.iter().chain(&n.xo).copied().collect();
+    let theta = inverse.apply(&xty);
+    Some((theta, inverse))
+}
+
+/// `θᵀ·G·θ` of the arrowhead.
+fn quadratic_form(n: &Normal, theta: &[f64]) -> f64 {
+    let k = n.model_columns();
+    let (tm, to) = theta.split_at(k);
+    let mut q = 0.0;
+    for i in 0..k {
+        for j in 0..k {
+            q += tm[i] * n.a[(i, j)] * tm[j];
+        }
+    }
+    for (r, &d) in n.d.iter().enumerate() {
+        let border: f64 = (0..k).map(|i| tm[i] * n.b[(i, r)]).sum();
+        q += 2.0 * border * to[r] + d * to[r] * to[r];
+    }
+    q
 }
 
 fn pseudo_inverse(g: &DMatrix<f64>, keep: &[bool]) -> DMatrix<f64> {
@@ -154,7 +557,7 @@ fn pseudo_inverse(g: &DMatrix<f64>, keep: &[bool]) -> DMatrix<f64> {
     let mut inv = DMatrix::zeros(p, p);
     for e in 0..p {
         let ev = eig.eigenvalues[e];
-        if ev > 1e-12 * max_ev {
+        if ev > PSEUDO_INVERSE_SINGULAR * max_ev {
             let v = eig.eigenvectors.column(e);
             inv += (v * v.transpose()) / ev;
         }
@@ -167,7 +570,9 @@ fn pseudo_inverse(g: &DMatrix<f64>, keep: &[bool]) -> DMatrix<f64> {
     out
 }
 
-fn solve_normal(g: &DMatrix<f64>, xty: &DVector<f64>, yy: f64, nonneg: &[bool]) -> Solve {
+/// The old dense solve of the whole system `g·θ = xty` (every column's pseudo-inverse
+/// scaled to unit diagonal), `nonneg` marking the bounded columns of all of it.
+fn solve_dense(g: &DMatrix<f64>, xty: &DVector<f64>, yy: f64, nonneg: &[bool]) -> Solve {
     let p = g.nrows();
     let bounded: Vec<usize> = (0..p).filter(|&i| nonneg[i]).collect();
     let mut best: Option<Solve> = None;
@@ -187,9 +592,9 @@ fn solve_normal(g: &DMatrix<f64>, xty: &DVector<f64>, yy: f64, nonneg: &[bool]) 
         if best.as_ref().is_none_or(|b| ssr < b.ssr) {
             best = Some(Solve {
                 theta: th.iter().copied().collect(),
-                g_inv,
                 ssr,
                 clamped: keep.iter().map(|k| !k).collect(),
+                inverse: Inverse::Dense(g_inv),
             });
         }
         if mask == 0 && best.is_some() {
@@ -200,147 +605,272 @@ fn solve_normal(g: &DMatrix<f64>, xty: &DVector<f64>, yy: f64, nonneg: &[bool]) 
     best.expect("holding every bounded column at zero is always feasible")
 }
 
-/// The Gram matrix of the columns that do not depend on `(α, b)`, computed once.
-struct FixedGram {
-    /// Full indices of the fixed columns: Mₑ, Kₑ, F_μ, offsets.
-    cols: Vec<usize>,
-    g: DMatrix<f64>,
-    xty: Vec<f64>,
-}
-
-impl FixedGram {
-    fn new(data: &Stacked, shape: &Shape) -> Self {
-        let mut cols = vec![MASS, STIFFNESS, COULOMB];
-        cols.extend((0..shape.records).map(|r| OFFSETS + r));
-        let k = cols.len();
-        let mut g = DMatrix::zeros(k, k);
-        let mut xty = vec![0.0; k];
-        let mut row = vec![0.0; k];
-        for i in 0..data.len() {
-            for (c, &full) in cols.iter().enumerate() {
-                row[c] = column(data, full, i, 0.0, 0.0);
-            }
-            for a in 0..k {
-                if row[a] == 0.0 {
-                    continue;
-                }
-                xty[a] += row[a] * data.f[i];
-                for b in 0..k {
-                    g[(a, b)] += row[a] * row[b];
-                }
+/// The solve of the arrowhead, the offsets eliminated ([`schur`]); where that is not sure
+/// to agree with the whole system's pseudo-inverse, [`solve_dense`] of the whole system.
+/// `nonneg` marks the bounded model columns.
+fn solve_normal(n: &Normal, nonneg: &[bool]) -> Solve {
+    let k = n.model_columns();
+    let records = n.d.len();
+    let bounded: Vec<usize> = (0..k).filter(|&i| nonneg[i]).collect();
+    let xty = n.xty();
+    let mut best: Option<Solve> = None;
+    for mask in 0..(1usize << bounded.len()) {
+        let mut keep = vec![true; k];
+        for (bit, &i) in bounded.iter().enumerate() {
+            if mask & (1 << bit) != 0 {
+                keep[i] = false;
             }
         }
-        // Corrected least squares: the sensors' noise is not motion.
-        g[(0, 0)] -= data.noise_sums[0];
-        g[(1, 1)] -= data.noise_sums[1];
-        Self { cols, g, xty }
+        let Some((theta, inverse)) = schur(n, &keep) else {
+            let mut nonneg_all = nonneg.to_vec();
+            nonneg_all.extend(std::iter::repeat_n(false, records));
+            return solve_dense(&n.dense(), &xty, n.yy, &nonneg_all);
+        };
+        if bounded.iter().any(|&i| keep[i] && theta[i] < 0.0) {
+            continue;
+        }
+        let t = DVector::from_column_slice(&theta);
+        let ssr = (n.yy - 2.0 * t.dot(&xty) + quadratic_form(n, &theta)).max(0.0);
+        if best.as_ref().is_none_or(|b| ssr < b.ssr) {
+            let mut clamped: Vec<bool> = keep.iter().map(|k| !k).collect();
+            clamped.extend(std::iter::repeat_n(false, records));
+            best = Some(Solve {
+                theta,
+                ssr,
+                clamped,
+                inverse,
+            });
+        }
+        if mask == 0 && best.is_some() {
+            break;
+        }
     }
+    best.expect("holding every bounded column at zero is always feasible")
+}
+
+/// The linear solve at one `(α, b)`, with the nonlinear columns `c = s·|v|^α` and
+/// `e = s·e^(−b|v|)` of every sample (stacked order) for the residuals and the Jacobian.
+struct Evaluation {
+    alpha: f64,
+    b: f64,
+    solve: Solve,
+    c: Vec<f64>,
+    e: Vec<f64>,
 }
 
 /// The equation-error problem: the stacked samples and which parameters are fitted.
 pub(crate) struct Separable<'a> {
     data: &'a Stacked,
     shape: Shape,
-    fixed: FixedGram,
+    /// Each block's [`FixedSums`], in record order.
+    fixed: Vec<FixedSums>,
     /// `Σ F²`.
     yy: f64,
+    /// The last evaluation: Levenberg–Marquardt asks for the Jacobian where it has just
+    /// computed the residuals.
+    last: RefCell<Option<Rc<Evaluation>>>,
 }
 
 impl<'a> Separable<'a> {
     pub(crate) fn new(data: &'a Stacked, shape: Shape) -> Self {
-        let fixed = FixedGram::new(data, &shape);
-        let yy = data.f.iter().map(|f| f * f).sum();
+        let fixed = data.blocks.iter().map(|b| FixedSums::cached(b)).collect();
+        let yy = data
+            .blocks
+            .iter()
+            .flat_map(|b| b.f.iter())
+            .map(|f| f * f)
+            .sum();
         Self {
             data,
             shape,
             fixed,
             yy,
+            last: RefCell::new(None),
         }
     }
 
-    /// The linear parameters at `(α, b)` (in [`Shape::linear`] order) and the sum of squared
-    /// residuals, from Gram sums: the nonlinear columns' products are the only per-call work.
-    fn linear_at(&self, alpha: f64, b: f64) -> (Vec<f64>, f64) {
-        let data = self.data;
-        let k = self.fixed.cols.len();
-        let r_off = 3; // offsets start at fixed column 3
-        let mut gc = vec![0.0; k];
-        let mut ge = vec![0.0; k];
-        let (mut cc, mut ee, mut ce, mut cy, mut ey) = (0.0, 0.0, 0.0, 0.0, 0.0);
-        for i in 0..data.len() {
-            let s = data.s[i];
-            let c = s * (alpha * data.ln_w[i]).exp();
-            let e = if self.shape.low {
-                s * (-b * data.w[i]).exp()
-            } else {
-                0.0
-            };
-            let base = [data.a[i], data.u[i], s];
-            for j in 0..3 {
-                gc[j] += c * base[j];
-                ge[j] += e * base[j];
-            }
-            let r = r_off + data.record[i];
-            gc[r] += c;
-            ge[r] += e;
-            cc += c * c;
-            ee += e * e;
-            ce += c * e;
-            cy += c * data.f[i];
-            ey += e * data.f[i];
+    fn normal(&self, nodes: impl ExactSizeIterator<Item = NodeSums>) -> Normal {
+        Normal::new(
+            self.fixed.iter().zip(nodes),
+            self.shape.low,
+            self.data.noise_sums,
+        )
+    }
+
+    /// Model columns of the design: Mₑ, Kₑ, F_μ, Cₑ and, with the low-velocity term, a.
+    fn model_columns(&self) -> usize {
+        if self.shape.low {
+            5
+        } else {
+            4
         }
-        // Assemble in Shape::linear order: Mₑ, Kₑ, F_μ, Cₑ, [a], offsets.
-        let lin = self.shape.linear();
-        let p = lin.len();
-        let pos =
-            |full: usize| -> Option<usize> { self.fixed.cols.iter().position(|&c| c == full) };
-        let entry = |x: usize, y: usize| -> f64 {
-            match (x, y) {
-                (VISCOUS, VISCOUS) => cc,
-                (LOW_FORCE, LOW_FORCE) => ee,
-                (VISCOUS, LOW_FORCE) | (LOW_FORCE, VISCOUS) => ce,
-                (VISCOUS, o) | (o, VISCOUS) => gc[pos(o).expect("fixed column")],
-                (LOW_FORCE, o) | (o, LOW_FORCE) => ge[pos(o).expect("fixed column")],
-                (o1, o2) => {
-                    self.fixed.g[(
-                        pos(o1).expect("fixed column"),
-                        pos(o2).expect("fixed column"),
-                    )]
+    }
+
+    /// The solve at `(α, b)` and the nonlinear columns: one pass over the samples. The
+    /// normal equations are summed as the dense design's `XᵀX` and `Xᵀy` are ([`Dot8`] by
+    /// the sample's row), and solved as the whole system always was, so the result is the
+    /// dense formulation's, bit for bit, at `O(samples + records³)`.
+    fn evaluate(&self, alpha: f64, b: f64) -> Rc<Evaluation> {
+        if let Some(ev) = self.last.borrow().as_ref() {
+            if ev.alpha.to_bits() == alpha.to_bits() && ev.b.to_bits() == b.to_bits() {
+                return Rc::clone(ev);
+            }
+        }
+        let k = self.model_columns();
+        let records = self.data.blocks.len();
+        let n = self.data.len();
+        let lanes = Dot8::lane_rows(n);
+        let mut mm = vec![Dot8::default(); k * k];
+        let mut mo = vec![Dot8::default(); records * k];
+        let mut xm = vec![Dot8::default(); k];
+        let mut xo = vec![Dot8::default(); records];
+        let mut counts = vec![0.0; records];
+        let (mut c_all, mut e_all) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        let mut tail = Vec::new();
+        let mut i = 0;
+        for block in &self.data.blocks {
+            let r = block.record;
+            counts[r] = block.len() as f64;
+            for j in 0..block.len() {
+                let s = block.s[j];
+                let c = s * (alpha * block.ln_w[j]).exp();
+                let e = if self.shape.low {
+                    s * (-b * block.w[j]).exp()
+                } else {
+                    0.0
+                };
+                c_all.push(c);
+                e_all.push(e);
+                let x = [block.a[j], block.u[j], s, c, e];
+                let f = block.f[j];
+                if i < lanes {
+                    for p in 0..k {
+                        for q in 0..=p {
+                            mm[p * k + q].add(i, x[p] * x[q]);
+                        }
+                        mo[r * k + p].add(i, x[p]);
+                        xm[p].add(i, x[p] * f);
+                    }
+                    xo[r].add(i, f);
+                } else {
+                    tail.push((r, x, f));
+                }
+                i += 1;
+            }
+        }
+        let mut g = DMatrix::zeros(k + records, k + records);
+        let mut xty = DVector::zeros(k + records);
+        for p in 0..k {
+            for q in 0..=p {
+                g[(p, q)] = mm[p * k + q].finish();
+            }
+            xty[p] = xm[p].finish();
+        }
+        for r in 0..records {
+            for p in 0..k {
+                g[(p, k + r)] = mo[r * k + p].finish();
+            }
+            g[(k + r, k + r)] = counts[r];
+            xty[k + r] = xo[r].finish();
+        }
+        for (r, x, f) in tail {
+            for p in 0..k {
+                for q in 0..=p {
+                    g[(p, q)] += x[p] * x[q];
+                }
+                g[(p, k + r)] += x[p];
+                xty[p] += x[p] * f;
+            }
+            xty[k + r] += f;
+        }
+        for p in 0..k + records {
+            for q in p + 1..k + records {
+                if q < k {
+                    g[(p, q)] = g[(q, p)];
+                } else {
+                    g[(q, p)] = g[(p, q)];
                 }
             }
-        };
-        let g = DMatrix::from_fn(p, p, |i, j| entry(lin[i], lin[j]));
-        let xty = DVector::from_fn(p, |i, _| match lin[i] {
-            VISCOUS => cy,
-            LOW_FORCE => ey,
-            o => self.fixed.xty[pos(o).expect("fixed column")],
-        });
-        let sol = solve_normal(&g, &xty, self.yy, &self.nonneg());
-        (sol.theta, sol.ssr)
-    }
-
-    /// The design matrix at `(α, b)` (columns in [`Shape::linear`] order).
-    fn design(&self, alpha: f64, b: f64) -> DMatrix<f64> {
-        let lin = self.shape.linear();
-        DMatrix::from_fn(self.data.len(), lin.len(), |i, c| {
-            column(self.data, lin[c], i, alpha, b)
-        })
-    }
-
-    fn solve_design(&self, x: &DMatrix<f64>) -> Solve {
-        let mut g = x.tr_mul(x);
-        // Columns 0 and 1 are Mₑ and Kₑ (Shape::linear): corrected as in FixedGram.
+        }
+        // Corrected least squares: the sensors' noise is not motion.
         g[(0, 0)] -= self.data.noise_sums[0];
         g[(1, 1)] -= self.data.noise_sums[1];
-        let xty = x.tr_mul(&DVector::from_column_slice(&self.data.f));
-        solve_normal(&g, &xty, self.yy, &self.nonneg())
+        let mut nonneg = self.nonneg();
+        nonneg.extend(std::iter::repeat_n(false, records));
+        let ev = Rc::new(Evaluation {
+            alpha,
+            b,
+            solve: solve_dense(&g, &xty, self.yy, &nonneg),
+            c: c_all,
+            e: e_all,
+        });
+        *self.last.borrow_mut() = Some(Rc::clone(&ev));
+        ev
     }
 
-    /// Which linear parameters are bounded below by zero ([`Shape::linear`] order).
+    /// `X·z` at every sample for `z` in [`Shape::linear`] order (the design's columns in
+    /// order: Mₑ, Kₑ, F_μ, Cₑ, [a], the sample's offset).
+    fn design_times(&self, ev: &Evaluation, z: &[f64], out: &mut Vec<f64>) {
+        let k = self.model_columns();
+        out.clear();
+        let mut at = 0;
+        for block in &self.data.blocks {
+            let offset = z[k + block.record];
+            for i in 0..block.len() {
+                let mut m = z[0] * block.a[i];
+                m += z[1] * block.u[i];
+                m += z[2] * block.s[i];
+                m += z[3] * ev.c[at];
+                if self.shape.low {
+                    m += z[4] * ev.e[at];
+                }
+                m += offset;
+                out.push(m);
+                at += 1;
+            }
+        }
+    }
+
+    /// `Xᵀ·v` in [`Shape::linear`] order, summed as the dense design's ([`Dot8`]).
+    fn design_tr_times(&self, ev: &Evaluation, v: &[f64]) -> Vec<f64> {
+        let k = self.model_columns();
+        let records = self.data.blocks.len();
+        let lanes = Dot8::lane_rows(v.len());
+        let mut model = vec![Dot8::default(); k];
+        let mut offsets = vec![Dot8::default(); records];
+        let mut tail = Vec::new();
+        let mut at = 0;
+        for block in &self.data.blocks {
+            for i in 0..block.len() {
+                let x = [block.a[i], block.u[i], block.s[i], ev.c[at], ev.e[at]];
+                if at < lanes {
+                    for p in 0..k {
+                        model[p].add(at, x[p] * v[at]);
+                    }
+                    offsets[block.record].add(at, v[at]);
+                } else {
+                    tail.push((block.record, x, v[at]));
+                }
+                at += 1;
+            }
+        }
+        let mut out: Vec<f64> = model.iter().chain(&offsets).map(Dot8::finish).collect();
+        for (r, x, y) in tail {
+            for p in 0..k {
+                out[p] += x[p] * y;
+            }
+            out[k + r] += y;
+        }
+        out
+    }
+
+    /// Which linear parameters are bounded below by zero ([`Shape::linear`] order, the
+    /// model's columns only: offsets are free).
     fn nonneg(&self) -> Vec<bool> {
         self.shape
             .linear()
             .iter()
+            .filter(|&&i| i < OFFSETS)
             .map(|&i| {
                 matches!(i, COULOMB | VISCOUS | LOW_FORCE)
                     || (i == STIFFNESS && self.shape.nonneg_stiffness)
@@ -359,10 +889,18 @@ impl<'a> Separable<'a> {
         } else {
             vec![0.0]
         };
+        let sums: Vec<Rc<GridSums>> = self
+            .data
+            .blocks
+            .iter()
+            .map(|b| GridSums::cached(b, &alphas, &decays, self.shape.low))
+            .collect();
+        let nonneg = self.nonneg();
         let mut best = (f64::INFINITY, alphas[0], decays[0]);
-        for &a in &alphas {
-            for &b in &decays {
-                let (_, ssr) = self.linear_at(a, b);
+        for (ka, &a) in alphas.iter().enumerate() {
+            for (kb, &b) in decays.iter().enumerate() {
+                let normal = self.normal(sums.iter().map(|g| g.node(ka, kb)));
+                let ssr = solve_normal(&normal, &nonneg).ssr;
                 if ssr < best.0 {
                     best = (ssr, a, b);
                 }
@@ -409,19 +947,16 @@ impl<'a> Separable<'a> {
             (res.params, res.iterations, res.converged)
         };
         let (alpha, b) = alpha_b(&self.shape, &q);
-        let x = self.design(alpha, b);
-        let sol = self.solve_design(&x);
+        let ev = self.evaluate(alpha, b);
+        let sol = &ev.solve;
         let mut full = vec![0.0; self.shape.full_len()];
         full[EXPONENT] = alpha;
         full[LOW_DECAY] = b;
         for (c, &i) in self.shape.linear().iter().enumerate() {
             full[i] = sol.theta[c];
         }
-        let residual: Vec<f64> = (&x * DVector::from_column_slice(&sol.theta))
-            .iter()
-            .zip(&self.data.f)
-            .map(|(m, f)| m - f)
-            .collect();
+        let mut residual = Vec::new();
+        self.residuals_at(&ev, &mut residual);
         let at_bound = nonlinear
             .iter()
             .zip(&q)
@@ -443,7 +978,7 @@ impl<'a> Separable<'a> {
             .filter(|i| !clamped.contains(i))
             .collect();
         SeparableFit {
-            jacobian: self.full_jacobian(&full, &free),
+            jacobian: self.full_jacobian(&full, &free, &ev),
             free,
             clamped,
             full,
@@ -454,16 +989,46 @@ impl<'a> Separable<'a> {
         }
     }
 
-    /// `∂r/∂θ` for the parameters `free` (full-vector indices) at `full`.
-    fn full_jacobian(&self, full: &[f64], free: &[usize]) -> Jacobian {
-        let (alpha, b) = (full[EXPONENT], full[LOW_DECAY]);
-        let d = self.data;
-        let mut j = Jacobian::dense(d.len(), free.len());
-        j.shared = DMatrix::from_fn(d.len(), free.len(), |i, c| match free[c] {
-            EXPONENT => full[VISCOUS] * d.s[i] * (alpha * d.ln_w[i]).exp() * d.ln_w[i],
-            LOW_DECAY => -full[LOW_FORCE] * d.s[i] * d.w[i] * (-b * d.w[i]).exp(),
-            other => column(d, other, i, alpha, b),
-        });
+    /// Residuals (model − data) of the solve `ev`.
+    fn residuals_at(&self, ev: &Evaluation, r: &mut Vec<f64>) {
+        self.design_times(ev, &ev.solve.theta, r);
+        let f = self.data.blocks.iter().flat_map(|b| b.f.iter());
+        for (r, f) in r.iter_mut().zip(f) {
+            *r -= f;
+        }
+    }
+
+    /// `∂r/∂θ` for the parameters `free` (full-vector indices: the model's, then every
+    /// offset) at `full`: the model's columns shared by every sample, the offset's local to
+    /// its record (a column of ones).
+    fn full_jacobian(&self, full: &[f64], free: &[usize], ev: &Evaluation) -> Jacobian {
+        let model: Vec<usize> = free.iter().copied().filter(|&i| i < OFFSETS).collect();
+        debug_assert_eq!(free.len(), model.len() + self.data.blocks.len());
+        let mut j = Jacobian::blocked(
+            self.data.len(),
+            model.len(),
+            1,
+            self.data.groups(),
+            self.data.blocks.len(),
+        );
+        j.local.fill(1.0);
+        let mut at = 0;
+        for block in &self.data.blocks {
+            for i in 0..block.len() {
+                for (col, &which) in model.iter().enumerate() {
+                    j.shared[(at, col)] = match which {
+                        MASS => block.a[i],
+                        STIFFNESS => block.u[i],
+                        COULOMB => block.s[i],
+                        VISCOUS => ev.c[at],
+                        EXPONENT => full[VISCOUS] * ev.c[at] * block.ln_w[i],
+                        LOW_FORCE => ev.e[at],
+                        _ => -full[LOW_FORCE] * block.w[i] * ev.e[at],
+                    };
+                }
+                at += 1;
+            }
+        }
         j
     }
 }
@@ -477,30 +1042,35 @@ impl Problem for Separable<'_> {
     }
     fn residuals(&self, q: &[f64], r: &mut [f64]) {
         let (alpha, b) = alpha_b(&self.shape, q);
-        let x = self.design(alpha, b);
-        let sol = self.solve_design(&x);
-        let model = &x * DVector::from_column_slice(&sol.theta);
-        for ((r, m), f) in r.iter_mut().zip(model.iter()).zip(&self.data.f) {
-            *r = m - f;
-        }
+        let ev = self.evaluate(alpha, b);
+        let mut out = Vec::with_capacity(r.len());
+        self.residuals_at(&ev, &mut out);
+        r.copy_from_slice(&out);
     }
     /// Kaufman's Jacobian: `∂r/∂q_k ≈ P⊥·(∂X/∂q_k)·θ̂`.
     fn jacobian(&self, q: &[f64], _r: &[f64], j: &mut Jacobian) {
-        let j = &mut j.shared;
         let (alpha, b) = alpha_b(&self.shape, q);
-        let x = self.design(alpha, b);
-        let sol = self.solve_design(&x);
+        let ev = self.evaluate(alpha, b);
         let lin = self.shape.linear();
-        let theta = |full: usize| sol.theta[lin.iter().position(|&c| c == full).unwrap_or(0)];
-        let d = self.data;
+        let theta = |full: usize| ev.solve.theta[lin.iter().position(|&c| c == full).unwrap_or(0)];
+        let mut dx = Vec::with_capacity(self.data.len());
+        let mut proj = Vec::with_capacity(self.data.len());
         for (k, &which) in self.shape.nonlinear().iter().enumerate() {
-            let dx: DVector<f64> = DVector::from_fn(d.len(), |i, _| match which {
-                EXPONENT => theta(VISCOUS) * d.s[i] * (alpha * d.ln_w[i]).exp() * d.ln_w[i],
-                _ => -theta(LOW_FORCE) * d.s[i] * d.w[i] * (-b * d.w[i]).exp(),
-            });
-            let proj = &x * (&sol.g_inv * x.tr_mul(&dx));
-            for i in 0..d.len() {
-                j[(i, k)] = dx[i] - proj[i];
+            dx.clear();
+            let mut at = 0;
+            for block in &self.data.blocks {
+                for i in 0..block.len() {
+                    dx.push(match which {
+                        EXPONENT => theta(VISCOUS) * ev.c[at] * block.ln_w[i],
+                        _ => -theta(LOW_FORCE) * block.w[i] * ev.e[at],
+                    });
+                    at += 1;
+                }
+            }
+            let z = ev.solve.apply(&self.design_tr_times(&ev, &dx));
+            self.design_times(&ev, &z, &mut proj);
+            for (i, (d, p)) in dx.iter().zip(&proj).enumerate() {
+                j.shared[(i, k)] = d - p;
             }
         }
     }
@@ -513,7 +1083,7 @@ pub(crate) struct SeparableFit {
     pub full: Vec<f64>,
     /// Residuals (model − data) of the stacked samples.
     pub residual: Vec<f64>,
-    /// `∂r/∂θ` of the parameters `free` at the optimum.
+    /// `∂r/∂θ` of the parameters `free` at the optimum (the offsets local to their records).
     pub jacobian: Jacobian,
     /// The fitted parameters not held at a bound ([`Shape::free`] less `clamped`).
     pub free: Vec<usize>,
@@ -536,7 +1106,7 @@ mod tests {
     #[test]
     fn exact_data_give_back_every_parameter() {
         let truth = [118e3, 0.95e6, 32e3, 61e3, 0.68, 9e3, 55.0, 3e3];
-        let mut d = Stacked::default();
+        let mut d = Block::default();
         for i in 0..4000 {
             let t = i as f64 / 200.0;
             let u = 0.05 * (1.3 * t).sin() + 0.01 * (7.1 * t).cos();
@@ -557,11 +1127,11 @@ mod tests {
             d.w.push(w);
             d.ln_w.push(w.ln());
             d.f.push(f);
-            d.record.push(0);
             d.time.push(i);
         }
+        let data = Stacked::from_blocks(vec![Rc::new(d)]);
         let fit = Separable::new(
-            &d,
+            &data,
             Shape {
                 alpha: None,
                 low: true,

@@ -139,11 +139,13 @@ pub(crate) fn correct(records: &[TestRecord]) -> Result<Corrected> {
     Ok(out)
 }
 
-/// For each record with an estimated delay: the records with that channel shifted by `±h`
-/// from the delay used, `h` (s), and the mean square error of the delay used, s².
+/// For each record with an estimated delay: that record (index `record`) with the channel
+/// shifted by `±h` from the delay used (the other records stay as corrected), `h` (s), and
+/// the mean square error of the delay used, s².
 pub(crate) struct Perturbation {
-    pub minus: Vec<TestRecord>,
-    pub plus: Vec<TestRecord>,
+    pub record: usize,
+    pub minus: TestRecord,
+    pub plus: TestRecord,
     pub h_s: f64,
     pub mse_s2: f64,
 }
@@ -163,14 +165,12 @@ pub(crate) fn perturbations(corrected: &Corrected) -> Result<Vec<Perturbation>> 
             // jitter by a few kg of Mₑ between nearby delays; a shorter step would measure
             // the jitter, not the slope (~100 kg per sample near the true delay).
             let h_s = (2.0 * mse_s2.sqrt()).max(STEP_SAMPLES / fs);
-            let shifted = |sign: f64| -> Result<Vec<TestRecord>> {
-                let mut set = corrected.records.clone();
-                set[r] = rec
-                    .with_channel_advanced(d.column, sign * h_s * fs)
-                    .map_err(signal_error(rec))?;
-                Ok(set)
+            let shifted = |sign: f64| -> Result<TestRecord> {
+                rec.with_channel_advanced(d.column, sign * h_s * fs)
+                    .map_err(signal_error(rec))
             };
             out.push(Perturbation {
+                record: r,
                 minus: shifted(-1.0)?,
                 plus: shifted(1.0)?,
                 h_s,
