@@ -232,6 +232,7 @@ impl OutputError {
     /// Each record at `p`: its simulated displacement (`None` if the model is invalid or the
     /// run fails), and the unweighted RMS of its displacement and acceleration residuals
     /// (NaN if so).
+    #[allow(clippy::type_complexity)] // one tuple per record, as `finish`'s callers take it
     pub(crate) fn finish(&self, p: &[f64]) -> Vec<(Option<Vec<f64>>, (f64, f64))> {
         let q = self.full(p);
         (0..self.records.len())

@@ -496,7 +496,8 @@ fn schur(n: &Normal, keep: &[bool]) -> Option<(Vec<f64>, Inverse)> {
         (n.a[(i, j)] - border) / (scale[x] * scale[y])
     });
     let eig = SymmetricEigen::new(reduced);
-    if !(eig.eigenvalues.min() > SCHUR_MIN_EIGENVALUE * (p + records) as f64) {
+    let smallest = eig.eigenvalues.min();
+    if smallest.is_nan() || smallest <= SCHUR_MIN_EIGENVALUE * (p + records) as f64 {
         return None;
     }
     let mut inv = DMatrix::zeros(p, p);
