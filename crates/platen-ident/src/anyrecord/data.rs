@@ -10,7 +10,6 @@ use platen_signal::CrossoverVelocity;
 use crate::error::{IdentError, Result};
 use crate::record::TestRecord;
 
-use super::separable::{FixedSums, GridSums};
 use super::settings::ValidRecordSettings;
 
 /// One record, ready for the fits.
@@ -119,7 +118,7 @@ pub(crate) struct Block {
     pub noise_var: [f64; 2],
     /// The equation error's sums over this block of the columns that do not depend on
     /// `(α, b)`, and at the nodes of its start grid: computed once and shared by every fit
-    /// that uses the block (module `separable`).
+    /// that uses the block (the equation error of module `separable`).
     pub(crate) fixed: OnceCell<FixedSums>,
     pub(crate) grid: RefCell<Vec<Rc<GridSums>>>,
 }
@@ -218,5 +217,176 @@ impl Stacked {
             group.extend(std::iter::repeat_n(b.record, b.len()));
         }
         (time, group)
+    }
+}
+
+/// Sums over one block of the columns that do not depend on `(α, b)`: `x = (a, u, s)`, the
+/// offset (`1`) and the force `y`.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct FixedSums {
+    /// `Σ xⱼ·xₖ`.
+    pub(super) xx: [[f64; 3]; 3],
+    /// `Σ xⱼ`.
+    pub(super) x: [f64; 3],
+    /// The number of samples.
+    pub(super) n: f64,
+    /// `Σ xⱼ·y`.
+    pub(super) xy: [f64; 3],
+    /// `Σ y`.
+    pub(super) y: f64,
+    /// `Σ y²`.
+    pub(super) yy: f64,
+}
+
+impl FixedSums {
+    fn of(b: &Block) -> Self {
+        let mut s = Self::default();
+        for i in 0..b.len() {
+            let x = [b.a[i], b.u[i], b.s[i]];
+            let y = b.f[i];
+            for j in 0..3 {
+                for k in 0..3 {
+                    s.xx[j][k] += x[j] * x[k];
+                }
+                s.x[j] += x[j];
+                s.xy[j] += x[j] * y;
+            }
+            s.n += 1.0;
+            s.y += y;
+            s.yy += y * y;
+        }
+        s
+    }
+
+    /// The block's, computed on first use.
+    pub(super) fn cached(b: &Block) -> Self {
+        *b.fixed.get_or_init(|| Self::of(b))
+    }
+}
+
+/// Sums over one block of a column `z` that depends on `(α, b)` (`c = s·|v|^α` or
+/// `e = s·e^(−b|v|)`) against the others.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct ColumnSums {
+    /// `Σ z·a`, `Σ z·u`, `Σ z·s`.
+    pub(super) zx: [f64; 3],
+    /// `Σ z` (against the block's offset).
+    pub(super) z: f64,
+    /// `Σ z²`.
+    pub(super) zz: f64,
+    /// `Σ z·y`.
+    pub(super) zy: f64,
+}
+
+impl ColumnSums {
+    #[inline(always)]
+    fn add(&mut self, z: f64, b: &Block, i: usize) {
+        self.zx[0] += z * b.a[i];
+        self.zx[1] += z * b.u[i];
+        self.zx[2] += z * b.s[i];
+        self.z += z;
+        self.zz += z * z;
+        self.zy += z * b.f[i];
+    }
+}
+
+/// A block's sums at one `(α, b)`.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct NodeSums {
+    pub(super) c: ColumnSums,
+    pub(super) e: ColumnSums,
+    /// `Σ c·e`.
+    pub(super) ce: f64,
+}
+
+/// A block's sums at every node of a start grid (`alphas × decays`).
+#[derive(Debug)]
+pub(super) struct GridSums {
+    alphas: Vec<f64>,
+    decays: Vec<f64>,
+    /// Per `α`.
+    c: Vec<ColumnSums>,
+    /// Per `b` (zero without the low-velocity term).
+    e: Vec<ColumnSums>,
+    /// Per `(α, b)`, `α` major.
+    ce: Vec<f64>,
+}
+
+impl GridSums {
+    /// Samples handled together: each node's column is computed once per sample (one
+    /// exponential per `α` and per `b`, not per pair) and kept for the cross sums.
+    const CHUNK: usize = 256;
+
+    fn of(block: &Block, alphas: &[f64], decays: &[f64], low: bool) -> Self {
+        let (na, nb) = (alphas.len(), decays.len());
+        let mut g = GridSums {
+            alphas: alphas.to_vec(),
+            decays: decays.to_vec(),
+            c: vec![ColumnSums::default(); na],
+            e: vec![ColumnSums::default(); nb],
+            ce: vec![0.0; na * nb],
+        };
+        let chunk = Self::CHUNK;
+        let mut cbuf = vec![0.0; na * chunk];
+        let mut ebuf = vec![0.0; nb * chunk];
+        let n = block.len();
+        let mut start = 0;
+        while start < n {
+            let len = chunk.min(n - start);
+            for (k, &alpha) in alphas.iter().enumerate() {
+                let sums = &mut g.c[k];
+                for (j, slot) in cbuf[k * chunk..k * chunk + len].iter_mut().enumerate() {
+                    let i = start + j;
+                    let c = block.s[i] * (alpha * block.ln_w[i]).exp();
+                    *slot = c;
+                    sums.add(c, block, i);
+                }
+            }
+            if low {
+                for (k, &b) in decays.iter().enumerate() {
+                    let sums = &mut g.e[k];
+                    for (j, slot) in ebuf[k * chunk..k * chunk + len].iter_mut().enumerate() {
+                        let i = start + j;
+                        let e = block.s[i] * (-b * block.w[i]).exp();
+                        *slot = e;
+                        sums.add(e, block, i);
+                    }
+                }
+                for ka in 0..na {
+                    let c = &cbuf[ka * chunk..ka * chunk + len];
+                    for kb in 0..nb {
+                        let e = &ebuf[kb * chunk..kb * chunk + len];
+                        let acc = &mut g.ce[ka * nb + kb];
+                        for (x, y) in c.iter().zip(e) {
+                            *acc += x * y;
+                        }
+                    }
+                }
+            }
+            start += len;
+        }
+        g
+    }
+
+    /// The block's sums at this grid, computed on first use and kept with the block.
+    pub(super) fn cached(block: &Block, alphas: &[f64], decays: &[f64], low: bool) -> Rc<Self> {
+        let mut cache = block.grid.borrow_mut();
+        if let Some(g) = cache
+            .iter()
+            .find(|g| g.alphas == alphas && g.decays == decays)
+        {
+            return Rc::clone(g);
+        }
+        let g = Rc::new(Self::of(block, alphas, decays, low));
+        cache.push(Rc::clone(&g));
+        g
+    }
+
+    pub(super) fn node(&self, ka: usize, kb: usize) -> NodeSums {
+        NodeSums {
+            c: self.c[ka],
+            e: self.e[kb],
+            ce: self.ce[ka * self.decays.len() + kb],
+        }
     }
 }

@@ -12,7 +12,7 @@
 //! indicator of its record's samples, so the normal equations are an arrowhead: the model's
 //! columns (at most five), dense, bordered by one diagonal entry per record.
 //!
-//! * The start grid's nodes work from sums formed record by record ([`Block`]), once per
+//! * The start grid's nodes work from sums formed record by record ([`Block`](super::data::Block)), once per
 //!   record and grid (kept with the block, so a refit that changes one record, the
 //!   channel-skew variance of module `skew`, forms them for that record only), and solve the
 //!   arrowhead by eliminating the offsets (a Schur complement); where that reduced system is
@@ -30,7 +30,7 @@ use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
 use crate::lm::{self, Dot8, Jacobian, LmSettings, Problem};
 
-use super::data::{Block, Stacked};
+use super::data::{FixedSums, GridSums, NodeSums, Stacked};
 
 /// Index of each parameter in the full vector `[Mₑ, Kₑ, F_μ, Cₑ, α, a, b, c_1…c_R]`.
 pub(crate) const MASS: usize = 0;
@@ -122,177 +122,6 @@ fn alpha_b(shape: &Shape, q: &[f64]) -> (f64, f64) {
     };
     let b = if shape.low { q[k] } else { 0.0 };
     (alpha, b)
-}
-
-/// Sums over one block of the columns that do not depend on `(α, b)`: `x = (a, u, s)`, the
-/// offset (`1`) and the force `y`.
-#[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct FixedSums {
-    /// `Σ xⱼ·xₖ`.
-    xx: [[f64; 3]; 3],
-    /// `Σ xⱼ`.
-    x: [f64; 3],
-    /// The number of samples.
-    n: f64,
-    /// `Σ xⱼ·y`.
-    xy: [f64; 3],
-    /// `Σ y`.
-    y: f64,
-    /// `Σ y²`.
-    yy: f64,
-}
-
-impl FixedSums {
-    fn of(b: &Block) -> Self {
-        let mut s = Self::default();
-        for i in 0..b.len() {
-            let x = [b.a[i], b.u[i], b.s[i]];
-            let y = b.f[i];
-            for j in 0..3 {
-                for k in 0..3 {
-                    s.xx[j][k] += x[j] * x[k];
-                }
-                s.x[j] += x[j];
-                s.xy[j] += x[j] * y;
-            }
-            s.n += 1.0;
-            s.y += y;
-            s.yy += y * y;
-        }
-        s
-    }
-
-    /// The block's, computed on first use.
-    fn cached(b: &Block) -> Self {
-        *b.fixed.get_or_init(|| Self::of(b))
-    }
-}
-
-/// Sums over one block of a column `z` that depends on `(α, b)` (`c = s·|v|^α` or
-/// `e = s·e^(−b|v|)`) against the others.
-#[derive(Debug, Clone, Copy, Default)]
-struct ColumnSums {
-    /// `Σ z·a`, `Σ z·u`, `Σ z·s`.
-    zx: [f64; 3],
-    /// `Σ z` (against the block's offset).
-    z: f64,
-    /// `Σ z²`.
-    zz: f64,
-    /// `Σ z·y`.
-    zy: f64,
-}
-
-impl ColumnSums {
-    #[inline(always)]
-    fn add(&mut self, z: f64, b: &Block, i: usize) {
-        self.zx[0] += z * b.a[i];
-        self.zx[1] += z * b.u[i];
-        self.zx[2] += z * b.s[i];
-        self.z += z;
-        self.zz += z * z;
-        self.zy += z * b.f[i];
-    }
-}
-
-/// A block's sums at one `(α, b)`.
-#[derive(Debug, Clone, Copy, Default)]
-struct NodeSums {
-    c: ColumnSums,
-    e: ColumnSums,
-    /// `Σ c·e`.
-    ce: f64,
-}
-
-/// A block's sums at every node of a start grid (`alphas × decays`).
-#[derive(Debug)]
-pub(crate) struct GridSums {
-    alphas: Vec<f64>,
-    decays: Vec<f64>,
-    /// Per `α`.
-    c: Vec<ColumnSums>,
-    /// Per `b` (zero without the low-velocity term).
-    e: Vec<ColumnSums>,
-    /// Per `(α, b)`, `α` major.
-    ce: Vec<f64>,
-}
-
-impl GridSums {
-    /// Samples handled together: each node's column is computed once per sample (one
-    /// exponential per `α` and per `b`, not per pair) and kept for the cross sums.
-    const CHUNK: usize = 256;
-
-    fn of(block: &Block, alphas: &[f64], decays: &[f64], low: bool) -> Self {
-        let (na, nb) = (alphas.len(), decays.len());
-        let mut g = GridSums {
-            alphas: alphas.to_vec(),
-            decays: decays.to_vec(),
-            c: vec![ColumnSums::default(); na],
-            e: vec![ColumnSums::default(); nb],
-            ce: vec![0.0; na * nb],
-        };
-        let chunk = Self::CHUNK;
-        let mut cbuf = vec![0.0; na * chunk];
-        let mut ebuf = vec![0.0; nb * chunk];
-        let n = block.len();
-        let mut start = 0;
-        while start < n {
-            let len = chunk.min(n - start);
-            for (k, &alpha) in alphas.iter().enumerate() {
-                let sums = &mut g.c[k];
-                for (j, slot) in cbuf[k * chunk..k * chunk + len].iter_mut().enumerate() {
-                    let i = start + j;
-                    let c = block.s[i] * (alpha * block.ln_w[i]).exp();
-                    *slot = c;
-                    sums.add(c, block, i);
-                }
-            }
-            if low {
-                for (k, &b) in decays.iter().enumerate() {
-                    let sums = &mut g.e[k];
-                    for (j, slot) in ebuf[k * chunk..k * chunk + len].iter_mut().enumerate() {
-                        let i = start + j;
-                        let e = block.s[i] * (-b * block.w[i]).exp();
-                        *slot = e;
-                        sums.add(e, block, i);
-                    }
-                }
-                for ka in 0..na {
-                    let c = &cbuf[ka * chunk..ka * chunk + len];
-                    for kb in 0..nb {
-                        let e = &ebuf[kb * chunk..kb * chunk + len];
-                        let acc = &mut g.ce[ka * nb + kb];
-                        for (x, y) in c.iter().zip(e) {
-                            *acc += x * y;
-                        }
-                    }
-                }
-            }
-            start += len;
-        }
-        g
-    }
-
-    /// The block's sums at this grid, computed on first use and kept with the block.
-    fn cached(block: &Block, alphas: &[f64], decays: &[f64], low: bool) -> Rc<Self> {
-        let mut cache = block.grid.borrow_mut();
-        if let Some(g) = cache
-            .iter()
-            .find(|g| g.alphas == alphas && g.decays == decays)
-        {
-            return Rc::clone(g);
-        }
-        let g = Rc::new(Self::of(block, alphas, decays, low));
-        cache.push(Rc::clone(&g));
-        g
-    }
-
-    fn node(&self, ka: usize, kb: usize) -> NodeSums {
-        NodeSums {
-            c: self.c[ka],
-            e: self.e[kb],
-            ce: self.ce[ka * self.decays.len() + kb],
-        }
-    }
 }
 
 /// The normal equations `G·θ = Xᵀy` of the linear parameters at one `(α, b)` in their
@@ -1100,6 +929,7 @@ pub(crate) struct SeparableFit {
 
 #[cfg(test)]
 mod tests {
+    use super::super::data::Block;
     use super::*;
 
     /// Exact equation-error data of a known law: the fit returns it to rounding, whatever the
