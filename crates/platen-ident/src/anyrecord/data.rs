@@ -223,19 +223,19 @@ impl Stacked {
 /// Sums over one block of the columns that do not depend on `(α, b)`: `x = (a, u, s)`, the
 /// offset (`1`) and the force `y`.
 #[derive(Debug, Clone, Copy, Default)]
-pub(super) struct FixedSums {
+pub(crate) struct FixedSums {
     /// `Σ xⱼ·xₖ`.
-    pub(super) xx: [[f64; 3]; 3],
+    pub(crate) xx: [[f64; 3]; 3],
     /// `Σ xⱼ`.
-    pub(super) x: [f64; 3],
+    pub(crate) x: [f64; 3],
     /// The number of samples.
-    pub(super) n: f64,
+    pub(crate) n: f64,
     /// `Σ xⱼ·y`.
-    pub(super) xy: [f64; 3],
+    pub(crate) xy: [f64; 3],
     /// `Σ y`.
-    pub(super) y: f64,
+    pub(crate) y: f64,
     /// `Σ y²`.
-    pub(super) yy: f64,
+    pub(crate) yy: f64,
 }
 
 impl FixedSums {
@@ -259,7 +259,7 @@ impl FixedSums {
     }
 
     /// The block's, computed on first use.
-    pub(super) fn cached(b: &Block) -> Self {
+    pub(crate) fn cached(b: &Block) -> Self {
         *b.fixed.get_or_init(|| Self::of(b))
     }
 }
@@ -267,20 +267,20 @@ impl FixedSums {
 /// Sums over one block of a column `z` that depends on `(α, b)` (`c = s·|v|^α` or
 /// `e = s·e^(−b|v|)`) against the others.
 #[derive(Debug, Clone, Copy, Default)]
-pub(super) struct ColumnSums {
+pub(crate) struct ColumnSums {
     /// `Σ z·a`, `Σ z·u`, `Σ z·s`.
-    pub(super) zx: [f64; 3],
+    pub(crate) zx: [f64; 3],
     /// `Σ z` (against the block's offset).
-    pub(super) z: f64,
+    pub(crate) z: f64,
     /// `Σ z²`.
-    pub(super) zz: f64,
+    pub(crate) zz: f64,
     /// `Σ z·y`.
-    pub(super) zy: f64,
+    pub(crate) zy: f64,
 }
 
 impl ColumnSums {
     #[inline(always)]
-    fn add(&mut self, z: f64, b: &Block, i: usize) {
+    pub(crate) fn add(&mut self, z: f64, b: &Block, i: usize) {
         self.zx[0] += z * b.a[i];
         self.zx[1] += z * b.u[i];
         self.zx[2] += z * b.s[i];
@@ -292,16 +292,16 @@ impl ColumnSums {
 
 /// A block's sums at one `(α, b)`.
 #[derive(Debug, Clone, Copy, Default)]
-pub(super) struct NodeSums {
-    pub(super) c: ColumnSums,
-    pub(super) e: ColumnSums,
+pub(crate) struct NodeSums {
+    pub(crate) c: ColumnSums,
+    pub(crate) e: ColumnSums,
     /// `Σ c·e`.
-    pub(super) ce: f64,
+    pub(crate) ce: f64,
 }
 
 /// A block's sums at every node of a start grid (`alphas × decays`).
 #[derive(Debug)]
-pub(super) struct GridSums {
+pub(crate) struct GridSums {
     alphas: Vec<f64>,
     decays: Vec<f64>,
     /// Per `α`.
@@ -369,7 +369,7 @@ impl GridSums {
     }
 
     /// The block's sums at this grid, computed on first use and kept with the block.
-    pub(super) fn cached(block: &Block, alphas: &[f64], decays: &[f64], low: bool) -> Rc<Self> {
+    pub(crate) fn cached(block: &Block, alphas: &[f64], decays: &[f64], low: bool) -> Rc<Self> {
         let mut cache = block.grid.borrow_mut();
         if let Some(g) = cache
             .iter()
@@ -382,7 +382,7 @@ impl GridSums {
         g
     }
 
-    pub(super) fn node(&self, ka: usize, kb: usize) -> NodeSums {
+    pub(crate) fn node(&self, ka: usize, kb: usize) -> NodeSums {
         NodeSums {
             c: self.c[ka],
             e: self.e[kb],

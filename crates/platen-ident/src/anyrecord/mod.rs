@@ -8,6 +8,7 @@ mod data;
 mod hac;
 mod output_error;
 mod plausible;
+mod refit;
 pub(crate) mod result;
 mod separable;
 pub(crate) mod settings;
@@ -28,6 +29,7 @@ use crate::result::ParameterEstimates;
 use data::{prepare, Block, Prepared, Stacked};
 use hac::Hac;
 use output_error::OutputError;
+use refit::{Refit, Refits};
 use result::{
     BandPoint, Correlations, EquationErrorFit, FitKind, FitUncertainty, FloorsReport,
     OutputErrorFit, RecordIdentification, RecordReport, RecordWarning,
@@ -235,7 +237,9 @@ pub fn identify_records(
 /// (module `skew`): `g·gᵀ·MSE(τ)` per delay, `g` the central difference of the fitted
 /// vector over the delay. A perturbed fit that frees or clamps other parameters than `fit`
 /// says nothing about `g` along them and is skipped. Each refit prepares the one record whose
-/// channel moved and shares every other record's samples and sums with `data`.
+/// channel moved and shares every other record's samples and sums with `data`; it follows
+/// the fit's minimum by Newton's method from the expanded sums (module `refit`), or, where
+/// that does not apply, runs the fit's own search.
 fn skew_covariance(
     hac: &mut Hac,
     fit: &SeparableFit,
@@ -244,11 +248,25 @@ fn skew_covariance(
     corrected: &skew::Corrected,
     settings: &ValidRecordSettings,
 ) -> Result<()> {
-    for p in skew::perturbations(corrected)? {
-        let refit = |rec: &TestRecord| -> Result<SeparableFit> {
+    let perturbations = skew::perturbations(corrected)?;
+    let refits = if perturbations.is_empty() {
+        None
+    } else {
+        Refits::new(data, fit, shape, refit::Sums::Expanded)
+    };
+    for p in perturbations {
+        let refit = |rec: &TestRecord| -> Result<Refit> {
             let prepared = prepare(std::slice::from_ref(rec), settings)?;
             let block = Block::new(p.record, rec, &prepared[0]);
-            Ok(Separable::new(&data.with_block(p.record, block), shape).fit())
+            let data = data.with_block(p.record, block);
+            if let Some(r) = refits.as_ref().and_then(|x| x.refit(&data, p.record)) {
+                return Ok(r);
+            }
+            let f = Separable::new(&data, shape).fit();
+            Ok(Refit {
+                full: f.full,
+                free: f.free,
+            })
         };
         let (minus, plus) = (refit(&p.minus)?, refit(&p.plus)?);
         if minus.free != fit.free || plus.free != fit.free {
@@ -504,7 +522,11 @@ fn run_output_error(
     let mut free_full: Vec<usize> = model_free.to_vec();
     free_full.extend((0..2 * records.len()).map(|k| 1000 + k));
     let (params, corr) = parameters(&full, &free_full, &hac, fixed_reason);
-    let (simulated, rms_end): (Vec<_>, Vec<_>) = problem.finish(&res.params).into_iter().unzip();
+    let (simulated, rms_end): (Vec<_>, Vec<_>) = problem
+        .finish(&res.params)
+        .into_iter()
+        .map(|end| (end.simulated_u_m, end.rms))
+        .unzip();
     let rms_start = problem.start_rms();
     Ok(OeOutcome {
         fit: OutputErrorFit {

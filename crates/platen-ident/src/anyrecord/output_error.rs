@@ -50,6 +50,14 @@ struct OeRecord {
     weight_a: f64,
 }
 
+/// A record at the end of the output-error fit.
+pub(crate) struct RecordEnd {
+    /// The simulated displacement, m (`None` if the model is invalid or the run fails).
+    pub simulated_u_m: Option<Vec<f64>>,
+    /// Unweighted RMS of the displacement and acceleration residuals (NaN if so).
+    pub rms: (f64, f64),
+}
+
 /// The output-error problem. Parameter vector: the model parameters fitted (full-vector
 /// indices `model_free`), then `(u₀, v₀)` of each record.
 pub(crate) struct OutputError {
@@ -229,22 +237,26 @@ impl OutputError {
         (time, group)
     }
 
-    /// Each record at `p`: its simulated displacement (`None` if the model is invalid or the
-    /// run fails), and the unweighted RMS of its displacement and acceleration residuals
-    /// (NaN if so).
-    #[allow(clippy::type_complexity)] // one tuple per record, as `finish`'s callers take it
-    pub(crate) fn finish(&self, p: &[f64]) -> Vec<(Option<Vec<f64>>, (f64, f64))> {
+    /// Each record at `p`, from one run.
+    pub(crate) fn finish(&self, p: &[f64]) -> Vec<RecordEnd> {
         let q = self.full(p);
         (0..self.records.len())
             .map(|r| match self.raw_residuals(&q, p, r) {
-                Some((ru, ra)) => {
-                    let rms = (rms(&ru), rms(&ra));
+                Some((ru, ra)) => RecordEnd {
                     // Back from the de-meaned residual to the simulation: add the measured
                     // channel and the mean offset (a constant, shown as fitted).
-                    let u = ru.iter().zip(&self.records[r].u).map(|(x, m)| x + m);
-                    (Some(u.collect()), rms)
-                }
-                None => (None, (f64::NAN, f64::NAN)),
+                    simulated_u_m: Some(
+                        ru.iter()
+                            .zip(&self.records[r].u)
+                            .map(|(x, m)| x + m)
+                            .collect(),
+                    ),
+                    rms: (rms(&ru), rms(&ra)),
+                },
+                None => RecordEnd {
+                    simulated_u_m: None,
+                    rms: (f64::NAN, f64::NAN),
+                },
             })
             .collect()
     }

@@ -46,8 +46,8 @@ pub(crate) const OFFSETS: usize = 7;
 /// Bounds of the nonlinear parameters: `α ∈ [0, 1]` (the model's range), `b ∈ [0.1, 10⁴]`
 /// s/m (at `b → 0` the term is a second Coulomb force, at `b > 10⁴` it dies within 0.1 mm/s,
 /// below any speed a fit can use).
-const ALPHA_BOUNDS: [f64; 2] = [0.0, 1.0];
-const DECAY_BOUNDS: [f64; 2] = [0.1, 1e4];
+pub(crate) const ALPHA_BOUNDS: [f64; 2] = [0.0, 1.0];
+pub(crate) const DECAY_BOUNDS: [f64; 2] = [0.1, 1e4];
 
 /// The reduced (offsets eliminated) system, scaled by the whole system's diagonal, is solved
 /// directly when its smallest eigenvalue exceeds this times the number of columns. Then the
@@ -108,10 +108,23 @@ impl Shape {
     pub(crate) fn full_len(&self) -> usize {
         OFFSETS + self.records
     }
+
+    /// Which linear parameters are bounded below by zero ([`Shape::linear`] order, the
+    /// model's columns only: offsets are free).
+    pub(crate) fn nonneg(&self) -> Vec<bool> {
+        self.linear()
+            .iter()
+            .filter(|&&i| i < OFFSETS)
+            .map(|&i| {
+                matches!(i, COULOMB | VISCOUS | LOW_FORCE)
+                    || (i == STIFFNESS && self.nonneg_stiffness)
+            })
+            .collect()
+    }
 }
 
 /// `(α, b)` from the searched vector.
-fn alpha_b(shape: &Shape, q: &[f64]) -> (f64, f64) {
+pub(crate) fn alpha_b(shape: &Shape, q: &[f64]) -> (f64, f64) {
     let mut k = 0;
     let alpha = match shape.alpha {
         Some(a) => a,
@@ -128,7 +141,7 @@ fn alpha_b(shape: &Shape, q: &[f64]) -> (f64, f64) {
 /// arrowhead shape: the model's columns (Mₑ, Kₑ, F_μ, Cₑ and, with the low-velocity term,
 /// a: [`Shape::linear`] order), dense, and one offset per record, whose columns are
 /// indicators of disjoint sets of samples. `G` holds the noise correction.
-struct Normal {
+pub(crate) struct Normal {
     /// `G` among the model's columns, `k × k`.
     a: DMatrix<f64>,
     /// `G` between the model's columns and each offset, `k × R`.
@@ -145,7 +158,7 @@ struct Normal {
 
 impl Normal {
     /// From each block's sums, in record order.
-    fn new<'a>(
+    pub(crate) fn new<'a>(
         parts: impl ExactSizeIterator<Item = (&'a FixedSums, NodeSums)>,
         low: bool,
         noise_sums: [f64; 2],
@@ -244,13 +257,13 @@ enum Inverse {
 /// subset of the bounded columns held at zero is tried (at most 8) and the feasible solve
 /// with the least residual kept. Each solve is scaled to unit diagonal and drops singular
 /// directions (collinear columns).
-struct Solve {
+pub(crate) struct Solve {
     /// In [`Shape::linear`] order.
-    theta: Vec<f64>,
+    pub theta: Vec<f64>,
     /// Sum of squared residuals.
-    ssr: f64,
+    pub ssr: f64,
     /// Columns held at their bound (zero).
-    clamped: Vec<bool>,
+    pub clamped: Vec<bool>,
     inverse: Inverse,
 }
 
@@ -296,7 +309,7 @@ impl Inverse {
 
 impl Solve {
     /// `G⁺·v` for `v` in [`Shape::linear`] order, zero in the clamped columns.
-    fn apply(&self, v: &[f64]) -> Vec<f64> {
+    pub(crate) fn apply(&self, v: &[f64]) -> Vec<f64> {
         self.inverse.apply(v)
     }
 }
@@ -438,7 +451,7 @@ fn solve_dense(g: &DMatrix<f64>, xty: &DVector<f64>, yy: f64, nonneg: &[bool]) -
 /// The solve of the arrowhead, the offsets eliminated ([`schur`]); where that is not sure
 /// to agree with the whole system's pseudo-inverse, [`solve_dense`] of the whole system.
 /// `nonneg` marks the bounded model columns.
-fn solve_normal(n: &Normal, nonneg: &[bool]) -> Solve {
+pub(crate) fn solve_normal(n: &Normal, nonneg: &[bool]) -> Solve {
     let k = n.model_columns();
     let records = n.d.len();
     let bounded: Vec<usize> = (0..k).filter(|&i| nonneg[i]).collect();
@@ -694,22 +707,12 @@ impl<'a> Separable<'a> {
         out
     }
 
-    /// Which linear parameters are bounded below by zero ([`Shape::linear`] order, the
-    /// model's columns only: offsets are free).
     fn nonneg(&self) -> Vec<bool> {
-        self.shape
-            .linear()
-            .iter()
-            .filter(|&&i| i < OFFSETS)
-            .map(|&i| {
-                matches!(i, COULOMB | VISCOUS | LOW_FORCE)
-                    || (i == STIFFNESS && self.shape.nonneg_stiffness)
-            })
-            .collect()
+        self.shape.nonneg()
     }
 
     /// The start of the search: the best node of the grid.
-    fn grid_start(&self) -> Vec<f64> {
+    pub(crate) fn grid_start(&self) -> Vec<f64> {
         let alphas: Vec<f64> = match self.shape.alpha {
             Some(a) => vec![a],
             None => (1..=10).map(|k| 0.1 * f64::from(k)).collect(),
