@@ -10,14 +10,21 @@
 //! so each channel weighs the same whatever its unit. The initial state `(u₀, v₀)` of each
 //! record is fitted too.
 //!
+//! **Cost.** Every evaluation is a set of forward runs, one per record (and, for the
+//! Jacobian, one per record and column: each model parameter's column reruns every record,
+//! each record's initial state only its own). The runs are independent: they are done in
+//! parallel over the records (rayon's pool: as many threads as cores) and assembled in
+//! record order, so the result is the same bits whatever the number of threads.
+//!
 //! Unlike the equation error this sees the platen at rest: how long it sticks and where it
 //! stops depend on `F_s = F_μ + a` exactly, so the low-velocity behaviour that the equation
 //! error leaves out (samples below its minimum speed) enters here.
 
-use std::cell::Cell;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use platen_integrate::{forward_rk4, ForceRecord, Rk4, Sample, SampleSink, State};
 use platen_model::IdentifiedParams;
+use rayon::prelude::*;
 
 use crate::lm::{Jacobian, Problem};
 use crate::record::TestRecord;
@@ -68,8 +75,8 @@ pub(crate) struct OutputError {
     rk4: Rk4,
     /// Unweighted RMS of each record's displacement and acceleration residuals at the start.
     start_rms: Vec<(f64, f64)>,
-    /// Forward runs of a record so far.
-    runs: Cell<usize>,
+    /// Forward runs of a record so far (counted from every thread).
+    runs: AtomicUsize,
 }
 
 /// Lower and upper bounds of the model parameters, in full-vector order (`Mₑ > 0`, the
@@ -134,12 +141,16 @@ impl OutputError {
             base,
             rk4: Rk4::with_steps_per_sample(steps_per_sample).ok()?,
             start_rms: Vec::with_capacity(records.len()),
-            runs: Cell::new(0),
+            runs: AtomicUsize::new(0),
         };
         // Channel weights from the start's residuals.
         let q = problem.full(&start);
-        for r in 0..problem.records.len() {
-            let (ru, ra) = problem.raw_residuals(&q, &start, r)?;
+        let start_runs: Vec<_> = (0..problem.records.len())
+            .into_par_iter()
+            .map(|r| problem.raw_residuals(&q, &start, r))
+            .collect();
+        for (r, run) in start_runs.into_iter().enumerate() {
+            let (ru, ra) = run?;
             let (su, sa) = (rms(&ru), rms(&ra));
             problem.start_rms.push((su, sa));
             let rec = &mut problem.records[r];
@@ -151,7 +162,7 @@ impl OutputError {
 
     /// Forward runs of a record so far (a run of every record counts one per record).
     pub(crate) fn runs(&self) -> usize {
-        self.runs.get()
+        self.runs.load(Ordering::Relaxed)
     }
 
     /// Unweighted RMS of each record's displacement and acceleration residuals at the start.
@@ -183,7 +194,7 @@ impl OutputError {
     /// Simulated − measured displacement and acceleration of record `r`, each with its
     /// mean removed; `None` if the model is invalid or the run fails.
     fn raw_residuals(&self, q: &[f64; 7], p: &[f64], r: usize) -> Option<(Vec<f64>, Vec<f64>)> {
-        self.runs.set(self.runs.get() + 1);
+        self.runs.fetch_add(1, Ordering::Relaxed);
         let model = Self::params(q).build().ok()?;
         let rec = &self.records[r];
         let n = rec.u.len();
@@ -241,6 +252,7 @@ impl OutputError {
     pub(crate) fn finish(&self, p: &[f64]) -> Vec<RecordEnd> {
         let q = self.full(p);
         (0..self.records.len())
+            .into_par_iter()
             .map(|r| match self.raw_residuals(&q, p, r) {
                 Some((ru, ra)) => RecordEnd {
                     // Back from the de-meaned residual to the simulation: add the measured
@@ -318,48 +330,55 @@ impl Problem for OutputError {
     fn residuals(&self, p: &[f64], out: &mut [f64]) {
         let q = self.full(p);
         let rows = self.row_starts();
+        let mut spans = Vec::with_capacity(self.records.len());
+        let mut rest = out;
         for r in 0..self.records.len() {
-            self.record_residuals(&q, p, r, &mut out[rows[r]..rows[r + 1]]);
+            let (span, tail) = rest.split_at_mut(rows[r + 1] - rows[r]);
+            spans.push(span);
+            rest = tail;
         }
+        spans
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(r, span)| self.record_residuals(&q, p, r, span));
     }
     /// Forward differences: every record rerun for a model parameter, only its own record
-    /// for a record's initial state; `base` is the residuals at `p`.
+    /// for a record's initial state; `base` is the residuals at `p`. Each record's rows of
+    /// the Jacobian come from that record's runs alone, so the records are done in parallel,
+    /// each writing its own rows.
     fn jacobian(&self, p: &[f64], base: &[f64], j: &mut Jacobian) {
-        let quotient = |r: f64, b: f64, h: f64| {
-            let d = (r - b) / h;
-            if d.is_finite() {
-                d
-            } else {
-                0.0
-            }
-        };
         let nm = self.model_free.len();
-        let mut trial = p.to_vec();
-        let mut r = vec![0.0; self.residual_count()];
-        for k in 0..nm {
-            let h = self.step(p, k);
-            trial[k] = p[k] + h;
-            self.residuals(&trial, &mut r);
-            trial[k] = p[k];
-            for (i, (&x, &b)) in r.iter().zip(base).enumerate() {
-                j.shared[(i, k)] = quotient(x, b, h);
-            }
-        }
         let q = self.full(p);
         let rows = self.row_starts();
-        for rec in 0..self.records.len() {
-            let span = rows[rec]..rows[rec + 1];
-            for state in 0..2 {
-                let k = nm + 2 * rec + state;
+        let mut shared = by_record(j.shared.as_mut_slice(), &rows);
+        let mut local = by_record(j.local.as_mut_slice(), &rows);
+        let tasks: Vec<_> = shared
+            .iter_mut()
+            .zip(local.iter_mut())
+            .enumerate()
+            .collect();
+        tasks.into_par_iter().for_each(|(rec, (shared, local))| {
+            let base = &base[rows[rec]..rows[rec + 1]];
+            let mut trial = p.to_vec();
+            let mut r = vec![0.0; base.len()];
+            let own = (nm + 2 * rec)..(nm + 2 * rec + 2);
+            for k in (0..nm).chain(own) {
                 let h = self.step(p, k);
                 trial[k] = p[k] + h;
-                self.record_residuals(&q, &trial, rec, &mut r[span.clone()]);
+                let qk = if k < nm { self.full(&trial) } else { q };
+                self.record_residuals(&qk, &trial, rec, &mut r);
                 trial[k] = p[k];
-                for i in span.clone() {
-                    j.local[(i, state)] = quotient(r[i], base[i], h);
+                let column: &mut [f64] = if k < nm {
+                    shared[k]
+                } else {
+                    local[k - nm - 2 * rec]
+                };
+                for ((d, &x), &b) in column.iter_mut().zip(&r).zip(base) {
+                    let quotient = (x - b) / h;
+                    *d = if quotient.is_finite() { quotient } else { 0.0 };
                 }
             }
-        }
+        });
     }
     fn new_jacobian(&self) -> Jacobian {
         let (_, group) = self.residual_layout();
@@ -371,6 +390,26 @@ impl Problem for OutputError {
             self.records.len(),
         )
     }
+}
+
+/// A column-major matrix's columns (each `rows[last]` long) cut at `rows`: for each record,
+/// its rows of every column, in column order.
+fn by_record<'a>(data: &'a mut [f64], rows: &[usize]) -> Vec<Vec<&'a mut [f64]>> {
+    let records = rows.len() - 1;
+    let mut out: Vec<Vec<&mut [f64]>> = (0..records).map(|_| Vec::new()).collect();
+    let height = rows[records];
+    if height == 0 {
+        return out;
+    }
+    for column in data.chunks_mut(height) {
+        let mut rest = column;
+        for (r, spans) in out.iter_mut().enumerate() {
+            let (span, tail) = rest.split_at_mut(rows[r + 1] - rows[r]);
+            spans.push(span);
+            rest = tail;
+        }
+    }
+    out
 }
 
 /// Root mean square.
