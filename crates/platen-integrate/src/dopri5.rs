@@ -46,6 +46,10 @@ use crate::record::ForceRecord;
 use crate::run::{check_run, sample_at, EnergyBalance, Kin, RunStats, State};
 use crate::stop::{AdaptiveFailure, Failure, StopReason};
 
+/// Most Dopri5 steps in one integration call before it gives up
+/// ([`AdaptiveFailure::TooManySteps`]); the closed loop's Dopri5 allows as many tries per piece.
+pub(crate) const MAX_STEPS: u32 = 100_000;
+
 /// Settings of the adaptive integrator.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Dopri5Settings {
@@ -511,7 +515,7 @@ impl<M: PlatenModel> AdaptiveRun<'_, M> {
             10.0,
             span,
             h,
-            100_000,
+            MAX_STEPS,
             // Stiffness detection off: the only large eigenvalue-like behaviour is the
             // √|v| singularity at v = 0, which the events handle.
             u32::MAX,

@@ -47,6 +47,7 @@ use platen_system::{
 };
 
 use crate::creep::{creep_speed_m_s, stiff_speed_m_s};
+use crate::dopri5::MAX_STEPS;
 use crate::error::{IntegrateError, Result};
 use crate::event::{
     arrive_at_rest, dip_to_zero, just_past, locate_zero_velocity, mode_at_rest, Direction,
@@ -55,7 +56,7 @@ use crate::event::{
 use crate::output::{SampleSink, SpecimenSample, SystemSample};
 use crate::rk4::{Grading, MAX_HALVINGS};
 use crate::run::{sample_at, EnergyBalance, Kin, RunStats, State};
-use crate::stop::{Failure, StopReason};
+use crate::stop::{AdaptiveFailure, Failure, StopReason};
 use crate::Motion;
 
 const NS: usize = Specimen::MAX_STOREYS;
@@ -234,6 +235,10 @@ struct Loop<'a, M, const L: usize> {
     queue: VecDeque<(f64, f64)>,
     /// Last Dopri5 step, s.
     h_dopri: f64,
+    /// Where and why Dopri5 gave up inside the current advance (the step budget spent or the
+    /// step shrunk to nothing): the run stops there with that failure
+    /// ([`Loop::segment`]), as the bare platen's Dopri5 does.
+    gave_up: Option<(f64, AdaptiveFailure)>,
     stats: LoopStats,
 }
 
@@ -272,6 +277,7 @@ impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
             controller: ControllerState::default(),
             queue: VecDeque::with_capacity(slots),
             h_dopri: h,
+            gave_up: None,
             stats: LoopStats {
                 min_supply_pressure_pa: sys.supply_pressure_at(rest.accumulator_oil_m3),
                 ..LoopStats::default()
@@ -579,7 +585,23 @@ impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
             } else {
                 (0.9 * err.powf(-0.2)).clamp(0.2, 5.0)
             };
-            if err <= 1.0 || step <= 1e-14 * dt.max(1e-9) || guard > 100_000 {
+            // NaN counts as not accurate.
+            let accurate = err <= 1.0;
+            if !accurate {
+                let underflow = step <= 1e-14 * dt.max(1e-9);
+                if underflow || guard > MAX_STEPS {
+                    // Dopri5 gives up: the piece ends where it got to and the run stops there
+                    // with the failure (`Loop::segment`).
+                    let reason = if underflow {
+                        AdaptiveFailure::StepSizeUnderflow
+                    } else {
+                        AdaptiveFailure::TooManySteps { steps: MAX_STEPS }
+                    };
+                    self.gave_up.get_or_insert((self.t + done, reason));
+                    return (yc, stage_min);
+                }
+            }
+            if accurate {
                 if let Mode::Slip(dir) = mode {
                     let d = dir.sign();
                     for yi in &ys {
@@ -656,6 +678,9 @@ impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
         let mut events = 0u32;
         while tau < span {
             let at = self.advance(span - tau)?;
+            if let Some((t_s, reason)) = self.gave_up.take() {
+                return Err(IntegrateError::failed(t_s, Failure::AdaptiveFailed(reason)));
+            }
             tau += at;
             self.t += at;
             events += 1;

@@ -666,6 +666,45 @@ fn a_command_past_the_actuators_reach_stops_at_the_end_stop() {
     }
 }
 
+/// Dopri5 asked for a tolerance no step can meet (10⁻³⁰⁰, far below rounding) gives up: the
+/// run stops with the adaptive failure, as the bare platen's Dopri5 does, instead of taking
+/// the step it could not make accurate (the closed loop used to accept it silently once the
+/// step had shrunk to 10⁻¹⁴ of the piece).
+#[test]
+fn dopri5_that_cannot_meet_its_tolerance_stops_with_the_failure() {
+    let sys = preset::lhpost_2008();
+    let model = lhpost_model();
+    let w = std::f64::consts::TAU;
+    let cmd = command(1024.0, 0.1, |t| {
+        (
+            0.01 * (w * t).sin(),
+            0.01 * w * (w * t).cos(),
+            -0.01 * w * w * (w * t).sin(),
+        )
+    });
+    let run = LoopRun {
+        system: &sys,
+        specimen: None,
+        command: &cmd,
+        method: LoopMethod::Dopri5 {
+            steps_per_period: 1,
+            rtol: 1e-300,
+            atol: 1e-300,
+        },
+        initial: State::default(),
+    };
+    let err = forward_closed_loop(&model, &run, cmd.len(), &mut Keep(Vec::new())).unwrap_err();
+    match err {
+        platen_integrate::IntegrateError::AdaptiveFailed { t_s, reason } => {
+            // Which limit it meets first (the step budget or the smallest step) depends on
+            // how many steps of exactly zero error the start at rest allows; either is a give-up.
+            println!("gave up at t = {t_s} s: {reason}");
+            assert!((0.0..0.1).contains(&t_s), "{t_s}");
+        }
+        other => panic!("{other}"),
+    }
+}
+
 /// A stiff specimen (storey modes far above the oil column) moves with the platen as a rigid
 /// payload: the oil column rings at the closed form with `M + Σmᵢ`, within 0.5 % (the storeys'
 /// own modes, above 140 Hz, add `(7.6/140)²/2 ≈ 0.15 %` of effective mass).
