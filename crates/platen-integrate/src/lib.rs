@@ -45,12 +45,14 @@
 
 #![warn(missing_docs)]
 
+mod closed_loop;
 mod creep;
 mod dopri5;
 mod ensemble;
 mod error;
 mod event;
 mod inverse;
+mod machine;
 mod method;
 mod output;
 mod record;
@@ -58,7 +60,6 @@ mod rk4;
 mod run;
 mod specimen;
 mod stop;
-mod system;
 
 pub use dopri5::{forward_dopri5, Dopri5Settings};
 pub use ensemble::{forward_rk4_ensemble, forward_rk4_lanes, EnsembleCase, ENSEMBLE_LANES};
@@ -72,12 +73,12 @@ pub use output::{
 };
 // The prescribed motion of inverse and closed-loop runs, and the derivatives its
 // constructors use, are platen-signal's; their errors convert into IntegrateError with `?`.
+pub use closed_loop::{forward_closed_loop, LoopMethod, LoopRun, LoopStats};
 pub use platen_signal::{derivative, second_derivative, Motion};
 pub use record::{
     sampling_grid, uniform_interval_s, ForceRecord, SamplingGrid, UNIFORM_RELATIVE_TOLERANCE,
 };
 pub use rk4::{forward_rk4, Rk4};
 pub use run::{EnergyBalance, RunStats, State};
-pub use specimen::forward_rk4_specimen;
+pub use specimen::{forward_rk4_specimen, forward_specimen};
 pub use stop::{AdaptiveFailure, Failure, StopReason};
-pub use system::{forward_closed_loop, LoopMethod, LoopRun, LoopStats};

@@ -38,19 +38,17 @@
 //! No allocation happens per step: the storey state lives in fixed-size arrays of
 //! [`Specimen::MAX_STOREYS`].
 
-use std::convert::Infallible;
-
 use platen_model::{PlatenModel, Specimen};
 
-use crate::creep::{creep_speed_m_s, stiff_speed_m_s};
+use crate::creep::creep_speed_m_s;
+use crate::dopri5::Dopri5Settings;
 use crate::error::{IntegrateError, Result};
-use crate::event::{
-    arrive_at_rest, dip_to_zero, just_past, locate_zero_velocity, mode_at_rest, Direction,
-    EventKind, Mode, StepStop, MAX_EVENTS_PER_STEP,
-};
+use crate::event::{Direction, Mode, MAX_EVENTS_PER_STEP};
+use crate::machine::{Machine, PieceMethod, Plant, U, V};
+use crate::method::Method;
 use crate::output::{Sample, SampleSink, SpecimenSample};
 use crate::record::ForceRecord;
-use crate::rk4::{direction, drive, Grading, Grid, GridStep, GridStepper, Rk4, MAX_HALVINGS};
+use crate::rk4::{direction, drive, Grid, GridStep, GridStepper, Rk4};
 use crate::run::{check_run, sample_at, EnergyBalance, Kin, RunStats, State};
 use crate::stop::{Failure, StopReason};
 
@@ -63,8 +61,6 @@ const MIN_PROGRESS: f64 = 4.0 * f64::EPSILON;
 /// storey dissipation, then the `n` storey displacements from `Z` and the `n` storey
 /// velocities from `Z + n` (the stepper's `zd`): the live state is the prefix `5 + 2n` of the
 /// fixed-size array, and the RK4 loops run over that prefix only.
-const U: usize = 0;
-const V: usize = 1;
 const W: usize = 2;
 const DI: usize = 3;
 const SD: usize = 4;
@@ -89,11 +85,48 @@ pub fn forward_rk4_specimen<M: PlatenModel, S: SampleSink>(
     samples: usize,
     sink: &mut S,
 ) -> Result<RunStats> {
+    forward_specimen(
+        model,
+        specimen,
+        record,
+        Method::Rk4(rk4),
+        initial,
+        samples,
+        sink,
+    )
+}
+
+/// Runs the model with `specimen` on the platen forward under `record`, as
+/// [`forward_rk4_specimen`], with the integrator `method`: fixed-step RK4, or the adaptive
+/// Dormand–Prince 5(4) over each sample interval (`rtol` on every displacement and velocity,
+/// `atol` in metres and m/s), with the same events.
+///
+/// # Errors
+/// As [`crate::forward_rk4`]; with Dopri5 also [`IntegrateError::AdaptiveFailed`] when it
+/// cannot meet its tolerance (step budget spent or step underflow), with the time.
+pub fn forward_specimen<M: PlatenModel, S: SampleSink>(
+    model: &M,
+    specimen: &Specimen,
+    record: &ForceRecord,
+    method: Method,
+    initial: State,
+    samples: usize,
+    sink: &mut S,
+) -> Result<RunStats> {
     check_run(record, initial, samples)?;
+    let (k, pieces) = match method {
+        Method::Rk4(rk4) => (u64::from(rk4.steps_per_sample()), PieceMethod::Rk4),
+        Method::Dopri5(settings) => (1, dopri5_pieces(settings)),
+    };
+    let grid = Grid::new(record, k);
     macro_rules! by_storeys {
         ($($n:literal => $len:literal),*) => {
             match specimen.len() {
-                $($n => run::<M, S, $len>(model, specimen, record, rk4, initial, samples, sink),)*
+                $($n => {
+                    let mut stepper =
+                        Stepper::<M, $len>::new(model, specimen, grid, initial, pieces);
+                    drive(&mut stepper, record.t_s(), k, samples, sink)
+                })*
                 other => unreachable!("a validated specimen has 1 to {NS} storeys, not {other}"),
             }
         };
@@ -102,19 +135,12 @@ pub fn forward_rk4_specimen<M: PlatenModel, S: SampleSink>(
                 9 => 23, 10 => 25, 11 => 27, 12 => 29)
 }
 
-/// [`forward_rk4_specimen`] with the state length `L = 5 + 2n` fixed at compile time.
-fn run<M: PlatenModel, S: SampleSink, const L: usize>(
-    model: &M,
-    specimen: &Specimen,
-    record: &ForceRecord,
-    rk4: Rk4,
-    initial: State,
-    samples: usize,
-    sink: &mut S,
-) -> Result<RunStats> {
-    let k = u64::from(rk4.steps_per_sample());
-    let mut stepper = Stepper::<M, L>::new(model, specimen, Grid::new(record, k), initial);
-    drive(&mut stepper, record.t_s(), k, samples, sink)
+/// The machine's adaptive pieces for `settings`.
+fn dopri5_pieces(settings: Dopri5Settings) -> PieceMethod {
+    PieceMethod::Dopri5 {
+        rtol: settings.rtol(),
+        atol: settings.atol(),
+    }
 }
 
 impl<M: PlatenModel, const L: usize> GridStepper for Stepper<'_, M, L> {
@@ -155,7 +181,7 @@ impl StoreyConstants {
 }
 
 /// The part of the storeys' rates that does not depend on the platen's acceleration `a`
-/// ([`Stepper::storey_part`]).
+/// ([`SpecimenPlant::storey_part`]).
 struct StoreyPart {
     /// The storey accelerations at `a = 0`: `z̈ᵢ = qᵢ − a`.
     q: [f64; NS],
@@ -191,58 +217,26 @@ fn storey_part<const L: usize>(st: &StoreyConstants, y: &Y<L>) -> StoreyPart {
     part
 }
 
-struct Stepper<'a, M, const L: usize> {
+/// The platen with a specimen on it, under a force record: the [`Plant`] of the mode machine.
+struct SpecimenPlant<'a, M, const L: usize> {
     model: &'a M,
     spec: &'a Specimen,
     /// The storeys' constants in fixed-size arrays (the first `N` are live), so that the
     /// storey loops run over compile-time bounds without indexing the specimen's `Vec`.
     storeys: StoreyConstants,
     grid: Grid<'a>,
-    y: Y<L>,
-    mode: Mode,
-    /// Rates at the current state in the current mode.
-    k: Y<L>,
-    /// Platen acceleration at the current state (0 in stick and creep).
-    a: f64,
-    w_stiff: f64,
+    /// The grid step being taken: positions are fractions `τ ∈ [0, 1]` of it.
+    n: GridStep,
     /// The actuator force's rate in the current grid interval, N/s (the force is linear
     /// between samples).
     f_rate: f64,
-    stats: RunStats,
 }
 
-impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
+impl<'a, M: PlatenModel, const L: usize> SpecimenPlant<'a, M, L> {
     /// The number of storeys.
     const N: usize = (L - Z) / 2;
     /// Where the storey velocities start.
     const ZD: usize = Z + Self::N;
-
-    fn new(model: &'a M, spec: &'a Specimen, grid: Grid<'a>, initial: State) -> Self {
-        let mut y = [0.0; L];
-        y[U] = initial.u_m;
-        y[V] = initial.v_m_s;
-        let mut s = Self {
-            model,
-            spec,
-            storeys: StoreyConstants::of(spec),
-            grid,
-            y,
-            mode: Mode::Stick,
-            k: [0.0; L],
-            a: 0.0,
-            w_stiff: 0.0,
-            f_rate: 0.0,
-            stats: RunStats::default(),
-        };
-        s.f_rate = s.force_rate(0);
-        let f0 = s.grid.force[0];
-        let mode = Mode::initial(model, y[U], y[V], f0 - s.base_shear(&y));
-        s.enter(mode, f0);
-        s.stats.energy = EnergyBalance::start(model, y[U], y[V]);
-        s.stats.energy.specimen_start_j = s.specimen_energy(&y);
-        s.stats.energy.specimen_end_j = s.stats.energy.specimen_start_j;
-        s
-    }
 
     /// The actuator force's rate between samples `j` and `j + 1`, N/s (0 past the record).
     fn force_rate(&self, j: usize) -> f64 {
@@ -284,63 +278,6 @@ impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
             dy[Self::ZD + i] = part.q[i] - a;
         }
         dy[SD] = part.power;
-    }
-
-    /// The rates of the full state in slip with direction `direction::<POSITIVE>()` under
-    /// actuator force `f`, into `dy`; returns the platen acceleration. The slip case of
-    /// [`Stepper::rates`], compiled per direction so that `±v` and `±D` fold (exact for ±1).
-    #[inline(always)]
-    fn slip_rates<const POSITIVE: bool>(&self, f: f64, y: &Y<L>, dy: &mut Y<L>) -> f64 {
-        let part = self.storey_part(y);
-        let bs = -part.shear0;
-        let r = self
-            .model
-            .slip_rates(f - bs, y[U], y[V], direction::<POSITIVE>());
-        dy[U] = y[V];
-        dy[V] = r.a_m_s2;
-        dy[W] = f * y[V];
-        dy[DI] = r.dissipated_power_w;
-        Self::storey_rates(&part, r.a_m_s2, y, dy);
-        r.a_m_s2
-    }
-
-    /// The rates of the full state in `mode` under actuator force `f`, into `dy`; returns the
-    /// platen acceleration.
-    #[inline(always)]
-    fn rates(&self, mode: Mode, f: f64, y: &Y<L>, dy: &mut Y<L>) -> f64 {
-        match mode {
-            Mode::Slip(Direction::Positive) => return self.slip_rates::<true>(f, y, dy),
-            Mode::Slip(Direction::Negative) => return self.slip_rates::<false>(f, y, dy),
-            _ => {}
-        }
-        let part = self.storey_part(y);
-        let bs = -part.shear0;
-        let a = match mode {
-            Mode::Slip(_) => unreachable!("slip returned above"),
-            Mode::Stick => {
-                dy[U] = 0.0;
-                dy[V] = 0.0;
-                dy[W] = 0.0;
-                dy[DI] = 0.0;
-                0.0
-            }
-            Mode::Creep(dir) => {
-                let s = dir.sign();
-                let w = creep_speed_m_s(self.model, dir, y[U], f - bs, self.w_stiff)
-                    .unwrap_or(self.w_stiff);
-                dy[U] = s * w;
-                dy[V] = 0.0;
-                dy[W] = f * s * w;
-                dy[DI] = self.model.dissipative_magnitude_n(y[U], w) * w;
-                if w > 0.0 {
-                    self.creep_acceleration(dir, y, w)
-                } else {
-                    0.0
-                }
-            }
-        };
-        Self::storey_rates(&part, a, y, dy);
-        a
     }
 
     /// The platen's acceleration `a = s·ẇ` in creep at speed `w` (`0 < w < w_*`): the rate of
@@ -388,160 +325,206 @@ impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
         }
     }
 
-    /// One RK4 step of length `len` (fraction of `h`) from fraction `s` of step `n`, from `y`
-    /// with rates `k1` there: the state at the end and the smallest stage speed `dir·v` (slip).
-    #[inline(always)]
-    fn rk4(&mut self, n: GridStep, s: f64, len: f64, y: &Y<L>, k1: &Y<L>) -> (Y<L>, f64) {
-        let mode = self.mode;
-        let h = len * self.grid.h;
-        let (f_mid, f_end) = (
-            self.grid.force(n, s + 0.5 * len),
-            self.grid.force(n, s + len),
-        );
-        let combine = |base: &Y<L>, k: &Y<L>, c: f64| {
-            let mut out = *base;
-            for i in 0..L {
-                out[i] += c * k[i];
-            }
-            out
-        };
-        let (mut k2, mut k3, mut k4) = ([0.0; L], [0.0; L], [0.0; L]);
-        let y2 = combine(y, k1, 0.5 * h);
-        self.rates(mode, f_mid, &y2, &mut k2);
-        let y3 = combine(y, &k2, 0.5 * h);
-        self.rates(mode, f_mid, &y3, &mut k3);
-        let y4 = combine(y, &k3, h);
-        self.rates(mode, f_end, &y4, &mut k4);
-        self.stats.rhs_evaluations += 3;
-        let h6 = h / 6.0;
-        let mut y1 = *y;
-        for i in 0..L {
-            y1[i] += h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
-        }
-        let stage_min = match mode {
-            Mode::Slip(dir) => {
-                let d = dir.sign();
-                (d * y2[V]).min(d * y3[V]).min(d * y4[V])
-            }
-            _ => f64::INFINITY,
-        };
-        if let Mode::Creep(dir) = mode {
-            y1[V] = self.creep_velocity(dir, &y1, f_end);
-        }
-        (y1, stage_min)
-    }
-
-    /// The signed creep velocity at state `y` under force `f`.
-    fn creep_velocity(&self, dir: Direction, y: &Y<L>, f: f64) -> f64 {
-        let w = creep_speed_m_s(self.model, dir, y[U], f - self.base_shear(y), self.w_stiff)
-            .unwrap_or(self.w_stiff);
+    /// The signed creep velocity at state `y` under force `f` (stiff speed `w_stiff`).
+    fn creep_velocity(&self, dir: Direction, w_stiff: f64, y: &Y<L>, f: f64) -> f64 {
+        let w = creep_speed_m_s(self.model, dir, y[U], f - self.base_shear(y), w_stiff)
+            .unwrap_or(w_stiff);
         dir.sign() * w
     }
+}
 
-    /// The current mode's state over a length `x` (fraction of `h`) from fraction `tau` of step
-    /// `n`, split by `grading`; with the smallest stage speed.
-    fn piece(&mut self, n: GridStep, tau: f64, x: f64, grading: Grading) -> (Y<L>, f64) {
-        let (mut y, mut k) = (self.y, self.k);
-        let mut stage_min = f64::INFINITY;
-        let mut s = tau;
-        for (i, &p) in grading.pieces().iter().enumerate() {
-            let len = p * x;
-            if i > 0 {
-                let f = self.grid.force(n, s);
-                self.rates(self.mode, f, &y, &mut k);
-                self.stats.rhs_evaluations += 1;
-            }
-            let (y1, m) = self.rk4(n, s, len, &y, &k);
-            y = y1;
-            stage_min = stage_min.min(m);
-            s += len;
-        }
-        (y, stage_min)
+impl<M: PlatenModel, const L: usize> Plant<L> for SpecimenPlant<'_, M, L> {
+    type Model = M;
+    /// The actuator force, N.
+    type Input = f64;
+
+    #[inline(always)]
+    fn model(&self) -> &M {
+        self.model
     }
 
-    /// The net force `N = F_A − F_E(u) − B` at state `y` under force `f`.
     #[inline(always)]
-    fn net(&self, y: &Y<L>, f: f64) -> f64 {
+    fn input(&self, at: f64) -> f64 {
+        self.grid.force(self.n, at)
+    }
+
+    #[inline(always)]
+    fn rates(&self, mode: Mode, w_stiff: f64, f: f64, y: &Y<L>, dy: &mut Y<L>) -> f64 {
+        match mode {
+            Mode::Slip(Direction::Positive) => return self.slip_rates::<true>(f, y, dy),
+            Mode::Slip(Direction::Negative) => return self.slip_rates::<false>(f, y, dy),
+            _ => {}
+        }
+        let part = self.storey_part(y);
+        let bs = -part.shear0;
+        let a = match mode {
+            Mode::Slip(_) => unreachable!("slip returned above"),
+            Mode::Stick => {
+                dy[U] = 0.0;
+                dy[V] = 0.0;
+                dy[W] = 0.0;
+                dy[DI] = 0.0;
+                0.0
+            }
+            Mode::Creep(dir) => {
+                let s = dir.sign();
+                let w = creep_speed_m_s(self.model, dir, y[U], f - bs, w_stiff).unwrap_or(w_stiff);
+                dy[U] = s * w;
+                dy[V] = 0.0;
+                dy[W] = f * s * w;
+                dy[DI] = self.model.dissipative_magnitude_n(y[U], w) * w;
+                if w > 0.0 {
+                    self.creep_acceleration(dir, y, w)
+                } else {
+                    0.0
+                }
+            }
+        };
+        Self::storey_rates(&part, a, y, dy);
+        a
+    }
+
+    /// The slip case of [`Plant::rates`], compiled per direction so that `±v` and `±D` fold
+    /// (exact for ±1).
+    #[inline(always)]
+    fn slip_rates<const POSITIVE: bool>(&self, f: f64, y: &Y<L>, dy: &mut Y<L>) -> f64 {
+        let part = self.storey_part(y);
+        let bs = -part.shear0;
+        let r = self
+            .model
+            .slip_rates(f - bs, y[U], y[V], direction::<POSITIVE>());
+        dy[U] = y[V];
+        dy[V] = r.a_m_s2;
+        dy[W] = f * y[V];
+        dy[DI] = r.dissipated_power_w;
+        Self::storey_rates(&part, r.a_m_s2, y, dy);
+        r.a_m_s2
+    }
+
+    #[inline(always)]
+    fn effective_force(&self, f: f64, y: &Y<L>) -> f64 {
+        f - self.base_shear(y)
+    }
+
+    /// `N = F_A − F_E(u) − B`.
+    #[inline(always)]
+    fn net(&self, f: f64, y: &Y<L>) -> f64 {
         f - self.model.elastic_force_n(y[U]) - self.base_shear(y)
     }
 
-    /// The current mode's event function: positive until the mode ends.
+    /// `Ṅ = Ḟ_A − Ḃ = Ḟ_A + k₁ż₁ + c₁z̈₁` (`u` fixed).
+    fn net_rate(&self, k: &Y<L>) -> f64 {
+        let st = self.spec.storeys()[0];
+        self.f_rate + st.stiffness_n_per_m * k[Z] + st.damping_n_s_per_m * k[Self::ZD]
+    }
+
+    /// In creep the velocity is slaved to the net force at the end of each piece.
     #[inline(always)]
-    fn event_g(&self, y: &Y<L>, f: f64) -> f64 {
-        match self.mode {
-            Mode::Slip(dir) => dir.sign() * y[V],
-            Mode::Stick => self.model.static_threshold_n(y[U]) - self.net(y, f).abs(),
-            Mode::Creep(dir) => {
-                let sn = dir.sign() * self.net(y, f);
-                (sn - self.model.static_threshold_n(y[U])).min(self.exit_level(dir, y[U]) - sn)
-            }
-        }
-    }
-
-    /// The drive `s·N` at which creep hands over to slip (the creep speed reaches `w_*`).
-    fn exit_level(&self, dir: Direction, u: f64) -> f64 {
-        let s = dir.sign();
-        self.model.static_threshold_n(u)
-            + self.model.dissipative_excess_n(u, self.w_stiff)
-            + s * self.model.velocity_inertial_force_n(u, s * self.w_stiff)
-    }
-
-    /// Whether the event function may dip to zero inside a piece of length `len` (fraction
-    /// of `h`) from the current state (force `f0`) to `y1` (force `f1`, rates
-    /// `k1`, platen acceleration `a1`): the cubic Hermite interpolant of the speed (slip) or
-    /// of `F_s ∓ N` (stick) touches zero.
-    #[allow(clippy::too_many_arguments)]
-    fn dips(&self, len: f64, f0: f64, y1: &Y<L>, f1: f64, k1: &Y<L>, a1: f64) -> bool {
-        let span = len * self.grid.h;
-        match self.mode {
-            Mode::Slip(dir) => {
-                let d = dir.sign();
-                dip_to_zero(d * self.y[V], d * y1[V], d * self.a * span, d * a1 * span).is_some()
-            }
-            Mode::Stick => {
-                // Ṅ = Ḟ_A − Ḃ = Ḟ_A + k₁ż₁ + c₁z̈₁ (u fixed), times the piece's length.
-                let slope = self.f_rate;
-                let st = self.spec.storeys()[0];
-                let n_rate = |k: &Y<L>| {
-                    (slope + st.stiffness_n_per_m * k[Z] + st.damping_n_s_per_m * k[Self::ZD])
-                        * span
-                };
-                let fs = self.model.static_threshold_n(self.y[U]);
-                let (n0, n1) = (self.net(&self.y, f0), self.net(y1, f1));
-                let (d0, d1) = (n_rate(&self.k), n_rate(k1));
-                dip_to_zero(fs - n0, fs - n1, -d0, -d1).is_some()
-                    || dip_to_zero(fs + n0, fs + n1, d0, d1).is_some()
-            }
-            Mode::Creep(_) => false,
-        }
-    }
-
-    /// Switches to `mode` at the current state under force `f`: its rates (and the stiff
-    /// speed of a creep phase).
-    fn enter(&mut self, mode: Mode, f: f64) {
-        self.mode = mode;
+    fn settle(&self, mode: Mode, w_stiff: f64, f: f64, y: &mut Y<L>) {
         if let Mode::Creep(dir) = mode {
-            self.w_stiff = stiff_speed_m_s(self.model, self.y[U], self.grid.h);
-            let y = self.y;
-            self.y[V] = self.creep_velocity(dir, &y, f);
+            y[V] = self.creep_velocity(dir, w_stiff, y, f);
         }
-        let (y, mut k) = (self.y, [0.0; L]);
-        self.a = self.rates(mode, f, &y, &mut k);
-        self.k = k;
-        self.stats.rhs_evaluations += 1;
+    }
+
+    const RATES_ON_COMMIT: bool = false;
+
+    /// Metres for the motion and the storeys, m/s for the velocities; the energy integrals
+    /// are quadratures and not controlled.
+    fn error_scale(&self, i: usize, y0: f64, y1: f64, rtol: f64, atol: f64) -> f64 {
+        match i {
+            W | DI | SD => f64::INFINITY,
+            _ => atol + rtol * y0.abs().max(y1.abs()),
+        }
+    }
+
+    #[inline(always)]
+    fn seconds(&self, len: f64) -> f64 {
+        len * self.grid.h
+    }
+    fn units(&self, seconds: f64) -> f64 {
+        seconds / self.grid.h
+    }
+    fn time_s(&self, at: f64) -> f64 {
+        self.grid.time_s(self.n, at)
+    }
+    fn tolerance_floor(&self) -> f64 {
+        0.0
+    }
+    fn min_progress(&self) -> f64 {
+        MIN_PROGRESS
+    }
+    fn land(&self, tau: f64, x: f64, _rest: f64) -> f64 {
+        let at = tau + x;
+        if 1.0 - at < 1e-12 {
+            1.0
+        } else {
+            at
+        }
+    }
+    fn reach(&self, tau: f64, len: f64) -> f64 {
+        tau + len
+    }
+    fn break_at(&self, tau: f64, x: f64, _rest: f64, _held: bool) -> f64 {
+        (tau + x).min(1.0)
+    }
+}
+
+/// A forward run with a specimen: the mode machine over the force record's grid.
+struct Stepper<'a, M, const L: usize> {
+    machine: Machine<SpecimenPlant<'a, M, L>, L>,
+    /// Whether the pieces are RK4 (whose slip steps away from rest take the fast path).
+    rk4: bool,
+}
+
+impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
+    fn new(
+        model: &'a M,
+        spec: &'a Specimen,
+        grid: Grid<'a>,
+        initial: State,
+        method: PieceMethod,
+    ) -> Self {
+        let mut y = [0.0; L];
+        y[U] = initial.u_m;
+        y[V] = initial.v_m_s;
+        let h = grid.h;
+        let mut plant = SpecimenPlant {
+            model,
+            spec,
+            storeys: StoreyConstants::of(spec),
+            grid,
+            n: GridStep { n: 0, j: 0, i: 0.0 },
+            f_rate: 0.0,
+        };
+        plant.f_rate = plant.force_rate(0);
+        let f0 = plant.grid.force[0];
+        let mode = Mode::initial(model, y[U], y[V], f0 - plant.base_shear(&y));
+        let specimen_start_j = plant.specimen_energy(&y);
+        let mut machine = Machine::new(plant, y, h, method);
+        machine.enter(mode, f0);
+        let energy = &mut machine.stats.energy;
+        *energy = EnergyBalance::start(model, y[U], y[V]);
+        energy.specimen_start_j = specimen_start_j;
+        energy.specimen_end_j = specimen_start_j;
+        Stepper {
+            machine,
+            rk4: method == PieceMethod::Rk4,
+        }
     }
 
     /// Advances from grid point `n` to `n + 1`, handling every event inside the step.
     ///
-    /// A step in slip away from rest first tries [`Stepper::slip_fast`] (compiled per
+    /// A step of RK4 in slip away from rest first tries [`Machine::slip_fast`] (compiled per
     /// direction); anything it does not commit, and every other mode, goes through the
-    /// generic [`Stepper::advance`].
+    /// machine's [`Machine::advance`].
     #[inline(always)]
     fn step(&mut self, n: GridStep) -> Result<()> {
-        self.stats.steps += 1;
-        let committed = match self.mode {
-            Mode::Slip(Direction::Positive) if self.y[V] != 0.0 => self.slip_fast::<true>(n),
-            Mode::Slip(Direction::Negative) if self.y[V] != 0.0 => self.slip_fast::<false>(n),
+        let m = &mut self.machine;
+        m.plant.n = n;
+        m.stats.steps += 1;
+        let committed = match m.mode {
+            Mode::Slip(Direction::Positive) if self.rk4 && m.y[V] != 0.0 => m.slip_fast::<true>(),
+            Mode::Slip(Direction::Negative) if self.rk4 && m.y[V] != 0.0 => m.slip_fast::<false>(),
             _ => false,
         };
         if committed {
@@ -550,348 +533,57 @@ impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
         self.step_with_events(n)
     }
 
-    /// One RK4 step over the whole grid step `n` in slip with direction
-    /// `direction::<POSITIVE>()` (the platen moving, `v ≠ 0`), committed when it is safe:
-    /// exactly the first try of [`Stepper::advance`] (`τ = 0`, a single piece of length 1),
-    /// the same operations in the same order, so what it commits is bit for bit what
-    /// [`Stepper::advance`] would. Returns whether it committed; if not, nothing has changed
-    /// (statistics included) and the step is taken again by [`Stepper::step_with_events`].
-    #[inline(always)]
-    fn slip_fast<const POSITIVE: bool>(&mut self, n: GridStep) -> bool {
-        let dir = direction::<POSITIVE>();
-        // The piece is the whole step: `len = 1 − 0`, `len·h = h`.
-        let h = self.grid.h;
-        let (f_mid, f_end) = (self.grid.force(n, 0.5), self.grid.force(n, 1.0));
-        let (y, k1) = (&self.y, &self.k);
-        let hh = 0.5 * h;
-        let (mut k2, mut k3, mut k4) = ([0.0; L], [0.0; L], [0.0; L]);
-        let mut y2 = *y;
-        for i in 0..L {
-            y2[i] += hh * k1[i];
-        }
-        self.slip_rates::<POSITIVE>(f_mid, &y2, &mut k2);
-        let mut y3 = *y;
-        for i in 0..L {
-            y3[i] += hh * k2[i];
-        }
-        self.slip_rates::<POSITIVE>(f_mid, &y3, &mut k3);
-        let mut y4 = *y;
-        for i in 0..L {
-            y4[i] += h * k3[i];
-        }
-        self.slip_rates::<POSITIVE>(f_end, &y4, &mut k4);
-        let h6 = h / 6.0;
-        let mut y1 = *y;
-        for i in 0..L {
-            y1[i] += h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
-        }
-        let stage_min = (dir * y2[V]).min(dir * y3[V]).min(dir * y4[V]);
-        if !(dir * y1[V] > 0.0 && stage_min > 0.0 && y1.iter().all(|x| x.is_finite())) {
-            return false;
-        }
-        let mut k_end = [0.0; L];
-        let a1 = self.slip_rates::<POSITIVE>(f_end, &y1, &mut k_end);
-        let (d0, d1) = (dir * self.a * h, dir * a1 * h);
-        if dip_to_zero(dir * self.y[V], dir * y1[V], d0, d1).is_some() || !a1.is_finite() {
-            return false;
-        }
-        self.stats.rhs_evaluations += 4;
-        (self.y, self.k, self.a) = (y1, k_end, a1);
-        true
-    }
-
-    /// [`Stepper::step`] through the generic [`Stepper::advance`]: every mode and event.
+    /// [`Stepper::step`] through the machine's advance: every mode and event.
     fn step_with_events(&mut self, n: GridStep) -> Result<()> {
-        self.f_rate = self.force_rate(n.j);
+        let m = &mut self.machine;
+        m.plant.f_rate = m.plant.force_rate(n.j);
         let mut tau = 0.0;
         let mut events = 0u32;
         loop {
-            match self.advance(n, tau)? {
-                StepStop::Step => return Ok(()),
-                StepStop::Event { at, .. } | StepStop::Moved { at } => tau = at,
+            tau = m.advance(tau, 1.0 - tau)?;
+            if let Some((t_s, reason)) = m.take_failure() {
+                return Err(IntegrateError::failed(t_s, Failure::AdaptiveFailed(reason)));
             }
-            events += 1;
             if tau >= 1.0 {
                 return Ok(());
             }
+            events += 1;
             if events > MAX_EVENTS_PER_STEP {
                 let stalled = Failure::EventLoopStalled { events };
-                return Err(IntegrateError::failed(self.grid.time_s(n, tau), stalled));
+                return Err(IntegrateError::failed(m.plant.grid.time_s(n, tau), stalled));
             }
-        }
-    }
-
-    /// Advances in the current mode from fraction `tau` of step `n` to the end of the step or
-    /// the mode's next event: the rest of the step is tried and halved until a piece is safe
-    /// (committed) or ends across the event, which is then located on the RK4 map.
-    fn advance(&mut self, n: GridStep, tau: f64) -> Result<StepStop> {
-        let f0 = self.grid.force(n, tau);
-        let slip = matches!(self.mode, Mode::Slip(_));
-        let from_rest = slip && self.y[V] == 0.0;
-        if let (Mode::Slip(dir), true) = (self.mode, from_rest) {
-            // Leaving rest below the stiff speed: creep (see the module docs).
-            let w_stiff = stiff_speed_m_s(self.model, self.y[U], self.grid.h);
-            let f_eff = f0 - self.base_shear(&self.y);
-            if creep_speed_m_s(self.model, dir, self.y[U], f_eff, w_stiff).is_some() {
-                self.enter(Mode::Creep(dir), f0);
-                return Ok(StepStop::Moved { at: tau });
-            }
-        }
-        let (try_grading, event_grading) = match (slip, from_rest) {
-            (true, true) => (Grading::Start, Grading::Both),
-            (true, false) => (Grading::Single, Grading::End),
-            _ => (Grading::Single, Grading::Single),
-        };
-        let mut len = 1.0 - tau;
-        for _ in 0..=MAX_HALVINGS {
-            let (y1, stage_min) = self.piece(n, tau, len, try_grading);
-            if !y1.iter().all(|x| x.is_finite()) {
-                return Err(self.non_finite(n, tau));
-            }
-            let f1 = self.grid.force(n, tau + len);
-            let g1 = self.event_g(&y1, f1);
-            if g1 > 0.0 && stage_min > 0.0 {
-                let mut k1 = [0.0; L];
-                let a1 = self.rates(self.mode, f1, &y1, &mut k1);
-                self.stats.rhs_evaluations += 1;
-                if !self.dips(len, f0, &y1, f1, &k1, a1) {
-                    if !a1.is_finite() {
-                        return Err(self.non_finite(n, tau + len));
-                    }
-                    if self.mode == Mode::Stick {
-                        self.stats.stick_time_s += len * self.grid.h;
-                    }
-                    (self.y, self.k, self.a) = (y1, k1, a1);
-                    let at = tau + len;
-                    return Ok(if at >= 1.0 {
-                        StepStop::Step
-                    } else {
-                        StepStop::Moved { at }
-                    });
-                }
-            } else if g1 <= 0.0 {
-                let (y2, g2) = if event_grading == try_grading {
-                    (y1, g1)
-                } else {
-                    let (y2, _) = self.piece(n, tau, len, event_grading);
-                    (y2, self.event_g(&y2, f1))
-                };
-                if g2 <= 0.0 {
-                    let g0 = self.event_g(&self.y, f0);
-                    let tolerance = 4.0 * f64::EPSILON * len;
-                    let Ok(found) = locate_zero_velocity(len, g0, (y2, g2), tolerance, |x| {
-                        self.stats.root_iterations += 1;
-                        let (y, _) = self.piece(n, tau, x, event_grading);
-                        let g = self.event_g(&y, self.grid.force(n, tau + x));
-                        Ok::<_, Infallible>((y, g))
-                    });
-                    let (x, y_event) = found.unwrap_or((0.0, self.y));
-                    return Ok(self.event(n, tau, x, y_event));
-                }
-            }
-            len *= 0.5;
-        }
-        // A piece of 2⁻⁶⁰ of the step still not safe: the event is here.
-        let y = self.y;
-        Ok(self.event(n, tau, 0.0, y))
-    }
-
-    /// The reset at the current mode's event, located at `x` (fraction of `h`) past fraction
-    /// `tau` of step `n` with state `y_event` there.
-    fn event(&mut self, n: GridStep, tau: f64, x: f64, y_event: Y<L>) -> StepStop {
-        let mut at = tau + x;
-        if 1.0 - at < 1e-12 {
-            at = 1.0;
-        }
-        match self.mode {
-            Mode::Slip(from) => {
-                self.y = y_event;
-                self.y[V] = 0.0;
-                let f = self.grid.force(n, at);
-                let f_eff = f - self.base_shear(&self.y);
-                let (mode, kind) = arrive_at_rest(self.model, self.y[U], f_eff, from);
-                self.enter(mode, f);
-                match kind {
-                    Some(kind) => {
-                        self.stats.record(kind);
-                        StepStop::Event { at, kind }
-                    }
-                    None => StepStop::Moved { at },
-                }
-            }
-            Mode::Stick => {
-                // Move past rounding so that |N| > F_s holds where slip starts.
-                let u = self.y[U];
-                let fs = self.model.static_threshold_n(u);
-                let end = 1.0 - tau;
-                let x_b = just_past(x, end, |x| {
-                    let (y, _) = self.piece_at_rest(n, tau, x);
-                    self.net(&y, self.grid.force(n, tau + x)).abs() > fs
-                });
-                let y = if x_b == x {
-                    y_event
-                } else {
-                    self.piece_at_rest(n, tau, x_b).0
-                };
-                let at = (tau + x_b).min(1.0);
-                self.stats.stick_time_s += x_b * self.grid.h;
-                self.y = y;
-                let f = self.grid.force(n, at);
-                let net = self.net(&y, f);
-                if net.abs() <= fs {
-                    // Rounding kept friction holding to the end of the step: still stuck.
-                    self.enter(Mode::Stick, f);
-                    return StepStop::Moved { at };
-                }
-                self.stats.record(EventKind::Breakaway);
-                self.enter(Mode::Slip(Direction::of_sign(net)), f);
-                StepStop::Event {
-                    at,
-                    kind: EventKind::Breakaway,
-                }
-            }
-            Mode::Creep(dir) => {
-                let start = self.y;
-                self.y = y_event;
-                let mut f = self.grid.force(n, at);
-                let sn = dir.sign() * self.net(&self.y, f);
-                let fs = self.model.static_threshold_n(self.y[U]);
-                if sn - fs <= self.exit_level(dir, self.y[U]) - sn {
-                    // The drive fell to the threshold: a stop (or, past rounding, creep on or
-                    // a reversal, as the net force at rest decides).
-                    self.y[V] = 0.0;
-                    let f_eff = f - self.base_shear(&self.y);
-                    let mut mode = mode_at_rest(self.model, self.y[U], f_eff);
-                    if mode == Mode::Slip(dir) && x <= MIN_PROGRESS {
-                        // The stop rounded onto the start of the advance, where the net force
-                        // at rest is a hair along the motion: creeping on from here would
-                        // locate the same stop again without moving time. Step just past it,
-                        // to where the net force at rest no longer drives the creep on (see
-                        // `crate::creep`, whose passes do the same).
-                        (at, f) = self.creep_just_past(n, tau, x, start, dir);
-                        mode = mode_at_rest(self.model, self.y[U], f - self.base_shear(&self.y));
-                    }
-                    match mode {
-                        Mode::Slip(d) if d == dir => {
-                            self.enter(Mode::Creep(dir), f);
-                            StepStop::Moved { at }
-                        }
-                        Mode::Stick => {
-                            self.stats.record(EventKind::Stop);
-                            self.enter(Mode::Stick, f);
-                            StepStop::Event {
-                                at,
-                                kind: EventKind::Stop,
-                            }
-                        }
-                        other => {
-                            self.stats.record(EventKind::Reversal);
-                            self.enter(other, f);
-                            StepStop::Event {
-                                at,
-                                kind: EventKind::Reversal,
-                            }
-                        }
-                    }
-                } else {
-                    // The creep speed reached the stiff speed: slip on from that velocity.
-                    let v = self.creep_velocity(dir, &self.y.clone(), f);
-                    self.y[V] = if v == 0.0 {
-                        dir.sign() * f64::MIN_POSITIVE
-                    } else {
-                        v
-                    };
-                    self.enter(Mode::Slip(dir), f);
-                    StepStop::Moved { at }
-                }
-            }
-        }
-    }
-
-    /// A creep stop located `x ≤` [`MIN_PROGRESS`] past fraction `tau` of step `n` (from the
-    /// state `start`) where the net force at rest still drives the creep on in `dir`: creeps
-    /// from `start` to the first of `x + 4ε, x + 8ε, …` ([`just_past`]) where it does not,
-    /// or to the end of the step, and makes that the state (at rest, `v = 0`). Returns where
-    /// (fraction of the step) and the force there.
-    fn creep_just_past(
-        &mut self,
-        n: GridStep,
-        tau: f64,
-        x: f64,
-        start: Y<L>,
-        dir: Direction,
-    ) -> (f64, f64) {
-        let stopped = self.y;
-        self.y = start;
-        let x_b = just_past(x, 1.0 - tau, |x| {
-            let (y, _) = self.piece(n, tau, x, Grading::Single);
-            let f = self.grid.force(n, tau + x);
-            mode_at_rest(self.model, y[U], f - self.base_shear(&y)) != Mode::Slip(dir)
-        });
-        self.y = if x_b > x {
-            self.piece(n, tau, x_b, Grading::Single).0
-        } else {
-            stopped
-        };
-        self.y[V] = 0.0;
-        let mut at = tau + x_b;
-        if 1.0 - at < 1e-12 {
-            at = 1.0;
-        }
-        (at, self.grid.force(n, at))
-    }
-
-    /// The stuck state over a length `x` from fraction `tau` of step `n` (one RK4 step).
-    fn piece_at_rest(&mut self, n: GridStep, tau: f64, x: f64) -> (Y<L>, f64) {
-        self.piece(n, tau, x, Grading::Single)
-    }
-
-    /// The error of a state found non-finite at fraction `tau` of step `n`.
-    fn non_finite(&self, n: GridStep, tau: f64) -> IntegrateError {
-        let cause = Failure::NonFiniteState {
-            u_m: self.y[U],
-            v_m_s: self.y[V],
-        };
-        IntegrateError::failed(self.grid.time_s(n, tau), cause)
-    }
-
-    fn kin(&self) -> Kin {
-        Kin {
-            u: self.y[U],
-            v: self.y[V],
-            work: self.y[W],
-            dissipated: self.y[DI],
         }
     }
 
     /// The output sample at sample `j` of the record (grid point `j·k`).
     fn sample(&self, j: usize, t_s: f64) -> Sample {
-        let f = self.grid.force[j];
-        let bs = self.base_shear(&self.y);
+        let (m, p) = (&self.machine, &self.machine.plant);
+        let f = p.grid.force[j];
+        let bs = p.base_shear(&m.y);
+        let kin = Kin {
+            u: m.y[U],
+            v: m.y[V],
+            work: m.y[W],
+            dissipated: m.y[DI],
+        };
         // The platen's own terms see F_A − B; the remainder F_D then excludes the base shear.
-        let mut sample = sample_at(
-            self.model,
-            j,
-            t_s,
-            f - bs,
-            self.kin(),
-            self.a,
-            self.mode == Mode::Stick,
-        );
+        let mut sample = sample_at(p.model, j, t_s, f - bs, kin, m.a, m.mode == Mode::Stick);
         sample.terms.actuator_n = f;
+        let n = SpecimenPlant::<M, L>::N;
+        let zd = SpecimenPlant::<M, L>::ZD;
         let mut spec = SpecimenSample {
             base_shear_n: bs,
-            storeys: Self::N,
+            storeys: n,
             u_m: [0.0; NS],
             a_m_s2: [0.0; NS],
             drift_m: [0.0; NS],
         };
         let mut below = 0.0;
-        for i in 0..Self::N {
-            spec.u_m[i] = self.y[Z + i];
-            spec.a_m_s2[i] = self.a + self.k[Self::ZD + i];
-            spec.drift_m[i] = self.y[Z + i] - below;
-            below = self.y[Z + i];
+        for i in 0..n {
+            spec.u_m[i] = m.y[Z + i];
+            spec.a_m_s2[i] = m.a + m.k[zd + i];
+            spec.drift_m[i] = m.y[Z + i] - below;
+            below = m.y[Z + i];
         }
         sample.specimen = Some(spec);
         sample
@@ -899,13 +591,18 @@ impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
 
     /// Closes the energy balance at the current state, the run having finished at `t_s`.
     fn finish(&mut self, t_s: f64) -> RunStats {
-        let y = self.y;
-        self.stats.energy.close(self.model, y[U], y[V], y[W], y[DI]);
-        self.stats.energy.specimen_end_j = self.specimen_energy(&y);
-        self.stats.energy.specimen_dissipated_j = y[SD];
-        self.stats.accepted_steps = self.stats.steps;
-        self.stats.stop = StopReason::Finished { t_s };
-        self.stats
+        let m = &mut self.machine;
+        let y = m.y;
+        let specimen_end_j = m.plant.specimen_energy(&y);
+        let stats = &mut m.stats;
+        stats.energy.close(m.plant.model, y[U], y[V], y[W], y[DI]);
+        stats.energy.specimen_end_j = specimen_end_j;
+        stats.energy.specimen_dissipated_j = y[SD];
+        if self.rk4 {
+            stats.accepted_steps = stats.steps;
+        }
+        stats.stop = StopReason::Finished { t_s };
+        *stats
     }
 }
 

@@ -1,0 +1,748 @@
+//! The one mode machine of the plants whose state goes beyond the platen's own: the platen
+//! carrying a specimen ([`crate::forward_rk4_specimen`]) and the closed loop
+//! ([`crate::forward_closed_loop`]). A [`Plant`] says what its state is and how it moves; the
+//! [`Machine`] advances it through the friction modes with RK4 or Dormand–Prince 5(4).
+//!
+//! # What the machine does
+//!
+//! Inside one span of time without an outside cut (a grid step of a force record, a piece of
+//! a controller period) the machine advances in the current mode until the span ends or the
+//! mode's event function (the speed in slip; `F_s − |N|` in stick; the creep band in creep)
+//! reaches zero:
+//! * the rest of the span is tried and halved until a piece is *safe* (the event function is
+//!   positive at its end, at the stages, and on the cubic Hermite interpolant of its start
+//!   and end) or ends across the event;
+//! * the event is located by Illinois root finding on the integrator's own map
+//!   ([`locate_zero_velocity`]) and its reset applied ([`Machine::event`]): slip → rest
+//!   ([`arrive_at_rest`]), breakaway (moved [`just_past`] rounding), creep → stop, reversal or
+//!   slip;
+//! * a platen leaving rest with a creep speed below the stiff speed creeps
+//!   ([`crate::creep`]).
+//!
+//! # Where time is kept
+//!
+//! A plant measures time inside its span in its own units (the fraction of a grid step for a
+//! force record, seconds from the start of the advance for the closed loop): the machine
+//! passes lengths and positions in those units and asks the plant ([`Plant::seconds`],
+//! [`Plant::land`], ...) where a located event lands, so that each plant's arithmetic of time
+//! is its own and its runs keep their bits.
+//!
+//! # The integrators
+//!
+//! A piece is one RK4 step, graded near rest ([`Grading`]), or an adaptive Dormand–Prince
+//! 5(4) that meets `rtol`/`atol` over it, scaled per state ([`Plant::error_scale`]). Dopri5
+//! that cannot meet its tolerance (the step budget [`MAX_STEPS`] spent or the step shrunk
+//! to nothing) stops the run with [`AdaptiveFailure`] ([`Machine::take_failure`]).
+
+use std::convert::Infallible;
+
+use platen_model::PlatenModel;
+
+use crate::creep::{creep_speed_m_s, stiff_speed_m_s};
+use crate::dopri5::MAX_STEPS;
+use crate::error::{IntegrateError, Result};
+use crate::event::{
+    arrive_at_rest, dip_to_zero, just_past, locate_zero_velocity, mode_at_rest, Direction,
+    EventKind, Mode,
+};
+use crate::rk4::{Grading, MAX_HALVINGS};
+use crate::run::RunStats;
+use crate::stop::{AdaptiveFailure, Failure};
+
+/// Positions in every plant's state: displacement and velocity of the platen.
+pub(crate) const U: usize = 0;
+/// The platen's velocity.
+pub(crate) const V: usize = 1;
+
+/// The state of a plant, `L` numbers.
+pub(crate) type Y<const L: usize> = [f64; L];
+
+/// The integrator of the pieces.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum PieceMethod {
+    /// One RK4 step per piece (graded near rest).
+    Rk4,
+    /// Adaptive Dormand–Prince 5(4) over each piece.
+    Dopri5 {
+        /// Relative tolerance.
+        rtol: f64,
+        /// Absolute tolerance in the plant's units ([`Plant::error_scale`]).
+        atol: f64,
+    },
+}
+
+/// A plant: the state of what the platen drives or is driven by, its right-hand side in each
+/// friction mode, the net force that decides stick and breakaway, and where its time lands.
+///
+/// Positions `at` are in the plant's own units of time inside the current span; `tau` is where
+/// the current advance started and `rest` the length left to the end of the span.
+pub(crate) trait Plant<const L: usize> {
+    /// The platen model.
+    type Model: PlatenModel;
+    /// What the right-hand side needs from outside the state at a position (a record's
+    /// actuator force; nothing in closed loop, whose force is part of the state).
+    type Input: Copy;
+
+    /// The platen model.
+    fn model(&self) -> &Self::Model;
+    /// The outside input at position `at`.
+    fn input(&self, at: f64) -> Self::Input;
+    /// The rates of the state in `mode` (creep at stiff speed `w_stiff`) into `dy`; returns
+    /// the platen's acceleration.
+    fn rates(&self, mode: Mode, w_stiff: f64, input: Self::Input, y: &Y<L>, dy: &mut Y<L>) -> f64;
+    /// [`Plant::rates`] in slip in direction `direction::<POSITIVE>()`, compiled per direction.
+    fn slip_rates<const POSITIVE: bool>(&self, input: Self::Input, y: &Y<L>, dy: &mut Y<L>) -> f64;
+    /// The force the friction law sees, `F_A − B` (the actuator force less the base shear).
+    fn effective_force(&self, input: Self::Input, y: &Y<L>) -> f64;
+    /// The net force `N = F_A − F_E(u) − B` that decides stick and breakaway.
+    fn net(&self, input: Self::Input, y: &Y<L>) -> f64;
+    /// The rate `Ṅ` of the net force in stick (`u` fixed) from the rates `k`.
+    fn net_rate(&self, k: &Y<L>) -> f64;
+    /// Sets what the state holds that the integrator does not move (the creep velocity
+    /// slaved to the force) at the end of a piece. Nothing by default.
+    fn settle(&self, _mode: Mode, _w_stiff: f64, _input: Self::Input, _y: &mut Y<L>) {}
+    /// A state the plant cannot take (an actuator at its end stop), found at time `t_s`.
+    fn check(&self, _y: &Y<L>, _t_s: f64) -> Result<()> {
+        Ok(())
+    }
+    /// Whether a state accepted at an event gets its rates at once (and goes through
+    /// [`Plant::admit`]) or only when the next mode is entered.
+    const RATES_ON_COMMIT: bool;
+    /// Accepts `y` as the state at time `t_s`: returns whether it changed it (a pressure held
+    /// at the cavitation floor), so that its rates are taken again.
+    fn admit(&mut self, _y: &mut Y<L>, _t_s: f64) -> bool {
+        false
+    }
+    /// The error scale of state `i` going from `y0` to `y1` for the adaptive step
+    /// (`atol·unit + rtol·|y|`; infinite for a quadrature that is not controlled).
+    fn error_scale(&self, i: usize, y0: f64, y1: f64, rtol: f64, atol: f64) -> f64;
+
+    /// A length in the plant's units, in seconds.
+    fn seconds(&self, len: f64) -> f64;
+    /// A length in seconds, in the plant's units.
+    fn units(&self, seconds: f64) -> f64;
+    /// The time at position `at`, s.
+    fn time_s(&self, at: f64) -> f64;
+    /// The smallest bracket the event root finder is asked for, in the plant's units (the
+    /// bracket is `4ε·max(len, floor)`).
+    fn tolerance_floor(&self) -> f64;
+    /// A creep stop this close to the start of its advance has not moved time.
+    fn min_progress(&self) -> f64;
+    /// Where an event located `x` past `tau` lands (snapped onto the span's end when a
+    /// hair short of it), in the units the plant's driver counts in.
+    fn land(&self, tau: f64, x: f64, rest: f64) -> f64;
+    /// Where a committed piece of length `len` from `tau` ends, in the driver's units.
+    fn reach(&self, tau: f64, len: f64) -> f64;
+    /// Where a breakaway located `x` past `tau` lands, in the driver's units; `held` when
+    /// rounding kept friction holding there (still stuck: time must still move).
+    fn break_at(&self, tau: f64, x: f64, rest: f64, held: bool) -> f64;
+}
+
+/// The machine: a plant's state in its friction mode, with the counters of the run.
+pub(crate) struct Machine<P, const L: usize> {
+    /// The plant.
+    pub(crate) plant: P,
+    /// The state.
+    pub(crate) y: Y<L>,
+    /// The rates at the state in the current mode.
+    pub(crate) k: Y<L>,
+    /// The platen's acceleration at the state (0 in stick and creep).
+    pub(crate) a: f64,
+    /// The friction mode.
+    pub(crate) mode: Mode,
+    /// The stiff speed of the current creep phase, m/s.
+    w_stiff: f64,
+    /// The grid's step, s: the stiff speed's scale and the adaptive step's ceiling.
+    h: f64,
+    /// The integrator of the pieces.
+    method: PieceMethod,
+    /// The last adaptive step, s.
+    h_dopri: f64,
+    /// Where and why Dopri5 gave up inside the current advance.
+    gave_up: Option<(f64, AdaptiveFailure)>,
+    /// The solver's counters.
+    pub(crate) stats: RunStats,
+}
+
+impl<P: Plant<L>, const L: usize> Machine<P, L> {
+    /// A machine at state `y` (mode still to be entered: [`Machine::enter`]).
+    pub(crate) fn new(plant: P, y: Y<L>, h: f64, method: PieceMethod) -> Self {
+        Machine {
+            plant,
+            y,
+            k: [0.0; L],
+            a: 0.0,
+            mode: Mode::Stick,
+            w_stiff: 0.0,
+            h,
+            method,
+            h_dopri: h,
+            gave_up: None,
+            stats: RunStats::default(),
+        }
+    }
+
+    /// Where and why the adaptive integrator gave up, once.
+    pub(crate) fn take_failure(&mut self) -> Option<(f64, AdaptiveFailure)> {
+        self.gave_up.take()
+    }
+
+    /// The signed creep velocity at `y` under `input`.
+    fn creep_velocity(&self, dir: Direction, input: P::Input, y: &Y<L>) -> f64 {
+        let f_eff = self.plant.effective_force(input, y);
+        let w = creep_speed_m_s(self.plant.model(), dir, y[U], f_eff, self.w_stiff)
+            .unwrap_or(self.w_stiff);
+        dir.sign() * w
+    }
+
+    /// Switches to `mode` at the current state under `input`: its rates (and the stiff speed
+    /// and velocity of a creep phase).
+    pub(crate) fn enter(&mut self, mode: Mode, input: P::Input) {
+        self.mode = mode;
+        if let Mode::Creep(dir) = mode {
+            self.w_stiff = stiff_speed_m_s(self.plant.model(), self.y[U], self.h);
+            let y = self.y;
+            self.y[V] = self.creep_velocity(dir, input, &y);
+        }
+        let (y, mut k) = (self.y, [0.0; L]);
+        self.a = self.plant.rates(mode, self.w_stiff, input, &y, &mut k);
+        self.k = k;
+        self.stats.rhs_evaluations += 1;
+    }
+
+    /// Accepts `y` at time `t_s` as the plant does ([`Plant::RATES_ON_COMMIT`]).
+    fn commit(&mut self, y: Y<L>, input: P::Input, t_s: f64) {
+        if P::RATES_ON_COMMIT {
+            let mut k = [0.0; L];
+            let a = self.plant.rates(self.mode, self.w_stiff, input, &y, &mut k);
+            self.stats.rhs_evaluations += 1;
+            self.commit_with(y, k, a, input, t_s);
+        } else {
+            self.y = y;
+        }
+    }
+
+    /// Accepts `y` with its rates `k` and acceleration `a` at time `t_s` (taken again if the
+    /// plant changes the state).
+    fn commit_with(&mut self, mut y: Y<L>, mut k: Y<L>, mut a: f64, input: P::Input, t_s: f64) {
+        if self.plant.admit(&mut y, t_s) {
+            a = self.plant.rates(self.mode, self.w_stiff, input, &y, &mut k);
+            self.stats.rhs_evaluations += 1;
+        }
+        (self.y, self.k, self.a) = (y, k, a);
+    }
+
+    // ---- one-step maps -------------------------------------------------------------------
+
+    /// One RK4 step of length `len` from position `s` (`y` with rates `k1` there): the end
+    /// state and the smallest stage speed along the slip direction.
+    #[inline(always)]
+    fn rk4(&mut self, s: f64, len: f64, y: &Y<L>, k1: &Y<L>) -> (Y<L>, f64) {
+        let mode = self.mode;
+        let dt = self.plant.seconds(len);
+        let (i_mid, i_end) = (self.plant.input(s + 0.5 * len), self.plant.input(s + len));
+        let combine = |base: &Y<L>, k: &Y<L>, c: f64| {
+            let mut out = *base;
+            for i in 0..L {
+                out[i] += c * k[i];
+            }
+            out
+        };
+        let (mut k2, mut k3, mut k4) = ([0.0; L], [0.0; L], [0.0; L]);
+        let w = self.w_stiff;
+        let y2 = combine(y, k1, 0.5 * dt);
+        self.plant.rates(mode, w, i_mid, &y2, &mut k2);
+        let y3 = combine(y, &k2, 0.5 * dt);
+        self.plant.rates(mode, w, i_mid, &y3, &mut k3);
+        let y4 = combine(y, &k3, dt);
+        self.plant.rates(mode, w, i_end, &y4, &mut k4);
+        self.stats.rhs_evaluations += 3;
+        let h6 = dt / 6.0;
+        let mut y1 = *y;
+        for i in 0..L {
+            y1[i] += h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
+        }
+        let stage_min = match mode {
+            Mode::Slip(dir) => {
+                let d = dir.sign();
+                (d * y2[V]).min(d * y3[V]).min(d * y4[V])
+            }
+            _ => f64::INFINITY,
+        };
+        self.plant.settle(mode, w, i_end, &mut y1);
+        (y1, stage_min)
+    }
+
+    /// Adaptive Dormand–Prince 5(4) over a length `len` from position `s` (`y` with rates
+    /// `k1` there): the end state and the smallest speed along the slip direction at its
+    /// stages.
+    fn dopri5(&mut self, s: f64, len: f64, y: &Y<L>, k1: &Y<L>, tol: (f64, f64)) -> (Y<L>, f64) {
+        let (rtol, atol) = tol;
+        let dt = self.plant.seconds(len);
+        let mode = self.mode;
+        let w = self.w_stiff;
+        let (mut yc, mut kc) = (*y, *k1);
+        let mut done = 0.0;
+        let mut stage_min = f64::INFINITY;
+        let mut hs = self.h_dopri.min(dt);
+        let mut guard = 0u32;
+        while done < dt {
+            guard += 1;
+            let last = dt - done <= hs * (1.0 + 1e-12);
+            let step = if last { dt - done } else { hs };
+            let mut ks = [[0.0; L]; 7];
+            ks[0] = kc;
+            let mut ys = [yc; 6];
+            for stage in 0..6 {
+                let mut yi = yc;
+                for i in 0..L {
+                    let mut acc = 0.0;
+                    for (j, kj) in ks.iter().enumerate().take(stage + 1) {
+                        acc += DP_A[stage][j] * kj[i];
+                    }
+                    yi[i] += step * acc;
+                }
+                ys[stage] = yi;
+                let at = s + self.plant.units(done + DP_C[stage] * step);
+                let input = self.plant.input(at);
+                let mut kn = [0.0; L];
+                self.plant.rates(mode, w, input, &yi, &mut kn);
+                ks[stage + 1] = kn;
+            }
+            self.stats.rhs_evaluations += 6;
+            let y_new = ys[5];
+            let mut err: f64 = 0.0;
+            for i in 0..L {
+                let mut e = 0.0;
+                for (j, kj) in ks.iter().enumerate() {
+                    e += DP_E[j] * kj[i];
+                }
+                let sc = self.plant.error_scale(i, yc[i], y_new[i], rtol, atol);
+                err = err.max((step * e / sc).abs());
+            }
+            let factor = if err == 0.0 {
+                5.0
+            } else {
+                (0.9 * err.powf(-0.2)).clamp(0.2, 5.0)
+            };
+            // NaN counts as not accurate.
+            let accurate = err <= 1.0;
+            if !accurate {
+                let underflow = step <= 1e-14 * dt.max(1e-9);
+                if underflow || guard > MAX_STEPS {
+                    // Dopri5 gives up: the piece ends where it got to and the run stops there
+                    // with the failure (`Machine::take_failure`).
+                    let reason = if underflow {
+                        AdaptiveFailure::StepSizeUnderflow
+                    } else {
+                        AdaptiveFailure::TooManySteps { steps: MAX_STEPS }
+                    };
+                    let t_s = self.plant.time_s(s) + done;
+                    self.gave_up.get_or_insert((t_s, reason));
+                    return (yc, stage_min);
+                }
+            }
+            if accurate {
+                if let Mode::Slip(dir) = mode {
+                    let d = dir.sign();
+                    for yi in &ys {
+                        stage_min = stage_min.min(d * yi[V]);
+                    }
+                }
+                done += step;
+                yc = y_new;
+                kc = ks[6];
+                self.stats.accepted_steps += 1;
+                if !last {
+                    hs = (step * factor).min(self.h);
+                    self.h_dopri = hs;
+                }
+                if last {
+                    break;
+                }
+            } else {
+                self.stats.rejected_steps += 1;
+                hs = step * factor;
+            }
+        }
+        let input = self.plant.input(s + len);
+        self.plant.settle(mode, w, input, &mut yc);
+        (yc, stage_min)
+    }
+
+    /// The current mode's state over a length `x` from position `tau`, as the method maps it
+    /// (RK4 split by `grading`); with the smallest stage speed.
+    fn piece(&mut self, tau: f64, x: f64, grading: Grading) -> (Y<L>, f64) {
+        let (mut y, mut k) = (self.y, self.k);
+        if let PieceMethod::Dopri5 { rtol, atol } = self.method {
+            return self.dopri5(tau, x, &y, &k, (rtol, atol));
+        }
+        let mut stage_min = f64::INFINITY;
+        let mut s = tau;
+        for (i, &p) in grading.pieces().iter().enumerate() {
+            let len = p * x;
+            if i > 0 {
+                let input = self.plant.input(s);
+                self.plant.rates(self.mode, self.w_stiff, input, &y, &mut k);
+                self.stats.rhs_evaluations += 1;
+            }
+            let (y1, m) = self.rk4(s, len, &y, &k);
+            y = y1;
+            stage_min = stage_min.min(m);
+            s += len;
+        }
+        (y, stage_min)
+    }
+
+    // ---- events --------------------------------------------------------------------------
+
+    /// The current mode's event function at `y` under `input`: positive until the mode ends.
+    #[inline(always)]
+    fn event_g(&self, input: P::Input, y: &Y<L>) -> f64 {
+        let model = self.plant.model();
+        match self.mode {
+            Mode::Slip(dir) => dir.sign() * y[V],
+            Mode::Stick => model.static_threshold_n(y[U]) - self.plant.net(input, y).abs(),
+            Mode::Creep(dir) => {
+                let sn = dir.sign() * self.plant.net(input, y);
+                (sn - model.static_threshold_n(y[U])).min(self.exit_level(dir, y[U]) - sn)
+            }
+        }
+    }
+
+    /// The drive `s·N` at which creep hands over to slip (the creep speed reaches `w_*`).
+    fn exit_level(&self, dir: Direction, u: f64) -> f64 {
+        let (s, m) = (dir.sign(), self.plant.model());
+        m.static_threshold_n(u)
+            + m.dissipative_excess_n(u, self.w_stiff)
+            + s * m.velocity_inertial_force_n(u, s * self.w_stiff)
+    }
+
+    /// Whether the event function may dip to zero inside a piece of length `len` from the
+    /// current state (input `i0`) to `y1` (input `i1`, rates `k1`, platen acceleration `a1`):
+    /// the cubic Hermite interpolant of the speed (slip) or of `F_s ∓ N` (stick) touches zero.
+    #[allow(clippy::too_many_arguments)]
+    fn dips(&self, len: f64, i0: P::Input, y1: &Y<L>, i1: P::Input, k1: &Y<L>, a1: f64) -> bool {
+        let span = self.plant.seconds(len);
+        match self.mode {
+            Mode::Slip(dir) => {
+                let d = dir.sign();
+                dip_to_zero(d * self.y[V], d * y1[V], d * self.a * span, d * a1 * span).is_some()
+            }
+            Mode::Stick => {
+                let fs = self.plant.model().static_threshold_n(self.y[U]);
+                let (n0, n1) = (self.plant.net(i0, &self.y), self.plant.net(i1, y1));
+                let (d0, d1) = (
+                    self.plant.net_rate(&self.k) * span,
+                    self.plant.net_rate(k1) * span,
+                );
+                dip_to_zero(fs - n0, fs - n1, -d0, -d1).is_some()
+                    || dip_to_zero(fs + n0, fs + n1, d0, d1).is_some()
+            }
+            Mode::Creep(_) => false,
+        }
+    }
+
+    /// The error of a state found non-finite at position `at`.
+    fn non_finite(&self, at: f64) -> IntegrateError {
+        let cause = Failure::NonFiniteState {
+            u_m: self.y[U],
+            v_m_s: self.y[V],
+        };
+        IntegrateError::failed(self.plant.time_s(at), cause)
+    }
+
+    /// One RK4 step over a whole span of length 1 from position 0 in slip with direction
+    /// `direction::<POSITIVE>()` (the platen moving, `v ≠ 0`), committed when it is safe:
+    /// exactly the first try of [`Machine::advance`] (a single piece of length 1), the same
+    /// operations in the same order, so what it commits is bit for bit what
+    /// [`Machine::advance`] would. Returns whether it committed; if not, nothing has changed
+    /// (counters included) and the span is taken again by [`Machine::advance`].
+    #[inline(always)]
+    pub(crate) fn slip_fast<const POSITIVE: bool>(&mut self) -> bool {
+        let dir = crate::rk4::direction::<POSITIVE>();
+        let h = self.plant.seconds(1.0);
+        let (i_mid, i_end) = (self.plant.input(0.5), self.plant.input(1.0));
+        let (y, k1) = (&self.y, &self.k);
+        let hh = 0.5 * h;
+        let (mut k2, mut k3, mut k4) = ([0.0; L], [0.0; L], [0.0; L]);
+        let mut y2 = *y;
+        for i in 0..L {
+            y2[i] += hh * k1[i];
+        }
+        self.plant.slip_rates::<POSITIVE>(i_mid, &y2, &mut k2);
+        let mut y3 = *y;
+        for i in 0..L {
+            y3[i] += hh * k2[i];
+        }
+        self.plant.slip_rates::<POSITIVE>(i_mid, &y3, &mut k3);
+        let mut y4 = *y;
+        for i in 0..L {
+            y4[i] += h * k3[i];
+        }
+        self.plant.slip_rates::<POSITIVE>(i_end, &y4, &mut k4);
+        let h6 = h / 6.0;
+        let mut y1 = *y;
+        for i in 0..L {
+            y1[i] += h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
+        }
+        let stage_min = (dir * y2[V]).min(dir * y3[V]).min(dir * y4[V]);
+        if !(dir * y1[V] > 0.0 && stage_min > 0.0 && y1.iter().all(|x| x.is_finite())) {
+            return false;
+        }
+        let mut k_end = [0.0; L];
+        let a1 = self.plant.slip_rates::<POSITIVE>(i_end, &y1, &mut k_end);
+        let (d0, d1) = (dir * self.a * h, dir * a1 * h);
+        if dip_to_zero(dir * self.y[V], dir * y1[V], d0, d1).is_some() || !a1.is_finite() {
+            return false;
+        }
+        self.stats.rhs_evaluations += 4;
+        (self.y, self.k, self.a) = (y1, k_end, a1);
+        true
+    }
+
+    /// Advances in the current mode from position `tau` over at most `rest`, to the end or to
+    /// the mode's next event (its reset applied). Returns where the advance stopped, in the
+    /// units of the plant's driver ([`Plant::reach`], [`Plant::land`]).
+    pub(crate) fn advance(&mut self, tau: f64, rest: f64) -> Result<f64> {
+        let i0 = self.plant.input(tau);
+        let slip = matches!(self.mode, Mode::Slip(_));
+        let from_rest = slip && self.y[V] == 0.0;
+        if let (Mode::Slip(dir), true) = (self.mode, from_rest) {
+            // Leaving rest below the stiff speed: creep.
+            let model = self.plant.model();
+            let w_stiff = stiff_speed_m_s(model, self.y[U], self.h);
+            let f_eff = self.plant.effective_force(i0, &self.y);
+            if creep_speed_m_s(model, dir, self.y[U], f_eff, w_stiff).is_some() {
+                self.enter(Mode::Creep(dir), i0);
+                return Ok(self.plant.reach(tau, 0.0));
+            }
+        }
+        let (try_grading, event_grading) = match (slip, from_rest) {
+            (true, true) => (Grading::Start, Grading::Both),
+            (true, false) => (Grading::Single, Grading::End),
+            _ => (Grading::Single, Grading::Single),
+        };
+        let mut len = rest;
+        for _ in 0..=MAX_HALVINGS {
+            let (y1, stage_min) = self.piece(tau, len, try_grading);
+            if !y1.iter().all(|x| x.is_finite()) {
+                return Err(self.non_finite(tau));
+            }
+            self.plant.check(&y1, self.plant.time_s(tau + len))?;
+            let i1 = self.plant.input(tau + len);
+            let g1 = self.event_g(i1, &y1);
+            if g1 > 0.0 && stage_min > 0.0 {
+                let mut k1 = [0.0; L];
+                let a1 = self.plant.rates(self.mode, self.w_stiff, i1, &y1, &mut k1);
+                self.stats.rhs_evaluations += 1;
+                if !self.dips(len, i0, &y1, i1, &k1, a1) {
+                    if !a1.is_finite() {
+                        return Err(self.non_finite(tau + len));
+                    }
+                    if self.mode == Mode::Stick {
+                        self.stats.stick_time_s += self.plant.seconds(len);
+                    }
+                    let t_s = self.plant.time_s(tau + len);
+                    self.commit_with(y1, k1, a1, i1, t_s);
+                    return Ok(self.plant.reach(tau, len));
+                }
+            } else if g1 <= 0.0 {
+                let (y2, g2) = if event_grading == try_grading {
+                    (y1, g1)
+                } else {
+                    let (y2, _) = self.piece(tau, len, event_grading);
+                    (y2, self.event_g(i1, &y2))
+                };
+                if g2 <= 0.0 {
+                    let g0 = self.event_g(i0, &self.y);
+                    let tolerance = 4.0 * f64::EPSILON * len.max(self.plant.tolerance_floor());
+                    let Ok(found) = locate_zero_velocity(len, g0, (y2, g2), tolerance, |x| {
+                        self.stats.root_iterations += 1;
+                        let (y, _) = self.piece(tau, x, event_grading);
+                        let g = self.event_g(self.plant.input(tau + x), &y);
+                        Ok::<_, Infallible>((y, g))
+                    });
+                    let (x, y_event) = found.unwrap_or((0.0, self.y));
+                    return Ok(self.event(tau, x, rest, y_event));
+                }
+            }
+            len *= 0.5;
+        }
+        // A piece of 2⁻⁶⁰ of the span still not safe: the event is here.
+        let y = self.y;
+        Ok(self.event(tau, 0.0, rest, y))
+    }
+
+    /// The reset at the current mode's event, located `x` past `tau` (`rest` to the span's
+    /// end) with state `y_event` there. Returns where time landed, in the driver's units.
+    fn event(&mut self, tau: f64, x: f64, rest: f64, y_event: Y<L>) -> f64 {
+        let mut at = self.plant.land(tau, x, rest);
+        match self.mode {
+            Mode::Slip(from) => {
+                let mut y = y_event;
+                y[V] = 0.0;
+                let input = self.plant.input(at);
+                self.commit(y, input, self.plant.time_s(at));
+                let f_eff = self.plant.effective_force(input, &self.y);
+                let (mode, kind) = arrive_at_rest(self.plant.model(), self.y[U], f_eff, from);
+                self.enter(mode, input);
+                if let Some(kind) = kind {
+                    self.stats.record(kind);
+                }
+                at
+            }
+            Mode::Stick => self.breakaway(tau, x, rest, y_event),
+            Mode::Creep(dir) => {
+                let start = (self.y, self.k);
+                let mut input = self.plant.input(at);
+                self.commit(y_event, input, self.plant.time_s(at));
+                let sn = dir.sign() * self.plant.net(input, &self.y);
+                let fs = self.plant.model().static_threshold_n(self.y[U]);
+                if sn - fs <= self.exit_level(dir, self.y[U]) - sn {
+                    // The drive fell to the threshold: a stop (or, past rounding, creep on or
+                    // a reversal, as the net force at rest decides).
+                    self.y[V] = 0.0;
+                    let f_eff = self.plant.effective_force(input, &self.y);
+                    let mut mode = mode_at_rest(self.plant.model(), self.y[U], f_eff);
+                    if mode == Mode::Slip(dir) && x <= self.plant.min_progress() {
+                        // The stop rounded onto the start of the advance, where the net force
+                        // at rest is a hair along the motion: creeping on from here would
+                        // locate the same stop again without moving time. Step just past it,
+                        // to where the net force at rest no longer drives the creep on (see
+                        // `crate::creep`, whose passes do the same).
+                        at = self.creep_just_past(tau, x, rest, start, dir);
+                        input = self.plant.input(at);
+                        let f_eff = self.plant.effective_force(input, &self.y);
+                        mode = mode_at_rest(self.plant.model(), self.y[U], f_eff);
+                    }
+                    match mode {
+                        Mode::Slip(d) if d == dir => self.enter(Mode::Creep(dir), input),
+                        Mode::Stick => {
+                            self.stats.record(EventKind::Stop);
+                            self.enter(Mode::Stick, input);
+                        }
+                        other => {
+                            self.stats.record(EventKind::Reversal);
+                            self.enter(other, input);
+                        }
+                    }
+                } else {
+                    // The creep speed reached the stiff speed: slip on from that velocity.
+                    let y = self.y;
+                    let v = self.creep_velocity(dir, input, &y);
+                    self.y[V] = if v == 0.0 {
+                        dir.sign() * f64::MIN_POSITIVE
+                    } else {
+                        v
+                    };
+                    self.enter(Mode::Slip(dir), input);
+                }
+                at
+            }
+        }
+    }
+
+    /// The breakaway located `x` past `tau`: moved [`just_past`] rounding so that
+    /// `|N| > F_s` holds where slip starts (or, if rounding kept friction holding to the end
+    /// of the span, still stuck there).
+    fn breakaway(&mut self, tau: f64, x: f64, rest: f64, y_event: Y<L>) -> f64 {
+        let fs = self.plant.model().static_threshold_n(self.y[U]);
+        let x_b = just_past(x, rest, |x| {
+            let (y, _) = self.piece(tau, x, Grading::Single);
+            self.plant.net(self.plant.input(tau + x), &y).abs() > fs
+        });
+        let y = if x_b == x {
+            y_event
+        } else {
+            self.piece(tau, x_b, Grading::Single).0
+        };
+        self.stats.stick_time_s += self.plant.seconds(x_b);
+        let input = self.plant.input(self.plant.break_at(tau, x_b, rest, false));
+        self.commit(y, input, self.plant.time_s(tau + x_b));
+        let net = self.plant.net(input, &self.y);
+        if net.abs() <= fs {
+            // Rounding kept friction holding to the end of the span: still stuck.
+            self.enter(Mode::Stick, input);
+            return self.plant.break_at(tau, x_b, rest, true);
+        }
+        self.stats.record(EventKind::Breakaway);
+        self.enter(Mode::Slip(Direction::of_sign(net)), input);
+        self.plant.break_at(tau, x_b, rest, false)
+    }
+
+    /// A creep stop located `x ≤` [`Plant::min_progress`] past `tau` (from the state and
+    /// rates `start`) where the net force at rest still drives the creep on in `dir`: creeps
+    /// from `start` to the first of `x + 4ε, x + 8ε, …` ([`just_past`]) where it does not, or
+    /// to the span's end, and accepts that state at rest (`v = 0`). Returns where, in the
+    /// driver's units.
+    fn creep_just_past(
+        &mut self,
+        tau: f64,
+        x: f64,
+        rest: f64,
+        start: (Y<L>, Y<L>),
+        dir: Direction,
+    ) -> f64 {
+        let stopped = (self.y, self.k, self.a);
+        (self.y, self.k) = start;
+        let x_b = just_past(x, rest, |x| {
+            let (y, _) = self.piece(tau, x, Grading::Single);
+            let f_eff = self.plant.effective_force(self.plant.input(tau + x), &y);
+            mode_at_rest(self.plant.model(), y[U], f_eff) != Mode::Slip(dir)
+        });
+        if x_b > x {
+            let (y, _) = self.piece(tau, x_b, Grading::Single);
+            let at = tau + x_b;
+            self.commit(y, self.plant.input(at), self.plant.time_s(at));
+        } else {
+            (self.y, self.k, self.a) = stopped;
+        }
+        self.y[V] = 0.0;
+        self.plant.land(tau, x_b, rest)
+    }
+}
+
+/// The Dormand–Prince 5(4) tableau: nodes.
+const DP_C: [f64; 6] = [0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0];
+/// The Dormand–Prince 5(4) tableau: stage coefficients (the last row is the 5th-order
+/// solution, so the 7th stage is the rate at the new state: first same as last).
+const DP_A: [[f64; 6]; 6] = [
+    [0.2, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
+    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
+    [
+        19372.0 / 6561.0,
+        -25360.0 / 2187.0,
+        64448.0 / 6561.0,
+        -212.0 / 729.0,
+        0.0,
+        0.0,
+    ],
+    [
+        9017.0 / 3168.0,
+        -355.0 / 33.0,
+        46732.0 / 5247.0,
+        49.0 / 176.0,
+        -5103.0 / 18656.0,
+        0.0,
+    ],
+    [
+        35.0 / 384.0,
+        0.0,
+        500.0 / 1113.0,
+        125.0 / 192.0,
+        -2187.0 / 6784.0,
+        11.0 / 84.0,
+    ],
+];
+/// The Dormand–Prince 5(4) tableau: the error estimate's weights (5th − 4th order).
+const DP_E: [f64; 7] = [
+    71.0 / 57600.0,
+    0.0,
+    -71.0 / 16695.0,
+    71.0 / 1920.0,
+    -17253.0 / 339200.0,
+    22.0 / 525.0,
+    -1.0 / 40.0,
+];
