@@ -4,8 +4,8 @@
 //! eigen-decomposition written for this test (the integrator works in relative coordinates).
 
 use platen_integrate::{
-    forward_rk4, forward_rk4_specimen, inverse_specimen, ForceRecord, Motion, Rk4, Sample,
-    SampleSink, State, Trajectory,
+    forward_rk4, forward_rk4_specimen, forward_specimen, inverse_specimen, Dopri5Settings,
+    ForceRecord, Method, Motion, Rk4, Sample, SampleSink, State, Trajectory,
 };
 use platen_model::{force_terms, IdentifiedParams, Specimen, Storey};
 
@@ -417,6 +417,55 @@ fn forward_with_stick_phases_matches_the_event_located_reference() {
     assert!(stats.breakaways >= 4, "{stats:?}");
     // The time spent stuck agrees with the reference's stick intervals (the last ends before
     // the record does): a misplaced stop or breakaway would show here first.
+    let stuck_s: f64 = sticks[0].iter().zip(&sticks[1]).map(|(a, b)| b - a).sum();
+    assert!(
+        (stats.stick_time_s - stuck_s).abs() < 1e-6,
+        "stuck {} s against the reference's {stuck_s} s",
+        stats.stick_time_s
+    );
+}
+
+/// The same event-located reference through the adaptive Dormand–Prince 5(4) with a specimen
+/// (one mode machine under both integrators): platen and storey displacements within the same
+/// 1e-7 m at every sample, the same 3 stops, and the time stuck within 1e-6 s. Its tolerances
+/// (1e-10 relative, 1e-12 m and m/s absolute) leave a local error far below the bound, so
+/// the bound again tests where the events are placed.
+#[test]
+fn dopri5_with_stick_phases_matches_the_event_located_reference() {
+    let model = params().build().unwrap();
+    let spec = reference_specimen();
+    let force = reference_columns("specimen_force.csv");
+    let reference = reference_columns("specimen_reference.csv");
+    let sticks = reference_columns("specimen_sticks.csv");
+    let record = ForceRecord::new(force[0].clone(), force[1].clone()).unwrap();
+    let mut run = Specimens::default();
+    let method = Method::Dopri5(Dopri5Settings::new(1e-10, 1e-12).unwrap());
+    let stats = forward_specimen(
+        &model,
+        &spec,
+        &record,
+        method,
+        State::default(),
+        record.len(),
+        &mut run,
+    )
+    .unwrap();
+    assert_eq!(run.samples.len(), reference[0].len());
+    let mut worst = [0.0f64; 3];
+    for (s, i) in run.samples.iter().zip(0..) {
+        let spec_sample = s.specimen.unwrap();
+        let got = [s.u_m, spec_sample.u_m[0], spec_sample.u_m[1]];
+        let want = [reference[1][i], reference[3][i], reference[4][i]];
+        for c in 0..3 {
+            worst[c] = worst[c].max((got[c] - want[c]).abs());
+        }
+    }
+    eprintln!("Dopri5 forward vs reference: largest |Δ| (u, z1, z2) = {worst:?} m; {stats:?}");
+    assert!(
+        worst.iter().all(|w| *w < 1e-7),
+        "largest differences (u, z1, z2) = {worst:?} m"
+    );
+    assert_eq!(stats.stick_events, 3, "{stats:?}");
     let stuck_s: f64 = sticks[0].iter().zip(&sticks[1]).map(|(a, b)| b - a).sum();
     assert!(
         (stats.stick_time_s - stuck_s).abs() < 1e-6,

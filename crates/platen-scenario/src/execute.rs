@@ -3,8 +3,8 @@
 use std::path::Path;
 
 use platen_integrate::{
-    forward_closed_loop, forward_rk4_specimen, inverse, inverse_specimen, ForwardIntegrator,
-    IntegrateError, LoopRun, LoopStats, Method, Motion, Peak, Peaks, RunStats, Sample, SampleSink,
+    forward_closed_loop, forward_specimen, inverse, inverse_specimen, ForwardIntegrator,
+    IntegrateError, LoopRun, LoopStats, Motion, Peak, Peaks, RunStats, Sample, SampleSink,
     SystemColumns, Trajectory,
 };
 use platen_io::series::SeriesWriter;
@@ -130,11 +130,10 @@ impl Model {
         }
     }
 
-    /// [`Model::run`] with `specimen` on the platen (forward runs with RK4).
+    /// [`Model::run`] with `specimen` on the platen (forward runs with either integrator).
     ///
     /// # Errors
-    /// As [`Model::run`]; a forward run with another integrator than RK4 is refused
-    /// ([`IntegrateError::InvalidStep`]: scenarios refuse it when they are validated).
+    /// As [`Model::run`].
     pub fn run_with_specimen<S: SampleSink>(
         &self,
         run: &Run,
@@ -158,13 +157,18 @@ fn run_specimen<M: PlatenModel, S: SampleSink>(
     let stats = match run {
         Run::Forward {
             record,
-            integrator: Method::Rk4(rk4),
+            integrator,
             initial,
             samples,
-        } => Some(forward_rk4_specimen(
-            model, specimen, record, *rk4, *initial, *samples, &mut sink,
+        } => Some(forward_specimen(
+            model,
+            specimen,
+            record,
+            *integrator,
+            *initial,
+            *samples,
+            &mut sink,
         )?),
-        Run::Forward { .. } => return Err(IntegrateError::InvalidStep { step_s: f64::NAN }),
         Run::Inverse { motion } => {
             inverse_specimen(model, specimen, motion, &mut sink);
             None

@@ -36,7 +36,7 @@
 
 use std::path::Path;
 
-use platen_integrate::{IntegrateError, Method};
+use platen_integrate::IntegrateError;
 use platen_model::{
     FullModel, IdentifiedKey, IdentifiedModel, ModelError, PhysicalKey, PlatenModel, Preset,
     Specimen, Storey, TableLimits,
@@ -213,7 +213,7 @@ impl Scenario {
                 limits.stroke_m,
             )?;
         }
-        let specimen = build_specimen(&ctx, file.specimen.as_ref(), &run)?;
+        let specimen = build_specimen(&ctx, file.specimen.as_ref())?;
         let closed_loop = match &file.table_system {
             None => None,
             Some(spec) => Some(closed_loop(
@@ -298,23 +298,11 @@ fn closed_loop(
     })
 }
 
-/// The validated `specimen`, with JSON paths in its errors; forward runs with a specimen
-/// need the RK4 integrator.
-fn build_specimen(ctx: &Ctx, given: Option<&SpecimenSpec>, run: &Run) -> Result<Option<Specimen>> {
+/// The validated `specimen`, with JSON paths in its errors.
+fn build_specimen(ctx: &Ctx, given: Option<&SpecimenSpec>) -> Result<Option<Specimen>> {
     let Some(given) = given else {
         return Ok(None);
     };
-    if let Run::Forward {
-        integrator: Method::Dopri5(_),
-        ..
-    } = run
-    {
-        return Err(ctx.invalid(
-            "integrator.method",
-            "dopri5",
-            "\"rk4\": forward runs with a specimen use the RK4 integrator",
-        ));
-    }
     let storeys = given
         .storeys
         .iter()
