@@ -46,10 +46,11 @@ use platen_system::{
 
 use crate::creep::creep_speed_m_s;
 use crate::error::{IntegrateError, Result};
-use crate::event::{Direction, Mode, MAX_EVENTS_PER_STEP};
+use crate::event::{Direction, EventKind, Mode, MAX_EVENTS_PER_STEP};
 use crate::machine::{Machine, PieceMethod, Plant, U, V};
 use crate::output::{SampleSink, SpecimenSample, SystemSample};
 use crate::run::{sample_at, EnergyBalance, Kin, RunStats, State};
+use crate::stepping::{Samples, Steppable};
 use crate::stop::{Failure, StopReason};
 use crate::Motion;
 
@@ -160,6 +161,28 @@ pub fn forward_closed_loop<M: PlatenModel, S: SampleSink>(
     samples: usize,
     sink: &mut S,
 ) -> Result<LoopStats> {
+    let Some((k, h, samples)) = check_loop(run, samples)? else {
+        return Ok(LoopStats::default());
+    };
+    macro_rules! by_storeys {
+        ($($n:literal => $len:literal),*) => {
+            match run.specimen.map_or(0, Specimen::len) {
+                $($n => {
+                    let mut stepper = Loop::<M, $len>::new(model, run, k, h, samples);
+                    stepper.run(sink)?;
+                    Ok(stepper.finish())
+                })*
+                other => unreachable!("a validated specimen has 1 to {NS} storeys, not {other}"),
+            }
+        };
+    }
+    by_storeys!(0 => 13, 1 => 15, 2 => 17, 3 => 19, 4 => 21, 5 => 23, 6 => 25, 7 => 27,
+                8 => 29, 9 => 31, 10 => 33, 11 => 35, 12 => 37)
+}
+
+/// The checks of a closed-loop run before it starts; its steps per period, step and samples
+/// (at most the command's), or `None` when there is no sample to deliver.
+pub(crate) fn check_loop(run: &LoopRun<'_>, samples: usize) -> Result<Option<(u32, f64, usize)>> {
     let (system, method) = (run.system, run.method);
     let k = method.steps_per_period();
     let period = 1.0 / system.controller.sample_rate_hz;
@@ -182,16 +205,26 @@ pub fn forward_closed_loop<M: PlatenModel, S: SampleSink>(
     }
     let samples = samples.min(run.command.len());
     if samples == 0 {
-        return Ok(LoopStats::default());
+        return Ok(None);
     }
-    let h = period / f64::from(k);
+    Ok(Some((k, period / f64::from(k), samples)))
+}
+
+/// The closed loop `run` as a [`Steppable`] run (its state length chosen by its storeys).
+pub(crate) fn boxed_loop<'a, M: PlatenModel>(
+    model: &'a M,
+    run: &LoopRun<'a>,
+    k: u32,
+    h: f64,
+    samples: usize,
+) -> Box<dyn Steppable + 'a> {
     macro_rules! by_storeys {
         ($($n:literal => $len:literal),*) => {
             match run.specimen.map_or(0, Specimen::len) {
                 $($n => {
-                    let mut stepper = Loop::<M, $len>::new(model, run, h);
-                    stepper.run(k, samples, sink)?;
-                    Ok(stepper.finish())
+                    let mut stepper = Loop::<M, $len>::new(model, run, k, h, samples);
+                    stepper.machine.log_events();
+                    Box::new(Some(stepper))
                 })*
                 other => unreachable!("a validated specimen has 1 to {NS} storeys, not {other}"),
             }
@@ -199,6 +232,33 @@ pub fn forward_closed_loop<M: PlatenModel, S: SampleSink>(
     }
     by_storeys!(0 => 13, 1 => 15, 2 => 17, 3 => 19, 4 => 21, 5 => 23, 6 => 25, 7 => 27,
                 8 => 29, 9 => 31, 10 => 33, 11 => 35, 12 => 37)
+}
+
+/// A closed loop advanced step by step (`None` once finished).
+impl<M: PlatenModel, const L: usize> Steppable for Option<Loop<'_, M, L>> {
+    fn advance(&mut self, out: &mut Samples) -> Result<bool> {
+        let Some(run) = self else {
+            return Ok(false);
+        };
+        loop {
+            if run.grid_step(out)? {
+                return Ok(false);
+            }
+            if !out.0.is_empty() {
+                return Ok(true);
+            }
+        }
+    }
+
+    fn drain_events(&mut self, out: &mut VecDeque<(f64, EventKind)>) {
+        if let Some(run) = self {
+            run.machine.drain_events(out);
+        }
+    }
+
+    fn finish(&mut self) -> RunStats {
+        self.take().map(|run| run.finish().run).unwrap_or_default()
+    }
 }
 
 /// The platen (and specimen) driven by the table system's actuators: the [`Plant`] of the mode
@@ -457,10 +517,19 @@ struct Loop<'a, M, const L: usize> {
     saturated_time_s: f64,
     /// Controller samples taken.
     controller_samples: u64,
+    /// Integration steps per controller period.
+    k: u64,
+    /// Output samples to deliver.
+    samples: usize,
+    /// The next grid step.
+    n: u64,
+    /// The next output sample.
+    j: usize,
 }
 
 impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
-    fn new(model: &'a M, run: &LoopRun<'a>, h: f64) -> Self {
+    /// The loop of `run`, `k` steps of `h` per controller period, to deliver `samples`.
+    fn new(model: &'a M, run: &LoopRun<'a>, k: u32, h: f64, samples: usize) -> Self {
         let (sys, spec, command, method) = (run.system, run.specimen, run.command, run.method);
         let n = spec.map_or(0, Specimen::len);
         let mut y = [0.0; L];
@@ -513,6 +582,10 @@ impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
             queue: VecDeque::with_capacity(slots),
             saturated_time_s: 0.0,
             controller_samples: 0,
+            k: u64::from(k),
+            samples,
+            n: 0,
+            j: 0,
         }
     }
 
@@ -653,59 +726,68 @@ impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
 
     /// Runs the grid: controller samples every `k` steps, each step cut where the valve's
     /// input changes or an output sample falls.
-    fn run<S: SampleSink>(&mut self, k: u32, samples: usize, sink: &mut S) -> Result<()> {
+    fn run<S: SampleSink>(&mut self, sink: &mut S) -> Result<()> {
+        while !self.grid_step(sink)? {}
+        Ok(())
+    }
+
+    /// One grid step from `t₀ + n·h`: the controller's sample when one falls there, the
+    /// output samples that fall in it, the cuts inside it. Returns whether the run is over
+    /// (every output sample delivered), having delivered the last ones.
+    fn grid_step<S: SampleSink>(&mut self, sink: &mut S) -> Result<bool> {
         let ts = self.command.t_s();
+        let samples = self.samples;
         let t_end = ts[samples - 1];
         let slack = 1e-9 * self.h;
-        let mut j = 0usize;
-        let mut n: u64 = 0;
-        let k = u64::from(k);
+        let n = self.n;
+        // At the grid point t₀ + n·h.
+        self.machine.plant.t = self.t0 + n as f64 * self.h;
+        if n % self.k == 0 {
+            self.tick();
+        }
+        self.apply_arrived(slack);
+        while self.j < samples && ts[self.j] <= self.t() + slack {
+            self.emit(self.j, sink);
+            self.j += 1;
+        }
+        if self.j >= samples || self.t() > t_end + slack {
+            self.machine.stats.stop = StopReason::Finished { t_s: t_end };
+            return Ok(true);
+        }
+        let t_next = self.t0 + (n + 1) as f64 * self.h;
+        // Cuts inside (t, t_next): arrivals of delayed drives and output samples.
         loop {
-            // At the grid point t₀ + n·h.
-            self.machine.plant.t = self.t0 + n as f64 * self.h;
-            if n % k == 0 {
-                self.tick();
-            }
-            self.apply_arrived(slack);
-            while j < samples && ts[j] <= self.t() + slack {
-                self.emit(j, sink);
-                j += 1;
-            }
-            if j >= samples || self.t() > t_end + slack {
+            let arrival = self.queue.front().map_or(f64::INFINITY, |&(t, _)| t);
+            let sample = if self.j < samples {
+                ts[self.j]
+            } else {
+                f64::INFINITY
+            };
+            let cut = arrival.min(sample);
+            if cut >= t_next - slack {
                 break;
             }
-            let t_next = self.t0 + (n + 1) as f64 * self.h;
-            // Cuts inside (t, t_next): arrivals of delayed drives and output samples.
-            loop {
-                let arrival = self.queue.front().map_or(f64::INFINITY, |&(t, _)| t);
-                let sample = if j < samples { ts[j] } else { f64::INFINITY };
-                let cut = arrival.min(sample);
-                if cut >= t_next - slack {
-                    break;
-                }
-                let span = cut - self.t();
-                if span > 0.0 {
-                    self.segment(span)?;
-                }
-                self.machine.plant.t = cut;
-                self.apply_arrived(slack);
-                while j < samples && ts[j] <= self.t() + slack {
-                    self.emit(j, sink);
-                    j += 1;
-                }
-            }
-            let span = t_next - self.t();
+            let span = cut - self.t();
             if span > 0.0 {
                 self.segment(span)?;
             }
-            if self.controller.saturated {
-                self.saturated_time_s += self.h;
+            self.machine.plant.t = cut;
+            self.apply_arrived(slack);
+            while self.j < samples && ts[self.j] <= self.t() + slack {
+                self.emit(self.j, sink);
+                self.j += 1;
             }
-            n += 1;
-            self.machine.stats.steps += 1;
         }
-        self.machine.stats.stop = StopReason::Finished { t_s: t_end };
-        Ok(())
+        let span = t_next - self.t();
+        if span > 0.0 {
+            self.segment(span)?;
+        }
+        if self.controller.saturated {
+            self.saturated_time_s += self.h;
+        }
+        self.n += 1;
+        self.machine.stats.steps += 1;
+        Ok(false)
     }
 
     fn finish(self) -> LoopStats {

@@ -11,10 +11,21 @@
 //!   decomposition. The motion is `platen_signal`'s (re-exported here), so an acceleration
 //!   record integrated there runs as it is; its checks' errors convert into
 //!   [`IntegrateError`] with `?`.
+//! * [`forward_specimen`] ([`forward_rk4_specimen`]): the platen carrying a shear-building
+//!   specimen under a force record, with RK4 or Dopri5.
 //! * [`forward_closed_loop`]: a displacement command → the table system's controller, valves
-//!   and actuators ([`platen_system::TableSystem`]) → the platen, in closed loop.
+//!   and actuators ([`platen_system::TableSystem`]) → the platen (and a specimen), in closed
+//!   loop, with RK4 or Dopri5.
+//! * [`Stepping`]: a specimen or closed-loop run advanced a [`Step`] at a time (an event with
+//!   its time and kind, a sample, the end), bit for bit the whole-record run.
 //!
-//! Both forward integrators share one event module (the friction modes, the `v = 0` root
+//! The specimen and the closed loop are *plants* of one mode machine (the friction modes,
+//! their events and resets, RK4 and Dopri5 pieces, written once); a new plant plugs into it
+//! by saying its state, its rates per mode and its net force. The bare platen keeps its own
+//! engine, whose breakaway is solved in closed form (the force is linear between samples
+//! and nothing else moves while it sticks).
+//!
+//! The bare platen's forward integrators share one event module (the friction modes, the `v = 0` root
 //! finder, the stick decision and the exact breakaway; the [`EventKind`]s it counts in
 //! [`RunStats`]), and say why a run stopped with a [`StopReason`]: `Finished` in the
 //! [`RunStats`] of a run that returns, `Failed` with the time and the typed [`Failure`] from
@@ -59,6 +70,7 @@ mod record;
 mod rk4;
 mod run;
 mod specimen;
+mod stepping;
 mod stop;
 
 pub use dopri5::{forward_dopri5, Dopri5Settings};
@@ -81,4 +93,5 @@ pub use record::{
 pub use rk4::{forward_rk4, Rk4};
 pub use run::{EnergyBalance, RunStats, State};
 pub use specimen::{forward_rk4_specimen, forward_specimen};
+pub use stepping::{Step, Stepping};
 pub use stop::{AdaptiveFailure, Failure, StopReason};

@@ -162,6 +162,9 @@ pub(crate) struct Machine<P, const L: usize> {
     gave_up: Option<(f64, AdaptiveFailure)>,
     /// The solver's counters.
     pub(crate) stats: RunStats,
+    /// The events with their times, when a stepping run asks for them
+    /// ([`Machine::log_events`]); `None` (no allocation) otherwise.
+    events: Option<Vec<(f64, EventKind)>>,
 }
 
 impl<P: Plant<L>, const L: usize> Machine<P, L> {
@@ -179,6 +182,27 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
             h_dopri: h,
             gave_up: None,
             stats: RunStats::default(),
+            events: None,
+        }
+    }
+
+    /// Keeps every event with its time from now on, for [`Machine::drain_events`].
+    pub(crate) fn log_events(&mut self) {
+        self.events.get_or_insert_with(Vec::new);
+    }
+
+    /// The events logged since the last call, oldest first, appended to `out`.
+    pub(crate) fn drain_events(&mut self, out: &mut std::collections::VecDeque<(f64, EventKind)>) {
+        if let Some(events) = &mut self.events {
+            out.extend(events.drain(..));
+        }
+    }
+
+    /// Counts the event `kind` at position `at` (and logs it with its time).
+    fn note(&mut self, kind: EventKind, at: f64) {
+        self.stats.record(kind);
+        if let Some(events) = &mut self.events {
+            events.push((self.plant.time_s(at), kind));
         }
     }
 
@@ -588,7 +612,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
                 let (mode, kind) = arrive_at_rest(self.plant.model(), self.y[U], f_eff, from);
                 self.enter(mode, input);
                 if let Some(kind) = kind {
-                    self.stats.record(kind);
+                    self.note(kind, at);
                 }
                 at
             }
@@ -619,11 +643,11 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
                     match mode {
                         Mode::Slip(d) if d == dir => self.enter(Mode::Creep(dir), input),
                         Mode::Stick => {
-                            self.stats.record(EventKind::Stop);
+                            self.note(EventKind::Stop, at);
                             self.enter(Mode::Stick, input);
                         }
                         other => {
-                            self.stats.record(EventKind::Reversal);
+                            self.note(EventKind::Reversal, at);
                             self.enter(other, input);
                         }
                     }
@@ -666,9 +690,10 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
             self.enter(Mode::Stick, input);
             return self.plant.break_at(tau, x_b, rest, true);
         }
-        self.stats.record(EventKind::Breakaway);
+        let at = self.plant.break_at(tau, x_b, rest, false);
+        self.note(EventKind::Breakaway, at);
         self.enter(Mode::Slip(Direction::of_sign(net)), input);
-        self.plant.break_at(tau, x_b, rest, false)
+        at
     }
 
     /// A creep stop located `x ≤` [`Plant::min_progress`] past `tau` (from the state and

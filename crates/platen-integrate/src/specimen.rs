@@ -38,18 +38,21 @@
 //! No allocation happens per step: the storey state lives in fixed-size arrays of
 //! [`Specimen::MAX_STOREYS`].
 
+use std::collections::VecDeque;
+
 use platen_model::{PlatenModel, Specimen};
 
 use crate::creep::creep_speed_m_s;
 use crate::dopri5::Dopri5Settings;
 use crate::error::{IntegrateError, Result};
-use crate::event::{Direction, Mode, MAX_EVENTS_PER_STEP};
+use crate::event::{Direction, EventKind, Mode, MAX_EVENTS_PER_STEP};
 use crate::machine::{Machine, PieceMethod, Plant, U, V};
 use crate::method::Method;
 use crate::output::{Sample, SampleSink, SpecimenSample};
 use crate::record::ForceRecord;
 use crate::rk4::{direction, drive, Grid, GridStep, GridStepper, Rk4};
 use crate::run::{check_run, sample_at, EnergyBalance, Kin, RunStats, State};
+use crate::stepping::{Samples, Steppable};
 use crate::stop::{Failure, StopReason};
 
 const NS: usize = Specimen::MAX_STOREYS;
@@ -133,6 +136,78 @@ pub fn forward_specimen<M: PlatenModel, S: SampleSink>(
     }
     by_storeys!(1 => 7, 2 => 9, 3 => 11, 4 => 13, 5 => 15, 6 => 17, 7 => 19, 8 => 21,
                 9 => 23, 10 => 25, 11 => 27, 12 => 29)
+}
+
+/// The specimen run as a [`Steppable`] run (its state length chosen by its storeys).
+pub(crate) fn boxed_specimen<'a, M: PlatenModel>(
+    model: &'a M,
+    specimen: &'a Specimen,
+    record: &'a ForceRecord,
+    method: Method,
+    initial: State,
+) -> Result<Box<dyn Steppable + 'a>> {
+    check_run(record, initial, record.len())?;
+    let (k, pieces) = match method {
+        Method::Rk4(rk4) => (u64::from(rk4.steps_per_sample()), PieceMethod::Rk4),
+        Method::Dopri5(settings) => (1, dopri5_pieces(settings)),
+    };
+    let grid = Grid::new(record, k);
+    macro_rules! by_storeys {
+        ($($n:literal => $len:literal),*) => {
+            match specimen.len() {
+                $($n => {
+                    let mut stepper =
+                        Stepper::<M, $len>::new(model, specimen, grid, initial, pieces);
+                    stepper.machine.log_events();
+                    Box::new(Steps { stepper, times: record.t_s(), k, j: None })
+                })*
+                other => unreachable!("a validated specimen has 1 to {NS} storeys, not {other}"),
+            }
+        };
+    }
+    Ok(
+        by_storeys!(1 => 7, 2 => 9, 3 => 11, 4 => 13, 5 => 15, 6 => 17, 7 => 19, 8 => 21,
+                   9 => 23, 10 => 25, 11 => 27, 12 => 29),
+    )
+}
+
+/// A specimen run advanced a sample interval at a time.
+struct Steps<'a, M, const L: usize> {
+    stepper: Stepper<'a, M, L>,
+    times: &'a [f64],
+    /// Steps per sample interval.
+    k: u64,
+    /// The last sample delivered.
+    j: Option<usize>,
+}
+
+impl<M: PlatenModel, const L: usize> Steppable for Steps<'_, M, L> {
+    fn advance(&mut self, out: &mut Samples) -> Result<bool> {
+        let last = self.times.len() - 1;
+        let j = match self.j {
+            None => 0,
+            Some(j) if j < last => {
+                for i in 0..self.k {
+                    let n = j as u64 * self.k + i;
+                    self.stepper.step(GridStep { n, j, i: i as f64 })?;
+                }
+                j + 1
+            }
+            Some(_) => return Ok(false),
+        };
+        out.accept(&self.stepper.sample(j, self.times[j]));
+        self.j = Some(j);
+        Ok(j < last)
+    }
+
+    fn drain_events(&mut self, out: &mut VecDeque<(f64, EventKind)>) {
+        self.stepper.machine.drain_events(out);
+    }
+
+    fn finish(&mut self) -> RunStats {
+        let t_s = self.times[self.j.unwrap_or(0)];
+        self.stepper.finish(t_s)
+    }
 }
 
 /// The machine's adaptive pieces for `settings`.

@@ -8,8 +8,9 @@
 use std::f64::consts::PI;
 
 use platen_integrate::{
-    forward_closed_loop, forward_rk4_specimen, forward_specimen, Dopri5Settings, ForceRecord,
-    LoopMethod, LoopRun, Method, Motion, Rk4, RunStats, Sample, SampleSink, State, Trajectory,
+    forward_closed_loop, forward_rk4_specimen, forward_specimen, Dopri5Settings, EventKind,
+    ForceRecord, LoopMethod, LoopRun, Method, Motion, Rk4, RunStats, Sample, SampleSink, State,
+    Step, Stepping, Trajectory,
 };
 use platen_model::{IdentifiedModel, IdentifiedParams, Specimen, Storey};
 
@@ -278,6 +279,39 @@ fn dopri5_with_a_specimen_has_the_3_dof_steady_state() {
         "{stats:?}"
     );
     check_3_dof_steady_state(&out, &stats, k, c, "Dopri5");
+}
+
+/// The same through the stepping API ([`Stepping`]): the run advanced event by event and
+/// sample by sample, its samples collected by the caller, meets the closed-form steady state;
+/// it reports every reversal the counters count (two a period) at times that rise, and no
+/// stop (nothing holds a frictionless platen).
+#[test]
+fn stepping_with_a_specimen_has_the_3_dof_steady_state() {
+    let k = 1.266e6;
+    let c = 0.4 * (k * M_KG).sqrt();
+    let model = frictionless(k, c, 1.0);
+    let record = sine_record(1e5, 2.0 * PI, 48.0);
+    let frame = frame();
+    let method = Method::Dopri5(Dopri5Settings::new(1e-10, 1e-12).unwrap());
+    let mut run = Stepping::specimen(&model, &frame, &record, method, State::default()).unwrap();
+    let mut out = Trajectory::with_capacity(record.len());
+    let mut reversals = Vec::new();
+    let stats = loop {
+        match run.step().unwrap() {
+            Step::Sample(s) => out.accept(&s),
+            Step::Event { t_s, kind } => {
+                assert_ne!(kind, EventKind::Stop, "at {t_s} s");
+                if kind == EventKind::Reversal {
+                    reversals.push(t_s);
+                }
+            }
+            Step::Finished(stats) => break stats,
+            other => panic!("{other:?}"),
+        }
+    };
+    assert_eq!(reversals.len() as u64, stats.reversals);
+    assert!(reversals.windows(2).all(|w| w[0] < w[1]), "{reversals:?}");
+    check_3_dof_steady_state(&out, &stats, k, c, "Stepping (Dopri5)");
 }
 
 /// The platen's and the roof's steady state of a run under 100 kN at 1 Hz against the
