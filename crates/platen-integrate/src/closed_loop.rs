@@ -47,9 +47,9 @@ use platen_system::{
 use crate::creep::creep_speed_m_s;
 use crate::error::{IntegrateError, Result};
 use crate::event::{Direction, EventKind, Mode, MAX_EVENTS_PER_STEP};
-use crate::machine::{Machine, PieceMethod, Plant, U, V};
-use crate::output::{SampleSink, SpecimenSample, SystemSample};
-use crate::run::{sample_at, EnergyBalance, Kin, RunStats, State};
+use crate::machine::{Machine, PieceMethod, Plant, DI, SD, U, V, W};
+use crate::output::{SampleSink, SystemSample};
+use crate::run::{EnergyBalance, RunStats, State};
 use crate::stepping::{Samples, Steppable};
 use crate::stop::{Failure, StopReason};
 use crate::Motion;
@@ -59,12 +59,6 @@ const NS: usize = Specimen::MAX_STOREYS;
 /// not moved time: if the net force at rest still drives the creep on, it is stepped just
 /// past (`just_past`) instead of creeping on in place.
 const MIN_PROGRESS: f64 = 4.0 * f64::EPSILON;
-/// `∫F_A·v dt`, J.
-const W: usize = 2;
-/// Platen dissipation, J.
-const DI: usize = 3;
-/// Storey-damper dissipation, J.
-const SD: usize = 4;
 const PA: usize = 5;
 const PB: usize = 6;
 const XV: usize = 7;
@@ -681,33 +675,7 @@ impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
     fn emit<S: SampleSink>(&mut self, j: usize, sink: &mut S) {
         let t_s = self.command.t_s()[j];
         let (m, p) = (&self.machine, &self.machine.plant);
-        let f = p.force(&m.y);
-        let bs = p.base_shear(&m.y);
-        let kin = Kin {
-            u: m.y[U],
-            v: m.y[V],
-            work: m.y[W],
-            dissipated: m.y[DI],
-        };
-        let mut sample = sample_at(p.model, j, t_s, f - bs, kin, m.a, m.mode == Mode::Stick);
-        sample.terms.actuator_n = f;
-        if p.spec.is_some() {
-            let mut sp = SpecimenSample {
-                base_shear_n: bs,
-                storeys: p.n,
-                u_m: [0.0; NS],
-                a_m_s2: [0.0; NS],
-                drift_m: [0.0; NS],
-            };
-            let mut below = 0.0;
-            for i in 0..p.n {
-                sp.u_m[i] = m.y[Z + i];
-                sp.a_m_s2[i] = m.a + m.k[Z + p.n + i];
-                sp.drift_m[i] = m.y[Z + i] - below;
-                below = m.y[Z + i];
-            }
-            sample.specimen = Some(sp);
-        }
+        let mut sample = m.sample(j, t_s, p.force(&m.y), p.base_shear(&m.y), p.n, Z);
         let ps = m.y[PS];
         let (p_a, p_b) = (m.y[PA].max(0.0), m.y[PB].max(0.0));
         let (q_a, _) = p.sys.valve_flows_with(&p.consts, m.y[XV], p_a, p_b, ps);

@@ -22,7 +22,7 @@ use crate::Motion;
 ///   velocity. The velocity-dependent terms are evaluated at `v = 0`; `u` and `a` are used as
 ///   given, and the sample is marked stuck.
 pub fn inverse<M: PlatenModel, S: SampleSink>(model: &M, motion: &Motion, sink: &mut S) {
-    let (t, u, v, a) = (motion.t_s(), motion.u_m(), motion.v_m_s(), motion.a_m_s2());
+    let (u, v, a) = (motion.u_m(), motion.v_m_s(), motion.a_m_s2());
     let band = motion.rest_velocity_m_s();
     for i in 0..motion.len() {
         let at_rest = band.is_some_and(|b| v[i].abs() <= b);
@@ -31,17 +31,7 @@ pub fn inverse<M: PlatenModel, S: SampleSink>(model: &M, motion: &Motion, sink: 
         } else {
             force_terms(model, u[i], v[i], a[i])
         };
-        sink.accept(&Sample {
-            index: i,
-            t_s: t[i],
-            u_m: u[i],
-            v_m_s: v[i],
-            a_m_s2: a[i],
-            terms,
-            stuck: at_rest || (v[i] == 0.0 && a[i] == 0.0),
-            specimen: None,
-            system: None,
-        });
+        sink.accept(&prescribed_sample(motion, i, terms, at_rest, None));
     }
 }
 
@@ -154,16 +144,29 @@ pub fn inverse_specimen<M: PlatenModel, S: SampleSink>(
             spec.drift_m[j] = z[j] - below;
             below = z[j];
         }
-        sink.accept(&Sample {
-            index: i,
-            t_s: t[i],
-            u_m: u[i],
-            v_m_s: v[i],
-            a_m_s2: a[i],
-            terms,
-            stuck: at_rest || (v[i] == 0.0 && a[i] == 0.0),
-            specimen: Some(spec),
-            system: None,
-        });
+        sink.accept(&prescribed_sample(motion, i, terms, at_rest, Some(spec)));
+    }
+}
+
+/// The output sample of an inverse run at sample `i` of the prescribed `motion`: its force
+/// `terms`, stuck when in the rest band or exactly still.
+fn prescribed_sample(
+    motion: &Motion,
+    i: usize,
+    terms: ForceTerms,
+    at_rest: bool,
+    specimen: Option<SpecimenSample>,
+) -> Sample {
+    let (v, a) = (motion.v_m_s()[i], motion.a_m_s2()[i]);
+    Sample {
+        index: i,
+        t_s: motion.t_s()[i],
+        u_m: motion.u_m()[i],
+        v_m_s: v,
+        a_m_s2: a,
+        terms,
+        stuck: at_rest || (v == 0.0 && a == 0.0),
+        specimen,
+        system: None,
     }
 }

@@ -36,7 +36,7 @@
 
 use std::convert::Infallible;
 
-use platen_model::PlatenModel;
+use platen_model::{PlatenModel, Specimen};
 
 use crate::creep::{creep_speed_m_s, stiff_speed_m_s};
 use crate::dopri5::MAX_STEPS;
@@ -45,14 +45,21 @@ use crate::event::{
     arrive_at_rest, dip_to_zero, just_past, locate_zero_velocity, mode_at_rest, Direction,
     EventKind, Mode,
 };
+use crate::output::{Sample, SpecimenSample};
 use crate::rk4::{Grading, MAX_HALVINGS};
-use crate::run::RunStats;
+use crate::run::{sample_at, Kin, RunStats};
 use crate::stop::{AdaptiveFailure, Failure};
 
-/// Positions in every plant's state: displacement and velocity of the platen.
+/// Positions in every plant's state: the platen's displacement, m,
 pub(crate) const U: usize = 0;
-/// The platen's velocity.
+/// its velocity, m/s,
 pub(crate) const V: usize = 1;
+/// the actuator's work `∫F_A·v dt`, J,
+pub(crate) const W: usize = 2;
+/// the platen's dissipation, J,
+pub(crate) const DI: usize = 3;
+/// and the storey dampers' dissipation, J. The plant's own states follow.
+pub(crate) const SD: usize = 4;
 
 /// The state of a plant, `L` numbers.
 pub(crate) type Y<const L: usize> = [f64; L];
@@ -204,6 +211,50 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         if let Some(events) = &mut self.events {
             events.push((self.plant.time_s(at), kind));
         }
+    }
+
+    /// The output sample at the current state: index `j` at `t_s`, actuator force `f`, and
+    /// the specimen's `storeys` (displacements from position `z` of the state, velocities
+    /// after them) with base shear `bs`. The platen's own terms see `F_A − B`, so the
+    /// remainder `F_D` excludes the base shear.
+    pub(crate) fn sample(
+        &self,
+        j: usize,
+        t_s: f64,
+        f: f64,
+        bs: f64,
+        storeys: usize,
+        z: usize,
+    ) -> Sample {
+        let y = &self.y;
+        let kin = Kin {
+            u: y[U],
+            v: y[V],
+            work: y[W],
+            dissipated: y[DI],
+        };
+        let model = self.plant.model();
+        let stuck = self.mode == Mode::Stick;
+        let mut sample = sample_at(model, j, t_s, f - bs, kin, self.a, stuck);
+        sample.terms.actuator_n = f;
+        if storeys > 0 {
+            let mut spec = SpecimenSample {
+                base_shear_n: bs,
+                storeys,
+                u_m: [0.0; Specimen::MAX_STOREYS],
+                a_m_s2: [0.0; Specimen::MAX_STOREYS],
+                drift_m: [0.0; Specimen::MAX_STOREYS],
+            };
+            let mut below = 0.0;
+            for i in 0..storeys {
+                spec.u_m[i] = y[z + i];
+                spec.a_m_s2[i] = self.a + self.k[z + storeys + i];
+                spec.drift_m[i] = y[z + i] - below;
+                below = y[z + i];
+            }
+            sample.specimen = Some(spec);
+        }
+        sample
     }
 
     /// Where and why the adaptive integrator gave up, once.

@@ -43,15 +43,14 @@ use std::collections::VecDeque;
 use platen_model::{PlatenModel, Specimen};
 
 use crate::creep::creep_speed_m_s;
-use crate::dopri5::Dopri5Settings;
 use crate::error::{IntegrateError, Result};
 use crate::event::{Direction, EventKind, Mode, MAX_EVENTS_PER_STEP};
-use crate::machine::{Machine, PieceMethod, Plant, U, V};
+use crate::machine::{Machine, PieceMethod, Plant, DI, SD, U, V, W};
 use crate::method::Method;
-use crate::output::{Sample, SampleSink, SpecimenSample};
+use crate::output::{Sample, SampleSink};
 use crate::record::ForceRecord;
 use crate::rk4::{direction, drive, Grid, GridStep, GridStepper, Rk4};
-use crate::run::{check_run, sample_at, EnergyBalance, Kin, RunStats, State};
+use crate::run::{check_run, EnergyBalance, RunStats, State};
 use crate::stepping::{Samples, Steppable};
 use crate::stop::{Failure, StopReason};
 
@@ -64,9 +63,6 @@ const MIN_PROGRESS: f64 = 4.0 * f64::EPSILON;
 /// storey dissipation, then the `n` storey displacements from `Z` and the `n` storey
 /// velocities from `Z + n` (the stepper's `zd`): the live state is the prefix `5 + 2n` of the
 /// fixed-size array, and the RK4 loops run over that prefix only.
-const W: usize = 2;
-const DI: usize = 3;
-const SD: usize = 4;
 const Z: usize = 5;
 
 /// The state of a specimen of `(L − 5)/2` storeys: the stepper is compiled for each length
@@ -117,28 +113,53 @@ pub fn forward_specimen<M: PlatenModel, S: SampleSink>(
     sink: &mut S,
 ) -> Result<RunStats> {
     check_run(record, initial, samples)?;
-    let (k, pieces) = match method {
-        Method::Rk4(rk4) => (u64::from(rk4.steps_per_sample()), PieceMethod::Rk4),
-        Method::Dopri5(settings) => (1, dopri5_pieces(settings)),
-    };
-    let grid = Grid::new(record, k);
-    macro_rules! by_storeys {
-        ($($n:literal => $len:literal),*) => {
-            match specimen.len() {
-                $($n => {
-                    let mut stepper =
-                        Stepper::<M, $len>::new(model, specimen, grid, initial, pieces);
-                    drive(&mut stepper, record.t_s(), k, samples, sink)
-                })*
-                other => unreachable!("a validated specimen has 1 to {NS} storeys, not {other}"),
-            }
-        };
-    }
-    by_storeys!(1 => 7, 2 => 9, 3 => 11, 4 => 13, 5 => 15, 6 => 17, 7 => 19, 8 => 21,
-                9 => 23, 10 => 25, 11 => 27, 12 => 29)
+    let (k, pieces, grid) = pieces_of(record, method);
+    with_stepper!(model, specimen, grid, initial, pieces, |stepper| {
+        drive(&mut stepper, record.t_s(), k, samples, sink)
+    })
 }
 
-/// The specimen run as a [`Steppable`] run (its state length chosen by its storeys).
+/// Binds `$stepper` to the stepper of `$specimen`'s storeys (its state length `5 + 2n` fixed
+/// at compile time: a 3-storey specimen steps arrays of 11, not of the largest specimen's
+/// 29) and evaluates `$body` with it.
+macro_rules! with_stepper {
+    ($model:expr, $specimen:expr, $grid:expr, $initial:expr, $pieces:expr, |$stepper:ident| $body:expr) => {
+        with_stepper!(@len $model, $specimen, $grid, $initial, $pieces, $stepper, $body;
+            1 => 7, 2 => 9, 3 => 11, 4 => 13, 5 => 15, 6 => 17, 7 => 19, 8 => 21,
+            9 => 23, 10 => 25, 11 => 27, 12 => 29)
+    };
+    (@len $model:expr, $specimen:expr, $grid:expr, $initial:expr, $pieces:expr, $stepper:ident, $body:expr;
+        $($n:literal => $len:literal),*) => {
+        match $specimen.len() {
+            $($n => {
+                #[allow(unused_mut)]
+                let mut $stepper =
+                    Stepper::<_, $len>::new($model, $specimen, $grid, $initial, $pieces);
+                $body
+            })*
+            other => unreachable!("a validated specimen has 1 to {NS} storeys, not {other}"),
+        }
+    };
+}
+use with_stepper;
+
+/// The steps per sample interval, the machine's pieces and the grid of a run with `method`
+/// (Dopri5 takes a sample interval a piece).
+fn pieces_of(record: &ForceRecord, method: Method) -> (u64, PieceMethod, Grid<'_>) {
+    let (k, pieces) = match method {
+        Method::Rk4(rk4) => (u64::from(rk4.steps_per_sample()), PieceMethod::Rk4),
+        Method::Dopri5(settings) => (
+            1,
+            PieceMethod::Dopri5 {
+                rtol: settings.rtol(),
+                atol: settings.atol(),
+            },
+        ),
+    };
+    (k, pieces, Grid::new(record, k))
+}
+
+/// The specimen run as a [`Steppable`] run.
 pub(crate) fn boxed_specimen<'a, M: PlatenModel>(
     model: &'a M,
     specimen: &'a Specimen,
@@ -147,28 +168,23 @@ pub(crate) fn boxed_specimen<'a, M: PlatenModel>(
     initial: State,
 ) -> Result<Box<dyn Steppable + 'a>> {
     check_run(record, initial, record.len())?;
-    let (k, pieces) = match method {
-        Method::Rk4(rk4) => (u64::from(rk4.steps_per_sample()), PieceMethod::Rk4),
-        Method::Dopri5(settings) => (1, dopri5_pieces(settings)),
-    };
-    let grid = Grid::new(record, k);
-    macro_rules! by_storeys {
-        ($($n:literal => $len:literal),*) => {
-            match specimen.len() {
-                $($n => {
-                    let mut stepper =
-                        Stepper::<M, $len>::new(model, specimen, grid, initial, pieces);
-                    stepper.machine.log_events();
-                    Box::new(Steps { stepper, times: record.t_s(), k, j: None })
-                })*
-                other => unreachable!("a validated specimen has 1 to {NS} storeys, not {other}"),
-            }
-        };
-    }
-    Ok(
-        by_storeys!(1 => 7, 2 => 9, 3 => 11, 4 => 13, 5 => 15, 6 => 17, 7 => 19, 8 => 21,
-                   9 => 23, 10 => 25, 11 => 27, 12 => 29),
-    )
+    let (k, pieces, grid) = pieces_of(record, method);
+    Ok(with_stepper!(
+        model,
+        specimen,
+        grid,
+        initial,
+        pieces,
+        |stepper| {
+            stepper.machine.log_events();
+            Box::new(Steps {
+                stepper,
+                times: record.t_s(),
+                k,
+                j: None,
+            })
+        }
+    ))
 }
 
 /// A specimen run advanced a sample interval at a time.
@@ -207,29 +223,6 @@ impl<M: PlatenModel, const L: usize> Steppable for Steps<'_, M, L> {
     fn finish(&mut self) -> RunStats {
         let t_s = self.times[self.j.unwrap_or(0)];
         self.stepper.finish(t_s)
-    }
-}
-
-/// The machine's adaptive pieces for `settings`.
-fn dopri5_pieces(settings: Dopri5Settings) -> PieceMethod {
-    PieceMethod::Dopri5 {
-        rtol: settings.rtol(),
-        atol: settings.atol(),
-    }
-}
-
-impl<M: PlatenModel, const L: usize> GridStepper for Stepper<'_, M, L> {
-    #[inline(always)]
-    fn step(&mut self, n: GridStep) -> Result<()> {
-        Stepper::step(self, n)
-    }
-    #[inline(always)]
-    fn sample(&self, j: usize, t_s: f64) -> Sample {
-        Stepper::sample(self, j, t_s)
-    }
-    #[inline(always)]
-    fn finish(&mut self, t_s: f64) -> RunStats {
-        Stepper::finish(self, t_s)
     }
 }
 
@@ -587,27 +580,6 @@ impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
         }
     }
 
-    /// Advances from grid point `n` to `n + 1`, handling every event inside the step.
-    ///
-    /// A step of RK4 in slip away from rest first tries [`Machine::slip_fast`] (compiled per
-    /// direction); anything it does not commit, and every other mode, goes through the
-    /// machine's [`Machine::advance`].
-    #[inline(always)]
-    fn step(&mut self, n: GridStep) -> Result<()> {
-        let m = &mut self.machine;
-        m.plant.n = n;
-        m.stats.steps += 1;
-        let committed = match m.mode {
-            Mode::Slip(Direction::Positive) if self.rk4 && m.y[V] != 0.0 => m.slip_fast::<true>(),
-            Mode::Slip(Direction::Negative) if self.rk4 && m.y[V] != 0.0 => m.slip_fast::<false>(),
-            _ => false,
-        };
-        if committed {
-            return Ok(());
-        }
-        self.step_with_events(n)
-    }
-
     /// [`Stepper::step`] through the machine's advance: every mode and event.
     fn step_with_events(&mut self, n: GridStep) -> Result<()> {
         let m = &mut self.machine;
@@ -629,39 +601,35 @@ impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
             }
         }
     }
+}
+
+impl<M: PlatenModel, const L: usize> GridStepper for Stepper<'_, M, L> {
+    /// Advances from grid point `n` to `n + 1`, handling every event inside the step.
+    ///
+    /// A step of RK4 in slip away from rest first tries [`Machine::slip_fast`] (compiled per
+    /// direction); anything it does not commit, and every other mode, goes through the
+    /// machine's [`Machine::advance`].
+    #[inline(always)]
+    fn step(&mut self, n: GridStep) -> Result<()> {
+        let m = &mut self.machine;
+        m.plant.n = n;
+        m.stats.steps += 1;
+        let committed = match m.mode {
+            Mode::Slip(Direction::Positive) if self.rk4 && m.y[V] != 0.0 => m.slip_fast::<true>(),
+            Mode::Slip(Direction::Negative) if self.rk4 && m.y[V] != 0.0 => m.slip_fast::<false>(),
+            _ => false,
+        };
+        if committed {
+            return Ok(());
+        }
+        self.step_with_events(n)
+    }
 
     /// The output sample at sample `j` of the record (grid point `j·k`).
     fn sample(&self, j: usize, t_s: f64) -> Sample {
         let (m, p) = (&self.machine, &self.machine.plant);
-        let f = p.grid.force[j];
-        let bs = p.base_shear(&m.y);
-        let kin = Kin {
-            u: m.y[U],
-            v: m.y[V],
-            work: m.y[W],
-            dissipated: m.y[DI],
-        };
-        // The platen's own terms see F_A − B; the remainder F_D then excludes the base shear.
-        let mut sample = sample_at(p.model, j, t_s, f - bs, kin, m.a, m.mode == Mode::Stick);
-        sample.terms.actuator_n = f;
         let n = SpecimenPlant::<M, L>::N;
-        let zd = SpecimenPlant::<M, L>::ZD;
-        let mut spec = SpecimenSample {
-            base_shear_n: bs,
-            storeys: n,
-            u_m: [0.0; NS],
-            a_m_s2: [0.0; NS],
-            drift_m: [0.0; NS],
-        };
-        let mut below = 0.0;
-        for i in 0..n {
-            spec.u_m[i] = m.y[Z + i];
-            spec.a_m_s2[i] = m.a + m.k[zd + i];
-            spec.drift_m[i] = m.y[Z + i] - below;
-            below = m.y[Z + i];
-        }
-        sample.specimen = Some(spec);
-        sample
+        m.sample(j, t_s, p.grid.force[j], p.base_shear(&m.y), n, Z)
     }
 
     /// Closes the energy balance at the current state, the run having finished at `t_s`.
