@@ -6,7 +6,7 @@
 //! When every file is periodic and no method is forced, the output is the periodic method's
 //! alone, as before.
 //!
-//! The records are read by [`platen_ident::inputs`] (files, `--columns`, a manifest with
+//! The records are read by [`platen_app`] (files, `--columns`, a manifest with
 //! kinds, pressures, column maps, a specimen's `floors` and scenario entries), identified by
 //! [`platen_ident::identify_any`] and reported by [`platen_report::identify_report`]; this
 //! file turns the arguments into a request and prints or writes what comes back.
@@ -19,7 +19,7 @@ use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
-use platen_ident::inputs::{
+use platen_app::{
     declared_record, files, read_base_system, read_system_records, InputError, RecordRequest,
 };
 use platen_ident::{identify_any, IdentifyOutput, MethodRequest, RecordSettings, Settings};
