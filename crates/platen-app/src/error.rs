@@ -34,6 +34,9 @@ pub enum InputError {
     /// Nothing to read.
     #[error("no test files: give recorded CSV files, or a manifest that lists them")]
     NoFiles,
+    /// No closed-loop record to identify a table system from.
+    #[error("identify --system needs at least one recorded CSV file")]
+    NoSystemFiles,
     /// The manifest cannot be read or is not a manifest.
     #[error(
         "reading the identification manifest (expected {{\"tests\": [{{\"file\": PATH, \"kind\": \

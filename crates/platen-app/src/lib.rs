@@ -8,8 +8,9 @@
 //!   record goes, into [`platen_ident::TestRecord`]s for [`platen_ident::identify_any`].
 //! * [`recorded`]: the recorded-like data of a motion scenario, made in memory (what
 //!   `platen generate recorded` writes and a manifest's `scenario` entry identifies).
-//! * [`system`]: the closed-loop records of a table-system identification and the table's
-//!   base, for [`platen_ident::system::identify_system`].
+//! * [`system`]: the closed-loop records of a table-system identification, which of them are
+//!   fitted and which held out, and the table's base, for
+//!   [`platen_ident::system::identify_system`].
 //!
 //! ```
 //! use platen_app::{read_records, RecordRequest};
@@ -52,4 +53,6 @@ pub use recorded::recorded_of;
 pub use records::{
     declared_record, files, read_records, FloorSpec, RecordInputs, RecordRequest, RecordSource,
 };
-pub use system::{read_base_system, read_system_records};
+pub use system::{
+    fitted, read_base_system, read_system_inputs, read_system_records, SystemInputs, SystemRequest,
+};
