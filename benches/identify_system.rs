@@ -11,7 +11,7 @@ use std::hint::black_box;
 use std::path::{Path, PathBuf};
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use platen::ident::inputs::read_system_records;
+use platen::app::read_system_records;
 use platen::ident::system::{identify_system, SystemSettings};
 use platen::io::columns::ColumnMap;
 

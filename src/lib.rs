@@ -1,6 +1,7 @@
 #![doc = include_str!("../README.md")]
 #![warn(missing_docs)]
 
+pub use platen_app as app;
 pub use platen_compare as compare;
 pub use platen_ident as ident;
 pub use platen_integrate as integrate;

@@ -132,10 +132,11 @@
 //!
 //! # Reading records
 //!
-//! [`read_records`] reads what `platen identify` and Python's `platen.identify` identify:
-//! recorded CSV files through a column map, an identification manifest that lists files
-//! (with kinds, pressures, column maps and a specimen's floors) or motion scenarios whose
-//! recorded-like data are made in memory ([`inputs`]).
+//! This crate reads no files: it takes [`TestRecord`]s and [`system::SystemRecord`]s in
+//! memory. Recorded CSV files through a column map, identification manifests and the
+//! recorded-like data of motion scenarios are read by the application layer, the
+//! `platen-app` crate (`platen_app::read_records`, `platen_app::read_system_inputs`),
+//! which `platen identify` and Python's `platen.identify` share.
 //!
 //! # Conventions
 //!
@@ -168,7 +169,6 @@ mod global;
 mod groups;
 mod identify;
 mod inertial;
-pub mod inputs;
 mod law;
 mod lm;
 mod paper_fit;
@@ -201,7 +201,6 @@ pub use error::{IdentError, Result};
 pub use estimate::{student_t_975, Estimate, Parameter};
 pub use identify::identify;
 pub use inertial::{MAX_MASS_RELATIVE_STD_ERROR, MIN_INERTIAL_TO_DISSIPATIVE};
-pub use inputs::{read_records, InputError, RecordInputs, RecordRequest, RecordSource};
 pub use platen_model::{DissipativeLaw, IdentifiedKey};
 pub use record::{Floors, TestKind, TestRecord, MIN_SAMPLES};
 pub use result::{

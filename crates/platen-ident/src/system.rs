@@ -20,8 +20,11 @@
 //!
 //! The first and last two samples of each record are left out. The fit uses the records
 //! marked for fitting; the others are held out and the drive the fitted gains predict is
-//! compared with theirs ([`HeldOut`]). A quantity the records cannot show is listed in
-//! [`SystemIdentification::not_identified`] with the reason.
+//! compared with theirs ([`HeldOut`]). Which records those are is the caller's choice: this
+//! crate reads no files and chooses none (`platen identify --system` holds out the last of
+//! two or more records, as the application layer's `platen_app::system::fitted` says). A
+//! quantity the records cannot show is listed in [`SystemIdentification::not_identified`]
+//! with the reason.
 //!
 //! The gains are constrained to the range a scenario accepts (every gain `≥ 0`): a gain the
 //! unconstrained fit would make negative is held at 0 and said so

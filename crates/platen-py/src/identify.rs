@@ -1,13 +1,13 @@
 //! `platen.identify`: `platen identify [FILE…] [--manifest M] --json`: periodic tests by the
 //! paper's hysteresis-loop method, any other record by the any-record method. The records are
-//! read by [`platen_ident::inputs`], the reading the CLI uses (column maps with `delay_s`,
+//! read by [`platen_app`], the reading the CLI uses (column maps with `delay_s`,
 //! manifests with kinds, pressures, `floors` and scenario entries).
 
 use std::path::PathBuf;
 
 use pyo3::prelude::*;
 
-use platen_ident::inputs::{read_records, InputError, RecordRequest};
+use platen_app::{read_records, InputError, RecordRequest};
 
 use crate::error::{chain, detached, Fail, Kind};
 use crate::{column_map, json_text};

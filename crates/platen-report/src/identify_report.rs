@@ -11,11 +11,12 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+use platen_app::RecordSource;
 use platen_ident::anyrecord::summary::{RecordInfoSummary, RecordSummary};
 use platen_ident::anyrecord::ChannelDelay;
 use platen_ident::{
     Correlations, Estimate, Flag, Identification, IdentificationSummary, Identified, IdentifiedKey,
-    Parameter, ParameterEstimates, RecordIdentification, RecordSource, TestKind, TestRecord,
+    Parameter, ParameterEstimates, RecordIdentification, TestKind, TestRecord,
 };
 
 use crate::figure::Figure;
@@ -104,7 +105,7 @@ impl IdentifyReport<'_> {
 
     fn entries(&self) -> Vec<RecordInfoSummary> {
         self.identified
-            .record_entries(self.records, &platen_ident::inputs::files(self.sources))
+            .record_entries(self.records, &platen_app::files(self.sources))
     }
 
     fn subset(&self, idx: &[usize]) -> Vec<&RecordSource> {
@@ -816,7 +817,7 @@ pub fn written_text(figures: &[PathBuf], report: Option<&Path>) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use platen_ident::inputs::{read_records, RecordRequest};
+    use platen_app::{read_records, RecordRequest};
     use platen_ident::{identify_any, MethodRequest, RecordSettings, Settings};
 
     /// Two of the paper's tests at 13.8 MPa, made in memory from their scenarios through a

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use anyhow::Result;
 
-use platen_ident::inputs::recorded_of;
+use platen_app::recorded_of;
 use platen_io::csv::write_csv_atomic;
 use platen_report::sweep_report::GenerateReport;
 use platen_scenario::recorded::Recorded;

@@ -6,10 +6,12 @@
 //! When every file is periodic and no method is forced, the output is the periodic method's
 //! alone, as before.
 //!
-//! The records are read by [`platen_ident::inputs`] (files, `--columns`, a manifest with
-//! kinds, pressures, column maps, a specimen's `floors` and scenario entries), identified by
-//! [`platen_ident::identify_any`] and reported by [`platen_report::identify_report`]; this
-//! file turns the arguments into a request and prints or writes what comes back.
+//! The records are read by [`platen_app`] (files, `--columns`, a manifest with kinds,
+//! pressures, column maps, a specimen's `floors` and scenario entries; for `--system`, the
+//! closed-loop records, the base and which record is held out), identified by
+//! [`platen_ident::identify_any`] (or [`platen_ident::system::identify_system`]) and reported
+//! by [`platen_report::identify_report`]; this file turns the arguments into a request and
+//! prints or writes what comes back.
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -19,9 +21,8 @@ use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 
-use platen_ident::inputs::{
-    declared_record, files, read_base_system, read_system_records, InputError, RecordRequest,
-};
+use platen_app::system::{read_system_inputs, SystemRequest};
+use platen_app::{declared_record, files, InputError, RecordRequest};
 use platen_ident::{identify_any, IdentifyOutput, MethodRequest, RecordSettings, Settings};
 use platen_io::columns::ColumnMap;
 use platen_report::identify_report::{written_text, IdentifyReport};
@@ -245,36 +246,33 @@ pub struct SystemOptions<'a> {
 }
 
 /// `platen identify --system FILE…`: the table's loop from closed-loop records (see
-/// `platen_ident::system`). With two or more files, the last is held out; the identified loop
-/// is judged on every record. Prints the identification and, with `--json`, a runnable
+/// `platen_ident::system`). Which records are fitted and which held out is
+/// [`platen_app::system`]'s (with two or more files, the last is held out); the identified
+/// loop is judged on every record. Prints the identification and, with `--json`, a runnable
 /// scenario that is the identified table with each value's provenance.
 pub fn run_system(files: &[PathBuf], o: &SystemOptions<'_>) -> Result<()> {
     use platen_ident::system::{identify_system, SystemSettings};
     use platen_report::system_identify_report::{prediction_figures, system_json, system_text};
     if files.is_empty() {
-        bail!("identify --system needs at least one recorded CSV file");
+        return Err(input_error(InputError::NoSystemFiles));
     }
     let map = match o.columns {
         Some(path) => ColumnMap::load(path)?,
         None => ColumnMap::default(),
     };
-    let records = read_system_records(files, &map).map_err(input_error)?;
-    let (base_system, base_stroke) = match o.base {
-        Some(path) => {
-            let (s, stroke) = read_base_system(path, &files[0], &map).map_err(input_error)?;
-            (Some(s), stroke)
-        }
-        None => (None, None),
+    let request = SystemRequest {
+        files: files.to_vec(),
+        columns: map,
+        base: o.base.map(Path::to_path_buf),
     };
-    let n = records.len();
-    let fit: Vec<bool> = (0..n).map(|i| n == 1 || i + 1 < n).collect();
+    let inputs = read_system_inputs(&request).map_err(input_error)?;
     let settings = SystemSettings {
-        base: base_system,
+        base: inputs.base,
         area_m2: o.area_m2,
         judge: true,
         ..SystemSettings::default()
     };
-    let id = identify_system(&records, &fit, &settings)?;
+    let id = identify_system(&inputs.records, &inputs.fit, &settings)?;
     let written = platen_report::render::write_outputs(
         o.plot,
         None,
@@ -283,9 +281,14 @@ pub fn run_system(files: &[PathBuf], o: &SystemOptions<'_>) -> Result<()> {
         |_, _| String::new(),
     )?;
     if o.json {
-        let held_path =
-            std::fs::canonicalize(&files[n - 1]).unwrap_or_else(|_| files[n - 1].clone());
-        let mut value = system_json(&id, &records[n - 1], &held_path, &map, base_stroke);
+        let held = inputs.commanding;
+        let mut value = system_json(
+            &id,
+            &inputs.records[held],
+            &inputs.commanding_path(),
+            &request.columns,
+            inputs.base_stroke_m,
+        );
         if o.plot.is_some() {
             value["figures"] = written
                 .iter()

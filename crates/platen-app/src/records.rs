@@ -27,7 +27,7 @@
 //!   ([`TestRecord::with_floors`]).
 //!
 //! ```no_run
-//! use platen_ident::inputs::{read_records, RecordRequest};
+//! use platen_app::records::{read_records, RecordRequest};
 //!
 //! let request = RecordRequest {
 //!     manifest: Some("scenarios/paper-tests/manifest.json".into()),
@@ -35,7 +35,7 @@
 //! };
 //! let inputs = read_records(&request)?;
 //! assert_eq!(inputs.records.len(), inputs.sources.len());
-//! # Ok::<(), platen_ident::inputs::InputError>(())
+//! # Ok::<(), platen_app::InputError>(())
 //! ```
 
 use std::collections::BTreeMap;
@@ -43,19 +43,14 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-use platen_integrate::{inverse, Motion, Peaks, Trajectory};
+use platen_ident::{TestKind, TestRecord};
 use platen_io::columns::{ColumnMap, ColumnSpec};
 use platen_io::json::parse_json_file;
-use platen_io::IoError;
-use platen_model::PlatenModel;
-use platen_scenario::recorded::{recorded_like, ArtefactSettings, Recorded};
 use platen_scenario::sampling::uniform_step_s;
-use platen_scenario::{Model, Run, Scenario, ScenarioError};
-use platen_system::TableSystem;
+use platen_scenario::Scenario;
 
-use crate::system::SystemRecord;
-
-use crate::{IdentError, TestKind, TestRecord};
+use crate::error::InputError;
+use crate::recorded::recorded_of;
 
 /// What to read: files, a manifest, a column map and hold-down pressures.
 #[derive(Debug, Clone, Default)]
@@ -121,258 +116,30 @@ pub struct RecordInputs {
 }
 
 impl RecordInputs {
-    /// Whether each record was declared `"kind": "record"` (for [`crate::identify_any`]).
+    /// Whether each record was declared `"kind": "record"` (for
+    /// [`platen_ident::identify_any`]).
     pub fn declared_record(&self) -> Vec<bool> {
         declared_record(&self.sources)
     }
 
-    /// The file each record came from, as given (for [`crate::Identified::output`]).
+    /// The file each record came from, as given (for [`platen_ident::Identified::output`]).
     pub fn files(&self) -> Vec<String> {
         files(&self.sources)
     }
 }
 
-/// Whether each source was declared `"kind": "record"` (for [`crate::identify_any`]).
+/// Whether each source was declared `"kind": "record"` (for
+/// [`platen_ident::identify_any`]).
 pub fn declared_record(sources: &[RecordSource]) -> Vec<bool> {
     sources.iter().map(|s| s.declared_record).collect()
 }
 
-/// The file of each source, as given (for [`crate::Identified::output`]).
+/// The file of each source, as given (for [`platen_ident::Identified::output`]).
 pub fn files(sources: &[RecordSource]) -> Vec<String> {
     sources
         .iter()
         .map(|s| s.path.display().to_string())
         .collect()
-}
-
-/// Why records could not be read. The messages name the file, the manifest's JSON path or
-/// the CSV line, and what was expected.
-#[non_exhaustive]
-#[derive(Debug, thiserror::Error)]
-pub enum InputError {
-    /// A pressure count that fits neither one for all files nor one per file.
-    #[error(
-        "pressure_mpa has {given} values for {files} files: give one value for all files, or one \
-         per file in order"
-    )]
-    PressureCount {
-        /// Pressures given.
-        given: usize,
-        /// Files given.
-        files: usize,
-    },
-    /// A request's hold-down pressure out of range.
-    #[error("pressure_mpa = {message}")]
-    Pressure {
-        /// The value and what was expected.
-        message: String,
-    },
-    /// Nothing to read.
-    #[error("no test files: give recorded CSV files, or a manifest that lists them")]
-    NoFiles,
-    /// The manifest cannot be read or is not a manifest.
-    #[error(
-        "reading the identification manifest (expected {{\"tests\": [{{\"file\": PATH, \"kind\": \
-         \"sine\"|\"triangle\"|\"record\", \"pressure_mpa\": P, \"name\": NAME, \"columns\": MAP, \
-         \"floors\": [{{\"column\": NAME, \"unit\": UNIT, \"mass_kg\": M}}]}}], \"columns\": MAP, \
-         \"floors\": FLOORS}}, with only `file` required)"
-    )]
-    Manifest {
-        /// The file's error (with its path and JSON path).
-        #[source]
-        source: IoError,
-    },
-    /// A manifest's `columns` object that is not a column map.
-    #[error("`{}`: {json_path} = {value}: expected {expected}", manifest.display())]
-    ManifestColumns {
-        /// The manifest.
-        manifest: PathBuf,
-        /// Where in it.
-        json_path: String,
-        /// The rejected value.
-        value: String,
-        /// What was expected.
-        expected: String,
-    },
-    /// A manifest entry's hold-down pressure out of range.
-    #[error("`{}`, at `tests[{entry}].pressure_mpa`: {message}", manifest.display())]
-    ManifestPressure {
-        /// The manifest.
-        manifest: PathBuf,
-        /// The entry's index.
-        entry: usize,
-        /// The value and what was expected.
-        message: String,
-    },
-    /// A manifest entry whose keys do not go together.
-    #[error("`{}`, at `tests[{entry}]`: {problem}", manifest.display())]
-    ManifestEntry {
-        /// The manifest.
-        manifest: PathBuf,
-        /// The entry's index.
-        entry: usize,
-        /// What is wrong.
-        problem: &'static str,
-    },
-    /// A floor's mass that is not a mass.
-    #[error(
-        "`{}`, at `floors[{floor}].mass_kg` (tests[{entry}]): {mass_kg}: expected a mass > 0 kg",
-        manifest.display()
-    )]
-    FloorMass {
-        /// The manifest.
-        manifest: PathBuf,
-        /// The floor's index.
-        floor: usize,
-        /// The entry's index.
-        entry: usize,
-        /// The rejected mass.
-        mass_kg: f64,
-    },
-    /// A floor's unit that is not an acceleration's.
-    #[error(
-        "`{}`, at `floors[{floor}].unit` (tests[{entry}]): {value}: expected {expected}",
-        manifest.display()
-    )]
-    FloorUnit {
-        /// The manifest.
-        manifest: PathBuf,
-        /// The floor's index.
-        floor: usize,
-        /// The entry's index.
-        entry: usize,
-        /// The rejected value.
-        value: String,
-        /// What was expected.
-        expected: String,
-    },
-    /// A file's pressure given twice, differently.
-    #[error(
-        "`{}`: hold-down pressure {given_mpa} MPa from --pressure-mpa but {manifest_mpa} MPa in \
-         the manifest `{}`",
-        path.display(),
-        manifest.display()
-    )]
-    PressureConflict {
-        /// The file.
-        path: PathBuf,
-        /// The manifest.
-        manifest: PathBuf,
-        /// The request's pressure, MPa.
-        given_mpa: f64,
-        /// The manifest's, MPa.
-        manifest_mpa: f64,
-    },
-    /// A file that cannot be read (its path, line and column in the error).
-    #[error(transparent)]
-    Io(#[from] IoError),
-    /// A record's channels that do not make a test record.
-    #[error("`{}`", path.display())]
-    Record {
-        /// The file.
-        path: PathBuf,
-        /// What is wrong.
-        #[source]
-        source: IdentError,
-    },
-    /// A scenario entry that cannot be loaded.
-    #[error(transparent)]
-    Scenario(#[from] ScenarioError),
-    /// `floors` on a scenario entry.
-    #[error(
-        "`{}`: a manifest's `floors` apply to recorded files; recorded-like data made from a \
-         scenario have no floor accelerometers",
-        path.display()
-    )]
-    ScenarioFloors {
-        /// The scenario.
-        path: PathBuf,
-    },
-    /// A scenario entry given a pressure other than its own.
-    #[error(
-        "`{}`: hold-down pressure {given_mpa} MPa given for it, but the scenario runs at \
-         {scenario_mpa} MPa",
-        path.display()
-    )]
-    ScenarioPressure {
-        /// The scenario.
-        path: PathBuf,
-        /// The pressure given, MPa.
-        given_mpa: f64,
-        /// The scenario's, MPa.
-        scenario_mpa: f64,
-    },
-    /// A force-driven scenario named for recorded-like data.
-    #[error(
-        "`{}`: recorded-like data needs a motion scenario (motion_csv, sine_motion, \
-         triangle_motion, white_noise_motion or ground_motion); this one is force-driven",
-        path.display()
-    )]
-    NotMotion {
-        /// The scenario.
-        path: PathBuf,
-    },
-    /// Recorded-like data that could not be made.
-    #[error("recorded-like data could not be made: {message}")]
-    RecordedLike {
-        /// Why.
-        message: String,
-    },
-    /// A closed-loop record that cannot be read or lacks a required column.
-    #[error(
-        "{}: identify --system needs the columns t_s, command_u_m and u_m (drive, delta_p_pa, \
-         cap_pressure_pa, rod_pressure_pa, a_m_s2, storey{{i}}_a_m_s2 where recorded)",
-        source.file().display()
-    )]
-    SystemColumns {
-        /// The file's error (with its path).
-        #[source]
-        source: IoError,
-    },
-    /// A table system's base (`--base`) that cannot be read.
-    #[error("--base {}: cannot read it", path.display())]
-    BaseUnreadable {
-        /// The file.
-        path: PathBuf,
-        /// Why.
-        #[source]
-        source: std::io::Error,
-    },
-    /// A table system's base that is not JSON.
-    #[error("--base {}: not JSON", path.display())]
-    BaseNotJson {
-        /// The file.
-        path: PathBuf,
-        /// Where and why.
-        #[source]
-        source: serde_json::Error,
-    },
-    /// A table system's base that is not a valid table system.
-    #[error("--base {}: not a table system", path.display())]
-    BaseNotSystem {
-        /// The file (boxed: the scenario error is large).
-        path: Box<Path>,
-        /// The scenario format's error.
-        #[source]
-        source: ScenarioError,
-    },
-    /// A base without a table system.
-    #[error("--base {}: no table_system in it", path.display())]
-    NoTableSystem {
-        /// The file.
-        path: PathBuf,
-    },
-    /// The recorded-like data of a scenario entry do not make a test record.
-    #[error("`{}` (recorded-like, seed {seed})", path.display())]
-    GeneratedRecord {
-        /// The scenario.
-        path: PathBuf,
-        /// The noise seed.
-        seed: u64,
-        /// What is wrong.
-        #[source]
-        source: IdentError,
-    },
 }
 
 /// Reads every record of `request`: [`RecordRequest::sources`], then [`RecordSource::read`]
@@ -775,7 +542,7 @@ impl RecordSource {
             rec = rec.with_floors(&floors).map_err(located)?;
         }
         // A column map's known channel skew (`delay_s`), applied by identification as given.
-        for column in crate::anyrecord::DELAYABLE_CHANNELS {
+        for column in platen_ident::anyrecord::DELAYABLE_CHANNELS {
             let delay = self.columns.delay_s(column);
             if let Some(d) = delay.filter(|_| column != "v_m_s" || has_v) {
                 rec = rec.with_channel_delay_s(column, d).map_err(located)?;
@@ -828,142 +595,6 @@ impl RecordSource {
     }
 }
 
-/// The recorded-like data of a loaded motion scenario (`path` names it in messages): what
-/// `platen generate recorded --seed SEED` writes.
-///
-/// # Errors
-/// [`InputError::NotMotion`] for a force-driven scenario, [`InputError::RecordedLike`] if
-/// the data cannot be made.
-pub fn recorded_of(scenario: &Scenario, path: &Path, seed: u64) -> Result<Recorded, InputError> {
-    fn recorded<M: PlatenModel>(
-        model: &M,
-        motion: &Motion,
-        seed: u64,
-    ) -> Result<Recorded, InputError> {
-        let mut truth = (Trajectory::with_capacity(motion.len()), Peaks::default());
-        inverse(model, motion, &mut truth);
-        recorded_like(
-            &truth.0,
-            model.static_threshold_n(0.0),
-            &ArtefactSettings::default(),
-            seed,
-        )
-        .map_err(|message| InputError::RecordedLike { message })
-    }
-    let Run::Inverse { motion } = &scenario.run else {
-        return Err(InputError::NotMotion {
-            path: path.to_owned(),
-        });
-    };
-    match &scenario.model {
-        Model::Identified(m) => recorded(m, motion, seed),
-        Model::Full(m) => recorded(&**m, motion, seed),
-    }
-}
-
-/// Reads the closed-loop records of a table-system identification
-/// ([`crate::system::identify_system`]): `t_s`, `command_u_m` and `u_m`, and where recorded
-/// `drive`, `delta_p_pa`, `cap_pressure_pa`, `rod_pressure_pa`, `a_m_s2` and the storeys'
-/// `storey{i}_a_m_s2`, through `columns`; each named by its path.
-///
-/// # Errors
-/// [`InputError::SystemColumns`] (with the file's error) for a file that cannot be read or
-/// lacks a required column.
-pub fn read_system_records(
-    files: &[PathBuf],
-    columns: &ColumnMap,
-) -> Result<Vec<SystemRecord>, InputError> {
-    let storey_names: Vec<String> = (1..=platen_model::Specimen::MAX_STOREYS)
-        .map(|i| format!("storey{i}_a_m_s2"))
-        .collect();
-    let mut optional = vec![
-        "drive",
-        "delta_p_pa",
-        "a_m_s2",
-        "cap_pressure_pa",
-        "rod_pressure_pa",
-    ];
-    optional.extend(storey_names.iter().map(String::as_str));
-    let mut records = Vec::with_capacity(files.len());
-    for path in files {
-        let mut t = columns
-            .read_table(path, &["t_s", "command_u_m", "u_m"], &optional)
-            .map_err(|source| InputError::SystemColumns { source })?;
-        let storeys = storey_names
-            .iter()
-            .map_while(|c| t.take_column(c))
-            .collect();
-        let mut take = |c: &str| t.take_column(c);
-        records.push(SystemRecord {
-            name: path.display().to_string(),
-            t_s: take("t_s").unwrap_or_default(),
-            command_u_m: take("command_u_m").unwrap_or_default(),
-            u_m: take("u_m").unwrap_or_default(),
-            drive: take("drive"),
-            delta_p_pa: take("delta_p_pa"),
-            a_m_s2: take("a_m_s2"),
-            cap_pressure_pa: take("cap_pressure_pa"),
-            rod_pressure_pa: take("rod_pressure_pa"),
-            storey_a_m_s2: storeys,
-        });
-    }
-    Ok(records)
-}
-
-/// Reads the base of a table-system identification (`--base`): a scenario with a
-/// `table_system`, or a `table_system` object, validated as a scenario would validate it
-/// (commanded by `record`'s `command_u_m` through `columns`), with its stroke limit if it
-/// gives one.
-///
-/// # Errors
-/// [`InputError::BaseUnreadable`], [`InputError::BaseNotJson`], [`InputError::BaseNotSystem`]
-/// (each with its cause) and [`InputError::NoTableSystem`].
-pub fn read_base_system(
-    path: &Path,
-    record: &Path,
-    columns: &ColumnMap,
-) -> Result<(TableSystem, Option<f64>), InputError> {
-    let text = std::fs::read_to_string(path).map_err(|source| InputError::BaseUnreadable {
-        path: path.to_owned(),
-        source,
-    })?;
-    let value: serde_json::Value =
-        serde_json::from_str(&text).map_err(|source| InputError::BaseNotJson {
-            path: path.to_owned(),
-            source,
-        })?;
-    let (spec, stroke) = match value.get("table_system") {
-        Some(ts) => (
-            ts.clone(),
-            value.pointer("/limits/stroke_m").and_then(|v| v.as_f64()),
-        ),
-        None => (value.clone(), None),
-    };
-    let record = std::fs::canonicalize(record).unwrap_or_else(|_| record.to_path_buf());
-    // Validated with a tiny stroke: the base's volumes are replaced by the fitted ones.
-    let scenario = serde_json::json!({
-        "model": { "preset": "lhpost-2008" },
-        "table_system": spec,
-        "limits": { "stroke_m": stroke.unwrap_or(1e-3) },
-        "excitation": {
-            "motion_csv": record.display().to_string(),
-            "columns": { "u_m": { "name": columns.header("command_u_m") } }
-        },
-    });
-    let not_system = |source| InputError::BaseNotSystem {
-        path: path.into(),
-        source,
-    };
-    let file = platen_scenario::file::parse(path, &scenario.to_string()).map_err(not_system)?;
-    let s = Scenario::from_file(path, file).map_err(not_system)?;
-    let Some(cl) = s.closed_loop else {
-        return Err(InputError::NoTableSystem {
-            path: path.to_owned(),
-        });
-    };
-    Ok((cl.system, stroke))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -976,7 +607,7 @@ mod tests {
     /// A fresh folder for this test's files.
     fn folder(name: &str) -> PathBuf {
         let dir =
-            std::env::temp_dir().join(format!("platen-ident-inputs-{name}-{}", std::process::id()));
+            std::env::temp_dir().join(format!("platen-app-records-{name}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         dir

@@ -8,7 +8,7 @@
 
 use std::path::{Path, PathBuf};
 
-use platen_ident::inputs::read_system_records;
+use platen_app::read_system_records;
 use platen_ident::system::{identify_system, Source, SystemIdentification, SystemSettings};
 use platen_ident::IdentError;
 use platen_io::columns::ColumnMap;
