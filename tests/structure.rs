@@ -7,6 +7,9 @@
 //!   root's `mod` declarations are not uses (its `use`/`pub use` are).
 //! * **A thin front end.** The binary (`src/bin/platen`) parses, calls and prints: it stays
 //!   under 2,500 lines, what a library user would also want living in the crates.
+//! * **Estimation without orchestration** (issue 34). `platen-ident` depends on the model,
+//!   signal, system and integrate crates only: reading records, manifests and scenarios is
+//!   `platen-app`'s.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
@@ -406,5 +409,38 @@ fn the_command_line_front_end_stays_thin() {
     assert!(
         n < 2_500,
         "src/bin/platen has {n} lines: move what a library user would also want into the crates"
+    );
+}
+
+/// The crates `platen-ident`'s library depends on (its `[dependencies]` table) are the
+/// estimation layer's: no scenario, no reading of files.
+#[test]
+fn the_estimation_crate_reads_no_files_and_runs_no_scenarios() {
+    let manifest = fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("crates/platen-ident/Cargo.toml"),
+    )
+    .unwrap();
+    let deps = manifest
+        .split("[dependencies]")
+        .nth(1)
+        .expect("a [dependencies] table")
+        .split("\n[")
+        .next()
+        .unwrap();
+    let platen: Vec<&str> = deps
+        .lines()
+        .map(str::trim)
+        .filter(|l| l.starts_with("platen-"))
+        .map(|l| l.split(['.', ' ', '=']).next().unwrap())
+        .collect();
+    assert_eq!(
+        platen,
+        [
+            "platen-model",
+            "platen-system",
+            "platen-integrate",
+            "platen-signal"
+        ],
+        "platen-ident's platen dependencies"
     );
 }

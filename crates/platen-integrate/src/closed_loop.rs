@@ -50,7 +50,7 @@ use crate::event::{Direction, EventKind, Mode, MAX_EVENTS_PER_STEP};
 use crate::machine::{Machine, PieceMethod, Plant, DI, SD, U, V, W};
 use crate::output::{SampleSink, SystemSample};
 use crate::run::{EnergyBalance, RunStats, State};
-use crate::stepping::{Samples, Steppable};
+use crate::steppable::{Samples, Steppable};
 use crate::stop::{Failure, StopReason};
 use crate::Motion;
 

@@ -70,6 +70,7 @@ mod record;
 mod rk4;
 mod run;
 mod specimen;
+mod steppable;
 mod stepping;
 mod stop;
 

@@ -51,7 +51,7 @@ use crate::output::{Sample, SampleSink};
 use crate::record::ForceRecord;
 use crate::rk4::{direction, drive, Grid, GridStep, GridStepper, Rk4};
 use crate::run::{check_run, EnergyBalance, RunStats, State};
-use crate::stepping::{Samples, Steppable};
+use crate::steppable::{Samples, Steppable};
 use crate::stop::{Failure, StopReason};
 
 const NS: usize = Specimen::MAX_STOREYS;

@@ -38,10 +38,11 @@ use crate::closed_loop::{boxed_loop, check_loop, LoopRun};
 use crate::error::Result;
 use crate::event::EventKind;
 use crate::method::Method;
-use crate::output::{Sample, SampleSink};
+use crate::output::Sample;
 use crate::record::ForceRecord;
 use crate::run::{RunStats, State};
 use crate::specimen::boxed_specimen;
+use crate::steppable::{Samples, Steppable};
 
 /// What one [`Stepping::step`] did.
 // A step is returned one at a time, never stored in bulk: copying the sample is nothing next
@@ -62,27 +63,6 @@ pub enum Step {
     Sample(Sample),
     /// Every sample has been delivered: the run's statistics, energy balance closed.
     Finished(RunStats),
-}
-
-/// A run of a plant of the mode machine that one advances step by step.
-pub(crate) trait Steppable {
-    /// Advances to the next output sample(s), pushing them to `out`; `false` once the run
-    /// has delivered its last sample.
-    fn advance(&mut self, out: &mut Samples) -> Result<bool>;
-    /// Moves the events logged since the last call into `out`.
-    fn drain_events(&mut self, out: &mut VecDeque<(f64, EventKind)>);
-    /// Closes the run's statistics.
-    fn finish(&mut self) -> RunStats;
-}
-
-/// The samples a step delivered, in order.
-#[derive(Debug, Default)]
-pub(crate) struct Samples(pub(crate) VecDeque<Sample>);
-
-impl SampleSink for Samples {
-    fn accept(&mut self, sample: &Sample) {
-        self.0.push_back(*sample);
-    }
 }
 
 /// A run advanced step by step ([`Stepping::step`]).
