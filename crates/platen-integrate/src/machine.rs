@@ -352,7 +352,6 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
     /// `k1` there): the end state and the smallest speed along the slip direction at its
     /// stages.
     fn dopri5(&mut self, s: f64, len: f64, y: &Y<L>, k1: &Y<L>, tol: (f64, f64)) -> (Y<L>, f64) {
-        let (rtol, atol) = tol;
         let dt = self.plant.seconds(len);
         let mode = self.mode;
         let w = self.w_stiff;
@@ -365,36 +364,9 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
             guard += 1;
             let last = dt - done <= hs * (1.0 + 1e-12);
             let step = if last { dt - done } else { hs };
-            let mut ks = [[0.0; L]; 7];
-            ks[0] = kc;
-            let mut ys = [yc; 6];
-            for stage in 0..6 {
-                let mut yi = yc;
-                for i in 0..L {
-                    let mut acc = 0.0;
-                    for (j, kj) in ks.iter().enumerate().take(stage + 1) {
-                        acc += DP_A[stage][j] * kj[i];
-                    }
-                    yi[i] += step * acc;
-                }
-                ys[stage] = yi;
-                let at = s + self.plant.units(done + DP_C[stage] * step);
-                let input = self.plant.input(at);
-                let mut kn = [0.0; L];
-                self.plant.rates(mode, w, input, &yi, &mut kn);
-                ks[stage + 1] = kn;
-            }
-            self.stats.rhs_evaluations += 6;
+            let (ks, ys) = self.dopri5_stages(s, done, step, &yc, &kc);
             let y_new = ys[5];
-            let mut err: f64 = 0.0;
-            for i in 0..L {
-                let mut e = 0.0;
-                for (j, kj) in ks.iter().enumerate() {
-                    e += DP_E[j] * kj[i];
-                }
-                let sc = self.plant.error_scale(i, yc[i], y_new[i], rtol, atol);
-                err = err.max((step * e / sc).abs());
-            }
+            let err = self.dopri5_error(step, &yc, &y_new, &ks, tol);
             let factor = if err == 0.0 {
                 5.0
             } else {
@@ -443,6 +415,63 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         let input = self.plant.input(s + len);
         self.plant.settle(mode, w, input, &mut yc);
         (yc, stage_min)
+    }
+
+    /// The six stages of one Dormand–Prince step of `step` seconds from `yc` (rates `kc`), `done`
+    /// seconds past position `s`: the rates at the stages (the 7th at the new state) and the
+    /// stage states (the 6th is the new state).
+    fn dopri5_stages(
+        &mut self,
+        s: f64,
+        done: f64,
+        step: f64,
+        yc: &Y<L>,
+        kc: &Y<L>,
+    ) -> ([Y<L>; 7], [Y<L>; 6]) {
+        let mut ks = [[0.0; L]; 7];
+        ks[0] = *kc;
+        let mut ys = [*yc; 6];
+        for stage in 0..6 {
+            let mut yi = *yc;
+            for i in 0..L {
+                let mut acc = 0.0;
+                for (j, kj) in ks.iter().enumerate().take(stage + 1) {
+                    acc += DP_A[stage][j] * kj[i];
+                }
+                yi[i] += step * acc;
+            }
+            ys[stage] = yi;
+            let at = s + self.plant.units(done + DP_C[stage] * step);
+            let input = self.plant.input(at);
+            let mut kn = [0.0; L];
+            self.plant
+                .rates(self.mode, self.w_stiff, input, &yi, &mut kn);
+            ks[stage + 1] = kn;
+        }
+        self.stats.rhs_evaluations += 6;
+        (ks, ys)
+    }
+
+    /// The scaled error norm (the largest over the states) of a Dormand–Prince step of
+    /// `step` seconds from `yc` to `y_new` with stage rates `ks`, at tolerances `(rtol, atol)`.
+    fn dopri5_error(
+        &self,
+        step: f64,
+        yc: &Y<L>,
+        y_new: &Y<L>,
+        ks: &[Y<L>; 7],
+        (rtol, atol): (f64, f64),
+    ) -> f64 {
+        let mut err: f64 = 0.0;
+        for i in 0..L {
+            let mut e = 0.0;
+            for (j, kj) in ks.iter().enumerate() {
+                e += DP_E[j] * kj[i];
+            }
+            let sc = self.plant.error_scale(i, yc[i], y_new[i], rtol, atol);
+            err = err.max((step * e / sc).abs());
+        }
+        err
     }
 
     /// The current mode's state over a length `x` from position `tau`, as the method maps it

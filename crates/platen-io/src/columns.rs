@@ -209,6 +209,9 @@ enum Kind {
     Pressure,
 }
 
+/// An invalid field: its JSON path, the value found, and what was expected.
+pub type Invalid = (String, String, String);
+
 /// A validated mapping: for each platen column, the header to read, the factor to SI, the
 /// offset and the zero.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -222,10 +225,7 @@ impl ColumnMap {
     /// # Errors
     /// `(json path, value, expected)` for an unknown platen column, an unknown unit, a unit of
     /// the wrong kind, or a pressure without (or an area with a non-pressure) unit.
-    pub fn new(
-        spec: &BTreeMap<String, ColumnSpec>,
-        json_path: &str,
-    ) -> Result<Self, (String, String, String)> {
+    pub fn new(spec: &BTreeMap<String, ColumnSpec>, json_path: &str) -> Result<Self, Invalid> {
         let mut entries = BTreeMap::new();
         for (ours, s) in spec {
             let kind = kind_of(ours).ok_or_else(|| {
@@ -236,189 +236,199 @@ impl ColumnMap {
                 )
             })?;
             let here = format!("{json_path}.{ours}");
-            if s.ignore {
-                let alone = ColumnSpec {
-                    ignore: true,
-                    ..ColumnSpec::default()
-                };
-                if kind == Kind::Time || *s != alone {
-                    return Err((
-                        format!("{here}.ignore"),
-                        "true".into(),
-                        if kind == Kind::Time {
-                            "no ignore on the time column t_s".into()
-                        } else {
-                            "ignore alone: no name, unit, scale, offset or zero with it".into()
-                        },
-                    ));
-                }
-                entries.insert(
-                    ours.clone(),
-                    Mapping {
-                        header: ours.clone(),
-                        factor: 1.0,
-                        offset: 0.0,
-                        zero: Zero::AsRecorded,
-                        ignored: true,
-                        named: false,
-                        delay_s: None,
-                    },
-                );
-                continue;
+            let mapping = if s.ignore {
+                Self::left_out(ours, s, kind, &here)?
+            } else {
+                Self::mapping(ours, s, kind, &here)?
+            };
+            entries.insert(ours.clone(), mapping);
+        }
+        Ok(Self { entries })
+    }
+
+    /// The mapping of column `ours` (of `kind`, at JSON path `here`) that `ignore` leaves out.
+    fn left_out(ours: &str, s: &ColumnSpec, kind: Kind, here: &str) -> Result<Mapping, Invalid> {
+        let alone = ColumnSpec {
+            ignore: true,
+            ..ColumnSpec::default()
+        };
+        if kind == Kind::Time || *s != alone {
+            return Err((
+                format!("{here}.ignore"),
+                "true".into(),
+                if kind == Kind::Time {
+                    "no ignore on the time column t_s".into()
+                } else {
+                    "ignore alone: no name, unit, scale, offset or zero with it".into()
+                },
+            ));
+        }
+        Ok(Mapping {
+            header: ours.to_owned(),
+            factor: 1.0,
+            offset: 0.0,
+            zero: Zero::AsRecorded,
+            ignored: true,
+            named: false,
+            delay_s: None,
+        })
+    }
+
+    /// The mapping of column `ours` (of `kind`, at JSON path `here`) from its spec.
+    fn mapping(ours: &str, s: &ColumnSpec, kind: Kind, here: &str) -> Result<Mapping, Invalid> {
+        let factor = Self::scale(s, kind, here, Self::unit_factor(s, kind, here)?)?;
+        let header = match s.name.as_deref().map(str::trim) {
+            None => ours.to_owned(),
+            Some("") => {
+                return Err((
+                    format!("{here}.name"),
+                    format!("{:?}", s.name.as_deref().unwrap_or_default()),
+                    "a header name of the file (not empty)".into(),
+                ))
             }
-            let factor = match (&s.unit, s.times_area_m2) {
-                (None, None) => 1.0,
-                (None, Some(_)) => {
-                    return Err((
+            Some(name) => name.to_owned(),
+        };
+        let delay_s = match s.delay_s {
+            None => None,
+            Some(_) if matches!(kind, Kind::Time) || ours == "u_m" => {
+                return Err((
+                    format!("{here}.delay_s"),
+                    s.delay_s.unwrap_or_default().to_string(),
+                    "no delay on t_s or u_m: a delay is a channel's skew relative to the \
+                     displacement u_m"
+                        .into(),
+                ))
+            }
+            Some(d) if d.is_finite() && d.abs() < MAX_DELAY_S => Some(d),
+            Some(d) => {
+                return Err((
+                    format!("{here}.delay_s"),
+                    d.to_string(),
+                    format!(
+                        "a finite delay in seconds, |delay_s| < {MAX_DELAY_S} s (a channel's \
+                         skew is milliseconds: 0.004, not 4)"
+                    ),
+                ))
+            }
+        };
+        let offset = s.offset.unwrap_or(0.0);
+        if !offset.is_finite() {
+            return Err((
+                format!("{here}.offset"),
+                offset.to_string(),
+                "a finite number in the file's unit".into(),
+            ));
+        }
+        let zero = match (s.remove_mean, s.zero_at_start) {
+            (true, true) => {
+                return Err((
+                    format!("{here}.remove_mean"),
+                    "true".into(),
+                    "either remove_mean or zero_at_start, not both".into(),
+                ))
+            }
+            (true, false) if kind == Kind::Time => {
+                return Err((
+                    format!("{here}.remove_mean"),
+                    "true".into(),
+                    "no mean removal on the time column (zero_at_start or offset shift it)".into(),
+                ))
+            }
+            (true, false) => Zero::Mean,
+            (false, true) => Zero::Start,
+            (false, false) => Zero::AsRecorded,
+        };
+        Ok(Mapping {
+            header,
+            factor,
+            offset,
+            zero,
+            ignored: false,
+            named: s.name.is_some(),
+            delay_s,
+        })
+    }
+
+    /// The factor of the spec's unit (times its area for a pressure read as a force).
+    fn unit_factor(s: &ColumnSpec, kind: Kind, here: &str) -> Result<f64, Invalid> {
+        let factor = match (&s.unit, s.times_area_m2) {
+            (None, None) => 1.0,
+            (None, Some(_)) => {
+                return Err((
+                    format!("{here}.unit"),
+                    "(missing)".into(),
+                    "a pressure unit for times_area_m2".into(),
+                ))
+            }
+            (Some(u), area) => {
+                let (unit_kind, f) = unit_factor(u).ok_or_else(|| {
+                    (
                         format!("{here}.unit"),
-                        "(missing)".into(),
-                        "a pressure unit for times_area_m2".into(),
-                    ))
-                }
-                (Some(u), area) => {
-                    let (unit_kind, f) = unit_factor(u).ok_or_else(|| {
-                        (
+                        format!("{u:?}"),
+                        expected_unit(kind),
+                    )
+                })?;
+                match (unit_kind, area) {
+                    (UnitKind::Pressure, Some(a)) if kind == Kind::Force => {
+                        if !(a.is_finite() && a > 0.0) {
+                            return Err((
+                                format!("{here}.times_area_m2"),
+                                a.to_string(),
+                                "an area > 0 m²".into(),
+                            ));
+                        }
+                        f * a
+                    }
+                    (UnitKind::Pressure, None) if kind == Kind::Pressure => f,
+                    (UnitKind::Pressure, _) => {
+                        return Err((
+                            format!("{here}.unit"),
+                            format!("{u:?}"),
+                            "a pressure unit only for force_n, with times_area_m2".into(),
+                        ))
+                    }
+                    (UnitKind::Of(k), None) if k == kind => f,
+                    (UnitKind::Of(_), Some(_)) => {
+                        return Err((
+                            format!("{here}.times_area_m2"),
+                            "(set)".into(),
+                            "times_area_m2 only with a pressure unit".into(),
+                        ))
+                    }
+                    (UnitKind::Of(_), None) => {
+                        return Err((
                             format!("{here}.unit"),
                             format!("{u:?}"),
                             expected_unit(kind),
-                        )
-                    })?;
-                    match (unit_kind, area) {
-                        (UnitKind::Pressure, Some(a)) if kind == Kind::Force => {
-                            if !(a.is_finite() && a > 0.0) {
-                                return Err((
-                                    format!("{here}.times_area_m2"),
-                                    a.to_string(),
-                                    "an area > 0 m²".into(),
-                                ));
-                            }
-                            f * a
-                        }
-                        (UnitKind::Pressure, None) if kind == Kind::Pressure => f,
-                        (UnitKind::Pressure, _) => {
-                            return Err((
-                                format!("{here}.unit"),
-                                format!("{u:?}"),
-                                "a pressure unit only for force_n, with times_area_m2".into(),
-                            ))
-                        }
-                        (UnitKind::Of(k), None) if k == kind => f,
-                        (UnitKind::Of(_), Some(_)) => {
-                            return Err((
-                                format!("{here}.times_area_m2"),
-                                "(set)".into(),
-                                "times_area_m2 only with a pressure unit".into(),
-                            ))
-                        }
-                        (UnitKind::Of(_), None) => {
-                            return Err((
-                                format!("{here}.unit"),
-                                format!("{u:?}"),
-                                expected_unit(kind),
-                            ))
-                        }
+                        ))
                     }
                 }
-            };
-            if kind == Kind::Drive
-                && s.unit.as_deref().map(str::trim) == Some("V")
-                && s.scale.is_none()
-            {
-                return Err((
-                    format!("{here}.scale"),
-                    "(missing)".into(),
-                    "a drive in volts needs scale = 1/(full-scale volts) to be a fraction of full \
-                     opening, e.g. 0.1 for a ±10 V servo amplifier"
-                        .into(),
-                ));
             }
-            let factor = match s.scale {
-                None => factor,
-                Some(k) if k.is_finite() && k != 0.0 => factor * k,
-                Some(k) => {
-                    return Err((
-                        format!("{here}.scale"),
-                        k.to_string(),
-                        "a finite, non-zero factor".into(),
-                    ))
-                }
-            };
-            let header = match s.name.as_deref().map(str::trim) {
-                None => ours.clone(),
-                Some("") => {
-                    return Err((
-                        format!("{here}.name"),
-                        format!("{:?}", s.name.as_deref().unwrap_or_default()),
-                        "a header name of the file (not empty)".into(),
-                    ))
-                }
-                Some(name) => name.to_owned(),
-            };
-            let delay_s = match s.delay_s {
-                None => None,
-                Some(_) if matches!(kind, Kind::Time) || ours == "u_m" => {
-                    return Err((
-                        format!("{here}.delay_s"),
-                        s.delay_s.unwrap_or_default().to_string(),
-                        "no delay on t_s or u_m: a delay is a channel's skew relative to the \
-                         displacement u_m"
-                            .into(),
-                    ))
-                }
-                Some(d) if d.is_finite() && d.abs() < MAX_DELAY_S => Some(d),
-                Some(d) => {
-                    return Err((
-                        format!("{here}.delay_s"),
-                        d.to_string(),
-                        format!(
-                            "a finite delay in seconds, |delay_s| < {MAX_DELAY_S} s (a channel's \
-                             skew is milliseconds: 0.004, not 4)"
-                        ),
-                    ))
-                }
-            };
-            let offset = s.offset.unwrap_or(0.0);
-            if !offset.is_finite() {
-                return Err((
-                    format!("{here}.offset"),
-                    offset.to_string(),
-                    "a finite number in the file's unit".into(),
-                ));
-            }
-            let zero = match (s.remove_mean, s.zero_at_start) {
-                (true, true) => {
-                    return Err((
-                        format!("{here}.remove_mean"),
-                        "true".into(),
-                        "either remove_mean or zero_at_start, not both".into(),
-                    ))
-                }
-                (true, false) if kind == Kind::Time => {
-                    return Err((
-                        format!("{here}.remove_mean"),
-                        "true".into(),
-                        "no mean removal on the time column (zero_at_start or offset shift it)"
-                            .into(),
-                    ))
-                }
-                (true, false) => Zero::Mean,
-                (false, true) => Zero::Start,
-                (false, false) => Zero::AsRecorded,
-            };
-            entries.insert(
-                ours.clone(),
-                Mapping {
-                    header,
-                    factor,
-                    offset,
-                    zero,
-                    ignored: false,
-                    named: s.name.is_some(),
-                    delay_s,
-                },
-            );
+        };
+        Ok(factor)
+    }
+
+    /// The unit's `factor` times the spec's `scale` (which a drive in volts needs).
+    fn scale(s: &ColumnSpec, kind: Kind, here: &str, factor: f64) -> Result<f64, Invalid> {
+        if kind == Kind::Drive && s.unit.as_deref().map(str::trim) == Some("V") && s.scale.is_none()
+        {
+            return Err((
+                format!("{here}.scale"),
+                "(missing)".into(),
+                "a drive in volts needs scale = 1/(full-scale volts) to be a fraction of full \
+                 opening, e.g. 0.1 for a ±10 V servo amplifier"
+                    .into(),
+            ));
         }
-        Ok(Self { entries })
+        match s.scale {
+            None => Ok(factor),
+            Some(k) if k.is_finite() && k != 0.0 => Ok(factor * k),
+            Some(k) => Err((
+                format!("{here}.scale"),
+                k.to_string(),
+                "a finite, non-zero factor".into(),
+            )),
+        }
     }
 
     /// Reads a column map from a JSON file whose top level is a `columns` object (the same

@@ -100,35 +100,10 @@ pub enum Supply {
     Accumulator(Accumulator),
 }
 
-/// The complete loop around the platen: command → controller → servo-valves → actuator
-/// chambers → actuator force.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TableSystem {
-    /// The actuators.
-    pub actuator: Actuator,
-    /// The servo-valves of each actuator.
-    pub servo_valve: ServoValve,
-    /// Effective bulk modulus of the oil (lines, hoses and entrained air included), Pa.
-    pub oil_bulk_modulus_pa: f64,
-    /// Supply pressure (absolute), Pa: the constant pressure, or the pumps' set pressure and
-    /// the accumulator's initial pressure.
-    pub supply_pressure_pa: f64,
-    /// Return (tank) pressure (absolute), Pa.
-    pub return_pressure_pa: f64,
-    /// Constant supply or accumulator bank.
-    pub supply: Supply,
-    /// The controller.
-    pub controller: Controller,
-}
-
-impl TableSystem {
-    /// Checks every value and that the chambers keep oil over the stroke `±stroke_m`:
-    /// `V_a0 − A_a·stroke > 0` and `V_b0 − A_b·stroke > 0`.
-    ///
-    /// # Errors
-    /// [`crate::SystemError::Invalid`] naming the first offending value by its path.
-    pub fn validate(&self, stroke_m: f64) -> Result<()> {
-        let a = &self.actuator;
+impl Actuator {
+    /// Its values, and that its chambers keep oil over the stroke `±stroke_m`.
+    fn validate(&self, stroke_m: f64) -> Result<()> {
+        let a = self;
         if a.count == 0 {
             return Err(invalid("actuator.count", 0.0, "at least 1 actuator"));
         }
@@ -163,7 +138,14 @@ impl TableSystem {
                 ));
             }
         }
-        let v = &self.servo_valve;
+        Ok(())
+    }
+}
+
+impl ServoValve {
+    /// Its values.
+    fn validate(&self) -> Result<()> {
+        let v = self;
         if v.count == 0 {
             return Err(invalid("servo_valve.count", 0.0, "at least 1 valve"));
         }
@@ -178,41 +160,14 @@ impl TableSystem {
         if v.delay_s > 1.0 {
             return Err(invalid("servo_valve.delay_s", v.delay_s, "at most 1 s"));
         }
-        positive("oil_bulk_modulus_pa", self.oil_bulk_modulus_pa)?;
-        positive("supply_pressure_pa", self.supply_pressure_pa)?;
-        non_negative("return_pressure_pa", self.return_pressure_pa)?;
-        if self.return_pressure_pa >= self.supply_pressure_pa {
-            return Err(invalid(
-                "return_pressure_pa",
-                self.return_pressure_pa,
-                format!("below the supply pressure {} Pa", self.supply_pressure_pa),
-            ));
-        }
-        if let Supply::Accumulator(acc) = &self.supply {
-            positive(
-                "accumulator.precharge_pressure_pa",
-                acc.precharge_pressure_pa,
-            )?;
-            if acc.precharge_pressure_pa >= self.supply_pressure_pa {
-                return Err(invalid(
-                    "accumulator.precharge_pressure_pa",
-                    acc.precharge_pressure_pa,
-                    format!("below the supply pressure {} Pa", self.supply_pressure_pa),
-                ));
-            }
-            positive("accumulator.volume_m3", acc.volume_m3)?;
-            if !(acc.polytropic_exponent.is_finite()
-                && (1.0..=1.7).contains(&acc.polytropic_exponent))
-            {
-                return Err(invalid(
-                    "accumulator.polytropic_exponent",
-                    acc.polytropic_exponent,
-                    "between 1 (isothermal) and 1.7",
-                ));
-            }
-            non_negative("accumulator.pump_flow_m3_s", acc.pump_flow_m3_s)?;
-        }
-        let c = &self.controller;
+        Ok(())
+    }
+}
+
+impl Controller {
+    /// Its rate, gains and filter.
+    fn validate(&self) -> Result<()> {
+        let c = self;
         positive("controller.sample_rate_hz", c.sample_rate_hz)?;
         for (path, value) in [
             (
@@ -250,6 +205,80 @@ impl TableSystem {
                     0.5 * c.sample_rate_hz
                 ),
             ));
+        }
+        Ok(())
+    }
+}
+
+/// The complete loop around the platen: command → controller → servo-valves → actuator
+/// chambers → actuator force.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TableSystem {
+    /// The actuators.
+    pub actuator: Actuator,
+    /// The servo-valves of each actuator.
+    pub servo_valve: ServoValve,
+    /// Effective bulk modulus of the oil (lines, hoses and entrained air included), Pa.
+    pub oil_bulk_modulus_pa: f64,
+    /// Supply pressure (absolute), Pa: the constant pressure, or the pumps' set pressure and
+    /// the accumulator's initial pressure.
+    pub supply_pressure_pa: f64,
+    /// Return (tank) pressure (absolute), Pa.
+    pub return_pressure_pa: f64,
+    /// Constant supply or accumulator bank.
+    pub supply: Supply,
+    /// The controller.
+    pub controller: Controller,
+}
+
+impl TableSystem {
+    /// Checks every value and that the chambers keep oil over the stroke `±stroke_m`:
+    /// `V_a0 − A_a·stroke > 0` and `V_b0 − A_b·stroke > 0`.
+    ///
+    /// # Errors
+    /// [`crate::SystemError::Invalid`] naming the first offending value by its path.
+    pub fn validate(&self, stroke_m: f64) -> Result<()> {
+        self.actuator.validate(stroke_m)?;
+        self.servo_valve.validate()?;
+        self.validate_supply()?;
+        self.controller.validate()
+    }
+
+    /// The oil, the supply and return pressures, and the accumulator bank.
+    fn validate_supply(&self) -> Result<()> {
+        positive("oil_bulk_modulus_pa", self.oil_bulk_modulus_pa)?;
+        positive("supply_pressure_pa", self.supply_pressure_pa)?;
+        non_negative("return_pressure_pa", self.return_pressure_pa)?;
+        if self.return_pressure_pa >= self.supply_pressure_pa {
+            return Err(invalid(
+                "return_pressure_pa",
+                self.return_pressure_pa,
+                format!("below the supply pressure {} Pa", self.supply_pressure_pa),
+            ));
+        }
+        if let Supply::Accumulator(acc) = &self.supply {
+            positive(
+                "accumulator.precharge_pressure_pa",
+                acc.precharge_pressure_pa,
+            )?;
+            if acc.precharge_pressure_pa >= self.supply_pressure_pa {
+                return Err(invalid(
+                    "accumulator.precharge_pressure_pa",
+                    acc.precharge_pressure_pa,
+                    format!("below the supply pressure {} Pa", self.supply_pressure_pa),
+                ));
+            }
+            positive("accumulator.volume_m3", acc.volume_m3)?;
+            if !(acc.polytropic_exponent.is_finite()
+                && (1.0..=1.7).contains(&acc.polytropic_exponent))
+            {
+                return Err(invalid(
+                    "accumulator.polytropic_exponent",
+                    acc.polytropic_exponent,
+                    "between 1 (isothermal) and 1.7",
+                ));
+            }
+            non_negative("accumulator.pump_flow_m3_s", acc.pump_flow_m3_s)?;
         }
         Ok(())
     }
