@@ -14,11 +14,17 @@ pub use platen_signal as signal;
 pub use platen_system as system;
 
 pub mod bench;
+mod error;
+pub mod prelude;
 
+pub use error::{Error, Result};
 /// Loads and runs a scenario file, keeping every column in memory.
 pub use platen_scenario::simulate;
 /// A finished run in memory: columns by name and the summary ([`simulate`]).
-pub use platen_scenario::RunResult as Run;
+pub use platen_scenario::RunResult;
+/// The old name of [`RunResult`], which read as [`scenario::Run`] (what a scenario runs).
+#[deprecated(note = "use platen::RunResult: platen::scenario::Run is what a scenario runs")]
+pub type Run = platen_scenario::RunResult;
 /// The validated scenario: [`Scenario::load`] then [`Scenario::run`] into any sink.
 pub use platen_scenario::Scenario;
 
