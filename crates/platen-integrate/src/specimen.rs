@@ -71,7 +71,7 @@ type Y<const L: usize> = [f64; L];
 
 /// Runs the model with `specimen` on the platen forward under `record` from `initial` (the
 /// specimen at rest relative to the platen), with fixed-step RK4 and exact stick-slip,
-/// delivering `samples` output samples (with their [`SpecimenSample`]) to `sink`.
+/// delivering `samples` output samples (with their [`crate::SpecimenSample`]) to `sink`.
 ///
 /// # Errors
 /// As [`crate::forward_rk4`].
