@@ -221,68 +221,18 @@ pub(crate) fn creep<M: PlatenModel>(
     for _ in 0..4 {
         let x_pass = run.at_s;
         let u = run.y.u;
-        let elastic = model.elastic_force_n(u);
-        let drive = |x: f64| s * (force(x) - elastic);
-        let (d0, d1) = (drive(run.at_s), drive(span_s));
-        let threshold = model.static_threshold_n(u);
-        let exit_level = threshold
-            + model.dissipative_excess_n(u, w_stiff)
-            + s * model.velocity_inertial_force_n(u, s * w_stiff);
-        // The drive is linear in time at fixed u: where does it reach the stop or exit level?
-        let rest = span_s - run.at_s;
-        let crossing = |level: f64| {
-            let x = run.at_s + rest * ((d0 - level) / (d0 - d1)).clamp(0.0, 1.0);
-            x.min(span_s)
-        };
-        let (end, x_end) = if d0 <= threshold {
-            (CreepEnd::Stops, run.at_s)
-        } else if d1 <= threshold {
-            (CreepEnd::Stops, crossing(threshold))
-        } else if d0 >= exit_level {
-            (CreepEnd::Slips, run.at_s)
-        } else if d1 >= exit_level {
-            (CreepEnd::Slips, crossing(exit_level))
-        } else {
-            (CreepEnd::Continues, span_s)
-        };
+        let (end, x_end) = pass_end(model, dir, u, run.at_s, span_s, w_stiff, &force);
         run.y = advance(
             model, dir, run.y, run.at_s, x_end, &force, w_stiff, &mut run,
         );
         run.at_s = x_end;
         match end {
-            CreepEnd::Stops => {
-                let u_end = run.y.u;
-                let net = force(x_end) - model.elastic_force_n(u_end);
-                let threshold_end = model.static_threshold_n(u_end);
-                if net.abs() <= threshold_end {
-                    run.y.v = 0.0;
-                    run.end = CreepEnd::Stops;
-                    return run;
-                }
-                if s * net < -threshold_end {
-                    // The net force is beyond the threshold against the motion: the platen
-                    // passed through rest (with no static friction, `F_s = 0`, the stop level
-                    // is `N = 0`, and rounding puts `N` on either side of it).
-                    run.y.v = 0.0;
-                    run.end = CreepEnd::Reverses;
-                    return run;
-                }
-                // Rounding left |N| above the threshold at the new displacement: solve again
-                // from here (the stop can only be later).
-                if x_end >= span_s {
-                    break;
-                }
-                if x_end - x_pass <= MIN_PROGRESS_S {
-                    // The crossing rounded onto the start of the pass, where the drive is a
-                    // hair above the stop level: step just past it, where it is not, so
-                    // every pass moves time forward by more than the callers' rounding.
-                    let elastic = model.elastic_force_n(u_end);
-                    let next =
-                        just_past(x_end, span_s, |x| s * (force(x) - elastic) <= threshold_end);
-                    run.y = advance(model, dir, run.y, run.at_s, next, &force, w_stiff, &mut run);
-                    run.at_s = next;
-                }
-            }
+            CreepEnd::Stops => match at_stop(model, dir, &mut run, x_pass, span_s, &force, w_stiff)
+            {
+                Pass::Ended => return run,
+                Pass::Again => {}
+                Pass::SpanDone => break,
+            },
             CreepEnd::Slips => {
                 let f = force(x_end);
                 let w = creep_speed_m_s(model, dir, run.y.u, f, w_stiff).unwrap_or(w_stiff);
@@ -300,6 +250,101 @@ pub(crate) fn creep<M: PlatenModel>(
     run.y.v = s * w;
     run.end = CreepEnd::Continues;
     run
+}
+
+/// Where a pass of [`creep`] from `at_s` ends, with the displacement `u` held (the drive
+/// `s·(F_A − F_E(u))` is then linear in time): at the stop level `F_s`, at the exit level
+/// (the creep speed reaching `w_stiff`), or at the end of the span.
+fn pass_end<M: PlatenModel>(
+    model: &M,
+    dir: Direction,
+    u: f64,
+    at_s: f64,
+    span_s: f64,
+    w_stiff: f64,
+    force: &impl Fn(f64) -> f64,
+) -> (CreepEnd, f64) {
+    let s = dir.sign();
+    let elastic = model.elastic_force_n(u);
+    let drive = |x: f64| s * (force(x) - elastic);
+    let (d0, d1) = (drive(at_s), drive(span_s));
+    let threshold = model.static_threshold_n(u);
+    let exit_level = threshold
+        + model.dissipative_excess_n(u, w_stiff)
+        + s * model.velocity_inertial_force_n(u, s * w_stiff);
+    // The drive is linear in time at fixed u: where does it reach the stop or exit level?
+    let rest = span_s - at_s;
+    let crossing = |level: f64| {
+        let x = at_s + rest * ((d0 - level) / (d0 - d1)).clamp(0.0, 1.0);
+        x.min(span_s)
+    };
+    if d0 <= threshold {
+        (CreepEnd::Stops, at_s)
+    } else if d1 <= threshold {
+        (CreepEnd::Stops, crossing(threshold))
+    } else if d0 >= exit_level {
+        (CreepEnd::Slips, at_s)
+    } else if d1 >= exit_level {
+        (CreepEnd::Slips, crossing(exit_level))
+    } else {
+        (CreepEnd::Continues, span_s)
+    }
+}
+
+/// What the stop a pass of [`creep`] reached leaves.
+enum Pass {
+    /// At rest: a stop or a reversal (`run` is finished).
+    Ended,
+    /// Rounding left the drive a hair above the stop level: another pass from here.
+    Again,
+    /// As `Again`, but the span is over.
+    SpanDone,
+}
+
+/// The stop a pass of [`creep`] reached at `run.at_s` (the pass started at `x_pass`): at rest
+/// if `|N| ≤ F_s` there, a reversal if `N` is beyond the threshold against the motion, else
+/// (rounding) another pass, stepped [`just_past`] the start if it did not move time.
+fn at_stop<M: PlatenModel>(
+    model: &M,
+    dir: Direction,
+    run: &mut CreepRun,
+    x_pass: f64,
+    span_s: f64,
+    force: &impl Fn(f64) -> f64,
+    w_stiff: f64,
+) -> Pass {
+    let (s, x_end) = (dir.sign(), run.at_s);
+    let u_end = run.y.u;
+    let net = force(x_end) - model.elastic_force_n(u_end);
+    let threshold_end = model.static_threshold_n(u_end);
+    if net.abs() <= threshold_end {
+        run.y.v = 0.0;
+        run.end = CreepEnd::Stops;
+        return Pass::Ended;
+    }
+    if s * net < -threshold_end {
+        // The net force is beyond the threshold against the motion: the platen passed
+        // through rest (with no static friction, `F_s = 0`, the stop level is `N = 0`, and
+        // rounding puts `N` on either side of it).
+        run.y.v = 0.0;
+        run.end = CreepEnd::Reverses;
+        return Pass::Ended;
+    }
+    // Rounding left |N| above the threshold at the new displacement: solve again from here
+    // (the stop can only be later).
+    if x_end >= span_s {
+        return Pass::SpanDone;
+    }
+    if x_end - x_pass <= MIN_PROGRESS_S {
+        // The crossing rounded onto the start of the pass, where the drive is a hair above
+        // the stop level: step just past it, where it is not, so every pass moves time
+        // forward by more than the callers' rounding.
+        let elastic = model.elastic_force_n(u_end);
+        let next = just_past(x_end, span_s, |x| s * (force(x) - elastic) <= threshold_end);
+        run.y = advance(model, dir, run.y, run.at_s, next, force, w_stiff, run);
+        run.at_s = next;
+    }
+    Pass::Again
 }
 
 /// RK4 on the reduced creep equation (`u̇ = s·w_qs`, with the actuator work and the dissipated
