@@ -419,34 +419,7 @@ pub fn identify_system(
     fit: &[bool],
     settings: &SystemSettings,
 ) -> Result<SystemIdentification> {
-    if records.is_empty() {
-        return Err(IdentError::NoTests);
-    }
-    let periods = records
-        .iter()
-        .map(SystemRecord::period_s)
-        .collect::<Result<Vec<f64>>>()?;
-    let fitted: Vec<usize> = (0..records.len())
-        .filter(|&i| fit.get(i).copied().unwrap_or(false))
-        .collect();
-    if fitted.is_empty() {
-        return Err(IdentError::InvalidRecord {
-            test: records[0].name.clone(),
-            message: "no record is marked for the fit".into(),
-        });
-    }
-    if let Some(e) = not_identifiable(records, &fitted) {
-        return Err(e);
-    }
-    if let Some(a) = settings.area_m2 {
-        if !(a.is_finite() && a > 0.0) {
-            return Err(IdentError::InvalidSetting {
-                name: "area_m2",
-                value: a,
-                expected: "a finite actuator area > 0, m²",
-            });
-        }
-    }
+    let (periods, fitted) = check_system_inputs(records, fit, settings)?;
     // Skew: the acceleration channels first (against the displacement), then the pressures
     // (by the force balance, inside the plant's fit).
     let mut channel_skew = Vec::new();
@@ -481,6 +454,93 @@ pub fn identify_system(
     )?;
     let records_c = corrected.as_slice();
     let h = periods[fitted[0]];
+    let (corner, gfit, sat, unconstrained) =
+        fit_gains(records_c, &periods, &fitted, cols, settings)?;
+    let c = &gfit.coef;
+    let gains = IdentifiedGains {
+        sample_rate_hz: nominal_rate_hz(h),
+        displacement_gain_per_m: c[0],
+        velocity_feedforward_s_per_m: c[1],
+        acceleration_feedforward_s2_per_m: c[2],
+        velocity_feedback_s_per_m: c[3],
+        acceleration_feedback_s2_per_m: c[4],
+        delta_p_gain_per_pa: c[5],
+        delta_p_highpass_hz: corner,
+    };
+    let gain_estimates = estimates_of(&gfit, unconstrained.as_ref(), cols, &mut not_identified);
+    let mut result = SystemIdentification {
+        gains: Some(gains),
+        fitted_records: fitted.iter().map(|&i| records[i].name.clone()).collect(),
+        records: Vec::new(),
+        saturated_samples: sat,
+        gain_estimates,
+        channel_skew,
+        plant: None,
+        judgement: None,
+        provenance: Vec::new(),
+        not_identified,
+    };
+    result.records = held_out(records_c, &periods, &fitted, cols, corner, c);
+    if let Some(sys) = plant.system.as_mut() {
+        set_controller(&mut sys.controller, &gains);
+    }
+    if settings.judge {
+        result.judgement = judge::judge(records_c, &periods, &fitted, &plant);
+    }
+    result.provenance = provenance::of(&result, &plant, &plant_input);
+    result.plant = Some(plant);
+    Ok(result)
+}
+
+/// The checks of [`identify_system`] before any fit: the records' periods and which are
+/// fitted.
+fn check_system_inputs(
+    records: &[SystemRecord],
+    fit: &[bool],
+    settings: &SystemSettings,
+) -> Result<(Vec<f64>, Vec<usize>)> {
+    if records.is_empty() {
+        return Err(IdentError::NoTests);
+    }
+    let periods = records
+        .iter()
+        .map(SystemRecord::period_s)
+        .collect::<Result<Vec<f64>>>()?;
+    let fitted: Vec<usize> = (0..records.len())
+        .filter(|&i| fit.get(i).copied().unwrap_or(false))
+        .collect();
+    if fitted.is_empty() {
+        return Err(IdentError::InvalidRecord {
+            test: records[0].name.clone(),
+            message: "no record is marked for the fit".into(),
+        });
+    }
+    if let Some(e) = not_identifiable(records, &fitted) {
+        return Err(e);
+    }
+    if let Some(a) = settings.area_m2 {
+        if !(a.is_finite() && a > 0.0) {
+            return Err(IdentError::InvalidSetting {
+                name: "area_m2",
+                value: a,
+                expected: "a finite actuator area > 0, m²",
+            });
+        }
+    }
+    Ok((periods, fitted))
+}
+
+/// The controller's gains fitted on the `fitted` records, at the given high-pass corner or
+/// the grid's best: the corner, the fit (gains ≥ 0, absent channels at 0), the saturated
+/// samples left out, and what the unconstrained fit gives (reported, not used).
+fn fit_gains(
+    records_c: &[SystemRecord],
+    periods: &[f64],
+    fitted: &[usize],
+    cols: Columns,
+    settings: &SystemSettings,
+) -> Result<(f64, fit::LinearFit, usize, Option<fit::LinearFit>)> {
+    let absent = absent_gains(cols);
     let corners: Vec<f64> = match (cols.delta_p, settings.delta_p_highpass_hz) {
         (false, _) => vec![0.0],
         (true, Some(c)) => vec![c],
@@ -489,19 +549,11 @@ pub fn identify_system(
     // Every gain ≥ 0 (a scenario refuses a negative one); the columns the records lack are
     // held at 0.
     let nonneg = [true; 6];
-    let absent = [
-        false,
-        false,
-        false,
-        false,
-        !cols.acceleration,
-        !cols.delta_p,
-    ];
     let mut best: Option<(f64, fit::LinearFit, usize)> = None;
     for &corner in &corners {
         let mut design = fit::Design::new(6);
         let mut sat = 0;
-        for &i in &fitted {
+        for &i in fitted {
             sat += push_rows(&mut design, i, &records_c[i], periods[i], cols, corner);
         }
         let Some(f) = design.fit(&nonneg, &absent) else {
@@ -515,7 +567,7 @@ pub fn identify_system(
         return Err(IdentError::InvalidRecord {
             test: fitted
                 .iter()
-                .map(|&i| records[i].name.clone())
+                .map(|&i| records_c[i].name.clone())
                 .collect::<Vec<_>>()
                 .join(", "),
             message: "the drive cannot be fitted: too few unsaturated samples or a command \
@@ -526,22 +578,35 @@ pub fn identify_system(
     // What the unconstrained fit gives for a gain held at 0 (reported, not used).
     let unconstrained = {
         let mut design = fit::Design::new(6);
-        for &i in &fitted {
+        for &i in fitted {
             push_rows(&mut design, i, &records_c[i], periods[i], cols, corner);
         }
         design.fit(&[false; 6], &absent)
     };
-    let c = &gfit.coef;
-    let gains = IdentifiedGains {
-        sample_rate_hz: nominal_rate_hz(h),
-        displacement_gain_per_m: c[0],
-        velocity_feedforward_s_per_m: c[1],
-        acceleration_feedforward_s2_per_m: c[2],
-        velocity_feedback_s_per_m: c[3],
-        acceleration_feedback_s2_per_m: c[4],
-        delta_p_gain_per_pa: c[5],
-        delta_p_highpass_hz: corner,
-    };
+    Ok((corner, gfit, sat, unconstrained))
+}
+
+/// The gains a fit holds at 0 because the records lack their channel.
+fn absent_gains(cols: Columns) -> [bool; 6] {
+    [
+        false,
+        false,
+        false,
+        false,
+        !cols.acceleration,
+        !cols.delta_p,
+    ]
+}
+
+/// The estimates of the gains the records show, each gain held at 0 listed in
+/// `not_identified` with what the unconstrained fit gives.
+fn estimates_of(
+    gfit: &fit::LinearFit,
+    unconstrained: Option<&fit::LinearFit>,
+    cols: Columns,
+    not_identified: &mut Vec<(String, String)>,
+) -> Vec<GainEstimate> {
+    let (c, absent) = (&gfit.coef, absent_gains(cols));
     let gain_estimates: Vec<GainEstimate> = (0..6)
         .filter(|&j| !absent[j])
         .map(|j| GainEstimate {
@@ -550,7 +615,7 @@ pub fn identify_system(
             std_error: Some(gfit.estimates[j].std_error).filter(|s| s.is_finite()),
             held_at_zero: gfit.clamped[j],
             unconstrained: gfit.clamped[j]
-                .then(|| unconstrained.as_ref().map(|u| u.coef[j]))
+                .then(|| unconstrained.map(|u| u.coef[j]))
                 .flatten(),
         })
         .collect();
@@ -566,18 +631,19 @@ pub fn identify_system(
             ),
         ));
     }
-    let mut result = SystemIdentification {
-        gains: Some(gains),
-        fitted_records: fitted.iter().map(|&i| records[i].name.clone()).collect(),
-        records: Vec::new(),
-        saturated_samples: sat,
-        gain_estimates,
-        channel_skew,
-        plant: None,
-        judgement: None,
-        provenance: Vec::new(),
-        not_identified,
-    };
+    gain_estimates
+}
+
+/// How well the gains predict each record's drive (the fitted ones and those held out).
+fn held_out(
+    records_c: &[SystemRecord],
+    periods: &[f64],
+    fitted: &[usize],
+    cols: Columns,
+    corner: f64,
+    c: &[f64],
+) -> Vec<HeldOut> {
+    let mut out = Vec::new();
     for (i, r) in records_c.iter().enumerate() {
         let usable = Columns {
             acceleration: cols.acceleration && r.a_m_s2.is_some(),
@@ -589,32 +655,28 @@ pub fn identify_system(
         let (err2, dd) = design.residual_and_rhs(c);
         let rms_d = (dd / n).sqrt();
         let rms_e = (err2 / n).sqrt();
-        result.records.push(HeldOut {
-            name: records[i].name.clone(),
+        out.push(HeldOut {
+            name: r.name.clone(),
             fitted: fitted.contains(&i),
             samples: design.len(),
             drive_rms_error: rms_e,
             drive_nrmse: if rms_d > 0.0 { rms_e / rms_d } else { f64::NAN },
         });
     }
-    if let Some(sys) = plant.system.as_mut() {
-        let ctl = &mut sys.controller;
-        ctl.sample_rate_hz = gains.sample_rate_hz;
-        ctl.displacement_gain_per_m = gains.displacement_gain_per_m;
-        ctl.integral_gain_per_m_s = 0.0;
-        ctl.velocity_feedforward_s_per_m = gains.velocity_feedforward_s_per_m;
-        ctl.acceleration_feedforward_s2_per_m = gains.acceleration_feedforward_s2_per_m;
-        ctl.velocity_feedback_s_per_m = gains.velocity_feedback_s_per_m;
-        ctl.acceleration_feedback_s2_per_m = gains.acceleration_feedback_s2_per_m;
-        ctl.delta_p_gain_per_pa = gains.delta_p_gain_per_pa;
-        ctl.delta_p_highpass_hz = gains.delta_p_highpass_hz;
-    }
-    if settings.judge {
-        result.judgement = judge::judge(records_c, &periods, &fitted, &plant);
-    }
-    result.provenance = provenance::of(&result, &plant, &plant_input);
-    result.plant = Some(plant);
-    Ok(result)
+    out
+}
+
+/// The identified `gains` into a table system's controller (no integrator).
+fn set_controller(ctl: &mut platen_system::Controller, gains: &IdentifiedGains) {
+    ctl.sample_rate_hz = gains.sample_rate_hz;
+    ctl.displacement_gain_per_m = gains.displacement_gain_per_m;
+    ctl.integral_gain_per_m_s = 0.0;
+    ctl.velocity_feedforward_s_per_m = gains.velocity_feedforward_s_per_m;
+    ctl.acceleration_feedforward_s2_per_m = gains.acceleration_feedforward_s2_per_m;
+    ctl.velocity_feedback_s_per_m = gains.velocity_feedback_s_per_m;
+    ctl.acceleration_feedback_s2_per_m = gains.acceleration_feedback_s2_per_m;
+    ctl.delta_p_gain_per_pa = gains.delta_p_gain_per_pa;
+    ctl.delta_p_highpass_hz = gains.delta_p_highpass_hz;
 }
 
 /// The controller's rate from the records' mean period `h`: a whole number of hertz when the

@@ -897,85 +897,132 @@ pub(crate) fn identify_plant(
             "platen mass, stiffness, friction; specimen",
             "no a_m_s2 in every fitted record: the inertia cannot be separated",
         )),
-        (Ok(from), true) => {
-            let from = *from;
-            if let Some(f) =
-                fit_mechanics(records, periods, fitted, input, from, storeys, skew_report)?
-            {
-                let c = &f.coef;
-                let se = |j: usize| f.estimates[j].std_error;
-                let ratio = (from == ForceFrom::ChambersRatioFree).then(|| c[4 + storeys]);
-                if let Some(r) = ratio {
-                    base.actuator.rod_area_m2 = r * base.actuator.cap_area_m2;
-                    plant.std_errors.insert(
-                        "table_system.actuator.rod_side_area_m2".into(),
-                        se(4 + storeys) * base.actuator.cap_area_m2,
-                    );
-                }
-                let mech = IdentifiedMechanics {
-                    effective_mass_kg: c[0],
-                    viscous_coefficient: c[1],
-                    stiffness_n_per_m: c[2],
-                    coulomb_force_n: c[3],
-                    samples: f.rows,
-                    force_rms_residual_n: f.rms_residual(),
-                    force_nrmse: f.nrmse(),
-                    rod_to_cap_area_ratio: ratio,
-                };
-                for (j, key) in [
-                    (0, "effective_mass_kg"),
-                    (1, "viscous_coefficient"),
-                    (2, "stiffness_n_per_m"),
-                    (3, "coulomb_force_n"),
-                ] {
-                    if se(j).is_finite() {
-                        plant
-                            .std_errors
-                            .insert(format!("model.identified.{key}"), se(j));
-                    }
-                }
-                for (name, j) in [
-                    ("viscous_coefficient", 1),
-                    ("stiffness_n_per_m", 2),
-                    ("coulomb_force_n", 3),
-                ] {
-                    if f.clamped[j] {
-                        not_identified.push(why(
-                            name,
-                            "held at 0: the unconstrained force balance makes it negative, \
-                             which no platen has",
-                        ));
-                    }
-                }
-                let masses: Vec<f64> = c[4..4 + storeys].to_vec();
-                for (j, _) in masses.iter().enumerate() {
-                    plant
-                        .std_errors
-                        .insert(format!("specimen.storeys[{j}].mass_kg"), se(4 + j));
-                }
-                plant.mechanics = Some(mech);
-                if storeys == 0 {
-                    not_identified.push(why(
-                        "specimen",
-                        "no storey{i}_a_m_s2 recorded: a specimen's base shear, if any, is \
-                         in the platen's mass, stiffness and damping",
-                    ));
-                } else if let Some(st) = fit_storeys(records, periods, fitted, &masses) {
-                    for (j, (_, e)) in st.iter().enumerate() {
-                        plant
-                            .std_errors
-                            .insert(format!("specimen.storeys[{j}].stiffness_n_per_m"), e[0]);
-                        plant
-                            .std_errors
-                            .insert(format!("specimen.storeys[{j}].damping_n_s_per_m"), e[1]);
-                    }
-                    plant.storeys = st.into_iter().map(|(s, _)| s).collect();
-                    plant.specimen_modes = modes(&plant.storeys);
-                }
-            }
-        }
+        (Ok(from), true) => plant_mechanics(
+            records,
+            periods,
+            fitted,
+            input,
+            (*from, storeys),
+            skew_report,
+            (&mut base, &mut plant),
+            not_identified,
+        )?,
     }
     plant.std_errors.retain(|_, v| v.is_finite());
+    plant_hydraulics(
+        records,
+        periods,
+        fitted,
+        &from,
+        &base,
+        &mut plant,
+        not_identified,
+    );
+    finish_plant(&mut plant, not_identified);
+    Ok(plant)
+}
+
+/// The platen's mechanics and the specimen's storeys of [`identify_plant`] (force `from`,
+/// `storeys` recorded): into `plant`, with a free rod-to-cap area ratio into `base`.
+#[allow(clippy::too_many_arguments)]
+fn plant_mechanics(
+    records: &mut [SystemRecord],
+    periods: &[f64],
+    fitted: &[usize],
+    input: &PlantInput,
+    (from, storeys): (ForceFrom, usize),
+    skew_report: &mut Vec<ChannelSkew>,
+    (base, plant): (&mut TableSystem, &mut IdentifiedPlant),
+    not_identified: &mut Vec<(String, String)>,
+) -> Result<()> {
+    let why = |what: &str, reason: &str| (what.to_owned(), reason.to_owned());
+    if let Some(f) = fit_mechanics(records, periods, fitted, input, from, storeys, skew_report)? {
+        let c = &f.coef;
+        let se = |j: usize| f.estimates[j].std_error;
+        let ratio = (from == ForceFrom::ChambersRatioFree).then(|| c[4 + storeys]);
+        if let Some(r) = ratio {
+            base.actuator.rod_area_m2 = r * base.actuator.cap_area_m2;
+            plant.std_errors.insert(
+                "table_system.actuator.rod_side_area_m2".into(),
+                se(4 + storeys) * base.actuator.cap_area_m2,
+            );
+        }
+        let mech = IdentifiedMechanics {
+            effective_mass_kg: c[0],
+            viscous_coefficient: c[1],
+            stiffness_n_per_m: c[2],
+            coulomb_force_n: c[3],
+            samples: f.rows,
+            force_rms_residual_n: f.rms_residual(),
+            force_nrmse: f.nrmse(),
+            rod_to_cap_area_ratio: ratio,
+        };
+        for (j, key) in [
+            (0, "effective_mass_kg"),
+            (1, "viscous_coefficient"),
+            (2, "stiffness_n_per_m"),
+            (3, "coulomb_force_n"),
+        ] {
+            if se(j).is_finite() {
+                plant
+                    .std_errors
+                    .insert(format!("model.identified.{key}"), se(j));
+            }
+        }
+        for (name, j) in [
+            ("viscous_coefficient", 1),
+            ("stiffness_n_per_m", 2),
+            ("coulomb_force_n", 3),
+        ] {
+            if f.clamped[j] {
+                not_identified.push(why(
+                    name,
+                    "held at 0: the unconstrained force balance makes it negative, \
+                     which no platen has",
+                ));
+            }
+        }
+        let masses: Vec<f64> = c[4..4 + storeys].to_vec();
+        for (j, _) in masses.iter().enumerate() {
+            plant
+                .std_errors
+                .insert(format!("specimen.storeys[{j}].mass_kg"), se(4 + j));
+        }
+        plant.mechanics = Some(mech);
+        if storeys == 0 {
+            not_identified.push(why(
+                "specimen",
+                "no storey{i}_a_m_s2 recorded: a specimen's base shear, if any, is \
+                 in the platen's mass, stiffness and damping",
+            ));
+        } else if let Some(st) = fit_storeys(records, periods, fitted, &masses) {
+            for (j, (_, e)) in st.iter().enumerate() {
+                plant
+                    .std_errors
+                    .insert(format!("specimen.storeys[{j}].stiffness_n_per_m"), e[0]);
+                plant
+                    .std_errors
+                    .insert(format!("specimen.storeys[{j}].damping_n_s_per_m"), e[1]);
+            }
+            plant.storeys = st.into_iter().map(|(s, _)| s).collect();
+            plant.specimen_modes = modes(&plant.storeys);
+        }
+    }
+    Ok(())
+}
+
+/// The servo-valves and the oil column of [`identify_plant`] (the continuity fit), and the
+/// table system they make when a scenario takes it.
+fn plant_hydraulics(
+    records: &[SystemRecord],
+    periods: &[f64],
+    fitted: &[usize],
+    from: &std::result::Result<ForceFrom, &str>,
+    base: &TableSystem,
+    plant: &mut IdentifiedPlant,
+    not_identified: &mut Vec<(String, String)>,
+) {
+    let why = |what: &str, reason: &str| (what.to_owned(), reason.to_owned());
     let drive = fitted.iter().all(|&i| records[i].drive.is_some());
     let chambers = matches!(from, Ok(ForceFrom::Chambers | ForceFrom::ChambersRatioFree));
     let cont: Option<Vec<(usize, &SystemRecord, f64, Continuity)>> = match from {
@@ -986,7 +1033,7 @@ pub(crate) fn identify_plant(
                     i,
                     &records[i],
                     periods[i],
-                    continuity(&records[i], periods[i], &base, chambers)?,
+                    continuity(&records[i], periods[i], base, chambers)?,
                 ))
             })
             .collect(),
@@ -994,8 +1041,8 @@ pub(crate) fn identify_plant(
     };
     match (cont, drive) {
         (Some(recs), true) => {
-            if let Some(hyd) = fit_valves(&recs, &base, &mut plant, not_identified) {
-                let mut sys = base;
+            if let Some(hyd) = fit_valves(&recs, base, plant, not_identified) {
+                let mut sys = *base;
                 sys.actuator.cap_volume_m3 = hyd.cap_volume_m3;
                 sys.actuator.rod_volume_m3 = hyd.rod_volume_m3;
                 sys.actuator.leakage_m3_s_per_pa = hyd.leakage_m3_s_per_pa;
@@ -1038,6 +1085,11 @@ pub(crate) fn identify_plant(
             "no drive recorded in every fitted record: the spool's input is unknown",
         )),
     }
+}
+
+/// The identified model and specimen of [`identify_plant`], from its mechanics and storeys.
+fn finish_plant(plant: &mut IdentifiedPlant, not_identified: &mut Vec<(String, String)>) {
+    let why = |what: &str, reason: &str| (what.to_owned(), reason.to_owned());
     if let Some(m) = &plant.mechanics {
         plant.model = Some(IdentifiedParams {
             effective_mass_kg: m.effective_mass_kg,
@@ -1067,7 +1119,6 @@ pub(crate) fn identify_plant(
         )
         .ok();
     }
-    Ok(plant)
 }
 
 /// The spool grid's best continuity fit, as the valves and oil column.

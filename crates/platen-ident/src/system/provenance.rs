@@ -50,21 +50,33 @@ pub(crate) fn of(
     plant: &IdentifiedPlant,
     input: &PlantInput,
 ) -> Vec<ValueProvenance> {
-    use Source::{Assumed, Given, Identified};
     let mut out = Vec::new();
-    let drawings = if input.base_given { Given } else { Assumed };
-    let nominal = |what: &str, value: f64| {
-        (!input.base_given).then(|| {
-            format!(
-                "no drawings: nominal {what} {value} (the records cannot show it; pass --base \
-                 to give the lab's)"
-            )
-        })
-    };
-    let with_note = |path: &str, source: Source, note: Option<String>| ValueProvenance {
+    model_provenance(plant, &mut out);
+    if plant.system.is_some() {
+        actuator_provenance(plant, input, &mut out);
+        loop_provenance(plant, input, &mut out);
+    }
+    controller_provenance(id, &mut out);
+    for p in &mut out {
+        if p.std_error.is_none() {
+            p.std_error = plant.std_errors.get(&p.path).copied();
+        }
+    }
+    out.sort_by(|a, b| a.path.cmp(&b.path));
+    out
+}
+
+/// A value with a note made for it.
+fn with_note(path: &str, source: Source, note: Option<String>) -> ValueProvenance {
+    ValueProvenance {
         note,
         ..entry(path, source, None)
-    };
+    }
+}
+
+/// The platen's model and the specimen's storeys.
+fn model_provenance(plant: &IdentifiedPlant, out: &mut Vec<ValueProvenance>) {
+    use Source::{Assumed, Identified};
     if plant.model.is_some() {
         for key in [
             "effective_mass_kg",
@@ -96,113 +108,150 @@ pub(crate) fn of(
             ));
         }
     }
-    if plant.system.is_some() {
-        let area_note = (!input.area_given).then(|| {
+}
+
+/// The actuators of the table system.
+fn actuator_provenance(
+    plant: &IdentifiedPlant,
+    input: &PlantInput,
+    out: &mut Vec<ValueProvenance>,
+) {
+    use Source::{Assumed, Given, Identified};
+    let drawings = if input.base_given { Given } else { Assumed };
+    let nominal = |what: &str, value: f64| {
+        (!input.base_given).then(|| {
             format!(
-                "no drawings: nominal {NOMINAL_AREA_M2} m² (the records show the plant only \
-                 in ratios to the area: every mass, force, flow and volume scales with it, the \
-                 motion does not)"
+                "no drawings: nominal {what} {value} (the records cannot show it; pass --base \
+                 to give the lab's)"
             )
-        });
-        let area_source = if input.area_given { Given } else { Assumed };
-        out.push(with_note(
-            "table_system.actuator.count",
-            drawings,
-            nominal("count", 1.0),
-        ));
-        out.push(with_note(
-            "table_system.actuator.cap_side_area_m2",
-            area_source,
-            area_note,
-        ));
-        let rod = match (
-            input.base_given,
-            plant.mechanics.and_then(|m| m.rod_to_cap_area_ratio),
-        ) {
-            (true, _) => entry("table_system.actuator.rod_side_area_m2", Given, None),
-            (false, Some(_)) => entry(
-                "table_system.actuator.rod_side_area_m2",
-                Identified,
-                Some("the rod side's share of the area, from the force balance of both pressures"),
-            ),
-            (false, None) => entry(
-                "table_system.actuator.rod_side_area_m2",
-                Assumed,
-                Some("equal to the cap side's: Δp alone gives the force of a double-ended actuator only"),
-            ),
-        };
-        out.push(rod);
-        for k in 0..2 {
-            out.push(entry(
-                &format!("table_system.actuator.chamber_volume_m3[{k}]"),
-                Identified,
-                Some("identified as V/β, at the oil_bulk_modulus_pa given or assumed"),
-            ));
-        }
-        out.push(entry(
-            "table_system.actuator.leakage_m3_s_per_pa",
+        })
+    };
+    let area_note = (!input.area_given).then(|| {
+        format!(
+            "no drawings: nominal {NOMINAL_AREA_M2} m² (the records show the plant only \
+             in ratios to the area: every mass, force, flow and volume scales with it, the \
+             motion does not)"
+        )
+    });
+    let area_source = if input.area_given { Given } else { Assumed };
+    out.push(with_note(
+        "table_system.actuator.count",
+        drawings,
+        nominal("count", 1.0),
+    ));
+    out.push(with_note(
+        "table_system.actuator.cap_side_area_m2",
+        area_source,
+        area_note,
+    ));
+    let rod = match (
+        input.base_given,
+        plant.mechanics.and_then(|m| m.rod_to_cap_area_ratio),
+    ) {
+        (true, _) => entry("table_system.actuator.rod_side_area_m2", Given, None),
+        (false, Some(_)) => entry(
+            "table_system.actuator.rod_side_area_m2",
             Identified,
-            None,
-        ));
-        out.push(with_note(
-            "table_system.servo_valve.count",
-            drawings,
-            nominal("count", 1.0),
-        ));
+            Some("the rod side's share of the area, from the force balance of both pressures"),
+        ),
+        (false, None) => entry(
+            "table_system.actuator.rod_side_area_m2",
+            Assumed,
+            Some(
+                "equal to the cap side's: Δp alone gives the force of a double-ended actuator only",
+            ),
+        ),
+    };
+    out.push(rod);
+    for k in 0..2 {
         out.push(entry(
-            "table_system.servo_valve.rated_flow_m3_s",
+            &format!("table_system.actuator.chamber_volume_m3[{k}]"),
             Identified,
-            Some("the land coefficient, quoted at the rated pressure drop"),
-        ));
-        out.push(with_note(
-            "table_system.servo_valve.rated_pressure_drop_pa",
-            drawings,
-            nominal("rated drop (Pa)", NOMINAL_RATED_DROP_PA),
-        ));
-        let lag_only = plant.hydraulics.is_some_and(|h| h.lag_only);
-        for key in ["natural_frequency_hz", "damping_ratio", "delay_s"] {
-            out.push(entry(
-                &format!("table_system.servo_valve.{key}"),
-                Identified,
-                Some(if lag_only {
-                    "the grid's best; only the equivalent lag τ + 2ζ/ω_n is visible in the \
-                     records' band"
-                } else {
-                    "the grid's best"
-                }),
-            ));
-        }
-        out.push(with_note(
-            "table_system.oil_bulk_modulus_pa",
-            drawings,
-            nominal("bulk modulus (Pa)", NOMINAL_BULK_MODULUS_PA),
-        ));
-        out.push(with_note(
-            "table_system.supply_pressure_pa",
-            drawings,
-            nominal("supply (Pa)", NOMINAL_SUPPLY_PRESSURE_PA),
-        ));
-        out.push(with_note(
-            "table_system.return_pressure_pa",
-            drawings,
-            nominal("return (Pa)", NOMINAL_RETURN_PRESSURE_PA),
-        ));
-        out.push(with_note(
-            "table_system.accumulator",
-            drawings,
-            (!input.base_given).then(|| "no drawings: a constant supply".to_owned()),
-        ));
-        out.push(entry(
-            "table_system.controller.sample_rate_hz",
-            Assumed,
-            Some("the records' rate, taken as the controller's"),
-        ));
-        out.push(entry(
-            "table_system.controller.integral_gain_per_m_s",
-            Assumed,
-            Some("0: an integrator is not fitted"),
+            Some("identified as V/β, at the oil_bulk_modulus_pa given or assumed"),
         ));
     }
+    out.push(entry(
+        "table_system.actuator.leakage_m3_s_per_pa",
+        Identified,
+        None,
+    ));
+}
+
+/// The servo-valves, the oil, the supply and the controller's fixed settings.
+fn loop_provenance(plant: &IdentifiedPlant, input: &PlantInput, out: &mut Vec<ValueProvenance>) {
+    use Source::{Assumed, Given, Identified};
+    let drawings = if input.base_given { Given } else { Assumed };
+    let nominal = |what: &str, value: f64| {
+        (!input.base_given).then(|| {
+            format!(
+                "no drawings: nominal {what} {value} (the records cannot show it; pass --base \
+                 to give the lab's)"
+            )
+        })
+    };
+    out.push(with_note(
+        "table_system.servo_valve.count",
+        drawings,
+        nominal("count", 1.0),
+    ));
+    out.push(entry(
+        "table_system.servo_valve.rated_flow_m3_s",
+        Identified,
+        Some("the land coefficient, quoted at the rated pressure drop"),
+    ));
+    out.push(with_note(
+        "table_system.servo_valve.rated_pressure_drop_pa",
+        drawings,
+        nominal("rated drop (Pa)", NOMINAL_RATED_DROP_PA),
+    ));
+    let lag_only = plant.hydraulics.is_some_and(|h| h.lag_only);
+    for key in ["natural_frequency_hz", "damping_ratio", "delay_s"] {
+        out.push(entry(
+            &format!("table_system.servo_valve.{key}"),
+            Identified,
+            Some(if lag_only {
+                "the grid's best; only the equivalent lag τ + 2ζ/ω_n is visible in the \
+                 records' band"
+            } else {
+                "the grid's best"
+            }),
+        ));
+    }
+    out.push(with_note(
+        "table_system.oil_bulk_modulus_pa",
+        drawings,
+        nominal("bulk modulus (Pa)", NOMINAL_BULK_MODULUS_PA),
+    ));
+    out.push(with_note(
+        "table_system.supply_pressure_pa",
+        drawings,
+        nominal("supply (Pa)", NOMINAL_SUPPLY_PRESSURE_PA),
+    ));
+    out.push(with_note(
+        "table_system.return_pressure_pa",
+        drawings,
+        nominal("return (Pa)", NOMINAL_RETURN_PRESSURE_PA),
+    ));
+    out.push(with_note(
+        "table_system.accumulator",
+        drawings,
+        (!input.base_given).then(|| "no drawings: a constant supply".to_owned()),
+    ));
+    out.push(entry(
+        "table_system.controller.sample_rate_hz",
+        Assumed,
+        Some("the records' rate, taken as the controller's"),
+    ));
+    out.push(entry(
+        "table_system.controller.integral_gain_per_m_s",
+        Assumed,
+        Some("0: an integrator is not fitted"),
+    ));
+}
+
+/// The controller's gains and filter.
+fn controller_provenance(id: &SystemIdentification, out: &mut Vec<ValueProvenance>) {
+    use Source::{Assumed, Identified};
     for g in &id.gain_estimates {
         out.push(ValueProvenance {
             path: format!("table_system.controller.{}", g.key),
@@ -241,11 +290,4 @@ pub(crate) fn of(
             }
         }
     }
-    for p in &mut out {
-        if p.std_error.is_none() {
-            p.std_error = plant.std_errors.get(&p.path).copied();
-        }
-    }
-    out.sort_by(|a, b| a.path.cmp(&b.path));
-    out
 }
