@@ -319,101 +319,151 @@ pub(crate) fn judge(
         plant.model.as_ref()?.effective_mass_kg + payload,
         super::plant::stroke_limit_m(system),
     );
+    let ctx = Judge {
+        model: &model,
+        system,
+        plant,
+        periods,
+        fitted,
+        boxes: &boxes,
+        band_hz,
+        steps_per_period,
+    };
     let mut predictions = Vec::new();
     let mut failed = Vec::new();
     for (i, r) in records.iter().enumerate() {
-        let Some(a_rec) = r.a_m_s2.as_ref() else {
-            continue;
-        };
-        let hi = periods[i];
-        let Ok(lp) = ButterworthLowpass::new(4, band_hz.min(0.4 * 0.5 / hi), 1.0 / hi) else {
-            continue;
-        };
-        let band = |x: &[f64]| lp.apply(x).ok();
-        let Ok(command) = Motion::from_displacement(r.t_s.clone(), r.command_u_m.clone()) else {
-            continue;
-        };
-        let run = LoopRun {
-            system,
-            specimen: plant.specimen.as_ref(),
-            command: &command,
-            method: LoopMethod::Rk4 { steps_per_period },
-            initial: State {
-                u_m: r.command_u_m[0],
-                v_m_s: 0.0,
-            },
-        };
-        let mut sink = Collect::default();
-        if let Err(e) = forward_closed_loop(&model, &run, r.t_s.len(), &mut sink) {
-            failed.push((r.name.clone(), e.to_string()));
-            continue;
+        match predict(&ctx, i, r) {
+            Ok(Some(p)) => predictions.push(p),
+            Ok(None) => {}
+            Err(f) => failed.push(f),
         }
-        let n = a_rec.len();
-        let a_ref = super::central(&r.command_u_m, hi).1;
-        let (Some(rec_b), Some(pred_b), Some(cmd_b)) = (band(a_rec), band(&sink.a), band(&a_ref))
-        else {
-            continue;
-        };
-        let box_b = boxes[0].as_ref().and_then(|b| band(&b.predict(&a_ref)));
-        let mut storeys = Vec::new();
-        let mut storey_model = Vec::new();
-        let mut storey_box = Vec::new();
-        for (k, st) in r.storey_a_m_s2.iter().enumerate() {
-            let (Some(rec_s), Some(pred_s)) = (band(st), sink.storeys.get(k).and_then(|p| band(p)))
-            else {
-                continue;
-            };
-            storey_model.push(nrmse(&rec_s, &pred_s));
-            if let Some(b) = boxes.get(k + 1).and_then(Option::as_ref) {
-                if let Some(bs) = band(&b.predict(&a_ref)) {
-                    storey_box.push(nrmse(&rec_s, &bs));
-                }
-            }
-            storeys.push((rec_s, pred_s));
-        }
-        let noise =
-            rms((1..n - 1).map(|j| a_rec[j + 1] - 2.0 * a_rec[j] + a_rec[j - 1])) / 6f64.sqrt();
-        predictions.push(Prediction {
-            name: r.name.clone(),
-            fitted: fitted.contains(&i),
-            acceleration_rms_m_s2: rms(a_rec.iter().copied()),
-            acceleration_rms_error_m_s2: rms(a_rec.iter().zip(&sink.a).map(|(x, y)| x - y)),
-            acceleration_noise_m_s2: noise,
-            displacement_rms_m: rms(r.u_m.iter().copied()),
-            displacement_rms_error_m: rms(r.u_m.iter().zip(&sink.u).map(|(x, y)| x - y)),
-            model: Baseline {
-                acceleration_nrmse: nrmse(&rec_b, &pred_b),
-                storey_acceleration_nrmse: storey_model,
-                displacement_nrmse: Some(nrmse(&r.u_m, &sink.u)),
-            },
-            black_box: box_b.as_ref().map(|b| Baseline {
-                acceleration_nrmse: nrmse(&rec_b, b),
-                storey_acceleration_nrmse: storey_box,
-                displacement_nrmse: None,
-            }),
-            perfect_tracking: Baseline {
-                acceleration_nrmse: nrmse(&rec_b, &cmd_b),
-                storey_acceleration_nrmse: Vec::new(),
-                displacement_nrmse: Some(nrmse(&r.u_m, &r.command_u_m)),
-            },
-            series: PredictionSeries {
-                t_s: r.t_s.clone(),
-                command_u_m: r.command_u_m.clone(),
-                recorded_u_m: r.u_m.clone(),
-                predicted_u_m: sink.u,
-                recorded_a_m_s2: rec_b,
-                predicted_a_m_s2: pred_b,
-                black_box_a_m_s2: box_b.unwrap_or_default(),
-                command_a_m_s2: cmd_b,
-                storeys,
-            },
-        });
     }
     if predictions.is_empty() && failed.is_empty() {
         return None;
     }
+    let held_out = medians(&predictions);
+    Some(Judgement {
+        band_hz,
+        black_box_taps: taps,
+        steps_per_period,
+        predictions,
+        failed,
+        held_out,
+    })
+}
+
+/// What [`judge`] runs every record with.
+struct Judge<'a> {
+    model: &'a platen_model::IdentifiedModel,
+    system: &'a platen_system::TableSystem,
+    plant: &'a IdentifiedPlant,
+    periods: &'a [f64],
+    fitted: &'a [usize],
+    boxes: &'a [Option<BlackBox>],
+    band_hz: f64,
+    steps_per_period: u32,
+}
+
+/// Record `i`'s prediction by the identified loop, the black box and perfect tracking; `None`
+/// when it has no table acceleration (or a filter or command cannot be made for it), `Err`
+/// with the record's name and why when the loop's run fails.
+fn predict(
+    ctx: &Judge<'_>,
+    i: usize,
+    r: &SystemRecord,
+) -> Result<Option<Prediction>, (String, String)> {
+    let Some(a_rec) = r.a_m_s2.as_ref() else {
+        return Ok(None);
+    };
+    let hi = ctx.periods[i];
+    let Ok(lp) = ButterworthLowpass::new(4, ctx.band_hz.min(0.4 * 0.5 / hi), 1.0 / hi) else {
+        return Ok(None);
+    };
+    let band = |x: &[f64]| lp.apply(x).ok();
+    let Ok(command) = Motion::from_displacement(r.t_s.clone(), r.command_u_m.clone()) else {
+        return Ok(None);
+    };
+    let run = LoopRun {
+        system: ctx.system,
+        specimen: ctx.plant.specimen.as_ref(),
+        command: &command,
+        method: LoopMethod::Rk4 {
+            steps_per_period: ctx.steps_per_period,
+        },
+        initial: State {
+            u_m: r.command_u_m[0],
+            v_m_s: 0.0,
+        },
+    };
+    let mut sink = Collect::default();
+    if let Err(e) = forward_closed_loop(ctx.model, &run, r.t_s.len(), &mut sink) {
+        return Err((r.name.clone(), e.to_string()));
+    }
+    let n = a_rec.len();
+    let a_ref = super::central(&r.command_u_m, hi).1;
+    let (Some(rec_b), Some(pred_b), Some(cmd_b)) = (band(a_rec), band(&sink.a), band(&a_ref))
+    else {
+        return Ok(None);
+    };
+    let box_b = ctx.boxes[0].as_ref().and_then(|b| band(&b.predict(&a_ref)));
+    let mut storeys = Vec::new();
+    let mut storey_model = Vec::new();
+    let mut storey_box = Vec::new();
+    for (k, st) in r.storey_a_m_s2.iter().enumerate() {
+        let (Some(rec_s), Some(pred_s)) = (band(st), sink.storeys.get(k).and_then(|p| band(p)))
+        else {
+            return Ok(None);
+        };
+        storey_model.push(nrmse(&rec_s, &pred_s));
+        if let Some(b) = ctx.boxes.get(k + 1).and_then(Option::as_ref) {
+            if let Some(bs) = band(&b.predict(&a_ref)) {
+                storey_box.push(nrmse(&rec_s, &bs));
+            }
+        }
+        storeys.push((rec_s, pred_s));
+    }
+    let noise = rms((1..n - 1).map(|j| a_rec[j + 1] - 2.0 * a_rec[j] + a_rec[j - 1])) / 6f64.sqrt();
+    Ok(Some(Prediction {
+        name: r.name.clone(),
+        fitted: ctx.fitted.contains(&i),
+        acceleration_rms_m_s2: rms(a_rec.iter().copied()),
+        acceleration_rms_error_m_s2: rms(a_rec.iter().zip(&sink.a).map(|(x, y)| x - y)),
+        acceleration_noise_m_s2: noise,
+        displacement_rms_m: rms(r.u_m.iter().copied()),
+        displacement_rms_error_m: rms(r.u_m.iter().zip(&sink.u).map(|(x, y)| x - y)),
+        model: Baseline {
+            acceleration_nrmse: nrmse(&rec_b, &pred_b),
+            storey_acceleration_nrmse: storey_model,
+            displacement_nrmse: Some(nrmse(&r.u_m, &sink.u)),
+        },
+        black_box: box_b.as_ref().map(|b| Baseline {
+            acceleration_nrmse: nrmse(&rec_b, b),
+            storey_acceleration_nrmse: storey_box,
+            displacement_nrmse: None,
+        }),
+        perfect_tracking: Baseline {
+            acceleration_nrmse: nrmse(&rec_b, &cmd_b),
+            storey_acceleration_nrmse: Vec::new(),
+            displacement_nrmse: Some(nrmse(&r.u_m, &r.command_u_m)),
+        },
+        series: PredictionSeries {
+            t_s: r.t_s.clone(),
+            command_u_m: r.command_u_m.clone(),
+            recorded_u_m: r.u_m.clone(),
+            predicted_u_m: sink.u,
+            recorded_a_m_s2: rec_b,
+            predicted_a_m_s2: pred_b,
+            black_box_a_m_s2: box_b.unwrap_or_default(),
+            command_a_m_s2: cmd_b,
+            storeys,
+        },
+    }))
+}
+
+/// The medians over the records held out of the fit, if any.
+fn medians(predictions: &[Prediction]) -> Option<HeldOutMedians> {
     let held: Vec<&Prediction> = predictions.iter().filter(|p| !p.fitted).collect();
-    let held_out = (!held.is_empty()).then(|| {
+    (!held.is_empty()).then(|| {
         let m = |f: &dyn Fn(&Prediction) -> Option<f64>| {
             let v: Vec<f64> = held.iter().filter_map(|p| f(p)).collect();
             (!v.is_empty()).then(|| median(v))
@@ -433,14 +483,6 @@ pub(crate) fn judge(
                 .unwrap_or(f64::NAN),
             model_beats_black_box: black.map(|b| model <= b),
         }
-    });
-    Some(Judgement {
-        band_hz,
-        black_box_taps: taps,
-        steps_per_period,
-        predictions,
-        failed,
-        held_out,
     })
 }
 
