@@ -105,37 +105,9 @@ pub fn identify_records(
         records: records.len(),
         nonneg_stiffness: settings.nonnegative_stiffness,
     };
-    let needed = 10 * (shape.free().len() + 2);
-    if data.len() < needed {
-        return Err(IdentError::InvalidRecord {
-            test: records[0].name().to_owned(),
-            message: format!(
-                "{} samples move faster than {} m/s over all records; the any-record method needs at least {needed}",
-                data.len(),
-                settings.min_speed_m_s
-            ),
-        });
-    }
+    enough_points(&data, &shape, records, settings)?;
     let mut warnings = Vec::new();
-    let mut fit = Separable::new(&data, shape).fit();
-    let mut hac = ee_covariance(&fit, &data);
-    let mut low_dropped = None;
-    if shape.low {
-        let (a, se) = match fit.free.iter().position(|&i| i == LOW_FORCE) {
-            Some(k) => (fit.full[LOW_FORCE], hac.cov[(k, k)].sqrt()),
-            None => (0.0, f64::NAN),
-        };
-        if fit.clamped.contains(&LOW_FORCE) {
-            warnings.push(RecordWarning::LowVelocityTermLeftOut {
-                force_n: a,
-                std_error_n: se,
-            });
-            low_dropped = Some((a, se));
-            shape.low = false;
-            fit = Separable::new(&data, shape).fit();
-            hac = ee_covariance(&fit, &data);
-        }
-    }
+    let (fit, mut hac, low_dropped) = fit_with_low_term(&data, &mut shape, &mut warnings);
     skew_covariance(&mut hac, &fit, shape, &data, &corrected, settings)?;
     let clamped = fit.clamped.clone();
     let fixed_reason = |key: IdentifiedKey| -> String {
@@ -182,28 +154,15 @@ pub fn identify_records(
         converged: fit.converged,
     };
 
-    let velocities: Vec<Vec<f64>> = prepared.iter().map(|p| p.v_m_s.clone()).collect();
-    let mut simulated = vec![None; records.len()];
-    let mut output_error = None;
-    if settings.output_error {
-        let model_free: Vec<usize> = free.iter().copied().filter(|&i| i < OFFSETS).collect();
-        match run_output_error(
-            records,
-            &velocities,
-            &fit.full,
-            &model_free,
-            settings,
-            &fixed_reason,
-        ) {
-            Ok(oe) => {
-                simulated = oe.simulated;
-                compare_fits(&ee_params, &oe.fit.parameters, &mut warnings);
-                oe_warnings(&oe.fit, &mut warnings);
-                output_error = Some(oe.fit);
-            }
-            Err(reason) => warnings.push(RecordWarning::OutputErrorNotUsed { reason }),
-        }
-    }
+    let (simulated, output_error) = output_error_check(
+        records,
+        &prepared,
+        (&fit.full, &free),
+        &ee_params,
+        settings,
+        &fixed_reason,
+        &mut warnings,
+    );
     plausible::check(
         &ee_params,
         output_error.as_ref().map(|oe| &oe.parameters),
@@ -231,6 +190,95 @@ pub fn identify_records(
         records: reports,
         warnings,
     })
+}
+
+/// The any-record method needs ten points per free parameter and two more.
+fn enough_points(
+    data: &Stacked,
+    shape: &Shape,
+    records: &[TestRecord],
+    settings: &ValidRecordSettings,
+) -> Result<()> {
+    let needed = 10 * (shape.free().len() + 2);
+    if data.len() < needed {
+        return Err(IdentError::InvalidRecord {
+            test: records[0].name().to_owned(),
+            message: format!(
+                "{} samples move faster than {} m/s over all records; the any-record method needs at least {needed}",
+                data.len(),
+                settings.min_speed_m_s
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// The equation-error fit with its covariance; a low-velocity term that the fit clamps at
+/// its bound is left out (with a warning) and the fit made again without it. Returns the
+/// fit, its covariance and the term left out (its force and standard error), if any.
+fn fit_with_low_term(
+    data: &Stacked,
+    shape: &mut Shape,
+    warnings: &mut Vec<RecordWarning>,
+) -> (SeparableFit, Hac, Option<(f64, f64)>) {
+    let mut fit = Separable::new(data, *shape).fit();
+    let mut hac = ee_covariance(&fit, data);
+    let mut low_dropped = None;
+    if shape.low {
+        let (a, se) = match fit.free.iter().position(|&i| i == LOW_FORCE) {
+            Some(k) => (fit.full[LOW_FORCE], hac.cov[(k, k)].sqrt()),
+            None => (0.0, f64::NAN),
+        };
+        if fit.clamped.contains(&LOW_FORCE) {
+            warnings.push(RecordWarning::LowVelocityTermLeftOut {
+                force_n: a,
+                std_error_n: se,
+            });
+            low_dropped = Some((a, se));
+            shape.low = false;
+            fit = Separable::new(data, *shape).fit();
+            hac = ee_covariance(&fit, data);
+        }
+    }
+    (fit, hac, low_dropped)
+}
+
+/// The output-error check (when `settings` ask for it) from the equation error's `full`
+/// vector with the `free` parameters: each record's simulated motion and the fit, or a
+/// warning saying why it was not used; its warnings and its comparison with `ee_params`.
+#[allow(clippy::type_complexity)]
+fn output_error_check(
+    records: &[TestRecord],
+    prepared: &[Prepared],
+    (full, free): (&[f64], &[usize]),
+    ee_params: &ParameterEstimates,
+    settings: &ValidRecordSettings,
+    fixed_reason: &dyn Fn(IdentifiedKey) -> String,
+    warnings: &mut Vec<RecordWarning>,
+) -> (Vec<Option<Vec<f64>>>, Option<OutputErrorFit>) {
+    let velocities: Vec<Vec<f64>> = prepared.iter().map(|p| p.v_m_s.clone()).collect();
+    let mut simulated = vec![None; records.len()];
+    let mut output_error = None;
+    if settings.output_error {
+        let model_free: Vec<usize> = free.iter().copied().filter(|&i| i < OFFSETS).collect();
+        match run_output_error(
+            records,
+            &velocities,
+            full,
+            &model_free,
+            settings,
+            fixed_reason,
+        ) {
+            Ok(oe) => {
+                simulated = oe.simulated;
+                compare_fits(ee_params, &oe.fit.parameters, warnings);
+                oe_warnings(&oe.fit, warnings);
+                output_error = Some(oe.fit);
+            }
+            Err(reason) => warnings.push(RecordWarning::OutputErrorNotUsed { reason }),
+        }
+    }
+    (simulated, output_error)
 }
 
 /// Adds the variance of the estimated channel delays to the equation error's covariance
