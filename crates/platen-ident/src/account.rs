@@ -73,55 +73,8 @@ pub fn identify_any(
     if records.is_empty() {
         return Err(IdentError::NoTests);
     }
-    let mut accounts = Vec::with_capacity(records.len());
-    let mut periodic_idx = Vec::new();
-    let mut record_idx = Vec::new();
-    let mut plans: Vec<RatePlan> = Vec::new();
-    for (k, rec) in records.iter().enumerate() {
-        let declared = declared_record.get(k).copied().unwrap_or(false);
-        let r = if declared {
-            Route::Record {
-                reason: "declared a record (kind \"record\")".to_owned(),
-            }
-        } else {
-            route(rec)
-        };
-        let mut account = RecordAccount {
-            method: Method::Record,
-            used: true,
-            reason: None,
-            routing: String::new(),
-        };
-        match (&r, request) {
-            (_, MethodRequest::Record) => {
-                account.routing = "the any-record method on every record (forced)".to_owned();
-            }
-            (Route::Record { reason }, _) => {
-                account.routing = format!("not a periodic test: {reason}");
-            }
-            (Route::Periodic { frequency_hz }, _) => {
-                match periodic_analysable(rec, settings, &mut plans) {
-                    Ok(()) => {
-                        account.method = Method::Periodic;
-                        account.routing =
-                            format!("a periodic test at {frequency_hz:.4} Hz (regular cycles)");
-                        periodic_idx.push(k);
-                    }
-                    Err(e) => {
-                        account.routing = format!(
-                            "the periodic method rejected it ({}): identified by the any-record method instead",
-                            cause(&e)
-                        );
-                    }
-                }
-            }
-        }
-        let to_record = account.method == Method::Record || request == MethodRequest::Both;
-        if to_record {
-            record_idx.push(k);
-        }
-        accounts.push(account);
-    }
+    let (mut accounts, periodic_idx, record_idx) =
+        route_all(records, declared_record, request, settings);
     let periodic = if periodic_idx.is_empty() {
         None
     } else {
@@ -177,6 +130,66 @@ pub fn identify_any(
         records: records_id,
         accounts,
     })
+}
+
+/// Routes every record to its method (module docs): its account, and the records of each
+/// method (with `Both`, every record goes to the any-record method too).
+fn route_all(
+    records: &[TestRecord],
+    declared_record: &[bool],
+    request: MethodRequest,
+    settings: &ValidSettings,
+) -> (Vec<RecordAccount>, Vec<usize>, Vec<usize>) {
+    let mut accounts = Vec::with_capacity(records.len());
+    let mut periodic_idx = Vec::new();
+    let mut record_idx = Vec::new();
+    let mut plans: Vec<RatePlan> = Vec::new();
+    for (k, rec) in records.iter().enumerate() {
+        let declared = declared_record.get(k).copied().unwrap_or(false);
+        let r = if declared {
+            Route::Record {
+                reason: "declared a record (kind \"record\")".to_owned(),
+            }
+        } else {
+            route(rec)
+        };
+        let mut account = RecordAccount {
+            method: Method::Record,
+            used: true,
+            reason: None,
+            routing: String::new(),
+        };
+        match (&r, request) {
+            (_, MethodRequest::Record) => {
+                account.routing = "the any-record method on every record (forced)".to_owned();
+            }
+            (Route::Record { reason }, _) => {
+                account.routing = format!("not a periodic test: {reason}");
+            }
+            (Route::Periodic { frequency_hz }, _) => {
+                match periodic_analysable(rec, settings, &mut plans) {
+                    Ok(()) => {
+                        account.method = Method::Periodic;
+                        account.routing =
+                            format!("a periodic test at {frequency_hz:.4} Hz (regular cycles)");
+                        periodic_idx.push(k);
+                    }
+                    Err(e) => {
+                        account.routing = format!(
+                            "the periodic method rejected it ({}): identified by the any-record method instead",
+                            cause(&e)
+                        );
+                    }
+                }
+            }
+        }
+        let to_record = account.method == Method::Record || request == MethodRequest::Both;
+        if to_record {
+            record_idx.push(k);
+        }
+        accounts.push(account);
+    }
+    (accounts, periodic_idx, record_idx)
 }
 
 /// Whether the paper's method can analyse `rec` alone (its cycle, filters and waveform).
