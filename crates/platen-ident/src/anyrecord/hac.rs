@@ -71,11 +71,9 @@ pub(crate) struct Hac {
 /// Each record's scores touch the shared parameters and its own local ones only, so the
 /// cost grows with the residuals and not with residuals × records.
 pub(crate) fn covariance(jac: &Jacobian, resid: &[f64], time: &[usize], group: &[usize]) -> Hac {
-    let n_res = jac.rows();
     let m = jac.cols();
-    let (m0, width) = (jac.shared.ncols(), jac.width());
-    debug_assert_eq!(resid.len(), n_res);
-    debug_assert!(width == 0 || jac.group == group);
+    debug_assert_eq!(resid.len(), jac.rows());
+    debug_assert!(jac.width() == 0 || jac.group == group);
     let jtj = jac.gram();
     let scale: Vec<f64> = (0..m)
         .map(|k| {
@@ -87,6 +85,43 @@ pub(crate) fn covariance(jac: &Jacobian, resid: &[f64], time: &[usize], group: &
             }
         })
         .collect();
+    let (inv, singular, condition) = bread_inverse(&jtj, &scale);
+
+    let (mut meat, blocks, white, n_time, block) = meat_of(jac, resid, time, group, &scale);
+    let k = blocks.max(2) as f64;
+    meat *= k / (k - 1.0);
+    let bandwidth = block;
+    let white = white.max(f64::MIN_POSITIVE);
+    let effective_samples = if m > 0 {
+        n_time as f64 * white / meat[(0, 0)].max(f64::MIN_POSITIVE)
+    } else {
+        n_time as f64
+    };
+    let scaled = &inv * meat * &inv;
+    let cov = DMatrix::from_fn(m, m, |i, j| {
+        if singular[i] || singular[j] {
+            f64::NAN
+        } else {
+            scaled[(i, j)] / (scale[i] * scale[j])
+        }
+    });
+    let cov_estimable = DMatrix::from_fn(m, m, |i, j| scaled[(i, j)] / (scale[i] * scale[j]));
+    Hac {
+        cov,
+        cov_estimable,
+        singular,
+        condition,
+        bandwidth,
+        critical_value: student_t_975(k - 1.0),
+        effective_samples: effective_samples.min(n_time as f64),
+    }
+}
+
+/// The inverse of the scaled normal matrix `jtj/(scaleᵢ·scaleⱼ)` on its well-conditioned
+/// eigenvectors, which parameters are singular (an eigenvector below [`SINGULAR`] of the
+/// largest weighs on them), and the condition number.
+fn bread_inverse(jtj: &DMatrix<f64>, scale: &[f64]) -> (DMatrix<f64>, Vec<bool>, f64) {
+    let m = scale.len();
     let bread = DMatrix::from_fn(m, m, |i, j| jtj[(i, j)] / (scale[i] * scale[j]));
     let eig = SymmetricEigen::new(bread);
     let max_ev = eig.eigenvalues.max();
@@ -106,7 +141,21 @@ pub(crate) fn covariance(jac: &Jacobian, resid: &[f64], time: &[usize], group: &
         }
         inv += (vec * vec.transpose()) / ev;
     }
+    (inv, singular, condition)
+}
 
+/// The scaled scores' long-run covariance by blocks (the sandwich's meat, not yet
+/// corrected for the number of blocks), the number of blocks, the first parameter's white
+/// sum of squares, the time samples and the block length.
+fn meat_of(
+    jac: &Jacobian,
+    resid: &[f64],
+    time: &[usize],
+    group: &[usize],
+    scale: &[f64],
+) -> (DMatrix<f64>, usize, f64, usize, usize) {
+    let m = jac.cols();
+    let (m0, width) = (jac.shared.ncols(), jac.width());
     // Each group's scores summed per sample index over its time span (the residuals that
     // share a time, in order), then cut into blocks of `block` consecutive sample indices.
     // The sums run in the order of the dense `residuals × parameters` form (each block's
@@ -163,33 +212,7 @@ pub(crate) fn covariance(jac: &Jacobian, resid: &[f64], time: &[usize], group: &
             white += series.column(x).norm_squared();
         }
     }
-    let k = blocks.max(2) as f64;
-    meat *= k / (k - 1.0);
-    let bandwidth = block;
-    let white = white.max(f64::MIN_POSITIVE);
-    let effective_samples = if m > 0 {
-        n_time as f64 * white / meat[(0, 0)].max(f64::MIN_POSITIVE)
-    } else {
-        n_time as f64
-    };
-    let scaled = &inv * meat * &inv;
-    let cov = DMatrix::from_fn(m, m, |i, j| {
-        if singular[i] || singular[j] {
-            f64::NAN
-        } else {
-            scaled[(i, j)] / (scale[i] * scale[j])
-        }
-    });
-    let cov_estimable = DMatrix::from_fn(m, m, |i, j| scaled[(i, j)] / (scale[i] * scale[j]));
-    Hac {
-        cov,
-        cov_estimable,
-        singular,
-        condition,
-        bandwidth,
-        critical_value: student_t_975(k - 1.0),
-        effective_samples: effective_samples.min(n_time as f64),
-    }
+    (meat, blocks, white, n_time, block)
 }
 
 #[cfg(test)]
