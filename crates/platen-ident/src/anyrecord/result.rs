@@ -312,31 +312,7 @@ impl fmt::Display for RecordWarning {
                 second,
                 correlation,
                 speeds_m_s,
-            } => {
-                let pair = (*first, *second);
-                if pair == (IdentifiedKey::CoulombForce, IdentifiedKey::LowVelocityForce)
-                    || pair == (IdentifiedKey::LowVelocityForce, IdentifiedKey::CoulombForce)
-                {
-                    write!(
-                        f,
-                        "{} and {} are not separable below {:.1} mm/s in this record ({}: correlation {correlation:+.3}): the record determines F_μ + a there, not each; add slower motion, or hold the low-velocity term (--no-low-velocity-term)",
-                        symbol(*first),
-                        symbol(*second),
-                        1e3 * speeds_m_s[1],
-                        fit.name()
-                    )
-                } else {
-                    write!(
-                        f,
-                        "{} and {} are not separable over {:.1}–{:.0} mm/s in this record ({}: correlation {correlation:+.3}): they trade off; the law F_D(v) is better determined than either (see its band)",
-                        symbol(*first),
-                        symbol(*second),
-                        1e3 * speeds_m_s[0],
-                        1e3 * speeds_m_s[1],
-                        fit.name()
-                    )
-                }
-            }
+            } => not_separable(f, *fit, (*first, *second), *correlation, *speeds_m_s),
             RecordWarning::Imprecise {
                 fit,
                 key,
@@ -400,27 +376,7 @@ impl fmt::Display for RecordWarning {
                 key,
                 value,
                 ci95,
-            } => {
-                write!(
-                    f,
-                    "implausible: {} = {value:.4e} {} ({}{}) is {} on a physical platen",
-                    symbol(*key),
-                    key.unit(),
-                    fit.name(),
-                    ci95.map_or(String::new(), |[lo, hi]| format!(
-                        ", 95 % interval {lo:.4e} to {hi:.4e}"
-                    )),
-                    if *key == IdentifiedKey::EffectiveMass {
-                        "impossible: a mass is positive"
-                    } else {
-                        "impossible: a stiffness is never negative"
-                    }
-                )?;
-                if *key == IdentifiedKey::Stiffness {
-                    f.write_str("; a table without a restoring stiffness of its own may use --nonnegative-stiffness")?;
-                }
-                Ok(())
-            }
+            } => negative_estimate(f, *fit, *key, *value, *ci95),
             RecordWarning::StiffnessConstrained => f.write_str(
                 "Kₑ ≥ 0 is active: the unconstrained fit wants a negative stiffness; Kₑ = 0 is reported (held at its bound)",
             ),
@@ -445,6 +401,73 @@ impl fmt::Display for RecordWarning {
             ),
         }
     }
+}
+
+/// [`RecordWarning::NotSeparable`]'s message.
+fn not_separable(
+    f: &mut fmt::Formatter<'_>,
+    fit: FitKind,
+    (first, second): (IdentifiedKey, IdentifiedKey),
+    correlation: f64,
+    speeds_m_s: [f64; 2],
+) -> fmt::Result {
+    let first = &first;
+    let second = &second;
+    let pair = (*first, *second);
+    if pair == (IdentifiedKey::CoulombForce, IdentifiedKey::LowVelocityForce)
+        || pair == (IdentifiedKey::LowVelocityForce, IdentifiedKey::CoulombForce)
+    {
+        write!(
+            f,
+            "{} and {} are not separable below {:.1} mm/s in this record ({}: correlation {correlation:+.3}): the record determines F_μ + a there, not each; add slower motion, or hold the low-velocity term (--no-low-velocity-term)",
+            symbol(*first),
+            symbol(*second),
+            1e3 * speeds_m_s[1],
+            fit.name()
+        )
+    } else {
+        write!(
+            f,
+            "{} and {} are not separable over {:.1}–{:.0} mm/s in this record ({}: correlation {correlation:+.3}): they trade off; the law F_D(v) is better determined than either (see its band)",
+            symbol(*first),
+            symbol(*second),
+            1e3 * speeds_m_s[0],
+            1e3 * speeds_m_s[1],
+            fit.name()
+        )
+    }
+}
+
+/// [`RecordWarning::NegativeEstimate`]'s message.
+fn negative_estimate(
+    f: &mut fmt::Formatter<'_>,
+    fit: FitKind,
+    key: IdentifiedKey,
+    value: f64,
+    ci95: Option<[f64; 2]>,
+) -> fmt::Result {
+    let key = &key;
+    write!(
+        f,
+        "implausible: {} = {value:.4e} {} ({}{}) is {} on a physical platen",
+        symbol(*key),
+        key.unit(),
+        fit.name(),
+        ci95.map_or(String::new(), |[lo, hi]| format!(
+            ", 95 % interval {lo:.4e} to {hi:.4e}"
+        )),
+        if *key == IdentifiedKey::EffectiveMass {
+            "impossible: a mass is positive"
+        } else {
+            "impossible: a stiffness is never negative"
+        }
+    )?;
+    if *key == IdentifiedKey::Stiffness {
+        f.write_str(
+            "; a table without a restoring stiffness of its own may use --nonnegative-stiffness",
+        )?;
+    }
+    Ok(())
 }
 
 /// The parameter's symbol.
