@@ -794,7 +794,7 @@ impl RecordSource {
             return Err(InputError::ScenarioFloors { path: path.clone() });
         }
         let scenario = Scenario::load(path)?;
-        let pressure_pa = scenario.hold_down_pressure_pa;
+        let pressure_pa = scenario.rig.hold_down_pressure_pa;
         if let Some(p) = self.pressure_mpa {
             // The same number written twice (13.8 in both files) may differ in its last bit.
             if (p * 1e6 - pressure_pa).abs() > 1e-9 * pressure_pa.abs().max(1.0) {
@@ -850,12 +850,16 @@ pub fn recorded_of(scenario: &Scenario, path: &Path, seed: u64) -> Result<Record
         )
         .map_err(|message| InputError::RecordedLike { message })
     }
-    let Run::Inverse { motion } = &scenario.run else {
+    let (Run::Inverse { motion }
+    | Run::ClosedLoop {
+        command: motion, ..
+    }) = &scenario.run
+    else {
         return Err(InputError::NotMotion {
             path: path.to_owned(),
         });
     };
-    match &scenario.model {
+    match &scenario.rig.model {
         Model::Identified(m) => recorded(m, motion, seed),
         Model::Full(m) => recorded(&**m, motion, seed),
     }
@@ -956,12 +960,12 @@ pub fn read_base_system(
     };
     let file = platen_scenario::file::parse(path, &scenario.to_string()).map_err(not_system)?;
     let s = Scenario::from_file(path, file).map_err(not_system)?;
-    let Some(cl) = s.closed_loop else {
+    let Some(system) = s.rig.table_system else {
         return Err(InputError::NoTableSystem {
             path: path.to_owned(),
         });
     };
-    Ok((cl.system, stroke))
+    Ok((system, stroke))
 }
 
 #[cfg(test)]

@@ -20,7 +20,7 @@ use std::path::Path;
 
 use platen_model::STANDARD_GRAVITY_M_S2;
 use platen_scenario::describe::{ModelDescription, SystemDescription, SystemParameters};
-use platen_scenario::Scenario;
+use platen_scenario::Rig;
 
 /// Significant digits of every printed value: the paper quotes its parameters to 3–4.
 pub const SIGNIFICANT_DIGITS: i32 = 4;
@@ -36,10 +36,10 @@ pub fn text(d: &ModelDescription) -> String {
 
 /// The lines `platen model --scenario` prints before the model's text: the scenario's path
 /// and name, the values it lays over its preset's and its specimen.
-pub fn scenario_header(path: &Path, scenario: &Scenario) -> String {
+pub fn scenario_header(path: &Path, name: &str, rig: &Rig) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "scenario {} ({})", path.display(), scenario.name);
-    let overrides: Vec<String> = scenario
+    let _ = writeln!(s, "scenario {} ({})", path.display(), name);
+    let overrides: Vec<String> = rig
         .overrides
         .values()
         .iter()
@@ -52,7 +52,7 @@ pub fn scenario_header(path: &Path, scenario: &Scenario) -> String {
             overrides.join(", ")
         );
     }
-    if let Some(sp) = &scenario.specimen {
+    if let Some(sp) = &rig.specimen {
         let storeys = sp.len();
         let _ = writeln!(
             s,

@@ -28,39 +28,17 @@
 //! spool, or the oil column at the stroke's ends), or Dopri5 at `rtol`/`atol`. A step that
 //! cannot resolve the fastest mode (`h·ω_max > 1`) is refused.
 
-use platen_integrate::{LoopMethod, State};
+use platen_integrate::LoopMethod;
 use platen_system::{
     preset as system_preset, Accumulator, Controller, Supply, SystemError, TableSystem,
 };
 
 use crate::ctx::Ctx;
 use crate::error::Result;
-use crate::file::{IntegratorSpec, ScenarioFile, DEFAULT_ATOL, DEFAULT_RTOL};
+use crate::file::{IntegratorSpec, DEFAULT_ATOL, DEFAULT_RTOL};
 pub use crate::system_file::{
     AccumulatorSpec, ActuatorSpec, ChamberVolumes, ControllerSpec, ServoValveSpec, TableSystemSpec,
 };
-
-/// A validated closed loop: the system, its integrator and the platen's initial state.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ClosedLoop {
-    /// The table system.
-    pub system: TableSystem,
-    /// The integrator.
-    pub method: LoopMethod,
-    /// The platen's state at the command's first sample (`None`: at rest at the command's
-    /// first displacement).
-    pub initial: Option<State>,
-}
-
-impl ClosedLoop {
-    /// The platen's initial state for `command_u0_m`, the command's first displacement.
-    pub fn initial_state(&self, command_u0_m: f64) -> State {
-        self.initial.unwrap_or(State {
-            u_m: command_u0_m,
-            v_m_s: 0.0,
-        })
-    }
-}
 
 /// Builds the table system of `spec` (a preset with values laid over it, or explicit), with
 /// every error named by its JSON path under `table_system`.
@@ -314,7 +292,7 @@ fn unresolvable(
 /// resolves the loop's fastest mode, or Dopri5.
 pub(crate) fn loop_method(
     ctx: &Ctx,
-    file: &ScenarioFile,
+    integrator: Option<&IntegratorSpec>,
     system: &TableSystem,
     mass_kg: f64,
     stroke_m: f64,
@@ -333,7 +311,7 @@ pub(crate) fn loop_method(
             steps_per_period: k,
         })
     };
-    match &file.integrator {
+    match integrator {
         None => default_rk4(),
         Some(IntegratorSpec::Rk4(spec)) => {
             let Some(step) = spec.step_s else {
