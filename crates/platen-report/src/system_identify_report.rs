@@ -9,7 +9,7 @@ use std::path::Path;
 
 use platen_ident::system::{Prediction, SystemIdentification, SystemRecord, ValueProvenance};
 use platen_io::columns::ColumnMap;
-use platen_scenario::describe::SystemParameters;
+use platen_scenario::TableSystemSpec;
 
 use crate::figure::{Figure, Panel, MODEL, RECORDED, SIMULATED};
 use crate::series::{line, patterned, thinned};
@@ -58,7 +58,7 @@ pub fn system_scenario(
             missing,
         };
     };
-    let table_system = serde_json::to_value(SystemParameters::from(&sys)).unwrap_or_default();
+    let table_system = serde_json::to_value(TableSystemSpec::from(&sys)).unwrap_or_default();
     let column = |ours: &str| serde_json::to_value(columns.reading_spec(ours)).unwrap_or_default();
     let mut scenario = serde_json::json!({
         "name": format!("identified table, commanded by {}", held.name),

@@ -18,9 +18,7 @@ use crate::rig::Rig;
 use crate::scenario::Model;
 
 pub use crate::describe_system::{
-    AccumulatorParameters, ActuatorParameters, ControllerParameters, LinearisationDescription,
-    LoopMarginsDescription, ServoValveParameters, SystemAnalysis, SystemDescription,
-    SystemParameters,
+    LinearisationDescription, LoopMarginsDescription, SystemAnalysis, SystemDescription,
 };
 
 /// The description of a model: the contract's seven identified keys of the selected form,
