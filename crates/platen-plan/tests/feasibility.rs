@@ -46,7 +46,7 @@ fn scan(table: &Table<'_>, m: &TargetMotion, from: f64, to: f64, step: f64) -> f
     while s <= to + 1e-12 {
         let u: Vec<f64> = m.u_m.iter().map(|x| x * s).collect();
         let a = table.run(&m.t_s, &u, "scan").unwrap();
-        let fits = limit_uses(&table, &a).iter().all(|l| l.respected());
+        let fits = limit_uses(table, &a).iter().all(|l| l.respected());
         // Monotonic on the grid: once a scale fails, no larger one fits.
         assert!(
             fits <= last_fit,
