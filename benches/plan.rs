@@ -13,15 +13,16 @@
 mod common;
 
 use std::hint::black_box;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use platen::integrate::State;
 use platen::model::preset;
 use platen::plan::{
-    iterate, load_scenario, max_scale, BaselineSettings, FrfSource, IterationSettings,
-    MaxScaleSettings, Table, Target, TargetMotion,
+    iterate, max_scale, BaselineSettings, FrfSource, IterationSettings, MaxScaleSettings, Table,
+    Target, TargetMotion,
 };
+use platen::scenario::LoadedRig;
 
 use common::baseline::baseline_rk4;
 use common::{report_ratios, sine_force, timed, PRESSURE_PA, RATE_HZ};
@@ -51,25 +52,23 @@ fn quake(t: f64) -> f64 {
     0.3 * 9.806_65 * env * s / 2.0
 }
 
-fn scenario_path() -> PathBuf {
-    let path = std::env::temp_dir().join(format!("platen-bench-plan-{}.json", std::process::id()));
-    std::fs::write(
-        &path,
+/// The LHPOST's identified platen in its preset table system's loop.
+fn rig(path: &Path) -> LoadedRig {
+    LoadedRig::parse(
+        path,
         r#"{"name": "LHPOST closed loop", "model": {"preset": "lhpost-2008"},
             "table_system": {"preset": "lhpost-2008"}}"#,
     )
-    .unwrap();
-    path
+    .unwrap()
 }
 
 fn bench(c: &mut Criterion) {
     let params = preset::lhpost_2008_identified(PRESSURE_PA);
     let force = sine_force(100e3, SECONDS);
     let base_steps = (force.len() - 1) as u64;
-    let path = scenario_path();
-    let scenario = load_scenario(&path).unwrap();
-    let _ = std::fs::remove_file(&path);
-    let table = Table::new(&scenario, &path).unwrap();
+    let path = PathBuf::from("lhpost-closed-loop.json");
+    let loaded = rig(&path);
+    let table = Table::of_loaded(&loaded, &path).unwrap();
     let n = SECONDS * RATE_HZ as usize + 1;
     let t_s: Vec<f64> = (0..n).map(|j| j as f64 / RATE_HZ).collect();
     let a_m_s2: Vec<f64> = t_s.iter().map(|&t| quake(t)).collect();
@@ -77,7 +76,7 @@ fn bench(c: &mut Criterion) {
     let motion = TargetMotion::new(
         &target,
         &BaselineSettings::default(),
-        scenario.limits.stroke_m,
+        loaded.rig.limits.stroke_m,
         RATE_HZ,
     )
     .unwrap();

@@ -65,7 +65,7 @@ fn read_columns(path: &Path, names: &[&str]) -> Vec<Vec<f64>> {
 /// model's force with oil-column ringing, valve tone, quantisation and noise.
 fn s9_recorded(dir: &Path) -> PathBuf {
     let scenario = Scenario::load(Path::new(&shipped("s9-sine-motion.json"))).unwrap();
-    let (Model::Identified(model), Run::Inverse { motion }) = (&scenario.model, &scenario.run)
+    let (Model::Identified(model), Run::Inverse { motion }) = (&scenario.rig.model, &scenario.run)
     else {
         panic!("S9 is an inverse scenario on the identified model");
     };

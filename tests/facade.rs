@@ -23,18 +23,25 @@ fn shipped_scenarios() -> (Vec<PathBuf>, Vec<PathBuf>) {
 
 #[test]
 fn every_shipped_scenario_without_a_record_validates_through_the_facade() {
-    let mut forward = 0;
-    let mut inverse = 0;
+    let (mut forward, mut inverse, mut closed_loop) = (0, 0, 0);
     for path in shipped_scenarios().1 {
         let s = Scenario::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         match s.run {
             Run::Forward { .. } => forward += 1,
             Run::Inverse { .. } => inverse += 1,
+            Run::ClosedLoop { .. } => closed_loop += 1,
         }
+        // A rig with a table system runs its motion as the loop's command.
+        assert_eq!(
+            s.rig.table_system.is_some(),
+            matches!(s.run, Run::ClosedLoop { .. }),
+            "{}",
+            path.display()
+        );
     }
     assert!(
         forward >= 1 && inverse >= 1,
-        "forward {forward}, inverse {inverse}"
+        "forward {forward}, inverse {inverse}, closed loop {closed_loop}"
     );
 }
 

@@ -22,7 +22,7 @@ fn scenarios(folder: &str) -> Vec<PathBuf> {
 fn run(path: &Path) -> (Scenario, Peaks) {
     let s = Scenario::load(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let mut peaks = Peaks::default();
-    match (&s.model, &s.run) {
+    match (&s.rig.model, &s.run) {
         (Model::Identified(m), Run::Inverse { motion }) => inverse(m, motion, &mut peaks),
         _ => panic!(
             "{}: the paper's tests are inverse runs of the identified model",
@@ -134,7 +134,7 @@ fn the_whole_program_runs_at_all_three_pressures() {
         for f in files {
             let (s, p) = run(&f);
             assert!(p.force_n.value.is_finite(), "{}", f.display());
-            assert!(s.hold_down_pressure_pa >= 0.0);
+            assert!(s.rig.hold_down_pressure_pa >= 0.0);
             count += 1;
         }
     }

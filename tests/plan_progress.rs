@@ -4,13 +4,13 @@
 use std::f64::consts::TAU;
 use std::path::Path;
 
-use platen::plan::{load_scenario, plan, plan_observed, PlanSettings, Target};
+use platen::plan::{load_rig, plan, plan_observed, PlanSettings, Target};
 
 #[test]
 fn plan_observed_reports_every_drive_run_in_order_and_plans_what_plan_does() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let path = root.join("scenarios/table-system/wn10g-closed-loop.json");
-    let scenario = load_scenario(&path).unwrap();
+    let scenario = load_rig(&path).unwrap();
     // A 1 Hz, 5 cm sine over 8 s with half-cosine ramps at both ends.
     let t: Vec<f64> = (0..=8 * 1024).map(|j| j as f64 / 1024.0).collect();
     let ramp = |x: f64| 0.5 - 0.5 * (std::f64::consts::PI * x.clamp(0.0, 1.0)).cos();

@@ -68,7 +68,7 @@ fn the_sr9_check_holds_for_other_parameters_and_artefacts() {
     )
     .unwrap();
     let s = Scenario::load(&motion).unwrap();
-    let (Model::Identified(m), Run::Inverse { motion: mo }) = (&s.model, &s.run) else {
+    let (Model::Identified(m), Run::Inverse { motion: mo }) = (&s.rig.model, &s.run) else {
         panic!()
     };
     let mut truth = (Trajectory::default(), Peaks::default());

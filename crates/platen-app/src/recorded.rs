@@ -32,12 +32,16 @@ pub fn recorded_of(scenario: &Scenario, path: &Path, seed: u64) -> Result<Record
         )
         .map_err(|message| InputError::RecordedLike { message })
     }
-    let Run::Inverse { motion } = &scenario.run else {
+    let (Run::Inverse { motion }
+    | Run::ClosedLoop {
+        command: motion, ..
+    }) = &scenario.run
+    else {
         return Err(InputError::NotMotion {
             path: path.to_owned(),
         });
     };
-    match &scenario.model {
+    match &scenario.rig.model {
         Model::Identified(m) => recorded(m, motion, seed),
         Model::Full(m) => recorded(&**m, motion, seed),
     }

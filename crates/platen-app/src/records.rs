@@ -561,7 +561,7 @@ impl RecordSource {
             return Err(InputError::ScenarioFloors { path: path.clone() });
         }
         let scenario = Scenario::load(path)?;
-        let pressure_pa = scenario.hold_down_pressure_pa;
+        let pressure_pa = scenario.rig.hold_down_pressure_pa;
         if let Some(p) = self.pressure_mpa {
             // The same number written twice (13.8 in both files) may differ in its last bit.
             if (p * 1e6 - pressure_pa).abs() > 1e-9 * pressure_pa.abs().max(1.0) {

@@ -201,12 +201,12 @@ pub fn read_base_system(
     };
     let file = platen_scenario::file::parse(path, &scenario.to_string()).map_err(not_system)?;
     let s = Scenario::from_file(path, file).map_err(not_system)?;
-    let Some(cl) = s.closed_loop else {
+    let Some(system) = s.rig.table_system else {
         return Err(InputError::NoTableSystem {
             path: path.to_owned(),
         });
     };
-    Ok((cl.system, stroke))
+    Ok((system, stroke))
 }
 
 #[cfg(test)]

@@ -15,11 +15,12 @@ pub enum Direction {
 }
 
 impl Direction {
-    /// The direction of `scenario`'s run.
+    /// The direction of `scenario`'s run. A closed loop is compared on its actuator force,
+    /// as an inverse run is: the loop makes the force that the command's motion needs.
     pub fn of(scenario: &Scenario) -> Self {
         match &scenario.run {
             Run::Forward { .. } => Direction::Forward,
-            Run::Inverse { .. } => Direction::Inverse,
+            Run::Inverse { .. } | Run::ClosedLoop { .. } => Direction::Inverse,
         }
     }
 

@@ -185,7 +185,7 @@ impl Comparison {
                 ));
             }
         }
-        let recorded_limits = RecordedLimitCheck::of_recording(&recording, &scenario.limits);
+        let recorded_limits = RecordedLimitCheck::of_recording(&recording, &scenario.rig.limits);
         let mut series: Vec<(Channel, Vec<f64>, Vec<f64>)> = direction
             .channels()
             .iter()
@@ -204,7 +204,7 @@ impl Comparison {
                 .map_err(CompareError::Align)?;
             series.push((channel, rec, sim));
         }
-        if scenario.specimen.is_none() {
+        if scenario.rig.specimen.is_none() {
             let unused = recording.specimen_columns();
             if !unused.is_empty() {
                 recorded.sources.notes.push(format!(
@@ -226,7 +226,7 @@ impl Comparison {
                     .push_str(", less the recorded base shear B");
                 Some(rec.clone())
             }
-            None if scenario.specimen.is_some() => {
+            None if scenario.rig.specimen.is_some() => {
                 let b = Channel::BaseShear.of(&sim).unwrap_or_default();
                 recorded
                     .sources
@@ -243,7 +243,7 @@ impl Comparison {
         };
         let channels = compare_channels(series, rate, &t_s, settings)?;
         let b = base_shear_n.as_deref();
-        let (recorded_dissipative_n, law, law_label) = match &scenario.model {
+        let (recorded_dissipative_n, law, law_label) = match &scenario.rig.model {
             Model::Identified(m) => dissipative(m, &recorded, b, "(Eq. 22)"),
             Model::Full(m) => dissipative(&**m, &recorded, b, "at u = 0 (Eq. 4)"),
         };
@@ -263,7 +263,7 @@ impl Comparison {
             recorded_path: recording.path,
             name: scenario.name.clone(),
             direction,
-            model_form: scenario.model.form(),
+            model_form: scenario.rig.model.form(),
             sample_rate_hz: rate.hz(),
             sample_interval_s: recording.step_s,
             t_s,

@@ -42,7 +42,7 @@
 //! better; a run that fails numerically counts as not fitting.
 
 use platen_integrate::Peak;
-use platen_scenario::{LimitCheck, LimitsSummary, Scenario};
+use platen_scenario::{LimitCheck, LimitsSummary};
 use platen_system::Supply;
 use serde::Serialize;
 
@@ -73,11 +73,11 @@ impl LimitUse {
     }
 }
 
-/// Every limit of `scenario` against the run `achieved` (see the [module
+/// Every limit of `table` against its run `achieved` (see the [module
 /// documentation](self)), in a fixed order.
-pub fn limit_uses(scenario: &Scenario, achieved: &Achieved) -> Vec<LimitUse> {
+pub fn limit_uses(table: &Table, achieved: &Achieved) -> Vec<LimitUse> {
     let p = &achieved.output.peaks;
-    let l = &scenario.limits;
+    let l = &table.rig().limits;
     let plain = |limit, peak: Peak, allowed: f64| LimitUse {
         limit,
         peak: peak.value,
@@ -91,28 +91,27 @@ pub fn limit_uses(scenario: &Scenario, achieved: &Achieved) -> Vec<LimitUse> {
         plain("acceleration_m_s2", p.a_m_s2, l.acceleration_m_s2),
         plain("force_n", p.force_n, l.force_n),
     ];
-    if let Some(cl) = &scenario.closed_loop {
-        let capacity = cl.system.capacities().valve_flow_m3_s;
-        uses.push(plain("valve_flow_m3_s", achieved.flow_peak, capacity));
-        if let Supply::Accumulator(acc) = cl.system.supply {
-            let set = cl.system.supply_pressure_pa;
-            let min = achieved.min_supply_pressure;
-            uses.push(LimitUse {
-                limit: "supply_pressure_pa",
-                peak: min.value,
-                allowed: acc.precharge_pressure_pa,
-                ratio: ((set - min.value) / (set - acc.precharge_pressure_pa)).max(0.0),
-                t_s: min.t_s,
-            });
-        }
+    let system = table.system();
+    let capacity = system.capacities().valve_flow_m3_s;
+    uses.push(plain("valve_flow_m3_s", achieved.flow_peak, capacity));
+    if let Supply::Accumulator(acc) = system.supply {
+        let set = system.supply_pressure_pa;
+        let min = achieved.min_supply_pressure;
+        uses.push(LimitUse {
+            limit: "supply_pressure_pa",
+            peak: min.value,
+            allowed: acc.precharge_pressure_pa,
+            ratio: ((set - min.value) / (set - acc.precharge_pressure_pa)).max(0.0),
+            t_s: min.t_s,
+        });
     }
     uses
 }
 
-/// The scenario's four table limits against a run, as `simulate` reports them.
-pub fn limits_summary(scenario: &Scenario, achieved: &Achieved) -> LimitsSummary {
+/// The rig's four table limits against a run of `table`, as `simulate` reports them.
+pub fn limits_summary(table: &Table, achieved: &Achieved) -> LimitsSummary {
     let p = &achieved.output.peaks;
-    let l = &scenario.limits;
+    let l = &table.rig().limits;
     let check = |peak: f64, limit: f64| LimitCheck {
         limit,
         peak,
@@ -202,7 +201,7 @@ pub fn feasibility(
     search: Option<&MaxScaleSettings>,
 ) -> Result<Feasibility> {
     let achieved = table.run_or_end_stop(&motion.t_s, &motion.u_m, "the target's command")?;
-    let uses = limit_uses(table.scenario(), &achieved);
+    let uses = limit_uses(table, &achieved);
     let limiting = failing(&uses);
     let max_scale = match search {
         Some(settings) => Some(max_scale_from(table, motion, settings, &uses)?),
@@ -210,7 +209,7 @@ pub fn feasibility(
     };
     Ok(Feasibility {
         feasible: limiting.is_empty(),
-        limits: limits_summary(table.scenario(), &achieved),
+        limits: limits_summary(table, &achieved),
         uses,
         limiting,
         achieved,
@@ -230,7 +229,7 @@ pub fn max_scale(
     settings: &MaxScaleSettings,
 ) -> Result<MaxScale> {
     let achieved = table.run_or_end_stop(&motion.t_s, &motion.u_m, "the target's command")?;
-    let uses = limit_uses(table.scenario(), &achieved);
+    let uses = limit_uses(table, &achieved);
     let mut found = max_scale_from(table, motion, settings, &uses)?;
     found.runs += 1;
     Ok(found)
@@ -267,7 +266,7 @@ fn max_scale_from(
         let u: Vec<f64> = motion.u_m.iter().map(|x| x * s).collect();
         match table.run_or_end_stop(&motion.t_s, &u, "a scaled command") {
             Ok(a) => {
-                let f = failing(&limit_uses(table.scenario(), &a));
+                let f = failing(&limit_uses(table, &a));
                 (f.is_empty(), f.iter().map(|u| u.limit).collect())
             }
             Err(_) => (false, vec!["run_failed"]),

@@ -3,7 +3,7 @@
 //! model's linearisation or measured on the simulated table ([`FrequencyResponse`]).
 //!
 //! * **Linearised** ([`FrfSource::Linearised`]): [`platen_system::TableSystem::closed_loop_response`]
-//!   about mid-stroke ([`platen_scenario::Scenario::loop_linearisation`]): the controller with
+//!   about mid-stroke ([`platen_scenario::Rig::loop_linearisation`]): the controller with
 //!   its zero-order hold and the valve's delay, the spool, the oil columns, and the platen's
 //!   mass, stiffness and secant damping **with the specimen as a rigid payload** (its
 //!   resonances are not in it).
@@ -106,11 +106,11 @@ impl FrequencyResponse {
     /// The linearised response of `table`'s loop about mid-stroke.
     pub fn linearised(table: &Table<'_>) -> Self {
         let (linearisation, _) = table
-            .scenario()
+            .rig()
             .loop_linearisation()
             .expect("a table has a closed loop");
         Self {
-            system: table.closed_loop().system,
+            system: *table.system(),
             linearisation,
             measured: None,
         }

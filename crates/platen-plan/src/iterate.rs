@@ -598,7 +598,7 @@ pub fn iterate_observed(
     on_run: &mut dyn FnMut(usize),
 ) -> Result<Iteration<Achieved>> {
     let fs = 1.0 / motion.interval_s();
-    let with_specimen = table.scenario().specimen.is_some();
+    let with_specimen = table.rig().specimen.is_some();
     let frf = match &settings.frf.resolve(with_specimen) {
         FrfSource::Linearised | FrfSource::Auto => FrequencyResponse::linearised(table),
         FrfSource::Measured(noise) => {

@@ -1,16 +1,16 @@
 //! Test planning on a simulated shake table: can the table run this target, what limits it
 //! and what scale fits, and which drive makes the table reproduce it. Physics-free: every
-//! answer comes from running a scenario's closed loop ([`platen_scenario`]: its model,
+//! answer comes from running a rig's closed loop ([`platen_scenario::Rig`]: its model,
 //! `table_system` and specimen) with displacement commands.
 //!
 //! ```no_run
 //! use std::path::Path;
-//! use platen_plan::{load_scenario, plan, write_drive, PlanSettings, Target};
+//! use platen_plan::{load_rig, plan, write_drive, PlanSettings, Target};
 //!
 //! let scenario_path = Path::new("scenarios/table-system/northridge-closed-loop.json");
-//! let scenario = load_scenario(scenario_path)?; // its excitation is ignored
+//! let rig = load_rig(scenario_path)?; // its excitation is ignored
 //! let target = Target::read_csv(Path::new("target.csv"))?; // t_s and a_m_s2 (or u_m)
-//! let p = plan(&scenario, scenario_path, &target, &PlanSettings::with_max_scale())?;
+//! let p = plan(&rig, scenario_path, &target, &PlanSettings::with_max_scale())?;
 //! println!("feasible: {}, max scale {:?}", p.feasibility.feasible,
 //!          p.feasibility.max_scale.as_ref().map(|m| m.scale));
 //! if let Some(it) = p.iteration() {
@@ -30,7 +30,7 @@
 //! * [`TargetMotion`] ([`baseline`]): the displacement command of a target, integrated from
 //!   an acceleration with a baseline treatment that starts and ends at rest and keeps the
 //!   displacement as small as a polynomial correction can.
-//! * [`Table`]: a scenario's closed loop driven by any command ([`Achieved`]).
+//! * [`Table`]: a rig's closed loop driven by any command ([`Achieved`]).
 //! * [`feasibility()`](feasibility::feasibility), [`max_scale`] ([`feasibility`]): peaks and
 //!   margins of stroke, velocity, acceleration, actuator force, valve flow and supply
 //!   pressure; the limits that fail; the largest scale that fits, by bisection on the
@@ -70,7 +70,8 @@ pub use iterate::{
     Response, Stop,
 };
 pub use plan::{
-    load_scenario, plan, plan_observed, write_drive, Plan, PlanSettings, PlanSummary, PlannedDrive,
+    load_rig, plan, plan_observed, plan_table, write_drive, Plan, PlanSettings, PlanSummary,
+    PlannedDrive,
 };
 pub use table::{Achieved, Table};
 pub use target::{Target, TargetKind, MIN_TARGET_SAMPLES};

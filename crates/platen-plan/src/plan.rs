@@ -6,9 +6,7 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use platen_io::csv::write_csv_atomic;
-use platen_io::{IoAction, IoError};
-use platen_scenario::file::ExcitationSpec;
-use platen_scenario::{Arrays, LimitsSummary, Scenario};
+use platen_scenario::{LimitsSummary, LoadedRig};
 
 use crate::baseline::{peak, rms, BaselineSettings, TargetMotion};
 use crate::error::{PlanError, Result};
@@ -94,65 +92,33 @@ impl Plan {
     }
 }
 
-/// Loads a scenario file for planning: as [`Scenario::load`], but the `excitation` may be
+/// Loads a scenario file's rig for planning ([`LoadedRig::load`]): its model, table system,
+/// specimen and limits, and its loop's integrator and initial state. The `excitation` may be
 /// absent and is ignored when present (the target takes its place, so its records are not
-/// read), as is `duration_s`. The scenario's `run` is a placeholder (16 samples at rest);
-/// the planner runs the scenario's closed loop with its own commands.
+/// read), as is `duration_s`.
 ///
 /// # Errors
-/// Every error of [`Scenario::load`] but the excitation's; [`PlanError::NoTableSystem`].
-pub fn load_scenario(path: &Path) -> Result<Scenario> {
-    let text = std::fs::read_to_string(path).map_err(|source| IoError::Io {
-        path: path.to_owned(),
-        action: IoAction::Reading,
-        source,
-    })?;
-    // Syntax errors first, with their line; then add an empty excitation where there is none
-    // (on the first line, so that every later line keeps its number).
-    let value: serde_json::Value = platen_io::json::parse_json(path, &text)?;
-    let text = match value.as_object() {
-        Some(map) if !map.contains_key("excitation") => {
-            let at = text.find('{').map_or(0, |i| i + 1);
-            let insert = if map.is_empty() {
-                "\"excitation\": {}"
-            } else {
-                "\"excitation\": {}, "
-            };
-            format!("{}{insert}{}", &text[..at], &text[at..])
-        }
-        _ => text,
-    };
-    let mut file = platen_scenario::file::parse(path, &text)?;
-    file.excitation = ExcitationSpec::default();
-    file.duration_s = None;
-    if file.table_system.is_none() {
-        return Err(PlanError::NoTableSystem {
-            scenario: path.to_owned(),
-        });
-    }
-    let t_s: Vec<f64> = (0..16).map(|j| j as f64 / 1024.0).collect();
-    let arrays = Arrays::Motion {
-        u_m: vec![0.0; t_s.len()],
-        t_s,
-        v_m_s: None,
-        a_m_s2: None,
-    };
-    Ok(Scenario::from_arrays(path, file, arrays)?)
+/// Every error of [`LoadedRig::load`] and [`LoadedRig::loop_settings`];
+/// [`PlanError::NoTableSystem`].
+pub fn load_rig(path: &Path) -> Result<LoadedRig> {
+    let loaded = LoadedRig::load(path)?;
+    Table::of_loaded(&loaded, path)?;
+    Ok(loaded)
 }
 
-/// Plans `target` on `scenario` (read from `scenario_path`, for messages): the target's
-/// motion, its feasibility and largest scale, then the drive iteration.
+/// Plans `target` on the rig `loaded` (read from `scenario_path`, for messages): the
+/// target's motion, its feasibility and largest scale, then the drive iteration.
 ///
 /// # Errors
 /// [`PlanError::NoTableSystem`]; [`PlanError::TargetRate`] for a target sampled faster than
 /// the controller; bad settings; a closed-loop run that fails.
 pub fn plan(
-    scenario: &Scenario,
+    loaded: &LoadedRig,
     scenario_path: &Path,
     target: &Target,
     settings: &PlanSettings,
 ) -> Result<Plan> {
-    plan_observed(scenario, scenario_path, target, settings, &mut |_| {})
+    plan_observed(loaded, scenario_path, target, settings, &mut |_| {})
 }
 
 /// [`plan`], calling `on_run(k)` when the closed-loop run of drive iteration `k` is done (0:
@@ -162,13 +128,37 @@ pub fn plan(
 /// # Errors
 /// As [`plan`].
 pub fn plan_observed(
-    scenario: &Scenario,
+    loaded: &LoadedRig,
     scenario_path: &Path,
     target: &Target,
     settings: &PlanSettings,
     on_run: &mut dyn FnMut(usize),
 ) -> Result<Plan> {
-    let table = Table::new(scenario, scenario_path)?;
+    let table = Table::of_loaded(loaded, scenario_path)?;
+    plan_table(
+        &table,
+        &loaded.name,
+        scenario_path,
+        target,
+        settings,
+        on_run,
+    )
+}
+
+/// [`plan_observed`] on a table built by hand (any [`Rig`](platen_scenario::Rig) with a
+/// table system and its [`LoopSettings`](platen_scenario::LoopSettings): [`Table::new`]);
+/// `name` and `scenario_path` name it in the summary.
+///
+/// # Errors
+/// As [`plan`].
+pub fn plan_table(
+    table: &Table,
+    name: &str,
+    scenario_path: &Path,
+    target: &Target,
+    settings: &PlanSettings,
+    on_run: &mut dyn FnMut(usize),
+) -> Result<Plan> {
     let controller_hz = table.controller_rate_hz();
     if target.sample_rate_hz() > controller_hz * (1.0 + 1e-9) {
         return Err(PlanError::TargetRate {
@@ -180,7 +170,7 @@ pub fn plan_observed(
     let motion = TargetMotion::new(
         target,
         &settings.baseline,
-        scenario.limits.stroke_m,
+        table.rig().limits.stroke_m,
         controller_hz,
     )?;
     if rms(&motion.a_m_s2) == 0.0 {
@@ -189,7 +179,7 @@ pub fn plan_observed(
             message: "the target's acceleration is zero everywhere: nothing to reproduce".into(),
         });
     }
-    let feasibility = feasibility(&table, &motion, settings.max_scale.as_ref())?;
+    let feasibility = feasibility(table, &motion, settings.max_scale.as_ref())?;
     let mut warnings = Vec::new();
     let largest = feasibility.max_scale.as_ref().map_or(String::new(), |m| {
         format!(" (largest scale that fits: {:.4})", m.scale)
@@ -210,8 +200,8 @@ pub fn plan_observed(
     let drive = match feasibility.achieved.end_stop {
         Some(_) => None,
         None => {
-            let iteration = iterate_observed(&table, &motion, &settings.iteration, on_run)?;
-            let uses = limit_uses(scenario, &iteration.achieved);
+            let iteration = iterate_observed(table, &motion, &settings.iteration, on_run)?;
+            let uses = limit_uses(table, &iteration.achieved);
             if feasibility.feasible {
                 if let Some(worst) = failing(&uses).first() {
                     warnings.push(format!(
@@ -231,7 +221,7 @@ pub fn plan_observed(
                 ));
             }
             Some(PlannedDrive {
-                limits: limits_summary(scenario, &iteration.achieved),
+                limits: limits_summary(table, &iteration.achieved),
                 frf: FrfSummary::new(&settings.iteration, &iteration),
                 uses,
                 iteration,
@@ -240,7 +230,7 @@ pub fn plan_observed(
     };
     Ok(Plan {
         scenario_path: scenario_path.to_owned(),
-        scenario_name: scenario.name.clone(),
+        scenario_name: name.to_owned(),
         target_origin: target.origin().to_owned(),
         target_samples: target.len(),
         target_rate_hz: target.sample_rate_hz(),

@@ -1,19 +1,21 @@
-//! The simulated table: a scenario's closed loop (model, `table_system`, specimen) driven by
-//! any displacement command ([`Table::run`]).
+//! The simulated table: a rig's closed loop (model, `table_system`, specimen) driven by any
+//! displacement command ([`Table::run`]).
 
 use std::path::{Path, PathBuf};
 
 use platen_integrate::{IntegrateError, Peak, Peaks, Sample, SampleSink};
-use platen_scenario::{ClosedLoop, RunOutput, Scenario};
+use platen_scenario::{LoadedRig, LoopSettings, Rig, RunOutput};
+use platen_system::TableSystem;
 
 use crate::baseline::command_motion;
 use crate::error::{PlanError, Result};
 
-/// A scenario's closed loop, ready to run any command: what the planner simulates.
+/// A rig's closed loop, ready to run any command: what the planner simulates.
 #[derive(Debug, Clone, Copy)]
 pub struct Table<'a> {
-    scenario: &'a Scenario,
-    closed_loop: &'a ClosedLoop,
+    rig: &'a Rig,
+    system: &'a TableSystem,
+    settings: LoopSettings,
 }
 
 /// What a run of the table gives: the achieved motion at the command's samples, and the
@@ -30,7 +32,7 @@ pub struct Achieved {
     pub v_m_s: Vec<f64>,
     /// Achieved acceleration, m/s² (0 while the platen sticks).
     pub a_m_s2: Vec<f64>,
-    /// The run's peaks, statistics and tracking ([`Scenario::run`]'s output).
+    /// The run's peaks, statistics and tracking ([`Rig::run`]'s output).
     pub output: RunOutput,
     /// The lowest supply pressure and when, Pa.
     pub min_supply_pressure: Peak,
@@ -97,16 +99,17 @@ impl SampleSink for Recorder {
 }
 
 impl<'a> Table<'a> {
-    /// The table of `scenario`, which must have a `table_system`; `path` names the scenario
-    /// in the error.
+    /// The table of `rig`, which must have a `table_system`, its loop integrated as
+    /// `settings` say; `path` names the rig's scenario file in the error.
     ///
     /// # Errors
     /// [`PlanError::NoTableSystem`].
-    pub fn new(scenario: &'a Scenario, path: &Path) -> Result<Self> {
-        match &scenario.closed_loop {
-            Some(closed_loop) => Ok(Self {
-                scenario,
-                closed_loop,
+    pub fn new(rig: &'a Rig, settings: LoopSettings, path: &Path) -> Result<Self> {
+        match &rig.table_system {
+            Some(system) => Ok(Self {
+                rig,
+                system,
+                settings,
             }),
             None => Err(PlanError::NoTableSystem {
                 scenario: PathBuf::from(path),
@@ -114,19 +117,39 @@ impl<'a> Table<'a> {
         }
     }
 
-    /// The scenario.
-    pub fn scenario(&self) -> &'a Scenario {
-        self.scenario
+    /// The table of a rig read from the scenario file `path` ([`LoadedRig::load`]), with the
+    /// file's loop settings ([`LoadedRig::loop_settings`]).
+    ///
+    /// # Errors
+    /// [`PlanError::Scenario`] for the file's errors (its integrator's too);
+    /// [`PlanError::NoTableSystem`].
+    pub fn of_loaded(loaded: &'a LoadedRig, path: &Path) -> Result<Self> {
+        match loaded.loop_settings()? {
+            Some(settings) => Self::new(&loaded.rig, settings, path),
+            None => Err(PlanError::NoTableSystem {
+                scenario: PathBuf::from(path),
+            }),
+        }
     }
 
-    /// The closed loop.
-    pub fn closed_loop(&self) -> &'a ClosedLoop {
-        self.closed_loop
+    /// The rig.
+    pub fn rig(&self) -> &'a Rig {
+        self.rig
+    }
+
+    /// The rig's table system.
+    pub fn system(&self) -> &'a TableSystem {
+        self.system
+    }
+
+    /// How the loop is integrated and where the platen starts.
+    pub fn settings(&self) -> &LoopSettings {
+        &self.settings
     }
 
     /// The controller's sample rate, Hz.
     pub fn controller_rate_hz(&self) -> f64 {
-        self.closed_loop.system.controller.sample_rate_hz
+        self.system.controller.sample_rate_hz
     }
 
     /// Runs the closed loop with the displacement command `u_m` at the stamps `t_s` (its
@@ -168,10 +191,11 @@ impl<'a> Table<'a> {
             flow: Peak::default(),
             stuck: 0,
         };
-        let result = self.scenario.model.run_closed_loop(
-            self.closed_loop,
+        let result = self.rig.model.run_closed_loop(
+            self.system,
+            &self.settings,
             &command,
-            self.scenario.specimen.as_ref(),
+            self.rig.specimen.as_ref(),
             &mut rec,
         );
         let (output, end_stop) = match result {

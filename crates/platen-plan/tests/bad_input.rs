@@ -8,7 +8,7 @@ use std::path::Path;
 
 use platen_io::IoError;
 use platen_plan::{
-    load_scenario, plan, write_drive, PlanError, PlanSettings, Target, MIN_TARGET_SAMPLES,
+    load_rig, plan, write_drive, PlanError, PlanSettings, Target, MIN_TARGET_SAMPLES,
 };
 
 /// Writes `text` to `name` in `dir` and reads it as a target.
@@ -182,24 +182,24 @@ fn scenarios_for_planning_need_a_table_system_and_no_excitation() {
         "bare.json",
         r#"{"model": {"preset": "lhpost-2008"}, "table_system": {"preset": "lhpost-2008"}}"#,
     );
-    assert!(load_scenario(&bare).unwrap().closed_loop.is_some());
+    assert!(load_rig(&bare).unwrap().rig.table_system.is_some());
     let ignored = write(
         "ignored.json",
         r#"{"model": {"preset": "lhpost-2008"}, "table_system": {"preset": "lhpost-2008"},
             "excitation": {"ground_motion": {"record": "not-here.AT2"}}, "duration_s": 3}"#,
     );
-    assert!(load_scenario(&ignored).is_ok());
+    assert!(load_rig(&ignored).is_ok());
     // No table system.
     let open = write("open.json", r#"{"model": {"preset": "lhpost-2008"}}"#);
-    let e = load_scenario(&open).unwrap_err();
+    let e = load_rig(&open).unwrap_err();
     assert!(matches!(e, PlanError::NoTableSystem { .. }), "{e:?}");
     assert!(e.to_string().contains("open.json") && e.to_string().contains("table_system"));
-    // A bad value keeps its JSON path (and its line: the excitation is added on line 1).
+    // A bad value keeps its JSON path and its line.
     let bad = write(
         "bad.json",
         "{\"model\": {\"preset\": \"lhpost-2008\"},\n \"table_system\": {\"preset\": \"lhpost-2008\",\n \"oil_bulk_modulus_pa\": \"stiff\"}}",
     );
-    let m = load_scenario(&bad).unwrap_err().to_string();
+    let m = load_rig(&bad).unwrap_err().to_string();
     assert!(
         m.contains("table_system.oil_bulk_modulus_pa") && m.contains("line 3"),
         "{m}"

@@ -28,7 +28,7 @@ use platen_integrate::{SpecimenColumns, SystemColumns, Trajectory};
 use platen_io::columns::ColumnMap;
 use platen_model::{IdentifiedKey, PhysicalKey, Preset};
 use platen_scenario::sweep::{csv_text, json_summary, SetAxis, Sweep};
-use platen_scenario::{file, Arrays, ModelKey, Run, RunSummary, Scenario};
+use platen_scenario::{file, Arrays, ModelKey, RunSummary, Scenario};
 
 use crate::error::{detached, Fail, Kind};
 
@@ -67,11 +67,7 @@ fn json_text<T: serde::Serialize>(value: &T) -> Result<String, Fail> {
 
 /// Runs `scenario` (named `path` in its summary), keeping every output column.
 fn run_scenario(scenario: &Scenario, path: &Path) -> Result<(Trajectory, String), Fail> {
-    let samples = match &scenario.run {
-        Run::Forward { samples, .. } => *samples,
-        Run::Inverse { motion } => motion.len(),
-    };
-    let mut trajectory = Trajectory::with_capacity(samples);
+    let mut trajectory = Trajectory::with_capacity(scenario.run.samples());
     let output = scenario.run(&mut trajectory)?;
     let summary = RunSummary::new(path, scenario, &output, None);
     Ok((trajectory, json_text(&summary)?))
@@ -302,7 +298,7 @@ fn sweep(
 ) -> PyResult<(String, String)> {
     Ok(detached(py, move || {
         let (path, scenario) = load(path.as_deref(), text.as_deref(), &origin)?;
-        let form = scenario.overrides.form();
+        let form = scenario.rig.overrides.form();
         let mut axes: Vec<SetAxis> = Vec::with_capacity(sets.len());
         for (name, values) in sets {
             let axis = set_axis(name, values, form)?;

@@ -7,8 +7,7 @@ use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 
 use platen_plan::{FrfSource, MaxScaleSettings, NoiseSettings, PlanError, PlanSettings, Target};
-use platen_scenario::file::ExcitationSpec;
-use platen_scenario::{file, Arrays, Scenario};
+use platen_scenario::LoadedRig;
 
 use crate::error::{chain, detached, Fail, Kind};
 use crate::{json_text, vector};
@@ -30,35 +29,6 @@ impl From<PlanError> for Fail {
             e => Fail::of(Kind::Input, &e),
         }
     }
-}
-
-/// The scenario JSON text `text` (named `origin`) for planning, as
-/// [`platen_plan::load_scenario`] reads a file: its excitation, if any, is ignored.
-fn scenario_from_text(origin: &Path, text: &str) -> Result<Scenario, Fail> {
-    let mut value: serde_json::Value = platen_io::json::parse_json(origin, text)?;
-    if let Some(map) = value.as_object_mut() {
-        map.entry("excitation")
-            .or_insert_with(|| serde_json::json!({}));
-    }
-    let text = serde_json::to_string(&value)
-        .map_err(|e| Fail::new(Kind::Internal, format!("internal error: {e}")))?;
-    let mut parsed = file::parse(origin, &text)?;
-    parsed.excitation = ExcitationSpec::default();
-    parsed.duration_s = None;
-    if parsed.table_system.is_none() {
-        return Err(PlanError::NoTableSystem {
-            scenario: origin.to_owned(),
-        }
-        .into());
-    }
-    let t_s: Vec<f64> = (0..16).map(|j| f64::from(j) / 1024.0).collect();
-    let arrays = Arrays::Motion {
-        u_m: vec![0.0; t_s.len()],
-        t_s,
-        v_m_s: None,
-        a_m_s2: None,
-    };
-    Ok(Scenario::from_arrays(origin, parsed, arrays)?)
 }
 
 /// Plans the target (`a_m_s2` or `u_m` at `t_s`) on a scenario file or a scenario dict's
@@ -95,15 +65,16 @@ pub fn plan<'py>(
                 )))
             }
         };
-        let (path, scenario) = match (path, text) {
+        let (path, rig) = match (path, text) {
             (Some(path), _) => {
-                let s = platen_plan::load_scenario(&path)?;
-                (path, s)
+                let rig = platen_plan::load_rig(&path)?;
+                (path, rig)
             }
             (None, Some(text)) => {
+                // As `load_rig` reads a file: the excitation, if any, is ignored.
                 let origin = PathBuf::from(&origin);
-                let s = scenario_from_text(&origin, &text)?;
-                (origin, s)
+                let rig = LoadedRig::parse(&origin, &text).map_err(PlanError::from)?;
+                (origin, rig)
             }
             (None, None) => return Err(Fail::input("no scenario: give a path or a dict")),
         };
@@ -129,7 +100,7 @@ pub fn plan<'py>(
             max_scale: max_scale.then(MaxScaleSettings::default),
             ..Default::default()
         };
-        let p = platen_plan::plan(&scenario, &path, &target, &settings).map_err(|e| match e {
+        let p = platen_plan::plan(&rig, &path, &target, &settings).map_err(|e| match e {
             PlanError::TargetRate { .. } => Fail::input(chain(&e)),
             e => e.into(),
         })?;

@@ -19,8 +19,9 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use platen_model::STANDARD_GRAVITY_M_S2;
-use platen_scenario::describe::{ModelDescription, SystemDescription, SystemParameters};
-use platen_scenario::Scenario;
+use platen_scenario::describe::{ModelDescription, SystemDescription};
+use platen_scenario::Rig;
+use platen_system::Supply;
 
 /// Significant digits of every printed value: the paper quotes its parameters to 3–4.
 pub const SIGNIFICANT_DIGITS: i32 = 4;
@@ -36,10 +37,10 @@ pub fn text(d: &ModelDescription) -> String {
 
 /// The lines `platen model --scenario` prints before the model's text: the scenario's path
 /// and name, the values it lays over its preset's and its specimen.
-pub fn scenario_header(path: &Path, scenario: &Scenario) -> String {
+pub fn scenario_header(path: &Path, name: &str, rig: &Rig) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "scenario {} ({})", path.display(), scenario.name);
-    let overrides: Vec<String> = scenario
+    let _ = writeln!(s, "scenario {} ({})", path.display(), name);
+    let overrides: Vec<String> = rig
         .overrides
         .values()
         .iter()
@@ -52,7 +53,7 @@ pub fn scenario_header(path: &Path, scenario: &Scenario) -> String {
             overrides.join(", ")
         );
     }
-    if let Some(sp) = &scenario.specimen {
+    if let Some(sp) = &rig.specimen {
         let storeys = sp.len();
         let _ = writeln!(
             s,
@@ -416,7 +417,7 @@ pub fn model_text(d: &ModelDescription) -> String {
 /// The table system's groups: its parameters, oil column, capacities, linearisation, loop
 /// and integration step, in engineering units.
 pub fn system_text(d: &SystemDescription) -> String {
-    let params = &d.parameters;
+    let params = &d.system;
     let a = &params.actuator;
     let v = &params.servo_valve;
     let lin = &d.linearisation;
@@ -428,27 +429,27 @@ pub fn system_text(d: &SystemDescription) -> String {
     };
     // The unit of an optional value: none when there is no value.
     let unit_of = |x: Option<f64>, unit: &'static str| if x.is_some() { unit } else { "" };
-    let supply = match &params.accumulator {
-        None => "supply pressure (constant)".to_owned(),
-        Some(acc) => format!(
+    let supply = match &params.supply {
+        Supply::Constant => "supply pressure (constant)".to_owned(),
+        Supply::Accumulator(acc) => format!(
             "supply pressure (accumulator, precharge {} MPa)",
             num(acc.precharge_pressure_pa / 1e6)
         ),
     };
     let parameters = vec![
         row("n", "actuators".into(), a.count.to_string(), ""),
-        row("A_a", "cap-side area".into(), num(a.cap_side_area_m2), "m²"),
-        row("A_b", "rod-side area".into(), num(a.rod_side_area_m2), "m²"),
+        row("A_a", "cap-side area".into(), num(a.cap_area_m2), "m²"),
+        row("A_b", "rod-side area".into(), num(a.rod_area_m2), "m²"),
         row(
             "V_a",
             "cap-side chamber volume at mid-stroke".into(),
-            num(a.chamber_volume_m3[0]),
+            num(a.cap_volume_m3),
             "m³",
         ),
         row(
             "V_b",
             "rod-side chamber volume at mid-stroke".into(),
-            num(a.chamber_volume_m3[1]),
+            num(a.rod_volume_m3),
             "m³",
         ),
         row(
@@ -684,8 +685,7 @@ pub fn system_text(d: &SystemDescription) -> String {
         .as_deref()
         .map_or("given by the scenario".to_owned(), |p| {
             // The preset's own values, or the scenario's laid over them.
-            let own = platen_system::preset::by_name(p)
-                .map_or(true, |s| SystemParameters::from(&s) == *params);
+            let own = platen_system::preset::by_name(p).map_or(true, |s| s == *params);
             let laid = if own {
                 ""
             } else {

@@ -186,7 +186,10 @@ impl<'a> RunRecorder<'a> {
     pub fn new(run: &'a Run) -> Self {
         match run {
             Run::Forward { samples, .. } => Self::with_span(run.time_span_s(), *samples),
-            Run::Inverse { motion } => Self {
+            Run::Inverse { motion }
+            | Run::ClosedLoop {
+                command: motion, ..
+            } => Self {
                 command: Command::new(motion.t_s(), motion.a_m_s2()),
                 ..Self::with_span(run.time_span_s(), motion.len())
             },
@@ -309,13 +312,15 @@ struct Channel {
 pub fn figures(recorder: RunRecorder<'_>, scenario: &Scenario) -> Vec<Figure> {
     let stride = recorder.stride;
     let samples = recorder.samples;
-    let closed_loop = match (&scenario.closed_loop, &recorder.command) {
-        (Some(cl), Some(command)) if !recorder.system.is_empty() => Some(LoopRecord {
-            system: cl.system,
-            channels: recorder.system.into_iter().map(Envelope::finish).collect(),
-            zoom_s: command.zoom_s,
-            zoom: recorder.zoom,
-        }),
+    let closed_loop = match (&scenario.run, &scenario.rig.table_system, &recorder.command) {
+        (Run::ClosedLoop { .. }, Some(system), Some(command)) if !recorder.system.is_empty() => {
+            Some(LoopRecord {
+                system: *system,
+                channels: recorder.system.into_iter().map(Envelope::finish).collect(),
+                zoom_s: command.zoom_s,
+                zoom: recorder.zoom,
+            })
+        }
         _ => None,
     };
     let kn = [false, false, false, true, true, true, true];
@@ -489,7 +494,7 @@ fn channel_panel(c: &Channel, points: &Points, color: plotters::style::RGBColor)
 
 /// u, v, a and F_A over time.
 fn motion(r: &Recorded, scenario: &Scenario) -> Figure {
-    let l: &TableLimits = &scenario.limits;
+    let l: &TableLimits = &scenario.rig.limits;
     let channels = [
         ("displacement", "u", "m", Some(l.stroke_m)),
         ("velocity", "v", "m/s", Some(l.velocity_m_s)),

@@ -48,7 +48,7 @@ pub fn text(
 
 /// `", overridden: name = value, …"` when the scenario lays values over its preset's.
 fn overridden(s: &Scenario) -> String {
-    let values = s.overrides.values();
+    let values = s.rig.overrides.values();
     if values.is_empty() {
         return String::new();
     }
@@ -92,20 +92,18 @@ fn specimen_lines(s: &mut String, peaks: &Peaks) {
 /// What ran, its peaks, a forward run's figures and the table's limits.
 fn run_lines(s: &mut String, sc: &Scenario, output: &RunOutput, out: Option<&Path>) {
     let (peaks, stats) = (&output.peaks, output.stats.as_ref());
-    let dir = if sc.closed_loop.is_some() {
-        "closed loop (command → controller → valves → platen)"
-    } else if stats.is_some() {
-        "forward (force → motion)"
-    } else {
-        "inverse (motion → force)"
+    let dir = match sc.run {
+        Run::ClosedLoop { .. } => "closed loop (command → controller → valves → platen)",
+        Run::Forward { .. } => "forward (force → motion)",
+        Run::Inverse { .. } => "inverse (motion → force)",
     };
     let _ = writeln!(
         s,
         "{}: {dir}, {} model, {} at {:.2} MPa{}",
         sc.name,
-        sc.model.form(),
-        sc.preset.name(),
-        sc.hold_down_pressure_pa / 1e6,
+        sc.rig.model.form(),
+        sc.rig.preset.name(),
+        sc.rig.hold_down_pressure_pa / 1e6,
         overridden(sc)
     );
     let _ = writeln!(
@@ -165,9 +163,9 @@ fn run_lines(s: &mut String, sc: &Scenario, output: &RunOutput, out: Option<&Pat
             st.energy.relative_residual()
         );
     }
-    let ex = peaks.exceedances(&sc.limits);
+    let ex = peaks.exceedances(&sc.rig.limits);
     if ex.is_empty() {
-        let l = &sc.limits;
+        let l = &sc.rig.limits;
         let _ = writeln!(
             s,
             "  within the table's limits (stroke ±{} m, {} m/s, {} g, {} MN)",

@@ -124,7 +124,7 @@ fn axis_figure(
         }
     }
     let many = groups.len() > MAX_LABELLED;
-    let l = &scenario.limits;
+    let l = &scenario.rig.limits;
     let quantities: [Quantity; 4] = [
         ("displacement", "m", 1.0, l.stroke_m, |o| o.peaks.u_m.value),
         ("velocity", "m/s", 1.0, l.velocity_m_s, |o| {

@@ -37,8 +37,8 @@ pub fn sweep_text(run: &SweepRun<'_>, figures: Option<&[PathBuf]>) -> String {
         "{}: {} cases ({} model, {})",
         scenario.name,
         run.cases.len(),
-        scenario.model.form(),
-        scenario.preset.name(),
+        scenario.rig.model.form(),
+        scenario.rig.preset.name(),
     );
     let mut head = format!("  {:>5} {:>8} {:>8}", "case", "scale", "MPa");
     for n in run.set_names {

@@ -4,12 +4,18 @@
 //! loop's predictions against the records, side by side with a linear black box and perfect
 //! tracking.
 
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
 use platen_ident::system::{Prediction, SystemIdentification, SystemRecord, ValueProvenance};
 use platen_io::columns::ColumnMap;
-use platen_scenario::describe::SystemParameters;
+use platen_io::columns::ColumnSpec;
+use platen_scenario::file::{
+    ExcitationSpec, IdentifiedOverrides, LimitsSpec, ModelSpec, ScenarioFile, SpecimenSpec,
+    StoreySpec,
+};
+use platen_scenario::TableSystemSpec;
 
 use crate::figure::{Figure, Panel, MODEL, RECORDED, SIMULATED};
 use crate::series::{line, patterned, thinned};
@@ -58,46 +64,29 @@ pub fn system_scenario(
             missing,
         };
     };
-    let table_system = serde_json::to_value(SystemParameters::from(&sys)).unwrap_or_default();
-    let column = |ours: &str| serde_json::to_value(columns.reading_spec(ours)).unwrap_or_default();
-    let mut scenario = serde_json::json!({
-        "name": format!("identified table, commanded by {}", held.name),
-        // The format needs a preset; every value of the identified form is given below, and
-        // every limit, so the preset contributes nothing.
-        "model": {
-            "preset": "lhpost-2008",
-            "identified": {
-                "effective_mass_kg": m.effective_mass_kg,
-                "stiffness_n_per_m": m.stiffness_n_per_m,
-                "coulomb_force_n": m.coulomb_force_n,
-                "viscous_coefficient": m.viscous_coefficient,
-                "viscous_exponent": m.viscous_exponent,
-                "low_velocity_force_n": m.low_velocity_force_n,
-                "low_velocity_decay_s_per_m": m.low_velocity_decay_s_per_m,
-            }
-        },
-        "table_system": table_system,
-        // The record's own a_m_s2 is the table's, not the command's: the command's velocity
-        // and acceleration are derived from command_u_m (the record's columns ignored).
-        "excitation": {
-            "motion_csv": held_path.display().to_string(),
-            "columns": {
-                "t_s": column("t_s"),
-                "u_m": column("command_u_m"),
-                "v_m_s": { "ignore": true },
-                "a_m_s2": { "ignore": true },
-            }
-        },
-    });
-    if let Some(sp) = plant.and_then(|p| p.specimen.as_ref()) {
-        scenario["specimen"] = serde_json::json!({
-            "storeys": sp.storeys().iter().map(|s| serde_json::json!({
-                "mass_kg": s.mass_kg,
-                "stiffness_n_per_m": s.stiffness_n_per_m,
-                "damping_n_s_per_m": s.damping_n_s_per_m,
-            })).collect::<Vec<_>>()
+    // The record's own a_m_s2 is the table's, not the command's: the command's velocity
+    // and acceleration are derived from command_u_m (the record's columns ignored).
+    let ignored = ColumnSpec {
+        ignore: true,
+        ..ColumnSpec::default()
+    };
+    let columns = BTreeMap::from([
+        ("t_s".to_owned(), columns.reading_spec("t_s")),
+        ("u_m".to_owned(), columns.reading_spec("command_u_m")),
+        ("v_m_s".to_owned(), ignored.clone()),
+        ("a_m_s2".to_owned(), ignored),
+    ]);
+    let specimen = plant
+        .and_then(|p| p.specimen.as_ref())
+        .map(|sp| SpecimenSpec {
+            storeys: (sp.storeys().iter())
+                .map(|s| StoreySpec {
+                    mass_kg: s.mass_kg,
+                    stiffness_n_per_m: s.stiffness_n_per_m,
+                    damping_n_s_per_m: s.damping_n_s_per_m,
+                })
+                .collect(),
         });
-    }
     // The chambers must keep oil over the stroke: the base's, else 90 % of what the
     // identified volumes allow. The other limits are this table's: its capacities by the
     // closed forms in the weaker direction, and the acceleration that force gives the moving
@@ -113,12 +102,45 @@ pub fn system_scenario(
     let specimen_kg: f64 = plant
         .and_then(|p| p.specimen.as_ref())
         .map_or(0.0, |sp| sp.storeys().iter().map(|s| s.mass_kg).sum());
-    scenario["limits"] = serde_json::json!({
-        "stroke_m": stroke,
-        "velocity_m_s": velocity,
-        "force_n": force,
-        "acceleration_m_s2": force / (m.effective_mass_kg + specimen_kg),
-    });
+    let file = ScenarioFile {
+        schema: None,
+        name: Some(format!("identified table, commanded by {}", held.name)),
+        description: None,
+        // The format needs a preset; every value of the identified form is given, and every
+        // limit, so the preset contributes nothing.
+        model: ModelSpec {
+            preset: "lhpost-2008".into(),
+            hold_down_pressure_mpa: None,
+            identified: Some(IdentifiedOverrides {
+                effective_mass_kg: Some(m.effective_mass_kg),
+                stiffness_n_per_m: Some(m.stiffness_n_per_m),
+                coulomb_force_n: Some(m.coulomb_force_n),
+                viscous_coefficient: Some(m.viscous_coefficient),
+                viscous_exponent: Some(m.viscous_exponent),
+                low_velocity_force_n: Some(m.low_velocity_force_n),
+                low_velocity_decay_s_per_m: Some(m.low_velocity_decay_s_per_m),
+            }),
+            full: None,
+        },
+        excitation: ExcitationSpec {
+            motion_csv: Some(held_path.to_path_buf()),
+            columns: Some(columns),
+            ..ExcitationSpec::default()
+        },
+        integrator: None,
+        initial: None,
+        duration_s: None,
+        limits: Some(LimitsSpec {
+            stroke_m: Some(stroke),
+            velocity_m_s: Some(velocity),
+            acceleration_m_s2: Some(force / (m.effective_mass_kg + specimen_kg)),
+            force_n: Some(force),
+        }),
+        specimen,
+        table_system: Some(TableSystemSpec::from(&sys)),
+    };
+    // Every key a string and every number finite or null: the conversion cannot fail.
+    let scenario = serde_json::to_value(&file).unwrap_or_default();
     let mut provenance = id.provenance.clone();
     let derived = |path: &str, note: &str| ValueProvenance {
         path: path.into(),

@@ -12,17 +12,13 @@ use std::path::Path;
 use serde::Serialize;
 use serde_json::Value;
 
-use platen_io::json::parse_json_file;
-use platen_io::IoError;
 use platen_model::{IdentifiedKey, IdentifiedParams, ModelError, PhysicalKey, Preset, TableLimits};
 
-use crate::error::Result;
-use crate::scenario::{Model, Scenario};
+use crate::rig::Rig;
+use crate::scenario::Model;
 
 pub use crate::describe_system::{
-    AccumulatorParameters, ActuatorParameters, ControllerParameters, LinearisationDescription,
-    LoopMarginsDescription, ServoValveParameters, SystemAnalysis, SystemDescription,
-    SystemParameters,
+    LinearisationDescription, LoopMarginsDescription, SystemAnalysis, SystemDescription,
 };
 
 /// The description of a model: the contract's seven identified keys of the selected form,
@@ -185,15 +181,15 @@ impl ModelDescription {
         Ok(description)
     }
 
-    /// The description of the scenario `s` read from `path`: its preset's at its pressure and
-    /// form with the scenario's own model laid in (its seven identified keys, for the full
-    /// form its identified equivalent, physical parameters and derived quantities), its
-    /// limits, `scenario` (the path as given), `model_overrides` and `specimen`. The table
-    /// system is left to [`SystemAnalysis`].
+    /// The description of the rig `s` of the scenario read from `path` ([`Rig::load`]): its
+    /// preset's at its pressure and form with the rig's own model laid in (its seven
+    /// identified keys, for the full form its identified equivalent, physical parameters and
+    /// derived quantities), its limits, `scenario` (the path as given), `model_overrides`
+    /// and `specimen`. The table system is left to [`SystemAnalysis`].
     ///
     /// # Errors
-    /// As [`ModelDescription::of_preset`] (not for a validated scenario).
-    pub fn of_scenario(path: &Path, s: &Scenario) -> std::result::Result<Self, ModelError> {
+    /// As [`ModelDescription::of_preset`] (not for a validated rig).
+    pub fn of_rig(path: &Path, s: &Rig) -> std::result::Result<Self, ModelError> {
         let mut d = Self::of_preset(s.preset, s.hold_down_pressure_pa, s.model.form() == "full")?;
         let seven = match &s.model {
             Model::Identified(m) => *m.params(),
@@ -287,56 +283,6 @@ pub fn describe_model(
     Ok(serde_json::to_value(d).unwrap_or(Value::Null))
 }
 
-/// A scenario read for its description ([`load_for_description`]).
-#[derive(Debug)]
-pub struct DescribedScenario {
-    /// The scenario, with a placeholder excitation (a few samples of a small sine) and
-    /// duration that are never run.
-    pub scenario: Scenario,
-    /// The `table_system.preset` the file names, if any.
-    pub table_system_preset: Option<String>,
-}
-
-/// The model, table system and specimen of the scenario at `path`: its excitation,
-/// integrator, initial state and duration are not read (so a scenario whose records are
-/// missing is still described).
-///
-/// # Errors
-/// [`crate::ScenarioError`] as [`Scenario::load`] reports it for the file's other keys.
-pub fn load_for_description(path: &Path) -> Result<DescribedScenario> {
-    let mut file: Value = parse_json_file(path)?;
-    let Some(obj) = file.as_object_mut() else {
-        // The scenario reader's own message for a file that is not an object.
-        Scenario::load(path)?;
-        return Err(IoError::Json {
-            path: path.to_owned(),
-            json_path: "top level".to_owned(),
-            message: "expected a JSON object".to_owned(),
-        }
-        .into());
-    };
-    let table_system_preset = obj
-        .get("table_system")
-        .and_then(|t| t.get("preset"))
-        .and_then(Value::as_str)
-        .map(str::to_owned);
-    for key in ["excitation", "duration_s", "integrator", "initial"] {
-        obj.remove(key);
-    }
-    // A few samples of a small sine: a valid command that is never run.
-    obj.insert(
-        "excitation".into(),
-        serde_json::json!({"sine_motion": {"amplitude_m": 1e-3, "frequency_hz": 1.0, "sample_rate_hz": 1024.0}}),
-    );
-    obj.insert("duration_s".into(), serde_json::json!(0.01));
-    let text = serde_json::to_string(&file).unwrap_or_default();
-    let scenario = Scenario::from_file(path, crate::file::parse(path, &text)?)?;
-    Ok(DescribedScenario {
-        scenario,
-        table_system_preset,
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -380,9 +326,9 @@ mod tests {
     fn a_scenario_lays_its_values_and_specimen_in() {
         let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios");
         let path = root.join("table-system/wn10g-closed-loop.json");
-        let loaded = load_for_description(&path).unwrap();
+        let loaded = crate::LoadedRig::load(&path).unwrap();
         assert_eq!(loaded.table_system_preset.as_deref(), Some("lhpost-2008"));
-        let d = ModelDescription::of_scenario(&path, &loaded.scenario).unwrap();
+        let d = ModelDescription::of_rig(&path, &loaded.rig).unwrap();
         assert_eq!(
             d.scenario.as_deref(),
             Some(path.display().to_string().as_str())

@@ -1,152 +1,15 @@
 //! A table system's closed forms and linearised loop, as `platen model --system` and
 //! `--scenario` describe them (re-exported by [`crate::describe`]): its parameters in the
-//! scenario format, the oil-column frequencies, the valve-limited velocities, the flow and
+//! scenario format ([`TableSystemSpec`]), the oil-column frequencies, the valve-limited velocities, the flow and
 //! force capacities, the linearisation about mid-stroke, the loop's margins and closed-loop
 //! passband, and the default RK4 step per controller period.
 
 use serde::Serialize;
 
-use platen_system::{
-    Linearisation, Margins, Mechanics, Passband, Supply, TableSystem, SECANT_SPEED_M_S,
-};
+use platen_system::{Linearisation, Margins, Mechanics, Passband, TableSystem, SECANT_SPEED_M_S};
 
 use crate::scenario::Model;
-
-/// A table system's parameters as the scenario format's `table_system` object, every key
-/// explicit (fields in alphabetical order, as the JSON object prints them).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct SystemParameters {
-    /// The accumulator bank (`None`, printed `null`: a constant supply).
-    pub accumulator: Option<AccumulatorParameters>,
-    /// The actuators.
-    pub actuator: ActuatorParameters,
-    /// The controller.
-    pub controller: ControllerParameters,
-    /// Effective bulk modulus of the oil, Pa.
-    pub oil_bulk_modulus_pa: f64,
-    /// Return pressure (absolute), Pa.
-    pub return_pressure_pa: f64,
-    /// The servo-valves of each actuator.
-    pub servo_valve: ServoValveParameters,
-    /// Supply pressure (absolute), Pa.
-    pub supply_pressure_pa: f64,
-}
-
-/// `table_system.actuator`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct ActuatorParameters {
-    /// Cap-side piston area, m².
-    pub cap_side_area_m2: f64,
-    /// Each chamber's volume at mid-stroke, lines included, `[cap, rod]`, m³.
-    pub chamber_volume_m3: [f64; 2],
-    /// Number of actuators acting together.
-    pub count: u32,
-    /// Cross-port leakage, m³/s per Pa.
-    pub leakage_m3_s_per_pa: f64,
-    /// Rod-side annulus area, m².
-    pub rod_side_area_m2: f64,
-}
-
-/// `table_system.servo_valve`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct ServoValveParameters {
-    /// Valves per actuator.
-    pub count: u32,
-    /// Spool damping ratio.
-    pub damping_ratio: f64,
-    /// Pure delay, s.
-    pub delay_s: f64,
-    /// Spool natural frequency, Hz.
-    pub natural_frequency_hz: f64,
-    /// Rated flow of one valve, m³/s.
-    pub rated_flow_m3_s: f64,
-    /// Total pressure drop of the rating, Pa.
-    pub rated_pressure_drop_pa: f64,
-}
-
-/// `table_system.accumulator`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct AccumulatorParameters {
-    /// Polytropic exponent of the gas.
-    pub polytropic_exponent: f64,
-    /// Gas precharge pressure, Pa.
-    pub precharge_pressure_pa: f64,
-    /// Largest pump flow, m³/s.
-    pub pump_flow_m3_s: f64,
-    /// Gas volume of the bank at precharge, m³.
-    pub volume_m3: f64,
-}
-
-/// `table_system.controller` (see [`platen_system::Controller`]).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct ControllerParameters {
-    /// `K_ab`, drive per m/s² of platen acceleration.
-    pub acceleration_feedback_s2_per_m: f64,
-    /// `K_af`, drive per m/s² of command acceleration.
-    pub acceleration_feedforward_s2_per_m: f64,
-    /// `K_Δp`, drive per Pa of (high-passed) pressure difference.
-    pub delta_p_gain_per_pa: f64,
-    /// Corner of the high-pass filter on `Δp`, Hz.
-    pub delta_p_highpass_hz: f64,
-    /// `K_p`, drive per m of error.
-    pub displacement_gain_per_m: f64,
-    /// `K_i`, drive per m·s of integrated error.
-    pub integral_gain_per_m_s: f64,
-    /// Sample rate, Hz.
-    pub sample_rate_hz: f64,
-    /// `K_vb`, drive per m/s of platen velocity.
-    pub velocity_feedback_s_per_m: f64,
-    /// `K_vf`, drive per m/s of command velocity.
-    pub velocity_feedforward_s_per_m: f64,
-}
-
-impl From<&TableSystem> for SystemParameters {
-    fn from(sys: &TableSystem) -> Self {
-        let a = &sys.actuator;
-        let v = &sys.servo_valve;
-        let c = &sys.controller;
-        Self {
-            accumulator: match &sys.supply {
-                Supply::Constant => None,
-                Supply::Accumulator(acc) => Some(AccumulatorParameters {
-                    polytropic_exponent: acc.polytropic_exponent,
-                    precharge_pressure_pa: acc.precharge_pressure_pa,
-                    pump_flow_m3_s: acc.pump_flow_m3_s,
-                    volume_m3: acc.volume_m3,
-                }),
-            },
-            actuator: ActuatorParameters {
-                cap_side_area_m2: a.cap_area_m2,
-                chamber_volume_m3: [a.cap_volume_m3, a.rod_volume_m3],
-                count: a.count,
-                leakage_m3_s_per_pa: a.leakage_m3_s_per_pa,
-                rod_side_area_m2: a.rod_area_m2,
-            },
-            controller: ControllerParameters {
-                acceleration_feedback_s2_per_m: c.acceleration_feedback_s2_per_m,
-                acceleration_feedforward_s2_per_m: c.acceleration_feedforward_s2_per_m,
-                delta_p_gain_per_pa: c.delta_p_gain_per_pa,
-                delta_p_highpass_hz: c.delta_p_highpass_hz,
-                displacement_gain_per_m: c.displacement_gain_per_m,
-                integral_gain_per_m_s: c.integral_gain_per_m_s,
-                sample_rate_hz: c.sample_rate_hz,
-                velocity_feedback_s_per_m: c.velocity_feedback_s_per_m,
-                velocity_feedforward_s_per_m: c.velocity_feedforward_s_per_m,
-            },
-            oil_bulk_modulus_pa: sys.oil_bulk_modulus_pa,
-            return_pressure_pa: sys.return_pressure_pa,
-            servo_valve: ServoValveParameters {
-                count: v.count,
-                damping_ratio: v.damping_ratio,
-                delay_s: v.delay_s,
-                natural_frequency_hz: v.natural_frequency_hz,
-                rated_flow_m3_s: v.rated_flow_m3_s,
-                rated_pressure_drop_pa: v.rated_pressure_drop_pa,
-            },
-            supply_pressure_pa: sys.supply_pressure_pa,
-        }
-    }
-}
+use crate::system_file::TableSystemSpec;
 
 /// The small-signal coefficients of the loop about mid-stroke (`linearisation`; see
 /// [`Linearisation`]).
@@ -257,8 +120,13 @@ pub struct SystemDescription {
     /// Oil-column frequency at mid-stroke with the specimen as a rigid payload, Hz.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub oil_column_frequency_with_specimen_hz: Option<f64>,
-    /// The system's parameters.
-    pub parameters: SystemParameters,
+    /// The system's parameters in the scenario format, every value given
+    /// ([`TableSystemSpec::from`]; printed with its keys sorted).
+    #[serde(serialize_with = "sorted")]
+    pub parameters: TableSystemSpec,
+    /// The system described (what `parameters` writes; not printed).
+    #[serde(skip)]
+    pub system: TableSystem,
     /// The preset the system came from (`None`, printed `null`: a scenario's own values).
     pub preset: Option<String>,
     /// The specimen's mass, kg.
@@ -276,6 +144,14 @@ pub struct SystemDescription {
     pub valve_limited_velocity_extend_m_s: f64,
     /// No-load velocity at full opening, retracting, m/s.
     pub valve_limited_velocity_retract_m_s: f64,
+}
+
+/// `value` written as a JSON object with its keys in alphabetical order (the order of the
+/// contract's JSON), whatever the order of its type's fields.
+fn sorted<S: serde::Serializer, T: Serialize>(value: &T, s: S) -> Result<S::Ok, S::Error> {
+    serde_json::to_value(value)
+        .map_err(serde::ser::Error::custom)?
+        .serialize(s)
 }
 
 /// A table system driving a model, linearised about mid-stroke: the bare table and, with a
@@ -368,7 +244,8 @@ impl SystemAnalysis {
             oil_column_frequency_with_specimen_hz: self
                 .loaded
                 .map(|l| sys.oil_column_frequency_hz(l.mechanics.mass_kg, 0.0)),
-            parameters: SystemParameters::from(sys),
+            parameters: TableSystemSpec::from(sys),
+            system: *sys,
             preset: self.preset.clone(),
             specimen_mass_kg: self.specimen_mass_kg,
             step_s: period / f64::from(self.steps_per_controller_period),
@@ -405,7 +282,7 @@ mod tests {
         assert!((d.oil_column_frequency_hz - 10.66).abs() < 0.01, "{d:?}");
         assert_eq!(d.oil_column_frequency_with_specimen_hz, None);
         assert!(d.loop_margins.stable);
-        assert_eq!(d.parameters, SystemParameters::from(&sys));
+        assert_eq!(d.parameters, TableSystemSpec::from(&sys));
         let loaded = SystemAnalysis::new(None, sys, &model(), 0.75, Some(40e3)).description();
         let with = loaded.oil_column_frequency_with_specimen_hz.unwrap();
         assert!(with < d.oil_column_frequency_hz, "{with}");

@@ -56,6 +56,12 @@ pub enum ScenarioError {
         path: PathBuf,
     },
 
+    /// A closed-loop run was given to a rig without a `table_system` (a [`crate::Scenario`]
+    /// or [`crate::Rig`] built by hand: a scenario file with a motion and no table system is
+    /// an inverse run).
+    #[error("a closed-loop run needs a rig with a table_system")]
+    NoTableSystem,
+
     /// A forward run failed numerically (or its record could not serve it); the error names
     /// the time. Nothing was written.
     #[error("forward run failed; no output was written")]

@@ -6,6 +6,8 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use platen_integrate::{Dopri5Settings, ForceRecord, IntegrateError, Method, Motion, Rk4, State};
+
+use crate::rig::LoopSettings;
 use platen_io::columns::ColumnMap;
 use platen_io::IoError;
 use platen_model::STANDARD_GRAVITY_M_S2;
@@ -16,7 +18,7 @@ use crate::file::*;
 use crate::generate::{self, GenerateError};
 use crate::sampling::{sampling_grid, uniform_step_s};
 
-/// What a scenario runs.
+/// What a scenario runs: what the rig ([`crate::Rig`]) does.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Run {
     /// Force-driven: the force record drives the model forward.
@@ -35,6 +37,15 @@ pub enum Run {
         /// The prescribed motion (already cut to the duration).
         motion: Motion,
     },
+    /// Commanded: the rig's table system drives the platen to follow a displacement
+    /// command, forward (a rig with a `table_system` and a motion excitation).
+    ClosedLoop {
+        /// The displacement command, with its velocity and acceleration (already cut to
+        /// the duration).
+        command: Motion,
+        /// The loop's integrator and the platen's initial state.
+        settings: LoopSettings,
+    },
 }
 
 impl Run {
@@ -46,6 +57,7 @@ impl Run {
                 record, samples, ..
             } => (record.t_s(), *samples),
             Run::Inverse { motion } => (motion.t_s(), motion.len()),
+            Run::ClosedLoop { command, .. } => (command.t_s(), command.len()),
         };
         match n.checked_sub(1).and_then(|last| t.get(last)) {
             Some(&end) => (t[0], end),
@@ -54,7 +66,7 @@ impl Run {
     }
 
     /// The same run with its excitation multiplied by `k`: the force record, or the
-    /// prescribed displacement, velocity and acceleration. `k = 1` borrows this run, so a
+    /// prescribed (or commanded) displacement, velocity and acceleration. `k = 1` borrows this run, so a
     /// sweep's unscaled cases copy no record.
     ///
     /// # Errors
@@ -77,23 +89,50 @@ impl Run {
                 initial: *initial,
                 samples: *samples,
             },
-            Run::Inverse { motion } => {
-                let scaled = Motion::new(
-                    motion.t_s().to_vec(),
-                    times(motion.u_m()),
-                    times(motion.v_m_s()),
-                    times(motion.a_m_s2()),
-                )?;
-                // The dead band is the velocity measurement's resolution: not scaled.
-                Run::Inverse {
-                    motion: match motion.rest_velocity_m_s() {
-                        Some(band) => scaled.with_rest_velocity(band)?,
-                        None => scaled,
-                    },
-                }
-            }
+            Run::Inverse { motion } => Run::Inverse {
+                motion: scaled_motion(motion, k)?,
+            },
+            Run::ClosedLoop { command, settings } => Run::ClosedLoop {
+                command: scaled_motion(command, k)?,
+                settings: *settings,
+            },
         }))
     }
+
+    /// Number of output samples: the force record's first `samples`, the motion's or the
+    /// command's every sample.
+    pub fn samples(&self) -> usize {
+        match self {
+            Run::Forward { samples, .. } => *samples,
+            Run::Inverse { motion } => motion.len(),
+            Run::ClosedLoop { command, .. } => command.len(),
+        }
+    }
+
+    /// The direction of the run: `"forward"` (a force, or a command through the loop,
+    /// integrated forward) or `"inverse"` (the force a motion needs).
+    pub fn direction(&self) -> &'static str {
+        match self {
+            Run::Forward { .. } | Run::ClosedLoop { .. } => "forward",
+            Run::Inverse { .. } => "inverse",
+        }
+    }
+}
+
+/// `motion` with its displacement, velocity and acceleration multiplied by `k`.
+fn scaled_motion(motion: &Motion, k: f64) -> std::result::Result<Motion, IntegrateError> {
+    let times = |c: &[f64]| c.iter().map(|x| x * k).collect();
+    let scaled = Motion::new(
+        motion.t_s().to_vec(),
+        times(motion.u_m()),
+        times(motion.v_m_s()),
+        times(motion.a_m_s2()),
+    )?;
+    // The dead band is the velocity measurement's resolution: not scaled.
+    Ok(match motion.rest_velocity_m_s() {
+        Some(band) => scaled.with_rest_velocity(band)?,
+        None => scaled,
+    })
 }
 
 /// Number of samples of a record of `len` samples at interval `dt` that `duration_s` covers.

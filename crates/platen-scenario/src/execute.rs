@@ -12,8 +12,9 @@ use platen_io::IoError;
 use platen_model::{PlatenModel, Specimen};
 
 use crate::error::{Result, ScenarioError};
+use crate::rig::{LoopSettings, Rig};
 use crate::scenario::{Model, Run, Scenario};
-use crate::system::ClosedLoop;
+use platen_system::TableSystem;
 
 /// What a run leaves besides its samples: the peaks (and span) of every output channel and,
 /// for a forward run, the solver's statistics and energy balance.
@@ -93,21 +94,36 @@ fn update(p: &mut Peak, value: f64, t_s: f64) {
 
 impl Scenario {
     /// Runs the scenario, delivering every output sample to `sink` in time order: forward
-    /// runs at the force record's sample times, inverse runs at the motion's.
+    /// runs at the force record's sample times, inverse runs at the motion's, closed loops
+    /// at the command's.
     ///
     /// # Errors
     /// [`ScenarioError::Run`] when a forward run fails numerically (the cause names the
     /// time); samples before the failure have been delivered to `sink`.
     pub fn run<S: SampleSink>(&self, sink: &mut S) -> Result<RunOutput> {
-        if let (Some(cl), Run::Inverse { motion }) = (&self.closed_loop, &self.run) {
-            return self
-                .model
-                .run_closed_loop(cl, motion, self.specimen.as_ref(), sink)
-                .map_err(ScenarioError::Run);
-        }
-        match &self.specimen {
-            None => self.model.run(&self.run, sink),
-            Some(specimen) => self.model.run_with_specimen(&self.run, specimen, sink),
+        self.rig.run(&self.run, sink)
+    }
+}
+
+impl Rig {
+    /// Runs `run` on this rig (its model, specimen and, for a closed loop, table system),
+    /// delivering every output sample to `sink` in time order.
+    ///
+    /// # Errors
+    /// [`ScenarioError::Run`] when a forward run fails numerically (the cause names the
+    /// time); [`ScenarioError::NoTableSystem`] for a closed loop on a rig without a table
+    /// system.
+    pub fn run<S: SampleSink>(&self, run: &Run, sink: &mut S) -> Result<RunOutput> {
+        match (run, &self.table_system) {
+            (Run::ClosedLoop { command, settings }, Some(system)) => {
+                self.model
+                    .run_closed_loop(system, settings, command, self.specimen.as_ref(), sink)
+            }
+            (Run::ClosedLoop { .. }, None) => return Err(ScenarioError::NoTableSystem),
+            (run, _) => match &self.specimen {
+                None => self.model.run(run, sink),
+                Some(specimen) => self.model.run_with_specimen(run, specimen, sink),
+            },
         }
         .map_err(ScenarioError::Run)
     }
@@ -115,7 +131,9 @@ impl Scenario {
 
 impl Model {
     /// Runs `run` on this model (a sweep's case: another model or a scaled excitation),
-    /// delivering every output sample to `sink`.
+    /// delivering every output sample to `sink`. The model has no table system: a
+    /// [`Run::ClosedLoop`]'s command runs as the motion it asks for (inverse); the rig runs
+    /// the loop ([`Rig::run`]).
     ///
     /// # Errors
     /// The integrator's error when a forward run fails numerically, with its time.
@@ -169,7 +187,10 @@ fn run_specimen<M: PlatenModel, S: SampleSink>(
             *samples,
             &mut sink,
         )?),
-        Run::Inverse { motion } => {
+        Run::Inverse { motion }
+        | Run::ClosedLoop {
+            command: motion, ..
+        } => {
             inverse_specimen(model, specimen, motion, &mut sink);
             None
         }
@@ -182,14 +203,16 @@ fn run_specimen<M: PlatenModel, S: SampleSink>(
 }
 
 impl Model {
-    /// Runs the closed loop `cl` on this model with `command` as the displacement command
-    /// (and `specimen` on the platen), delivering every sample to `sink`.
+    /// Runs the closed loop of `system` on this model with `command` as the displacement
+    /// command, integrated as `settings` say (and `specimen` on the platen), delivering every
+    /// sample to `sink`.
     ///
     /// # Errors
     /// The integrator's error when the run fails numerically, with its time.
     pub fn run_closed_loop<S: SampleSink>(
         &self,
-        cl: &ClosedLoop,
+        system: &TableSystem,
+        settings: &LoopSettings,
         command: &Motion,
         specimen: Option<&Specimen>,
         sink: &mut S,
@@ -200,11 +223,11 @@ impl Model {
         };
         let mut sink = (sink, (Peaks::default(), tracker));
         let run = LoopRun {
-            system: &cl.system,
+            system,
             specimen,
             command,
-            method: cl.method,
-            initial: cl.initial_state(command.u_m()[0]),
+            method: settings.method,
+            initial: settings.initial_state(command.u_m()[0]),
         };
         let stats = match self {
             Model::Identified(m) => forward_closed_loop(m, &run, command.len(), &mut sink)?,
@@ -236,7 +259,10 @@ fn run_model<M: PlatenModel, S: SampleSink>(
             initial,
             samples,
         } => Some(integrator.forward(model, record, *initial, *samples, &mut sink)?),
-        Run::Inverse { motion } => {
+        Run::Inverse { motion }
+        | Run::ClosedLoop {
+            command: motion, ..
+        } => {
             inverse(model, motion, &mut sink);
             None
         }

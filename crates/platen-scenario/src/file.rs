@@ -12,35 +12,45 @@ use platen_io::json::parse_json;
 
 use crate::error::Result;
 
-/// The scenario file as written (after JSON parsing, before validation).
-#[derive(Debug, Clone, Deserialize, JsonSchema)]
+/// The scenario file as written (after JSON parsing, before validation), and as a program
+/// writes one (serialised, absent values are not written).
+#[derive(Debug, Clone, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ScenarioFile {
     /// The JSON Schema this file follows (ignored; lets editors find `platen schema`'s output).
     #[serde(rename = "$schema")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub schema: Option<String>,
     /// A short name for reports (default: the file stem).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
     /// Free text.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub description: Option<String>,
     /// The model.
     pub model: ModelSpec,
     /// The excitation.
     pub excitation: ExcitationSpec,
     /// The integrator (forward runs).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub integrator: Option<IntegratorSpec>,
     /// The initial state (forward runs).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub initial: Option<InitialSpec>,
     /// Simulated duration, s (default: the record's span).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub duration_s: Option<f64>,
     /// The table's limits, laid over the preset's (default: the preset's; the LHPOST's are
     /// ±0.75 m, 1.8 m/s, 4.2 g, 6.8 MN).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub limits: Option<LimitsSpec>,
     /// A specimen on the platen: a shear building, bottom storey first.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub specimen: Option<SpecimenSpec>,
     /// The loop around the platen (controller, valves, actuators, supply): with one, a motion
     /// excitation is the displacement command of a closed-loop forward run
     /// ([`crate::system`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub table_system: Option<crate::system_file::TableSystemSpec>,
 }
 
@@ -70,26 +80,33 @@ pub struct StoreySpec {
 #[serde(deny_unknown_fields)]
 pub struct LimitsSpec {
     /// Displacement stroke, ±m.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub stroke_m: Option<f64>,
     /// Peak velocity, m/s.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub velocity_m_s: Option<f64>,
     /// Peak acceleration, m/s².
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub acceleration_m_s2: Option<f64>,
     /// Horizontal actuator force capacity, N.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub force_n: Option<f64>,
 }
 
 /// `model`: a preset, its hold-down pressure, and the form with overrides.
-#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ModelSpec {
     /// Preset name (`lhpost-2008`).
     pub preset: String,
     /// Hold-down nitrogen pressure, MPa (default: the preset's nominal 13.8 MPa).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub hold_down_pressure_mpa: Option<f64>,
     /// Identified-model values laid over the preset's (Eq. 22/23).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub identified: Option<IdentifiedOverrides>,
     /// Selects the full Lagrangian model; physical values laid over the preset's.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub full: Option<PhysicalOverrides>,
 }
 
@@ -98,12 +115,19 @@ pub struct ModelSpec {
 #[serde(deny_unknown_fields)]
 #[allow(missing_docs)]
 pub struct IdentifiedOverrides {
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub effective_mass_kg: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub stiffness_n_per_m: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub coulomb_force_n: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub viscous_coefficient: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub viscous_exponent: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub low_velocity_force_n: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub low_velocity_decay_s_per_m: Option<f64>,
 }
 
@@ -114,65 +138,97 @@ pub struct IdentifiedOverrides {
 #[serde(deny_unknown_fields)]
 #[allow(missing_docs)]
 pub struct PhysicalOverrides {
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub platen_mass_kg: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub actuator_moving_mass_kg: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub strut_piston_mass_kg: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub strut_cylinder_mass_kg: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub strut_height_m: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub strut_piston_length_m: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub strut_area_m2: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub gas_heat_capacity_ratio: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub supported_weight_n: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub bearing_friction_coefficient: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub lateral_friction_coefficient: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub lateral_normal_force_n: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub hinge_swivel_friction_coefficient: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub hinge_radius_m: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub hinge_force_distribution_factor: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub viscous_coefficient: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub viscous_exponent: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub strut_viscous_coefficient: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub strut_viscous_exponent: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub low_velocity_force_n: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub low_velocity_decay_s_per_m: Option<f64>,
 }
 
 /// `excitation`: exactly one source.
-#[derive(Debug, Clone, Default, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, Default, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ExcitationSpec {
     /// Recorded actuator force (`t_s`, `force_n`): forward run.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub force_csv: Option<PathBuf>,
     /// Prescribed motion (`t_s`, `u_m`, optional `v_m_s`, `a_m_s2`): inverse run.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub motion_csv: Option<PathBuf>,
     /// Generated sine force: forward run.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub sine_force: Option<SineForce>,
     /// Generated sine displacement (the paper's S tests): inverse run.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub sine_motion: Option<SineMotion>,
     /// Generated triangle displacement with rounded reversals (the paper's T tests): inverse run.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub triangle_motion: Option<TriangleMotion>,
     /// Generated band-limited white-noise motion (the paper's WN tests): inverse run.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub white_noise_motion: Option<WhiteNoiseMotion>,
     /// Table motion from a ground-acceleration record (an earthquake test): inverse run.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub ground_motion: Option<GroundMotion>,
     /// Zero-phase low-pass of a force excitation before it drives the model, Hz (the paper
     /// low-passed the SR9 force at 0.6 Hz). Forward runs only.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub lowpass_hz: Option<f64>,
     /// The filter of `lowpass_hz` (default `brickwall`).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub lowpass_filter: Option<LowpassFilter>,
     /// Velocity dead band of an inverse run, m/s (default: none, only `v = 0` is at rest):
     /// where `|v|` is at most this the platen counts as at rest, and the friction is the
     /// static reaction that balances the inertial and elastic forces within `±F_s` instead of
     /// flipping with the sign of a noisy measured velocity
     /// ([`platen_integrate::inverse`]). Motion excitations only.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub rest_velocity_m_s: Option<f64>,
     /// A lab's own channel names and units for `force_csv` / `motion_csv`
     /// (see [`crate::columns`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub columns: Option<BTreeMap<String, ColumnSpec>>,
 }
 
 /// Zero-phase low-pass filters for `lowpass_hz`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, JsonSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum LowpassFilter {
     /// Frequency-domain brick wall: unit gain and zero phase below the cut-off, nothing above.
@@ -193,7 +249,7 @@ pub enum LowpassFilter {
 /// velocity and displacement from rest, sampled at `sample_rate_hz`
 /// ([`platen_signal::AccelerogramMotion`]). With the default `baseline` (`none`) the velocity
 /// and displacement at the record's own sample times are PEER's `.VT2` and `.DT2`.
-#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GroundMotion {
     /// The record's file name: looked up next to the scenario, then in the folder named by
@@ -211,13 +267,18 @@ pub struct GroundMotion {
     /// acceleration: order 0 removes a bias, for a raw record) or `velocity` (remove it from
     /// the velocity, its derivative from the acceleration and its integral from the
     /// displacement).
-    #[serde(default = "default_baseline")]
+    #[serde(
+        default = "default_baseline",
+        skip_serializing_if = "BaselineKind::is_none",
+        serialize_with = "BaselineKind::write"
+    )]
     pub baseline: BaselineKind,
     /// Polynomial order of the baseline correction (default 0, at most 8).
     #[serde(default)]
     pub baseline_order: usize,
     /// For a record given as CSV (a `.csv` file): the time and acceleration columns' names and
     /// units, e.g. `{"t_s": {"name": "time"}, "a_m_s2": {"name": "acc (g)", "unit": "g"}}`.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub columns: Option<BTreeMap<String, ColumnSpec>>,
 }
 
@@ -233,6 +294,22 @@ pub enum BaselineKind {
     Velocity,
 }
 
+impl BaselineKind {
+    /// Whether this is [`BaselineKind::None`] (the default, not written).
+    fn is_none(&self) -> bool {
+        *self == BaselineKind::None
+    }
+
+    /// Writes the kind by its name in the file.
+    fn write<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.serialize_str(match self {
+            BaselineKind::None => "none",
+            BaselineKind::Acceleration => "acceleration",
+            BaselineKind::Velocity => "velocity",
+        })
+    }
+}
+
 fn default_scale() -> f64 {
     1.0
 }
@@ -243,7 +320,7 @@ fn default_baseline() -> BaselineKind {
 
 /// `F(t) = r(t)·amplitude_n·sin(2π·frequency_hz·t)`, with `r` a linear ramp from 0 to 1 over
 /// `ramp_s` (0: none), sampled at `sample_rate_hz` from `t = 0`.
-#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SineForce {
     /// Force amplitude, N.
@@ -260,7 +337,7 @@ pub struct SineForce {
 
 /// `u(t) = amplitude_m·sin(2π·frequency_hz·t)` with its exact velocity and acceleration,
 /// sampled at `sample_rate_hz` from `t = 0` (the paper's S tests).
-#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SineMotion {
     /// Displacement amplitude, m.
@@ -276,7 +353,7 @@ pub struct SineMotion {
 /// ([`crate::generate::triangle_motion`]): peak `amplitude_m`, constant velocity
 /// `velocity_m_s`, reversal arcs at `reversal_acceleration_m_s2`; period
 /// `4U/V + 2V/A_r`.
-#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TriangleMotion {
     /// Peak displacement, m.
@@ -291,7 +368,7 @@ pub struct TriangleMotion {
 }
 
 /// Band-limited white-noise motion ([`crate::generate::white_noise_motion`]).
-#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct WhiteNoiseMotion {
     /// RMS acceleration, in g (`0.1` for the paper's WN10%g).
@@ -321,7 +398,7 @@ fn default_rate() -> f64 {
 }
 
 /// `integrator`, selected by `method`.
-#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, Deserialize, Serialize, JsonSchema)]
 #[serde(tag = "method", rename_all = "lowercase")]
 pub enum IntegratorSpec {
     /// Fixed-step RK4 with exact stick-slip.
@@ -331,12 +408,14 @@ pub enum IntegratorSpec {
 }
 
 /// `{"method": "dopri5", "rtol": …, "atol": …}`.
-#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Dopri5Spec {
     /// Relative tolerance (default 1e-8).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub rtol: Option<f64>,
     /// Absolute tolerance, in the state's units (m, m/s) (default 1e-11).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub atol: Option<f64>,
 }
 
@@ -346,22 +425,25 @@ pub const DEFAULT_RTOL: f64 = 1e-8;
 pub const DEFAULT_ATOL: f64 = 1e-11;
 
 /// `{"method": "rk4", "step_s": …}`.
-#[derive(Debug, Clone, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Rk4Spec {
     /// Step, s; must divide the record's sample interval (default: the sample interval).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub step_s: Option<f64>,
 }
 
 /// `initial`: the state at the record's first sample, given (`{"u_m": …, "v_m_s": …}`) or
 /// taken from the force record's own `u_m` and `v_m_s` columns (`{"from_record": true}`, for
 /// a recorded test that did not start at rest, like the paper's SR9).
-#[derive(Debug, Clone, Default, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, Default, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct InitialSpec {
     /// Displacement, m (default 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub u_m: Option<f64>,
     /// Velocity, m/s (default 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub v_m_s: Option<f64>,
     /// Take the state from the first row of the force CSV's `u_m` and `v_m_s` columns.
     #[serde(default)]

@@ -1,7 +1,11 @@
-//! Scenario files, time-series CSV readers and writers for `platen`.
+//! Scenario files for `platen`: a rig and a run, validated, and the executor that runs them.
 //!
 //! * [`scenario`]: the scenario JSON format ([`Scenario::load`] validates a file and loads
-//!   its records before anything is simulated);
+//!   its records before anything is simulated): a [`Rig`] (what the table is: model, limits,
+//!   table system, specimen) and a [`Run`] (what it does: [`Run::Forward`] from a force,
+//!   [`Run::Inverse`] from a motion, [`Run::ClosedLoop`] from a command);
+//! * [`Rig::load`], [`LoadedRig::load`]: a scenario file's rig without a run (no excitation
+//!   needed), for a planner's own commands;
 //! * [`Scenario::from_arrays`]: the same format with the records given in memory (Python's
 //!   `platen.forward` and `platen.inverse`);
 //! * [`Scenario::run`]: the executor every front end calls (CLI, sweep, bench, Python).
@@ -25,6 +29,7 @@ mod execute;
 pub mod file;
 pub mod generate;
 pub mod recorded;
+mod rig;
 pub mod sampling;
 pub mod scenario;
 mod summary;
@@ -39,9 +44,10 @@ pub use error::{Result, ScenarioError};
 pub use execute::{CsvSink, LoopOutput, RunOutput, Tracking};
 /// Column maps are part of the scenario format (`excitation.columns`).
 pub use platen_io::columns;
+pub use rig::{LoadedRig, LoopSettings, Rig};
 pub use scenario::{Model, ModelKey, ModelOverrides, Run, Scenario};
 pub use summary::{
     simulate, EnergySummary, ExceedanceSummary, ForwardSummary, LimitCheck, LimitsSummary,
     RunResult, RunSummary, SolverSummary,
 };
-pub use system::{ClosedLoop, TableSystemSpec};
+pub use system::TableSystemSpec;

@@ -1,4 +1,5 @@
-//! The scenario file: which model, which excitation, which integrator.
+//! The scenario file: a rig (which model, limits, table system and specimen: [`Rig`]) and a
+//! run (which excitation, integrator and initial state: [`Run`]).
 //!
 //! ```json
 //! {
@@ -28,7 +29,9 @@
 //! * `duration_s` defaults to the record's span; required for generated excitations.
 //! * `specimen` (optional): `{"storeys": [{"mass_kg", "stiffness_n_per_m",
 //!   "damping_n_s_per_m"}, …]}`, bottom storey first: a shear building on the platen
-//!   ([`platen_model::Specimen`]); forward runs with one use RK4.
+//!   ([`platen_model::Specimen`]).
+//! * `table_system` (optional, [`crate::system`]): the loop around the platen; a motion
+//!   excitation is then the displacement command of a closed loop ([`Run::ClosedLoop`]).
 //! * `limits` (optional): any of `stroke_m`, `velocity_m_s`, `acceleration_m_s2`, `force_n`,
 //!   laid over the preset's table limits; the summary checks the run's peaks against them.
 //!
@@ -39,15 +42,13 @@ use std::path::Path;
 use platen_integrate::IntegrateError;
 use platen_model::{
     FullModel, IdentifiedKey, IdentifiedModel, ModelError, PhysicalKey, PlatenModel, Preset,
-    Specimen, Storey, TableLimits,
 };
 
-use crate::ctx::{check_finite, check_positive, Ctx};
+use crate::ctx::Ctx;
 use crate::error::Result;
 use crate::excitation::build_run;
 use crate::file::given_values;
-use crate::system::{build_table_system, loop_method, ClosedLoop, TableSystemSpec};
-use platen_integrate::State;
+use crate::rig::{scenario_name, LoopSettings, Rig, RigKeys, RigStart};
 use platen_io::json::parse_json_file;
 
 pub use crate::excitation::{Derived, Run};
@@ -80,38 +81,25 @@ impl Model {
     }
 }
 
-/// A validated scenario, ready to run.
+/// A validated scenario, ready to run: a rig ([`Rig`]: what the table is) and a run
+/// ([`Run`]: what it does).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scenario {
     /// The scenario's name.
     pub name: String,
-    /// The preset it is based on.
-    pub preset: Preset,
-    /// The hold-down pressure, Pa.
-    pub hold_down_pressure_pa: f64,
-    /// The model.
-    pub model: Model,
-    /// The form and the values laid over the preset: what rebuilds the model at another
-    /// pressure or with other parameter values ([`Scenario::model_at`]).
-    pub overrides: ModelOverrides,
-    /// The table's limits.
-    pub limits: TableLimits,
+    /// The table: model, limits, table system and specimen.
+    pub rig: Rig,
     /// What to run.
     pub run: Run,
     /// The excitation's channels that platen derived (not given by the file or generator), by
     /// name, with how: what the summary reports under `derived`.
     pub derived: Derived,
-    /// The specimen on the platen, if any.
-    pub specimen: Option<Specimen>,
-    /// The loop around the platen, if any: the run's motion is then the displacement command
-    /// of a closed-loop forward run.
-    pub closed_loop: Option<ClosedLoop>,
 }
 
 impl Scenario {
     /// Number of storeys of the specimen (0 without one).
     pub fn storeys(&self) -> usize {
-        self.specimen.as_ref().map_or(0, Specimen::len)
+        self.rig.storeys()
     }
 
     /// The same scenario with its excitation multiplied by `k` (see [`Run::scaled`]).
@@ -121,41 +109,21 @@ impl Scenario {
     pub fn scaled(&self, k: f64) -> std::result::Result<Scenario, IntegrateError> {
         Ok(Scenario {
             name: self.name.clone(),
-            preset: self.preset,
-            hold_down_pressure_pa: self.hold_down_pressure_pa,
-            model: self.model.clone(),
-            overrides: self.overrides.clone(),
-            limits: self.limits,
+            rig: self.rig.clone(),
             run: self.run.scaled(k)?.into_owned(),
             derived: self.derived.clone(),
-            specimen: self.specimen.clone(),
-            closed_loop: self.closed_loop,
         })
     }
 
     /// The scenario at another hold-down pressure: its model rebuilt from its preset at
     /// `pressure_pa` with the scenario's own overrides (what `platen simulate --pressure-mpa`
-    /// runs).
+    /// runs; see [`Rig::at_pressure`]).
     ///
     /// # Errors
     /// As [`ModelOverrides::build`].
     pub fn at_pressure(mut self, pressure_pa: f64) -> std::result::Result<Scenario, ModelError> {
-        self.model = self.model_at(pressure_pa, &[])?;
-        self.hold_down_pressure_pa = pressure_pa;
+        self.rig = self.rig.at_pressure(pressure_pa)?;
         Ok(self)
-    }
-
-    /// The scenario's model rebuilt from its preset at `pressure_pa`, with the scenario's own
-    /// overrides and then `extra` laid over it (what a sweep varies).
-    ///
-    /// # Errors
-    /// As [`ModelOverrides::build`].
-    pub fn model_at(
-        &self,
-        pressure_pa: f64,
-        extra: &[(ModelKey, f64)],
-    ) -> std::result::Result<Model, ModelError> {
-        self.overrides.build(self.preset, pressure_pa, extra)
     }
 
     /// Reads, parses and validates the scenario at `path`, and loads every record it names.
@@ -177,86 +145,55 @@ impl Scenario {
         Self::validate(path, &file, build_run)
     }
 
-    /// Validates `file`'s model and settings, with `run` building what it runs (from the
-    /// file's excitation, or from records given in memory: [`Scenario::from_arrays`]).
+    /// Validates `file`'s rig and settings, with `run` building what it runs (from the
+    /// file's excitation, or from records given in memory: [`Scenario::from_arrays`]). With
+    /// a table system, a motion is the command of a closed loop ([`Run::ClosedLoop`]).
     pub(crate) fn validate(
         path: &Path,
         file: &ScenarioFile,
         run: impl FnOnce(&Ctx, &ScenarioFile) -> Result<(Run, Derived)>,
     ) -> Result<Self> {
         let ctx = Ctx { path };
-        let preset = Preset::from_name(&file.model.preset).map_err(|e| {
-            ctx.invalid(
-                "model.preset",
-                format!("{:?}", file.model.preset),
-                e.to_string(),
-            )
-        })?;
-        let pressure_pa = match file.model.hold_down_pressure_mpa {
-            Some(p) => match crate::units::expected_pressure_mpa(p) {
-                Some(expected) => {
-                    return Err(ctx.invalid("model.hold_down_pressure_mpa", p, expected))
-                }
-                None => p * 1e6,
-            },
-            None => preset.nominal_pressure_pa(),
-        };
-        let overrides = model_overrides(&ctx, &file.model)?;
-        let model = build_model(&ctx, preset, pressure_pa, &overrides)?;
-        let limits = table_limits(&ctx, preset, file.limits.as_ref())?;
+        let keys = RigKeys::of(file);
+        let start = RigStart::validate(&ctx, &keys)?;
         let (run, derived) = run(&ctx, file)?;
         if let (Some(rel), Run::Inverse { motion }) = (&file.excitation.motion_csv, &run) {
             crate::units::check_displacement_record(
                 &ctx.resolve(rel),
                 motion.t_s(),
                 motion.u_m(),
-                limits.stroke_m,
+                start.limits.stroke_m,
             )?;
         }
-        let specimen = build_specimen(&ctx, file.specimen.as_ref())?;
-        let closed_loop = match &file.table_system {
-            None => None,
-            Some(spec) => Some(closed_loop(
-                &ctx,
-                file,
-                spec,
-                &run,
-                &model,
-                specimen.as_ref(),
-                &limits,
-            )?),
+        if file.table_system.is_some() {
+            refuse_force(&ctx, file, &run)?;
+        }
+        let rig = start.finish(&ctx, &keys)?;
+        let run = match (&rig.table_system, run) {
+            (Some(system), Run::Inverse { motion }) => Run::ClosedLoop {
+                settings: LoopSettings::validate(
+                    &ctx,
+                    file.integrator.as_ref(),
+                    file.initial.as_ref(),
+                    &rig,
+                    system,
+                )?,
+                command: motion,
+            },
+            (_, run) => run,
         };
-        let name = file.name.clone().unwrap_or_else(|| {
-            path.file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_default()
-        });
         Ok(Self {
-            name,
-            preset,
-            hold_down_pressure_pa: pressure_pa,
-            model,
-            overrides,
-            limits,
+            name: scenario_name(path, file.name.as_deref()),
+            rig,
             run,
             derived,
-            specimen,
-            closed_loop,
         })
     }
 }
 
-/// The validated closed loop of a scenario with a `table_system`: its excitation must be a
-/// motion (the command).
-fn closed_loop(
-    ctx: &Ctx,
-    file: &ScenarioFile,
-    spec: &TableSystemSpec,
-    run: &Run,
-    model: &Model,
-    specimen: Option<&Specimen>,
-    limits: &TableLimits,
-) -> Result<ClosedLoop> {
+/// The error of a scenario with a `table_system` whose excitation is a force: the motion is
+/// the displacement command and the loop makes the force.
+fn refuse_force(ctx: &Ctx, file: &ScenarioFile, run: &Run) -> Result<()> {
     if let Run::Forward { .. } = run {
         let key = if file.excitation.force_csv.is_some() {
             "excitation.force_csv"
@@ -272,84 +209,7 @@ fn closed_loop(
              `table_system` the motion is the displacement command and the loop makes the force",
         ));
     }
-    let system = build_table_system(ctx, spec, limits.stroke_m)?;
-    let mass = model.mass_kg_at(0.0) + specimen.map_or(0.0, Specimen::total_mass_kg);
-    let method = loop_method(ctx, file, &system, mass, limits.stroke_m)?;
-    let initial = match &file.initial {
-        None => None,
-        Some(init) => {
-            if init.from_record {
-                return Err(ctx.invalid(
-                    "initial.from_record",
-                    true,
-                    "`u_m` and `v_m_s`: a closed loop has no force record to take them from",
-                ));
-            }
-            Some(State {
-                u_m: check_finite(ctx, "initial.u_m", init.u_m.unwrap_or(0.0))?,
-                v_m_s: check_finite(ctx, "initial.v_m_s", init.v_m_s.unwrap_or(0.0))?,
-            })
-        }
-    };
-    Ok(ClosedLoop {
-        system,
-        method,
-        initial,
-    })
-}
-
-/// The validated `specimen`, with JSON paths in its errors.
-fn build_specimen(ctx: &Ctx, given: Option<&SpecimenSpec>) -> Result<Option<Specimen>> {
-    let Some(given) = given else {
-        return Ok(None);
-    };
-    let storeys = given
-        .storeys
-        .iter()
-        .map(|s| Storey {
-            mass_kg: s.mass_kg,
-            stiffness_n_per_m: s.stiffness_n_per_m,
-            damping_n_s_per_m: s.damping_n_s_per_m,
-        })
-        .collect();
-    Specimen::new(storeys).map(Some).map_err(|e| match e {
-        ModelError::InvalidStorey { index, source } => match *source {
-            ModelError::InvalidParameter {
-                name,
-                value,
-                expected,
-            } => ctx.invalid(
-                &format!("specimen.storeys[{index}].{name}"),
-                value,
-                expected,
-            ),
-            other => ctx.invalid(&format!("specimen.storeys[{index}]"), "", other.to_string()),
-        },
-        other => ctx.invalid("specimen.storeys", given.storeys.len(), other.to_string()),
-    })
-}
-
-/// The preset's table limits with the scenario's `limits` laid over them.
-fn table_limits(ctx: &Ctx, preset: Preset, given: Option<&LimitsSpec>) -> Result<TableLimits> {
-    let mut limits = preset.limits();
-    let Some(given) = given else {
-        return Ok(limits);
-    };
-    for (name, value, slot) in [
-        ("stroke_m", given.stroke_m, &mut limits.stroke_m),
-        ("velocity_m_s", given.velocity_m_s, &mut limits.velocity_m_s),
-        (
-            "acceleration_m_s2",
-            given.acceleration_m_s2,
-            &mut limits.acceleration_m_s2,
-        ),
-        ("force_n", given.force_n, &mut limits.force_n),
-    ] {
-        if let Some(v) = value {
-            *slot = check_positive(ctx, &format!("limits.{name}"), v)?;
-        }
-    }
-    Ok(limits)
+    Ok(())
 }
 
 /// A model parameter of either form, by its contract name.
@@ -447,7 +307,7 @@ fn wrong_form(form: &'static str, key: ModelKey) -> ModelError {
 }
 
 /// The scenario's model form and overrides, validated by name.
-fn model_overrides(ctx: &Ctx, spec: &ModelSpec) -> Result<ModelOverrides> {
+pub(crate) fn model_overrides(ctx: &Ctx, spec: &ModelSpec) -> Result<ModelOverrides> {
     let (full, given, section) = match (&spec.identified, &spec.full) {
         (Some(_), Some(_)) => return Err(ctx.invalid(
             "model",
@@ -473,7 +333,8 @@ fn model_overrides(ctx: &Ctx, spec: &ModelSpec) -> Result<ModelOverrides> {
     Ok(ModelOverrides { full, values })
 }
 
-fn build_model(
+/// The model of `preset` at `pressure_pa` with `overrides`, with JSON paths in its errors.
+pub(crate) fn build_model(
     ctx: &Ctx,
     preset: Preset,
     pressure_pa: f64,

@@ -10,6 +10,7 @@ use platen_integrate::{Exceedance, ForwardIntegrator, Peaks, RunStats, Trajector
 use platen_model::{PlatenModel, TableLimits};
 
 use crate::error::Result;
+use crate::rig::Rig;
 use crate::scenario::{Derived, Run, Scenario};
 use crate::RunOutput;
 
@@ -152,23 +153,32 @@ impl From<&platen_system::Margins> for MarginsSummary {
     }
 }
 
-impl Scenario {
-    /// The linearised loop of a closed-loop scenario: its mechanics (the model's mass, the
-    /// slope of its elastic force and its secant damping, with the specimen as a rigid
-    /// payload) at mid-stroke, and its margins.
+impl Rig {
+    /// The linearised loop of a rig with a table system: its mechanics (the model's mass,
+    /// the slope of its elastic force and its secant damping, with the specimen as a rigid
+    /// payload) at mid-stroke, and its margins (`None` without a table system).
     pub fn loop_linearisation(
         &self,
     ) -> Option<(platen_system::Linearisation, platen_system::Margins)> {
-        let cl = self.closed_loop.as_ref()?;
-        let payload = self.specimen.as_ref().map_or(0.0, |s| s.total_mass_kg());
-        let mech = match &self.model {
-            crate::Model::Identified(m) => platen_system::Mechanics::of_model(m, payload),
-            crate::Model::Full(m) => platen_system::Mechanics::of_model(&**m, payload),
-        };
-        let lin = cl.system.linearise(mech, 0.0);
-        let margins = cl.system.margins(&lin);
-        Some((lin, margins))
+        self.table_system
+            .as_ref()
+            .map(|system| linearise(self, system))
     }
+}
+
+/// The loop of `system` on `rig`, linearised at mid-stroke, and its margins.
+fn linearise(
+    rig: &Rig,
+    system: &platen_system::TableSystem,
+) -> (platen_system::Linearisation, platen_system::Margins) {
+    let payload = rig.specimen.as_ref().map_or(0.0, |s| s.total_mass_kg());
+    let mech = match &rig.model {
+        crate::Model::Identified(m) => platen_system::Mechanics::of_model(m, payload),
+        crate::Model::Full(m) => platen_system::Mechanics::of_model(&**m, payload),
+    };
+    let lin = system.linearise(mech, 0.0);
+    let margins = system.margins(&lin);
+    (lin, margins)
 }
 
 /// The peaks of a specimen run.
@@ -292,23 +302,20 @@ impl RunSummary {
     /// The summary of `output`, a run of `scenario` (read from `path`) that wrote `out`.
     pub fn new(path: &Path, scenario: &Scenario, output: &RunOutput, out: Option<&Path>) -> Self {
         let peaks = &output.peaks;
+        let rig = &scenario.rig;
         Self {
             scenario: path.display().to_string(),
             name: scenario.name.clone(),
-            direction: if output.stats.is_some() {
-                "forward"
-            } else {
-                "inverse"
-            },
-            model_form: scenario.model.form(),
-            preset: scenario.preset.name(),
-            model_overrides: scenario
+            direction: scenario.run.direction(),
+            model_form: rig.model.form(),
+            preset: rig.preset.name(),
+            model_overrides: rig
                 .overrides
                 .values()
                 .iter()
                 .map(|(key, value)| (key.name(), *value))
                 .collect(),
-            hold_down_pressure_mpa: scenario.hold_down_pressure_pa / 1e6,
+            hold_down_pressure_mpa: rig.hold_down_pressure_pa / 1e6,
             samples: peaks.samples,
             duration_s: peaks.span_s.1 - peaks.span_s.0,
             peak_u_m: peaks.u_m.value,
@@ -322,13 +329,13 @@ impl RunSummary {
             forward: output
                 .stats
                 .as_ref()
-                .map(|st| ForwardSummary::new(st, &scenario.run, scenario.specimen.is_some())),
+                .map(|st| ForwardSummary::new(st, &scenario.run, rig.specimen.is_some())),
             limit_exceedances: peaks
-                .exceedances(&scenario.limits)
+                .exceedances(&rig.limits)
                 .iter()
                 .map(ExceedanceSummary::from)
                 .collect(),
-            limits: LimitsSummary::new(peaks, &scenario.limits),
+            limits: LimitsSummary::new(peaks, &rig.limits),
             derived: scenario.derived.clone(),
             out: out.map(|p| p.display().to_string()),
             oil_column_frequency_hz: None,
@@ -375,7 +382,7 @@ impl RunSummary {
         }
         let never_moved = self.peak_v_m_s == 0.0;
         let u0 = initial.u_m;
-        let (elastic_n, static_n) = match &scenario.model {
+        let (elastic_n, static_n) = match &scenario.rig.model {
             crate::Model::Identified(m) => (m.elastic_force_n(u0), m.static_threshold_n(u0)),
             crate::Model::Full(m) => (m.elastic_force_n(u0), m.static_threshold_n(u0)),
         };
@@ -431,24 +438,16 @@ impl RunSummary {
 impl RunSummary {
     /// The summary with a closed-loop run's figures and warnings laid in.
     fn with_loop(mut self, scenario: &Scenario, output: &RunOutput) -> Self {
-        let (Some(cl), Some(lo)) = (&scenario.closed_loop, &output.system) else {
+        let (Run::ClosedLoop { settings, .. }, Some(system), Some(lo)) =
+            (&scenario.run, &scenario.rig.table_system, &output.system)
+        else {
             return self;
         };
-        if let Some(f) = self.forward.as_mut() {
-            f.solver.method = match cl.method {
-                platen_integrate::LoopMethod::Rk4 { .. } => "rk4",
-                platen_integrate::LoopMethod::Dopri5 { .. } => "dopri5",
-            };
-        }
-        let (lin, margins) = scenario
-            .loop_linearisation()
-            .expect("a closed-loop scenario has a linearisation");
-        self.oil_column_frequency_hz = Some(
-            cl.system
-                .oil_column_frequency_hz(lin.mechanics.mass_kg, 0.0),
-        );
+        let (lin, margins) = linearise(&scenario.rig, system);
+        self.oil_column_frequency_hz =
+            Some(system.oil_column_frequency_hz(lin.mechanics.mass_kg, 0.0));
         let (st, tr) = (&lo.stats, &lo.tracking);
-        let capacity = cl.system.capacities().valve_flow_m3_s;
+        let capacity = system.capacities().valve_flow_m3_s;
         if !margins.stable {
             self.warnings.push(format!(
                 "the linearised loop is unstable (gain margin {}, phase margin {}): the run \
@@ -487,7 +486,7 @@ impl RunSummary {
             cavitation_at_s: st.cavitation_at_s,
             hydraulic_energy_j: st.hydraulic_energy_j,
             controller_samples: st.controller_samples,
-            steps_per_controller_period: cl.method.steps_per_period(),
+            steps_per_controller_period: settings.method.steps_per_period(),
             loop_margins: MarginsSummary::from(&margins),
         });
         self
@@ -499,6 +498,10 @@ impl ForwardSummary {
         let specimen = |x: f64| with_specimen.then_some(x);
         let method = match run {
             Run::Forward { integrator, .. } => integrator.name(),
+            Run::ClosedLoop { settings, .. } => match settings.method {
+                platen_integrate::LoopMethod::Rk4 { .. } => "rk4",
+                platen_integrate::LoopMethod::Dopri5 { .. } => "dopri5",
+            },
             Run::Inverse { .. } => "none",
         };
         let e = &st.energy;

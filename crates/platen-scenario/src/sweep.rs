@@ -78,8 +78,8 @@ impl Sweep {
         };
         let pressures: Vec<(f64, f64)> = if pressures_mpa.is_empty() {
             vec![(
-                scenario.hold_down_pressure_pa / 1e6,
-                scenario.hold_down_pressure_pa,
+                scenario.rig.hold_down_pressure_pa / 1e6,
+                scenario.rig.hold_down_pressure_pa,
             )]
         } else {
             pressures_mpa.iter().map(|&p| (p, p * 1e6)).collect()
@@ -93,14 +93,14 @@ impl Sweep {
                         .zip(&combo)
                         .map(|(axis, &v)| (axis.key, v))
                         .collect();
-                    let model =
-                        scenario
-                            .model_at(pressure_pa, &named)
-                            .map_err(|source| CaseError {
-                                case: cases.len(),
-                                description: describe(scale, pressure_mpa, sets, &combo),
-                                source,
-                            })?;
+                    let model = scenario
+                        .rig
+                        .model_at(pressure_pa, &named)
+                        .map_err(|source| CaseError {
+                            case: cases.len(),
+                            description: describe(scale, pressure_mpa, sets, &combo),
+                            source,
+                        })?;
                     cases.push(Case {
                         scale,
                         pressure_mpa,
@@ -269,7 +269,7 @@ fn failed(e: IntegrateError) -> Outcome {
 /// The limits a case's peaks exceed: `"stroke;velocity"`, or `"none"`.
 pub fn exceeded(scenario: &Scenario, peaks: &Peaks) -> String {
     let names: Vec<&str> = peaks
-        .exceedances(&scenario.limits)
+        .exceedances(&scenario.rig.limits)
         .iter()
         .map(|e| e.quantity)
         .collect();
@@ -488,7 +488,7 @@ impl SweepSummary {
                     events: o.stats.map(|s| s.events()),
                     limit_exceedances: o
                         .peaks
-                        .exceedances(&scenario.limits)
+                        .exceedances(&scenario.rig.limits)
                         .iter()
                         .map(ExceedanceSummary::from)
                         .collect(),
@@ -498,17 +498,21 @@ impl SweepSummary {
         SweepSummary {
             scenario: path.display().to_string(),
             name: scenario.name.clone(),
+            // A sweep runs the model alone ([`Model::run`]): a closed loop's command runs as
+            // the motion it asks for.
             direction: match scenario.run {
                 Run::Forward { .. } => "forward",
-                Run::Inverse { .. } => "inverse",
+                Run::Inverse { .. } | Run::ClosedLoop { .. } => "inverse",
             },
-            model_form: scenario.model.form(),
-            preset: scenario.preset.name(),
+            model_form: scenario.rig.model.form(),
+            preset: scenario.rig.preset.name(),
             cases: cases.len(),
             failed: outs.iter().filter(|o| o.error.is_some()).count(),
             exceeding_a_limit: outs
                 .iter()
-                .filter(|o| o.error.is_none() && !o.peaks.exceedances(&scenario.limits).is_empty())
+                .filter(|o| {
+                    o.error.is_none() && !o.peaks.exceedances(&scenario.rig.limits).is_empty()
+                })
                 .count(),
             out: out.map(|p| p.display().to_string()),
             results,

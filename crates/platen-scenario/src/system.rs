@@ -28,39 +28,18 @@
 //! spool, or the oil column at the stroke's ends), or Dopri5 at `rtol`/`atol`. A step that
 //! cannot resolve the fastest mode (`h·ω_max > 1`) is refused.
 
-use platen_integrate::{LoopMethod, State};
+use platen_integrate::LoopMethod;
 use platen_system::{
     preset as system_preset, Accumulator, Controller, Supply, SystemError, TableSystem,
 };
 
 use crate::ctx::Ctx;
 use crate::error::Result;
-use crate::file::{IntegratorSpec, ScenarioFile, DEFAULT_ATOL, DEFAULT_RTOL};
+use crate::file::{IntegratorSpec, DEFAULT_ATOL, DEFAULT_RTOL};
+use crate::system_file::Overlay;
 pub use crate::system_file::{
     AccumulatorSpec, ActuatorSpec, ChamberVolumes, ControllerSpec, ServoValveSpec, TableSystemSpec,
 };
-
-/// A validated closed loop: the system, its integrator and the platen's initial state.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ClosedLoop {
-    /// The table system.
-    pub system: TableSystem,
-    /// The integrator.
-    pub method: LoopMethod,
-    /// The platen's state at the command's first sample (`None`: at rest at the command's
-    /// first displacement).
-    pub initial: Option<State>,
-}
-
-impl ClosedLoop {
-    /// The platen's initial state for `command_u0_m`, the command's first displacement.
-    pub fn initial_state(&self, command_u0_m: f64) -> State {
-        self.initial.unwrap_or(State {
-            u_m: command_u0_m,
-            v_m_s: 0.0,
-        })
-    }
-}
 
 /// Builds the table system of `spec` (a preset with values laid over it, or explicit), with
 /// every error named by its JSON path under `table_system`.
@@ -69,148 +48,16 @@ pub(crate) fn build_table_system(
     spec: &TableSystemSpec,
     stroke_m: f64,
 ) -> Result<TableSystem> {
-    let base =
-        match &spec.preset {
-            Some(name) => Some(system_preset::by_name(name).map_err(|e| {
+    let spec = match &spec.preset {
+        Some(name) => {
+            let base = system_preset::by_name(name).map_err(|e| {
                 ctx.invalid("table_system.preset", format!("{name:?}"), e.to_string())
-            })?),
-            None => None,
-        };
-    let need = |path: &str, given: Option<f64>, base: Option<f64>| -> Result<f64> {
-        given.or(base).ok_or_else(|| {
-            ctx.invalid(
-                &format!("table_system.{path}"),
-                "(missing)",
-                "a value (or a `preset` to take it from)",
-            )
-        })
-    };
-    let a = spec.actuator.clone().unwrap_or_default();
-    let ba = base.map(|b| b.actuator);
-    let count = a
-        .count
-        .or(ba.map(|b| b.count))
-        .ok_or_else(|| ctx.invalid("table_system.actuator.count", "(missing)", "a count ≥ 1"))?;
-    let (cap, rod) = match (a.area_m2, a.cap_side_area_m2, a.rod_side_area_m2) {
-        (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
-            return Err(ctx.invalid(
-                "table_system.actuator.area_m2",
-                a.area_m2.unwrap_or(f64::NAN),
-                "either `area_m2` (double-ended) or `cap_side_area_m2` and `rod_side_area_m2`, not both",
-            ))
+            })?;
+            spec.clone().overlay(TableSystemSpec::from(&base))
         }
-        (Some(area), None, None) => (area, area),
-        (None, c, r) => (
-            need("actuator.cap_side_area_m2", c, ba.map(|b| b.cap_area_m2))?,
-            need("actuator.rod_side_area_m2", r, ba.map(|b| b.rod_area_m2))?,
-        ),
+        None => spec.clone(),
     };
-    let (v_cap, v_rod) = match a.chamber_volume_m3 {
-        Some(ChamberVolumes::Both(v)) => (v, v),
-        Some(ChamberVolumes::Each([c, r])) => (c, r),
-        None => match ba {
-            Some(b) => (b.cap_volume_m3, b.rod_volume_m3),
-            None => {
-                return Err(ctx.invalid(
-                    "table_system.actuator.chamber_volume_m3",
-                    "(missing)",
-                    "a volume, or [cap, rod]",
-                ))
-            }
-        },
-    };
-    let leakage = a
-        .leakage_m3_s_per_pa
-        .or(ba.map(|b| b.leakage_m3_s_per_pa))
-        .unwrap_or(0.0);
-    let v = spec.servo_valve.clone().unwrap_or_default();
-    let bv = base.map(|b| b.servo_valve);
-    let valve_count = v
-        .count
-        .or(bv.map(|b| b.count))
-        .ok_or_else(|| ctx.invalid("table_system.servo_valve.count", "(missing)", "a count ≥ 1"))?;
-    let mut system = TableSystem {
-        actuator: platen_system::Actuator {
-            count,
-            cap_area_m2: cap,
-            rod_area_m2: rod,
-            cap_volume_m3: v_cap,
-            rod_volume_m3: v_rod,
-            leakage_m3_s_per_pa: leakage,
-        },
-        servo_valve: platen_system::ServoValve {
-            count: valve_count,
-            rated_flow_m3_s: need(
-                "servo_valve.rated_flow_m3_s",
-                v.rated_flow_m3_s,
-                bv.map(|b| b.rated_flow_m3_s),
-            )?,
-            rated_pressure_drop_pa: need(
-                "servo_valve.rated_pressure_drop_pa",
-                v.rated_pressure_drop_pa,
-                bv.map(|b| b.rated_pressure_drop_pa),
-            )?,
-            natural_frequency_hz: need(
-                "servo_valve.natural_frequency_hz",
-                v.natural_frequency_hz,
-                bv.map(|b| b.natural_frequency_hz),
-            )?,
-            damping_ratio: need(
-                "servo_valve.damping_ratio",
-                v.damping_ratio,
-                bv.map(|b| b.damping_ratio),
-            )?,
-            delay_s: v.delay_s.or(bv.map(|b| b.delay_s)).unwrap_or(0.0),
-        },
-        oil_bulk_modulus_pa: need(
-            "oil_bulk_modulus_pa",
-            spec.oil_bulk_modulus_pa,
-            base.map(|b| b.oil_bulk_modulus_pa),
-        )?,
-        supply_pressure_pa: need(
-            "supply_pressure_pa",
-            spec.supply_pressure_pa,
-            base.map(|b| b.supply_pressure_pa),
-        )?,
-        return_pressure_pa: need(
-            "return_pressure_pa",
-            spec.return_pressure_pa,
-            base.map(|b| b.return_pressure_pa),
-        )?,
-        supply: Supply::Constant,
-        controller: controller(ctx, spec.controller.as_ref(), base.map(|b| b.controller))?,
-    };
-    let base_bank = match base.map(|b| b.supply) {
-        Some(Supply::Accumulator(acc)) => Some(acc),
-        _ => None,
-    };
-    system.supply = match &spec.accumulator {
-        Some(None) => Supply::Constant,
-        None => base_bank.map_or(Supply::Constant, Supply::Accumulator),
-        Some(Some(acc)) => {
-            let field = |name: &str, given: Option<f64>, base: Option<f64>| {
-                need(&format!("accumulator.{name}"), given, base)
-            };
-            Supply::Accumulator(Accumulator {
-                precharge_pressure_pa: field(
-                    "precharge_pressure_pa",
-                    acc.precharge_pressure_pa,
-                    base_bank.map(|b| b.precharge_pressure_pa),
-                )?,
-                volume_m3: field("volume_m3", acc.volume_m3, base_bank.map(|b| b.volume_m3))?,
-                polytropic_exponent: field(
-                    "polytropic_exponent",
-                    acc.polytropic_exponent,
-                    base_bank.map(|b| b.polytropic_exponent),
-                )?,
-                pump_flow_m3_s: field(
-                    "pump_flow_m3_s",
-                    acc.pump_flow_m3_s,
-                    base_bank.map(|b| b.pump_flow_m3_s),
-                )?,
-            })
-        }
-    };
+    let system = complete_system(ctx, &spec)?;
     system.validate(stroke_m).map_err(|e| match e {
         SystemError::Invalid {
             path,
@@ -222,51 +69,108 @@ pub(crate) fn build_table_system(
     Ok(system)
 }
 
-fn controller(
-    ctx: &Ctx,
-    given: Option<&ControllerSpec>,
-    base: Option<Controller>,
-) -> Result<Controller> {
-    let c = given.cloned().unwrap_or_default();
-    let rate = c
-        .sample_rate_hz
-        .or(base.map(|b| b.sample_rate_hz))
-        .ok_or_else(|| {
-            ctx.invalid(
-                "table_system.controller.sample_rate_hz",
-                "(missing)",
-                "the controller's sample rate, Hz",
-            )
-        })?;
-    let gain = |given: Option<f64>, base: Option<f64>| given.or(base).unwrap_or(0.0);
-    Ok(Controller {
-        sample_rate_hz: rate,
-        displacement_gain_per_m: gain(
-            c.displacement_gain_per_m,
-            base.map(|b| b.displacement_gain_per_m),
+/// The system of `spec` (its preset's values already laid under it): every required value
+/// given, or an error naming the first missing one by its JSON path; absent gains, leakage
+/// and delay are 0, an absent accumulator a constant supply.
+fn complete_system(ctx: &Ctx, spec: &TableSystemSpec) -> Result<TableSystem> {
+    let missing = |path: &str, expected: &str| {
+        ctx.invalid(&format!("table_system.{path}"), "(missing)", expected)
+    };
+    let need = |path: &str, value: Option<f64>| {
+        value.ok_or_else(|| missing(path, "a value (or a `preset` to take it from)"))
+    };
+    let a = spec.actuator.clone().unwrap_or_default();
+    let count = a
+        .count
+        .ok_or_else(|| missing("actuator.count", "a count ≥ 1"))?;
+    let (cap, rod) = match (a.area_m2, a.cap_side_area_m2, a.rod_side_area_m2) {
+        (Some(area), None, None) => (area, area),
+        (Some(area), _, _) => {
+            return Err(ctx.invalid(
+                "table_system.actuator.area_m2",
+                area,
+                "either `area_m2` (double-ended) or `cap_side_area_m2` and `rod_side_area_m2`, not both",
+            ))
+        }
+        (None, c, r) => (
+            need("actuator.cap_side_area_m2", c)?,
+            need("actuator.rod_side_area_m2", r)?,
         ),
-        integral_gain_per_m_s: gain(
-            c.integral_gain_per_m_s,
-            base.map(|b| b.integral_gain_per_m_s),
-        ),
-        velocity_feedforward_s_per_m: gain(
-            c.velocity_feedforward_s_per_m,
-            base.map(|b| b.velocity_feedforward_s_per_m),
-        ),
-        acceleration_feedforward_s2_per_m: gain(
-            c.acceleration_feedforward_s2_per_m,
-            base.map(|b| b.acceleration_feedforward_s2_per_m),
-        ),
-        velocity_feedback_s_per_m: gain(
-            c.velocity_feedback_s_per_m,
-            base.map(|b| b.velocity_feedback_s_per_m),
-        ),
-        acceleration_feedback_s2_per_m: gain(
-            c.acceleration_feedback_s2_per_m,
-            base.map(|b| b.acceleration_feedback_s2_per_m),
-        ),
-        delta_p_gain_per_pa: gain(c.delta_p_gain_per_pa, base.map(|b| b.delta_p_gain_per_pa)),
-        delta_p_highpass_hz: gain(c.delta_p_highpass_hz, base.map(|b| b.delta_p_highpass_hz)),
+    };
+    let (cap_volume, rod_volume) = match a.chamber_volume_m3 {
+        Some(ChamberVolumes::Both(v)) => (v, v),
+        Some(ChamberVolumes::Each([c, r])) => (c, r),
+        None => {
+            return Err(missing(
+                "actuator.chamber_volume_m3",
+                "a volume, or [cap, rod]",
+            ))
+        }
+    };
+    let v = spec.servo_valve.clone().unwrap_or_default();
+    let valve_count = v
+        .count
+        .ok_or_else(|| missing("servo_valve.count", "a count ≥ 1"))?;
+    let servo_valve = platen_system::ServoValve {
+        count: valve_count,
+        rated_flow_m3_s: need("servo_valve.rated_flow_m3_s", v.rated_flow_m3_s)?,
+        rated_pressure_drop_pa: need(
+            "servo_valve.rated_pressure_drop_pa",
+            v.rated_pressure_drop_pa,
+        )?,
+        natural_frequency_hz: need("servo_valve.natural_frequency_hz", v.natural_frequency_hz)?,
+        damping_ratio: need("servo_valve.damping_ratio", v.damping_ratio)?,
+        delay_s: v.delay_s.unwrap_or(0.0),
+    };
+    let oil_bulk_modulus_pa = need("oil_bulk_modulus_pa", spec.oil_bulk_modulus_pa)?;
+    let supply_pressure_pa = need("supply_pressure_pa", spec.supply_pressure_pa)?;
+    let return_pressure_pa = need("return_pressure_pa", spec.return_pressure_pa)?;
+    let c = spec.controller.clone().unwrap_or_default();
+    let sample_rate_hz = c.sample_rate_hz.ok_or_else(|| {
+        missing(
+            "controller.sample_rate_hz",
+            "the controller's sample rate, Hz",
+        )
+    })?;
+    let gain = |g: Option<f64>| g.unwrap_or(0.0);
+    let controller = Controller {
+        sample_rate_hz,
+        displacement_gain_per_m: gain(c.displacement_gain_per_m),
+        integral_gain_per_m_s: gain(c.integral_gain_per_m_s),
+        velocity_feedforward_s_per_m: gain(c.velocity_feedforward_s_per_m),
+        acceleration_feedforward_s2_per_m: gain(c.acceleration_feedforward_s2_per_m),
+        velocity_feedback_s_per_m: gain(c.velocity_feedback_s_per_m),
+        acceleration_feedback_s2_per_m: gain(c.acceleration_feedback_s2_per_m),
+        delta_p_gain_per_pa: gain(c.delta_p_gain_per_pa),
+        delta_p_highpass_hz: gain(c.delta_p_highpass_hz),
+    };
+    let supply = match &spec.accumulator {
+        Some(Some(acc)) => Supply::Accumulator(Accumulator {
+            precharge_pressure_pa: need(
+                "accumulator.precharge_pressure_pa",
+                acc.precharge_pressure_pa,
+            )?,
+            volume_m3: need("accumulator.volume_m3", acc.volume_m3)?,
+            polytropic_exponent: need("accumulator.polytropic_exponent", acc.polytropic_exponent)?,
+            pump_flow_m3_s: need("accumulator.pump_flow_m3_s", acc.pump_flow_m3_s)?,
+        }),
+        _ => Supply::Constant,
+    };
+    Ok(TableSystem {
+        actuator: platen_system::Actuator {
+            count,
+            cap_area_m2: cap,
+            rod_area_m2: rod,
+            cap_volume_m3: cap_volume,
+            rod_volume_m3: rod_volume,
+            leakage_m3_s_per_pa: a.leakage_m3_s_per_pa.unwrap_or(0.0),
+        },
+        servo_valve,
+        oil_bulk_modulus_pa,
+        supply_pressure_pa,
+        return_pressure_pa,
+        supply,
+        controller,
     })
 }
 
@@ -314,7 +218,7 @@ fn unresolvable(
 /// resolves the loop's fastest mode, or Dopri5.
 pub(crate) fn loop_method(
     ctx: &Ctx,
-    file: &ScenarioFile,
+    integrator: Option<&IntegratorSpec>,
     system: &TableSystem,
     mass_kg: f64,
     stroke_m: f64,
@@ -333,7 +237,7 @@ pub(crate) fn loop_method(
             steps_per_period: k,
         })
     };
-    match &file.integrator {
+    match integrator {
         None => default_rk4(),
         Some(IntegratorSpec::Rk4(spec)) => {
             let Some(step) = spec.step_s else {

@@ -29,7 +29,7 @@ fn shipped(name: &str) -> PathBuf {
 #[test]
 fn the_forward_specimen_example_closes_its_energy_balance() {
     let scenario = Scenario::load(&shipped("frame-forward.json")).unwrap();
-    assert!(scenario.specimen.is_some());
+    assert!(scenario.rig.specimen.is_some());
     let mut trajectory = Trajectory::default();
     let output = scenario.run(&mut trajectory).unwrap();
     let stats = output.stats.expect("a forward run has solver statistics");

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use serde_json::{json, Value};
 
 use platen_integrate::{LoopMethod, SampleSink, Trajectory};
-use platen_scenario::{CsvSink, RunSummary, Scenario, ScenarioError};
+use platen_scenario::{CsvSink, LoopSettings, Run, RunSummary, Scenario, ScenarioError};
 use platen_system::{preset, Accumulator, Actuator, Controller, ServoValve, Supply, TableSystem};
 
 /// A short closed-loop scenario: the identified LHPOST platen commanded by a 2 cm, 1 Hz sine,
@@ -50,6 +50,14 @@ fn write(dir: &Path, name: &str, scenario: &Value) -> PathBuf {
     path
 }
 
+/// The loop settings of a closed-loop scenario's run.
+fn loop_of(s: &Scenario) -> LoopSettings {
+    match &s.run {
+        Run::ClosedLoop { settings, .. } => *settings,
+        other => panic!("not a closed loop: {other:?}"),
+    }
+}
+
 fn load(scenario: &Value) -> Result<Scenario, ScenarioError> {
     let dir = tempfile::tempdir().unwrap();
     Scenario::load(&write(dir.path(), "scenario", scenario))
@@ -58,7 +66,7 @@ fn load(scenario: &Value) -> Result<Scenario, ScenarioError> {
 /// Loads `scenario`, which must be refused naming `json_path` and saying `expected`.
 fn refused(scenario: &Value, json_path: &str, expected: &str) -> String {
     let error = match load(scenario) {
-        Ok(s) => panic!("accepted ({json_path}): {:?}", s.closed_loop),
+        Ok(s) => panic!("accepted ({json_path}): {:?}", s.rig.table_system),
         Err(e) => e,
     };
     let message = error.to_string();
@@ -238,7 +246,7 @@ fn a_chamber_that_would_empty_within_the_stroke_is_refused() {
         "limits",
         json!({"stroke_m": 0.5}),
     );
-    assert!(load(&short).unwrap().closed_loop.is_some());
+    assert!(load(&short).unwrap().rig.table_system.is_some());
 }
 
 #[test]
@@ -311,14 +319,14 @@ fn an_rk4_step_must_divide_the_controller_period_and_resolve_the_fastest_mode() 
     ))
     .unwrap();
     assert_eq!(
-        half.closed_loop.unwrap().method,
+        loop_of(&half).method,
         LoopMethod::Rk4 {
             steps_per_period: 2
         }
     );
     // Default: the least k with h·ω ≤ 0.25: ceil(2π·246/1024/0.25) = 7.
     assert_eq!(
-        load(&base).unwrap().closed_loop.unwrap().method,
+        loop_of(&load(&base).unwrap()).method,
         LoopMethod::Rk4 {
             steps_per_period: 7
         }
@@ -331,7 +339,7 @@ fn an_rk4_step_must_divide_the_controller_period_and_resolve_the_fastest_mode() 
     ))
     .unwrap();
     assert!(matches!(
-        dopri.closed_loop.unwrap().method,
+        loop_of(&dopri).method,
         LoopMethod::Dopri5 { rtol, .. } if rtol == 1e-7
     ));
     refused(
@@ -568,7 +576,7 @@ fn initial_from_record_with_a_table_system_is_refused() {
         "initial",
         json!({"u_m": 0.01, "v_m_s": 0.0}),
     );
-    let cl = load(&s).unwrap().closed_loop.unwrap();
+    let cl = loop_of(&load(&s).unwrap());
     assert_eq!(cl.initial_state(0.0).u_m, 0.01);
 }
 
@@ -597,11 +605,11 @@ fn preset_overrides_change_only_what_they_name() {
     let mut expected = preset::lhpost_2008();
     assert_ne!(expected.controller.displacement_gain_per_m, 5.0);
     expected.controller.displacement_gain_per_m = 5.0;
-    assert_eq!(s.closed_loop.unwrap().system, expected);
+    assert_eq!(s.rig.table_system.unwrap(), expected);
 
     // The preset alone is the preset.
     let s = load(&scenario_with(lhpost(json!({})))).unwrap();
-    assert_eq!(s.closed_loop.unwrap().system, preset::lhpost_2008());
+    assert_eq!(s.rig.table_system.unwrap(), preset::lhpost_2008());
 
     // One value deep inside each section.
     let s = load(&scenario_with(lhpost(json!({
@@ -619,14 +627,14 @@ fn preset_overrides_change_only_what_they_name() {
         panic!("the preset has an accumulator")
     };
     bank.volume_m3 = 4.0;
-    assert_eq!(s.closed_loop.unwrap().system, expected);
+    assert_eq!(s.rig.table_system.unwrap(), expected);
 
     // A double-ended area over the single-ended preset sets both sides.
     let s = load(&scenario_with(lhpost(
         json!({"actuator": {"area_m2": 0.15}}),
     )))
     .unwrap();
-    let a = s.closed_loop.unwrap().system.actuator;
+    let a = s.rig.table_system.unwrap().actuator;
     assert_eq!((a.cap_area_m2, a.rod_area_m2), (0.15, 0.15));
     assert_eq!(
         (a.cap_volume_m3, a.rod_volume_m3),
@@ -638,7 +646,7 @@ fn preset_overrides_change_only_what_they_name() {
 #[test]
 fn a_null_accumulator_is_a_constant_supply() {
     let s = load(&scenario_with(lhpost(json!({"accumulator": null})))).unwrap();
-    let system = s.closed_loop.unwrap().system;
+    let system = s.rig.table_system.unwrap();
     assert_eq!(system.supply, Supply::Constant);
     let mut expected = preset::lhpost_2008();
     expected.supply = Supply::Constant;
@@ -646,7 +654,7 @@ fn a_null_accumulator_is_a_constant_supply() {
     // Absent: the preset's bank.
     let s = load(&scenario_with(lhpost(json!({})))).unwrap();
     assert!(matches!(
-        s.closed_loop.unwrap().system.supply,
+        s.rig.table_system.unwrap().supply,
         Supply::Accumulator(_)
     ));
 }
@@ -654,19 +662,14 @@ fn a_null_accumulator_is_a_constant_supply() {
 #[test]
 fn an_explicit_double_ended_system_equals_the_one_built_by_hand() {
     let s = load(&scenario_with(explicit())).unwrap();
-    let cl = s.closed_loop.unwrap();
-    assert_eq!(cl.system, explicit_by_hand());
-    assert_eq!(cl.initial, None);
+    assert_eq!(s.rig.table_system.unwrap(), explicit_by_hand());
+    assert_eq!(loop_of(&s).initial, None);
     // Both chamber forms, and single-ended areas, give the same double-ended system.
     let mut ts = explicit();
     ts["actuator"] = json!({"count": 1, "cap_side_area_m2": 0.02, "rod_side_area_m2": 0.02,
                             "chamber_volume_m3": [0.02, 0.02], "leakage_m3_s_per_pa": 1e-11});
     assert_eq!(
-        load(&scenario_with(ts))
-            .unwrap()
-            .closed_loop
-            .unwrap()
-            .system,
+        load(&scenario_with(ts)).unwrap().rig.table_system.unwrap(),
         explicit_by_hand()
     );
     // An explicit accumulator.
@@ -681,11 +684,7 @@ fn an_explicit_double_ended_system_equals_the_one_built_by_hand() {
         pump_flow_m3_s: 0.002,
     });
     assert_eq!(
-        load(&scenario_with(ts))
-            .unwrap()
-            .closed_loop
-            .unwrap()
-            .system,
+        load(&scenario_with(ts)).unwrap().rig.table_system.unwrap(),
         expected
     );
     // And the system runs: every sample carries the loop's columns.
@@ -779,7 +778,7 @@ fn an_unstable_loop_runs_and_warns_with_its_margins() {
         )),
     );
     let scenario = Scenario::load(&path).unwrap();
-    let (_, margins) = scenario.loop_linearisation().unwrap();
+    let (_, margins) = scenario.rig.loop_linearisation().unwrap();
     assert!(!margins.stable, "{margins:?}");
     let mut sink = Finite::default();
     // Never a panic: either the run finishes or it stops with a numerical failure.
@@ -865,7 +864,7 @@ fn a_malformed_chamber_volume_says_what_was_expected() {
     }
     // Integers are volumes too.
     let s = scenario_with(lhpost(json!({"actuator": {"chamber_volume_m3": [1, 1]}})));
-    let a = load(&s).unwrap().closed_loop.unwrap().system.actuator;
+    let a = load(&s).unwrap().rig.table_system.unwrap().actuator;
     assert_eq!((a.cap_volume_m3, a.rod_volume_m3), (1.0, 1.0));
 }
 
@@ -890,7 +889,7 @@ fn a_loop_too_fast_for_rk4_is_refused_instead_of_run_at_a_clamped_step() {
     );
     // Dopri5 takes it.
     let dopri = with(fast_valve, "integrator", json!({"method": "dopri5"}));
-    assert!(load(&dopri).unwrap().closed_loop.is_some());
+    assert!(load(&dopri).unwrap().rig.table_system.is_some());
     // An oil column that stiff (β = 1e24 Pa) is refused under `table_system`.
     refused(
         &scenario_with(lhpost(json!({"oil_bulk_modulus_pa": 1e24}))),
@@ -902,7 +901,7 @@ fn a_loop_too_fast_for_rk4_is_refused_instead_of_run_at_a_clamped_step() {
         json!({"servo_valve": {"natural_frequency_hz": 1e8}}),
     ));
     assert_eq!(
-        load(&s).unwrap().closed_loop.unwrap().method,
+        loop_of(&load(&s).unwrap()).method,
         LoopMethod::Rk4 {
             steps_per_period: 1_000_000
         }
@@ -934,8 +933,12 @@ fn a_table_system_spec_written_back_reads_as_the_same_system() {
     ] {
         let spec: platen_scenario::TableSystemSpec = serde_json::from_value(ts.clone()).unwrap();
         let written = serde_json::to_value(&spec).unwrap();
-        let first = load(&scenario_with(ts.clone())).unwrap().closed_loop;
-        let again = load(&scenario_with(written.clone())).unwrap().closed_loop;
+        let (first, again) = (
+            load(&scenario_with(ts.clone())).unwrap(),
+            load(&scenario_with(written.clone())).unwrap(),
+        );
+        let first = (first.rig.table_system, loop_of(&first));
+        let again = (again.rig.table_system, loop_of(&again));
         assert_eq!(first, again, "{ts} written as {written}");
     }
 }

@@ -40,7 +40,11 @@ pub fn run(what: What, scenario_path: &Path, out: &Path, seed: u64, json_out: bo
                 )?;
                 report(json_out, out, n, "force", None)?;
             }
-            Run::Inverse { motion } => {
+            // A closed loop's command is the motion it asks for.
+            Run::Inverse { motion }
+            | Run::ClosedLoop {
+                command: motion, ..
+            } => {
                 write_csv_atomic(
                     out,
                     &["t_s", "u_m", "v_m_s", "a_m_s2"],

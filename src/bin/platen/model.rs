@@ -13,6 +13,7 @@ use anyhow::{bail, Context, Result};
 use platen_model::Preset;
 use platen_report::{model_text, system_figures, FigureSize};
 use platen_scenario::describe::{self, ModelDescription, SystemAnalysis};
+use platen_scenario::LoadedRig;
 use platen_system::TableSystem;
 
 use crate::Form;
@@ -50,16 +51,22 @@ pub fn run(o: &Options<'_>) -> Result<()> {
     let mut header = String::new();
     let (mut description, model, stroke_m, specimen_kg, given, name) = match o.scenario {
         Some(path) => {
-            let loaded = describe::load_for_description(path)?;
-            let s = loaded.scenario;
-            header = model_text::scenario_header(path, &s);
-            let given = s
-                .closed_loop
-                .as_ref()
-                .map(|cl| (loaded.table_system_preset, cl.system));
-            let specimen_kg = s.specimen.as_ref().map(|sp| sp.total_mass_kg());
-            let d = ModelDescription::of_scenario(path, &s)?;
-            (d, s.model, s.limits.stroke_m, specimen_kg, given, s.name)
+            let loaded = LoadedRig::load(path)?;
+            let rig = loaded.rig;
+            header = model_text::scenario_header(path, &loaded.name, &rig);
+            let given = rig
+                .table_system
+                .map(|system| (loaded.table_system_preset, system));
+            let specimen_kg = rig.specimen.as_ref().map(|sp| sp.total_mass_kg());
+            let d = ModelDescription::of_rig(path, &rig)?;
+            (
+                d,
+                rig.model,
+                rig.limits.stroke_m,
+                specimen_kg,
+                given,
+                loaded.name,
+            )
         }
         None => {
             let preset = Preset::from_name(o.preset)?;

@@ -13,8 +13,8 @@ use clap::ValueEnum;
 
 use platen_io::csv::CsvWriter;
 use platen_plan::{
-    load_scenario, plan_observed, FrfSource, MaxScaleSettings, NoiseSettings, PlanError,
-    PlanSettings, Target,
+    load_rig, plan_observed, FrfSource, MaxScaleSettings, NoiseSettings, PlanError, PlanSettings,
+    Target,
 };
 use platen_report::plan_figures;
 use platen_report::simulate_report::with_outputs;
@@ -155,7 +155,7 @@ pub fn run(args: &Args) -> Result<()> {
     };
     // The drive's temporary file first: an unwritable destination fails before any run.
     let mut writer = CsvWriter::create(&args.out, &["t_s", "u_m"])?;
-    let scenario = load_scenario(&args.scenario).map_err(cli_error)?;
+    let rig = load_rig(&args.scenario).map_err(cli_error)?;
     let target = Target::read_csv(&args.target).map_err(cli_error)?;
     // A bar of the drive iterations (on a terminal, after a second).
     let progress = Progress::new(
@@ -163,7 +163,7 @@ pub fn run(args: &Args) -> Result<()> {
         "{bar:30} {pos}/{len} runs of the drive iteration, {elapsed_precise} elapsed",
     );
     let on_run = &mut |k: usize| progress.set_position(k as u64 + 1);
-    let p = plan_observed(&scenario, &args.scenario, &target, &settings, on_run);
+    let p = plan_observed(&rig, &args.scenario, &target, &settings, on_run);
     progress.finish();
     let p = p.map_err(cli_error)?;
     let written = match p.drive() {

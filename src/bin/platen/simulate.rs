@@ -41,15 +41,15 @@ pub fn run(opts: &Options<'_>) -> Result<()> {
     // Create the temporary output first, so that an unwritable path fails before the run.
     let storeys = scenario.storeys();
     let mut stream = out
-        .map(|p| CsvSink::create_for(p, storeys, scenario.closed_loop.is_some()))
+        .map(|p| {
+            let closed_loop = matches!(scenario.run, Run::ClosedLoop { .. });
+            CsvSink::create_for(p, storeys, closed_loop)
+        })
         .transpose()?;
     // The figures' points are collected as the run goes, in memory that does not grow with it.
     let mut recorder = opts.plot.map(|_| RunRecorder::new(&scenario.run));
     // A bar of the samples written (on a terminal, after a second).
-    let expected = match &scenario.run {
-        Run::Forward { samples, .. } => *samples,
-        Run::Inverse { motion } => motion.len(),
-    };
+    let expected = scenario.run.samples();
     let progress = Progress::new(
         expected as u64,
         "{bar:30} {percent:>3}% of {human_len} samples, {eta} left",

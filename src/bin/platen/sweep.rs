@@ -24,7 +24,7 @@ use platen_io::write_bytes_atomic;
 use platen_model::{IdentifiedKey, PhysicalKey};
 use platen_report::simulate_report::with_outputs;
 use platen_scenario::sweep::{self, Outcome, Sweep};
-use platen_scenario::{ModelKey, Scenario};
+use platen_scenario::{ModelKey, Run, Scenario};
 
 pub use platen_scenario::sweep::SetAxis;
 
@@ -109,16 +109,25 @@ pub fn run(
     plot: &Plot<'_>,
 ) -> Result<()> {
     let scenario = Scenario::load(path)?;
-    if scenario.specimen.is_some() {
+    if scenario.rig.specimen.is_some() {
         anyhow::bail!(
             "{}: sweeps of a scenario with a specimen are not supported yet (simulate runs it)",
             path.display()
         );
     }
+    if let Run::ClosedLoop { .. } = scenario.run {
+        anyhow::bail!(
+            "{}: sweeps of a closed-loop scenario (a table_system) are not supported yet \
+             (simulate runs it)",
+            path.display()
+        );
+    }
     check_axes(path, &scenario, sets);
     // The base case must reproduce the scenario's own model exactly.
-    let base = scenario.model_at(scenario.hold_down_pressure_pa, &[])?;
-    if base != scenario.model {
+    let base = scenario
+        .rig
+        .model_at(scenario.rig.hold_down_pressure_pa, &[])?;
+    if base != scenario.rig.model {
         return Err(anyhow!(
             "internal error: the sweep's model differs from the scenario's ({})",
             path.display()
@@ -174,7 +183,7 @@ pub fn run(
 
 /// A form mismatch or an axis given twice is a usage error (exit code 2).
 fn check_axes(path: &Path, scenario: &Scenario, sets: &[SetAxis]) {
-    let form = scenario.overrides.form();
+    let form = scenario.rig.overrides.form();
     for (i, axis) in sets.iter().enumerate() {
         if axis.key.form() != form {
             usage_error(format!(

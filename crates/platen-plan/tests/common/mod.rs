@@ -6,7 +6,7 @@
 use std::f64::consts::PI;
 use std::path::Path;
 
-use platen_scenario::{file, Arrays, Scenario};
+use platen_scenario::{file, Arrays, LoadedRig, Scenario};
 
 /// Standard gravity, m/s².
 pub const G: f64 = 9.806_65;
@@ -29,11 +29,10 @@ pub fn scenario_with(json: &str, t_s: Vec<f64>, u_m: Vec<f64>) -> Scenario {
     .unwrap()
 }
 
-/// A scenario built from `json` with a placeholder command: the planner only uses its model,
-/// table_system, specimen and limits.
-pub fn scenario(json: &str) -> Scenario {
-    let t_s: Vec<f64> = (0..16).map(|j| j as f64 / 1024.0).collect();
-    scenario_with(json, t_s, vec![0.0; 16])
+/// The rig of the scenario `json` (its excitation, if any, is not read): what the planner
+/// drives.
+pub fn scenario(json: &str) -> LoadedRig {
+    LoadedRig::parse(Path::new("plan-test.json"), json).unwrap()
 }
 
 /// The LHPOST preset's scenario JSON: identified platen and its table system (`extra` is
@@ -46,7 +45,7 @@ pub fn lhpost_json(extra: &str) -> String {
 }
 
 /// The LHPOST preset (see [`lhpost_json`]).
-pub fn lhpost(extra: &str) -> Scenario {
+pub fn lhpost(extra: &str) -> LoadedRig {
     scenario(&lhpost_json(extra))
 }
 
