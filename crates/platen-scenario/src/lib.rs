@@ -28,6 +28,7 @@ mod excitation;
 mod execute;
 pub mod file;
 pub mod generate;
+mod model;
 pub mod recorded;
 mod rig;
 pub mod sampling;
@@ -42,10 +43,11 @@ pub use arrays::Arrays;
 pub use describe::describe_model;
 pub use error::{Result, ScenarioError};
 pub use execute::{CsvSink, LoopOutput, RunOutput, Tracking};
+pub use model::{Model, ModelKey, ModelOverrides};
 /// Column maps are part of the scenario format (`excitation.columns`).
 pub use platen_io::columns;
 pub use rig::{LoadedRig, LoopSettings, Rig};
-pub use scenario::{Model, ModelKey, ModelOverrides, Run, Scenario};
+pub use scenario::{Run, Scenario};
 pub use summary::{
     simulate, EnergySummary, ExceedanceSummary, ForwardSummary, LimitCheck, LimitsSummary,
     RunResult, RunSummary, SolverSummary,

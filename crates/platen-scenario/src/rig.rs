@@ -29,7 +29,7 @@ use platen_system::TableSystem;
 use crate::ctx::{check_finite, check_positive, Ctx};
 use crate::error::Result;
 use crate::file::{InitialSpec, IntegratorSpec, LimitsSpec, ModelSpec, ScenarioFile, SpecimenSpec};
-use crate::scenario::{build_model, model_overrides, Model, ModelKey, ModelOverrides};
+use crate::model::{build_model, model_overrides, Model, ModelKey, ModelOverrides};
 use crate::system::{build_table_system, loop_method};
 use crate::system_file::TableSystemSpec;
 
