@@ -379,50 +379,8 @@ fn reference_specimen() -> Specimen {
 /// step is near 1e-9 m, so the bound fails if an event is misplaced by more than ~1e-7 s·v.
 #[test]
 fn forward_with_stick_phases_matches_the_event_located_reference() {
-    let model = params().build().unwrap();
-    let spec = reference_specimen();
-    let force = reference_columns("specimen_force.csv");
-    let reference = reference_columns("specimen_reference.csv");
-    let sticks = reference_columns("specimen_sticks.csv");
-    let record = ForceRecord::new(force[0].clone(), force[1].clone()).unwrap();
-    let mut run = Specimens::default();
-    let stats = forward_rk4_specimen(
-        &model,
-        &spec,
-        &record,
-        Rk4::with_steps_per_sample(1).unwrap(),
-        State::default(),
-        record.len(),
-        &mut run,
-    )
-    .unwrap();
-    assert_eq!(run.samples.len(), reference[0].len());
-    let mut worst = [0.0f64; 3];
-    for (s, i) in run.samples.iter().zip(0..) {
-        let spec_sample = s.specimen.unwrap();
-        let got = [s.u_m, spec_sample.u_m[0], spec_sample.u_m[1]];
-        let want = [reference[1][i], reference[3][i], reference[4][i]];
-        for c in 0..3 {
-            worst[c] = worst[c].max((got[c] - want[c]).abs());
-        }
-    }
-    eprintln!("forward vs reference: largest |Δ| (u, z1, z2) = {worst:?} m; {stats:?}");
-    assert!(
-        worst.iter().all(|w| *w < 1e-7),
-        "largest differences (u, z1, z2) = {worst:?} m"
-    );
-    // The reference sticks 4 times (from rest at t = 0, then 3 stops); the run does too.
-    assert_eq!(sticks[0].len(), 4);
-    assert_eq!(stats.stick_events, 3, "{stats:?}");
-    assert!(stats.breakaways >= 4, "{stats:?}");
-    // The time spent stuck agrees with the reference's stick intervals (the last ends before
-    // the record does): a misplaced stop or breakaway would show here first.
-    let stuck_s: f64 = sticks[0].iter().zip(&sticks[1]).map(|(a, b)| b - a).sum();
-    assert!(
-        (stats.stick_time_s - stuck_s).abs() < 1e-6,
-        "stuck {} s against the reference's {stuck_s} s",
-        stats.stick_time_s
-    );
+    let rk4 = Method::Rk4(Rk4::with_steps_per_sample(1).unwrap());
+    matches_the_event_located_reference(rk4, "RK4");
 }
 
 /// The same event-located reference through the adaptive Dormand–Prince 5(4) with a specimen
@@ -432,6 +390,13 @@ fn forward_with_stick_phases_matches_the_event_located_reference() {
 /// the bound again tests where the events are placed.
 #[test]
 fn dopri5_with_stick_phases_matches_the_event_located_reference() {
+    let dopri5 = Method::Dopri5(Dopri5Settings::new(1e-10, 1e-12).unwrap());
+    matches_the_event_located_reference(dopri5, "Dopri5");
+}
+
+/// The forward run with `method` against the event-located reference: every sample within
+/// 1e-7 m, the reference's 3 stops (4 stick phases), and its time stuck within 1e-6 s.
+fn matches_the_event_located_reference(method: Method, what: &str) {
     let model = params().build().unwrap();
     let spec = reference_specimen();
     let force = reference_columns("specimen_force.csv");
@@ -439,7 +404,6 @@ fn dopri5_with_stick_phases_matches_the_event_located_reference() {
     let sticks = reference_columns("specimen_sticks.csv");
     let record = ForceRecord::new(force[0].clone(), force[1].clone()).unwrap();
     let mut run = Specimens::default();
-    let method = Method::Dopri5(Dopri5Settings::new(1e-10, 1e-12).unwrap());
     let stats = forward_specimen(
         &model,
         &spec,
@@ -460,16 +424,21 @@ fn dopri5_with_stick_phases_matches_the_event_located_reference() {
             worst[c] = worst[c].max((got[c] - want[c]).abs());
         }
     }
-    eprintln!("Dopri5 forward vs reference: largest |Δ| (u, z1, z2) = {worst:?} m; {stats:?}");
+    eprintln!("{what} forward vs reference: largest |Δ| (u, z1, z2) = {worst:?} m; {stats:?}");
     assert!(
         worst.iter().all(|w| *w < 1e-7),
-        "largest differences (u, z1, z2) = {worst:?} m"
+        "{what}: largest differences (u, z1, z2) = {worst:?} m"
     );
-    assert_eq!(stats.stick_events, 3, "{stats:?}");
+    // The reference sticks 4 times (from rest at t = 0, then 3 stops); the run does too.
+    assert_eq!(sticks[0].len(), 4);
+    assert_eq!(stats.stick_events, 3, "{what}: {stats:?}");
+    assert!(stats.breakaways >= 4, "{what}: {stats:?}");
+    // The time spent stuck agrees with the reference's stick intervals (the last ends before
+    // the record does): a misplaced stop or breakaway would show here first.
     let stuck_s: f64 = sticks[0].iter().zip(&sticks[1]).map(|(a, b)| b - a).sum();
     assert!(
         (stats.stick_time_s - stuck_s).abs() < 1e-6,
-        "stuck {} s against the reference's {stuck_s} s",
+        "{what}: stuck {} s against the reference's {stuck_s} s",
         stats.stick_time_s
     );
 }

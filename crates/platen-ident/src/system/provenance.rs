@@ -66,6 +66,26 @@ pub(crate) fn of(
     out
 }
 
+/// Where the values a lab's drawings give come from: given with `--base`, else assumed.
+fn drawings(input: &PlantInput) -> Source {
+    if input.base_given {
+        Source::Given
+    } else {
+        Source::Assumed
+    }
+}
+
+/// The note of a value the drawings give, when there are none: the nominal `value` of
+/// `what` taken instead.
+fn nominal(input: &PlantInput, what: &str, value: f64) -> Option<String> {
+    (!input.base_given).then(|| {
+        format!(
+            "no drawings: nominal {what} {value} (the records cannot show it; pass --base to \
+             give the lab's)"
+        )
+    })
+}
+
 /// A value with a note made for it.
 fn with_note(path: &str, source: Source, note: Option<String>) -> ValueProvenance {
     ValueProvenance {
@@ -117,15 +137,8 @@ fn actuator_provenance(
     out: &mut Vec<ValueProvenance>,
 ) {
     use Source::{Assumed, Given, Identified};
-    let drawings = if input.base_given { Given } else { Assumed };
-    let nominal = |what: &str, value: f64| {
-        (!input.base_given).then(|| {
-            format!(
-                "no drawings: nominal {what} {value} (the records cannot show it; pass --base \
-                 to give the lab's)"
-            )
-        })
-    };
+    let drawings = drawings(input);
+    let nominal = |what: &str, value: f64| nominal(input, what, value);
     let area_note = (!input.area_given).then(|| {
         format!(
             "no drawings: nominal {NOMINAL_AREA_M2} m² (the records show the plant only \
@@ -179,16 +192,9 @@ fn actuator_provenance(
 
 /// The servo-valves, the oil, the supply and the controller's fixed settings.
 fn loop_provenance(plant: &IdentifiedPlant, input: &PlantInput, out: &mut Vec<ValueProvenance>) {
-    use Source::{Assumed, Given, Identified};
-    let drawings = if input.base_given { Given } else { Assumed };
-    let nominal = |what: &str, value: f64| {
-        (!input.base_given).then(|| {
-            format!(
-                "no drawings: nominal {what} {value} (the records cannot show it; pass --base \
-                 to give the lab's)"
-            )
-        })
-    };
+    use Source::{Assumed, Identified};
+    let drawings = drawings(input);
+    let nominal = |what: &str, value: f64| nominal(input, what, value);
     out.push(with_note(
         "table_system.servo_valve.count",
         drawings,
