@@ -29,11 +29,13 @@
 
 use platen_model::{Exponent, IdentifiedModel, SlipRates};
 
+use crate::bare::Stepper;
 use crate::error::Result;
 use crate::event::Mode;
+use crate::machine::{DI, V};
 use crate::output::SampleSink;
 use crate::record::ForceRecord;
-use crate::rk4::{forward_rk4, Grid, GridStep, Rk4, Stepper};
+use crate::rk4::{forward_rk4, Grid, GridStep, GridStepper, Rk4};
 use crate::run::{check_run, Kin, RunStats, State};
 
 /// The number of lanes [`forward_rk4_ensemble`] advances together (measured best of 4 and 8
@@ -351,7 +353,7 @@ fn run_group<const N: usize, P: LanePow, S: SampleSink>(
         .iter()
         .map(|c| Stepper::new(c.model, Grid::new(c.record, k), c.initial))
         .collect();
-    let h = lanes[0].grid.h;
+    let h = lanes[0].machine.plant.grid.h;
     let times = cases[0].record.t_s();
     let mut errors: Vec<Option<crate::error::IntegrateError>> = vec![None; m];
     for (lane, sink) in lanes.iter().zip(sinks.iter_mut()) {
@@ -367,19 +369,22 @@ fn run_group<const N: usize, P: LanePow, S: SampleSink>(
                 if errors[l].is_some() {
                     continue;
                 }
-                if let Mode::Slip(d) = lane.mode {
-                    if lane.y.v != 0.0 {
+                let m = &lane.machine;
+                if let Mode::Slip(d) = m.mode {
+                    if m.y[V] != 0.0 {
+                        let y = lane.kin();
                         fast[l] = true;
-                        input.u[l] = lane.y.u;
-                        input.v[l] = lane.y.v;
-                        input.work[l] = lane.y.work;
-                        input.dissipated[l] = lane.y.dissipated;
-                        input.a0[l] = lane.rates.a_m_s2;
-                        input.p0[l] = lane.rates.dissipated_power_w;
+                        input.u[l] = y.u;
+                        input.v[l] = y.v;
+                        input.work[l] = y.work;
+                        input.dissipated[l] = y.dissipated;
+                        input.a0[l] = m.a;
+                        input.p0[l] = m.k[DI];
                         input.dir[l] = d.sign();
-                        input.f_start[l] = lane.grid.force(g, 0.0);
-                        input.f_mid[l] = lane.grid.force(g, 0.5 * (1.0 + 0.0));
-                        input.f_end[l] = lane.grid.force(g, 1.0);
+                        let grid = &m.plant.grid;
+                        input.f_start[l] = grid.force(g, 0.0);
+                        input.f_mid[l] = grid.force(g, 0.5 * (1.0 + 0.0));
+                        input.f_end[l] = grid.force(g, 1.0);
                     }
                 }
             }
@@ -394,10 +399,11 @@ fn run_group<const N: usize, P: LanePow, S: SampleSink>(
                 }
                 match &out {
                     Some(out) if fast[l] && out.accept[l] => {
-                        lane.stats.steps += 1;
-                        lane.stats.rhs_evaluations += 4;
-                        lane.y = out.y[l];
-                        lane.rates = out.rates[l];
+                        let stats = &mut lane.machine.stats;
+                        stats.steps += 1;
+                        stats.rhs_evaluations += 4;
+                        let r = out.rates[l];
+                        lane.commit_slip(out.y[l], r.a_m_s2, r.dissipated_power_w, input.f_end[l]);
                     }
                     _ => {
                         if let Err(e) = lane.step(g) {

@@ -230,27 +230,6 @@ fn dip_to_zero_exact(w0: f64, w1: f64, d0: f64, d1: f64) -> Option<f64> {
         .reduce(f64::min)
 }
 
-/// Why an advance inside one step stopped: the stepper's stop reason.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum StepStop {
-    /// The end of the step was reached (the state there is committed).
-    Step,
-    /// An event was located at `at` (the integrator's own time inside the step) and its reset
-    /// applied: the state and mode are those after the event.
-    Event {
-        /// Where the event happened, in the integrator's units of time inside the step.
-        at: f64,
-        /// What happened.
-        kind: EventKind,
-    },
-    /// The state advanced to `at` without a stick-slip event: the mode changed between slip
-    /// and creep, or part of the step was committed on the way to a possible crossing.
-    Moved {
-        /// Where the advance stopped, in the integrator's units of time inside the step.
-        at: f64,
-    },
-}
-
 /// A breakaway inside the rest of a step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Breakaway {

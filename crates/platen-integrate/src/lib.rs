@@ -19,11 +19,11 @@
 //! * [`Stepping`]: a specimen or closed-loop run advanced a [`Step`] at a time (an event with
 //!   its time and kind, a sample, the end), bit for bit the whole-record run.
 //!
-//! The specimen and the closed loop are *plants* of one mode machine (the friction modes,
-//! their events and resets, RK4 and Dopri5 pieces, written once); a new plant plugs into it
-//! by saying its state, its rates per mode and its net force. The bare platen keeps its own
-//! engine, whose breakaway is solved in closed form (the force is linear between samples
-//! and nothing else moves while it sticks).
+//! The bare platen's RK4, the specimen and the closed loop are *plants* of one mode machine
+//! (the friction modes, their events and resets, RK4 and Dopri5 pieces, written once); a new
+//! plant plugs into it by saying its state, its rates per mode and its net force. The bare
+//! platen rests exactly: nothing else moves while it sticks and the force is linear between
+//! samples, so its breakaway and its creep are its own closed forms.
 //!
 //! The bare platen's forward integrators share one event module (the friction modes, the `v = 0` root
 //! finder, the stick decision and the exact breakaway; the [`EventKind`]s it counts in
@@ -56,6 +56,7 @@
 
 #![warn(missing_docs)]
 
+mod bare;
 mod closed_loop;
 mod creep;
 mod dopri5;

@@ -64,6 +64,28 @@ pub(crate) const SD: usize = 4;
 /// The state of a plant, `L` numbers.
 pub(crate) type Y<const L: usize> = [f64; L];
 
+/// The stages of one RK4 step of `h6·6` seconds from position `s`, for
+/// [`Plant::rk4_quadrature`]: the start state `y`, the stage states `y2`, `y3`, `y4` and the
+/// inputs in the middle and at the end.
+pub(crate) struct Rk4Stages<'a, const L: usize, I> {
+    /// Where the step starts, in the plant's units.
+    pub(crate) s: f64,
+    /// The step over six, s.
+    pub(crate) h6: f64,
+    /// The input in the middle of the step.
+    pub(crate) i_mid: I,
+    /// The input at the end of the step.
+    pub(crate) i_end: I,
+    /// The state at the start.
+    pub(crate) y: &'a Y<L>,
+    /// The second stage's state.
+    pub(crate) y2: &'a Y<L>,
+    /// The third stage's state.
+    pub(crate) y3: &'a Y<L>,
+    /// The fourth stage's state.
+    pub(crate) y4: &'a Y<L>,
+}
+
 /// The integrator of the pieces.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum PieceMethod {
@@ -120,6 +142,34 @@ pub(crate) trait Plant<const L: usize> {
     fn admit(&mut self, _y: &mut Y<L>, _t_s: f64) -> bool {
         false
     }
+    /// Whether the integrated state `y` is finite (all of it by default; a plant may leave
+    /// out quadratures that only report, such as the bare platen's energy integrals).
+    #[inline(always)]
+    fn is_finite(&self, y: &Y<L>) -> bool {
+        y.iter().all(|x| x.is_finite())
+    }
+    /// Whether stick and creep have rates of their own (the state beyond the platen moves
+    /// while it rests, as a specimen or the oil columns do). The bare platen's have none: it
+    /// rests exactly, with its own closed forms for stick and creep (see [`crate::bare`]), and
+    /// entering those modes takes no evaluation.
+    const RATES_AT_REST: bool = true;
+    /// Whether the counters count a fast RK4 step that is tried and not committed (the bare
+    /// platen's do: its runs report those evaluations).
+    const COUNTS_TRIED_STEPS: bool = false;
+    /// Whether a platen leaving rest at position `tau` (state `y`, stiff speed `w_stiff`) in
+    /// `dir` creeps: its creep speed under the net force is below the stiff speed. By
+    /// default at `tau`; a plant whose force is linear over the span may ask at both ends.
+    fn creeps_from_rest(&self, dir: Direction, tau: f64, y: &Y<L>, w_stiff: f64) -> bool {
+        let f_eff = self.effective_force(self.input(tau), y);
+        creep_speed_m_s(self.model(), dir, y[U], f_eff, w_stiff).is_some()
+    }
+    /// State `i` at the end of an RK4 step with the stages `st`, when the plant sums it its
+    /// own way (the bare platen's work `F·v` grouped at the shared middle force); `None`
+    /// for the classical combination of the rates.
+    #[inline(always)]
+    fn rk4_quadrature(&self, _i: usize, _st: &Rk4Stages<'_, L, Self::Input>) -> Option<f64> {
+        None
+    }
     /// The error scale of state `i` going from `y0` to `y1` for the adaptive step
     /// (`atol·unit + rtol·|y|`; infinite for a quadrature that is not controlled).
     fn error_scale(&self, i: usize, y0: f64, y1: f64, rtol: f64, atol: f64) -> f64;
@@ -158,7 +208,7 @@ pub(crate) struct Machine<P, const L: usize> {
     /// The friction mode.
     pub(crate) mode: Mode,
     /// The stiff speed of the current creep phase, m/s.
-    w_stiff: f64,
+    pub(crate) w_stiff: f64,
     /// The grid's step, s: the stiff speed's scale and the adaptive step's ceiling.
     h: f64,
     /// The integrator of the pieces.
@@ -193,6 +243,12 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         }
     }
 
+    /// Whether the pieces are RK4 (whose slip steps away from rest may take
+    /// [`Machine::slip_fast`]).
+    pub(crate) fn is_rk4(&self) -> bool {
+        self.method == PieceMethod::Rk4
+    }
+
     /// Keeps every event with its time from now on, for [`Machine::drain_events`].
     pub(crate) fn log_events(&mut self) {
         self.events.get_or_insert_with(Vec::new);
@@ -206,7 +262,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
     }
 
     /// Counts the event `kind` at position `at` (and logs it with its time).
-    fn note(&mut self, kind: EventKind, at: f64) {
+    pub(crate) fn note(&mut self, kind: EventKind, at: f64) {
         self.stats.record(kind);
         if let Some(events) = &mut self.events {
             events.push((self.plant.time_s(at), kind));
@@ -274,6 +330,15 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
     /// and velocity of a creep phase).
     pub(crate) fn enter(&mut self, mode: Mode, input: P::Input) {
         self.mode = mode;
+        if !P::RATES_AT_REST && !matches!(mode, Mode::Slip(_)) {
+            // At rest with no rates of its own: nothing moves but what the plant's closed
+            // forms move.
+            if let Mode::Creep(_) = mode {
+                self.w_stiff = stiff_speed_m_s(self.plant.model(), self.y[U], self.h);
+            }
+            (self.k, self.a) = ([0.0; L], 0.0);
+            return;
+        }
         if let Mode::Creep(dir) = mode {
             self.w_stiff = stiff_speed_m_s(self.plant.model(), self.y[U], self.h);
             let y = self.y;
@@ -333,10 +398,17 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         self.plant.rates(mode, w, i_end, &y4, &mut k4);
         self.stats.rhs_evaluations += 3;
         let h6 = dt / 6.0;
-        let mut y1 = *y;
-        for i in 0..L {
-            y1[i] += h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
-        }
+        let st = Rk4Stages {
+            s,
+            h6,
+            i_mid,
+            i_end,
+            y,
+            y2: &y2,
+            y3: &y3,
+            y4: &y4,
+        };
+        let mut y1 = self.combine_rk4(&st, k1, &k2, &k3, &k4);
         let stage_min = match mode {
             Mode::Slip(dir) => {
                 let d = dir.sign();
@@ -346,6 +418,27 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         };
         self.plant.settle(mode, w, i_end, &mut y1);
         (y1, stage_min)
+    }
+
+    /// The end of an RK4 step with stages `st` and rates `k1`…`k4`: the classical
+    /// combination, or the plant's own quadrature of a state ([`Plant::rk4_quadrature`]).
+    #[inline(always)]
+    fn combine_rk4(
+        &self,
+        st: &Rk4Stages<'_, L, P::Input>,
+        k1: &Y<L>,
+        k2: &Y<L>,
+        k3: &Y<L>,
+        k4: &Y<L>,
+    ) -> Y<L> {
+        let mut y1 = *st.y;
+        for i in 0..L {
+            y1[i] = match self.plant.rk4_quadrature(i, st) {
+                Some(yi) => yi,
+                None => y1[i] + st.h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]),
+            };
+        }
+        y1
     }
 
     /// Adaptive Dormand–Prince 5(4) over a length `len` from position `s` (`y` with rates
@@ -556,17 +649,18 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         IntegrateError::failed(self.plant.time_s(at), cause)
     }
 
-    /// One RK4 step over a whole span of length 1 from position 0 in slip with direction
-    /// `direction::<POSITIVE>()` (the platen moving, `v ≠ 0`), committed when it is safe:
-    /// exactly the first try of [`Machine::advance`] (a single piece of length 1), the same
-    /// operations in the same order, so what it commits is bit for bit what
-    /// [`Machine::advance`] would. Returns whether it committed; if not, nothing has changed
-    /// (counters included) and the span is taken again by [`Machine::advance`].
+    /// One RK4 step over the rest of a span of length 1, from position `tau`, in slip with
+    /// direction `direction::<POSITIVE>()` (the platen moving, `v ≠ 0`), committed when it is
+    /// safe: from `tau = 0` exactly the first try of [`Machine::advance`] (a single piece of
+    /// length 1), the same operations in the same order, so what it commits is bit for bit
+    /// what [`Machine::advance`] would. Returns whether it committed; if not, nothing has
+    /// changed but the counters of a plant that counts tried steps
+    /// ([`Plant::COUNTS_TRIED_STEPS`]), and the span is taken again by [`Machine::advance`].
     #[inline(always)]
-    pub(crate) fn slip_fast<const POSITIVE: bool>(&mut self) -> bool {
+    pub(crate) fn slip_fast<const POSITIVE: bool>(&mut self, tau: f64) -> bool {
         let dir = crate::rk4::direction::<POSITIVE>();
-        let h = self.plant.seconds(1.0);
-        let (i_mid, i_end) = (self.plant.input(0.5), self.plant.input(1.0));
+        let h = self.plant.seconds(1.0 - tau);
+        let (i_mid, i_end) = (self.plant.input(0.5 * (1.0 + tau)), self.plant.input(1.0));
         let (y, k1) = (&self.y, &self.k);
         let hh = 0.5 * h;
         let (mut k2, mut k3, mut k4) = ([0.0; L], [0.0; L], [0.0; L]);
@@ -585,22 +679,36 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
             y4[i] += h * k3[i];
         }
         self.plant.slip_rates::<POSITIVE>(i_end, &y4, &mut k4);
-        let h6 = h / 6.0;
-        let mut y1 = *y;
-        for i in 0..L {
-            y1[i] += h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]);
+        let st = Rk4Stages {
+            s: tau,
+            h6: h / 6.0,
+            i_mid,
+            i_end,
+            y,
+            y2: &y2,
+            y3: &y3,
+            y4: &y4,
+        };
+        let y1 = self.combine_rk4(&st, k1, &k2, &k3, &k4);
+        if P::COUNTS_TRIED_STEPS {
+            self.stats.rhs_evaluations += 3;
         }
         let stage_min = (dir * y2[V]).min(dir * y3[V]).min(dir * y4[V]);
-        if !(dir * y1[V] > 0.0 && stage_min > 0.0 && y1.iter().all(|x| x.is_finite())) {
+        if !(dir * y1[V] > 0.0 && stage_min > 0.0 && self.plant.is_finite(&y1)) {
             return false;
         }
         let mut k_end = [0.0; L];
         let a1 = self.plant.slip_rates::<POSITIVE>(i_end, &y1, &mut k_end);
+        if P::COUNTS_TRIED_STEPS {
+            self.stats.rhs_evaluations += 1;
+        }
         let (d0, d1) = (dir * self.a * h, dir * a1 * h);
         if dip_to_zero(dir * self.y[V], dir * y1[V], d0, d1).is_some() || !a1.is_finite() {
             return false;
         }
-        self.stats.rhs_evaluations += 4;
+        if !P::COUNTS_TRIED_STEPS {
+            self.stats.rhs_evaluations += 4;
+        }
         (self.y, self.k, self.a) = (y1, k_end, a1);
         true
     }
@@ -614,10 +722,8 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         let from_rest = slip && self.y[V] == 0.0;
         if let (Mode::Slip(dir), true) = (self.mode, from_rest) {
             // Leaving rest below the stiff speed: creep.
-            let model = self.plant.model();
-            let w_stiff = stiff_speed_m_s(model, self.y[U], self.h);
-            let f_eff = self.plant.effective_force(i0, &self.y);
-            if creep_speed_m_s(model, dir, self.y[U], f_eff, w_stiff).is_some() {
+            let w_stiff = stiff_speed_m_s(self.plant.model(), self.y[U], self.h);
+            if self.plant.creeps_from_rest(dir, tau, &self.y, w_stiff) {
                 self.enter(Mode::Creep(dir), i0);
                 return Ok(self.plant.reach(tau, 0.0));
             }
@@ -630,7 +736,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         let mut len = rest;
         for _ in 0..=MAX_HALVINGS {
             let (y1, stage_min) = self.piece(tau, len, try_grading);
-            if !y1.iter().all(|x| x.is_finite()) {
+            if !self.plant.is_finite(&y1) {
                 return Err(self.non_finite(tau));
             }
             self.plant.check(&y1, self.plant.time_s(tau + len))?;

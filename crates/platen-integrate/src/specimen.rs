@@ -615,8 +615,12 @@ impl<M: PlatenModel, const L: usize> GridStepper for Stepper<'_, M, L> {
         m.plant.n = n;
         m.stats.steps += 1;
         let committed = match m.mode {
-            Mode::Slip(Direction::Positive) if self.rk4 && m.y[V] != 0.0 => m.slip_fast::<true>(),
-            Mode::Slip(Direction::Negative) if self.rk4 && m.y[V] != 0.0 => m.slip_fast::<false>(),
+            Mode::Slip(Direction::Positive) if self.rk4 && m.y[V] != 0.0 => {
+                m.slip_fast::<true>(0.0)
+            }
+            Mode::Slip(Direction::Negative) if self.rk4 && m.y[V] != 0.0 => {
+                m.slip_fast::<false>(0.0)
+            }
             _ => false,
         };
         if committed {
