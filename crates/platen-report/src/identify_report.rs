@@ -16,7 +16,7 @@ use platen_ident::anyrecord::summary::{RecordInfoSummary, RecordSummary};
 use platen_ident::anyrecord::ChannelDelay;
 use platen_ident::{
     Correlations, Estimate, Flag, Identification, IdentificationSummary, Identified, IdentifiedKey,
-    Parameter, ParameterEstimates, RecordIdentification, TestKind, TestRecord,
+    OutputErrorFit, Parameter, ParameterEstimates, RecordIdentification, TestKind, TestRecord,
 };
 
 use crate::figure::Figure;
@@ -260,25 +260,7 @@ pub fn record_report(id: &RecordIdentification, inputs: &[&RecordSource]) -> Str
     }
     correlation_lines(&mut s, "equation error", &u.correlations);
     if let Some(oe) = &id.output_error {
-        let _ = writeln!(
-            s,
-            "\nOutput-error check (forward simulation with exact stick-slip fitted to u and a; {} iterations, {} simulations{}):",
-            oe.iterations,
-            oe.simulations,
-            if oe.converged { "" } else { ", NOT converged" }
-        );
-        parameter_lines(&mut s, &oe.parameters);
-        for (k, (u, a)) in oe.rms_u_m.iter().zip(&oe.rms_a_m_s2).enumerate() {
-            let _ = writeln!(
-                s,
-                "  record {}: RMS residual u {:.3} → {:.3} mm, a {:.4} → {:.4} m/s²",
-                k + 1,
-                1e3 * u[0],
-                1e3 * u[1],
-                a[0],
-                a[1]
-            );
-        }
+        output_error_lines(&mut s, oe);
     }
     let _ = writeln!(s, "\nDissipative force F_D(|v|) with its 95 % band");
     let step = (id.band.len() / 8).max(1);
@@ -299,6 +281,29 @@ pub fn record_report(id: &RecordIdentification, inputs: &[&RecordSource]) -> Str
         }
     }
     s
+}
+
+/// The output-error check: its parameters and each record's residuals before and after.
+fn output_error_lines(s: &mut String, oe: &OutputErrorFit) {
+    let _ = writeln!(
+        s,
+        "\nOutput-error check (forward simulation with exact stick-slip fitted to u and a; {} iterations, {} simulations{}):",
+        oe.iterations,
+        oe.simulations,
+        if oe.converged { "" } else { ", NOT converged" }
+    );
+    parameter_lines(s, &oe.parameters);
+    for (k, (u, a)) in oe.rms_u_m.iter().zip(&oe.rms_a_m_s2).enumerate() {
+        let _ = writeln!(
+            s,
+            "  record {}: RMS residual u {:.3} → {:.3} mm, a {:.4} → {:.4} m/s²",
+            k + 1,
+            1e3 * u[0],
+            1e3 * u[1],
+            a[0],
+            a[1]
+        );
+    }
 }
 
 /// The seven parameters, one line each.

@@ -22,6 +22,8 @@ use platen_model::STANDARD_GRAVITY_M_S2;
 use platen_scenario::describe::{ModelDescription, SystemDescription};
 use platen_scenario::Rig;
 use platen_system::Supply;
+use Shown::{Count, Number, Optional};
+use Value::{Field, NaturalFrequency, Physical};
 
 /// Significant digits of every printed value: the paper quotes its parameters to 3–4.
 pub const SIGNIFICANT_DIGITS: i32 = 4;
@@ -30,7 +32,7 @@ pub const SIGNIFICANT_DIGITS: i32 = 4;
 pub fn text(d: &ModelDescription) -> String {
     let mut s = model_text(d);
     if let Some(system) = &d.table_system {
-        s.push_str(&system_text(system));
+        s.push_str(&table_system_text(system));
     }
     s
 }
@@ -76,8 +78,8 @@ enum Unit {
     Kilonewton,
     /// MN (SI N / 10⁶).
     Meganewton,
-    /// kN/(m/s)^α with the exponent α given (`None`: unknown).
-    KilonewtonPerVelocityTo(Option<f64>),
+    /// kN/(m/s)^α with the exponent α the value given (none: unknown).
+    KilonewtonPerVelocityTo(Value),
     /// MPa (SI Pa / 10⁶).
     Megapascal,
     /// m.
@@ -90,6 +92,8 @@ enum Unit {
     Gravity,
     /// s/m.
     SecondPerMetre,
+    /// Hz.
+    Hertz,
     /// Percent of a dimensionless ratio (friction coefficients).
     Percent,
     /// A dimensionless number.
@@ -97,15 +101,15 @@ enum Unit {
 }
 
 impl Unit {
-    /// The shown number and unit of SI value `v`.
-    fn show(self, v: f64) -> (f64, String) {
+    /// The shown number and unit of SI value `v` of description `d`.
+    fn show(self, v: f64, d: &ModelDescription) -> (f64, String) {
         match self {
             Unit::Tonne => (v / 1e3, "t".into()),
             Unit::MeganewtonPerMetre => (v / 1e6, "MN/m".into()),
             Unit::Kilonewton => (v / 1e3, "kN".into()),
             Unit::Meganewton => (v / 1e6, "MN".into()),
             Unit::KilonewtonPerVelocityTo(exponent) => {
-                let unit = match exponent {
+                let unit = match exponent.of(d) {
                     Some(1.0) => "kN·s/m".to_string(),
                     Some(e) => format!("kN/(m/s)^{e}"),
                     None => "kN/(m/s)^α".to_string(),
@@ -118,6 +122,7 @@ impl Unit {
             Unit::MetrePerSecond => (v, "m/s".into()),
             Unit::Gravity => (v / STANDARD_GRAVITY_M_S2, "g".into()),
             Unit::SecondPerMetre => (v, "s/m".into()),
+            Unit::Hertz => (v, "Hz".into()),
             Unit::Percent => (v * 100.0, "%".into()),
             Unit::None => (v, String::new()),
         }
@@ -129,13 +134,152 @@ fn finite(v: f64) -> Option<f64> {
     Some(v).filter(|v| v.is_finite())
 }
 
-/// The printed cells of the quantities given (symbol, description, SI value, unit); a
-/// value that is absent or not finite is left out.
-fn rows(quantities: &[(&str, &str, Option<f64>, Unit)]) -> Vec<[String; 4]> {
+/// Where a quantity's SI value is in a model description.
+#[derive(Clone, Copy)]
+enum Value {
+    /// A field of the description (not shown unless finite).
+    Field(fn(&ModelDescription) -> f64),
+    /// A physical parameter, by its key (not shown unless present and finite).
+    Physical(&'static str),
+    /// The natural frequency of the linear part, √(Kₑ/Mₑ)/2π, in Hz (shown when Kₑ and Mₑ
+    /// are finite).
+    NaturalFrequency,
+}
+
+impl Value {
+    /// The value in `d`, if it is shown.
+    fn of(self, d: &ModelDescription) -> Option<f64> {
+        match self {
+            Value::Field(field) => finite(field(d)),
+            Value::Physical(key) => d.physical.get(key).copied().and_then(finite),
+            Value::NaturalFrequency => {
+                let (k, m) = (finite(d.stiffness_n_per_m)?, finite(d.effective_mass_kg)?);
+                Some((k / m).sqrt() / std::f64::consts::TAU)
+            }
+        }
+    }
+}
+
+/// A line of the model's text: symbol, description, value and how it is shown.
+type Quantity = (&'static str, &'static str, Value, Unit);
+
+/// The unit of the simulated viscous coefficient: kN/(m/s)^α, α the simulated exponent.
+const VISCOUS: Unit = Unit::KilonewtonPerVelocityTo(Field(|d| d.viscous_exponent));
+
+/// The unit of the actuators' physical viscous coefficient, to their exponent.
+const ACTUATOR_VISCOUS: Unit = Unit::KilonewtonPerVelocityTo(Physical("viscous_exponent"));
+
+/// The unit of the struts' physical viscous coefficient, to their exponent.
+const STRUT_VISCOUS: Unit = Unit::KilonewtonPerVelocityTo(Physical("strut_viscous_exponent"));
+
+/// The model simulated: its seven identified keys and the natural frequency they give.
+#[rustfmt::skip]
+const SIMULATED: [Quantity; 8] = [
+    ("Mₑ",  "effective mass",
+        Field(|d| d.effective_mass_kg),          Unit::Tonne),
+    ("Kₑ",  "stiffness (hold-down struts)",
+        Field(|d| d.stiffness_n_per_m),          Unit::MeganewtonPerMetre),
+    ("F_μ", "Coulomb friction force",
+        Field(|d| d.coulomb_force_n),            Unit::Kilonewton),
+    ("Cₑ",  "viscous coefficient",
+        Field(|d| d.viscous_coefficient),        VISCOUS),
+    ("α",   "viscous exponent",
+        Field(|d| d.viscous_exponent),           Unit::None),
+    ("a",   "low-velocity friction force",
+        Field(|d| d.low_velocity_force_n),       Unit::Kilonewton),
+    ("b",   "low-velocity friction decay",
+        Field(|d| d.low_velocity_decay_s_per_m), Unit::SecondPerMetre),
+    ("fₙ",  "natural frequency √(Kₑ/Mₑ)/2π",
+        NaturalFrequency,                        Unit::Hertz),
+];
+
+/// The quantities derived from the physical parameters (full model, Eq. 5–8).
+#[rustfmt::skip]
+const DERIVED: [Quantity; 9] = [
+    ("Mₑ",     "effective mass (Eq. 5a)",
+        Field(|d| d.full_effective_mass_kg),         Unit::Tonne),
+    ("M̄ₑ",    "effective mass of one strut (Eq. 5b)",
+        Field(|d| d.strut_effective_mass_kg),        Unit::Tonne),
+    ("M̄′ₑ",   "strut rotational mass (Eq. 5c)",
+        Field(|d| d.strut_rotational_mass_kg),       Unit::Tonne),
+    ("Kₑ",     "stiffness (Eq. 6a)",
+        Field(|d| d.full_stiffness_n_per_m),         Unit::MeganewtonPerMetre),
+    ("K′ₑ",    "cubic stiffness (Eq. 6b)",
+        Field(|d| d.cubic_stiffness_n_per_m),        Unit::MeganewtonPerMetre),
+    ("F_hd",   "hold-down force 2p₀A",
+        Field(|d| d.hold_down_force_n),              Unit::Meganewton),
+    ("μ′ₑ",    "hold-down friction coefficient (Eq. 7b)",
+        Field(|d| d.hold_down_friction_coefficient), Unit::Percent),
+    ("μ⁽ⁱᵛ⁾ₑ", "hinge friction coefficient (Eq. 8)",
+        Field(|d| d.hinge_friction_coefficient),     Unit::Percent),
+    ("F_μ",    "Coulomb friction force (Eq. 7a)",
+        Field(|d| d.full_coulomb_force_n),           Unit::Kilonewton),
+];
+
+/// The physical parameters of the full model, by their keys.
+#[rustfmt::skip]
+const PHYSICAL: [Quantity; 22] = [
+    ("M_pl",     "platen mass",
+        Physical("platen_mass_kg"),                    Unit::Tonne),
+    ("M_act",    "moving mass of one actuator",
+        Physical("actuator_moving_mass_kg"),           Unit::Tonne),
+    ("M₁",       "strut piston mass",
+        Physical("strut_piston_mass_kg"),              Unit::Tonne),
+    ("M₂",       "strut cylinder mass",
+        Physical("strut_cylinder_mass_kg"),            Unit::Tonne),
+    ("h",        "strut height",
+        Physical("strut_height_m"),                    Unit::Metre),
+    ("l₀",       "strut piston length",
+        Physical("strut_piston_length_m"),             Unit::Metre),
+    ("p₀",       "nitrogen pre-charge pressure",
+        Physical("hold_down_pressure_pa"),             Unit::Megapascal),
+    ("A",        "strut chamber area",
+        Physical("strut_area_m2"),                     Unit::SquareMetre),
+    ("γ",        "gas heat capacity ratio",
+        Physical("gas_heat_capacity_ratio"),           Unit::None),
+    ("F_pl+act", "weight on the vertical bearings",
+        Physical("supported_weight_n"),                Unit::Kilonewton),
+    ("μ″ₑ",      "vertical bearing friction",
+        Physical("bearing_friction_coefficient"),      Unit::Percent),
+    ("μ‴ₑ",      "lateral bearing friction",
+        Physical("lateral_friction_coefficient"),      Unit::Percent),
+    ("F_l",      "normal force on the lateral bearings",
+        Physical("lateral_normal_force_n"),            Unit::Kilonewton),
+    ("μ_hg",     "strut swivel friction",
+        Physical("hinge_swivel_friction_coefficient"), Unit::Percent),
+    ("a",        "strut hinge radius",
+        Physical("hinge_radius_m"),                    Unit::Metre),
+    ("κ",        "hinge force-distribution factor",
+        Physical("hinge_force_distribution_factor"),   Unit::None),
+    ("Cₑ",       "actuator viscous coefficient",
+        Physical("viscous_coefficient"),               ACTUATOR_VISCOUS),
+    ("α",        "actuator viscous exponent",
+        Physical("viscous_exponent"),                  Unit::None),
+    ("c_β",      "strut viscous coefficient",
+        Physical("strut_viscous_coefficient"),         STRUT_VISCOUS),
+    ("β",        "strut viscous exponent",
+        Physical("strut_viscous_exponent"),            Unit::None),
+    ("a",        "low-velocity friction force",
+        Physical("low_velocity_force_n"),              Unit::Kilonewton),
+    ("b",        "low-velocity friction decay",
+        Physical("low_velocity_decay_s_per_m"),        Unit::SecondPerMetre),
+];
+
+/// The table's limits.
+#[rustfmt::skip]
+const LIMITS: [Quantity; 4] = [
+    ("", "stroke, either way",       Field(|d| d.limits.stroke_m),          Unit::Metre),
+    ("", "velocity",                 Field(|d| d.limits.velocity_m_s),      Unit::MetrePerSecond),
+    ("", "acceleration, bare table", Field(|d| d.limits.acceleration_m_s2), Unit::Gravity),
+    ("", "actuator force",           Field(|d| d.limits.force_n),           Unit::Meganewton),
+];
+
+/// The printed cells of `quantities` in `d`; a quantity without a shown value is left out.
+fn rows(d: &ModelDescription, quantities: &[Quantity]) -> Vec<[String; 4]> {
     quantities
         .iter()
-        .filter_map(|&(sym, what, v, unit)| {
-            let (shown, unit) = unit.show(finite(v?)?);
+        .filter_map(|&(sym, what, value, unit)| {
+            let (shown, unit) = unit.show(value.of(d)?, d);
             Some([
                 sym.to_owned(),
                 what.to_owned(),
@@ -158,573 +302,287 @@ pub fn model_text(d: &ModelDescription) -> String {
     } else {
         "Model simulated (identified form, Eq. 22/23)"
     };
-    let alpha = finite(d.viscous_exponent);
-    let mut simulated = rows(&[
+    let groups: Vec<Group> = [
+        (heading, &SIMULATED[..]),
         (
-            "Mₑ",
-            "effective mass",
-            Some(d.effective_mass_kg),
-            Unit::Tonne,
+            "Derived from the physical parameters (full model, Eq. 5–8)",
+            &DERIVED,
         ),
-        (
-            "Kₑ",
-            "stiffness (hold-down struts)",
-            Some(d.stiffness_n_per_m),
-            Unit::MeganewtonPerMetre,
-        ),
-        (
-            "F_μ",
-            "Coulomb friction force",
-            Some(d.coulomb_force_n),
-            Unit::Kilonewton,
-        ),
-        (
-            "Cₑ",
-            "viscous coefficient",
-            Some(d.viscous_coefficient),
-            Unit::KilonewtonPerVelocityTo(alpha),
-        ),
-        (
-            "α",
-            "viscous exponent",
-            Some(d.viscous_exponent),
-            Unit::None,
-        ),
-        (
-            "a",
-            "low-velocity friction force",
-            Some(d.low_velocity_force_n),
-            Unit::Kilonewton,
-        ),
-        (
-            "b",
-            "low-velocity friction decay",
-            Some(d.low_velocity_decay_s_per_m),
-            Unit::SecondPerMetre,
-        ),
-    ]);
-    // The natural frequency of the linear part, √(Kₑ/Mₑ)/2π.
-    if let (Some(k), Some(m)) = (finite(d.stiffness_n_per_m), finite(d.effective_mass_kg)) {
-        simulated.push([
-            "fₙ".into(),
-            "natural frequency √(Kₑ/Mₑ)/2π".into(),
-            significant((k / m).sqrt() / std::f64::consts::TAU, SIGNIFICANT_DIGITS),
-            "Hz".into(),
-        ]);
-    }
-    let derived = rows(&[
-        (
-            "Mₑ",
-            "effective mass (Eq. 5a)",
-            Some(d.full_effective_mass_kg),
-            Unit::Tonne,
-        ),
-        (
-            "M̄ₑ",
-            "effective mass of one strut (Eq. 5b)",
-            Some(d.strut_effective_mass_kg),
-            Unit::Tonne,
-        ),
-        (
-            "M̄′ₑ",
-            "strut rotational mass (Eq. 5c)",
-            Some(d.strut_rotational_mass_kg),
-            Unit::Tonne,
-        ),
-        (
-            "Kₑ",
-            "stiffness (Eq. 6a)",
-            Some(d.full_stiffness_n_per_m),
-            Unit::MeganewtonPerMetre,
-        ),
-        (
-            "K′ₑ",
-            "cubic stiffness (Eq. 6b)",
-            Some(d.cubic_stiffness_n_per_m),
-            Unit::MeganewtonPerMetre,
-        ),
-        (
-            "F_hd",
-            "hold-down force 2p₀A",
-            Some(d.hold_down_force_n),
-            Unit::Meganewton,
-        ),
-        (
-            "μ′ₑ",
-            "hold-down friction coefficient (Eq. 7b)",
-            Some(d.hold_down_friction_coefficient),
-            Unit::Percent,
-        ),
-        (
-            "μ⁽ⁱᵛ⁾ₑ",
-            "hinge friction coefficient (Eq. 8)",
-            Some(d.hinge_friction_coefficient),
-            Unit::Percent,
-        ),
-        (
-            "F_μ",
-            "Coulomb friction force (Eq. 7a)",
-            Some(d.full_coulomb_force_n),
-            Unit::Kilonewton,
-        ),
-    ]);
-    let p = |key: &str| d.physical.get(key).copied();
-    let exponent = |key: &str| p(key).and_then(finite);
-    let physical = rows(&[
-        ("M_pl", "platen mass", p("platen_mass_kg"), Unit::Tonne),
-        (
-            "M_act",
-            "moving mass of one actuator",
-            p("actuator_moving_mass_kg"),
-            Unit::Tonne,
-        ),
-        (
-            "M₁",
-            "strut piston mass",
-            p("strut_piston_mass_kg"),
-            Unit::Tonne,
-        ),
-        (
-            "M₂",
-            "strut cylinder mass",
-            p("strut_cylinder_mass_kg"),
-            Unit::Tonne,
-        ),
-        ("h", "strut height", p("strut_height_m"), Unit::Metre),
-        (
-            "l₀",
-            "strut piston length",
-            p("strut_piston_length_m"),
-            Unit::Metre,
-        ),
-        (
-            "p₀",
-            "nitrogen pre-charge pressure",
-            p("hold_down_pressure_pa"),
-            Unit::Megapascal,
-        ),
-        (
-            "A",
-            "strut chamber area",
-            p("strut_area_m2"),
-            Unit::SquareMetre,
-        ),
-        (
-            "γ",
-            "gas heat capacity ratio",
-            p("gas_heat_capacity_ratio"),
-            Unit::None,
-        ),
-        (
-            "F_pl+act",
-            "weight on the vertical bearings",
-            p("supported_weight_n"),
-            Unit::Kilonewton,
-        ),
-        (
-            "μ″ₑ",
-            "vertical bearing friction",
-            p("bearing_friction_coefficient"),
-            Unit::Percent,
-        ),
-        (
-            "μ‴ₑ",
-            "lateral bearing friction",
-            p("lateral_friction_coefficient"),
-            Unit::Percent,
-        ),
-        (
-            "F_l",
-            "normal force on the lateral bearings",
-            p("lateral_normal_force_n"),
-            Unit::Kilonewton,
-        ),
-        (
-            "μ_hg",
-            "strut swivel friction",
-            p("hinge_swivel_friction_coefficient"),
-            Unit::Percent,
-        ),
-        ("a", "strut hinge radius", p("hinge_radius_m"), Unit::Metre),
-        (
-            "κ",
-            "hinge force-distribution factor",
-            p("hinge_force_distribution_factor"),
-            Unit::None,
-        ),
-        (
-            "Cₑ",
-            "actuator viscous coefficient",
-            p("viscous_coefficient"),
-            Unit::KilonewtonPerVelocityTo(exponent("viscous_exponent")),
-        ),
-        (
-            "α",
-            "actuator viscous exponent",
-            p("viscous_exponent"),
-            Unit::None,
-        ),
-        (
-            "c_β",
-            "strut viscous coefficient",
-            p("strut_viscous_coefficient"),
-            Unit::KilonewtonPerVelocityTo(exponent("strut_viscous_exponent")),
-        ),
-        (
-            "β",
-            "strut viscous exponent",
-            p("strut_viscous_exponent"),
-            Unit::None,
-        ),
-        (
-            "a",
-            "low-velocity friction force",
-            p("low_velocity_force_n"),
-            Unit::Kilonewton,
-        ),
-        (
-            "b",
-            "low-velocity friction decay",
-            p("low_velocity_decay_s_per_m"),
-            Unit::SecondPerMetre,
-        ),
-    ]);
-    let l = &d.limits;
-    let limits = rows(&[
-        ("", "stroke, either way", Some(l.stroke_m), Unit::Metre),
-        ("", "velocity", Some(l.velocity_m_s), Unit::MetrePerSecond),
-        (
-            "",
-            "acceleration, bare table",
-            Some(l.acceleration_m_s2),
-            Unit::Gravity,
-        ),
-        ("", "actuator force", Some(l.force_n), Unit::Meganewton),
-    ]);
-    let groups: Vec<Group> = vec![
-        (heading.to_owned(), simulated),
-        (
-            "Derived from the physical parameters (full model, Eq. 5–8)".to_owned(),
-            derived,
-        ),
-        ("Physical parameters (full model)".to_owned(), physical),
-        ("Table limits".to_owned(), limits),
-    ];
+        ("Physical parameters (full model)", &PHYSICAL),
+        ("Table limits", &LIMITS),
+    ]
+    .into_iter()
+    .map(|(title, quantities)| (title.to_owned(), rows(d, quantities)))
+    .collect();
     write_groups(&mut s, groups);
     s
 }
 
+/// A printed value of the table system's text.
+#[derive(Clone, Copy)]
+enum Shown {
+    /// A number, to [`SIGNIFICANT_DIGITS`].
+    Number(f64),
+    /// A count.
+    Count(u32),
+    /// A number there may be none of: `none`, without a unit, when there is none.
+    Optional(Option<f64>),
+}
+
+/// A line of the table system's text: symbol, description, value and unit.
+type Line<'a> = (&'static str, &'a str, Shown, &'static str);
+
+/// The group titled `title` of `lines`, printed.
+fn group(title: String, lines: &[Line]) -> Group {
+    let num = |x: f64| significant(x, SIGNIFICANT_DIGITS);
+    let cells = lines.iter().map(|&(sym, what, value, unit)| {
+        let (value, unit) = match value {
+            Number(x) => (num(x), unit),
+            Count(n) => (n.to_string(), unit),
+            Optional(x) => (
+                x.map_or("none".to_owned(), num),
+                if x.is_some() { unit } else { "" },
+            ),
+        };
+        [sym.to_owned(), what.to_owned(), value, unit.to_owned()]
+    });
+    (title, cells.collect())
+}
+
 /// The table system's groups: its parameters, oil column, capacities, linearisation, loop
 /// and integration step, in engineering units.
-pub fn system_text(d: &SystemDescription) -> String {
-    let params = &d.system;
-    let a = &params.actuator;
-    let v = &params.servo_valve;
-    let lin = &d.linearisation;
-    let m = &d.loop_margins;
-    let num = |x: f64| significant(x, SIGNIFICANT_DIGITS);
-    let opt = |x: Option<f64>| x.map_or("none".to_owned(), num);
-    let row = |sym: &str, what: String, value: String, unit: &str| {
-        [sym.to_owned(), what, value, unit.to_owned()]
-    };
-    // The unit of an optional value: none when there is no value.
-    let unit_of = |x: Option<f64>, unit: &'static str| if x.is_some() { unit } else { "" };
-    let supply = match &params.supply {
-        Supply::Constant => "supply pressure (constant)".to_owned(),
-        Supply::Accumulator(acc) => format!(
-            "supply pressure (accumulator, precharge {} MPa)",
-            num(acc.precharge_pressure_pa / 1e6)
-        ),
-    };
-    let parameters = vec![
-        row("n", "actuators".into(), a.count.to_string(), ""),
-        row("A_a", "cap-side area".into(), num(a.cap_area_m2), "m²"),
-        row("A_b", "rod-side area".into(), num(a.rod_area_m2), "m²"),
-        row(
-            "V_a",
-            "cap-side chamber volume at mid-stroke".into(),
-            num(a.cap_volume_m3),
-            "m³",
-        ),
-        row(
-            "V_b",
-            "rod-side chamber volume at mid-stroke".into(),
-            num(a.rod_volume_m3),
-            "m³",
-        ),
-        row(
-            "β",
-            "oil bulk modulus".into(),
-            num(params.oil_bulk_modulus_pa / 1e9),
-            "GPa",
-        ),
-        row(
-            "m",
-            "servo-valves per actuator".into(),
-            v.count.to_string(),
-            "",
-        ),
-        row(
-            "Q_r",
-            format!(
-                "rated flow of one valve (at {} MPa drop)",
-                num(v.rated_pressure_drop_pa / 1e6)
-            ),
-            num(v.rated_flow_m3_s * 60e3),
-            "l/min",
-        ),
-        row(
-            "f_v",
-            "spool natural frequency".into(),
-            num(v.natural_frequency_hz),
-            "Hz",
-        ),
-        row("P_s", supply, num(params.supply_pressure_pa / 1e6), "MPa"),
-        row(
-            "P_R",
-            "return pressure".into(),
-            num(params.return_pressure_pa / 1e6),
-            "MPa",
-        ),
-        row(
-            "f_c",
-            "controller sample rate".into(),
-            num(params.controller.sample_rate_hz),
-            "Hz",
-        ),
+pub fn table_system_text(d: &SystemDescription) -> String {
+    let groups = vec![
+        system_parameters(d),
+        oil_column(d),
+        capacities(d),
+        linearisation(d),
+        loop_margins(d),
+        integration(d),
     ];
-    let with_specimen = if d.specimen_mass_kg.is_some() {
-        ", with the specimen"
-    } else {
-        ""
-    };
-    let mut oil = vec![row(
-        "f_oc",
-        format!(
-            "oil column at mid-stroke, bare table (M = {} t)",
-            num(d.model_mass_kg / 1e3)
-        ),
-        num(d.oil_column_frequency_hz),
-        "Hz",
-    )];
-    if let (Some(f), Some(kg)) = (d.oil_column_frequency_with_specimen_hz, d.specimen_mass_kg) {
-        oil.push(row(
-            "f_oc",
-            format!(
-                "oil column at mid-stroke, with the specimen (M + {} t)",
-                num(kg / 1e3)
-            ),
-            num(f),
-            "Hz",
-        ));
-    }
-    oil.push(row(
-        "f_oc",
-        format!(
-            "oil column retracted, u = −{} m{with_specimen}",
-            num(d.stroke_m)
-        ),
-        num(d.oil_column_frequency_retracted_hz),
-        "Hz",
-    ));
-    oil.push(row(
-        "f_oc",
-        format!(
-            "oil column extended, u = +{} m{with_specimen}",
-            num(d.stroke_m)
-        ),
-        num(d.oil_column_frequency_extended_hz),
-        "Hz",
-    ));
-    let capacities = vec![
-        row(
-            "v_ext",
-            "valve-limited velocity, extending (no load)".into(),
-            num(d.valve_limited_velocity_extend_m_s),
-            "m/s",
-        ),
-        row(
-            "v_ret",
-            "valve-limited velocity, retracting (no load)".into(),
-            num(d.valve_limited_velocity_retract_m_s),
-            "m/s",
-        ),
-        row(
-            "Q_max",
-            "valve flow capacity (null drop on each land)".into(),
-            num(d.valve_flow_capacity_m3_s),
-            "m³/s",
-        ),
-        row(
-            "F_push",
-            "force capacity, pushing (stall)".into(),
-            num(d.force_capacity_push_n / 1e6),
-            "MN",
-        ),
-        row(
-            "F_pull",
-            "force capacity, pulling (stall)".into(),
-            num(d.force_capacity_pull_n / 1e6),
-            "MN",
-        ),
-    ];
-    let linearisation = vec![
-        row(
-            "p_a0",
-            "null pressure, cap side".into(),
-            num(d.null_pressure_a_pa / 1e6),
-            "MPa",
-        ),
-        row(
-            "p_b0",
-            "null pressure, rod side".into(),
-            num(d.null_pressure_b_pa / 1e6),
-            "MPa",
-        ),
-        row(
-            "K_qa",
-            "flow gain, cap-side land (one actuator)".into(),
-            num(lin.flow_gain_a_m3_s),
-            "m³/s",
-        ),
-        row(
-            "K_qb",
-            "flow gain, rod-side land (one actuator)".into(),
-            num(lin.flow_gain_b_m3_s),
-            "m³/s",
-        ),
-        row(
-            "K_c",
-            "flow-pressure coefficient (critically centred)".into(),
-            num(lin.flow_pressure_m3_s_per_pa * 1e9),
-            "l/s/MPa",
-        ),
-        row(
-            "V_a/β",
-            "hydraulic compliance, chamber a".into(),
-            num(lin.compliance_a_m3_per_pa * 1e9),
-            "l/MPa",
-        ),
-        row(
-            "V_b/β",
-            "hydraulic compliance, chamber b".into(),
-            num(lin.compliance_b_m3_per_pa * 1e9),
-            "l/MPa",
-        ),
-        row("M", "moving mass".into(), num(lin.mass_kg / 1e3), "t"),
-        row(
-            "K",
-            "restoring stiffness".into(),
-            num(lin.stiffness_n_per_m / 1e6),
-            "MN/m",
-        ),
-        row(
-            "C",
-            format!("secant damping at {} m/s", lin.damping_secant_speed_m_s),
-            num(lin.damping_n_s_per_m / 1e3),
-            "kN·s/m",
-        ),
-    ];
-    let margins = vec![
-        row(
-            "GM",
-            "gain margin".into(),
-            opt(m.gain_margin_db),
-            unit_of(m.gain_margin_db, "dB"),
-        ),
-        row(
-            "f_pc",
-            "phase crossover".into(),
-            opt(m.phase_crossover_hz),
-            unit_of(m.phase_crossover_hz, "Hz"),
-        ),
-        row(
-            "PM",
-            "phase margin".into(),
-            opt(m.phase_margin_deg),
-            unit_of(m.phase_margin_deg, "°"),
-        ),
-        row(
-            "f_gc",
-            "gain crossover".into(),
-            opt(m.gain_crossover_hz),
-            unit_of(m.gain_crossover_hz, "Hz"),
-        ),
-        row(
-            "|U/R|",
-            "peak closed-loop gain, command → displacement".into(),
-            num(m.peak_gain),
-            "",
-        ),
-        row("f_peak", "at".into(), num(m.peak_gain_hz), "Hz"),
-        row(
-            "f_bw",
-            "bandwidth (|U/R| below −3 dB above it)".into(),
-            opt(d.closed_loop_bandwidth_hz),
-            unit_of(d.closed_loop_bandwidth_hz, "Hz"),
-        ),
-        row(
-            "|U/R|",
-            "lowest closed-loop gain below the peak".into(),
-            num(d.closed_loop_min_gain),
-            "",
-        ),
-        row("f_min", "at".into(), num(d.closed_loop_min_gain_hz), "Hz"),
-    ];
-    let integration = vec![
-        row(
-            "k",
-            "RK4 steps per controller period".into(),
-            d.steps_per_controller_period.to_string(),
-            "",
-        ),
-        row("h", "step T/k".into(), num(d.step_s * 1e3), "ms"),
-    ];
-    let name = d
-        .preset
+    let mut s = String::new();
+    write_groups(&mut s, groups);
+    s
+}
+
+/// The system's name: its preset's (marked when the scenario lays values over them) or the
+/// scenario's.
+fn system_name(d: &SystemDescription) -> String {
+    d.preset
         .as_deref()
         .map_or("given by the scenario".to_owned(), |p| {
             // The preset's own values, or the scenario's laid over them.
-            let own = platen_system::preset::by_name(p).map_or(true, |s| s == *params);
+            let own = platen_system::preset::by_name(p).map_or(true, |s| s == d.system);
             let laid = if own {
                 ""
             } else {
                 ", with the scenario's values"
             };
             format!("{p}{laid}")
-        });
-    let payload = if d.specimen_mass_kg.is_some() {
-        "; the specimen as a rigid payload"
+        })
+}
+
+/// The system's parameters: actuators, oil, valves, supply and controller.
+fn system_parameters(d: &SystemDescription) -> Group {
+    let (p, a, v) = (&d.system, &d.system.actuator, &d.system.servo_valve);
+    let num = |x: f64| significant(x, SIGNIFICANT_DIGITS);
+    let rated = format!(
+        "rated flow of one valve (at {} MPa drop)",
+        num(v.rated_pressure_drop_pa / 1e6)
+    );
+    let supply = match &p.supply {
+        Supply::Constant => "supply pressure (constant)".to_owned(),
+        Supply::Accumulator(acc) => format!(
+            "supply pressure (accumulator, precharge {} MPa)",
+            num(acc.precharge_pressure_pa / 1e6)
+        ),
+    };
+    #[rustfmt::skip]
+    let lines: [Line; 12] = [
+        ("n",   "actuators",
+            Count(a.count),                      ""),
+        ("A_a", "cap-side area",
+            Number(a.cap_area_m2),               "m²"),
+        ("A_b", "rod-side area",
+            Number(a.rod_area_m2),               "m²"),
+        ("V_a", "cap-side chamber volume at mid-stroke",
+            Number(a.cap_volume_m3),             "m³"),
+        ("V_b", "rod-side chamber volume at mid-stroke",
+            Number(a.rod_volume_m3),             "m³"),
+        ("β",   "oil bulk modulus",
+            Number(p.oil_bulk_modulus_pa / 1e9), "GPa"),
+        ("m",   "servo-valves per actuator",
+            Count(v.count),                      ""),
+        ("Q_r", &rated,
+            Number(v.rated_flow_m3_s * 60e3),    "l/min"),
+        ("f_v", "spool natural frequency",
+            Number(v.natural_frequency_hz),      "Hz"),
+        ("P_s", &supply,
+            Number(p.supply_pressure_pa / 1e6),  "MPa"),
+        ("P_R", "return pressure",
+            Number(p.return_pressure_pa / 1e6),  "MPa"),
+        ("f_c", "controller sample rate",
+            Number(p.controller.sample_rate_hz), "Hz"),
+    ];
+    group(format!("Table system ({})", system_name(d)), &lines)
+}
+
+/// The oil column's frequency at mid-stroke (bare and with the specimen), retracted and
+/// extended.
+fn oil_column(d: &SystemDescription) -> Group {
+    let num = |x: f64| significant(x, SIGNIFICANT_DIGITS);
+    let with_specimen = if d.specimen_mass_kg.is_some() {
+        ", with the specimen"
     } else {
         ""
     };
-    let groups: Vec<Group> = vec![
-        (format!("Table system ({name})"), parameters),
-        ("Oil column (linearised, rigid moving mass)".into(), oil),
-        ("Capacities (closed forms)".into(), capacities),
-        (
-            format!("Linearisation at mid-stroke (centred spool, null pressures{payload})"),
-            linearisation,
-        ),
-        (
-            format!(
-                "Loop, linearised and broken at the drive{payload}: {}",
-                if m.stable {
-                    "stable (Nyquist)"
-                } else {
-                    "UNSTABLE (Nyquist)"
-                }
-            ),
-            margins,
-        ),
-        (
-            "Integration (closed-loop runs' default)".into(),
-            integration,
-        ),
+    let bare = format!(
+        "oil column at mid-stroke, bare table (M = {} t)",
+        num(d.model_mass_kg / 1e3)
+    );
+    let loaded = d.specimen_mass_kg.map(|kg| {
+        format!(
+            "oil column at mid-stroke, with the specimen (M + {} t)",
+            num(kg / 1e3)
+        )
+    });
+    let retracted = format!(
+        "oil column retracted, u = −{} m{with_specimen}",
+        num(d.stroke_m)
+    );
+    let extended = format!(
+        "oil column extended, u = +{} m{with_specimen}",
+        num(d.stroke_m)
+    );
+    let mut lines = vec![(
+        "f_oc",
+        bare.as_str(),
+        Number(d.oil_column_frequency_hz),
+        "Hz",
+    )];
+    if let (Some(f), Some(what)) = (d.oil_column_frequency_with_specimen_hz, &loaded) {
+        lines.push(("f_oc", what, Number(f), "Hz"));
+    }
+    lines.push((
+        "f_oc",
+        &retracted,
+        Number(d.oil_column_frequency_retracted_hz),
+        "Hz",
+    ));
+    lines.push((
+        "f_oc",
+        &extended,
+        Number(d.oil_column_frequency_extended_hz),
+        "Hz",
+    ));
+    group("Oil column (linearised, rigid moving mass)".into(), &lines)
+}
+
+/// The table's capacities by the closed forms.
+fn capacities(d: &SystemDescription) -> Group {
+    #[rustfmt::skip]
+    let lines: [Line; 5] = [
+        ("v_ext",  "valve-limited velocity, extending (no load)",
+            Number(d.valve_limited_velocity_extend_m_s),  "m/s"),
+        ("v_ret",  "valve-limited velocity, retracting (no load)",
+            Number(d.valve_limited_velocity_retract_m_s), "m/s"),
+        ("Q_max",  "valve flow capacity (null drop on each land)",
+            Number(d.valve_flow_capacity_m3_s),           "m³/s"),
+        ("F_push", "force capacity, pushing (stall)",
+            Number(d.force_capacity_push_n / 1e6),        "MN"),
+        ("F_pull", "force capacity, pulling (stall)",
+            Number(d.force_capacity_pull_n / 1e6),        "MN"),
     ];
-    let mut s = String::new();
-    write_groups(&mut s, groups);
-    s
+    group("Capacities (closed forms)".into(), &lines)
+}
+
+/// The end of a loop group's title: the specimen as a rigid payload, when there is one.
+fn payload(d: &SystemDescription) -> &'static str {
+    if d.specimen_mass_kg.is_some() {
+        "; the specimen as a rigid payload"
+    } else {
+        ""
+    }
+}
+
+/// The linearisation at mid-stroke.
+fn linearisation(d: &SystemDescription) -> Group {
+    let lin = &d.linearisation;
+    let damping = format!("secant damping at {} m/s", lin.damping_secant_speed_m_s);
+    let title = format!(
+        "Linearisation at mid-stroke (centred spool, null pressures{})",
+        payload(d)
+    );
+    #[rustfmt::skip]
+    let lines: [Line; 10] = [
+        ("p_a0",  "null pressure, cap side",
+            Number(d.null_pressure_a_pa / 1e6),          "MPa"),
+        ("p_b0",  "null pressure, rod side",
+            Number(d.null_pressure_b_pa / 1e6),          "MPa"),
+        ("K_qa",  "flow gain, cap-side land (one actuator)",
+            Number(lin.flow_gain_a_m3_s),                "m³/s"),
+        ("K_qb",  "flow gain, rod-side land (one actuator)",
+            Number(lin.flow_gain_b_m3_s),                "m³/s"),
+        ("K_c",   "flow-pressure coefficient (critically centred)",
+            Number(lin.flow_pressure_m3_s_per_pa * 1e9), "l/s/MPa"),
+        ("V_a/β", "hydraulic compliance, chamber a",
+            Number(lin.compliance_a_m3_per_pa * 1e9),    "l/MPa"),
+        ("V_b/β", "hydraulic compliance, chamber b",
+            Number(lin.compliance_b_m3_per_pa * 1e9),    "l/MPa"),
+        ("M",     "moving mass",
+            Number(lin.mass_kg / 1e3),                   "t"),
+        ("K",     "restoring stiffness",
+            Number(lin.stiffness_n_per_m / 1e6),         "MN/m"),
+        ("C",     &damping,
+            Number(lin.damping_n_s_per_m / 1e3),         "kN·s/m"),
+    ];
+    group(title, &lines)
+}
+
+/// The loop broken at the drive: its margins, and the closed loop's peak and bandwidth.
+fn loop_margins(d: &SystemDescription) -> Group {
+    let m = &d.loop_margins;
+    let stability = if m.stable {
+        "stable (Nyquist)"
+    } else {
+        "UNSTABLE (Nyquist)"
+    };
+    let title = format!(
+        "Loop, linearised and broken at the drive{}: {stability}",
+        payload(d)
+    );
+    #[rustfmt::skip]
+    let lines: [Line; 9] = [
+        ("GM",     "gain margin",
+            Optional(m.gain_margin_db),           "dB"),
+        ("f_pc",   "phase crossover",
+            Optional(m.phase_crossover_hz),       "Hz"),
+        ("PM",     "phase margin",
+            Optional(m.phase_margin_deg),         "°"),
+        ("f_gc",   "gain crossover",
+            Optional(m.gain_crossover_hz),        "Hz"),
+        ("|U/R|",  "peak closed-loop gain, command → displacement",
+            Number(m.peak_gain),                  ""),
+        ("f_peak", "at",
+            Number(m.peak_gain_hz),               "Hz"),
+        ("f_bw",   "bandwidth (|U/R| below −3 dB above it)",
+            Optional(d.closed_loop_bandwidth_hz), "Hz"),
+        ("|U/R|",  "lowest closed-loop gain below the peak",
+            Number(d.closed_loop_min_gain),       ""),
+        ("f_min",  "at",
+            Number(d.closed_loop_min_gain_hz),    "Hz"),
+    ];
+    group(title, &lines)
+}
+
+/// The closed-loop runs' default integration step.
+fn integration(d: &SystemDescription) -> Group {
+    #[rustfmt::skip]
+    let lines: [Line; 2] = [
+        ("k", "RK4 steps per controller period", Count(d.steps_per_controller_period), ""),
+        ("h", "step T/k",                        Number(d.step_s * 1e3),               "ms"),
+    ];
+    group("Integration (closed-loop runs' default)".into(), &lines)
 }
 
 /// `v` rounded to `digits` significant digits, in fixed notation, without trailing zeros
@@ -854,7 +712,7 @@ mod tests {
         );
         let sys = platen_system::preset::lhpost_2008();
         let own = SystemAnalysis::new(Some("lhpost-2008".into()), sys, &model, 0.75, None);
-        let s = system_text(&own.description());
+        let s = table_system_text(&own.description());
         assert!(s.starts_with("\nTable system (lhpost-2008)\n"), "{s}");
         assert!(s.contains("  f_oc    oil column at mid-stroke, bare table (M = 144.0 t)"));
         assert!(s.contains("broken at the drive: stable (Nyquist)"));
@@ -862,7 +720,7 @@ mod tests {
         changed.controller.displacement_gain_per_m *= 2.0;
         let laid =
             SystemAnalysis::new(Some("lhpost-2008".into()), changed, &model, 0.75, Some(4e4));
-        let s = system_text(&laid.description());
+        let s = table_system_text(&laid.description());
         assert!(
             s.contains("Table system (lhpost-2008, with the scenario's values)"),
             "{s}"

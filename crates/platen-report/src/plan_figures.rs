@@ -8,7 +8,7 @@
 
 use std::fmt::Write as _;
 
-use platen_plan::{LimitUse, Plan};
+use platen_plan::{Achieved, Iteration, LimitUse, Plan};
 use platen_signal::ResponseSpectrum;
 
 use crate::figure::{Dash, Figure, Panel, MODEL, RECORDED, RESIDUAL, SIMULATED};
@@ -346,42 +346,7 @@ pub fn page(
         ),
     ];
     if let Some(it) = p.iteration() {
-        let rows: Vec<Vec<String>> = it
-            .records
-            .iter()
-            .map(|r| {
-                vec![
-                    r.iteration.to_string(),
-                    format!("{:.2} %", 100.0 * r.acceleration_nrmse),
-                    format!("{:.2} %", 100.0 * r.displacement_nrmse),
-                    format!(
-                        "{:.2} % at {:.3} s",
-                        100.0 * r.spectrum_error,
-                        r.spectrum_error_period_s
-                    ),
-                ]
-            })
-            .collect();
-        sections.push(html::heading("Iterations"));
-        sections.push(html::table(
-            &[
-                "k",
-                "acceleration NRMSE",
-                "displacement NRMSE",
-                "spectrum error (5 %)",
-            ],
-            &rows,
-            false,
-        ));
-        let mut stop = format!(
-            "Stop: {}; the drive is iteration {}.",
-            it.stop.name(),
-            it.best
-        );
-        if let platen_plan::Stop::Stalled { reason } = &it.stop {
-            let _ = write!(stop, " Stalled: {reason}.");
-        }
-        sections.push(html::paragraph(&stop, None));
+        sections.extend(iteration_sections(it));
     }
     for w in &p.warnings {
         sections.push(html::paragraph(&format!("Warning: {w}"), Some("note")));
@@ -395,4 +360,46 @@ pub fn page(
         rendered,
         summary,
     })
+}
+
+/// The iterations' section of the page: each iteration's errors and why they stopped.
+fn iteration_sections(it: &Iteration<Achieved>) -> Vec<String> {
+    let rows: Vec<Vec<String>> = it
+        .records
+        .iter()
+        .map(|r| {
+            vec![
+                r.iteration.to_string(),
+                format!("{:.2} %", 100.0 * r.acceleration_nrmse),
+                format!("{:.2} %", 100.0 * r.displacement_nrmse),
+                format!(
+                    "{:.2} % at {:.3} s",
+                    100.0 * r.spectrum_error,
+                    r.spectrum_error_period_s
+                ),
+            ]
+        })
+        .collect();
+    let mut stop = format!(
+        "Stop: {}; the drive is iteration {}.",
+        it.stop.name(),
+        it.best
+    );
+    if let platen_plan::Stop::Stalled { reason } = &it.stop {
+        let _ = write!(stop, " Stalled: {reason}.");
+    }
+    vec![
+        html::heading("Iterations"),
+        html::table(
+            &[
+                "k",
+                "acceleration NRMSE",
+                "displacement NRMSE",
+                "spectrum error (5 %)",
+            ],
+            &rows,
+            false,
+        ),
+        html::paragraph(&stop, None),
+    ]
 }

@@ -646,17 +646,32 @@ fn lowest(points: &Points) -> f64 {
 /// The figures of a closed-loop run: tracking, tracking errors, valve, pressures, flow,
 /// supply.
 fn loop_figures(r: &Recorded, lo: &LoopRecord, scenario: &Scenario) -> Vec<Figure> {
-    let c = &lo.channels;
-    let channel = |quantity, symbol, unit, limit: Option<f64>, limit_name, shown_from| Channel {
+    vec![
+        tracking(r, lo, scenario),
+        tracking_errors(r, lo, scenario),
+        valve(lo, scenario),
+        pressures(lo, scenario),
+        flow(lo, scenario),
+        supply(&times(&lo.channels[SUPPLY], 1e-6), &lo.system, scenario),
+    ]
+}
+
+/// A channel without a limit, in `unit`.
+fn unlimited(quantity: &'static str, symbol: &'static str, unit: &'static str) -> Channel {
+    Channel {
         quantity,
         symbol,
         unit,
-        limit,
-        limit_name,
-        limit_shown_from: shown_from,
-    };
-    let mut out = vec![tracking(r, lo, scenario)];
-    out.push(Figure {
+        limit: None,
+        limit_name: "",
+        limit_shown_from: 1.0,
+    }
+}
+
+/// The displacement and acceleration errors of the closed loop.
+fn tracking_errors(r: &Recorded, lo: &LoopRecord, scenario: &Scenario) -> Figure {
+    let c = &lo.channels;
+    Figure {
         name: "tracking-error".into(),
         title: format!("{}: tracking errors (achieved − command)", scenario.name),
         caption: format!(
@@ -667,12 +682,12 @@ fn loop_figures(r: &Recorded, lo: &LoopRecord, scenario: &Scenario) -> Vec<Figur
         ),
         panels: vec![
             channel_panel(
-                &channel("displacement error", "u − u_ref", "mm", None, "", 1.0),
+                &unlimited("displacement error", "u − u_ref", "mm"),
                 &times(&c[ERR_U], 1e3),
                 RESIDUAL,
             ),
             channel_panel(
-                &channel("acceleration error", "a − a_ref", "m/s²", None, "", 1.0),
+                &unlimited("acceleration error", "a − a_ref", "m/s²"),
                 &c[ERR_A],
                 RESIDUAL,
             ),
@@ -680,18 +695,20 @@ fn loop_figures(r: &Recorded, lo: &LoopRecord, scenario: &Scenario) -> Vec<Figur
         columns: 1,
         rows: Vec::new(),
         size: (1200, 800),
-    });
-    let full = |quantity, symbol| {
-        channel(
-            quantity,
-            symbol,
-            "",
-            Some(1.0),
-            "full opening",
-            LIMIT_SHOWN_FROM,
-        )
+    }
+}
+
+/// The controller's drive and the spool opening, fractions of full opening.
+fn valve(lo: &LoopRecord, scenario: &Scenario) -> Figure {
+    let full = |quantity, symbol| Channel {
+        quantity,
+        symbol,
+        unit: "",
+        limit: Some(1.0),
+        limit_name: "full opening",
+        limit_shown_from: LIMIT_SHOWN_FROM,
     };
-    out.push(Figure {
+    Figure {
         name: "valve".into(),
         title: format!("{}: drive and spool opening", scenario.name),
         caption: format!(
@@ -704,15 +721,20 @@ fn loop_figures(r: &Recorded, lo: &LoopRecord, scenario: &Scenario) -> Vec<Figur
             .iter()
             .map(|&(quantity, symbol, i)| Panel {
                 y_label: format!("{symbol} (1 = full opening)"),
-                ..channel_panel(&full(quantity, symbol), &c[i], SIMULATED)
+                ..channel_panel(&full(quantity, symbol), &lo.channels[i], SIMULATED)
             })
             .collect(),
         columns: 1,
         rows: Vec::new(),
         size: (1200, 800),
-    });
+    }
+}
+
+/// The pressure difference across the pistons and the chambers' absolute pressures.
+fn pressures(lo: &LoopRecord, scenario: &Scenario) -> Figure {
+    let c = &lo.channels;
     let mut dp = channel_panel(
-        &channel("pressure difference", "Δp", "MPa", None, "", 1.0),
+        &unlimited("pressure difference", "Δp", "MPa"),
         &times(&c[DELTA_P], 1e-6),
         SIMULATED,
     );
@@ -735,7 +757,7 @@ fn loop_figures(r: &Recorded, lo: &LoopRecord, scenario: &Scenario) -> Vec<Figur
             ],
         )
     };
-    out.push(Figure {
+    Figure {
         name: "pressure-difference".into(),
         title: format!("{}: actuator chamber pressures", scenario.name),
         caption: "The pressure difference Δp = p_a − p_b across the pistons, and the \
@@ -746,38 +768,41 @@ fn loop_figures(r: &Recorded, lo: &LoopRecord, scenario: &Scenario) -> Vec<Figur
         columns: 1,
         rows: Vec::new(),
         size: (1200, 800),
-    });
+    }
+}
+
+/// The valves' flow against their capacity.
+fn flow(lo: &LoopRecord, scenario: &Scenario) -> Figure {
+    let c = &lo.channels;
     let capacity = lo.system.capacities().valve_flow_m3_s;
-    let mut flow = channel_panel(
-        &channel(
-            "valve flow",
-            "Q",
-            "m³/s",
-            Some(capacity),
-            "valve capacity",
-            0.0,
-        ),
+    let mut panel = channel_panel(
+        &Channel {
+            quantity: "valve flow",
+            symbol: "Q",
+            unit: "m³/s",
+            limit: Some(capacity),
+            limit_name: "valve capacity",
+            limit_shown_from: 0.0,
+        },
         &c[FLOW],
         SIMULATED,
     );
-    flow.title.push_str(&format!(
+    panel.title.push_str(&format!(
         ", {:.0} % of the capacity",
         100.0 * peak_magnitude(&c[FLOW]) / capacity
     ));
-    out.push(Figure {
+    Figure {
         name: "flow".into(),
         title: format!("{}: valve flow against the valves' capacity", scenario.name),
         caption: "The flow of all servo-valves into the cap-side chambers (negative: out of \
                   them) over time, against the valves' capacity ±Q_max (dashed): their flow \
                   at full opening with the null pressure drop on each land."
             .into(),
-        panels: vec![flow],
+        panels: vec![panel],
         columns: 1,
         rows: Vec::new(),
         size: (1200, 520),
-    });
-    out.push(supply(&times(&c[SUPPLY], 1e-6), &lo.system, scenario));
-    out
+    }
 }
 
 /// The command and the achieved displacement and acceleration, whole and zoomed.

@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use platen_integrate::{ForwardIntegrator as _, Peaks};
+use platen_integrate::{ForwardIntegrator as _, Peaks, RunStats};
 use platen_model::STANDARD_GRAVITY_M_S2;
 use platen_scenario::{Run, RunOutput, RunSummary, Scenario};
 
@@ -115,6 +115,19 @@ fn run_lines(s: &mut String, sc: &Scenario, output: &RunOutput, out: Option<&Pat
     for (channel, how) in &sc.derived {
         let _ = writeln!(s, "  derived {channel}: {how}");
     }
+    peak_lines(s, peaks);
+    specimen_lines(s, peaks);
+    if let (Some(st), Run::Forward { integrator, .. }) = (stats, &sc.run) {
+        forward_lines(s, st, integrator.name());
+    }
+    limit_lines(s, sc, peaks);
+    if let Some(out) = out {
+        let _ = writeln!(s, "  wrote {}", out.display());
+    }
+}
+
+/// The peaks of the table's motion and the actuator force.
+fn peak_lines(s: &mut String, peaks: &Peaks) {
     let _ = writeln!(
         s,
         "  peak displacement {:>+10.4} m     at {:.3} s",
@@ -138,31 +151,36 @@ fn run_lines(s: &mut String, sc: &Scenario, output: &RunOutput, out: Option<&Pat
         peaks.force_n.value / 1e3,
         peaks.force_n.t_s
     );
-    specimen_lines(s, peaks);
-    if let (Some(st), Run::Forward { integrator, .. }) = (stats, &sc.run) {
-        let _ = writeln!(
-            s,
-            "  stick: {:.3} s in all, {} stops, {} breakaways, {} reversals",
-            st.stick_time_s, st.stick_events, st.breakaways, st.reversals
-        );
-        let _ = writeln!(
-            s,
-            "  solver: {}, {} steps ({} rejected), {} right-hand-side evaluations, {} events located",
-            integrator.name(),
-            st.steps,
-            st.rejected_steps,
-            st.rhs_evaluations,
-            st.events()
-        );
-        let _ = writeln!(
-            s,
-            "  energy: actuator work {:.4e} J = ΔE_kin + ΔE_el + dissipated {:.4e} J; residual {:.2e} J ({:.1e} relative)",
-            st.energy.actuator_work_j,
-            st.energy.dissipated_j,
-            st.energy.residual_j(),
-            st.energy.relative_residual()
-        );
-    }
+}
+
+/// A forward run's stick, solver and energy figures; `integrator` names its method.
+fn forward_lines(s: &mut String, st: &RunStats, integrator: &str) {
+    let _ = writeln!(
+        s,
+        "  stick: {:.3} s in all, {} stops, {} breakaways, {} reversals",
+        st.stick_time_s, st.stick_events, st.breakaways, st.reversals
+    );
+    let _ = writeln!(
+        s,
+        "  solver: {}, {} steps ({} rejected), {} right-hand-side evaluations, {} events located",
+        integrator,
+        st.steps,
+        st.rejected_steps,
+        st.rhs_evaluations,
+        st.events()
+    );
+    let _ = writeln!(
+        s,
+        "  energy: actuator work {:.4e} J = ΔE_kin + ΔE_el + dissipated {:.4e} J; residual {:.2e} J ({:.1e} relative)",
+        st.energy.actuator_work_j,
+        st.energy.dissipated_j,
+        st.energy.residual_j(),
+        st.energy.relative_residual()
+    );
+}
+
+/// The table's limits: within them, or each one exceeded.
+fn limit_lines(s: &mut String, sc: &Scenario, peaks: &Peaks) {
     let ex = peaks.exceedances(&sc.rig.limits);
     if ex.is_empty() {
         let l = &sc.rig.limits;
@@ -181,9 +199,6 @@ fn run_lines(s: &mut String, sc: &Scenario, output: &RunOutput, out: Option<&Pat
             "  EXCEEDS {} limit: peak {:+.4} vs limit {:.4} (SI units) at {:.3} s",
             e.quantity, e.peak, e.limit, e.t_s
         );
-    }
-    if let Some(out) = out {
-        let _ = writeln!(s, "  wrote {}", out.display());
     }
 }
 

@@ -114,16 +114,9 @@ fn axis_figure(
     outcomes: &[Outcome],
 ) -> Figure {
     let others: Vec<usize> = varying.iter().copied().filter(|&o| o != a).collect();
-    // Groups of cases with the same values on the other axes, in case order.
-    let mut groups: Vec<(Vec<f64>, Vec<usize>)> = Vec::new();
-    for case in 0..outcomes.len() {
-        let key: Vec<f64> = others.iter().map(|&o| axes[o].values[case]).collect();
-        match groups.iter_mut().find(|(k, _)| *k == key) {
-            Some((_, members)) => members.push(case),
-            None => groups.push((key, vec![case])),
-        }
-    }
+    let groups = case_groups(axes, &others, outcomes.len());
     let many = groups.len() > MAX_LABELLED;
+    let styles = group_styles(axes, &others, &groups);
     let l = &scenario.rig.limits;
     let quantities: [Quantity; 4] = [
         ("displacement", "m", 1.0, l.stroke_m, |o| o.peaks.u_m.value),
@@ -138,116 +131,12 @@ fn axis_figure(
         }),
     ];
     let axis = &axes[a];
-    let x_range = {
-        let lo = axis.values.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = axis
-            .values
-            .iter()
-            .copied()
-            .fold(f64::NEG_INFINITY, f64::max);
-        let pad = 0.04 * (hi - lo);
-        (lo - pad, hi + pad)
-    };
     let panels = quantities
         .iter()
-        .map(|&(quantity, unit, scale, limit_si, peak)| {
-            let mut lines: Vec<Series> = groups
-                .iter()
-                .enumerate()
-                .map(|(g, (key, members))| {
-                    let mut pts: Vec<(f64, f64)> = members
-                        .iter()
-                        .filter(|&&c| outcomes[c].error.is_none())
-                        .map(|&c| (axis.values[c], peak(&outcomes[c]).abs() * scale))
-                        .collect();
-                    pts.sort_by(|p, q| p.0.total_cmp(&q.0));
-                    let (label, color) = if many {
-                        let label = if g == 0 {
-                            format!(
-                                "one line per combination of the other axes ({})",
-                                groups.len()
-                            )
-                        } else {
-                            String::new()
-                        };
-                        (label, MANY)
-                    } else {
-                        let label = others
-                            .iter()
-                            .zip(key)
-                            .map(|(&o, &v)| (axes[o].value_text)(&axes[o].name, v))
-                            .collect::<Vec<_>>()
-                            .join(", ");
-                        let label = if label.is_empty() {
-                            "cases".to_owned()
-                        } else {
-                            label
-                        };
-                        (label, LINE_COLORS[g % LINE_COLORS.len()])
-                    };
-                    series(
-                        label,
-                        pts,
-                        crate::figure::Style::Line {
-                            color,
-                            width: 2,
-                            dash: Dash::Solid,
-                        },
-                    )
-                })
-                .collect();
-            // Markers on every case, so a line of two points still shows its cases.
-            let markers: Vec<Series> = lines
-                .iter()
-                .map(|s| {
-                    let color = match s.style {
-                        crate::figure::Style::Line { color, .. } => color,
-                        _ => MANY,
-                    };
-                    crate::series::points("", s.points.clone(), color, 4)
-                })
-                .collect();
-            let limit = limit_si * scale;
-            let largest = lines
-                .iter()
-                .flat_map(|s| s.points.iter().map(|p| p.1))
-                .fold(0.0, f64::max);
-            let drawn = largest >= LIMIT_DRAWN_FROM * limit;
-            // The same legend text in every panel (the limit's value is in the title), so
-            // the figure's panels share one legend.
-            lines.push(patterned(
-                "table limit",
-                vec![(x_range.0, limit), (x_range.1, limit)],
-                MODEL,
-                2,
-                Dash::Dashed,
-            ));
-            if !drawn {
-                if let Some(limit_line) = lines.last_mut() {
-                    limit_line.points.clear();
-                }
-            }
-            lines.extend(markers);
-            let top = if drawn { largest.max(limit) } else { largest };
-            let title = if drawn {
-                format!("peak |{quantity}|, table limit {} {unit}", limit_text(limit))
-            } else {
-                format!(
-                    "peak |{quantity}| (table limit {} {unit}, off the scale: {:.0} % of it at most)",
-                    limit_text(limit),
-                    100.0 * largest / limit
-                )
-            };
-            Panel {
-                x_range: Some(x_range),
-                y_range: Some((0.0, 1.04 * top.max(f64::MIN_POSITIVE))),
-                ..Panel::new(
-                    title,
-                    axis.label.clone(),
-                    format!("|peak {quantity}| ({unit})"),
-                    lines,
-                )
-            }
+        .map(|&q| {
+            let (_, _, scale, _, peak) = q;
+            let lines = peak_lines(axis, &groups, &styles, outcomes, |o| peak(o).abs() * scale);
+            peak_panel(q, lines, axis)
         })
         .collect();
     let failed = outcomes.iter().filter(|o| o.error.is_some()).count();
@@ -279,5 +168,160 @@ fn axis_figure(
         columns: 2,
         rows: Vec::new(),
         size: (1400, 1000),
+    }
+}
+
+/// One line per group of cases in its style: `shown` of each of its cases (failed cases
+/// left out) against the axis's value.
+fn peak_lines(
+    axis: &Axis,
+    groups: &[(Vec<f64>, Vec<usize>)],
+    styles: &[(String, RGBColor)],
+    outcomes: &[Outcome],
+    shown: impl Fn(&Outcome) -> f64,
+) -> Vec<Series> {
+    groups
+        .iter()
+        .zip(styles)
+        .map(|((_, members), (label, color))| {
+            let mut pts: Vec<(f64, f64)> = members
+                .iter()
+                .filter(|&&c| outcomes[c].error.is_none())
+                .map(|&c| (axis.values[c], shown(&outcomes[c])))
+                .collect();
+            pts.sort_by(|p, q| p.0.total_cmp(&q.0));
+            series(
+                label.clone(),
+                pts,
+                crate::figure::Style::Line {
+                    color: *color,
+                    width: 2,
+                    dash: Dash::Solid,
+                },
+            )
+        })
+        .collect()
+}
+
+/// The cases (of `cases` in all) grouped by their values on the axes `others`, in case
+/// order: each group's values and members.
+fn case_groups(axes: &[Axis], others: &[usize], cases: usize) -> Vec<(Vec<f64>, Vec<usize>)> {
+    let mut groups: Vec<(Vec<f64>, Vec<usize>)> = Vec::new();
+    for case in 0..cases {
+        let key: Vec<f64> = others.iter().map(|&o| axes[o].values[case]).collect();
+        match groups.iter_mut().find(|(k, _)| *k == key) {
+            Some((_, members)) => members.push(case),
+            None => groups.push((key, vec![case])),
+        }
+    }
+    groups
+}
+
+/// The legend label and colour of each group's line: its values on the other axes in its
+/// own colour, or, with too many groups, grey lines under one legend entry.
+fn group_styles(
+    axes: &[Axis],
+    others: &[usize],
+    groups: &[(Vec<f64>, Vec<usize>)],
+) -> Vec<(String, RGBColor)> {
+    let many = groups.len() > MAX_LABELLED;
+    (groups.iter().enumerate())
+        .map(|(g, (key, _))| {
+            if many {
+                let label = if g == 0 {
+                    format!(
+                        "one line per combination of the other axes ({})",
+                        groups.len()
+                    )
+                } else {
+                    String::new()
+                };
+                (label, MANY)
+            } else {
+                let label = others
+                    .iter()
+                    .zip(key)
+                    .map(|(&o, &v)| (axes[o].value_text)(&axes[o].name, v))
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                let label = if label.is_empty() {
+                    "cases".to_owned()
+                } else {
+                    label
+                };
+                (label, LINE_COLORS[g % LINE_COLORS.len()])
+            }
+        })
+        .collect()
+}
+
+/// The panel of one quantity against `axis`: the `lines` of its peaks, markers on every
+/// case, and the table's limit when a peak reaches [`LIMIT_DRAWN_FROM`] of it.
+fn peak_panel(q: Quantity, mut lines: Vec<Series>, axis: &Axis) -> Panel {
+    let (quantity, unit, scale, limit_si, _) = q;
+    let x_range = {
+        let lo = axis.values.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = axis
+            .values
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max);
+        let pad = 0.04 * (hi - lo);
+        (lo - pad, hi + pad)
+    };
+    // Markers on every case, so a line of two points still shows its cases.
+    let markers: Vec<Series> = lines
+        .iter()
+        .map(|s| {
+            let color = match s.style {
+                crate::figure::Style::Line { color, .. } => color,
+                _ => MANY,
+            };
+            crate::series::points("", s.points.clone(), color, 4)
+        })
+        .collect();
+    let limit = limit_si * scale;
+    let largest = lines
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.1))
+        .fold(0.0, f64::max);
+    let drawn = largest >= LIMIT_DRAWN_FROM * limit;
+    // The same legend text in every panel (the limit's value is in the title), so
+    // the figure's panels share one legend.
+    lines.push(patterned(
+        "table limit",
+        vec![(x_range.0, limit), (x_range.1, limit)],
+        MODEL,
+        2,
+        Dash::Dashed,
+    ));
+    if !drawn {
+        if let Some(limit_line) = lines.last_mut() {
+            limit_line.points.clear();
+        }
+    }
+    lines.extend(markers);
+    let top = if drawn { largest.max(limit) } else { largest };
+    let title = if drawn {
+        format!(
+            "peak |{quantity}|, table limit {} {unit}",
+            limit_text(limit)
+        )
+    } else {
+        format!(
+            "peak |{quantity}| (table limit {} {unit}, off the scale: {:.0} % of it at most)",
+            limit_text(limit),
+            100.0 * largest / limit
+        )
+    };
+    Panel {
+        x_range: Some(x_range),
+        y_range: Some((0.0, 1.04 * top.max(f64::MIN_POSITIVE))),
+        ..Panel::new(
+            title,
+            axis.label.clone(),
+            format!("|peak {quantity}| ({unit})"),
+            lines,
+        )
     }
 }

@@ -332,50 +332,8 @@ fn loop_gain_figure(
     range: (f64, f64),
     bode: &[Bode],
 ) -> Figure {
-    let first = &bode[0];
-    let mag_extent = extent(bode.iter().map(|b| &b.magnitude_db));
-    let phase_extent = extent(bode.iter().map(|b| &b.phase_deg));
-    let mut magnitude = curve_series(curves, |i| bode[i].magnitude_db.clone());
-    magnitude.push(reference("0 dB (|L| = 1)", 0.0, range));
-    magnitude.extend(oil_column_lines(
-        system,
-        curves,
-        range,
-        (mag_extent.0.min(0.0), mag_extent.1.max(0.0)),
-    ));
-    let in_range = |f: &f64| *f >= range.0 && *f <= range.1;
-    if let Some(fc) = margins.gain_crossover_hz.filter(in_range) {
-        magnitude.push(points("gain crossover", vec![(fc, 0.0)], SIMULATED, 6));
-    }
-    let mut phase = curve_series(curves, |i| bode[i].phase_deg.clone());
-    // −180° and its odd multiples that the phase reaches (at most 20).
-    let levels: Vec<f64> = (0..20)
-        .map(|k| -180.0 * f64::from(2 * k + 1))
-        .enumerate()
-        .take_while(|&(k, level)| k == 0 || level >= phase_extent.0)
-        .map(|(_, level)| level)
-        .collect();
-    for (k, &level) in levels.iter().enumerate() {
-        let label = match (k, levels.len()) {
-            (0, 1) => "−180°",
-            (0, _) => "−180° (mod 360°)",
-            _ => "",
-        };
-        phase.push(reference(label, level, range));
-    }
-    phase.extend(oil_column_lines(
-        system,
-        curves,
-        range,
-        (phase_extent.0.min(-180.0), phase_extent.1),
-    ));
-    if let Some(fp) = margins.phase_crossover_hz.filter(in_range) {
-        if let Some(p) = at(&first.phase_deg, fp) {
-            // The crossing of −180° (mod 360°) nearest the unwrapped phase there.
-            let level = -180.0 + 360.0 * ((p + 180.0) / 360.0).round();
-            phase.push(points("phase crossover", vec![(fp, level)], SIMULATED, 6));
-        }
-    }
+    let magnitude = loop_magnitude(system, curves, margins, range, bode);
+    let phase = loop_phase(system, curves, margins, range, bode);
     let stability = if margins.stable { "stable" } else { "UNSTABLE" };
     Figure {
         name: "bode-loop-gain".into(),
@@ -420,6 +378,75 @@ fn loop_gain_figure(
         rows: Vec::new(),
         size: (1200, 900),
     }
+}
+
+/// The loop gain's magnitude: the curves, 0 dB, the oil-column frequencies and the gain
+/// crossover.
+fn loop_magnitude(
+    system: &TableSystem,
+    curves: &[LoopCurve],
+    margins: &Margins,
+    range: (f64, f64),
+    bode: &[Bode],
+) -> Vec<Series> {
+    let mag_extent = extent(bode.iter().map(|b| &b.magnitude_db));
+    let mut magnitude = curve_series(curves, |i| bode[i].magnitude_db.clone());
+    magnitude.push(reference("0 dB (|L| = 1)", 0.0, range));
+    magnitude.extend(oil_column_lines(
+        system,
+        curves,
+        range,
+        (mag_extent.0.min(0.0), mag_extent.1.max(0.0)),
+    ));
+    let in_range = |f: &f64| *f >= range.0 && *f <= range.1;
+    if let Some(fc) = margins.gain_crossover_hz.filter(in_range) {
+        magnitude.push(points("gain crossover", vec![(fc, 0.0)], SIMULATED, 6));
+    }
+    magnitude
+}
+
+/// The loop gain's phase: the curves, −180° and its odd multiples the phase reaches, the
+/// oil-column frequencies and the phase crossover.
+fn loop_phase(
+    system: &TableSystem,
+    curves: &[LoopCurve],
+    margins: &Margins,
+    range: (f64, f64),
+    bode: &[Bode],
+) -> Vec<Series> {
+    let first = &bode[0];
+    let phase_extent = extent(bode.iter().map(|b| &b.phase_deg));
+    let in_range = |f: &f64| *f >= range.0 && *f <= range.1;
+    let mut phase = curve_series(curves, |i| bode[i].phase_deg.clone());
+    // −180° and its odd multiples that the phase reaches (at most 20).
+    let levels: Vec<f64> = (0..20)
+        .map(|k| -180.0 * f64::from(2 * k + 1))
+        .enumerate()
+        .take_while(|&(k, level)| k == 0 || level >= phase_extent.0)
+        .map(|(_, level)| level)
+        .collect();
+    for (k, &level) in levels.iter().enumerate() {
+        let label = match (k, levels.len()) {
+            (0, 1) => "−180°",
+            (0, _) => "−180° (mod 360°)",
+            _ => "",
+        };
+        phase.push(reference(label, level, range));
+    }
+    phase.extend(oil_column_lines(
+        system,
+        curves,
+        range,
+        (phase_extent.0.min(-180.0), phase_extent.1),
+    ));
+    if let Some(fp) = margins.phase_crossover_hz.filter(in_range) {
+        if let Some(p) = at(&first.phase_deg, fp) {
+            // The crossing of −180° (mod 360°) nearest the unwrapped phase there.
+            let level = -180.0 + 360.0 * ((p + 180.0) / 360.0).round();
+            phase.push(points("phase crossover", vec![(fp, level)], SIMULATED, 6));
+        }
+    }
+    phase
 }
 
 #[cfg(test)]

@@ -252,7 +252,9 @@ pub struct SystemOptions<'a> {
 /// scenario that is the identified table with each value's provenance.
 pub fn run_system(files: &[PathBuf], o: &SystemOptions<'_>) -> Result<()> {
     use platen_ident::system::{identify_system, SystemSettings};
-    use platen_report::system_identify_report::{prediction_figures, system_json, system_text};
+    use platen_report::system_identify_report::{
+        identified_system_text, prediction_figures, system_json,
+    };
     if files.is_empty() {
         return Err(input_error(InputError::NoSystemFiles));
     }
@@ -298,7 +300,7 @@ pub fn run_system(files: &[PathBuf], o: &SystemOptions<'_>) -> Result<()> {
         }
         outln!("{}", serde_json::to_string_pretty(&value)?);
     } else {
-        outln!("{}", system_text(&id).trim_end());
+        outln!("{}", identified_system_text(&id).trim_end());
         let w = written_text(&written, None);
         if !w.is_empty() {
             outln!("{}", w.trim_end());
