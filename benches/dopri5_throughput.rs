@@ -1,4 +1,4 @@
-//! Cost of the adaptive Dopri5 forward run (ode_solvers' Dormand–Prince 5(4), exact
+//! Cost of the adaptive Dopri5 forward run (the mode machine's Dormand–Prince 5(4), exact
 //! stick-slip) per accepted step, next to the fixed-step RK4 and the plain-loop baseline on
 //! the same record in the same run.
 //!

@@ -142,7 +142,7 @@ pub enum IntegrateError {
     AdaptiveFailed {
         /// Time of the failure, s.
         t_s: f64,
-        /// What ode_solvers reported.
+        /// Why Dopri5 gave up.
         reason: AdaptiveFailure,
     },
     /// A closed-loop run drove the platen to the end of its actuators.

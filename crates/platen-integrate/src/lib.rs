@@ -5,7 +5,7 @@
 //!   (modes slip+, slip−, stick; `v = 0` located inside the step; breakaway solved exactly).
 //! * [`forward_rk4_ensemble`]: several such runs of the identified model (a sweep's cases)
 //!   advanced together in SIMD lanes, bit for bit the runs of [`forward_rk4`].
-//! * [`forward_dopri5`]: the same with the adaptive Dormand–Prince 5(4) of `ode_solvers`.
+//! * [`forward_dopri5`]: the same with adaptive Dormand–Prince 5(4) pieces.
 //! * [`ForwardIntegrator`] and [`Method`]: one entry point for both, as a scenario selects it.
 //! * [`inverse`]: a prescribed [`Motion`] → the actuator force it needs and its
 //!   decomposition. The motion is `platen_signal`'s (re-exported here), so an acceleration
@@ -25,7 +25,7 @@
 //! platen rests exactly: nothing else moves while it sticks and the force is linear between
 //! samples, so its breakaway and its creep are its own closed forms.
 //!
-//! The bare platen's forward integrators share one event module (the friction modes, the `v = 0` root
+//! Every plant's forward integrators share one event module (the friction modes, the `v = 0` root
 //! finder, the stick decision and the exact breakaway; the [`EventKind`]s it counts in
 //! [`RunStats`]), and say why a run stopped with a [`StopReason`]: `Finished` in the
 //! [`RunStats`] of a run that returns, `Failed` with the time and the typed [`Failure`] from

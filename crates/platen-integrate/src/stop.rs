@@ -59,7 +59,7 @@ pub enum Failure {
     },
 }
 
-/// Why ode_solvers' Dopri5 gave up.
+/// Why the adaptive Dopri5 gave up.
 #[non_exhaustive]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum AdaptiveFailure {
@@ -70,7 +70,8 @@ pub enum AdaptiveFailure {
     },
     /// The step size fell below what the time resolution allows.
     StepSizeUnderflow,
-    /// The integrator's stiffness detection fired (it is switched off in this crate).
+    /// A stiffness detection fired (kept for matching; this crate's Dopri5 has none and
+    /// never reports it).
     StiffnessDetected,
 }
 

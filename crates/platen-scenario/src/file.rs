@@ -403,7 +403,7 @@ fn default_rate() -> f64 {
 pub enum IntegratorSpec {
     /// Fixed-step RK4 with exact stick-slip.
     Rk4(Rk4Spec),
-    /// Adaptive Dormand–Prince 5(4) (ode_solvers' Dopri5) with exact stick-slip.
+    /// Adaptive Dormand–Prince 5(4) (the mode machine's Dopri5, as every plant's) with exact stick-slip.
     Dopri5(Dopri5Spec),
 }
 
