@@ -692,11 +692,7 @@ pub fn iterate_with<R: Response>(
         let record = iteration_record(k, &r, &drive, motion, &spectrum);
         let acceleration_nrmse = record.acceleration_nrmse;
         records.push(record);
-        let error: Vec<f64> = target_a
-            .iter()
-            .zip(r.a_m_s2())
-            .map(|(t, a)| t - a)
-            .collect();
+        let error = acceleration_error(target_a, r.a_m_s2());
         let is_best = progress.judge(acceleration_nrmse, settings.min_improvement);
         let converged = acceleration_nrmse <= settings.target_nrmse;
         let at_max = k >= settings.max_iterations;
@@ -744,6 +740,15 @@ pub fn iterate_with<R: Response>(
         fft_len: correction.fft_len(),
         measured: None,
     })
+}
+
+/// The acceleration error `T − R`, m/s², over the samples both have.
+fn acceleration_error(target_a: &[f64], achieved_a: &[f64]) -> Vec<f64> {
+    target_a
+        .iter()
+        .zip(achieved_a)
+        .map(|(t, a)| t - a)
+        .collect()
 }
 
 /// The best run of [`iterate_with`] so far.
