@@ -408,117 +408,147 @@ fn time<T>(f: impl FnOnce() -> T) -> (f64, T) {
     (start.elapsed().as_secs_f64(), out)
 }
 
+/// A job's wall time, s, its units of work, and, for the baseline, its final state.
+type Timed = (f64, u64, Option<State>);
+
 impl Job {
     /// Runs the job once on `inputs` into `out` (emptied first) and returns its wall time, s,
     /// its units of work, and, for the baseline, its final state.
-    fn run_once(self, inputs: &Inputs, out: &mut Trajectory) -> Result<(f64, u64, Option<State>)> {
-        let samples = inputs.samples;
+    fn run_once(self, inputs: &Inputs, out: &mut Trajectory) -> Result<Timed> {
         match self {
-            Job::Baseline => {
-                let (s, end) = time(|| {
-                    baseline::baseline_rk4(
-                        black_box(&inputs.identified_params),
-                        black_box(&inputs.force),
-                        black_box(1.0 / RATE_HZ),
-                        State::default(),
-                    )
-                });
-                Ok((s, (samples - 1) as u64, Some(black_box(end))))
-            }
-            Job::Forward(form, method) => {
-                clear(out);
-                let record = black_box(&inputs.record);
-                let initial = State::default();
-                let (s, stats) = match form {
-                    Form::Identified => time(|| {
-                        let model = black_box(&inputs.identified);
-                        method.forward(model, record, initial, samples, out)
-                    }),
-                    Form::Full => time(|| {
-                        let model = black_box(&inputs.full);
-                        method.forward(model, record, initial, samples, out)
-                    }),
-                };
-                let what = match method {
-                    Method::Rk4(_) => "forward RK4 run",
-                    Method::Dopri5(_) => "forward Dopri5 run",
-                };
-                let stats = integrate(what, stats)?;
-                black_box(&*out);
-                Ok((s, stats.accepted_steps, None))
-            }
-            Job::ForwardSpecimen(rk4) => {
-                clear(out);
-                let record = black_box(&inputs.record);
-                let (s, stats) = time(|| {
-                    forward_rk4_specimen(
-                        black_box(&inputs.identified),
-                        black_box(&inputs.specimen),
-                        record,
-                        rk4,
-                        State::default(),
-                        samples,
-                        out,
-                    )
-                });
-                let stats = integrate("forward RK4 run with a specimen", stats)?;
-                black_box(&*out);
-                Ok((s, stats.accepted_steps, None))
-            }
-            Job::TableSystem => {
-                clear(out);
-                let system = &inputs.system;
-                let run = LoopRun {
-                    system,
-                    specimen: None,
-                    command: black_box(&inputs.motion),
-                    method: LoopMethod::Rk4 {
-                        steps_per_period: system.default_steps_per_period(144e3, 0.75),
-                    },
-                    initial: State::default(),
-                };
-                let model = black_box(&inputs.identified);
-                let (s, stats) = time(|| forward_closed_loop(model, &run, samples, out));
-                let stats = integrate("closed-loop run", stats)?;
-                black_box(&*out);
-                Ok((s, stats.run.steps, None))
-            }
-            Job::Ensemble(rk4) => {
-                let cases = inputs.ensemble_cases();
-                let mut peaks = vec![Peaks::default(); cases.len()];
-                let (s, results) =
-                    time(|| forward_rk4_ensemble(black_box(&cases), rk4, samples, &mut peaks));
-                for r in results {
-                    integrate("ensemble run", r)?;
-                }
-                black_box(&peaks);
-                Ok((s, ((samples - 1) * cases.len()) as u64, None))
-            }
-            Job::EnsembleScalar(rk4) => {
-                let cases = inputs.ensemble_cases();
-                let mut peaks = vec![Peaks::default(); cases.len()];
-                let (s, results) = time(|| {
-                    black_box(&cases)
-                        .iter()
-                        .zip(peaks.iter_mut())
-                        .map(|(c, p)| forward_rk4(c.model, c.record, rk4, c.initial, samples, p))
-                        .collect::<Vec<_>>()
-                });
-                for r in results {
-                    integrate("ensemble case, scalar", r)?;
-                }
-                black_box(&peaks);
-                Ok((s, ((samples - 1) * cases.len()) as u64, None))
-            }
-            Job::Inverse => {
-                clear(out);
-                let model = black_box(&inputs.identified);
-                let (s, ()) = time(|| inverse(model, black_box(&inputs.motion), out));
-                black_box(&*out);
-                Ok((s, inputs.motion.len() as u64, None))
-            }
+            Job::Baseline => Ok(time_baseline(inputs)),
+            Job::Forward(form, method) => time_forward(form, method, inputs, out),
+            Job::ForwardSpecimen(rk4) => time_forward_specimen(rk4, inputs, out),
+            Job::TableSystem => time_table_system(inputs, out),
+            Job::Ensemble(rk4) => time_ensemble(rk4, inputs),
+            Job::EnsembleScalar(rk4) => time_ensemble_scalar(rk4, inputs),
+            Job::Inverse => Ok(time_inverse(inputs, out)),
         }
     }
+}
+
+/// [`Job::Baseline`].
+fn time_baseline(inputs: &Inputs) -> Timed {
+    let (s, end) = time(|| {
+        baseline::baseline_rk4(
+            black_box(&inputs.identified_params),
+            black_box(&inputs.force),
+            black_box(1.0 / RATE_HZ),
+            State::default(),
+        )
+    });
+    (s, (inputs.samples - 1) as u64, Some(black_box(end)))
+}
+
+/// [`Job::Forward`].
+fn time_forward(
+    form: Form,
+    method: Method,
+    inputs: &Inputs,
+    out: &mut Trajectory,
+) -> Result<Timed> {
+    let samples = inputs.samples;
+    clear(out);
+    let record = black_box(&inputs.record);
+    let initial = State::default();
+    let (s, stats) = match form {
+        Form::Identified => time(|| {
+            let model = black_box(&inputs.identified);
+            method.forward(model, record, initial, samples, out)
+        }),
+        Form::Full => time(|| {
+            let model = black_box(&inputs.full);
+            method.forward(model, record, initial, samples, out)
+        }),
+    };
+    let what = match method {
+        Method::Rk4(_) => "forward RK4 run",
+        Method::Dopri5(_) => "forward Dopri5 run",
+    };
+    let stats = integrate(what, stats)?;
+    black_box(&*out);
+    Ok((s, stats.accepted_steps, None))
+}
+
+/// [`Job::ForwardSpecimen`].
+fn time_forward_specimen(rk4: Rk4, inputs: &Inputs, out: &mut Trajectory) -> Result<Timed> {
+    clear(out);
+    let record = black_box(&inputs.record);
+    let (s, stats) = time(|| {
+        forward_rk4_specimen(
+            black_box(&inputs.identified),
+            black_box(&inputs.specimen),
+            record,
+            rk4,
+            State::default(),
+            inputs.samples,
+            out,
+        )
+    });
+    let stats = integrate("forward RK4 run with a specimen", stats)?;
+    black_box(&*out);
+    Ok((s, stats.accepted_steps, None))
+}
+
+/// [`Job::TableSystem`].
+fn time_table_system(inputs: &Inputs, out: &mut Trajectory) -> Result<Timed> {
+    clear(out);
+    let system = &inputs.system;
+    let run = LoopRun {
+        system,
+        specimen: None,
+        command: black_box(&inputs.motion),
+        method: LoopMethod::Rk4 {
+            steps_per_period: system.default_steps_per_period(144e3, 0.75),
+        },
+        initial: State::default(),
+    };
+    let model = black_box(&inputs.identified);
+    let (s, stats) = time(|| forward_closed_loop(model, &run, inputs.samples, out));
+    let stats = integrate("closed-loop run", stats)?;
+    black_box(&*out);
+    Ok((s, stats.run.steps, None))
+}
+
+/// [`Job::Ensemble`].
+fn time_ensemble(rk4: Rk4, inputs: &Inputs) -> Result<Timed> {
+    let samples = inputs.samples;
+    let cases = inputs.ensemble_cases();
+    let mut peaks = vec![Peaks::default(); cases.len()];
+    let (s, results) = time(|| forward_rk4_ensemble(black_box(&cases), rk4, samples, &mut peaks));
+    for r in results {
+        integrate("ensemble run", r)?;
+    }
+    black_box(&peaks);
+    Ok((s, ((samples - 1) * cases.len()) as u64, None))
+}
+
+/// [`Job::EnsembleScalar`].
+fn time_ensemble_scalar(rk4: Rk4, inputs: &Inputs) -> Result<Timed> {
+    let samples = inputs.samples;
+    let cases = inputs.ensemble_cases();
+    let mut peaks = vec![Peaks::default(); cases.len()];
+    let (s, results) = time(|| {
+        black_box(&cases)
+            .iter()
+            .zip(peaks.iter_mut())
+            .map(|(c, p)| forward_rk4(c.model, c.record, rk4, c.initial, samples, p))
+            .collect::<Vec<_>>()
+    });
+    for r in results {
+        integrate("ensemble case, scalar", r)?;
+    }
+    black_box(&peaks);
+    Ok((s, ((samples - 1) * cases.len()) as u64, None))
+}
+
+/// [`Job::Inverse`].
+fn time_inverse(inputs: &Inputs, out: &mut Trajectory) -> Timed {
+    clear(out);
+    let model = black_box(&inputs.identified);
+    let (s, ()) = time(|| inverse(model, black_box(&inputs.motion), out));
+    black_box(&*out);
+    (s, inputs.motion.len() as u64, None)
 }
 
 /// The one timing loop: every workload in turn, `repeats` times. Returns the baseline's

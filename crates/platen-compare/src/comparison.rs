@@ -172,91 +172,34 @@ impl Comparison {
         let mut recorded = recorded_quantities(&recording, &range, direction, &simulated, rate)?;
         if let (Some(given), Some(used)) = (settings_window_given, window) {
             if given != used {
-                recorded.sources.notes.push(format!(
-                    "--window {},{} s reaches past the compared span {} s to {} s by less than \
-                     half a sample interval ({} s): the metrics window is {},{} s.",
-                    given.start_s,
-                    given.end_s,
-                    t_s[0],
-                    t_s[t_s.len() - 1],
-                    0.5 * recording.step_s,
-                    used.start_s,
-                    used.end_s
-                ));
+                let note = window_note(given, used, &t_s, recording.step_s);
+                recorded.sources.notes.push(note);
             }
         }
         let recorded_limits = RecordedLimitCheck::of_recording(&recording, &scenario.rig.limits);
-        let mut series: Vec<(Channel, Vec<f64>, Vec<f64>)> = direction
-            .channels()
-            .iter()
-            .map(|&channel| {
-                let (rec, sim) = match channel {
-                    Channel::Displacement => (&recorded.u_m, &simulated.u_m),
-                    Channel::Velocity => (&recorded.v_m_s, &simulated.v_m_s),
-                    _ => (&recorded.force_n, &simulated.force_n),
-                };
-                (channel, rec.clone(), sim.clone())
-            })
-            .collect();
-        for channel in specimen_channels {
-            let rec = recording.column(channel.name(), &range).unwrap_or_default();
-            let sim = interpolate_linear(&sim.t_s, channel.of(&sim).unwrap_or_default(), &t_s)
-                .map_err(CompareError::Align)?;
-            series.push((channel, rec, sim));
-        }
-        if scenario.rig.specimen.is_none() {
-            let unused = recording.specimen_columns();
-            if !unused.is_empty() {
-                recorded.sources.notes.push(format!(
-                    "`{}` has the specimen's columns {}: the scenario has no specimen, so they \
-                     are not compared.",
-                    recording.path.display(),
-                    unused.join(", ")
-                ));
-            }
-        }
-        // With a specimen the actuator force also carries the base shear: the recorded
-        // dissipative force is F_A − F_I − F_E − B, with the recorded B where the file has
-        // one and the simulated B otherwise.
-        let base_shear_n = match series.iter().find(|s| s.0 == Channel::BaseShear) {
-            Some((_, rec, _)) => {
-                recorded
-                    .sources
-                    .dissipative
-                    .push_str(", less the recorded base shear B");
-                Some(rec.clone())
-            }
-            None if scenario.rig.specimen.is_some() => {
-                let b = Channel::BaseShear.of(&sim).unwrap_or_default();
-                recorded
-                    .sources
-                    .dissipative
-                    .push_str(", less the simulated base shear B");
-                recorded.sources.notes.push(format!(
-                    "`{}` has no base_shear_n column: the recorded F_D subtracts the simulated \
-                     base shear.",
-                    recording.path.display()
-                ));
-                Some(interpolate_linear(&sim.t_s, b, &t_s).map_err(CompareError::Align)?)
-            }
-            None => None,
+        let on_times = OnRecordedTimes {
+            recording: &recording,
+            range: &range,
+            sim: &sim,
+            t_s: &t_s,
         };
+        let series = on_times.series(direction, &recorded, &simulated, specimen_channels)?;
+        if scenario.rig.specimen.is_none() {
+            recorded
+                .sources
+                .notes
+                .extend(unused_specimen_note(&recording));
+        }
+        let with_specimen = scenario.rig.specimen.is_some();
+        let base_shear_n = on_times.base_shear(&series, with_specimen, &mut recorded.sources)?;
         let channels = compare_channels(series, rate, &t_s, settings)?;
         let b = base_shear_n.as_deref();
         let (recorded_dissipative_n, law, law_label) = match &scenario.rig.model {
             Model::Identified(m) => dissipative(m, &recorded, b, "(Eq. 22)"),
             Model::Full(m) => dissipative(&**m, &recorded, b, "at u = 0 (Eq. 4)"),
         };
-        let recorded_input_force_n = match direction {
-            Direction::Forward => recording.column("force_n", &range),
-            Direction::Inverse => None,
-        };
-        if recorded_input_force_n.is_none() && direction == Direction::Forward {
-            recorded.sources.notes.push(format!(
-                "`{}` has no force_n column: the recorded loops and F_D use the driving force.",
-                recording.path.display()
-            ));
-        }
+        let recorded_input_force_n =
+            recorded_input_force(direction, &recording, &range, &mut recorded.sources.notes);
         Ok(Comparison {
             scenario_path: scenario_path.to_path_buf(),
             recorded_span_s: recording.span_s(),
@@ -293,6 +236,139 @@ impl Comparison {
     /// The first and last compared time, s.
     pub fn compared_span_s(&self) -> (f64, f64) {
         (self.t_s[0], self.t_s[self.t_s.len() - 1])
+    }
+}
+
+/// The note of a `--window` that reached past the compared span by less than half a sample
+/// interval (`step_s`), and was clamped from `given` to `used`.
+fn window_note(given: Window, used: Window, t_s: &[f64], step_s: f64) -> String {
+    format!(
+        "--window {},{} s reaches past the compared span {} s to {} s by less than \
+         half a sample interval ({} s): the metrics window is {},{} s.",
+        given.start_s,
+        given.end_s,
+        t_s[0],
+        t_s[t_s.len() - 1],
+        0.5 * step_s,
+        used.start_s,
+        used.end_s
+    )
+}
+
+/// The note of a recording with specimen columns for a scenario without a specimen.
+fn unused_specimen_note(recording: &Recording) -> Option<String> {
+    let unused = recording.specimen_columns();
+    (!unused.is_empty()).then(|| {
+        format!(
+            "`{}` has the specimen's columns {}: the scenario has no specimen, so they \
+             are not compared.",
+            recording.path.display(),
+            unused.join(", ")
+        )
+    })
+}
+
+/// The recorded force of a forward run, if the file has one (a note in `notes` when not).
+fn recorded_input_force(
+    direction: Direction,
+    recording: &Recording,
+    range: &Range<usize>,
+    notes: &mut Vec<String>,
+) -> Option<Vec<f64>> {
+    let force_n = match direction {
+        Direction::Forward => recording.column("force_n", range),
+        Direction::Inverse => None,
+    };
+    if force_n.is_none() && direction == Direction::Forward {
+        notes.push(format!(
+            "`{}` has no force_n column: the recorded loops and F_D use the driving force.",
+            recording.path.display()
+        ));
+    }
+    force_n
+}
+
+/// A channel with its recorded and simulated values on the compared times.
+type Series = (Channel, Vec<f64>, Vec<f64>);
+
+/// The recording's compared samples (`range`, at the times `t_s`) and the run `sim` to be
+/// put on them.
+struct OnRecordedTimes<'a> {
+    recording: &'a Recording,
+    range: &'a Range<usize>,
+    sim: &'a Trajectory,
+    t_s: &'a [f64],
+}
+
+impl OnRecordedTimes<'_> {
+    /// The compared channels: the platen's of `direction` (from `recorded` and
+    /// `simulated`), then the specimen's.
+    fn series(
+        &self,
+        direction: Direction,
+        recorded: &Quantities,
+        simulated: &Quantities,
+        specimen_channels: Vec<Channel>,
+    ) -> Result<Vec<Series>> {
+        let mut series: Vec<Series> = direction
+            .channels()
+            .iter()
+            .map(|&channel| {
+                let (rec, sim) = match channel {
+                    Channel::Displacement => (&recorded.u_m, &simulated.u_m),
+                    Channel::Velocity => (&recorded.v_m_s, &simulated.v_m_s),
+                    _ => (&recorded.force_n, &simulated.force_n),
+                };
+                (channel, rec.clone(), sim.clone())
+            })
+            .collect();
+        for channel in specimen_channels {
+            let rec = self
+                .recording
+                .column(channel.name(), self.range)
+                .unwrap_or_default();
+            let sim = interpolate_linear(
+                &self.sim.t_s,
+                channel.of(self.sim).unwrap_or_default(),
+                self.t_s,
+            )
+            .map_err(CompareError::Align)?;
+            series.push((channel, rec, sim));
+        }
+        Ok(series)
+    }
+
+    /// The base shear the recorded dissipative force subtracts, noted in `sources`: with a
+    /// specimen the actuator force also carries the base shear, so the recorded dissipative
+    /// force is F_A − F_I − F_E − B, with the recorded B where the file has one (in
+    /// `series`) and the simulated B otherwise.
+    fn base_shear(
+        &self,
+        series: &[Series],
+        with_specimen: bool,
+        sources: &mut Sources,
+    ) -> Result<Option<Vec<f64>>> {
+        Ok(match series.iter().find(|s| s.0 == Channel::BaseShear) {
+            Some((_, rec, _)) => {
+                sources
+                    .dissipative
+                    .push_str(", less the recorded base shear B");
+                Some(rec.clone())
+            }
+            None if with_specimen => {
+                let b = Channel::BaseShear.of(self.sim).unwrap_or_default();
+                sources
+                    .dissipative
+                    .push_str(", less the simulated base shear B");
+                sources.notes.push(format!(
+                    "`{}` has no base_shear_n column: the recorded F_D subtracts the simulated \
+                     base shear.",
+                    self.recording.path.display()
+                ));
+                Some(interpolate_linear(&self.sim.t_s, b, self.t_s).map_err(CompareError::Align)?)
+            }
+            None => None,
+        })
     }
 }
 

@@ -231,7 +231,37 @@ fn acceleration_motion(
         raw
     };
     let span_s = (n - 1) as f64 / rate_hz;
-    let degrees: Vec<usize> = match settings.end {
+    let degrees = end_degrees(settings.end)?;
+    let (degree, p) = choose_end(&u, &v, span_s, degrees, settings, stroke_m, rms(&raw));
+    let (mut sum2, mut peak_c) = (0.0, 0.0_f64);
+    for i in 0..n {
+        let s = i as f64 / (n - 1) as f64;
+        let (pv, pd, pdd) = p.all(s);
+        u[i] -= pv;
+        v[i] -= pd;
+        a[i] -= pdd;
+        // What the treatment removed from the target's acceleration (with `pre`).
+        let removed = raw[i] - a[i];
+        sum2 += removed * removed;
+        peak_c = peak_c.max(removed.abs());
+    }
+    Ok(TargetMotion {
+        t_s,
+        u_m: u,
+        v_m_s: v,
+        a_m_s2: a,
+        kind: TargetKind::Acceleration,
+        end_degree: Some(degree),
+        correction_rms_m_s2: (sum2 / n as f64).sqrt(),
+        correction_peak_m_s2: peak_c,
+        target_rms_m_s2: rms(target.values()),
+    })
+}
+
+/// The end polynomial's degrees to try: the one asked for (checked), or every one for
+/// [`EndCorrection::Auto`].
+fn end_degrees(end: EndCorrection) -> Result<Vec<usize>> {
+    Ok(match end {
         EndCorrection::Degree(d) => {
             if !(3..=MAX_END_DEGREE).contains(&d) {
                 return Err(PlanError::Setting {
@@ -243,14 +273,26 @@ fn acceleration_motion(
             vec![d]
         }
         EndCorrection::Auto => (3..=MAX_END_DEGREE).collect(),
-    };
-    // Auto: among the degrees whose correction stays small (its RMS at most
-    // AUTO_MAX_CORRECTION of the target's), the lowest that fits the stroke, else the one
-    // with the smallest peak; degree 3 (the least correction) when none stays small.
-    let target_rms = rms(&raw);
+    })
+}
+
+/// The end polynomial of `u`, `v` (sampled uniformly over `span_s`) among `degrees`, and its
+/// degree. Auto: among the degrees whose correction stays small (its RMS at most
+/// AUTO_MAX_CORRECTION of the target's, `target_rms`), the lowest that fits the stroke, else
+/// the one with the smallest peak; degree 3 (the least correction) when none stays small.
+fn choose_end(
+    u: &[f64],
+    v: &[f64],
+    span_s: f64,
+    degrees: Vec<usize>,
+    settings: &BaselineSettings,
+    stroke_m: f64,
+    target_rms: f64,
+) -> (usize, EndPolynomial) {
+    let n = u.len();
     let mut chosen: Option<(usize, EndPolynomial, f64)> = None;
     for d in degrees {
-        let p = EndPolynomial::fit(&u, &v, span_s, d);
+        let p = EndPolynomial::fit(u, v, span_s, d);
         let (mut peak_u, mut sum2) = (0.0_f64, 0.0);
         for (i, &ui) in u.iter().enumerate() {
             let (pv, _, pdd) = p.all(i as f64 / (n - 1) as f64);
@@ -278,29 +320,7 @@ fn acceleration_motion(
     let Some((degree, p, _)) = chosen else {
         unreachable!("at least one degree is tried")
     };
-    let (mut sum2, mut peak_c) = (0.0, 0.0_f64);
-    for i in 0..n {
-        let s = i as f64 / (n - 1) as f64;
-        let (pv, pd, pdd) = p.all(s);
-        u[i] -= pv;
-        v[i] -= pd;
-        a[i] -= pdd;
-        // What the treatment removed from the target's acceleration (with `pre`).
-        let removed = raw[i] - a[i];
-        sum2 += removed * removed;
-        peak_c = peak_c.max(removed.abs());
-    }
-    Ok(TargetMotion {
-        t_s,
-        u_m: u,
-        v_m_s: v,
-        a_m_s2: a,
-        kind: TargetKind::Acceleration,
-        end_degree: Some(degree),
-        correction_rms_m_s2: (sum2 / n as f64).sqrt(),
-        correction_peak_m_s2: peak_c,
-        target_rms_m_s2: rms(target.values()),
-    })
+    (degree, p)
 }
 
 /// `P(s) = H(s) + w(s)·Σ cⱼLⱼ(2s − 1)`, `w = s²(1 − s)²`, `s = t/T`: the end-matching

@@ -241,6 +241,38 @@ fn max_scale_from(
     settings: &MaxScaleSettings,
     unscaled: &[LimitUse],
 ) -> Result<MaxScale> {
+    let (tol, lo_bound, hi_bound) = checked(settings)?;
+    let worst = unscaled.iter().map(|u| u.ratio).fold(0.0, f64::max);
+    let unscaled_fits = unscaled.iter().all(LimitUse::respected);
+    let linear_estimate = if worst > 0.0 { 1.0 / worst } else { hi_bound };
+    let start = linear_estimate.clamp(lo_bound, hi_bound);
+    let mut search = Search {
+        table,
+        motion,
+        bounds: (lo_bound, hi_bound),
+        linear_estimate,
+        lo: f64::NAN,
+        hi: f64::NAN,
+        hi_failing: Vec::new(),
+        runs: 0,
+    };
+    // The bracket [lo (fits), hi (fails)], from the unscaled run and the linear estimate.
+    if unscaled_fits {
+        search.lo = 1.0;
+    } else {
+        search.hi = 1.0;
+        search.hi_failing = failing(unscaled).iter().map(|u| u.limit).collect();
+    }
+    search.around(start);
+    if let Some(found) = search.grow() {
+        return Ok(found);
+    }
+    search.bisect(tol);
+    Ok(search.found(false))
+}
+
+/// The search's relative tolerance and its bounds `[min_scale, max_scale]`, checked.
+fn checked(settings: &MaxScaleSettings) -> Result<(f64, f64, f64)> {
     let tol = check_setting(
         "relative_tolerance",
         settings.relative_tolerance,
@@ -259,113 +291,126 @@ fn max_scale_from(
         settings.max_scale > 1.0,
         "a finite scale > 1",
     )?;
-    let mut runs = 0;
-    // Whether the command scaled by `s` fits, and what fails.
-    let mut fits = |s: f64| -> (bool, Vec<&'static str>) {
-        runs += 1;
+    Ok((tol, lo_bound, hi_bound))
+}
+
+/// The state of [`max_scale_from`]'s search: the bracket `[lo (fits), hi (fails)]` (NaN
+/// while an end is not known), what fails at `hi`, and the closed-loop runs spent.
+struct Search<'s, 't> {
+    table: &'s Table<'t>,
+    motion: &'s TargetMotion,
+    /// `[min_scale, max_scale]`.
+    bounds: (f64, f64),
+    linear_estimate: f64,
+    lo: f64,
+    hi: f64,
+    hi_failing: Vec<&'static str>,
+    runs: usize,
+}
+
+impl Search<'_, '_> {
+    /// Whether the command scaled by `s` fits, and what fails.
+    fn fits(&mut self, s: f64) -> (bool, Vec<&'static str>) {
+        self.runs += 1;
+        let motion = self.motion;
         let u: Vec<f64> = motion.u_m.iter().map(|x| x * s).collect();
-        match table.run_or_end_stop(&motion.t_s, &u, "a scaled command") {
+        match self
+            .table
+            .run_or_end_stop(&motion.t_s, &u, "a scaled command")
+        {
             Ok(a) => {
-                let f = failing(&limit_uses(table, &a));
+                let f = failing(&limit_uses(self.table, &a));
                 (f.is_empty(), f.iter().map(|u| u.limit).collect())
             }
             Err(_) => (false, vec!["run_failed"]),
         }
-    };
-    let worst = unscaled.iter().map(|u| u.ratio).fold(0.0, f64::max);
-    let unscaled_fits = unscaled.iter().all(LimitUse::respected);
-    let linear_estimate = if worst > 0.0 { 1.0 / worst } else { hi_bound };
-    let start = linear_estimate.clamp(lo_bound, hi_bound);
-    // The bracket [lo (fits), hi (fails)], from the unscaled run and the linear estimate.
-    let (mut lo, mut hi, mut hi_failing) = if unscaled_fits {
-        (1.0, f64::NAN, Vec::new())
-    } else {
-        (
-            f64::NAN,
-            1.0,
-            failing(unscaled).iter().map(|u| u.limit).collect(),
-        )
-    };
-    let (below, above) = (start * (1.0 - 0.02), start * (1.0 + 0.02));
-    if lo.is_nan() || lo < below {
-        let s = below.clamp(lo_bound, hi_bound);
-        let (ok, f) = fits(s);
-        if ok {
-            lo = s;
-        } else if hi.is_nan() || s < hi {
-            hi = s;
-            hi_failing = f;
-        }
     }
-    if hi.is_nan() || hi > above {
-        let s = above.clamp(lo_bound, hi_bound);
-        if lo.is_nan() || s > lo {
-            let (ok, f) = fits(s);
+
+    /// Runs `s` and makes it the lower end if it fits, else the upper end.
+    fn bisect_at(&mut self, s: f64) -> bool {
+        let (ok, f) = self.fits(s);
+        if ok {
+            self.lo = s;
+        } else {
+            self.hi = s;
+            self.hi_failing = f;
+        }
+        ok
+    }
+
+    /// Tries 2 % either side of `start` (the linear estimate within the bounds), where they
+    /// narrow the bracket.
+    fn around(&mut self, start: f64) {
+        let (lo_bound, hi_bound) = self.bounds;
+        let (below, above) = (start * (1.0 - 0.02), start * (1.0 + 0.02));
+        if self.lo.is_nan() || self.lo < below {
+            let s = below.clamp(lo_bound, hi_bound);
+            let (ok, f) = self.fits(s);
             if ok {
-                lo = lo.max(s);
-            } else {
-                hi = s;
-                hi_failing = f;
+                self.lo = s;
+            } else if self.hi.is_nan() || s < self.hi {
+                self.hi = s;
+                self.hi_failing = f;
+            }
+        }
+        if self.hi.is_nan() || self.hi > above {
+            let s = above.clamp(lo_bound, hi_bound);
+            if self.lo.is_nan() || s > self.lo {
+                let (ok, f) = self.fits(s);
+                if ok {
+                    self.lo = self.lo.max(s);
+                } else {
+                    self.hi = s;
+                    self.hi_failing = f;
+                }
             }
         }
     }
-    // Grow the bracket until it holds, within the bounds.
-    while lo.is_nan() {
-        let s = (hi / 1.5).max(lo_bound);
-        let (ok, f) = fits(s);
-        if ok {
-            lo = s;
-        } else {
-            hi = s;
-            hi_failing = f;
-            if s <= lo_bound {
-                return Ok(MaxScale {
+
+    /// Grows the bracket by 1.5× until it holds, within the bounds; the answer when a bound
+    /// is reached (nothing fits at the lower bound, everything at the upper).
+    fn grow(&mut self) -> Option<MaxScale> {
+        let (lo_bound, hi_bound) = self.bounds;
+        while self.lo.is_nan() {
+            let s = (self.hi / 1.5).max(lo_bound);
+            if !self.bisect_at(s) && s <= lo_bound {
+                return Some(MaxScale {
                     scale: 0.0,
                     bracket: [0.0, lo_bound],
-                    at_upper_bound: false,
-                    linear_estimate,
-                    limiting: hi_failing,
-                    runs,
+                    ..self.found(false)
                 });
             }
         }
-    }
-    while hi.is_nan() {
-        let s = (lo * 1.5).min(hi_bound);
-        let (ok, f) = fits(s);
-        if ok {
-            lo = s;
-            if s >= hi_bound {
-                return Ok(MaxScale {
+        while self.hi.is_nan() {
+            let s = (self.lo * 1.5).min(hi_bound);
+            if self.bisect_at(s) && s >= hi_bound {
+                return Some(MaxScale {
                     scale: hi_bound,
                     bracket: [hi_bound, hi_bound],
-                    at_upper_bound: true,
-                    linear_estimate,
                     limiting: Vec::new(),
-                    runs,
+                    ..self.found(true)
                 });
             }
-        } else {
-            hi = s;
-            hi_failing = f;
+        }
+        None
+    }
+
+    /// Bisects until the bracket is at most `tol` of its lower end wide.
+    fn bisect(&mut self, tol: f64) {
+        while (self.hi - self.lo) > tol * self.lo {
+            self.bisect_at(0.5 * (self.lo + self.hi));
         }
     }
-    while (hi - lo) > tol * lo {
-        let s = 0.5 * (lo + hi);
-        let (ok, f) = fits(s);
-        if ok {
-            lo = s;
-        } else {
-            hi = s;
-            hi_failing = f;
+
+    /// The answer: the lower end, the bracket and what fails at its upper end.
+    fn found(&self, at_upper_bound: bool) -> MaxScale {
+        MaxScale {
+            scale: self.lo,
+            bracket: [self.lo, self.hi],
+            at_upper_bound,
+            linear_estimate: self.linear_estimate,
+            limiting: self.hi_failing.clone(),
+            runs: self.runs,
         }
     }
-    Ok(MaxScale {
-        scale: lo,
-        bracket: [lo, hi],
-        at_upper_bound: false,
-        linear_estimate,
-        limiting: hi_failing,
-        runs,
-    })
 }

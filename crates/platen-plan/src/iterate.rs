@@ -310,6 +310,98 @@ pub struct Correction {
     pub in_band_fraction: f64,
 }
 
+/// The correction band `w(f)`: 1 inside `hz`, half-cosine roll-offs over its lowest and
+/// highest `edge_fraction`, 0 outside.
+struct Band {
+    hz: (f64, f64),
+    edge_fraction: f64,
+}
+
+impl Band {
+    /// `w(f)`.
+    fn weight(&self, f: f64) -> f64 {
+        let (lo, hi) = self.hz;
+        let e = self.edge_fraction;
+        if f < lo || f > hi {
+            return 0.0;
+        }
+        let (lo_end, hi_start) = (lo * (1.0 + e), hi * (1.0 - e));
+        let ramp = |x: f64| 0.5 - 0.5 * (std::f64::consts::PI * x).cos();
+        let mut w = 1.0;
+        if f < lo_end {
+            w *= ramp((f - lo) / (lo_end - lo));
+        }
+        if f > hi_start {
+            w *= ramp((hi - f) / (hi - hi_start));
+        }
+        w
+    }
+
+    /// `Ĥ` on the bins `0..=half` `df` apart (0 outside the band and at 0 Hz), and its
+    /// largest magnitude.
+    fn frf_on_bins(&self, half: usize, df: f64, frf: &dyn Fn(f64) -> C64) -> (Vec<C64>, f64) {
+        let mut h = vec![C64::new(0.0, 0.0); half + 1];
+        let mut max_h = 0.0_f64;
+        for (k, slot) in h.iter_mut().enumerate().skip(1) {
+            let f = k as f64 * df;
+            if self.weight(f) > 0.0 {
+                *slot = frf(f);
+                max_h = max_h.max(slot.norm());
+            }
+        }
+        (h, max_h)
+    }
+
+    /// The weights `g·w·Ĥ⁻¹/(−ω²)` on the `m` FFT bins (negative frequencies conjugate) from
+    /// `h` ([`Band::frf_on_bins`]) with the regularisation `floor` = `(ε·max|Ĥ|)²`, and the
+    /// positive-frequency bins inside the band.
+    fn inverse_weights(
+        &self,
+        h: &[C64],
+        m: usize,
+        df: f64,
+        floor: f64,
+        gain: f64,
+    ) -> (Vec<C64>, Vec<bool>) {
+        let half = m / 2;
+        let mut weights = vec![C64::new(0.0, 0.0); m];
+        let mut in_band = vec![false; half + 1];
+        for k in 1..=half {
+            // The Nyquist bin of an even length has no conjugate partner: leave it out.
+            if m % 2 == 0 && k == half {
+                continue;
+            }
+            let f = k as f64 * df;
+            let w = self.weight(f);
+            if w <= 0.0 {
+                continue;
+            }
+            let hk = h[k];
+            let denominator = hk.norm_sqr() + floor;
+            if denominator <= 0.0 {
+                continue;
+            }
+            let omega = std::f64::consts::TAU * f;
+            let value = hk.conj() * (gain * w / denominator / -(omega * omega));
+            weights[k] = value;
+            weights[m - k] = value.conj();
+            in_band[k] = true;
+        }
+        (weights, in_band)
+    }
+}
+
+/// `n` ones tapered to zero by a half-cosine over `taper_n` samples at both ends.
+fn half_cosine_taper(n: usize, taper_n: usize) -> Vec<f64> {
+    let mut taper = vec![1.0; n];
+    for j in 0..taper_n {
+        let w = 0.5 - 0.5 * (std::f64::consts::PI * j as f64 / taper_n as f64).cos();
+        taper[j] = w;
+        taper[n - 1 - j] = w;
+    }
+    taper
+}
+
 impl DriveCorrection {
     /// Plans the correction of records of `samples` samples at `sample_rate_hz`, with `Ĥ` =
     /// `frf` and `settings`' gain, band, regularisation, padding and taper.
@@ -328,79 +420,29 @@ impl DriveCorrection {
         let pad = (s.pad_s * sample_rate_hz).round() as usize;
         let m = if pad == 0 { n } else { fft_size(n + pad) };
         let df = sample_rate_hz / m as f64;
-        let half = m / 2;
-        let (lo, hi) = s.band_hz;
-        let e = settings.edge_fraction;
-        let weight = |f: f64| -> f64 {
-            if f < lo || f > hi {
-                return 0.0;
-            }
-            let (lo_end, hi_start) = (lo * (1.0 + e), hi * (1.0 - e));
-            let ramp = |x: f64| 0.5 - 0.5 * (std::f64::consts::PI * x).cos();
-            let mut w = 1.0;
-            if f < lo_end {
-                w *= ramp((f - lo) / (lo_end - lo));
-            }
-            if f > hi_start {
-                w *= ramp((hi - f) / (hi - hi_start));
-            }
-            w
+        let band = Band {
+            hz: s.band_hz,
+            edge_fraction: settings.edge_fraction,
         };
-        let mut h = vec![C64::new(0.0, 0.0); half + 1];
-        let mut max_h = 0.0_f64;
-        for (k, slot) in h.iter_mut().enumerate().skip(1) {
-            let f = k as f64 * df;
-            if weight(f) > 0.0 {
-                *slot = frf(f);
-                max_h = max_h.max(slot.norm());
-            }
-        }
+        let (h, max_h) = band.frf_on_bins(m / 2, df, frf);
         let floor = (settings.regularisation * max_h).powi(2);
-        let mut weights = vec![C64::new(0.0, 0.0); m];
-        let mut in_band = vec![false; half + 1];
-        for k in 1..=half {
-            // The Nyquist bin of an even length has no conjugate partner: leave it out.
-            if m % 2 == 0 && k == half {
-                continue;
-            }
-            let f = k as f64 * df;
-            let w = weight(f);
-            if w <= 0.0 {
-                continue;
-            }
-            let hk = h[k];
-            let denominator = hk.norm_sqr() + floor;
-            if denominator <= 0.0 {
-                continue;
-            }
-            let omega = std::f64::consts::TAU * f;
-            let value = hk.conj() * (settings.gain * w / denominator / -(omega * omega));
-            weights[k] = value;
-            weights[m - k] = value.conj();
-            in_band[k] = true;
-        }
+        let (weights, in_band) = band.inverse_weights(&h, m, df, floor, settings.gain);
         if !in_band.iter().any(|&b| b) {
             return Err(PlanError::Setting {
                 name: "band_hz",
-                value: lo,
+                value: s.band_hz.0,
                 expected: "a band holding at least one FFT bin of the record (a longer record or \
                            a wider band)",
             });
         }
         let taper_n = ((settings.taper_s * sample_rate_hz).round() as usize).min(n / 2);
-        let mut taper = vec![1.0; n];
-        for j in 0..taper_n {
-            let w = 0.5 - 0.5 * (std::f64::consts::PI * j as f64 / taper_n as f64).cos();
-            taper[j] = w;
-            taper[n - 1 - j] = w;
-        }
         let mut planner = FftPlanner::<f64>::new();
         Ok(Self {
             n,
             m,
             weights,
             in_band,
-            taper,
+            taper: half_cosine_taper(n, taper_n),
             forward: planner.plan_fft_forward(m),
             inverse: planner.plan_fft_inverse(m),
         })
@@ -637,62 +679,36 @@ pub fn iterate_with<R: Response>(
     let target_a = &motion.a_m_s2;
     let mut drive = motion.u_m.clone();
     let mut records = Vec::new();
-    let mut best: Option<(usize, Vec<f64>, R, f64)> = None;
-    let mut without_improvement = 0;
+    let mut progress = Progress::<R> {
+        best: None,
+        without_improvement: 0,
+    };
     let mut k = 0;
     let stop = loop {
         let r = plant(&drive, k)?;
-        if let Some((t_s, u_m)) = r.end_stop() {
-            if best.is_none() {
-                return Err(PlanError::Run {
-                    what: format!("iteration {k}"),
-                    source: platen_integrate::IntegrateError::EndStop { t_s, u_m },
-                });
-            }
-            break Stop::Stalled {
-                reason: format!(
-                    "the drive of iteration {k} drives the platen to the end of its actuators \
-                     at {t_s:.3} s (u = {u_m:.3} m): the iteration keeps the best drive before it"
-                ),
-            };
+        if let Some(stop) = end_stopped(&r, k, progress.best.is_none())? {
+            break stop;
         }
-        let acceleration_nrmse = nrmse(r.a_m_s2(), target_a);
-        let (spectrum_error, period) = spectrum.error(r.a_m_s2());
-        records.push(IterationRecord {
-            iteration: k,
-            acceleration_nrmse,
-            displacement_nrmse: nrmse(r.u_m(), &motion.u_m),
-            spectrum_error,
-            spectrum_error_period_s: period,
-            peak_drive_u_m: peak(&drive),
-            peak_a_m_s2: signed_peak(r.a_m_s2()),
-            valve_saturated_time_s: r.saturated_time_s(),
-            stick_time_s: r.stick_time_s(),
-        });
-        let error: Vec<f64> = target_a
-            .iter()
-            .zip(r.a_m_s2())
-            .map(|(t, a)| t - a)
-            .collect();
-        let improved = best
-            .as_ref()
-            .is_none_or(|b| acceleration_nrmse < b.3 * (1.0 - settings.min_improvement));
-        let is_best = best.as_ref().is_none_or(|b| acceleration_nrmse < b.3);
-        if improved {
-            without_improvement = 0;
-        } else {
-            without_improvement += 1;
-        }
+        let record = iteration_record(k, &r, &drive, motion, &spectrum);
+        let acceleration_nrmse = record.acceleration_nrmse;
+        records.push(record);
+        let error = acceleration_error(target_a, r.a_m_s2());
+        let is_best = progress.judge(acceleration_nrmse, settings.min_improvement);
         let converged = acceleration_nrmse <= settings.target_nrmse;
         let at_max = k >= settings.max_iterations;
-        let stalled = without_improvement >= settings.stall_iterations;
+        let stalled = progress.without_improvement >= settings.stall_iterations;
         let c = (!converged).then(|| correction.apply(&error));
         let reason = match (&c, stalled) {
             (Some(c), true) => Some(stall_reason(&r, c.in_band_fraction, band_hz)),
             _ => None,
         };
         if is_best {
-            best = Some((k, drive.clone(), r, acceleration_nrmse));
+            progress.best = Some(BestRun {
+                k,
+                drive: drive.clone(),
+                achieved: r,
+                nrmse: acceleration_nrmse,
+            });
         }
         if converged {
             break Stop::Converged;
@@ -711,19 +727,107 @@ pub fn iterate_with<R: Response>(
         }
         k += 1;
     };
-    let Some((best, drive_u_m, achieved, _)) = best else {
+    let Some(best) = progress.best else {
         unreachable!("iteration 0 always runs")
     };
     Ok(Iteration {
-        drive_u_m,
-        best,
-        achieved,
+        drive_u_m: best.drive,
+        best: best.k,
+        achieved: best.achieved,
         records,
         stop,
         band_hz,
         fft_len: correction.fft_len(),
         measured: None,
     })
+}
+
+/// The acceleration error `T − R`, m/s², over the samples both have.
+fn acceleration_error(target_a: &[f64], achieved_a: &[f64]) -> Vec<f64> {
+    target_a
+        .iter()
+        .zip(achieved_a)
+        .map(|(t, a)| t - a)
+        .collect()
+}
+
+/// The best run of [`iterate_with`] so far.
+struct BestRun<R> {
+    /// Its iteration.
+    k: usize,
+    /// Its drive, m.
+    drive: Vec<f64>,
+    /// What it achieved.
+    achieved: R,
+    /// Its acceleration NRMSE.
+    nrmse: f64,
+}
+
+/// How [`iterate_with`] is doing: its best run so far and the iterations since the last
+/// improvement.
+struct Progress<R> {
+    best: Option<BestRun<R>>,
+    without_improvement: usize,
+}
+
+impl<R> Progress<R> {
+    /// Counts a run of acceleration NRMSE `nrmse` as an improvement (on the best by more than
+    /// `min_improvement`, relative) or not, and says whether it is the new best.
+    fn judge(&mut self, nrmse: f64, min_improvement: f64) -> bool {
+        let best = self.best.as_ref();
+        let improved = best.is_none_or(|b| nrmse < b.nrmse * (1.0 - min_improvement));
+        let is_best = best.is_none_or(|b| nrmse < b.nrmse);
+        if improved {
+            self.without_improvement = 0;
+        } else {
+            self.without_improvement += 1;
+        }
+        is_best
+    }
+}
+
+/// How the run `r` of iteration `k` ends the iteration when it reached the end of the
+/// actuators: an error when there is no best drive yet (`no_best`), else a stall that keeps
+/// the best drive before it. `None` when it did not.
+fn end_stopped<R: Response>(r: &R, k: usize, no_best: bool) -> Result<Option<Stop>> {
+    let Some((t_s, u_m)) = r.end_stop() else {
+        return Ok(None);
+    };
+    if no_best {
+        return Err(PlanError::Run {
+            what: format!("iteration {k}"),
+            source: platen_integrate::IntegrateError::EndStop { t_s, u_m },
+        });
+    }
+    Ok(Some(Stop::Stalled {
+        reason: format!(
+            "the drive of iteration {k} drives the platen to the end of its actuators \
+             at {t_s:.3} s (u = {u_m:.3} m): the iteration keeps the best drive before it"
+        ),
+    }))
+}
+
+/// The figures of iteration `k`, whose `drive` achieved `r`.
+fn iteration_record<R: Response>(
+    k: usize,
+    r: &R,
+    drive: &[f64],
+    motion: &TargetMotion,
+    spectrum: &SpectrumCheck,
+) -> IterationRecord {
+    let acceleration_nrmse = nrmse(r.a_m_s2(), &motion.a_m_s2);
+    let (spectrum_error, period) = spectrum.error(r.a_m_s2());
+    IterationRecord {
+        iteration: k,
+        acceleration_nrmse,
+        displacement_nrmse: nrmse(r.u_m(), &motion.u_m),
+        spectrum_error,
+        spectrum_error_period_s: period,
+        peak_drive_u_m: peak(drive),
+        peak_a_m_s2: signed_peak(r.a_m_s2()),
+        valve_saturated_time_s: r.saturated_time_s(),
+        stick_time_s: r.stick_time_s(),
+    }
 }
 
 fn signed_peak(x: &[f64]) -> f64 {

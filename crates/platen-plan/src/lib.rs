@@ -3,6 +3,24 @@
 //! answer comes from running a rig's closed loop ([`platen_scenario::Rig`]: its model,
 //! `table_system` and specimen) with displacement commands.
 //!
+//! A 2 Hz, 2 m/s² sine planned on the LHPOST (the `lhpost-2008` platen and table system):
+//!
+//! ```
+//! use std::path::Path;
+//! use platen_plan::{plan, PlanSettings, Target};
+//!
+//! let json = r#"{"model": {"preset": "lhpost-2008"}, "table_system": {"preset": "lhpost-2008"}}"#;
+//! let rig = platen_scenario::LoadedRig::parse(Path::new("lhpost.json"), json)?;
+//! let t: Vec<f64> = (0..4097).map(|j| j as f64 / 1024.0).collect(); // 4 s at 1024 Hz
+//! let a = t.iter().map(|t| 2.0 * (std::f64::consts::TAU * 2.0 * t).sin()).collect();
+//! let target = Target::acceleration(Path::new("sine"), t, a)?;
+//! let p = plan(&rig, Path::new("lhpost.json"), &target, &PlanSettings::default())?;
+//! assert!(p.feasibility.feasible && p.iteration().unwrap().best_record().acceleration_nrmse < 0.1);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! From a scenario file and a target CSV, as `platen plan` does, writing the drive:
+//!
 //! ```no_run
 //! use std::path::Path;
 //! use platen_plan::{load_rig, plan, write_drive, PlanSettings, Target};
@@ -40,7 +58,8 @@
 //! * [`iterate()`](fn@iterate), [`iterate_with`] ([`mod@iterate`]): offline drive iteration
 //!   `D_{k+1} = D_k + g·Ĥ⁻¹(T − R_k)` with a regularised inverse in a band, and its stop
 //!   criteria.
-//! * [`plan()`](plan::plan): all of it, with the summary `platen plan --json` prints.
+//! * [`plan()`](fn@plan), [`plan_observed`], [`plan_table`]: all of it, with the summary
+//!   `platen plan --json` prints ([`PlanSummary`]).
 //!
 //! # Conventions
 //!
@@ -57,7 +76,7 @@ mod error;
 pub mod feasibility;
 pub mod frf;
 pub mod iterate;
-pub mod plan;
+mod plan;
 mod table;
 mod target;
 
@@ -70,8 +89,8 @@ pub use iterate::{
     Response, Stop,
 };
 pub use plan::{
-    load_rig, plan, plan_observed, plan_table, write_drive, Plan, PlanSettings, PlanSummary,
-    PlannedDrive,
+    load_rig, plan, plan_observed, plan_table, write_drive, DriveSummary, FrfSummary, Plan,
+    PlanSettings, PlanSummary, PlannedDrive, TargetSummary,
 };
 pub use table::{Achieved, Table};
 pub use target::{Target, TargetKind, MIN_TARGET_SAMPLES};

@@ -159,6 +159,35 @@ pub fn plan_table(
     settings: &PlanSettings,
     on_run: &mut dyn FnMut(usize),
 ) -> Result<Plan> {
+    let motion = target_motion(table, target, settings)?;
+    let feasibility = feasibility(table, &motion, settings.max_scale.as_ref())?;
+    let mut warnings: Vec<String> = feasibility_warning(&feasibility).into_iter().collect();
+    let drive = match feasibility.achieved.end_stop {
+        Some(_) => None,
+        None => Some(planned_drive(
+            table,
+            &motion,
+            &feasibility,
+            &settings.iteration,
+            on_run,
+            &mut warnings,
+        )?),
+    };
+    Ok(Plan {
+        scenario_path: scenario_path.to_owned(),
+        scenario_name: name.to_owned(),
+        target_origin: target.origin().to_owned(),
+        target_samples: target.len(),
+        target_rate_hz: target.sample_rate_hz(),
+        motion,
+        feasibility,
+        drive,
+        warnings,
+    })
+}
+
+/// The motion asked of `table` for `target`: at most the controller's rate, not zero.
+fn target_motion(table: &Table, target: &Target, settings: &PlanSettings) -> Result<TargetMotion> {
     let controller_hz = table.controller_rate_hz();
     if target.sample_rate_hz() > controller_hz * (1.0 + 1e-9) {
         return Err(PlanError::TargetRate {
@@ -179,65 +208,67 @@ pub fn plan_table(
             message: "the target's acceleration is zero everywhere: nothing to reproduce".into(),
         });
     }
-    let feasibility = feasibility(table, &motion, settings.max_scale.as_ref())?;
-    let mut warnings = Vec::new();
+    Ok(motion)
+}
+
+/// The warning of a target whose own command reaches the end of the actuators, or that is
+/// not feasible.
+fn feasibility_warning(feasibility: &Feasibility) -> Option<String> {
     let largest = feasibility.max_scale.as_ref().map_or(String::new(), |m| {
         format!(" (largest scale that fits: {:.4})", m.scale)
     });
     if let Some(stop) = feasibility.achieved.end_stop {
-        warnings.push(format!(
+        Some(format!(
             "the target's command drives the platen to the end of its actuators at {:.3} s \
              (u = {:.3} m): not iterated, no drive{largest}",
             stop.t_s, stop.value
-        ));
-    } else if let Some(worst) = feasibility.limiting.first() {
+        ))
+    } else {
+        feasibility.limiting.first().map(|worst| {
+            format!(
+                "the target is not feasible: {} reaches {:.3} times its limit at {:.3} s{largest}; \
+                 the drive reproduces it on the model, the table cannot run it",
+                worst.limit, worst.ratio, worst.t_s
+            )
+        })
+    }
+}
+
+/// The drive iteration on `table` and its best drive's limits, with what it warns of pushed
+/// on `warnings`.
+fn planned_drive(
+    table: &Table,
+    motion: &TargetMotion,
+    feasibility: &Feasibility,
+    settings: &IterationSettings,
+    on_run: &mut dyn FnMut(usize),
+    warnings: &mut Vec<String>,
+) -> Result<PlannedDrive> {
+    let iteration = iterate_observed(table, motion, settings, on_run)?;
+    let uses = limit_uses(table, &iteration.achieved);
+    if feasibility.feasible {
+        if let Some(worst) = failing(&uses).first() {
+            warnings.push(format!(
+                "the target's own command fits, but the iterated drive's run exceeds \
+                 {} ({:.3} times its limit at {:.3} s)",
+                worst.limit, worst.ratio, worst.t_s
+            ));
+        }
+    }
+    if let Stop::Stalled { reason } = &iteration.stop {
+        warnings.push(format!("the drive iteration stalled: {reason}"));
+    }
+    if let Some(t) = iteration.achieved.cavitation_at_s() {
         warnings.push(format!(
-            "the target is not feasible: {} reaches {:.3} times its limit at {:.3} s{largest}; \
-             the drive reproduces it on the model, the table cannot run it",
-            worst.limit, worst.ratio, worst.t_s
+            "a chamber pressure reached the cavitation floor at {t:.4} s in the drive's \
+             run"
         ));
     }
-    let drive = match feasibility.achieved.end_stop {
-        Some(_) => None,
-        None => {
-            let iteration = iterate_observed(table, &motion, &settings.iteration, on_run)?;
-            let uses = limit_uses(table, &iteration.achieved);
-            if feasibility.feasible {
-                if let Some(worst) = failing(&uses).first() {
-                    warnings.push(format!(
-                        "the target's own command fits, but the iterated drive's run exceeds \
-                         {} ({:.3} times its limit at {:.3} s)",
-                        worst.limit, worst.ratio, worst.t_s
-                    ));
-                }
-            }
-            if let Stop::Stalled { reason } = &iteration.stop {
-                warnings.push(format!("the drive iteration stalled: {reason}"));
-            }
-            if let Some(t) = iteration.achieved.cavitation_at_s() {
-                warnings.push(format!(
-                    "a chamber pressure reached the cavitation floor at {t:.4} s in the drive's \
-                     run"
-                ));
-            }
-            Some(PlannedDrive {
-                limits: limits_summary(table, &iteration.achieved),
-                frf: FrfSummary::new(&settings.iteration, &iteration),
-                uses,
-                iteration,
-            })
-        }
-    };
-    Ok(Plan {
-        scenario_path: scenario_path.to_owned(),
-        scenario_name: name.to_owned(),
-        target_origin: target.origin().to_owned(),
-        target_samples: target.len(),
-        target_rate_hz: target.sample_rate_hz(),
-        motion,
-        feasibility,
-        drive,
-        warnings,
+    Ok(PlannedDrive {
+        limits: limits_summary(table, &iteration.achieved),
+        frf: FrfSummary::new(settings, &iteration),
+        uses,
+        iteration,
     })
 }
 

@@ -34,8 +34,8 @@ use platen_system::{
 };
 
 use crate::ctx::Ctx;
-use crate::error::Result;
-use crate::file::{IntegratorSpec, DEFAULT_ATOL, DEFAULT_RTOL};
+use crate::error::{Result, ScenarioError};
+use crate::file::{Dopri5Spec, IntegratorSpec, DEFAULT_ATOL, DEFAULT_RTOL};
 use crate::system_file::Overlay;
 pub use crate::system_file::{
     AccumulatorSpec, ActuatorSpec, ChamberVolumes, ControllerSpec, ServoValveSpec, TableSystemSpec,
@@ -73,16 +73,73 @@ pub(crate) fn build_table_system(
 /// given, or an error naming the first missing one by its JSON path; absent gains, leakage
 /// and delay are 0, an absent accumulator a constant supply.
 fn complete_system(ctx: &Ctx, spec: &TableSystemSpec) -> Result<TableSystem> {
-    let missing = |path: &str, expected: &str| {
-        ctx.invalid(&format!("table_system.{path}"), "(missing)", expected)
+    let actuator = complete_actuator(ctx, spec.actuator.clone().unwrap_or_default())?;
+    let servo_valve = complete_servo_valve(ctx, spec.servo_valve.clone().unwrap_or_default())?;
+    let [oil_bulk_modulus_pa, supply_pressure_pa, return_pressure_pa] = need_all(
+        ctx,
+        [
+            ("oil_bulk_modulus_pa", spec.oil_bulk_modulus_pa),
+            ("supply_pressure_pa", spec.supply_pressure_pa),
+            ("return_pressure_pa", spec.return_pressure_pa),
+        ],
+    )?;
+    let controller = complete_controller(ctx, spec.controller.clone().unwrap_or_default())?;
+    let supply = match &spec.accumulator {
+        Some(Some(acc)) => {
+            let [precharge_pressure_pa, volume_m3, polytropic_exponent, pump_flow_m3_s] = need_all(
+                ctx,
+                [
+                    (
+                        "accumulator.precharge_pressure_pa",
+                        acc.precharge_pressure_pa,
+                    ),
+                    ("accumulator.volume_m3", acc.volume_m3),
+                    ("accumulator.polytropic_exponent", acc.polytropic_exponent),
+                    ("accumulator.pump_flow_m3_s", acc.pump_flow_m3_s),
+                ],
+            )?;
+            Supply::Accumulator(Accumulator {
+                precharge_pressure_pa,
+                volume_m3,
+                polytropic_exponent,
+                pump_flow_m3_s,
+            })
+        }
+        _ => Supply::Constant,
     };
-    let need = |path: &str, value: Option<f64>| {
-        value.ok_or_else(|| missing(path, "a value (or a `preset` to take it from)"))
-    };
-    let a = spec.actuator.clone().unwrap_or_default();
+    Ok(TableSystem {
+        actuator,
+        servo_valve,
+        oil_bulk_modulus_pa,
+        supply_pressure_pa,
+        return_pressure_pa,
+        supply,
+        controller,
+    })
+}
+
+/// The error of a value missing at `path` under `table_system`.
+fn missing(ctx: &Ctx, path: &str, expected: &str) -> ScenarioError {
+    ctx.invalid(&format!("table_system.{path}"), "(missing)", expected)
+}
+
+/// The values of `fields` (their JSON paths under `table_system` and values), in order, or
+/// the error naming the first missing one.
+fn need_all<const N: usize>(ctx: &Ctx, fields: [(&str, Option<f64>); N]) -> Result<[f64; N]> {
+    let mut values = [0.0; N];
+    for (slot, (path, value)) in values.iter_mut().zip(fields) {
+        *slot =
+            value.ok_or_else(|| missing(ctx, path, "a value (or a `preset` to take it from)"))?;
+    }
+    Ok(values)
+}
+
+/// The actuator of `a`: a count, double- or single-ended areas, chamber volumes; an absent
+/// leakage is 0.
+fn complete_actuator(ctx: &Ctx, a: ActuatorSpec) -> Result<platen_system::Actuator> {
     let count = a
         .count
-        .ok_or_else(|| missing("actuator.count", "a count ≥ 1"))?;
+        .ok_or_else(|| missing(ctx, "actuator.count", "a count ≥ 1"))?;
     let (cap, rod) = match (a.area_m2, a.cap_side_area_m2, a.rod_side_area_m2) {
         (Some(area), None, None) => (area, area),
         (Some(area), _, _) => {
@@ -92,48 +149,76 @@ fn complete_system(ctx: &Ctx, spec: &TableSystemSpec) -> Result<TableSystem> {
                 "either `area_m2` (double-ended) or `cap_side_area_m2` and `rod_side_area_m2`, not both",
             ))
         }
-        (None, c, r) => (
-            need("actuator.cap_side_area_m2", c)?,
-            need("actuator.rod_side_area_m2", r)?,
-        ),
+        (None, c, r) => {
+            let [cap, rod] = need_all(
+                ctx,
+                [
+                    ("actuator.cap_side_area_m2", c),
+                    ("actuator.rod_side_area_m2", r),
+                ],
+            )?;
+            (cap, rod)
+        }
     };
     let (cap_volume, rod_volume) = match a.chamber_volume_m3 {
         Some(ChamberVolumes::Both(v)) => (v, v),
         Some(ChamberVolumes::Each([c, r])) => (c, r),
         None => {
             return Err(missing(
+                ctx,
                 "actuator.chamber_volume_m3",
                 "a volume, or [cap, rod]",
             ))
         }
     };
-    let v = spec.servo_valve.clone().unwrap_or_default();
-    let valve_count = v
+    Ok(platen_system::Actuator {
+        count,
+        cap_area_m2: cap,
+        rod_area_m2: rod,
+        cap_volume_m3: cap_volume,
+        rod_volume_m3: rod_volume,
+        leakage_m3_s_per_pa: a.leakage_m3_s_per_pa.unwrap_or(0.0),
+    })
+}
+
+/// The servo-valves of `v`; an absent delay is 0.
+fn complete_servo_valve(ctx: &Ctx, v: ServoValveSpec) -> Result<platen_system::ServoValve> {
+    let count = v
         .count
-        .ok_or_else(|| missing("servo_valve.count", "a count ≥ 1"))?;
-    let servo_valve = platen_system::ServoValve {
-        count: valve_count,
-        rated_flow_m3_s: need("servo_valve.rated_flow_m3_s", v.rated_flow_m3_s)?,
-        rated_pressure_drop_pa: need(
-            "servo_valve.rated_pressure_drop_pa",
-            v.rated_pressure_drop_pa,
-        )?,
-        natural_frequency_hz: need("servo_valve.natural_frequency_hz", v.natural_frequency_hz)?,
-        damping_ratio: need("servo_valve.damping_ratio", v.damping_ratio)?,
+        .ok_or_else(|| missing(ctx, "servo_valve.count", "a count ≥ 1"))?;
+    let [rated_flow_m3_s, rated_pressure_drop_pa, natural_frequency_hz, damping_ratio] = need_all(
+        ctx,
+        [
+            ("servo_valve.rated_flow_m3_s", v.rated_flow_m3_s),
+            (
+                "servo_valve.rated_pressure_drop_pa",
+                v.rated_pressure_drop_pa,
+            ),
+            ("servo_valve.natural_frequency_hz", v.natural_frequency_hz),
+            ("servo_valve.damping_ratio", v.damping_ratio),
+        ],
+    )?;
+    Ok(platen_system::ServoValve {
+        count,
+        rated_flow_m3_s,
+        rated_pressure_drop_pa,
+        natural_frequency_hz,
+        damping_ratio,
         delay_s: v.delay_s.unwrap_or(0.0),
-    };
-    let oil_bulk_modulus_pa = need("oil_bulk_modulus_pa", spec.oil_bulk_modulus_pa)?;
-    let supply_pressure_pa = need("supply_pressure_pa", spec.supply_pressure_pa)?;
-    let return_pressure_pa = need("return_pressure_pa", spec.return_pressure_pa)?;
-    let c = spec.controller.clone().unwrap_or_default();
+    })
+}
+
+/// The controller of `c`: its sample rate, and its gains (absent gains are 0).
+fn complete_controller(ctx: &Ctx, c: ControllerSpec) -> Result<Controller> {
     let sample_rate_hz = c.sample_rate_hz.ok_or_else(|| {
         missing(
+            ctx,
             "controller.sample_rate_hz",
             "the controller's sample rate, Hz",
         )
     })?;
     let gain = |g: Option<f64>| g.unwrap_or(0.0);
-    let controller = Controller {
+    Ok(Controller {
         sample_rate_hz,
         displacement_gain_per_m: gain(c.displacement_gain_per_m),
         integral_gain_per_m_s: gain(c.integral_gain_per_m_s),
@@ -143,34 +228,6 @@ fn complete_system(ctx: &Ctx, spec: &TableSystemSpec) -> Result<TableSystem> {
         acceleration_feedback_s2_per_m: gain(c.acceleration_feedback_s2_per_m),
         delta_p_gain_per_pa: gain(c.delta_p_gain_per_pa),
         delta_p_highpass_hz: gain(c.delta_p_highpass_hz),
-    };
-    let supply = match &spec.accumulator {
-        Some(Some(acc)) => Supply::Accumulator(Accumulator {
-            precharge_pressure_pa: need(
-                "accumulator.precharge_pressure_pa",
-                acc.precharge_pressure_pa,
-            )?,
-            volume_m3: need("accumulator.volume_m3", acc.volume_m3)?,
-            polytropic_exponent: need("accumulator.polytropic_exponent", acc.polytropic_exponent)?,
-            pump_flow_m3_s: need("accumulator.pump_flow_m3_s", acc.pump_flow_m3_s)?,
-        }),
-        _ => Supply::Constant,
-    };
-    Ok(TableSystem {
-        actuator: platen_system::Actuator {
-            count,
-            cap_area_m2: cap,
-            rod_area_m2: rod,
-            cap_volume_m3: cap_volume,
-            rod_volume_m3: rod_volume,
-            leakage_m3_s_per_pa: a.leakage_m3_s_per_pa.unwrap_or(0.0),
-        },
-        servo_valve,
-        oil_bulk_modulus_pa,
-        supply_pressure_pa,
-        return_pressure_pa,
-        supply,
-        controller,
     })
 }
 
@@ -239,67 +296,83 @@ pub(crate) fn loop_method(
     };
     match integrator {
         None => default_rk4(),
-        Some(IntegratorSpec::Rk4(spec)) => {
-            let Some(step) = spec.step_s else {
-                return default_rk4();
-            };
-            let here = "integrator.step_s";
-            if !(step.is_finite() && step > 0.0) {
-                return Err(ctx.invalid(here, step, "a finite step > 0 s"));
-            }
-            let k = (period / step).round();
-            if k < 1.0 || (k * step - period).abs() > 1e-9 * period {
-                return Err(ctx.invalid(
-                    here,
-                    step,
-                    format!(
-                        "the controller's period {period} s divided by a whole number \
-                         (it updates the drive every {period} s)"
-                    ),
-                ));
-            }
-            if k > MAX_STEPS_PER_PERIOD {
-                return Err(ctx.invalid(
-                    here,
-                    step,
-                    format!(
-                        "at least the controller's period {period} s divided by \
-                         {MAX_STEPS_PER_PERIOD:e} ({:e} s)",
-                        period / MAX_STEPS_PER_PERIOD
-                    ),
-                ));
-            }
-            if step * fastest > 1.0 {
-                let k_default = system.default_steps_per_period(mass_kg, stroke_m);
-                return Err(ctx.invalid(
-                    here,
-                    step,
-                    format!(
-                        "a step that resolves the loop's fastest mode ({:.1} Hz): at most {:.3e} s \
-                         (default {:.3e} s)",
-                        fastest / std::f64::consts::TAU,
-                        1.0 / fastest,
-                        period / f64::from(k_default)
-                    ),
-                ));
-            }
-            Ok(LoopMethod::Rk4 {
-                steps_per_period: k as u32,
-            })
-        }
-        Some(IntegratorSpec::Dopri5(spec)) => {
-            let rtol = spec.rtol.unwrap_or(DEFAULT_RTOL);
-            let atol = spec.atol.unwrap_or(DEFAULT_ATOL);
-            for (path, v) in [("integrator.rtol", rtol), ("integrator.atol", atol)] {
-                if !(v.is_finite() && v > 0.0) {
-                    return Err(ctx.invalid(path, v, "a finite tolerance > 0"));
-                }
-            }
-            Ok(LoopMethod::Dopri5 {
-                steps_per_period: 1,
-                rtol,
-                atol,
-            })
+        Some(IntegratorSpec::Rk4(spec)) => match spec.step_s {
+            None => default_rk4(),
+            Some(step) => rk4_at_step(ctx, step, period, fastest, || {
+                system.default_steps_per_period(mass_kg, stroke_m)
+            }),
+        },
+        Some(IntegratorSpec::Dopri5(spec)) => dopri5(ctx, spec),
+    }
+}
+
+/// RK4 at `step` (`integrator.step_s`): it must divide the controller's `period` into at most
+/// [`MAX_STEPS_PER_PERIOD`] steps and resolve the loop's `fastest` mode, rad/s (the default
+/// steps per period, `k_default`, are named when it does not).
+fn rk4_at_step(
+    ctx: &Ctx,
+    step: f64,
+    period: f64,
+    fastest: f64,
+    k_default: impl FnOnce() -> u32,
+) -> Result<LoopMethod> {
+    let here = "integrator.step_s";
+    if !(step.is_finite() && step > 0.0) {
+        return Err(ctx.invalid(here, step, "a finite step > 0 s"));
+    }
+    let k = (period / step).round();
+    if k < 1.0 || (k * step - period).abs() > 1e-9 * period {
+        return Err(ctx.invalid(
+            here,
+            step,
+            format!(
+                "the controller's period {period} s divided by a whole number \
+                 (it updates the drive every {period} s)"
+            ),
+        ));
+    }
+    if k > MAX_STEPS_PER_PERIOD {
+        return Err(ctx.invalid(
+            here,
+            step,
+            format!(
+                "at least the controller's period {period} s divided by \
+                 {MAX_STEPS_PER_PERIOD:e} ({:e} s)",
+                period / MAX_STEPS_PER_PERIOD
+            ),
+        ));
+    }
+    if step * fastest > 1.0 {
+        let k_default = k_default();
+        return Err(ctx.invalid(
+            here,
+            step,
+            format!(
+                "a step that resolves the loop's fastest mode ({:.1} Hz): at most {:.3e} s \
+                 (default {:.3e} s)",
+                fastest / std::f64::consts::TAU,
+                1.0 / fastest,
+                period / f64::from(k_default)
+            ),
+        ));
+    }
+    Ok(LoopMethod::Rk4 {
+        steps_per_period: k as u32,
+    })
+}
+
+/// Dopri5 at `spec`'s tolerances (default [`DEFAULT_RTOL`], [`DEFAULT_ATOL`]), checked.
+fn dopri5(ctx: &Ctx, spec: &Dopri5Spec) -> Result<LoopMethod> {
+    let rtol = spec.rtol.unwrap_or(DEFAULT_RTOL);
+    let atol = spec.atol.unwrap_or(DEFAULT_ATOL);
+    for (path, v) in [("integrator.rtol", rtol), ("integrator.atol", atol)] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(ctx.invalid(path, v, "a finite tolerance > 0"));
         }
     }
+    Ok(LoopMethod::Dopri5 {
+        steps_per_period: 1,
+        rtol,
+        atol,
+    })
 }

@@ -6,11 +6,25 @@ use anyhow::Result;
 
 use platen::bench::{self, RATE_HZ};
 
-/// Runs `platen bench`: `seconds` simulated seconds per record, `repeats` runs of each
+/// The arguments of `platen bench`.
+#[derive(clap::Args)]
+pub struct BenchArgs {
+    /// Print a machine-readable summary on stdout (keys rk4_ns_per_step, …).
+    #[arg(long)]
+    pub json: bool,
+    /// Simulated seconds of every workload's 1024 Hz record.
+    #[arg(long, default_value_t = 600.0, value_parser = parse_seconds)]
+    seconds: f64,
+    /// Runs of each workload (round-robin); the median is reported.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    repeats: u32,
+}
+
+/// Runs `platen bench`: `--seconds` simulated seconds per record, `--repeats` runs of each
 /// workload, the report as JSON or as a table.
-pub fn run(seconds: f64, repeats: u32, json_out: bool) -> Result<()> {
-    let m = bench::measure(seconds, repeats)?;
-    if json_out {
+pub fn run(args: &BenchArgs) -> Result<()> {
+    let m = bench::measure(args.seconds, args.repeats)?;
+    if args.json {
         outln!("{}", serde_json::to_string_pretty(&m.report())?);
     } else {
         out!("{}", m.text());

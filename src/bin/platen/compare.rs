@@ -4,7 +4,7 @@
 //! The comparison is [`platen_compare::Comparison`]; the figures, the page and the terminal
 //! summary are [`platen_report`]'s. This file parses the options and prints.
 
-use std::path::Path;
+use std::path::PathBuf;
 
 use anyhow::Result;
 
@@ -12,6 +12,8 @@ use platen_compare::{Comparison, Settings};
 use platen_report::{compare_figures, html, text};
 
 pub use platen_compare::Window;
+
+use crate::{plot, usage};
 
 /// Parses `--window T0,T1`.
 pub fn parse_window(text: &str) -> Result<Window, String> {
@@ -47,60 +49,71 @@ pub fn parse_max_lag(text: &str) -> Result<f64, String> {
     }
 }
 
-/// The options of `platen compare`.
-pub struct Options<'a> {
+/// The arguments of `platen compare`.
+#[derive(clap::Args)]
+pub struct CompareArgs {
     /// Scenario JSON file.
-    pub scenario: &'a Path,
-    /// Recorded CSV file.
-    pub recorded: &'a Path,
-    /// Print JSON on stdout.
+    scenario: PathBuf,
+    /// Recorded CSV file (t_s and u_m, v_m_s for a forward run, force_n for an inverse
+    /// one; a_m_s2 and the other columns are used by the figures where present). It must
+    /// be uniformly sampled and cover the scenario's time span.
+    #[arg(long, value_name = "REC.csv")]
+    recorded: PathBuf,
+    /// Print the metrics as JSON (one object per channel: u_m, v_m_s or force_n).
+    #[arg(long)]
     pub json: bool,
-    /// Folder for the SVG figures.
-    pub plot: Option<&'a Path>,
-    /// Metrics window.
-    pub window: Option<Window>,
-    /// HTML report file.
-    pub report: Option<&'a Path>,
-    /// Lag search bound, s.
-    pub max_lag_s: f64,
-    /// JSON file mapping the record's own channel names and units to platen's columns.
-    pub columns: Option<&'a Path>,
-    /// Size of the figures.
-    pub size: platen_report::FigureSize,
+    /// Write the figures to this folder as SVG and PNG (time histories with a zoom, residuals,
+    /// hysteresis loops, dissipative force against velocity with the model's law).
+    #[arg(long, value_name = "DIR")]
+    plot: Option<PathBuf>,
+    /// Compute the metrics over this time window only, s (also the zoomed interval).
+    #[arg(long, value_name = "T0,T1", allow_hyphen_values = true, value_parser = parse_window)]
+    window: Option<Window>,
+    /// Write a self-contained HTML report (metrics table and figures) to this file.
+    #[arg(long, value_name = "FILE.html", value_parser = usage::OutFile("report.html"))]
+    report: Option<PathBuf>,
+    /// JSON file mapping the record's channel names and units to platen's columns, as a
+    /// scenario's excitation.columns: {"u_m": {"name": "Table disp", "unit": "mm"}, …}.
+    #[arg(long, value_name = "MAP.json")]
+    columns: Option<PathBuf>,
+    /// Largest lag searched by cross-correlation, either way, s.
+    #[arg(long, value_name = "S", default_value_t = 0.25, value_parser = parse_max_lag)]
+    max_lag: f64,
+    #[command(flatten)]
+    size: plot::SizeArgs,
 }
 
 /// Runs `platen compare`.
-pub fn run(options: &Options<'_>) -> Result<()> {
+pub fn run(args: &CompareArgs) -> Result<()> {
+    let size = args.size.size();
+    let (plot, report) = (args.plot.as_deref(), args.report.as_deref());
     let settings = Settings {
-        window: options.window,
-        max_lag_s: options.max_lag_s,
+        window: args.window,
+        max_lag_s: args.max_lag,
     };
     let comparison = Comparison::from_files(
-        options.scenario,
-        options.recorded,
-        options.columns,
+        &args.scenario,
+        &args.recorded,
+        args.columns.as_deref(),
         &settings,
     )?;
     let written = platen_report::write_outputs(
-        options.plot,
-        options.report,
-        &options.size,
+        plot,
+        report,
+        &size,
         || compare_figures::figures(&comparison),
         |figures, rendered| html::compare_page(&comparison, figures, rendered),
     )?;
-    if options.json {
+    if args.json {
         // The text summary lists them; with --json they also go to stderr, as simulate's.
         for warning in comparison.warnings() {
             eprintln!("warning: {warning}");
         }
-        let summary = comparison.summary(&written, options.report);
+        let summary = comparison.summary(&written, report);
         let summary = serde_json::to_value(&summary)?;
         outln!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
-        out!(
-            "{}",
-            text::compare_summary(&comparison, &written, options.report)
-        );
+        out!("{}", text::compare_summary(&comparison, &written, report));
     }
     Ok(())
 }

@@ -1,7 +1,7 @@
 //! `platen generate`: write the excitation of a scenario, or the recorded-like data a table's
 //! data system would have produced for a motion scenario.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 
@@ -10,6 +10,8 @@ use platen_io::csv::write_csv_atomic;
 use platen_report::sweep_report::GenerateReport;
 use platen_scenario::recorded::Recorded;
 use platen_scenario::{Run, Scenario};
+
+use crate::usage;
 
 /// What to generate.
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -24,10 +26,30 @@ pub enum What {
     Recorded,
 }
 
+/// The arguments of `platen generate`.
+#[derive(clap::Args)]
+pub struct GenerateArgs {
+    /// What to write.
+    #[arg(value_enum)]
+    what: What,
+    /// Scenario JSON file.
+    scenario: PathBuf,
+    /// Output CSV file.
+    #[arg(long, value_parser = usage::OutFile("excitation.csv"))]
+    out: PathBuf,
+    /// Seed of the noise of recorded-like data.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Print a machine-readable summary on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
 /// Runs `platen generate`.
-pub fn run(what: What, scenario_path: &Path, out: &Path, seed: u64, json_out: bool) -> Result<()> {
+pub fn run(args: &GenerateArgs) -> Result<()> {
+    let (scenario_path, out, seed, json_out) = (&args.scenario, &args.out, args.seed, args.json);
     let scenario = Scenario::load(scenario_path)?;
-    match what {
+    match args.what {
         What::Excitation => match &scenario.run {
             Run::Forward {
                 record, samples, ..

@@ -6,114 +6,187 @@
 //! text form is [`platen_report::model_text`]'s, and `--plot` draws the linearised loop's
 //! Bode plots ([`platen_report::system_figures::analysis_figures`]).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
+use clap::ValueEnum;
 
 use platen_model::Preset;
-use platen_report::{model_text, system_figures, FigureSize};
+use platen_report::{model_text, system_figures};
 use platen_scenario::describe::{self, ModelDescription, SystemAnalysis};
-use platen_scenario::LoadedRig;
+use platen_scenario::{LoadedRig, Model};
 use platen_system::TableSystem;
 
-use crate::Form;
+use crate::plot;
 
-/// The options of `platen model`.
-pub struct Options<'a> {
-    /// Model preset (without a scenario).
-    pub preset: &'a str,
-    /// Hold-down pressure, MPa (without a scenario; default the preset's).
-    pub pressure_mpa: Option<f64>,
-    /// The form described (without a scenario).
-    pub form: Form,
-    /// A table-system preset (replaces a scenario's `table_system`).
-    pub system: Option<&'a str>,
-    /// A scenario whose model, table system and specimen are described.
-    pub scenario: Option<&'a Path>,
+/// The arguments of `platen model`.
+#[derive(clap::Args)]
+pub struct ModelArgs {
+    /// Preset name.
+    #[arg(long, default_value = "lhpost-2008")]
+    preset: String,
+    /// Hold-down nitrogen pressure, MPa (default: the preset's nominal pressure).
+    #[arg(long)]
+    pressure_mpa: Option<f64>,
+    /// Which form to describe.
+    #[arg(long, value_enum, default_value_t = Form::Identified)]
+    form: Form,
+    /// Describe this table system too (a table-system preset: lhpost-2008); with
+    /// --scenario it replaces the scenario's table_system.
+    #[arg(long, value_name = "PRESET")]
+    system: Option<String>,
+    /// Describe the model, table_system and specimen of this scenario (its model
+    /// preset, pressure, form and values; its excitation, integrator, initial state and
+    /// duration are not read).
+    #[arg(
+        long,
+        value_name = "FILE",
+        conflicts_with_all = ["preset", "pressure_mpa", "form"]
+    )]
+    scenario: Option<PathBuf>,
     /// Print JSON on stdout.
+    #[arg(long)]
     pub json: bool,
-    /// Folder for the Bode figures (SVG and PNG).
-    pub plot: Option<&'a Path>,
-    /// Size of the figures.
-    pub size: FigureSize,
+    /// Write the Bode plots of the linearised loop to this folder as SVG and PNG: the
+    /// closed loop command → displacement (bode-closed-loop) and the loop gain L broken
+    /// at the drive (bode-loop-gain), magnitude and phase, 0.1 Hz to the controller's
+    /// Nyquist frequency or 200 Hz. Needs a table system (--system or --scenario).
+    #[arg(long, value_name = "DIR")]
+    plot: Option<PathBuf>,
+    #[command(flatten)]
+    size: plot::SizeArgs,
 }
 
-pub fn run(o: &Options<'_>) -> Result<()> {
+/// `--form`.
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum Form {
+    /// The identified model of Eq. 22/23.
+    Identified,
+    /// The full Lagrangian model of Eq. 1–8.
+    Full,
+}
+
+/// What `platen model` describes: the description, the model, its stroke and specimen, the
+/// scenario's table system and what the figures' titles name.
+struct Described {
+    /// The scenario's header line (empty without `--scenario`).
+    header: String,
+    description: ModelDescription,
+    model: Model,
+    stroke_m: f64,
+    specimen_kg: Option<f64>,
+    /// The scenario's table system and the preset it names.
+    given: Option<(Option<String>, TableSystem)>,
+    name: String,
+}
+
+/// Runs `platen model`.
+pub fn run(args: &ModelArgs) -> Result<()> {
+    let size = args.size.size();
     let names = platen_system::preset::PRESET_NAMES;
-    if o.system.is_none() && o.scenario.is_none() && o.plot.is_some() {
+    if args.system.is_none() && args.scenario.is_none() && args.plot.is_some() {
         bail!(
             "--plot draws the Bode plots of a table system's loop: give --system PRESET \
              ({names}) or a --scenario with a `table_system`"
         );
     }
-    // The description, the model, its stroke and specimen, the scenario's table system and
-    // what the figures' titles name.
-    let mut header = String::new();
-    let (mut description, model, stroke_m, specimen_kg, given, name) = match o.scenario {
-        Some(path) => {
-            let loaded = LoadedRig::load(path)?;
-            let rig = loaded.rig;
-            header = model_text::scenario_header(path, &loaded.name, &rig);
-            let given = rig
-                .table_system
-                .map(|system| (loaded.table_system_preset, system));
-            let specimen_kg = rig.specimen.as_ref().map(|sp| sp.total_mass_kg());
-            let d = ModelDescription::of_rig(path, &rig)?;
-            (
-                d,
-                rig.model,
-                rig.limits.stroke_m,
-                specimen_kg,
-                given,
-                loaded.name,
-            )
-        }
-        None => {
-            let preset = Preset::from_name(o.preset)?;
-            let pressure_pa = pressure_pa(preset, o.pressure_mpa)?;
-            let full = matches!(o.form, Form::Full);
-            let d = ModelDescription::of_preset(preset, pressure_pa, full)?;
-            let model = describe::preset_model(preset, pressure_pa, full)?;
-            let name = o.system.unwrap_or(preset.name()).to_owned();
-            (d, model, preset.limits().stroke_m, None, None, name)
-        }
+    let mut described = match &args.scenario {
+        Some(path) => of_scenario(path)?,
+        None => of_preset(args)?,
     };
-    let system = match o.system {
-        Some(name) => Some((Some(name.to_owned()), system_preset(name, stroke_m)?)),
-        None => given,
+    let system = match &args.system {
+        Some(name) => Some((Some(name.clone()), system_preset(name, described.stroke_m)?)),
+        None => described.given.take(),
     };
-    let analysis = system
-        .map(|(preset, system)| SystemAnalysis::new(preset, system, &model, stroke_m, specimen_kg));
-    description.table_system = analysis.as_ref().map(SystemAnalysis::description);
-    let written = match (&analysis, o.plot) {
+    let analysis = system.map(|(preset, system)| {
+        SystemAnalysis::new(
+            preset,
+            system,
+            &described.model,
+            described.stroke_m,
+            described.specimen_kg,
+        )
+    });
+    described.description.table_system = analysis.as_ref().map(SystemAnalysis::description);
+    let written = match (&analysis, args.plot.as_deref()) {
         (None, Some(_)) => bail!(
             "--plot draws the Bode plots of a table system's loop, and {} has no \
              `table_system`: give --system PRESET ({names})",
-            o.scenario
+            args.scenario
+                .as_ref()
                 .map_or("the scenario".into(), |p| p.display().to_string()),
         ),
-        (Some(a), Some(_)) => platen_report::write_outputs(
-            o.plot,
+        (Some(a), plot @ Some(_)) => platen_report::write_outputs(
+            plot,
             None,
-            &o.size,
-            || system_figures::analysis_figures(&name, a),
+            &size,
+            || system_figures::analysis_figures(&described.name, a),
             |_, _| String::new(),
         )?,
         _ => Vec::new(),
     };
-    if o.json {
-        let mut value = serde_json::to_value(&description)?;
-        if o.plot.is_some() {
+    print(args, &described, &written)
+}
+
+/// The model, table system and specimen of the scenario at `path`.
+fn of_scenario(path: &Path) -> Result<Described> {
+    let loaded = LoadedRig::load(path)?;
+    let rig = loaded.rig;
+    let header = model_text::scenario_header(path, &loaded.name, &rig);
+    let given = rig
+        .table_system
+        .map(|system| (loaded.table_system_preset, system));
+    let specimen_kg = rig.specimen.as_ref().map(|sp| sp.total_mass_kg());
+    let description = ModelDescription::of_rig(path, &rig)?;
+    Ok(Described {
+        header,
+        description,
+        model: rig.model,
+        stroke_m: rig.limits.stroke_m,
+        specimen_kg,
+        given,
+        name: loaded.name,
+    })
+}
+
+/// The preset's model at `--pressure-mpa` in `--form`.
+fn of_preset(args: &ModelArgs) -> Result<Described> {
+    let preset = Preset::from_name(&args.preset)?;
+    let pressure_pa = pressure_pa(preset, args.pressure_mpa)?;
+    let full = matches!(args.form, Form::Full);
+    let description = ModelDescription::of_preset(preset, pressure_pa, full)?;
+    let model = describe::preset_model(preset, pressure_pa, full)?;
+    let name = args.system.as_deref().unwrap_or(preset.name()).to_owned();
+    Ok(Described {
+        header: String::new(),
+        description,
+        model,
+        stroke_m: preset.limits().stroke_m,
+        specimen_kg: None,
+        given: None,
+        name,
+    })
+}
+
+/// Prints the description (JSON or text) and the figures written.
+fn print(args: &ModelArgs, described: &Described, written: &[PathBuf]) -> Result<()> {
+    if args.json {
+        let mut value = serde_json::to_value(&described.description)?;
+        if args.plot.is_some() {
             let files: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
             value["figures"] = files.into();
         }
         outln!("{}", serde_json::to_string_pretty(&value)?);
         return Ok(());
     }
-    out!("{header}{}", model_text::text(&description));
+    out!(
+        "{}{}",
+        described.header,
+        model_text::text(&described.description)
+    );
     if !written.is_empty() {
         outln!("\nwrote {} figure files (SVG and PNG):", written.len());
-        for path in &written {
+        for path in written {
             outln!("  {}", path.display());
         }
     }

@@ -4,36 +4,53 @@
 //! the target that is renamed over it when the run is complete and removed if it fails, so a
 //! one-hour 1024 Hz run holds no trajectory in memory.
 
-use std::path::Path;
+use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 
 use platen_report::simulate_report::with_outputs;
-use platen_report::{run_figures, run_figures::RunRecorder, FigureSize};
+use platen_report::{run_figures, run_figures::RunRecorder};
 use platen_scenario::{CsvSink, Run, RunSummary, Scenario};
 
 use crate::progress::{Progress, Ticker};
+use crate::{plot, sweep, usage};
 
-/// The options of `platen simulate`.
-pub struct Options<'a> {
+/// The arguments of `platen simulate`.
+#[derive(clap::Args)]
+pub struct SimulateArgs {
     /// Scenario JSON file.
-    pub scenario: &'a Path,
-    /// CSV file for the time series.
-    pub out: Option<&'a Path>,
-    /// Print JSON on stdout.
+    scenario: PathBuf,
+    /// Write the time series (t_s, u_m, v_m_s, a_m_s2, force_n, inertial_force_n,
+    /// elastic_force_n, dissipative_force_n; then a specimen's and a closed loop's
+    /// columns) to this CSV file; a name ending in .parquet writes Parquet instead (the
+    /// same columns, float64, one row per sample).
+    #[arg(long, value_parser = usage::OutFile("run.csv"))]
+    out: Option<PathBuf>,
+    /// Print a machine-readable summary on stdout.
+    #[arg(long)]
     pub json: bool,
-    /// Folder for the figures (SVG and PNG).
-    pub plot: Option<&'a Path>,
-    /// Size of the figures.
-    pub size: FigureSize,
-    /// The hold-down pressure to run at, MPa, instead of the scenario's.
-    pub pressure_mpa: Option<f64>,
+    /// Write the run's figures to this folder as SVG and PNG: motion and actuator force
+    /// over time (with the table's limits near a peak), the force decomposition
+    /// F_A = F_I + F_E + F_D, hysteresis loops of F_A against u, v and a; for a closed
+    /// loop also command against achieved motion, tracking error, drive and spool,
+    /// pressure difference, flow against the valves' capacity, supply pressure.
+    #[arg(long, value_name = "DIR")]
+    plot: Option<PathBuf>,
+    #[command(flatten)]
+    size: plot::SizeArgs,
+    /// Run at this hold-down pressure, MPa, instead of the scenario's (the model rebuilt
+    /// from its preset at P with the scenario's overrides, as `sweep --pressure-mpa`).
+    #[arg(long, value_name = "P", allow_negative_numbers = true, value_parser = sweep::parse_pressure_mpa)]
+    pressure_mpa: Option<f64>,
 }
 
-pub fn run(opts: &Options<'_>) -> Result<()> {
-    let (path, out) = (opts.scenario, opts.out);
+/// Runs `platen simulate`.
+pub fn run(args: &SimulateArgs) -> Result<()> {
+    let size = args.size.size();
+    let (path, out) = (args.scenario.as_path(), args.out.as_deref());
+    let plot = args.plot.as_deref();
     let mut scenario = Scenario::load(path)?;
-    if let Some(p) = opts.pressure_mpa {
+    if let Some(p) = args.pressure_mpa {
         scenario = scenario
             .at_pressure(p * 1e6)
             .with_context(|| format!("`{}`: the model at --pressure-mpa {p}", path.display()))?;
@@ -47,7 +64,7 @@ pub fn run(opts: &Options<'_>) -> Result<()> {
         })
         .transpose()?;
     // The figures' points are collected as the run goes, in memory that does not grow with it.
-    let mut recorder = opts.plot.map(|_| RunRecorder::new(&scenario.run));
+    let mut recorder = plot.map(|_| RunRecorder::new(&scenario.run));
     // A bar of the samples written (on a terminal, after a second).
     let expected = scenario.run.samples();
     let progress = Progress::new(
@@ -70,9 +87,9 @@ pub fn run(opts: &Options<'_>) -> Result<()> {
     }
     let written = match recorder {
         Some(recorder) => platen_report::write_outputs(
-            opts.plot,
+            plot,
             None,
-            &opts.size,
+            &size,
             || run_figures::figures(recorder, &scenario),
             |_, _| String::new(),
         )?,
@@ -82,9 +99,9 @@ pub fn run(opts: &Options<'_>) -> Result<()> {
     for warning in &summary.warnings {
         eprintln!("warning: {warning}");
     }
-    if opts.json {
+    if args.json {
         // Through a Value, so the keys come out in alphabetical order.
-        let figures = opts.plot.map(|_| written.as_slice());
+        let figures = plot.map(|_| written.as_slice());
         let value = with_outputs(serde_json::to_value(&summary)?, figures, None);
         outln!("{}", serde_json::to_string_pretty(&value)?);
     } else {

@@ -14,7 +14,7 @@
 //! * A case that fails numerically is reported in its row's `status`; the other cases still
 //!   run, the output is written, and the command exits with code 4.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{anyhow, Result};
@@ -27,6 +27,8 @@ use platen_scenario::sweep::{self, Outcome, Sweep};
 use platen_scenario::{ModelKey, Run, Scenario};
 
 pub use platen_scenario::sweep::SetAxis;
+
+use crate::{plot, usage};
 
 fn parse_number(s: &str) -> std::result::Result<f64, String> {
     match s.trim().parse::<f64>() {
@@ -90,24 +92,91 @@ pub fn parse_set(s: &str) -> std::result::Result<SetAxis, String> {
     })
 }
 
-/// Where `platen sweep` writes its figures, and their size.
-pub struct Plot<'a> {
-    /// Folder for the figures (SVG and PNG).
-    pub dir: Option<&'a Path>,
-    /// Size of the figures.
-    pub size: platen_report::FigureSize,
+/// The arguments of `platen sweep`.
+#[derive(clap::Args)]
+pub struct SweepArgs {
+    /// Scenario JSON file.
+    scenario: PathBuf,
+    /// Factors multiplying the excitation (the force record, or the prescribed motion),
+    /// comma separated: --scale 0.5,1,1.5.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, value_parser = parse_scale)]
+    scale: Vec<f64>,
+    /// Hold-down nitrogen pressures, MPa, comma separated: --pressure-mpa 0,6.9,13.8.
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true, value_parser = parse_pressure_mpa)]
+    pressure_mpa: Vec<f64>,
+    /// A model parameter and its values, repeatable: --set identified.coulomb_force_n=20e3,25e3
+    /// or --set full.platen_mass_kg=130e3,140e3 (the scenario's form: identified or full).
+    #[arg(long = "set", value_name = "FORM.NAME=V1,V2,…", value_parser = parse_set)]
+    set: Vec<SetAxis>,
+    /// Write one row per case to this CSV file (written atomically when all cases are done).
+    #[arg(long, value_parser = usage::OutFile("cases.csv"))]
+    out: Option<PathBuf>,
+    /// Print a machine-readable summary of every case on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Write figures to this folder as SVG and PNG: for each axis with two or more
+    /// values, the peaks of every case against it with the table's limits.
+    #[arg(long, value_name = "DIR")]
+    plot: Option<PathBuf>,
+    #[command(flatten)]
+    size: plot::SizeArgs,
 }
 
-/// Runs every case of the grid over the scenario at `path` and reports one row per case.
-pub fn run(
-    path: &Path,
-    scales: &[f64],
-    pressures_mpa: &[f64],
-    sets: &[SetAxis],
-    out: Option<&Path>,
-    json_out: bool,
-    plot: &Plot<'_>,
-) -> Result<()> {
+/// Runs every case of the grid over the scenario and reports one row per case.
+pub fn run(args: &SweepArgs) -> Result<()> {
+    let size = args.size.size();
+    let (path, out) = (args.scenario.as_path(), args.out.as_deref());
+    let scenario = load(path, &args.set)?;
+    let grid = Sweep::new(&scenario, &args.scale, &args.pressure_mpa, &args.set)?;
+    let progress = crate::progress::Progress::new(
+        grid.cases.len() as u64,
+        "{bar:40} {pos}/{len} cases  {elapsed_precise} elapsed, {eta} left",
+    );
+    let start = Instant::now();
+    let outcomes = grid.run(&scenario.run, || progress.inc());
+    progress.finish();
+    let wall_s = start.elapsed().as_secs_f64();
+
+    let (cases, set_names) = (&grid.cases, &grid.set_names);
+    if let Some(out) = out {
+        let csv = sweep::csv_text(&scenario, set_names, cases, &outcomes);
+        write_bytes_atomic(out, csv.as_bytes())?;
+    }
+    let written = platen_report::write_outputs(
+        args.plot.as_deref(),
+        None,
+        &size,
+        || platen_report::sweep_figures::figures(&scenario, set_names, cases, &outcomes),
+        |_, _| String::new(),
+    )?;
+    let figures = args.plot.as_ref().map(|_| written.as_slice());
+    if args.json {
+        let summary = sweep::json_summary(path, &scenario, set_names, cases, &outcomes, out);
+        let summary = with_outputs(summary, figures, None);
+        outln!("{}", serde_json::to_string_pretty(&summary)?);
+    } else {
+        let run = platen_report::sweep_report::SweepRun {
+            scenario: &scenario,
+            set_names,
+            cases,
+            outcomes: &outcomes,
+            out,
+        };
+        out!("{}", platen_report::sweep_report::sweep_text(&run, figures));
+        // How long it took is a diagnostic (stderr), so the summary's bytes are the same on
+        // every run and every machine.
+        eprintln!(
+            "{} cases in {wall_s:.2} s on {} threads",
+            cases.len(),
+            rayon::current_num_threads()
+        );
+    }
+    failures(&outcomes, out.is_some())
+}
+
+/// Loads the scenario at `path` and checks that it can be swept with the `--set` axes:
+/// no specimen, no closed loop, axes of its form, and a base case that is its own model.
+fn load(path: &Path, sets: &[SetAxis]) -> Result<Scenario> {
     let scenario = Scenario::load(path)?;
     if scenario.rig.specimen.is_some() {
         anyhow::bail!(
@@ -133,52 +202,7 @@ pub fn run(
             path.display()
         ));
     }
-    let grid = Sweep::new(&scenario, scales, pressures_mpa, sets)?;
-    let progress = crate::progress::Progress::new(
-        grid.cases.len() as u64,
-        "{bar:40} {pos}/{len} cases  {elapsed_precise} elapsed, {eta} left",
-    );
-    let start = Instant::now();
-    let outcomes = grid.run(&scenario.run, || progress.inc());
-    progress.finish();
-    let wall_s = start.elapsed().as_secs_f64();
-
-    let (cases, set_names) = (&grid.cases, &grid.set_names);
-    if let Some(out) = out {
-        let csv = sweep::csv_text(&scenario, set_names, cases, &outcomes);
-        write_bytes_atomic(out, csv.as_bytes())?;
-    }
-    let written = platen_report::write_outputs(
-        plot.dir,
-        None,
-        &plot.size,
-        || platen_report::sweep_figures::figures(&scenario, set_names, cases, &outcomes),
-        |_, _| String::new(),
-    )?;
-    if json_out {
-        let summary = sweep::json_summary(path, &scenario, set_names, cases, &outcomes, out);
-        let figures = plot.dir.map(|_| written.as_slice());
-        let summary = with_outputs(summary, figures, None);
-        outln!("{}", serde_json::to_string_pretty(&summary)?);
-    } else {
-        let run = platen_report::sweep_report::SweepRun {
-            scenario: &scenario,
-            set_names,
-            cases,
-            outcomes: &outcomes,
-            out,
-        };
-        let figures = plot.dir.map(|_| written.as_slice());
-        out!("{}", platen_report::sweep_report::sweep_text(&run, figures));
-        // How long it took is a diagnostic (stderr), so the summary's bytes are the same on
-        // every run and every machine.
-        eprintln!(
-            "{} cases in {wall_s:.2} s on {} threads",
-            cases.len(),
-            rayon::current_num_threads()
-        );
-    }
-    failures(&outcomes, out.is_some())
+    Ok(scenario)
 }
 
 /// A form mismatch or an axis given twice is a usage error (exit code 2).
