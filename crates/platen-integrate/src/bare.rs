@@ -53,11 +53,6 @@ impl<M: PlatenModel> Plant<L> for BarePlant<'_, M> {
         self.model
     }
 
-    #[inline(always)]
-    fn input(&self, at: f64) -> f64 {
-        self.grid.force(self.n, at)
-    }
-
     /// Slip's rates; nothing at rest ([`Plant::RATES_AT_REST`] is false: rest is exact).
     #[inline(always)]
     fn rates(&self, mode: Mode, _w_stiff: f64, f: f64, y: &Y, dy: &mut Y) -> f64 {
@@ -136,36 +131,7 @@ impl<M: PlatenModel> Plant<L> for BarePlant<'_, M> {
         }
     }
 
-    #[inline(always)]
-    fn seconds(&self, len: f64) -> f64 {
-        len * self.grid.h
-    }
-    fn units(&self, seconds: f64) -> f64 {
-        seconds / self.grid.h
-    }
-    fn time_s(&self, at: f64) -> f64 {
-        self.grid.time_s(self.n, at)
-    }
-    fn tolerance_floor(&self) -> f64 {
-        0.0
-    }
-    fn min_progress(&self) -> f64 {
-        4.0 * f64::EPSILON
-    }
-    fn land(&self, tau: f64, x: f64, _rest: f64) -> f64 {
-        let at = tau + x;
-        if 1.0 - at < 1e-12 {
-            1.0
-        } else {
-            at
-        }
-    }
-    fn reach(&self, tau: f64, len: f64) -> f64 {
-        tau + len
-    }
-    fn break_at(&self, tau: f64, x: f64, _rest: f64, _held: bool) -> f64 {
-        (tau + x).min(1.0)
-    }
+    crate::rk4::grid_time!();
 }
 
 /// A forward run of the bare platen (also one lane of [`crate::ensemble`]): the mode machine

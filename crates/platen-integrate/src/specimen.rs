@@ -55,10 +55,6 @@ use crate::steppable::{Samples, Steppable};
 use crate::stop::{Failure, StopReason};
 
 const NS: usize = Specimen::MAX_STOREYS;
-/// A creep stop located this close (fraction of a step) to where the advance started has not
-/// moved time: if the net force at rest still drives the creep on, it is stepped just past
-/// ([`just_past`], whose first increment is `4ε`) instead of creeping on in place.
-const MIN_PROGRESS: f64 = 4.0 * f64::EPSILON;
 /// Positions in the state vector: displacement, velocity, actuator work, platen dissipation,
 /// storey dissipation, then the `n` storey displacements from `Z` and the `n` storey
 /// velocities from `Z + n` (the stepper's `zd`): the live state is the prefix `5 + 2n` of the
@@ -412,11 +408,6 @@ impl<M: PlatenModel, const L: usize> Plant<L> for SpecimenPlant<'_, M, L> {
     }
 
     #[inline(always)]
-    fn input(&self, at: f64) -> f64 {
-        self.grid.force(self.n, at)
-    }
-
-    #[inline(always)]
     fn rates(&self, mode: Mode, w_stiff: f64, f: f64, y: &Y<L>, dy: &mut Y<L>) -> f64 {
         match mode {
             Mode::Slip(Direction::Positive) => return self.slip_rates::<true>(f, y, dy),
@@ -505,36 +496,7 @@ impl<M: PlatenModel, const L: usize> Plant<L> for SpecimenPlant<'_, M, L> {
         }
     }
 
-    #[inline(always)]
-    fn seconds(&self, len: f64) -> f64 {
-        len * self.grid.h
-    }
-    fn units(&self, seconds: f64) -> f64 {
-        seconds / self.grid.h
-    }
-    fn time_s(&self, at: f64) -> f64 {
-        self.grid.time_s(self.n, at)
-    }
-    fn tolerance_floor(&self) -> f64 {
-        0.0
-    }
-    fn min_progress(&self) -> f64 {
-        MIN_PROGRESS
-    }
-    fn land(&self, tau: f64, x: f64, _rest: f64) -> f64 {
-        let at = tau + x;
-        if 1.0 - at < 1e-12 {
-            1.0
-        } else {
-            at
-        }
-    }
-    fn reach(&self, tau: f64, len: f64) -> f64 {
-        tau + len
-    }
-    fn break_at(&self, tau: f64, x: f64, _rest: f64, _held: bool) -> f64 {
-        (tau + x).min(1.0)
-    }
+    crate::rk4::grid_time!();
 }
 
 /// A forward run with a specimen: the mode machine over the force record's grid.
