@@ -135,6 +135,24 @@ run bad_compare_missing compare scenarios/sr9/sr9-forward.json --recorded "$bad/
 run bad_identify_missing identify "$bad/none.csv"
 run bad_sweep_axis sweep scenarios/sr9-like-sine-force.json --set identified.nonsense=1
 
+# identify --system: the loop identified from what labs record (the shipped synthetic records
+# of tests/data), with a base, figures, a column map, and its bad inputs.
+d=tests/data/system_ident
+t=tests/data/small_table
+run sys_three_json identify --system $d/wn-a.csv $d/chirp.csv $d/wn-b.csv --json
+run sys_three_text identify --system $d/wn-a.csv $d/chirp.csv $d/wn-b.csv
+run sys_base_json identify --system $d/wn-a.csv $d/chirp.csv $d/wn-b.csv --base $d/base.json --json
+run sys_one_json identify --system $d/wn-a.csv --json
+run sys_plot_json identify --system $d/wn-a.csv $d/wn-b.csv --json --plot "$out/sys-fig"
+run sys_small_json identify --system $t/wn.csv $t/sweep.csv $t/eq4.csv --columns $t/columns.json --json
+run sys_area_json identify --system $t/wn.csv $t/eq4.csv --columns $t/columns.json --area-m2 0.01 --json
+run sys_empty identify --system --manifest scenarios/paper-tests/manifest.json
+run sys_missing identify --system $d/missing-command.csv --json
+run sys_nofile identify --system /nonexistent.csv
+run sys_bad_base identify --system $d/wn-a.csv --base scenarios/paper-tests/manifest.json --json
+run sys_no_drive identify --system $t/no-drive.csv --columns $t/columns.json
+run sys_const identify --system $t/constant-command.csv --columns $t/columns.json --json
+
 # The outputs name the folder they were written to; make the listing path-independent.
 grep -rl -- "$out" "$out" | while read -r f; do
   sed -i "s#$out#OUT#g" "$f"
