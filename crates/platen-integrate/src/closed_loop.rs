@@ -500,8 +500,6 @@ impl<M: PlatenModel, const L: usize> Plant<L> for LoopPlant<'_, M, L> {
 struct Loop<'a, M, const L: usize> {
     machine: Machine<LoopPlant<'a, M, L>, L>,
     command: &'a Motion,
-    /// Whether the pieces are RK4 (every grid step then counts as accepted).
-    rk4: bool,
     h: f64,
     t0: f64,
     controller: ControllerState,
@@ -569,7 +567,6 @@ impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
         Loop {
             machine,
             command,
-            rk4: pieces == PieceMethod::Rk4,
             h,
             t0,
             controller: ControllerState::default(),
@@ -765,7 +762,7 @@ impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
         run.energy.close(m.plant.model, y[U], y[V], y[W], y[DI]);
         run.energy.specimen_end_j = m.plant.specimen_energy(&y);
         run.energy.specimen_dissipated_j = y[SD];
-        if self.rk4 {
+        if m.is_rk4() {
             run.accepted_steps = run.steps;
         }
         LoopStats {

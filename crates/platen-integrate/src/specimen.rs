@@ -502,8 +502,6 @@ impl<M: PlatenModel, const L: usize> Plant<L> for SpecimenPlant<'_, M, L> {
 /// A forward run with a specimen: the mode machine over the force record's grid.
 struct Stepper<'a, M, const L: usize> {
     machine: Machine<SpecimenPlant<'a, M, L>, L>,
-    /// Whether the pieces are RK4 (whose slip steps away from rest take the fast path).
-    rk4: bool,
 }
 
 impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
@@ -536,10 +534,7 @@ impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
         *energy = EnergyBalance::start(model, y[U], y[V]);
         energy.specimen_start_j = specimen_start_j;
         energy.specimen_end_j = specimen_start_j;
-        Stepper {
-            machine,
-            rk4: method == PieceMethod::Rk4,
-        }
+        Stepper { machine }
     }
 
     /// [`Stepper::step`] through the machine's advance: every mode and event.
@@ -576,13 +571,10 @@ impl<M: PlatenModel, const L: usize> GridStepper for Stepper<'_, M, L> {
         let m = &mut self.machine;
         m.plant.n = n;
         m.stats.steps += 1;
+        let rk4 = m.is_rk4();
         let committed = match m.mode {
-            Mode::Slip(Direction::Positive) if self.rk4 && m.y[V] != 0.0 => {
-                m.slip_fast::<true>(0.0)
-            }
-            Mode::Slip(Direction::Negative) if self.rk4 && m.y[V] != 0.0 => {
-                m.slip_fast::<false>(0.0)
-            }
+            Mode::Slip(Direction::Positive) if rk4 && m.y[V] != 0.0 => m.slip_fast::<true>(0.0),
+            Mode::Slip(Direction::Negative) if rk4 && m.y[V] != 0.0 => m.slip_fast::<false>(0.0),
             _ => false,
         };
         if committed {
@@ -603,11 +595,12 @@ impl<M: PlatenModel, const L: usize> GridStepper for Stepper<'_, M, L> {
         let m = &mut self.machine;
         let y = m.y;
         let specimen_end_j = m.plant.specimen_energy(&y);
+        let rk4 = m.is_rk4();
         let stats = &mut m.stats;
         stats.energy.close(m.plant.model, y[U], y[V], y[W], y[DI]);
         stats.energy.specimen_end_j = specimen_end_j;
         stats.energy.specimen_dissipated_j = y[SD];
-        if self.rk4 {
+        if rk4 {
             stats.accepted_steps = stats.steps;
         }
         stats.stop = StopReason::Finished { t_s };

@@ -8,32 +8,10 @@ use platen_integrate::{
     forward_dopri5, forward_rk4, inverse, Dopri5Settings, ForceRecord, Motion, Rk4, RunStats,
     State, Trajectory,
 };
-use platen_model::{IdentifiedModel, IdentifiedParams};
+use platen_model::IdentifiedModel;
 
-const M_KG: f64 = 144e3;
-const RATE_HZ: f64 = 1024.0;
-
-fn frictionless(stiffness_n_per_m: f64, viscous: f64, alpha: f64) -> IdentifiedModel {
-    IdentifiedParams {
-        effective_mass_kg: M_KG,
-        stiffness_n_per_m,
-        coulomb_force_n: 0.0,
-        viscous_coefficient: viscous,
-        viscous_exponent: alpha,
-        low_velocity_force_n: 0.0,
-        low_velocity_decay_s_per_m: 78.5,
-    }
-    .build()
-    .unwrap()
-}
-
-fn sine_record(amplitude_n: f64, omega: f64, duration_s: f64) -> ForceRecord {
-    let n = (duration_s * RATE_HZ) as usize;
-    let force = (0..=n)
-        .map(|j| amplitude_n * (omega * j as f64 / RATE_HZ).sin())
-        .collect();
-    ForceRecord::from_rate(RATE_HZ, force).unwrap()
-}
+mod common;
+use common::{frictionless, sine_fit, sine_record, M_KG, RATE_HZ};
 
 /// Both integrators from rest over the whole record: RK4 at one step per sample
 /// (h = 1/1024 s) and Dopri5 at rtol 1e-10, atol 1e-12.
@@ -62,18 +40,6 @@ fn both(
     )
     .unwrap();
     [("rk4", rk4, s_rk4), ("dopri5", dp5, s_dp5)]
-}
-
-/// Least-squares fit of `A·sin ωt + B·cos ωt` over the samples `from..from + n`, `n` a whole
-/// number of periods of samples (there the sines and cosines are orthogonal, so the fit is
-/// the projection `A = 2/n·Σ u sin ωt`, `B = 2/n·Σ u cos ωt`).
-fn sine_fit(t: &[f64], u: &[f64], omega: f64, from: usize, n: usize) -> (f64, f64) {
-    let (mut a, mut b) = (0.0, 0.0);
-    for j in from..from + n {
-        a += u[j] * (omega * t[j]).sin();
-        b += u[j] * (omega * t[j]).cos();
-    }
-    (2.0 * a / n as f64, 2.0 * b / n as f64)
 }
 
 /// `M·ü + C·u̇ + K·u = F₀ sin ωt` (α = 1, friction off): after the transient, the displacement

@@ -12,30 +12,16 @@ use platen_integrate::{
     ForceRecord, LoopMethod, LoopRun, Method, Motion, Rk4, RunStats, Sample, SampleSink, State,
     Step, Stepping, Trajectory,
 };
-use platen_model::{IdentifiedModel, IdentifiedParams, Specimen, Storey};
+use platen_model::{IdentifiedModel, Specimen, Storey};
 
-const M_KG: f64 = 144e3;
-const RATE_HZ: f64 = 1024.0;
+mod common;
+use common::{frictionless, sine_fit, sine_record, M_KG, RATE_HZ};
 
 /// The two storeys of [`frame`]: mass, kg, stiffness, N/m, damping, N·s/m (bottom first).
 const STOREYS: [(f64, f64, f64); 2] = [
     (30e3, 27_083_177.88, 86_208.43),
     (25e3, 19_345_127.06, 61_577.45),
 ];
-
-fn frictionless(stiffness_n_per_m: f64, viscous: f64, alpha: f64) -> IdentifiedModel {
-    IdentifiedParams {
-        effective_mass_kg: M_KG,
-        stiffness_n_per_m,
-        coulomb_force_n: 0.0,
-        viscous_coefficient: viscous,
-        viscous_exponent: alpha,
-        low_velocity_force_n: 0.0,
-        low_velocity_decay_s_per_m: 78.5,
-    }
-    .build()
-    .unwrap()
-}
 
 /// The 55 t two-storey frame of `scenarios/specimen/frame-forward.json` (fixed-base modes
 /// 3.0 and 7.06 Hz, stiffness-proportional damping, 3 % in the first mode).
@@ -51,14 +37,6 @@ fn frame() -> Specimen {
             .collect(),
     )
     .unwrap()
-}
-
-fn sine_record(amplitude_n: f64, omega: f64, duration_s: f64) -> ForceRecord {
-    let n = (duration_s * RATE_HZ) as usize;
-    let force = (0..=n)
-        .map(|j| amplitude_n * (omega * j as f64 / RATE_HZ).sin())
-        .collect();
-    ForceRecord::from_rate(RATE_HZ, force).unwrap()
 }
 
 /// The specimen run from rest over the whole record, RK4 at `steps_per_sample`; a failure is
@@ -212,18 +190,6 @@ fn frequency_response(k: f64, c: f64, omega: f64, f0: f64) -> [Complex; 3] {
         [zero, zero.sub(l2), l2.add(mass(m2))],
     ];
     solve3(a, [Complex::new(f0, 0.0), zero, zero])
-}
-
-/// Least-squares fit of `A·sin ωt + B·cos ωt` over the samples `from..from + n`, `n` a whole
-/// number of periods of samples (there the sines and cosines are orthogonal, so the fit is
-/// the projection `A = 2/n·Σ u sin ωt`, `B = 2/n·Σ u cos ωt`).
-fn sine_fit(t: &[f64], u: &[f64], omega: f64, from: usize, n: usize) -> (f64, f64) {
-    let (mut a, mut b) = (0.0, 0.0);
-    for j in from..from + n {
-        a += u[j] * (omega * t[j]).sin();
-        b += u[j] * (omega * t[j]).cos();
-    }
-    (2.0 * a / n as f64, 2.0 * b / n as f64)
 }
 
 /// `F_μ = a = 0`, α = 1 and the frame on the platen: a linear 3-DOF system. Under
