@@ -192,7 +192,7 @@ fn the_plant_in_ratios_to_the_area_within_their_intervals() {
     // laminar transition and the spool grid are not.
     let sys = plant.system.unwrap();
     let flow_gain = h.land_coefficient
-        * (0.5 * (sys.supply_pressure_pa - sys.return_pressure_pa)).sqrt()
+        * (0.5 * (sys.supply_pressure_pa() - sys.return_pressure_pa())).sqrt()
         / area;
     let want = t("/servo_valve/no_load_velocity_full_drive_m_s");
     eprintln!("flow gain {flow_gain:.5} m/s at full drive (truth {want})");

@@ -481,9 +481,14 @@ pub fn identify_system(
         not_identified,
     };
     result.records = held_out(records_c, &periods, &fitted, cols, corner, c);
-    if let Some(sys) = plant.system.as_mut() {
-        set_controller(&mut sys.controller, &gains);
-    }
+    // The identified gains on the identified system: still a table system only if they are
+    // gains a controller takes (checked again at the same stroke).
+    plant.system = plant.system.and_then(|sys| {
+        let stroke_m = stroke_limit_m(&sys);
+        let mut parts = sys.into_parts();
+        set_controller(&mut parts.controller, &gains);
+        platen_system::TableSystem::new(parts, stroke_m).ok()
+    });
     if settings.judge {
         result.judgement = judge::judge(records_c, &periods, &fitted, &plant);
     }

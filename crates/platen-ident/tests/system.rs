@@ -141,7 +141,7 @@ fn base() -> platen_system::TableSystem {
     let t = truth();
     let p = &t["plant"];
     let f = |k: &str| p[k].as_f64().unwrap();
-    let mut s = platen_system::preset::lhpost_2008();
+    let mut s = platen_system::preset::lhpost_2008().into_parts();
     s.actuator.count = 1;
     s.actuator.cap_area_m2 = f("cap_area_m2");
     s.actuator.rod_area_m2 = f("rod_area_m2");
@@ -151,7 +151,7 @@ fn base() -> platen_system::TableSystem {
     s.return_pressure_pa = f("return_pressure_pa");
     s.oil_bulk_modulus_pa = f("bulk_modulus_pa");
     s.supply = platen_system::Supply::Constant;
-    s
+    platen_system::TableSystem::new(s, 0.0).unwrap()
 }
 
 #[test]

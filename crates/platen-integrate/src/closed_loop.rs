@@ -179,7 +179,7 @@ pub fn forward_closed_loop<M: PlatenModel, S: SampleSink>(
 pub(crate) fn check_loop(run: &LoopRun<'_>, samples: usize) -> Result<Option<(u32, f64, usize)>> {
     let (system, method) = (run.system, run.method);
     let k = method.steps_per_period();
-    let period = 1.0 / system.controller.sample_rate_hz;
+    let period = 1.0 / system.controller().sample_rate_hz;
     if k == 0 {
         return Err(IntegrateError::InvalidStep { step_s: 0.0 });
     }
@@ -365,7 +365,7 @@ impl<M: PlatenModel, const L: usize> Plant<L> for LoopPlant<'_, M, L> {
         dy[OIL] = hr.accumulator_oil;
         dy[PS] = hr.supply_pressure;
         dy[EH] = hr.hydraulic_power_w;
-        let act = &self.sys.actuator;
+        let act = self.sys.actuator();
         let dp = y[PA].max(0.0) - y[PB].max(0.0);
         dy[EL] = f64::from(act.count) * act.leakage_m3_s_per_pa * dp * dp;
         if let Some(spec) = self.spec {
@@ -404,7 +404,7 @@ impl<M: PlatenModel, const L: usize> Plant<L> for LoopPlant<'_, M, L> {
 
     /// `Ṅ = n(A_a·ṗ_a − A_b·ṗ_b) + k₁ż₁ + c₁z̈₁` (`u` fixed).
     fn net_rate(&self, k: &Y<L>) -> f64 {
-        let act = &self.sys.actuator;
+        let act = self.sys.actuator();
         let df = f64::from(act.count) * (act.cap_area_m2 * k[PA] - act.rod_area_m2 * k[PB]);
         match self.spec {
             Some(spec) => {
@@ -446,14 +446,14 @@ impl<M: PlatenModel, const L: usize> Plant<L> for LoopPlant<'_, M, L> {
     fn error_scale(&self, i: usize, y0: f64, y1: f64, rtol: f64, atol: f64) -> f64 {
         let m = y0.abs().max(y1.abs());
         let unit = match i {
-            PA | PB => self.sys.supply_pressure_pa * 1e3,
+            PA | PB => self.sys.supply_pressure_pa() * 1e3,
             XV => 1e3,
-            XR => 1e3 * std::f64::consts::TAU * self.sys.servo_valve.natural_frequency_hz,
-            OIL => match &self.sys.supply {
+            XR => 1e3 * std::f64::consts::TAU * self.sys.servo_valve().natural_frequency_hz,
+            OIL => match self.sys.supply() {
                 Supply::Accumulator(acc) => acc.volume_m3,
                 Supply::Constant => 1.0,
             },
-            PS => self.sys.supply_pressure_pa * 1e3,
+            PS => self.sys.supply_pressure_pa() * 1e3,
             V => 1.0,
             W | DI | SD | EH | EL => return f64::INFINITY,
             _ => 1.0,
@@ -533,8 +533,8 @@ impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
         y[OIL] = rest.accumulator_oil_m3;
         y[PS] = rest.supply_pressure_pa;
         let t0 = command.t_s()[0];
-        let delay = sys.servo_valve.delay_s;
-        let slots = (delay * sys.controller.sample_rate_hz).ceil() as usize + 2;
+        let delay = sys.servo_valve().delay_s;
+        let slots = (delay * sys.controller().sample_rate_hz).ceil() as usize + 2;
         let plant = LoopPlant {
             model,
             sys,
@@ -644,10 +644,10 @@ impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
             delta_p_pa: m.y[PA].max(0.0) - m.y[PB].max(0.0),
         };
         let sys = m.plant.sys;
-        let d = sys.controller.update(&mut self.controller, &input);
+        let d = sys.controller().update(&mut self.controller, &input);
         self.controller_samples += 1;
         self.queue
-            .push_back((self.t() + sys.servo_valve.delay_s, d));
+            .push_back((self.t() + sys.servo_valve().delay_s, d));
     }
 
     /// Applies every delayed drive that has arrived by the current time (to `slack`).
@@ -683,7 +683,7 @@ impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
             delta_p_pa: p_a - p_b,
             p_a_pa: p_a,
             p_b_pa: p_b,
-            flow_m3_s: f64::from(p.sys.actuator.count) * q_a,
+            flow_m3_s: f64::from(p.sys.actuator().count) * q_a,
             supply_pressure_pa: ps,
         });
         sink.accept(&sample);

@@ -8,7 +8,9 @@ use platen_integrate::{
     Trajectory,
 };
 use platen_model::{IdentifiedModel, IdentifiedParams, PlatenModel};
-use platen_system::{preset, Actuator, Controller, ServoValve, Supply, TableSystem};
+use platen_system::{
+    preset, Actuator, Controller, ServoValve, Supply, TableSystem, TableSystemParts,
+};
 
 struct Keep(Vec<Sample>);
 
@@ -42,7 +44,12 @@ fn lhpost_model() -> IdentifiedModel {
 /// A symmetric mid-size table (not the LHPOST): one double-ended actuator of 0.02 m², 12 l
 /// chambers, `valves` valves of 600 l/min at 7 MPa, 21/0.3 MPa supply/return; every gain 0.
 fn symmetric(valves: u32, leakage: f64) -> TableSystem {
-    TableSystem {
+    TableSystem::new(symmetric_parts(valves, leakage), 0.0).unwrap()
+}
+
+/// The values of [`symmetric`], to change before validating.
+fn symmetric_parts(valves: u32, leakage: f64) -> TableSystemParts {
+    TableSystemParts {
         actuator: Actuator {
             count: 1,
             cap_area_m2: 0.02,
@@ -175,7 +182,7 @@ fn leakage_damps_the_oil_column_at_its_closed_form_rate() {
     }
     let (first, last) = (peaks[0], peaks[peaks.len() - 1]);
     let sigma = (first.1 / last.1).ln() / (last.0 - first.0);
-    let expected = leak * sys.oil_bulk_modulus_pa / 0.012;
+    let expected = leak * sys.oil_bulk_modulus_pa() / 0.012;
     let rel = (sigma / expected - 1.0).abs();
     println!("decay: simulated {sigma:.5} 1/s, closed form {expected:.5} 1/s, {rel:.2e}");
     assert!(rel < 5e-3, "{sigma} vs {expected}");
@@ -185,8 +192,9 @@ fn leakage_damps_the_oil_column_at_its_closed_form_rate() {
 /// `m·Q_r·√((P_s − P_R)/Δp_r)/A` within 1 %.
 #[test]
 fn a_full_opening_runs_at_the_valve_limited_velocity() {
-    let mut sys = symmetric(2, 0.0);
-    sys.controller.velocity_feedforward_s_per_m = 10.0;
+    let mut parts = symmetric_parts(2, 0.0);
+    parts.controller.velocity_feedforward_s_per_m = 10.0;
+    let sys = TableSystem::new(parts, 0.0).unwrap();
     // A light platen with a whisper of damping: its load, 17 N, is 4e-5 of the supply.
     let model = linear(2000.0, 0.0, 10.0);
     let cmd = command(4096.0, 0.25, |t| (5.0 * t, 5.0, 0.0));
@@ -208,8 +216,9 @@ fn a_full_opening_runs_at_the_valve_limited_velocity() {
 /// force `A·(P_s − P_R)` (`p_a → P_s`, `p_b → P_R`), within 1e-4; the platen never moves.
 #[test]
 fn a_locked_platen_feels_the_stall_force() {
-    let mut sys = symmetric(1, 0.0);
-    sys.controller.displacement_gain_per_m = 100.0;
+    let mut parts = symmetric_parts(1, 0.0);
+    parts.controller.displacement_gain_per_m = 100.0;
+    let sys = TableSystem::new(parts, 0.0).unwrap();
     let model = IdentifiedParams {
         effective_mass_kg: 20_000.0,
         stiffness_n_per_m: 0.0,
@@ -259,14 +268,15 @@ fn a_payload_lowers_the_oil_column_as_the_closed_form_says() {
 /// within 2 %.
 #[test]
 fn the_lhpost_preset_rings_at_the_papers_oil_column_frequency() {
-    let mut sys = preset::lhpost_2008();
-    sys.actuator.leakage_m3_s_per_pa = 0.0;
-    sys.supply = Supply::Constant;
-    let c = &mut sys.controller;
+    let mut parts = preset::lhpost_2008().into_parts();
+    parts.actuator.leakage_m3_s_per_pa = 0.0;
+    parts.supply = Supply::Constant;
+    let c = &mut parts.controller;
     c.displacement_gain_per_m = 0.0;
     c.velocity_feedforward_s_per_m = 0.0;
     c.acceleration_feedforward_s2_per_m = 0.0;
     c.delta_p_gain_per_pa = 0.0;
+    let sys = TableSystem::new(parts, 0.0).unwrap();
     let closed = sys.oil_column_frequency_hz(144e3, 0.0);
     assert!((closed / 10.66 - 1.0).abs() < 2e-3, "{closed}");
     let cmd = command(1024.0, 3.0, |_| (0.0, 0.0, 0.0));
@@ -383,8 +393,8 @@ fn hydraulic_energy_balances_work_leakage_and_compression() {
         State::default(),
     );
     assert!(stats.cavitation_at_s.is_none());
-    let act = &sys.actuator;
-    let (n, beta) = (f64::from(act.count), sys.oil_bulk_modulus_pa);
+    let act = sys.actuator();
+    let (n, beta) = (f64::from(act.count), sys.oil_bulk_modulus_pa());
     let stored = |s: &Sample| {
         let sy = s.system.unwrap();
         let (va, vb) = sys.chamber_volumes_m3(s.u_m);
@@ -547,7 +557,7 @@ fn reference_system() -> (TableSystem, f64, f64, f64) {
             .unwrap_or_else(|| panic!("{p}"))
     };
     let ts = "/table_system";
-    let sys = TableSystem {
+    let parts = TableSystemParts {
         actuator: Actuator {
             count: f(&format!("{ts}/actuator/count")) as u32,
             cap_area_m2: f(&format!("{ts}/actuator/cap_side_area_m2")),
@@ -586,6 +596,7 @@ fn reference_system() -> (TableSystem, f64, f64, f64) {
             delta_p_highpass_hz: f(&format!("{ts}/controller/delta_p_highpass_hz")),
         },
     };
+    let sys = TableSystem::new(parts, 0.0).unwrap();
     (
         sys,
         f("/mechanics/mass_kg"),
@@ -639,7 +650,7 @@ fn the_small_signal_response_matches_the_independent_linear_reference() {
         "/../../tests/data/reference/table_system_frf.csv"
     );
     let text = std::fs::read_to_string(path).unwrap();
-    let rate = sys.controller.sample_rate_hz;
+    let rate = sys.controller().sample_rate_hz;
     let k = sys.default_steps_per_period(mass, 0.0);
     let mech = platen_system::Mechanics {
         mass_kg: mass,

@@ -214,6 +214,11 @@ pub type Invalid = (String, String, String);
 
 /// A validated mapping: for each platen column, the header to read, the factor to SI, the
 /// offset and the zero.
+///
+/// Always valid: its entries are private and every way to make one checks them
+/// ([`ColumnMap::new`] from the plain [`ColumnSpec`]s, [`ColumnMap::load`],
+/// [`ColumnMap::from_json`]); the default map, empty, reads every column under platen's own
+/// name in SI units.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ColumnMap {
     entries: BTreeMap<String, Mapping>,

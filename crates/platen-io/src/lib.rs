@@ -12,6 +12,11 @@
 //! assert_eq!(table.column("force_n"), Some(&[0.0, 1e3][..]));
 //! ```
 //!
+//! # Invariant
+//!
+//! A column map ([`columns::ColumnMap`]) is always valid: it has no public fields, and its
+//! constructors check every column, unit and delay before it exists.
+//!
 //! # Conventions
 //!
 //! SI units inside; the unit is in every column name (`t_s`, `u_m`, `v_m_s`, `a_m_s2`,

@@ -94,8 +94,8 @@ pub fn limit_uses(table: &Table, achieved: &Achieved) -> Vec<LimitUse> {
     let system = table.system();
     let capacity = system.capacities().valve_flow_m3_s;
     uses.push(plain("valve_flow_m3_s", achieved.flow_peak, capacity));
-    if let Supply::Accumulator(acc) = system.supply {
-        let set = system.supply_pressure_pa;
+    if let Supply::Accumulator(acc) = system.supply() {
+        let set = system.supply_pressure_pa();
         let min = achieved.min_supply_pressure;
         uses.push(LimitUse {
             limit: "supply_pressure_pa",

@@ -149,7 +149,7 @@ impl<'a> Table<'a> {
 
     /// The controller's sample rate, Hz.
     pub fn controller_rate_hz(&self) -> f64 {
-        self.system.controller.sample_rate_hz
+        self.system.controller().sample_rate_hz
     }
 
     /// Runs the closed loop with the displacement command `u_m` at the stamps `t_s` (its

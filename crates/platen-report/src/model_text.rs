@@ -384,13 +384,13 @@ fn system_name(d: &SystemDescription) -> String {
 
 /// The system's parameters: actuators, oil, valves, supply and controller.
 fn system_parameters(d: &SystemDescription) -> Group {
-    let (p, a, v) = (&d.system, &d.system.actuator, &d.system.servo_valve);
+    let (p, a, v) = (&d.system, d.system.actuator(), d.system.servo_valve());
     let num = |x: f64| significant(x, SIGNIFICANT_DIGITS);
     let rated = format!(
         "rated flow of one valve (at {} MPa drop)",
         num(v.rated_pressure_drop_pa / 1e6)
     );
-    let supply = match &p.supply {
+    let supply = match p.supply() {
         Supply::Constant => "supply pressure (constant)".to_owned(),
         Supply::Accumulator(acc) => format!(
             "supply pressure (accumulator, precharge {} MPa)",
@@ -410,7 +410,7 @@ fn system_parameters(d: &SystemDescription) -> Group {
         ("V_b", "rod-side chamber volume at mid-stroke",
             Number(a.rod_volume_m3),             "m³"),
         ("β",   "oil bulk modulus",
-            Number(p.oil_bulk_modulus_pa / 1e9), "GPa"),
+            Number(p.oil_bulk_modulus_pa() / 1e9), "GPa"),
         ("m",   "servo-valves per actuator",
             Count(v.count),                      ""),
         ("Q_r", &rated,
@@ -418,11 +418,11 @@ fn system_parameters(d: &SystemDescription) -> Group {
         ("f_v", "spool natural frequency",
             Number(v.natural_frequency_hz),      "Hz"),
         ("P_s", &supply,
-            Number(p.supply_pressure_pa / 1e6),  "MPa"),
+            Number(p.supply_pressure_pa() / 1e6),  "MPa"),
         ("P_R", "return pressure",
-            Number(p.return_pressure_pa / 1e6),  "MPa"),
+            Number(p.return_pressure_pa() / 1e6),  "MPa"),
         ("f_c", "controller sample rate",
-            Number(p.controller.sample_rate_hz), "Hz"),
+            Number(p.controller().sample_rate_hz), "Hz"),
     ];
     group(format!("Table system ({})", system_name(d)), &lines)
 }
@@ -716,8 +716,9 @@ mod tests {
         assert!(s.starts_with("\nTable system (lhpost-2008)\n"), "{s}");
         assert!(s.contains("  f_oc    oil column at mid-stroke, bare table (M = 144.0 t)"));
         assert!(s.contains("broken at the drive: stable (Nyquist)"));
-        let mut changed = sys;
+        let mut changed = sys.into_parts();
         changed.controller.displacement_gain_per_m *= 2.0;
+        let changed = platen_system::TableSystem::new(changed, 0.0).unwrap();
         let laid =
             SystemAnalysis::new(Some("lhpost-2008".into()), changed, &model, 0.75, Some(4e4));
         let s = table_system_text(&laid.description());

@@ -877,9 +877,9 @@ fn tracking(r: &Recorded, lo: &LoopRecord, scenario: &Scenario) -> Figure {
 
 /// The supply pressure over time (MPa), with the set pressure.
 fn supply(points: &Points, system: &TableSystem, scenario: &Scenario) -> Figure {
-    let set = system.supply_pressure_pa * 1e-6;
+    let set = system.supply_pressure_pa() * 1e-6;
     let t = span(points);
-    let kind = match system.supply {
+    let kind = match system.supply() {
         Supply::Constant => "constant supply",
         Supply::Accumulator(_) => "accumulator bank",
     };

@@ -36,7 +36,7 @@ pub struct LoopCurve {
 /// The frequency axis of `system`'s figures, Hz: from [`F_MIN_HZ`] to the lower of
 /// [`F_MAX_HZ`] and the controller's Nyquist frequency.
 pub fn frequency_range_hz(system: &TableSystem) -> (f64, f64) {
-    let nyquist = 0.5 * system.controller.sample_rate_hz;
+    let nyquist = 0.5 * system.controller().sample_rate_hz;
     (F_MIN_HZ, F_MAX_HZ.min(nyquist).max(2.0 * F_MIN_HZ))
 }
 
@@ -288,7 +288,7 @@ fn closed_loop_figure(
              damping, so stick-slip is not.",
             significant(range.0, 3),
             significant(range.1, 3),
-            significant(system.controller.sample_rate_hz, 4)
+            significant(system.controller().sample_rate_hz, 4)
         ),
         panels: vec![
             bode_panel(

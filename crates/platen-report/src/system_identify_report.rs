@@ -153,7 +153,7 @@ fn scenario_limits(
     // identified volumes allow. The other limits are this table's: its capacities by the
     // closed forms in the weaker direction, and the acceleration that force gives the moving
     // mass (platen and specimen).
-    let a = &sys.actuator;
+    let a = sys.actuator();
     let room = (a.cap_volume_m3 / a.cap_area_m2).min(a.rod_volume_m3 / a.rod_area_m2);
     let stroke = base_stroke
         .filter(|s| *s < room)

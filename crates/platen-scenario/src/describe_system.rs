@@ -224,12 +224,12 @@ impl SystemAnalysis {
         let caps = sys.capacities();
         let driven_kg = self.driven().mechanics.mass_kg;
         let (p_a0, p_b0) = sys.null_pressures_pa();
-        let period = sys.controller.period_s();
+        let period = sys.controller().period_s();
         SystemDescription {
             closed_loop_bandwidth_hz: self.passband.bandwidth_hz,
             closed_loop_min_gain: self.passband.min_gain,
             closed_loop_min_gain_hz: self.passband.min_gain_hz,
-            controller_sample_rate_hz: sys.controller.sample_rate_hz,
+            controller_sample_rate_hz: sys.controller().sample_rate_hz,
             force_capacity_pull_n: caps.pull_force_n,
             force_capacity_push_n: caps.push_force_n,
             linearisation: LinearisationDescription::from(self.driven()),

@@ -31,6 +31,7 @@
 use platen_integrate::LoopMethod;
 use platen_system::{
     preset as system_preset, Accumulator, Controller, Supply, SystemError, TableSystem,
+    TableSystemParts,
 };
 
 use crate::ctx::Ctx;
@@ -57,22 +58,21 @@ pub(crate) fn build_table_system(
         }
         None => spec.clone(),
     };
-    let system = complete_system(ctx, &spec)?;
-    system.validate(stroke_m).map_err(|e| match e {
+    let parts = complete_system(ctx, &spec)?;
+    TableSystem::new(parts, stroke_m).map_err(|e| match e {
         SystemError::Invalid {
             path,
             value,
             expected,
         } => ctx.invalid(&format!("table_system.{path}"), value, expected),
         other => ctx.invalid("table_system", "", other.to_string()),
-    })?;
-    Ok(system)
+    })
 }
 
-/// The system of `spec` (its preset's values already laid under it): every required value
-/// given, or an error naming the first missing one by its JSON path; absent gains, leakage
-/// and delay are 0, an absent accumulator a constant supply.
-fn complete_system(ctx: &Ctx, spec: &TableSystemSpec) -> Result<TableSystem> {
+/// The values of the system of `spec` (its preset's values already laid under it), not yet
+/// validated: every required value given, or an error naming the first missing one by its
+/// JSON path; absent gains, leakage and delay are 0, an absent accumulator a constant supply.
+fn complete_system(ctx: &Ctx, spec: &TableSystemSpec) -> Result<TableSystemParts> {
     let actuator = complete_actuator(ctx, spec.actuator.clone().unwrap_or_default())?;
     let servo_valve = complete_servo_valve(ctx, spec.servo_valve.clone().unwrap_or_default())?;
     let [oil_bulk_modulus_pa, supply_pressure_pa, return_pressure_pa] = need_all(
@@ -107,7 +107,7 @@ fn complete_system(ctx: &Ctx, spec: &TableSystemSpec) -> Result<TableSystem> {
         }
         _ => Supply::Constant,
     };
-    Ok(TableSystem {
+    Ok(TableSystemParts {
         actuator,
         servo_valve,
         oil_bulk_modulus_pa,
@@ -250,9 +250,9 @@ fn unresolvable(
         "RK4 resolves modes up to {f_max:.3e} Hz with the controller at {} Hz \
          ({MAX_STEPS_PER_PERIOD:e} steps per controller period); use \
          {{\"method\": \"dopri5\"}} or a faster controller",
-        system.controller.sample_rate_hz
+        system.controller().sample_rate_hz
     );
-    let valve_hz = system.servo_valve.natural_frequency_hz;
+    let valve_hz = system.servo_valve().natural_frequency_hz;
     if tau * valve_hz >= fastest {
         ctx.invalid(
             "table_system.servo_valve.natural_frequency_hz",
@@ -280,7 +280,7 @@ pub(crate) fn loop_method(
     mass_kg: f64,
     stroke_m: f64,
 ) -> Result<LoopMethod> {
-    let period = system.controller.period_s();
+    let period = system.controller().period_s();
     let fastest = system.fastest_rate_rad_s(mass_kg, stroke_m);
     // The default step: the least `k` with `h·ω_max ≤ 0.25`, but at most
     // `MAX_STEPS_PER_PERIOD`; a loop that this many steps cannot resolve is refused (RK4 at

@@ -299,7 +299,7 @@ impl From<&TableSystem> for TableSystemSpec {
     /// The system as the scenario format writes it, every value given (single-ended areas,
     /// `[cap, rod]` volumes, `"accumulator": null` for a constant supply), no preset.
     fn from(sys: &TableSystem) -> Self {
-        let (a, v, c) = (&sys.actuator, &sys.servo_valve, &sys.controller);
+        let (a, v, c) = (sys.actuator(), sys.servo_valve(), sys.controller());
         TableSystemSpec {
             preset: None,
             actuator: Some(ActuatorSpec {
@@ -318,10 +318,10 @@ impl From<&TableSystem> for TableSystemSpec {
                 damping_ratio: Some(v.damping_ratio),
                 delay_s: Some(v.delay_s),
             }),
-            oil_bulk_modulus_pa: Some(sys.oil_bulk_modulus_pa),
-            supply_pressure_pa: Some(sys.supply_pressure_pa),
-            return_pressure_pa: Some(sys.return_pressure_pa),
-            accumulator: Some(match sys.supply {
+            oil_bulk_modulus_pa: Some(sys.oil_bulk_modulus_pa()),
+            supply_pressure_pa: Some(sys.supply_pressure_pa()),
+            return_pressure_pa: Some(sys.return_pressure_pa()),
+            accumulator: Some(match sys.supply() {
                 Supply::Constant => None,
                 Supply::Accumulator(acc) => Some(AccumulatorSpec {
                     precharge_pressure_pa: Some(acc.precharge_pressure_pa),

@@ -10,7 +10,9 @@ use serde_json::{json, Value};
 
 use platen_integrate::{LoopMethod, SampleSink, Trajectory};
 use platen_scenario::{CsvSink, LoopSettings, Run, RunSummary, Scenario, ScenarioError};
-use platen_system::{preset, Accumulator, Actuator, Controller, ServoValve, Supply, TableSystem};
+use platen_system::{
+    preset, Accumulator, Actuator, Controller, ServoValve, Supply, TableSystem, TableSystemParts,
+};
 
 /// A short closed-loop scenario: the identified LHPOST platen commanded by a 2 cm, 1 Hz sine,
 /// with `table_system` as given.
@@ -103,39 +105,43 @@ fn explicit() -> Value {
 
 /// `explicit()`, built in Rust.
 fn explicit_by_hand() -> TableSystem {
-    TableSystem {
-        actuator: Actuator {
-            count: 1,
-            cap_area_m2: 0.02,
-            rod_area_m2: 0.02,
-            cap_volume_m3: 0.02,
-            rod_volume_m3: 0.02,
-            leakage_m3_s_per_pa: 1e-11,
+    TableSystem::new(
+        TableSystemParts {
+            actuator: Actuator {
+                count: 1,
+                cap_area_m2: 0.02,
+                rod_area_m2: 0.02,
+                cap_volume_m3: 0.02,
+                rod_volume_m3: 0.02,
+                leakage_m3_s_per_pa: 1e-11,
+            },
+            servo_valve: ServoValve {
+                count: 1,
+                rated_flow_m3_s: 0.01,
+                rated_pressure_drop_pa: 7e6,
+                natural_frequency_hz: 120.0,
+                damping_ratio: 0.7,
+                delay_s: 0.0005,
+            },
+            oil_bulk_modulus_pa: 1.2e9,
+            supply_pressure_pa: 21e6,
+            return_pressure_pa: 3e5,
+            supply: Supply::Constant,
+            controller: Controller {
+                sample_rate_hz: 4096.0,
+                displacement_gain_per_m: 20.0,
+                integral_gain_per_m_s: 0.0,
+                velocity_feedforward_s_per_m: 0.9,
+                acceleration_feedforward_s2_per_m: 0.0,
+                velocity_feedback_s_per_m: 0.0,
+                acceleration_feedback_s2_per_m: 0.0,
+                delta_p_gain_per_pa: 2e-8,
+                delta_p_highpass_hz: 1.0,
+            },
         },
-        servo_valve: ServoValve {
-            count: 1,
-            rated_flow_m3_s: 0.01,
-            rated_pressure_drop_pa: 7e6,
-            natural_frequency_hz: 120.0,
-            damping_ratio: 0.7,
-            delay_s: 0.0005,
-        },
-        oil_bulk_modulus_pa: 1.2e9,
-        supply_pressure_pa: 21e6,
-        return_pressure_pa: 3e5,
-        supply: Supply::Constant,
-        controller: Controller {
-            sample_rate_hz: 4096.0,
-            displacement_gain_per_m: 20.0,
-            integral_gain_per_m_s: 0.0,
-            velocity_feedforward_s_per_m: 0.9,
-            acceleration_feedforward_s2_per_m: 0.0,
-            velocity_feedback_s_per_m: 0.0,
-            acceleration_feedback_s2_per_m: 0.0,
-            delta_p_gain_per_pa: 2e-8,
-            delta_p_highpass_hz: 1.0,
-        },
-    }
+        0.0,
+    )
+    .unwrap()
 }
 
 // ---------------------------------------------------------------------------------------
@@ -602,10 +608,10 @@ fn preset_overrides_change_only_what_they_name() {
         json!({"controller": {"displacement_gain_per_m": 5}}),
     )))
     .unwrap();
-    let mut expected = preset::lhpost_2008();
+    let mut expected = preset::lhpost_2008().into_parts();
     assert_ne!(expected.controller.displacement_gain_per_m, 5.0);
     expected.controller.displacement_gain_per_m = 5.0;
-    assert_eq!(s.rig.table_system.unwrap(), expected);
+    assert_eq!(s.rig.table_system.unwrap().into_parts(), expected);
 
     // The preset alone is the preset.
     let s = load(&scenario_with(lhpost(json!({})))).unwrap();
@@ -619,7 +625,7 @@ fn preset_overrides_change_only_what_they_name() {
         "supply_pressure_pa": 21e6
     }))))
     .unwrap();
-    let mut expected = preset::lhpost_2008();
+    let mut expected = preset::lhpost_2008().into_parts();
     expected.actuator.leakage_m3_s_per_pa = 0.0;
     expected.servo_valve.delay_s = 0.001;
     expected.supply_pressure_pa = 21e6;
@@ -627,14 +633,14 @@ fn preset_overrides_change_only_what_they_name() {
         panic!("the preset has an accumulator")
     };
     bank.volume_m3 = 4.0;
-    assert_eq!(s.rig.table_system.unwrap(), expected);
+    assert_eq!(s.rig.table_system.unwrap().into_parts(), expected);
 
     // A double-ended area over the single-ended preset sets both sides.
     let s = load(&scenario_with(lhpost(
         json!({"actuator": {"area_m2": 0.15}}),
     )))
     .unwrap();
-    let a = s.rig.table_system.unwrap().actuator;
+    let a = *s.rig.table_system.unwrap().actuator();
     assert_eq!((a.cap_area_m2, a.rod_area_m2), (0.15, 0.15));
     assert_eq!(
         (a.cap_volume_m3, a.rod_volume_m3),
@@ -647,14 +653,14 @@ fn preset_overrides_change_only_what_they_name() {
 fn a_null_accumulator_is_a_constant_supply() {
     let s = load(&scenario_with(lhpost(json!({"accumulator": null})))).unwrap();
     let system = s.rig.table_system.unwrap();
-    assert_eq!(system.supply, Supply::Constant);
-    let mut expected = preset::lhpost_2008();
+    assert_eq!(*system.supply(), Supply::Constant);
+    let mut expected = preset::lhpost_2008().into_parts();
     expected.supply = Supply::Constant;
-    assert_eq!(system, expected);
+    assert_eq!(system.into_parts(), expected);
     // Absent: the preset's bank.
     let s = load(&scenario_with(lhpost(json!({})))).unwrap();
     assert!(matches!(
-        s.rig.table_system.unwrap().supply,
+        s.rig.table_system.unwrap().supply(),
         Supply::Accumulator(_)
     ));
 }
@@ -676,7 +682,7 @@ fn an_explicit_double_ended_system_equals_the_one_built_by_hand() {
     let mut ts = explicit();
     ts["accumulator"] = json!({"precharge_pressure_pa": 1e7, "volume_m3": 0.5,
                                "polytropic_exponent": 1.4, "pump_flow_m3_s": 0.002});
-    let mut expected = explicit_by_hand();
+    let mut expected = explicit_by_hand().into_parts();
     expected.supply = Supply::Accumulator(Accumulator {
         precharge_pressure_pa: 1e7,
         volume_m3: 0.5,
@@ -684,7 +690,12 @@ fn an_explicit_double_ended_system_equals_the_one_built_by_hand() {
         pump_flow_m3_s: 0.002,
     });
     assert_eq!(
-        load(&scenario_with(ts)).unwrap().rig.table_system.unwrap(),
+        load(&scenario_with(ts))
+            .unwrap()
+            .rig
+            .table_system
+            .unwrap()
+            .into_parts(),
         expected
     );
     // And the system runs: every sample carries the loop's columns.
@@ -864,7 +875,7 @@ fn a_malformed_chamber_volume_says_what_was_expected() {
     }
     // Integers are volumes too.
     let s = scenario_with(lhpost(json!({"actuator": {"chamber_volume_m3": [1, 1]}})));
-    let a = load(&s).unwrap().rig.table_system.unwrap().actuator;
+    let a = *load(&s).unwrap().rig.table_system.unwrap().actuator();
     assert_eq!((a.cap_volume_m3, a.rod_volume_m3), (1.0, 1.0));
 }
 

@@ -19,6 +19,13 @@
 //! * **Supply** ([`Supply`]): constant, or an accumulator bank whose pressure follows its gas
 //!   (`P·V_g^n` constant) as the valves draw oil and the pumps refill it.
 //!
+//! # Invariant
+//!
+//! A [`TableSystem`] is always valid: its values are private and the only way to make one,
+//! [`TableSystem::new`] (or `TryFrom<TableSystemParts>`), checks them all, with the same
+//! checks, in the same order and with the same messages as ever. To change a value, take its
+//! parts ([`TableSystem::into_parts`]), change them and call [`TableSystem::new`] again.
+//!
 //! # Conventions
 //!
 //! SI units, unit in every name; pressures absolute, Pa; `u`, `v` positive along the force
@@ -49,4 +56,6 @@ pub use controller::{ControllerInput, ControllerState};
 pub use error::{Result, SystemError};
 pub use hydraulics::{HydraulicConstants, HydraulicRates, HydraulicState, LAMINAR_FRACTION};
 pub use linear::{Capacities, Linearisation, Margins, Mechanics, Passband, SECANT_SPEED_M_S};
-pub use params::{Accumulator, Actuator, Controller, ServoValve, Supply, TableSystem};
+pub use params::{
+    Accumulator, Actuator, Controller, ServoValve, Supply, TableSystem, TableSystemParts,
+};

@@ -1,4 +1,4 @@
-//! The parameters of the table system, validated ([`TableSystem::validate`]).
+//! The parameters of the table system, validated when made ([`TableSystem::new`]).
 
 use crate::error::{invalid, non_negative, positive, Result};
 
@@ -210,10 +210,10 @@ impl Controller {
     }
 }
 
-/// The complete loop around the platen: command → controller → servo-valves → actuator
-/// chambers → actuator force.
+/// The values of a [`TableSystem`], unchecked: what [`TableSystem::new`] validates, and what
+/// [`TableSystem::into_parts`] gives back to change a value and validate again.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TableSystem {
+pub struct TableSystemParts {
     /// The actuators.
     pub actuator: Actuator,
     /// The servo-valves of each actuator.
@@ -231,13 +231,145 @@ pub struct TableSystem {
     pub controller: Controller,
 }
 
+/// The complete loop around the platen: command → controller → servo-valves → actuator
+/// chambers → actuator force.
+///
+/// Always valid: the only way to make one is [`TableSystem::new`], which checks every value
+/// (and the chambers over a stroke); to change a value, take its
+/// [`parts`](TableSystem::into_parts), change them and call [`TableSystem::new`] again.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TableSystem {
+    pub(crate) actuator: Actuator,
+    pub(crate) servo_valve: ServoValve,
+    pub(crate) oil_bulk_modulus_pa: f64,
+    pub(crate) supply_pressure_pa: f64,
+    pub(crate) return_pressure_pa: f64,
+    pub(crate) supply: Supply,
+    pub(crate) controller: Controller,
+}
+
+impl TableSystemParts {
+    /// The oil-column frequency of these values, checked or not (e.g. fitted ones, before
+    /// [`TableSystem::new`] decides whether they make a table system): the same formula as
+    /// [`TableSystem::oil_column_frequency_hz`], Hz.
+    pub fn oil_column_frequency_hz(&self, mass_kg: f64, u_m: f64) -> f64 {
+        TableSystem::unchecked(*self).oil_column_frequency_hz(mass_kg, u_m)
+    }
+}
+
+impl TryFrom<TableSystemParts> for TableSystem {
+    type Error = crate::SystemError;
+
+    /// [`TableSystem::new`] with no stroke to check the chambers over.
+    fn try_from(parts: TableSystemParts) -> Result<Self> {
+        TableSystem::new(parts, 0.0)
+    }
+}
+
+impl From<TableSystem> for TableSystemParts {
+    fn from(sys: TableSystem) -> Self {
+        sys.into_parts()
+    }
+}
+
 impl TableSystem {
-    /// Checks every value and that the chambers keep oil over the stroke `±stroke_m`:
-    /// `V_a0 − A_a·stroke > 0` and `V_b0 − A_b·stroke > 0`.
+    /// A table system from its values, checked: every value, and that the chambers keep oil
+    /// over the stroke `±stroke_m` (`V_a0 − A_a·stroke > 0` and `V_b0 − A_b·stroke > 0`; a
+    /// stroke that is not finite and positive, e.g. 0, skips that check).
     ///
     /// # Errors
     /// [`crate::SystemError::Invalid`] naming the first offending value by its path.
-    pub fn validate(&self, stroke_m: f64) -> Result<()> {
+    pub fn new(parts: TableSystemParts, stroke_m: f64) -> Result<Self> {
+        let sys = TableSystem::unchecked(parts);
+        sys.check(stroke_m)?;
+        Ok(sys)
+    }
+
+    /// The values as they are, not checked: only for computing with values that may not make
+    /// a table system, never handed out.
+    fn unchecked(parts: TableSystemParts) -> Self {
+        let TableSystemParts {
+            actuator,
+            servo_valve,
+            oil_bulk_modulus_pa,
+            supply_pressure_pa,
+            return_pressure_pa,
+            supply,
+            controller,
+        } = parts;
+        TableSystem {
+            actuator,
+            servo_valve,
+            oil_bulk_modulus_pa,
+            supply_pressure_pa,
+            return_pressure_pa,
+            supply,
+            controller,
+        }
+    }
+
+    /// Its values, to change some and make a new one with [`TableSystem::new`].
+    pub fn into_parts(self) -> TableSystemParts {
+        TableSystemParts {
+            actuator: self.actuator,
+            servo_valve: self.servo_valve,
+            oil_bulk_modulus_pa: self.oil_bulk_modulus_pa,
+            supply_pressure_pa: self.supply_pressure_pa,
+            return_pressure_pa: self.return_pressure_pa,
+            supply: self.supply,
+            controller: self.controller,
+        }
+    }
+
+    /// The actuators.
+    pub fn actuator(&self) -> &Actuator {
+        &self.actuator
+    }
+
+    /// The servo-valves of each actuator.
+    pub fn servo_valve(&self) -> &ServoValve {
+        &self.servo_valve
+    }
+
+    /// Effective bulk modulus of the oil (lines, hoses and entrained air included), Pa.
+    pub fn oil_bulk_modulus_pa(&self) -> f64 {
+        self.oil_bulk_modulus_pa
+    }
+
+    /// Supply pressure (absolute), Pa: the constant pressure, or the pumps' set pressure and
+    /// the accumulator's initial pressure.
+    pub fn supply_pressure_pa(&self) -> f64 {
+        self.supply_pressure_pa
+    }
+
+    /// Return (tank) pressure (absolute), Pa.
+    pub fn return_pressure_pa(&self) -> f64 {
+        self.return_pressure_pa
+    }
+
+    /// Constant supply or accumulator bank.
+    pub fn supply(&self) -> &Supply {
+        &self.supply
+    }
+
+    /// The controller.
+    pub fn controller(&self) -> &Controller {
+        &self.controller
+    }
+
+    /// Checks that the chambers keep oil over the stroke `±stroke_m`, for a system made for
+    /// another stroke (or none): `V_a0 − A_a·stroke > 0` and `V_b0 − A_b·stroke > 0`. Its
+    /// values were checked when it was made; they are checked again, in the same order as
+    /// [`TableSystem::new`] does, so the error is the one `new` would give at this stroke.
+    ///
+    /// # Errors
+    /// [`crate::SystemError::Invalid`] naming the first offending value by its path.
+    pub fn check_stroke(&self, stroke_m: f64) -> Result<()> {
+        self.check(stroke_m)
+    }
+
+    /// Every value, and the chambers over the stroke `±stroke_m`.
+    fn check(&self, stroke_m: f64) -> Result<()> {
         self.actuator.validate(stroke_m)?;
         self.servo_valve.validate()?;
         self.validate_supply()?;

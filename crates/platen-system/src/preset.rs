@@ -26,7 +26,9 @@
 //! and pull; the preset's `limits.force_n` stays 6.8 MN.
 
 use crate::error::{Result, SystemError};
-use crate::params::{Accumulator, Actuator, Controller, ServoValve, Supply, TableSystem};
+use crate::params::{
+    Accumulator, Actuator, Controller, ServoValve, Supply, TableSystem, TableSystemParts,
+};
 
 /// Names accepted by [`by_name`].
 pub const PRESET_NAMES: &str = "lhpost-2008";
@@ -58,7 +60,7 @@ pub fn by_name(name: &str) -> Result<TableSystem> {
 /// margin of 74° and a closed-loop peak of 1.45 at 7.6 Hz; `platen model --system lhpost-2008` prints
 /// them. On Northridge (Tarzana, 100 %) the platen follows the command within 2.0 mm RMS.
 pub fn lhpost_2008() -> TableSystem {
-    TableSystem {
+    let parts = TableSystemParts {
         actuator: Actuator {
             count: 2,
             cap_area_m2: 0.2051,
@@ -95,5 +97,6 @@ pub fn lhpost_2008() -> TableSystem {
             delta_p_gain_per_pa: 2e-8,
             delta_p_highpass_hz: 0.1,
         },
-    }
+    };
+    TableSystem::new(parts, 0.0).expect("the LHPOST preset is valid")
 }

@@ -2,12 +2,17 @@
 
 use platen_system::{
     preset, Actuator, Controller, ControllerInput, ControllerState, Mechanics, ServoValve, Supply,
-    SystemError, TableSystem,
+    SystemError, TableSystem, TableSystemParts,
 };
 
 /// A double-ended actuator of area `a` and total oil volume `v_t` (half in each chamber).
 fn symmetric(a: f64, v_t: f64, beta: f64) -> TableSystem {
-    TableSystem {
+    TableSystem::new(symmetric_parts(a, v_t, beta), 0.0).unwrap()
+}
+
+/// The values of [`symmetric`], to change before validating.
+fn symmetric_parts(a: f64, v_t: f64, beta: f64) -> TableSystemParts {
+    TableSystemParts {
         actuator: Actuator {
             count: 1,
             cap_area_m2: a,
@@ -62,7 +67,7 @@ fn the_lhpost_preset_meets_the_published_figures() {
     let sys = preset::lhpost_2008();
     assert!((sys.oil_column_frequency_hz(144e3, 0.0) / 10.66 - 1.0).abs() < 2e-3);
     let cap = sys.capacities();
-    let n = f64::from(sys.actuator.count);
+    let n = f64::from(sys.actuator().count);
     assert_eq!(n, 2.0);
     assert!(
         (cap.push_force_n / n / 4.2e6 - 1.0).abs() < 1e-3,
@@ -75,12 +80,12 @@ fn the_lhpost_preset_meets_the_published_figures() {
         cap.pull_force_n
     );
     assert!(cap.extend_velocity_m_s >= 1.8 && cap.retract_velocity_m_s >= 1.8);
-    assert_eq!(sys.servo_valve.count, 2);
-    assert!((sys.servo_valve.rated_flow_m3_s * 60_000.0 - 10_000.0).abs() < 1e-9);
-    assert_eq!(sys.servo_valve.rated_pressure_drop_pa, 7e6);
-    assert_eq!(sys.servo_valve.natural_frequency_hz, 246.0);
+    assert_eq!(sys.servo_valve().count, 2);
+    assert!((sys.servo_valve().rated_flow_m3_s * 60_000.0 - 10_000.0).abs() < 1e-9);
+    assert_eq!(sys.servo_valve().rated_pressure_drop_pa, 7e6);
+    assert_eq!(sys.servo_valve().natural_frequency_hz, 246.0);
     // The rest of the stroke: a chamber keeps oil at ±0.75 m.
-    sys.validate(0.75).unwrap();
+    sys.check_stroke(0.75).unwrap();
     // The loop is stable with margins.
     let mech = Mechanics {
         mass_kg: 144e3,
@@ -118,11 +123,12 @@ fn the_valve_limited_velocities_are_the_orifice_law_at_no_load() {
 /// decays as `((2/T − ω)/(2/T + ω))^k`, the bilinear map of `e^(−ωt)`.
 #[test]
 fn the_delta_p_highpass_is_the_bilinear_map_of_its_continuous_filter() {
-    let mut sys = symmetric(0.02, 0.02, 1e9);
-    let c = &mut sys.controller;
+    let mut parts = symmetric_parts(0.02, 0.02, 1e9);
+    let c = &mut parts.controller;
     c.delta_p_gain_per_pa = 1e-7;
     c.delta_p_highpass_hz = 2.0;
-    let c = sys.controller;
+    let sys = TableSystem::new(parts, 0.0).unwrap();
+    let c = sys.controller();
     let mut st = ControllerState::default();
     let input = |dp: f64| ControllerInput {
         delta_p_pa: dp,
@@ -143,10 +149,11 @@ fn the_delta_p_highpass_is_the_bilinear_map_of_its_continuous_filter() {
 /// The drive saturates at ±1 and the integrator does not wind up while it is saturated.
 #[test]
 fn the_drive_saturates_and_the_integrator_does_not_wind_up() {
-    let mut sys = symmetric(0.02, 0.02, 1e9);
-    sys.controller.displacement_gain_per_m = 10.0;
-    sys.controller.integral_gain_per_m_s = 100.0;
-    let c = sys.controller;
+    let mut parts = symmetric_parts(0.02, 0.02, 1e9);
+    parts.controller.displacement_gain_per_m = 10.0;
+    parts.controller.integral_gain_per_m_s = 100.0;
+    let sys = TableSystem::new(parts, 0.0).unwrap();
+    let c = sys.controller();
     let mut st = ControllerState::default();
     let at = |r: f64| ControllerInput {
         command_u_m: r,
@@ -164,8 +171,8 @@ fn the_drive_saturates_and_the_integrator_does_not_wind_up() {
 /// Impossible systems are refused with the path of the offending value.
 #[test]
 fn impossible_systems_are_refused_with_their_path() {
-    let good = symmetric(0.02, 0.04, 1e9);
-    type Spoil = Box<dyn Fn(&mut TableSystem)>;
+    let good = symmetric_parts(0.02, 0.04, 1e9);
+    type Spoil = Box<dyn Fn(&mut TableSystemParts)>;
     let cases: Vec<(&str, Spoil)> = vec![
         (
             "actuator.cap_side_area_m2",
@@ -199,10 +206,10 @@ fn impossible_systems_are_refused_with_their_path() {
     for (path, spoil) in cases {
         let mut s = good;
         spoil(&mut s);
-        match s.validate(0.75) {
+        match TableSystem::new(s, 0.75) {
             Err(SystemError::Invalid { path: p, .. }) => assert_eq!(p, path),
             other => panic!("{path}: {other:?}"),
         }
     }
-    good.validate(0.75).unwrap();
+    TableSystem::new(good, 0.75).unwrap();
 }

@@ -212,7 +212,7 @@ fn system_preset(name: &str, stroke_m: f64) -> Result<TableSystem> {
     let system =
         platen_system::preset::by_name(name).with_context(|| format!("--system {name}"))?;
     system
-        .validate(stroke_m)
+        .check_stroke(stroke_m)
         .with_context(|| format!("--system {name} over the stroke ±{stroke_m} m"))?;
     Ok(system)
 }

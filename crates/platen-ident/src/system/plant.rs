@@ -56,7 +56,7 @@ use std::collections::BTreeMap;
 use nalgebra::{DMatrix, SymmetricEigen};
 use platen_model::{IdentifiedParams, Specimen, Storey};
 use platen_signal::{ButterworthLowpass, ZeroPhaseFilter};
-use platen_system::{Actuator, Controller, ServoValve, Supply, TableSystem};
+use platen_system::{Actuator, Controller, ServoValve, Supply, TableSystem, TableSystemParts};
 
 use super::fit::{Design, LinearFit};
 use super::skew::{self, ChannelSkew, MIN_APPLIED_SAMPLES, PRESSURE_SHIFT_GRID};
@@ -109,7 +109,11 @@ pub const STROKE_FRACTION_OF_ROOM: f64 = 0.9;
 /// The stroke limit of an identified table system: [`STROKE_FRACTION_OF_ROOM`] of the
 /// stroke its chambers allow (`min(V_a0/A_a, V_b0/A_b)`), m.
 pub fn stroke_limit_m(system: &TableSystem) -> f64 {
-    let a = &system.actuator;
+    actuator_stroke_limit_m(system.actuator())
+}
+
+/// [`stroke_limit_m`] of an actuator's values, checked or not.
+fn actuator_stroke_limit_m(a: &Actuator) -> f64 {
     STROKE_FRACTION_OF_ROOM * (a.cap_volume_m3 / a.cap_area_m2).min(a.rod_volume_m3 / a.rod_area_m2)
 }
 
@@ -242,8 +246,8 @@ pub struct IdentifiedPlant {
 /// The geometry the plant is laid on ([`super::SystemSettings`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct PlantInput {
-    /// The base (given, or nominal).
-    pub base: TableSystem,
+    /// The base's values (given, or nominal), which the fit changes.
+    pub base: TableSystemParts,
     /// Whether `base` is the lab's (else nominal).
     pub base_given: bool,
     /// Whether the area was given (with the base, or alone).
@@ -255,14 +259,14 @@ impl PlantInput {
     pub fn new(settings: &SystemSettings, first: &SystemRecord) -> Self {
         if let Some(base) = settings.base {
             return Self {
-                base,
+                base: base.into_parts(),
                 base_given: true,
                 area_given: true,
             };
         }
         let area = settings.area_m2.unwrap_or(NOMINAL_AREA_M2);
         let h = first.period_s().unwrap_or(1e-3);
-        let base = TableSystem {
+        let base = TableSystemParts {
             actuator: Actuator {
                 count: 1,
                 cap_area_m2: area,
@@ -741,7 +745,12 @@ fn lowpass(x: &[f64], h: f64) -> [Vec<f64>; 3] {
     [s(q), s(qd), s(qdd)]
 }
 
-fn continuity(r: &SystemRecord, h: f64, base: &TableSystem, chambers: bool) -> Option<Continuity> {
+fn continuity(
+    r: &SystemRecord,
+    h: f64,
+    base: &TableSystemParts,
+    chambers: bool,
+) -> Option<Continuity> {
     let a = &base.actuator;
     let [_, lp_v, _] = lowpass(&r.u_m, h);
     if !chambers {
@@ -789,7 +798,7 @@ fn continuity(r: &SystemRecord, h: f64, base: &TableSystem, chambers: bool) -> O
 /// `[K, C_L, V₀/β]`), every one `≥ 0`.
 fn fit_continuity(
     recs: &[(usize, &SystemRecord, f64, Continuity)],
-    base: &TableSystem,
+    base: &TableSystemParts,
     spool_of: &dyn Fn(&[f64], f64) -> Vec<f64>,
 ) -> Option<LinearFit> {
     let laminar = platen_system::LAMINAR_FRACTION * base.servo_valve.rated_pressure_drop_pa;
@@ -932,7 +941,7 @@ fn plant_mechanics(
     input: &PlantInput,
     (from, storeys): (ForceFrom, usize),
     skew_report: &mut Vec<ChannelSkew>,
-    (base, plant): (&mut TableSystem, &mut IdentifiedPlant),
+    (base, plant): (&mut TableSystemParts, &mut IdentifiedPlant),
     not_identified: &mut Vec<(String, String)>,
 ) -> Result<()> {
     let why = |what: &str, reason: &str| (what.to_owned(), reason.to_owned());
@@ -1018,7 +1027,7 @@ fn plant_hydraulics(
     periods: &[f64],
     fitted: &[usize],
     from: &std::result::Result<ForceFrom, &str>,
-    base: &TableSystem,
+    base: &TableSystemParts,
     plant: &mut IdentifiedPlant,
     not_identified: &mut Vec<(String, String)>,
 ) {
@@ -1059,8 +1068,8 @@ fn plant_hydraulics(
                         sys.oil_column_frequency_hz(m.effective_mass_kg + payload, 0.0);
                 }
                 // Only a system a scenario takes is printed and run.
-                match sys.validate(stroke_limit_m(&sys)) {
-                    Ok(()) => plant.system = Some(sys),
+                match TableSystem::new(sys, actuator_stroke_limit_m(&sys.actuator)) {
+                    Ok(sys) => plant.system = Some(sys),
                     Err(e) => not_identified.push(why(
                         "the table system as a whole",
                         &format!(
@@ -1124,7 +1133,7 @@ fn finish_plant(plant: &mut IdentifiedPlant, not_identified: &mut Vec<(String, S
 /// The spool grid's best continuity fit, as the valves and oil column.
 fn fit_valves(
     recs: &[(usize, &SystemRecord, f64, Continuity)],
-    base: &TableSystem,
+    base: &TableSystemParts,
     plant: &mut IdentifiedPlant,
     not_identified: &mut Vec<(String, String)>,
 ) -> Option<IdentifiedHydraulics> {
