@@ -24,9 +24,9 @@ use crate::error::{IntegrateError, Result};
 use crate::event::{
     arrive_at_rest, breakaway, just_past, Direction, EventKind, Mode, MAX_EVENTS_PER_STEP,
 };
-use crate::machine::{Machine, PieceMethod, Plant, Rk4Stages, DI, U, V, W};
+use crate::grid::{Grid, GridStep, GridStepper};
+use crate::machine::{direction, Machine, PieceMethod, Plant, Rk4Stages, DI, U, V, W};
 use crate::output::Sample;
-use crate::rk4::{direction, Grid, GridStep, GridStepper};
 use crate::run::{EnergyBalance, Kin, RunStats, State};
 use crate::stop::{Failure, StopReason};
 
@@ -131,7 +131,7 @@ impl<M: PlatenModel> Plant<L> for BarePlant<'_, M> {
         }
     }
 
-    crate::rk4::grid_time!();
+    crate::grid::grid_time!();
 }
 
 /// A forward run of the bare platen (also one lane of [`crate::ensemble`]): the mode machine

@@ -26,14 +26,11 @@ use platen_model::PlatenModel;
 
 use crate::bare::Stepper;
 use crate::error::{IntegrateError, Result};
+use crate::grid::{drive, Grid};
 use crate::machine::PieceMethod;
 use crate::output::SampleSink;
 use crate::record::ForceRecord;
-use crate::rk4::{drive, Grid};
 use crate::run::{check_run, RunStats, State};
-
-/// Most Dopri5 steps in one piece before it gives up ([`crate::AdaptiveFailure::TooManySteps`]).
-pub(crate) const MAX_STEPS: u32 = 100_000;
 
 /// Settings of the adaptive integrator.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -32,10 +32,11 @@ use platen_model::{Exponent, IdentifiedModel, SlipRates};
 use crate::bare::Stepper;
 use crate::error::Result;
 use crate::event::Mode;
+use crate::grid::{Grid, GridStep, GridStepper};
 use crate::machine::{DI, V};
 use crate::output::SampleSink;
 use crate::record::ForceRecord;
-use crate::rk4::{forward_rk4, Grid, GridStep, GridStepper, Rk4};
+use crate::rk4::{forward_rk4, Rk4};
 use crate::run::{check_run, Kin, RunStats, State};
 
 /// The number of lanes [`forward_rk4_ensemble`] advances together (measured best of 4 and 8

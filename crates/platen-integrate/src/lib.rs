@@ -63,6 +63,7 @@ mod dopri5;
 mod ensemble;
 mod error;
 mod event;
+mod grid;
 mod inverse;
 mod machine;
 mod method;

@@ -25,8 +25,8 @@
 //!   step `h`.
 //!
 //! The bare platen is a plant of the one mode machine ([`crate::machine`], with its exact rest
-//! in [`crate::bare`]); this module keeps the grid, the driver over it and the grading of the
-//! pieces near rest that every plant's RK4 shares.
+//! in [`crate::bare`]); this module keeps the RK4 settings and the entry point, the grid and
+//! its driver are [`crate::grid`]'s, the grading of the pieces near rest the machine's.
 //!
 //! No allocation happens per step; a run allocates only what its [`SampleSink`] stores.
 
@@ -34,7 +34,8 @@ use platen_model::PlatenModel;
 
 use crate::bare::Stepper;
 use crate::error::{IntegrateError, Result};
-use crate::output::{Sample, SampleSink};
+use crate::grid::{drive, Grid};
+use crate::output::SampleSink;
 use crate::record::ForceRecord;
 use crate::run::{check_run, RunStats, State};
 
@@ -90,114 +91,6 @@ impl Rk4 {
     }
 }
 
-/// Grid step `n` (from `t₀`), which is sub-step `i` of the sample interval that starts at
-/// sample `j` (`n = j·k + i`). Carried together so that the hot loop never divides.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct GridStep {
-    pub(crate) n: u64,
-    pub(crate) j: usize,
-    /// `i` as a number (exact: `i < k ≤ 1e9`).
-    pub(crate) i: f64,
-}
-
-/// The force record seen from the integer time grid.
-pub(crate) struct Grid<'a> {
-    pub(crate) force: &'a [f64],
-    pub(crate) inv_k: f64,
-    pub(crate) h: f64,
-    pub(crate) t0: f64,
-}
-
-impl<'a> Grid<'a> {
-    /// The grid of `k` steps per sample interval of `record`.
-    pub(crate) fn new(record: &'a ForceRecord, k: u64) -> Self {
-        Grid {
-            force: record.force_n(),
-            inv_k: 1.0 / k as f64,
-            h: record.dt_s() / k as f64,
-            t0: record.t_s()[0],
-        }
-    }
-
-    /// Force at fraction `tau ∈ [0, 1]` of grid step `n`: linear between the two samples
-    /// that bracket the step, exact at both samples.
-    #[inline(always)]
-    pub(crate) fn force(&self, n: GridStep, tau: f64) -> f64 {
-        let j = n.j;
-        let w = (n.i + tau) * self.inv_k;
-        if w == 0.0 {
-            self.force[j]
-        } else {
-            self.force[j] * (1.0 - w) + self.force[j + 1] * w
-        }
-    }
-
-    #[inline]
-    pub(crate) fn time_s(&self, n: GridStep, tau: f64) -> f64 {
-        self.t0 + (n.n as f64 + tau) * self.h
-    }
-}
-
-/// The input and the time hooks of a [`crate::machine::Plant`] that runs on a force record's
-/// grid (fields `grid: Grid` and `n: GridStep`): positions are fractions of grid step `n`, the
-/// input is the record's force there, an event a hair short of the step's end lands on it.
-macro_rules! grid_time {
-    () => {
-        #[inline(always)]
-        fn input(&self, at: f64) -> f64 {
-            self.grid.force(self.n, at)
-        }
-        #[inline(always)]
-        fn seconds(&self, len: f64) -> f64 {
-            len * self.grid.h
-        }
-        fn units(&self, seconds: f64) -> f64 {
-            seconds / self.grid.h
-        }
-        fn time_s(&self, at: f64) -> f64 {
-            self.grid.time_s(self.n, at)
-        }
-        fn tolerance_floor(&self) -> f64 {
-            0.0
-        }
-        /// A creep stop located this close (fraction of a step) to where the advance
-        /// started has not moved time (see [`crate::machine::Plant::min_progress`]).
-        fn min_progress(&self) -> f64 {
-            4.0 * f64::EPSILON
-        }
-        fn land(&self, tau: f64, x: f64, _rest: f64) -> f64 {
-            let at = tau + x;
-            if 1.0 - at < 1e-12 {
-                1.0
-            } else {
-                at
-            }
-        }
-        fn reach(&self, tau: f64, len: f64) -> f64 {
-            tau + len
-        }
-        fn break_at(&self, tau: f64, x: f64, _rest: f64, _held: bool) -> f64 {
-            (tau + x).min(1.0)
-        }
-    };
-}
-pub(crate) use grid_time;
-
-/// The friction direction of slip as a number: `+1.0` for `POSITIVE`, `−1.0` otherwise.
-///
-/// The slip path is monomorphised over the direction so that, once the model's
-/// `slip_rates` is inlined, `direction·v` and `direction·D` fold to `v`/`−v` and `D`/`−D`
-/// (exact for ±1, so the results are bit for bit those of a run-time direction) and two
-/// multiplications leave the dependency chain of every stage.
-#[inline(always)]
-pub(crate) const fn direction<const POSITIVE: bool>() -> f64 {
-    if POSITIVE {
-        1.0
-    } else {
-        -1.0
-    }
-}
-
 /// Runs the model forward under the recorded force `record` from `initial`, with fixed-step
 /// RK4 and exact stick-slip, delivering `samples` output samples (the record's first
 /// `samples` sample times) to `sink`.
@@ -221,103 +114,3 @@ pub fn forward_rk4<M: PlatenModel, S: SampleSink>(
     let mut stepper = Stepper::new(model, Grid::new(record, k), initial);
     drive(&mut stepper, record.t_s(), k, samples, sink)
 }
-
-/// A fixed-step integrator on the integer time grid: what [`drive`] runs.
-pub(crate) trait GridStepper {
-    /// Advances from grid point `n` to `n + 1`, handling every event inside the step.
-    fn step(&mut self, n: GridStep) -> Result<()>;
-    /// The output sample at sample `j` of the record (grid point `j·k`), at time `t_s`.
-    fn sample(&self, j: usize, t_s: f64) -> Sample;
-    /// Closes the run's statistics, the run having finished at `t_s`.
-    fn finish(&mut self, t_s: f64) -> RunStats;
-}
-
-/// Runs `stepper` over the first `samples` sample `times` (`k` steps per interval), delivering
-/// every sample to `sink`.
-#[inline(always)]
-pub(crate) fn drive<T: GridStepper, S: SampleSink>(
-    stepper: &mut T,
-    times: &[f64],
-    k: u64,
-    samples: usize,
-    sink: &mut S,
-) -> Result<RunStats> {
-    if samples == 0 {
-        return Ok(stepper.finish(times[0]));
-    }
-    sink.accept(&stepper.sample(0, times[0]));
-    let mut n = 0u64;
-    for j in 0..samples - 1 {
-        for i in 0..k {
-            stepper.step(GridStep { n, j, i: i as f64 })?;
-            n += 1;
-        }
-        sink.accept(&stepper.sample(j + 1, times[j + 1]));
-    }
-    Ok(stepper.finish(times[samples - 1]))
-}
-
-/// How a slip interval is split into RK4 sub-steps.
-///
-/// Near `v = 0` the `|v|^α` law (α < 1) makes the right-hand side singular like `√(t − t*)`,
-/// which cuts a single RK4 step's accuracy to `O(h^1.5)` (about 1e-7 m/s per event at
-/// h = 1/1024 s on the paper's model). Geometric sub-steps that halve towards the singular
-/// end make the step that holds it `2⁵` times shorter, which removes that error to the
-/// 1e-10 m level, at the cost of a few extra stages per event only.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum Grading {
-    /// One plain RK4 step.
-    Single,
-    /// Singular at the start (leaving rest).
-    Start,
-    /// Singular at the end (arriving at rest).
-    End,
-    /// Singular at both ends.
-    Both,
-}
-
-const GRADED_START: [f64; 6] = [
-    1.0 / 32.0,
-    1.0 / 32.0,
-    1.0 / 16.0,
-    1.0 / 8.0,
-    1.0 / 4.0,
-    1.0 / 2.0,
-];
-const GRADED_END: [f64; 6] = [
-    1.0 / 2.0,
-    1.0 / 4.0,
-    1.0 / 8.0,
-    1.0 / 16.0,
-    1.0 / 32.0,
-    1.0 / 32.0,
-];
-const GRADED_BOTH: [f64; 12] = [
-    1.0 / 64.0,
-    1.0 / 64.0,
-    1.0 / 32.0,
-    1.0 / 16.0,
-    1.0 / 8.0,
-    1.0 / 4.0,
-    1.0 / 4.0,
-    1.0 / 8.0,
-    1.0 / 16.0,
-    1.0 / 32.0,
-    1.0 / 64.0,
-    1.0 / 64.0,
-];
-
-impl Grading {
-    pub(crate) fn pieces(self) -> &'static [f64] {
-        match self {
-            Grading::Single => &[1.0],
-            Grading::Start => &GRADED_START,
-            Grading::End => &GRADED_END,
-            Grading::Both => &GRADED_BOTH,
-        }
-    }
-}
-
-/// Halvings of a careful piece before its start is taken as a state at rest (2⁻⁶⁰ of a step:
-/// the speed there is below what a piece that short can resolve).
-pub(crate) const MAX_HALVINGS: u32 = 60;

@@ -45,11 +45,12 @@ use platen_model::{PlatenModel, Specimen};
 use crate::creep::creep_speed_m_s;
 use crate::error::{IntegrateError, Result};
 use crate::event::{Direction, EventKind, Mode, MAX_EVENTS_PER_STEP};
-use crate::machine::{Machine, PieceMethod, Plant, DI, SD, U, V, W};
+use crate::grid::{drive, Grid, GridStep, GridStepper};
+use crate::machine::{direction, Machine, PieceMethod, Plant, DI, SD, U, V, W};
 use crate::method::Method;
 use crate::output::{Sample, SampleSink};
 use crate::record::ForceRecord;
-use crate::rk4::{direction, drive, Grid, GridStep, GridStepper, Rk4};
+use crate::rk4::Rk4;
 use crate::run::{check_run, EnergyBalance, RunStats, State};
 use crate::steppable::{Samples, Steppable};
 use crate::stop::{Failure, StopReason};
@@ -496,7 +497,7 @@ impl<M: PlatenModel, const L: usize> Plant<L> for SpecimenPlant<'_, M, L> {
         }
     }
 
-    crate::rk4::grid_time!();
+    crate::grid::grid_time!();
 }
 
 /// A forward run with a specimen: the mode machine over the force record's grid.
