@@ -40,6 +40,24 @@ pub enum ModelError {
         /// The names that exist, comma separated.
         known: String,
     },
+    /// A value of a multi-axis table out of its range; `path` is its place in the scenario's
+    /// `table` (for example `actuators[2].pad.axis`).
+    #[error("table.{path}: expected {expected}")]
+    InvalidTable {
+        /// Where the value is, as a JSON path under `table`.
+        path: String,
+        /// What a valid value looks like.
+        expected: String,
+    },
+    /// The actuators of a multi-axis table cannot move a DOF that is not held.
+    #[error(
+        "table: no combination of the actuators moves the platen in `{dof}`, which is not held \
+         (hold it in `held_dofs` or add an actuator that acts on it)"
+    )]
+    UncontrolledDof {
+        /// The DOF (contract name) that dominates the direction nothing pushes.
+        dof: &'static str,
+    },
 }
 
 /// Result alias of this crate.

@@ -42,6 +42,7 @@ mod full;
 mod identified;
 mod keys;
 mod law;
+pub mod multi_axis;
 mod physical_keys;
 mod power;
 pub mod preset;
