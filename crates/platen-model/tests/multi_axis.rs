@@ -234,3 +234,49 @@ fn bad_tables_are_refused_with_their_path() {
     let err = RigidPlaten::new(-1.0, Matrix3::identity(), Vector3::zeros()).unwrap_err();
     assert!(err.to_string().contains("table.platen.mass_kg"), "{err}");
 }
+
+/// A stiff eccentric specimen (a 40 t mass at (1.5, −0.8, 6) m on three springs far stiffer
+/// than the oil columns) moves with the platen as one rigid body: the modes equal those of
+/// the platen with the mass added by the parallel-axis theorem, to 1e-5. The springs give
+/// the specimen ω² = 1e11 s⁻², so the rigid-body limit is reached to (ω_platen/ω_spec)² ≤ 1e-6
+/// and the eigensolver's rounding (ε·1e11 against ω² ≥ 200) stays near 1e-7.
+#[test]
+fn a_stiff_eccentric_specimen_moves_the_modes_as_the_combined_rigid_body() {
+    use nalgebra::DMatrix;
+    use platen_model::multi_axis::LinearSpecimen;
+    let t = table(&[], [0.1, 0.0, -0.45]);
+    let (ms, r) = (40e3, Vector3::new(1.5, -0.8, 6.0));
+    let (ex, ey, h) = (r[0], r[1], r[2]);
+    let influence = DMatrix::from_row_slice(
+        3,
+        6,
+        &[
+            1.0, 0.0, 0.0, 0.0, h, -ey, //
+            0.0, 1.0, 0.0, -h, 0.0, ex, //
+            0.0, 0.0, 1.0, ey, -ex, 0.0,
+        ],
+    );
+    let k = 1e11 * ms;
+    let specimen = LinearSpecimen::new(
+        DMatrix::identity(3, 3) * ms,
+        DMatrix::identity(3, 3) * k,
+        DMatrix::zeros(3, 3),
+        influence,
+    )
+    .unwrap();
+    let with = t.modes_with(&specimen);
+    // The combined body: mass, centre of mass and inertia about it (parallel axes).
+    let p = t.platen();
+    let m = p.mass_kg() + ms;
+    let c = (p.centre_of_mass_m() * p.mass_kg() + r * ms) / m;
+    let shift = |mass: f64, d: Vector3<f64>| (Matrix3::identity() * d.dot(&d) - d * d.transpose()) * mass;
+    let inertia = p.inertia_kg_m2() + shift(p.mass_kg(), p.centre_of_mass_m() - c) + shift(ms, r - c);
+    let mut parts = t.parts().clone();
+    parts.platen = RigidPlaten::new(m, inertia, c).unwrap();
+    let rigid = MultiAxisTable::new(parts).unwrap().modes();
+    for (a, b) in with.iter().zip(&rigid) {
+        assert!((a.frequency_hz / b.frequency_hz - 1.0).abs() < 1e-5, "{a:?} against {b:?}");
+    }
+    // And the eccentric mass lowers them.
+    assert!(with[0].frequency_hz < t.modes()[0].frequency_hz);
+}

@@ -23,6 +23,7 @@
 
 mod dof;
 mod modes;
+mod specimen;
 mod table;
 
 pub use dof::{
@@ -30,6 +31,7 @@ pub use dof::{
     DofSet,
 };
 pub use modes::Mode;
+pub use specimen::LinearSpecimen;
 pub use table::{
     Actuator, ActuatorPose, Bearing, BearingLoad, MultiAxisTable, Mount, Pad, Point, RigidPlaten,
     Strut, StrutPose, TableParts, Wrench,

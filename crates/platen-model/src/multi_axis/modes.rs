@@ -1,6 +1,6 @@
 //! The platen's modes at neutral on its oil columns and hold-down struts, valves shut.
 
-use nalgebra::{DMatrix, Matrix6, SymmetricEigen};
+use nalgebra::{DMatrix, DVector, Matrix6, SymmetricEigen};
 
 use super::dof::{Coords, Dof};
 use super::table::{MultiAxisTable, Wrench};
@@ -52,40 +52,50 @@ impl MultiAxisTable {
 
     /// The modes of the mass and stiffness matrices `m`, `k` (about the reference point, at
     /// neutral) over the free DOFs.
-    pub(crate) fn modes_of(&self, m: &Matrix6<f64>, k: &Matrix6<f64>) -> Vec<Mode> {
+    fn modes_of(&self, m: &Matrix6<f64>, k: &Matrix6<f64>) -> Vec<Mode> {
         let free: Vec<usize> = self.free().iter().map(Dof::index).collect();
         let n = free.len();
         let pick = |a: &Matrix6<f64>| DMatrix::from_fn(n, n, |r, c| a[(free[r], free[c])]);
-        let (mf, kf) = (pick(m), pick(k));
-        let Some(chol) = mf.clone().cholesky() else {
-            return Vec::new();
-        };
-        let l = chol.l();
-        let Some(l_inv) = l.clone().try_inverse() else {
-            return Vec::new();
-        };
-        let c = &l_inv * &kf * l_inv.transpose();
-        let c = (&c + c.transpose()) * 0.5;
-        let eig = SymmetricEigen::new(c);
-        let mut modes: Vec<Mode> = (0..n)
-            .map(|i| {
-                let y = eig.eigenvectors.column(i);
-                let phi = l_inv.transpose() * y;
+        generalised_modes(&pick(m), &pick(k))
+            .into_iter()
+            .map(|(frequency_hz, phi)| {
                 let mut shape = Coords::zeros();
                 for (r, &d) in free.iter().enumerate() {
                     shape[d] = phi[r];
                 }
-                let big = shape.iter().copied().fold(0.0, |b: f64, x| if x.abs() > b.abs() { x } else { b });
-                if big < 0.0 {
-                    shape = -shape;
-                }
                 Mode {
-                    frequency_hz: eig.eigenvalues[i].max(0.0).sqrt() / std::f64::consts::TAU,
+                    frequency_hz,
                     shape,
                 }
             })
-            .collect();
-        modes.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
-        modes
+            .collect()
     }
+}
+
+/// The solutions of `K·φ = ω²·M·φ` (`M` positive definite, `K` symmetric), lowest first: the
+/// frequency in Hz (0 for a negative `ω²` of rounding) and `φ` with `φᵀ·M·φ = 1` and its
+/// largest-magnitude component positive. Empty if `M` is not positive definite.
+pub(crate) fn generalised_modes(m: &DMatrix<f64>, k: &DMatrix<f64>) -> Vec<(f64, DVector<f64>)> {
+    let Some(chol) = m.clone().cholesky() else {
+        return Vec::new();
+    };
+    let l = chol.l();
+    let Some(l_inv) = l.try_inverse() else {
+        return Vec::new();
+    };
+    let c = &l_inv * k * l_inv.transpose();
+    let c = (&c + c.transpose()) * 0.5;
+    let eig = SymmetricEigen::new(c);
+    let mut modes: Vec<(f64, DVector<f64>)> = (0..m.nrows())
+        .map(|i| {
+            let mut phi = l_inv.transpose() * eig.eigenvectors.column(i);
+            let big = phi.iter().copied().fold(0.0, |b: f64, x| if x.abs() > b.abs() { x } else { b });
+            if big < 0.0 {
+                phi = -phi;
+            }
+            (eig.eigenvalues[i].max(0.0).sqrt() / std::f64::consts::TAU, phi)
+        })
+        .collect();
+    modes.sort_by(|a, b| a.0.total_cmp(&b.0));
+    modes
 }

@@ -1,0 +1,208 @@
+//! A general linear specimen on the multi-axis platen.
+
+use nalgebra::{DMatrix, DVector, Matrix6};
+
+use super::modes::Mode;
+use super::table::{MultiAxisTable, Wrench};
+use crate::error::{ModelError, Result};
+use crate::Specimen;
+
+/// A linear specimen fixed on the platen: `n` DOFs `z` relative to the platen with mass,
+/// stiffness and damping matrices (SI units per DOF) and an influence matrix `Γ` (`n × 6`:
+/// each DOF's rigid-body share of the platen's accelerations `(ẗ, ω̇)` about the reference
+/// point, table axes). It moves by `M·(z̈ + Γ·a) + C·ż + K·z = 0` and pushes on the platen
+/// with the wrench `Γᵀ·(C·ż + K·z)` (the reaction to `Γᵀ·M·(z̈ + Γ·a)`, the force of the
+/// platen on it).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinearSpecimen {
+    mass: DMatrix<f64>,
+    stiffness: DMatrix<f64>,
+    damping: DMatrix<f64>,
+    influence: DMatrix<f64>,
+    /// The Cholesky factor's inverse product `M⁻¹`, kept for the rates.
+    mass_inverse: DMatrix<f64>,
+}
+
+fn invalid(path: &str, expected: impl Into<String>) -> ModelError {
+    ModelError::InvalidTable {
+        path: path.into(),
+        expected: expected.into(),
+    }
+}
+
+fn square(path: &str, m: &DMatrix<f64>, n: usize) -> Result<()> {
+    if m.nrows() != n || m.ncols() != n {
+        return Err(invalid(path, format!("a {n}×{n} matrix (one row and column per DOF)")));
+    }
+    if !m.iter().all(|x| x.is_finite()) {
+        return Err(invalid(path, "finite numbers"));
+    }
+    let scale = m.abs().max().max(f64::MIN_POSITIVE);
+    if (m - m.transpose()).abs().max() > 1e-9 * scale {
+        return Err(invalid(path, "a symmetric matrix"));
+    }
+    Ok(())
+}
+
+impl LinearSpecimen {
+    /// A specimen of these matrices. Paths in errors are under `specimen`.
+    ///
+    /// # Errors
+    /// [`ModelError::InvalidTable`] when a matrix is not `n × n` and symmetric (the influence
+    /// `n × 6`), the mass matrix is not positive definite, or stiffness or damping has a
+    /// negative eigenvalue.
+    pub fn new(
+        mass: DMatrix<f64>,
+        stiffness: DMatrix<f64>,
+        damping: DMatrix<f64>,
+        influence: DMatrix<f64>,
+    ) -> Result<Self> {
+        let n = mass.nrows();
+        if n == 0 {
+            return Err(invalid("specimen.mass_matrix", "at least one DOF"));
+        }
+        square("specimen.mass_matrix", &mass, n)?;
+        square("specimen.stiffness_matrix", &stiffness, n)?;
+        square("specimen.damping_matrix", &damping, n)?;
+        if influence.nrows() != n || influence.ncols() != 6 || !influence.iter().all(|x| x.is_finite())
+        {
+            return Err(invalid(
+                "specimen.influence",
+                format!("{n} rows of six finite numbers (x, y, z, roll, pitch, yaw)"),
+            ));
+        }
+        let Some(chol) = mass.clone().cholesky() else {
+            return Err(invalid("specimen.mass_matrix", "a positive definite matrix"));
+        };
+        for (path, m) in [("specimen.stiffness_matrix", &stiffness), ("specimen.damping_matrix", &damping)] {
+            let eig = m.clone().symmetric_eigenvalues();
+            let scale = m.abs().max();
+            if eig.min() < -1e-9 * scale {
+                return Err(invalid(path, "a positive semi-definite matrix"));
+            }
+        }
+        Ok(LinearSpecimen {
+            mass_inverse: chol.inverse(),
+            mass,
+            stiffness,
+            damping,
+            influence,
+        })
+    }
+
+    /// The storeys of a shear frame along x as a linear specimen: floor `i` relative to the
+    /// platen, influence `(1, 0, 0, 0, 0, 0)` (the storeys carry no heights, so no
+    /// overturning moment).
+    pub fn from_storeys(specimen: &Specimen) -> Self {
+        let n = specimen.len();
+        let m = |v: Vec<f64>| DMatrix::from_row_slice(n, n, &v);
+        let mut influence = DMatrix::zeros(n, 6);
+        influence.column_mut(0).fill(1.0);
+        Self::new(
+            m(specimen.mass_matrix()),
+            m(specimen.stiffness_matrix()),
+            m(specimen.damping_matrix()),
+            influence,
+        )
+        .expect("a valid shear frame gives valid matrices")
+    }
+
+    /// Its number of DOFs.
+    pub fn len(&self) -> usize {
+        self.mass.nrows()
+    }
+
+    /// Whether it has no DOF (never: a specimen has at least one).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The mass matrix.
+    pub fn mass(&self) -> &DMatrix<f64> {
+        &self.mass
+    }
+
+    /// The stiffness matrix.
+    pub fn stiffness(&self) -> &DMatrix<f64> {
+        &self.stiffness
+    }
+
+    /// The damping matrix.
+    pub fn damping(&self) -> &DMatrix<f64> {
+        &self.damping
+    }
+
+    /// The influence matrix `Γ`, `n × 6`.
+    pub fn influence(&self) -> &DMatrix<f64> {
+        &self.influence
+    }
+
+    /// Its elastic and damping forces `C·ż + K·z`.
+    pub fn restoring(&self, z: &DVector<f64>, zd: &DVector<f64>) -> DVector<f64> {
+        &self.stiffness * z + &self.damping * zd
+    }
+
+    /// Its wrench on the platen `Γᵀ·(C·ż + K·z)` (about the reference point).
+    pub fn wrench_on_platen(&self, z: &DVector<f64>, zd: &DVector<f64>) -> Wrench {
+        let w = self.influence.transpose() * self.restoring(z, zd);
+        Wrench::from_iterator(w.iter().copied())
+    }
+
+    /// Its relative accelerations `z̈ = −Γ·a − M⁻¹·(C·ż + K·z)` under the platen's
+    /// acceleration `a = (ẗ, ω̇)`.
+    pub fn accelerations(&self, z: &DVector<f64>, zd: &DVector<f64>, platen: &Wrench) -> DVector<f64> {
+        -(&self.influence * platen) - &self.mass_inverse * self.restoring(z, zd)
+    }
+
+    /// Its rigid-body mass about the reference point, `Γᵀ·M·Γ` (6 × 6).
+    pub fn rigid_mass(&self) -> Matrix6<f64> {
+        let m = self.influence.transpose() * &self.mass * &self.influence;
+        Matrix6::from_iterator(m.iter().copied())
+    }
+}
+
+impl MultiAxisTable {
+    /// The modes at neutral with `specimen` on the platen: the generalised eigenproblem of
+    /// the platen and specimen together, mass `[[M_p + ΓᵀMΓ, ΓᵀM], [MΓ, M]]` and stiffness
+    /// `diag(K_p, K)` (the platen's axial springs, see
+    /// [`axial_stiffness_matrix`](Self::axial_stiffness_matrix)), lowest first; each shape is
+    /// its platen part (x … yaw), the whole mode mass-normalised.
+    pub fn modes_with(&self, specimen: &LinearSpecimen) -> Vec<Mode> {
+        let free: Vec<usize> = self.free().iter().map(|d| d.index()).collect();
+        let (nf, n) = (free.len(), specimen.len());
+        let mp = self.spatial_mass_matrix(&super::Coords::zeros());
+        let kp = self.axial_stiffness_matrix();
+        let g = specimen.influence();
+        let ms = specimen.mass();
+        let gtmg = g.transpose() * ms * g;
+        let mg = ms * g;
+        let size = nf + n;
+        let mut m = DMatrix::zeros(size, size);
+        let mut k = DMatrix::zeros(size, size);
+        for (r, &a) in free.iter().enumerate() {
+            for (c, &b) in free.iter().enumerate() {
+                m[(r, c)] = mp[(a, b)] + gtmg[(a, b)];
+                k[(r, c)] = kp[(a, b)];
+            }
+            for j in 0..n {
+                m[(r, nf + j)] = mg[(j, a)];
+                m[(nf + j, r)] = mg[(j, a)];
+            }
+        }
+        m.view_mut((nf, nf), (n, n)).copy_from(ms);
+        k.view_mut((nf, nf), (n, n)).copy_from(specimen.stiffness());
+        super::modes::generalised_modes(&m, &k)
+            .into_iter()
+            .map(|(f, phi)| {
+                let mut shape = super::Coords::zeros();
+                for (r, &d) in free.iter().enumerate() {
+                    shape[d] = phi[r];
+                }
+                Mode {
+                    frequency_hz: f,
+                    shape,
+                }
+            })
+            .collect()
+    }
+}
