@@ -76,7 +76,10 @@ fn table(held: &[Dof], com: [f64; 3]) -> MultiAxisTable {
     MultiAxisTable::new(TableParts {
         platen,
         actuators,
-        struts: vec![paper_strut("s1", [-3.0, 0.0]), paper_strut("s2", [3.0, 0.0])],
+        struts: vec![
+            paper_strut("s1", [-3.0, 0.0]),
+            paper_strut("s2", [3.0, 0.0]),
+        ],
         bearings: vec![],
         held: DofSet::of(held),
         oil_bulk_modulus_pa: 1.5e9,
@@ -101,12 +104,18 @@ fn two_paper_struts_give_the_papers_stiffness_and_its_cubic_term() {
     let k_prime = 0.5 * (1.44 * 3.3 / 2.1 - 1.0) * k_e;
     let u = 0.05;
     let cubic = (horizontal(u) - k_e * u) / ((u / 3.3f64).powi(2) * u);
-    assert!((cubic / k_prime - 1.0).abs() < 0.01, "K' = {cubic} against {k_prime}");
+    assert!(
+        (cubic / k_prime - 1.0).abs() < 0.01,
+        "K' = {cubic} against {k_prime}"
+    );
     let u = 0.75;
     let paper = k_prime * (u / 3.3f64).powi(2) * u;
     assert!((29e3..31e3).contains(&paper) && paper / (k_e * u) < 0.033);
     let exact = horizontal(u) - k_e * u;
-    assert!((exact / paper - 1.0).abs() < 0.07, "exact cubic part {exact} N");
+    assert!(
+        (exact / paper - 1.0).abs() < 0.07,
+        "exact cubic part {exact} N"
+    );
 }
 
 /// The unit wrench of every actuator is the gradient of its stroke (virtual work): for the
@@ -124,8 +133,13 @@ fn a_swivels_unit_wrench_is_the_gradient_of_its_length() {
             up[k] += h;
             let mut down = q;
             down[k] -= h;
-            let fd = (t.actuator_at(i, &up).stroke_m - t.actuator_at(i, &down).stroke_m) / (2.0 * h);
-            assert!((g[k] - fd).abs() < 1e-7, "actuator {i}, coordinate {k}: {} against {fd}", g[k]);
+            let fd =
+                (t.actuator_at(i, &up).stroke_m - t.actuator_at(i, &down).stroke_m) / (2.0 * h);
+            assert!(
+                (g[k] - fd).abs() < 1e-7,
+                "actuator {i}, coordinate {k}: {} against {fd}",
+                g[k]
+            );
         }
     }
 }
@@ -138,14 +152,20 @@ fn newton_euler_in_the_cases_that_have_closed_forms() {
     let q = Coords::new(0.1, 0.2, 0.0, 0.0, 0.0, 0.0);
     let acc = Coords::new(1.0, -2.0, 0.5, 0.0, 0.0, 0.0);
     let w = t.required_wrench(&q, &Coords::zeros(), &acc);
-    let expect = [MASS_KG, -2.0 * MASS_KG, (0.5 + STANDARD_GRAVITY_M_S2) * MASS_KG];
+    let expect = [
+        MASS_KG,
+        -2.0 * MASS_KG,
+        (0.5 + STANDARD_GRAVITY_M_S2) * MASS_KG,
+    ];
     for k in 0..3 {
         assert!((w[k] - expect[k]).abs() < 1e-6 * MASS_KG);
         assert!(w[k + 3].abs() < 1e-6);
     }
     let spin = Coords::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.7);
     let w = t.required_wrench(&Coords::zeros(), &spin, &Coords::zeros());
-    assert!(w.fixed_rows::<3>(3).norm() < 1e-6 && (w[2] - MASS_KG * STANDARD_GRAVITY_M_S2).abs() < 1e-6);
+    assert!(
+        w.fixed_rows::<3>(3).norm() < 1e-6 && (w[2] - MASS_KG * STANDARD_GRAVITY_M_S2).abs() < 1e-6
+    );
     // Off the principal axes the gyroscopic moment ω × I·ω appears: ω = (0.3, 0, 0.7) rad/s
     // about the centre of mass gives (0, 0.7·0.3·(I_xx − I_zz), 0). Constant ω at neutral
     // with roll′ = 0.3 and yaw′ = 0.7 needs pitch″ = −roll′·yaw′ (the angles' own coupling,
@@ -154,7 +174,11 @@ fn newton_euler_in_the_cases_that_have_closed_forms() {
     let rates = Coords::new(0.0, 0.0, 0.0, 0.3, 0.0, 0.7);
     let w = t.required_wrench(&q, &rates, &Coords::new(0.0, 0.0, 0.0, 0.0, -0.21, 0.0));
     let gyro = 0.7 * 0.3 * (1.9e6 - 2.5e6);
-    assert!((w[4] - gyro).abs() < 1e-6 * gyro.abs(), "{} against {gyro}", w[4]);
+    assert!(
+        (w[4] - gyro).abs() < 1e-6 * gyro.abs(),
+        "{} against {gyro}",
+        w[4]
+    );
 }
 
 /// The forward map inverts the inverse one, held DOFs included.
@@ -201,7 +225,11 @@ fn a_symmetric_table_decouples_as_its_symmetry_says() {
         let y_roll = s[1].abs() + s[3].abs();
         let groups = [x_pitch, y_roll, s[2].abs(), s[5].abs()];
         let big = groups.iter().copied().fold(0.0, f64::max);
-        assert_eq!(groups.iter().filter(|&&g| g > 1e-9 * big).count(), 1, "{m:?}");
+        assert_eq!(
+            groups.iter().filter(|&&g| g > 1e-9 * big).count(),
+            1,
+            "{m:?}"
+        );
     }
 }
 
@@ -211,7 +239,10 @@ fn bad_tables_are_refused_with_their_path() {
     let mut parts = good.parts().clone();
     parts.actuators[2] = swivel("h3", [0.0, -3.8, -0.5], [0.0, -3.8, -0.5]);
     let err = MultiAxisTable::new(parts).unwrap_err();
-    assert!(err.to_string().contains("table.actuators[2].platen_m"), "{err}");
+    assert!(
+        err.to_string().contains("table.actuators[2].platen_m"),
+        "{err}"
+    );
 
     // Without the two y actuators nothing pushes y (nor yaw, which the x pair still turns).
     let mut parts = good.parts().clone();
@@ -227,9 +258,16 @@ fn bad_tables_are_refused_with_their_path() {
         Vector3::zeros(),
     )
     .unwrap_err();
-    assert!(err.to_string().contains("table.platen.inertia_kg_m2"), "{err}");
-    let err = RigidPlaten::new(1e5, Matrix3::from_diagonal(&Vector3::new(1e6, 1e6, 3e6)), Vector3::zeros())
-        .unwrap_err();
+    assert!(
+        err.to_string().contains("table.platen.inertia_kg_m2"),
+        "{err}"
+    );
+    let err = RigidPlaten::new(
+        1e5,
+        Matrix3::from_diagonal(&Vector3::new(1e6, 1e6, 3e6)),
+        Vector3::zeros(),
+    )
+    .unwrap_err();
     assert!(err.to_string().contains("triangle"), "{err}");
     let err = RigidPlaten::new(-1.0, Matrix3::identity(), Vector3::zeros()).unwrap_err();
     assert!(err.to_string().contains("table.platen.mass_kg"), "{err}");
@@ -269,14 +307,73 @@ fn a_stiff_eccentric_specimen_moves_the_modes_as_the_combined_rigid_body() {
     let p = t.platen();
     let m = p.mass_kg() + ms;
     let c = (p.centre_of_mass_m() * p.mass_kg() + r * ms) / m;
-    let shift = |mass: f64, d: Vector3<f64>| (Matrix3::identity() * d.dot(&d) - d * d.transpose()) * mass;
-    let inertia = p.inertia_kg_m2() + shift(p.mass_kg(), p.centre_of_mass_m() - c) + shift(ms, r - c);
+    let shift =
+        |mass: f64, d: Vector3<f64>| (Matrix3::identity() * d.dot(&d) - d * d.transpose()) * mass;
+    let inertia =
+        p.inertia_kg_m2() + shift(p.mass_kg(), p.centre_of_mass_m() - c) + shift(ms, r - c);
     let mut parts = t.parts().clone();
     parts.platen = RigidPlaten::new(m, inertia, c).unwrap();
     let rigid = MultiAxisTable::new(parts).unwrap().modes();
     for (a, b) in with.iter().zip(&rigid) {
-        assert!((a.frequency_hz / b.frequency_hz - 1.0).abs() < 1e-5, "{a:?} against {b:?}");
+        assert!(
+            (a.frequency_hz / b.frequency_hz - 1.0).abs() < 1e-5,
+            "{a:?} against {b:?}"
+        );
     }
     // And the eccentric mass lowers them.
     assert!(with[0].frequency_hz < t.modes()[0].frequency_hz);
+}
+
+/// Sliding along x at constant speed on pads of μ = 0.44 % (the paper's μₑ) takes
+/// μ·(m·g + pull of the struts) from the x actuators: the paper's μₑ·F_z, with F_z the weight
+/// and the hold-down force the pads carry.
+#[test]
+fn steady_sliding_takes_mu_times_the_load_on_the_pads() {
+    let t = table(&[], [0.0, 0.0, -0.45]);
+    let q = Coords::new(0.3, 0.0, 0.0, 0.0, 0.0, 0.0);
+    let qd = Coords::new(0.5, 0.0, 0.0, 0.0, 0.0, 0.0);
+    let s = t
+        .inverse(&q, &qd, &Coords::zeros(), &Default::default())
+        .unwrap();
+    let f = &s.actuator_forces_n;
+    // The struts lean by 0.3 m over 3.3 m: their pull's vertical part.
+    let strut = |j: usize| t.strut_at(j, &q);
+    let pull_z: f64 = (0..2).map(|j| -strut(j).wrench[2]).sum();
+    let load = MASS_KG * STANDARD_GRAVITY_M_S2 + pull_z;
+    let pads: f64 = f[4..].iter().sum();
+    assert!(
+        (pads / load - 1.0).abs() < 1e-12,
+        "pads carry {pads} N of {load} N"
+    );
+    let strut_x: f64 = (0..2).map(|j| strut(j).wrench[0]).sum();
+    // Every actuator's x part: at x = 0.3 m the y pair leans by 0.3 m over 3 m and helps.
+    let x: f64 = (0..f.len())
+        .map(|i| f[i] * t.actuator_at(i, &q).unit[0])
+        .sum();
+    let expect = 0.0044 * load - strut_x;
+    assert!(
+        (x / expect - 1.0).abs() < 1e-12,
+        "the actuators push {x} N along x, expected {expect} N"
+    );
+    assert!((s.friction[0] + 0.0044 * load).abs() < 1e-9 * load);
+}
+
+/// A motion in y alone: the two y actuators share it, one pushing and one pulling by the
+/// same amount (minimum norm: no squeeze), and the forces reproduce the required wrench.
+#[test]
+fn redundant_actuators_resolve_without_squeeze() {
+    let t = table(&[], [0.0, 0.0, -0.45]);
+    let q = Coords::zeros();
+    let qdd = Coords::new(0.0, 2.0, 0.0, 0.0, 0.0, 0.0);
+    let s = t
+        .inverse(&q, &Coords::zeros(), &qdd, &Default::default())
+        .unwrap();
+    let f = &s.actuator_forces_n;
+    assert!((f[2] + f[3]).abs() < 1e-6 * f[2].abs(), "{f:?}");
+    let total: platen_model::multi_axis::Wrench = (0..f.len())
+        .map(|i| t.actuator_at(i, &q).unit_wrench * f[i])
+        .sum();
+    let needed = t.required_wrench(&q, &Coords::zeros(), &qdd) - s.struts;
+    assert!((total - needed).norm() < 1e-8 * needed.norm());
+    assert!(s.constraint.norm() < 1e-8 * needed.norm());
 }

@@ -120,17 +120,7 @@ pub fn translation(q: &Coords) -> Vector3<f64> {
 pub fn angular_rate_map(q: &Coords) -> Matrix3<f64> {
     let (sp, cp) = q[4].sin_cos();
     let (sy, cy) = q[5].sin_cos();
-    Matrix3::new(
-        cy * cp,
-        -sy,
-        0.0,
-        sy * cp,
-        cy,
-        0.0,
-        -sp,
-        0.0,
-        1.0,
-    )
+    Matrix3::new(cy * cp, -sy, 0.0, sy * cp, cy, 0.0, -sp, 0.0, 1.0)
 }
 
 /// `Ė·θ̇`: the part of the angular acceleration `ω̇ = E·θ̈ + Ė·θ̇` that the angle rates give

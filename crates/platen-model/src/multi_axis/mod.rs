@@ -22,6 +22,7 @@
 //!   its base.
 
 mod dof;
+mod friction;
 mod modes;
 mod specimen;
 mod table;
@@ -30,9 +31,10 @@ pub use dof::{
     angular_rate_bias, angular_rate_map, angular_velocity, rotation, translation, Coords, Dof,
     DofSet,
 };
+pub use friction::{Contact, ContactLoad, InverseSample};
 pub use modes::Mode;
 pub use specimen::LinearSpecimen;
 pub use table::{
-    Actuator, ActuatorPose, Bearing, BearingLoad, MultiAxisTable, Mount, Pad, Point, RigidPlaten,
+    Actuator, ActuatorPose, Bearing, BearingLoad, Mount, MultiAxisTable, Pad, Point, RigidPlaten,
     Strut, StrutPose, TableParts, Wrench,
 };

@@ -89,11 +89,17 @@ pub(crate) fn generalised_modes(m: &DMatrix<f64>, k: &DMatrix<f64>) -> Vec<(f64,
     let mut modes: Vec<(f64, DVector<f64>)> = (0..m.nrows())
         .map(|i| {
             let mut phi = l_inv.transpose() * eig.eigenvectors.column(i);
-            let big = phi.iter().copied().fold(0.0, |b: f64, x| if x.abs() > b.abs() { x } else { b });
+            let big = phi
+                .iter()
+                .copied()
+                .fold(0.0, |b: f64, x| if x.abs() > b.abs() { x } else { b });
             if big < 0.0 {
                 phi = -phi;
             }
-            (eig.eigenvalues[i].max(0.0).sqrt() / std::f64::consts::TAU, phi)
+            (
+                eig.eigenvalues[i].max(0.0).sqrt() / std::f64::consts::TAU,
+                phi,
+            )
         })
         .collect();
     modes.sort_by(|a, b| a.0.total_cmp(&b.0));

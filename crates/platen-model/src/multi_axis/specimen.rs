@@ -32,7 +32,10 @@ fn invalid(path: &str, expected: impl Into<String>) -> ModelError {
 
 fn square(path: &str, m: &DMatrix<f64>, n: usize) -> Result<()> {
     if m.nrows() != n || m.ncols() != n {
-        return Err(invalid(path, format!("a {n}×{n} matrix (one row and column per DOF)")));
+        return Err(invalid(
+            path,
+            format!("a {n}×{n} matrix (one row and column per DOF)"),
+        ));
     }
     if !m.iter().all(|x| x.is_finite()) {
         return Err(invalid(path, "finite numbers"));
@@ -64,7 +67,9 @@ impl LinearSpecimen {
         square("specimen.mass_matrix", &mass, n)?;
         square("specimen.stiffness_matrix", &stiffness, n)?;
         square("specimen.damping_matrix", &damping, n)?;
-        if influence.nrows() != n || influence.ncols() != 6 || !influence.iter().all(|x| x.is_finite())
+        if influence.nrows() != n
+            || influence.ncols() != 6
+            || !influence.iter().all(|x| x.is_finite())
         {
             return Err(invalid(
                 "specimen.influence",
@@ -72,9 +77,15 @@ impl LinearSpecimen {
             ));
         }
         let Some(chol) = mass.clone().cholesky() else {
-            return Err(invalid("specimen.mass_matrix", "a positive definite matrix"));
+            return Err(invalid(
+                "specimen.mass_matrix",
+                "a positive definite matrix",
+            ));
         };
-        for (path, m) in [("specimen.stiffness_matrix", &stiffness), ("specimen.damping_matrix", &damping)] {
+        for (path, m) in [
+            ("specimen.stiffness_matrix", &stiffness),
+            ("specimen.damping_matrix", &damping),
+        ] {
             let eig = m.clone().symmetric_eigenvalues();
             let scale = m.abs().max();
             if eig.min() < -1e-9 * scale {
@@ -150,7 +161,12 @@ impl LinearSpecimen {
 
     /// Its relative accelerations `z̈ = −Γ·a − M⁻¹·(C·ż + K·z)` under the platen's
     /// acceleration `a = (ẗ, ω̇)`.
-    pub fn accelerations(&self, z: &DVector<f64>, zd: &DVector<f64>, platen: &Wrench) -> DVector<f64> {
+    pub fn accelerations(
+        &self,
+        z: &DVector<f64>,
+        zd: &DVector<f64>,
+        platen: &Wrench,
+    ) -> DVector<f64> {
         -(&self.influence * platen) - &self.mass_inverse * self.restoring(z, zd)
     }
 

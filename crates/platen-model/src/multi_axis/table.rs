@@ -44,7 +44,10 @@ fn positive(path: String, value: f64, unit: &str) -> Result<f64> {
     if value.is_finite() && value > 0.0 {
         Ok(value)
     } else {
-        Err(invalid(path, format!("a finite number > 0, {unit} (got {value})")))
+        Err(invalid(
+            path,
+            format!("a finite number > 0, {unit} (got {value})"),
+        ))
     }
 }
 
@@ -52,7 +55,10 @@ fn non_negative(path: String, value: f64, unit: &str) -> Result<f64> {
     if value.is_finite() && value >= 0.0 {
         Ok(value)
     } else {
-        Err(invalid(path, format!("a finite number >= 0, {unit} (got {value})")))
+        Err(invalid(
+            path,
+            format!("a finite number >= 0, {unit} (got {value})"),
+        ))
     }
 }
 
@@ -294,7 +300,11 @@ impl MultiAxisTable {
     /// a bearing on an unknown or pad actuator, duplicate names, …), and
     /// [`ModelError::UncontrolledDof`] when the actuators cannot move a DOF that is not held.
     pub fn new(parts: TableParts) -> Result<Self> {
-        positive("oil_bulk_modulus_pa".into(), parts.oil_bulk_modulus_pa, "Pa")?;
+        positive(
+            "oil_bulk_modulus_pa".into(),
+            parts.oil_bulk_modulus_pa,
+            "Pa",
+        )?;
         let mut neutral_lengths_m = Vec::with_capacity(parts.actuators.len());
         for (i, a) in parts.actuators.iter().enumerate() {
             let at = |key: &str| format!("actuators[{i}].{key}");
@@ -302,7 +312,10 @@ impl MultiAxisTable {
                 return Err(invalid(at("name"), "a non-empty name"));
             }
             if parts.actuators[..i].iter().any(|b| b.name == a.name) {
-                return Err(invalid(at("name"), format!("a name used once (`{}` repeats)", a.name)));
+                return Err(invalid(
+                    at("name"),
+                    format!("a name used once (`{}` repeats)", a.name),
+                ));
             }
             finite_point(&at("base_m"), &a.base_m)?;
             positive(at("cap_side_area_m2"), a.cap_side_area_m2, "m²")?;
@@ -329,7 +342,11 @@ impl MultiAxisTable {
                             "a direction that crosses the platen's underside (not horizontal)",
                         ));
                     }
-                    non_negative(at("pad.friction_coefficient"), pad.friction_coefficient, "1")?;
+                    non_negative(
+                        at("pad.friction_coefficient"),
+                        pad.friction_coefficient,
+                        "1",
+                    )?;
                     neutral_lengths_m.push(0.0);
                 }
             }
@@ -340,7 +357,10 @@ impl MultiAxisTable {
             if parts.struts[..j].iter().any(|b| b.name == s.name)
                 || parts.actuators.iter().any(|a| a.name == s.name)
             {
-                return Err(invalid(at("name"), format!("a name used once (`{}` repeats)", s.name)));
+                return Err(invalid(
+                    at("name"),
+                    format!("a name used once (`{}` repeats)", s.name),
+                ));
             }
             finite_point(&at("base_m"), &s.base_m)?;
             finite_point(&at("platen_m"), &s.platen_m)?;
@@ -353,7 +373,10 @@ impl MultiAxisTable {
             }
             let length = (s.platen_m - s.base_m).norm();
             if length <= 1e-6 {
-                return Err(invalid(at("platen_m"), "a platen point apart from the base point"));
+                return Err(invalid(
+                    at("platen_m"),
+                    "a platen point apart from the base point",
+                ));
             }
             strut_neutral_m.push(length);
         }
@@ -367,12 +390,10 @@ impl MultiAxisTable {
                 }
                 BearingLoad::Actuator(i) => match parts.actuators.get(i).map(|a| &a.mount) {
                     Some(Mount::Swivel { .. }) => {}
-                    _ => {
-                        return Err(invalid(
-                            at("actuator"),
-                            "the name of a swivel-mounted actuator (a pad carries its own friction)",
-                        ))
-                    }
+                    _ => return Err(invalid(
+                        at("actuator"),
+                        "the name of a swivel-mounted actuator (a pad carries its own friction)",
+                    )),
                 },
             }
         }
@@ -468,8 +489,8 @@ impl MultiAxisTable {
             Mount::Pad(pad) => {
                 // The axis point c + s·a on the plane {t + R·p : p_z = c_z}.
                 let normal = r * Vector3::z();
-                let s = (pad.contact_m[2] - normal.dot(&(pad.contact_m - t)))
-                    / normal.dot(&pad.axis);
+                let s =
+                    (pad.contact_m[2] - normal.dot(&(pad.contact_m - t))) / normal.dot(&pad.axis);
                 let point = pad.contact_m + pad.axis.into_inner() * s;
                 ActuatorPose {
                     stroke_m: s,
@@ -502,7 +523,9 @@ impl MultiAxisTable {
 
     /// The struts' wrench on the platen at pose `q`.
     pub fn struts_wrench(&self, q: &Coords) -> Wrench {
-        (0..self.parts.struts.len()).map(|j| self.strut_at(j, q).wrench).sum()
+        (0..self.parts.struts.len())
+            .map(|j| self.strut_at(j, q).wrench)
+            .sum()
     }
 
     /// The rigid-body mass matrix about the reference point in table axes at pose `q`:
@@ -516,10 +539,12 @@ impl MultiAxisTable {
         let x = rc.cross_matrix();
         let m = p.mass_kg;
         let mut out = Matrix6::zeros();
-        out.fixed_view_mut::<3, 3>(0, 0).copy_from(&(Matrix3::identity() * m));
+        out.fixed_view_mut::<3, 3>(0, 0)
+            .copy_from(&(Matrix3::identity() * m));
         out.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-x * m));
         out.fixed_view_mut::<3, 3>(3, 0).copy_from(&(x * m));
-        out.fixed_view_mut::<3, 3>(3, 3).copy_from(&(iw - x * x * m));
+        out.fixed_view_mut::<3, 3>(3, 3)
+            .copy_from(&(iw - x * x * m));
         out
     }
 
@@ -558,8 +583,7 @@ impl MultiAxisTable {
         let omega = e * qd.fixed_rows::<3>(3);
         let alpha = e * qdd.fixed_rows::<3>(3) + angular_rate_bias(q, qd);
         let acc = Vector6::new(qdd[0], qdd[1], qdd[2], alpha[0], alpha[1], alpha[2]);
-        self.spatial_mass_matrix(q) * acc + self.velocity_wrench(q, &omega)
-            - self.gravity_wrench(q)
+        self.spatial_mass_matrix(q) * acc + self.velocity_wrench(q, &omega) - self.gravity_wrench(q)
     }
 
     /// The generalised force `Q = Jᵀ·W` of a wrench about the reference point, with
