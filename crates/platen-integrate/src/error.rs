@@ -77,6 +77,13 @@ pub enum IntegrateError {
         /// The fitted interval, s.
         interval_s: f64,
     },
+    /// The actuators of a multi-axis table cannot hold its free DOFs at the pose of a
+    /// sample (their geometry loses rank there).
+    #[error("at t = {t_s} s the actuators cannot hold the platen's free DOFs (their geometry loses rank at that pose)")]
+    Unresolvable {
+        /// The sample's time, s.
+        t_s: f64,
+    },
     /// The integration step does not divide the sample interval.
     #[error(
         "step_s = {step_s} s does not divide the sample interval {sample_interval_s} s into a \

@@ -67,6 +67,7 @@ mod grid;
 mod inverse;
 mod machine;
 mod method;
+mod multi_axis;
 mod output;
 mod record;
 mod rk4;
@@ -82,6 +83,7 @@ pub use error::{IntegrateError, Result};
 pub use event::EventKind;
 pub use inverse::{inverse, inverse_specimen, INVERSE_SPECIMEN_SUBSTEPS};
 pub use method::{ForwardIntegrator, Method};
+pub use multi_axis::{inverse_table, PoseMotion, TableRun};
 pub use output::{
     Exceedance, Peak, Peaks, Sample, SampleSink, SpecimenColumns, SpecimenSample, SystemColumns,
     SystemSample, Trajectory,

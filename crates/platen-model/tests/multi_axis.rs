@@ -377,3 +377,27 @@ fn redundant_actuators_resolve_without_squeeze() {
     assert!((total - needed).norm() < 1e-8 * needed.norm());
     assert!(s.constraint.norm() < 1e-8 * needed.norm());
 }
+
+/// Along x alone the capacities are the x pair's: stroke ±0.75 m (the y pair and the pads
+/// stay within theirs), force 2·(A_cap·p_s − A_rod·p_r) and that force over the mass.
+#[test]
+fn the_capacities_of_a_table_held_but_in_x_are_its_x_pairs() {
+    let t = table(&[Dof::Y, Dof::Z, Dof::Roll, Dof::Pitch, Dof::Yaw], [0.0; 3]);
+    let caps = t.capacities(21e6, 0.5e6);
+    assert_eq!(caps.len(), 1);
+    let c = caps[0];
+    assert_eq!(c.dof, Dof::X);
+    assert!((c.stroke - 0.75).abs() < 1e-9, "{c:?}");
+    let force = 2.0 * (0.05 * 21e6 - 0.05 * 0.5e6);
+    assert!((c.force / force - 1.0).abs() < 1e-12, "{c:?}");
+    assert!(
+        (c.acceleration / (force / MASS_KG) - 1.0).abs() < 1e-12,
+        "{c:?}"
+    );
+    // All six free: yaw's stroke is where the first actuator reaches its end.
+    let caps = table(&[], [0.0, 0.0, -0.45]).capacities(21e6, 0.5e6);
+    assert_eq!(caps.len(), 6);
+    assert!(caps
+        .iter()
+        .all(|c| c.stroke > 0.0 && c.force > 0.0 && c.acceleration > 0.0));
+}

@@ -35,6 +35,6 @@ pub use friction::{Contact, ContactLoad, InverseSample};
 pub use modes::Mode;
 pub use specimen::LinearSpecimen;
 pub use table::{
-    Actuator, ActuatorPose, Bearing, BearingLoad, Mount, MultiAxisTable, Pad, Point, RigidPlaten,
-    Strut, StrutPose, TableParts, Wrench,
+    Actuator, ActuatorPose, AxisCapacity, Bearing, BearingLoad, Mount, MultiAxisTable, Pad, Point,
+    RigidPlaten, Strut, StrutPose, TableParts, Wrench,
 };
