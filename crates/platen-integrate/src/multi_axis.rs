@@ -146,10 +146,12 @@ impl Columns {
 
 /// The inverse of the multi-axis platen: at every sample of `motion`, the actuator forces
 /// ([`MultiAxisTable::inverse`]) with every term, the actuators' strokes, the struts' pulls
-/// and, with a `specimen`, its base force and overturning moments. The specimen starts at
-/// rest relative to the platen and is driven by the platen's acceleration `(ẗ, ω̇)`, linear
-/// between samples, with [`INVERSE_SPECIMEN_SUBSTEPS`] RK4 sub-steps per interval (as the
-/// uniaxial [`inverse_specimen`](crate::inverse_specimen)).
+/// and, with a `specimen`, its base force and overturning moments. The specimen is driven by
+/// the platen's acceleration `(ẗ, ω̇)` less gravity's `(0, 0, −g)` (so that it weighs on the
+/// platen), linear between samples, with [`INVERSE_SPECIMEN_SUBSTEPS`] RK4 sub-steps per
+/// interval (as the uniaxial [`inverse_specimen`](crate::inverse_specimen)); it starts at
+/// rest in its static deflection under its weight (undeflected if its stiffness is
+/// singular). A specimen with no vertical share (storeys along x) does not weigh.
 ///
 /// Columns: `t_s`; the pose `x_m` … `yaw_rad`, rates `x_m_s` … `yaw_rad_s`, accelerations
 /// `x_m_s2` … `yaw_rad_s2`; per actuator `{name}_stroke_m`, `{name}_force_n`; per strut
@@ -193,15 +195,19 @@ pub fn inverse_table(
         names.extend(wrench_names(term));
     }
     let mut out = Columns::new(names, n);
-    let mut spec = specimen.map(|s| SpecimenState::new(s.len()));
+    let mut spec = specimen.map(|s| SpecimenState {
+        z: s.equilibrium_under(&-GRAVITY)
+            .unwrap_or_else(|| DVector::zeros(s.len())),
+        zd: DVector::zeros(s.len()),
+    });
     let mut row = Vec::new();
     let t = motion.t_s();
     for i in 0..n {
         let (q, qd, qdd) = motion.at(i);
         if let (Some(s), Some(st)) = (specimen, spec.as_mut()) {
             if i > 0 {
-                let a0 = platen_acceleration(&motion.at(i - 1));
-                let a1 = platen_acceleration(&(q, qd, qdd));
+                let a0 = platen_acceleration(&motion.at(i - 1)) - GRAVITY;
+                let a1 = platen_acceleration(&(q, qd, qdd)) - GRAVITY;
                 st.advance(s, t[i] - t[i - 1], &a0, &a1);
             }
         }
@@ -240,6 +246,16 @@ pub fn inverse_table(
     Ok(out.finish())
 }
 
+/// Gravity as a spatial acceleration, m/s².
+const GRAVITY: Wrench = Wrench::new(
+    0.0,
+    0.0,
+    -platen_model::STANDARD_GRAVITY_M_S2,
+    0.0,
+    0.0,
+    0.0,
+);
+
 /// The platen's acceleration `(ẗ, ω̇)` from its pose, rates and second derivatives.
 fn platen_acceleration((q, qd, qdd): &(Coords, Coords, Coords)) -> Wrench {
     let e = platen_model::multi_axis::angular_rate_map(q);
@@ -254,13 +270,6 @@ struct SpecimenState {
 }
 
 impl SpecimenState {
-    fn new(n: usize) -> Self {
-        SpecimenState {
-            z: DVector::zeros(n),
-            zd: DVector::zeros(n),
-        }
-    }
-
     /// RK4 over an interval of `dt` s with the platen's acceleration linear from `a0` to `a1`.
     fn advance(&mut self, s: &LinearSpecimen, dt: f64, a0: &Wrench, a1: &Wrench) {
         let steps = INVERSE_SPECIMEN_SUBSTEPS;

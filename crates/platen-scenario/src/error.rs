@@ -27,6 +27,18 @@ pub enum ScenarioError {
     #[error(transparent)]
     Io(#[from] IoError),
 
+    /// A scenario of a multi-axis table (with a `table`) where the uniaxial platen's scenario
+    /// was asked for: it runs through [`crate::multi_axis::TableScenario`].
+    #[error("`{}`: this scenario has a multi-axis `table`: `platen simulate` and `platen model` run it; this command takes the uniaxial platen's scenarios only, for now", path.display())]
+    MultiAxis {
+        /// The scenario file.
+        path: PathBuf,
+    },
+
+    /// A multi-axis run failed (the actuators lose rank at a pose of the motion).
+    #[error("the multi-axis run failed: {0}; no output was written")]
+    TableRun(#[source] IntegrateError),
+
     /// A record is shorter than the scenario's `duration_s`.
     #[error("`{}`: record spans {span_s} s{} but the scenario's duration_s is {duration_s} s", path.display(), samples.map_or(String::new(), |n| format!(" ({n} samples)")))]
     RecordTooShort {

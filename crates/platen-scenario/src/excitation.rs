@@ -571,7 +571,7 @@ pub(crate) fn rejected(path: &Path, cause: impl Into<IntegrateError>) -> Scenari
 /// Reads platen's columns `required` and `optional` from `path` through the excitation's
 /// `columns` mapping (file headers and units), in SI units. The time column must increase
 /// strictly; a violation names its line.
-fn read_mapped(
+pub(crate) fn read_mapped(
     ctx: &Ctx,
     path: &Path,
     ex: &ExcitationSpec,

@@ -27,8 +27,9 @@ pub struct ScenarioFile {
     /// Free text.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub description: Option<String>,
-    /// The model.
-    pub model: ModelSpec,
+    /// The model of the uniaxial platen (required without a `table`; absent with one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub model: Option<ModelSpec>,
     /// The excitation.
     pub excitation: ExcitationSpec,
     /// The integrator (forward runs).
@@ -52,14 +53,43 @@ pub struct ScenarioFile {
     /// ([`crate::system`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub table_system: Option<crate::system_file::TableSystemSpec>,
+    /// A multi-axis (six-DOF) table instead of the uniaxial platen of `model`
+    /// ([`crate::multi_axis`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub table: Option<crate::multi_axis::TableSpec>,
 }
 
-/// `specimen`: a linear shear building fixed on the platen.
-#[derive(Debug, Clone, Deserialize, Serialize, JsonSchema)]
+/// `specimen`: a linear shear building fixed on the platen (`storeys`), or, on a multi-axis
+/// `table`, a general linear specimen (the four matrices).
+#[derive(Debug, Clone, Default, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SpecimenSpec {
     /// The storeys, bottom first (1 to 12).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub storeys: Vec<StoreySpec>,
+    /// Mass matrix, n × n, SI units per DOF (kg or kg·m²), DOFs relative to the platen.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mass_matrix: Option<Vec<Vec<f64>>>,
+    /// Stiffness matrix, n × n (N/m or N·m/rad per DOF).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stiffness_matrix: Option<Vec<Vec<f64>>>,
+    /// Damping matrix, n × n (N·s/m or N·m·s/rad per DOF).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub damping_matrix: Option<Vec<Vec<f64>>>,
+    /// Influence matrix, n rows of six numbers: each DOF's rigid-body share of the platen's
+    /// x, y, z, roll, pitch, yaw.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub influence: Option<Vec<Vec<f64>>>,
+}
+
+impl SpecimenSpec {
+    /// Whether it is the general linear form (any of the four matrices given).
+    pub fn is_general(&self) -> bool {
+        self.mass_matrix.is_some()
+            || self.stiffness_matrix.is_some()
+            || self.damping_matrix.is_some()
+            || self.influence.is_some()
+    }
 }
 
 /// One storey of `specimen.storeys`.

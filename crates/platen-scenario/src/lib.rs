@@ -29,6 +29,7 @@ mod execute;
 pub mod file;
 pub mod generate;
 mod model;
+pub mod multi_axis;
 pub mod recorded;
 mod rig;
 pub mod sampling;

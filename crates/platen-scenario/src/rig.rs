@@ -27,7 +27,7 @@ use platen_model::{ModelError, Preset, Specimen, Storey, TableLimits};
 use platen_system::TableSystem;
 
 use crate::ctx::{check_finite, check_positive, Ctx};
-use crate::error::Result;
+use crate::error::{Result, ScenarioError};
 use crate::file::{InitialSpec, IntegratorSpec, LimitsSpec, ModelSpec, ScenarioFile, SpecimenSpec};
 use crate::model::{build_model, model_overrides, Model, ModelKey, ModelOverrides};
 use crate::system::{build_table_system, loop_method};
@@ -289,14 +289,30 @@ pub(crate) struct RigKeys<'a> {
 }
 
 impl<'a> RigKeys<'a> {
-    /// The rig's keys of a whole scenario file.
-    pub(crate) fn of(file: &'a ScenarioFile) -> Self {
-        RigKeys {
-            model: &file.model,
+    /// The rig's keys of a whole scenario file of the uniaxial platen.
+    ///
+    /// # Errors
+    /// A file without `model` (a multi-axis file, with a `table`, is not a rig of the
+    /// uniaxial platen: [`crate::multi_axis::TableScenario`]).
+    pub(crate) fn of(ctx: &Ctx, file: &'a ScenarioFile) -> Result<Self> {
+        if file.table.is_some() {
+            return Err(ScenarioError::MultiAxis {
+                path: ctx.path.to_owned(),
+            });
+        }
+        let model = file.model.as_ref().ok_or_else(|| {
+            ctx.invalid(
+                "model",
+                "(absent)",
+                "a model, for example {\"preset\": \"lhpost-2008\"} (or a multi-axis `table`)",
+            )
+        })?;
+        Ok(RigKeys {
+            model,
             limits: file.limits.as_ref(),
             specimen: file.specimen.as_ref(),
             table_system: file.table_system.as_ref(),
-        }
+        })
     }
 }
 
@@ -363,6 +379,13 @@ fn build_specimen(ctx: &Ctx, given: Option<&SpecimenSpec>) -> Result<Option<Spec
     let Some(given) = given else {
         return Ok(None);
     };
+    if given.is_general() {
+        return Err(ctx.invalid(
+            "specimen.mass_matrix",
+            "(a general linear specimen)",
+            "storeys: a general linear specimen (matrices) runs on a multi-axis `table` for now",
+        ));
+    }
     let storeys = given
         .storeys
         .iter()

@@ -125,7 +125,7 @@ impl Scenario {
         run: impl FnOnce(&Ctx, &ScenarioFile) -> Result<(Run, Derived)>,
     ) -> Result<Self> {
         let ctx = Ctx { path };
-        let keys = RigKeys::of(file);
+        let keys = RigKeys::of(&ctx, file)?;
         let start = RigStart::validate(&ctx, &keys)?;
         let (run, derived) = run(&ctx, file)?;
         if let (Some(rel), Run::Inverse { motion }) = (&file.excitation.motion_csv, &run) {

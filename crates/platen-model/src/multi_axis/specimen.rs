@@ -170,6 +170,13 @@ impl LinearSpecimen {
         -(&self.influence * platen) - &self.mass_inverse * self.restoring(z, zd)
     }
 
+    /// Its static deflection under a steady platen acceleration `a` (gravity as the
+    /// acceleration `−g`): `K·z = −M·Γ·a`. `None` if the stiffness is singular.
+    pub fn equilibrium_under(&self, a: &Wrench) -> Option<DVector<f64>> {
+        let load = -(&self.mass * (&self.influence * a));
+        self.stiffness.clone().cholesky().map(|c| c.solve(&load))
+    }
+
     /// Its rigid-body mass about the reference point, `Γᵀ·M·Γ` (6 × 6).
     pub fn rigid_mass(&self) -> Matrix6<f64> {
         let m = self.influence.transpose() * &self.mass * &self.influence;
