@@ -66,7 +66,7 @@ pub fn system_scenario(
         description: None,
         // The format needs a preset; every value of the identified form is given, and every
         // limit, so the preset contributes nothing.
-        model: ModelSpec {
+        model: Some(ModelSpec {
             preset: "lhpost-2008".into(),
             hold_down_pressure_mpa: None,
             identified: Some(IdentifiedOverrides {
@@ -79,7 +79,7 @@ pub fn system_scenario(
                 low_velocity_decay_s_per_m: Some(m.low_velocity_decay_s_per_m),
             }),
             full: None,
-        },
+        }),
         excitation: held_excitation(held_path, columns),
         integrator: None,
         initial: None,
@@ -93,8 +93,10 @@ pub fn system_scenario(
                     damping_n_s_per_m: s.damping_n_s_per_m,
                 })
                 .collect(),
+            ..SpecimenSpec::default()
         }),
         table_system: Some(TableSystemSpec::from(&sys)),
+        table: None,
     };
     // Every key a string and every number finite or null: the conversion cannot fail.
     let scenario = serde_json::to_value(&file).unwrap_or_default();
