@@ -13,6 +13,9 @@
 //! * [`system_figures`] draws the Bode plots of a table system's linearised loop
 //!   (`platen model --system … --plot`), on a logarithmic frequency axis
 //!   ([`Panel::x_log`]).
+//! * [`table_figures`] draws a run of the multi-axis (six-DOF) platen: its pose, the
+//!   actuators' strokes and forces against their limits, and the specimen's overturning
+//!   moments and base forces.
 //! * [`plan_figures`] draws a test plan (`platen plan --plot`, `--report`): target against
 //!   achieved acceleration, response spectra, convergence and the limits' margins.
 //! * [`render`] writes them: SVG, PNG copies rendered by resvg with the embedded Noto Sans,
@@ -79,6 +82,7 @@ pub mod sweep_figures;
 pub mod sweep_report;
 pub mod system_figures;
 pub mod system_identify_report;
+pub mod table_figures;
 pub mod text;
 
 pub use error::{ReportError, Result};
