@@ -45,14 +45,19 @@ const CONTRACT_COLUMNS: [&str; 8] = [
     "dissipative_force_n",
 ];
 
-/// The shipped scenarios but the paper's periodic program (scenarios/paper-tests, 72 files,
-/// run in tests/paper_program.rs): those that need a PEER record (a `ground_motion`) and the
-/// others.
+/// The shipped scenarios of the uniaxial platen but the paper's periodic program
+/// (scenarios/paper-tests, 72 files, run in tests/paper_program.rs): those that need a PEER
+/// record (a `ground_motion`) and the others. The multi-axis ones (scenarios/multi-axis)
+/// have their own columns: tests/multi_axis_cli.rs.
 fn shipped_scenarios() -> (Vec<PathBuf>, Vec<PathBuf>) {
     let mut paths = Vec::new();
     for entry in std::fs::read_dir(workspace().join("scenarios")).unwrap() {
         let path = entry.unwrap().path();
-        if path.is_dir() && path.file_name().is_some_and(|n| n != "paper-tests") {
+        if path.is_dir()
+            && path
+                .file_name()
+                .is_some_and(|n| n != "paper-tests" && n != "multi-axis")
+        {
             paths.extend(std::fs::read_dir(&path).unwrap().map(|e| e.unwrap().path()));
         } else {
             paths.push(path);

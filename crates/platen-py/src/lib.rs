@@ -34,7 +34,7 @@ use crate::error::{detached, Fail, Kind};
 
 /// What a run hands to Python: the column names, one float64 array per column (moved, not
 /// copied), and the summary as JSON text (keys in alphabetical order, as `--json`).
-type RunParts<'py> = (Vec<&'static str>, Vec<Bound<'py, PyArray1<f64>>>, String);
+type RunParts<'py> = (Vec<String>, Vec<Bound<'py, PyArray1<f64>>>, String);
 
 /// A scenario given as a file (`path`) or as JSON text named `origin`.
 fn load(
@@ -121,7 +121,35 @@ fn to_python(py: Python<'_>, (mut trajectory, summary): (Trajectory, String)) ->
             .map(|c| c.into_pyarray(py)),
         );
     }
+    (
+        names.into_iter().map(String::from).collect(),
+        arrays,
+        summary,
+    )
+}
+
+/// A multi-axis scenario's run: its named columns as NumPy arrays and its summary.
+fn table_to_python(
+    py: Python<'_>,
+    (run, summary): (platen_integrate::TableRun, String),
+) -> RunParts<'_> {
+    let (names, arrays) = run
+        .columns
+        .into_iter()
+        .map(|(name, column)| (name, column.into_pyarray(py)))
+        .unzip();
     (names, arrays, summary)
+}
+
+/// Runs a parsed scenario file of a multi-axis table (one with a `table`).
+fn run_table(
+    path: &Path,
+    parsed: &file::ScenarioFile,
+) -> Result<(platen_integrate::TableRun, String), Fail> {
+    let scenario = platen_scenario::multi_axis::TableScenario::from_file(path, parsed)?;
+    let run = scenario.run()?;
+    let summary = json_text(&scenario.summary(&run, None))?;
+    Ok((run, summary))
 }
 
 /// Runs a scenario file or a scenario dict's JSON text: `platen.simulate`.
@@ -133,8 +161,25 @@ fn simulate<'py>(
     text: Option<String>,
     origin: String,
 ) -> PyResult<RunParts<'py>> {
+    let (path, parsed) = match (path, text) {
+        (Some(path), _) => {
+            let parsed: file::ScenarioFile =
+                platen_io::json::parse_json_file(&path).map_err(Fail::from)?;
+            (path, parsed)
+        }
+        (None, Some(text)) => {
+            let origin = PathBuf::from(&origin);
+            let parsed = file::parse(&origin, &text).map_err(Fail::from)?;
+            (origin, parsed)
+        }
+        (None, None) => return Err(Fail::input("no scenario: give a path or a dict").into()),
+    };
+    if parsed.table.is_some() {
+        let parts = detached(py, move || run_table(&path, &parsed))?;
+        return Ok(table_to_python(py, parts));
+    }
     let parts = detached(py, move || {
-        let (path, scenario) = load(path.as_deref(), text.as_deref(), &origin)?;
+        let scenario = Scenario::from_file(&path, parsed)?;
         run_scenario(&scenario, &path)
     })?;
     Ok(to_python(py, parts))

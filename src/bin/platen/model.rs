@@ -90,6 +90,12 @@ pub fn run(args: &ModelArgs) -> Result<()> {
              ({names}) or a --scenario with a `table_system`"
         );
     }
+    if let Some(path) = &args.scenario {
+        let file: platen_scenario::file::ScenarioFile = platen_io::json::parse_json_file(path)?;
+        if file.table.is_some() {
+            return describe_table(args, path, &file);
+        }
+    }
     let mut described = match &args.scenario {
         Some(path) => of_scenario(path)?,
         None => of_preset(args)?,
@@ -215,4 +221,30 @@ fn system_preset(name: &str, stroke_m: f64) -> Result<TableSystem> {
         .check_stroke(stroke_m)
         .with_context(|| format!("--system {name} over the stroke ±{stroke_m} m"))?;
     Ok(system)
+}
+
+/// `platen model --scenario` on a multi-axis scenario: its modes and capacities.
+fn describe_table(
+    args: &ModelArgs,
+    path: &Path,
+    file: &platen_scenario::file::ScenarioFile,
+) -> Result<()> {
+    if args.system.is_some() || args.plot.is_some() {
+        bail!(
+            "`{}` has a multi-axis `table`: --system and --plot describe the uniaxial table \
+             system's loop",
+            path.display()
+        );
+    }
+    let scenario = platen_scenario::multi_axis::TableScenario::from_file(path, file)?;
+    let description = scenario.describe();
+    if args.json {
+        outln!("{}", serde_json::to_string_pretty(&description)?);
+    } else {
+        out!(
+            "{}",
+            platen_scenario::multi_axis::description_text(&description)
+        );
+    }
+    Ok(())
 }

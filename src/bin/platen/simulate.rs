@@ -10,6 +10,8 @@ use anyhow::{Context, Result};
 
 use platen_report::simulate_report::with_outputs;
 use platen_report::{run_figures, run_figures::RunRecorder};
+use platen_scenario::file::ScenarioFile;
+use platen_scenario::multi_axis::TableScenario;
 use platen_scenario::{CsvSink, Run, RunSummary, Scenario};
 
 use crate::progress::{Progress, Ticker};
@@ -49,7 +51,11 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     let size = args.size.size();
     let (path, out) = (args.scenario.as_path(), args.out.as_deref());
     let plot = args.plot.as_deref();
-    let mut scenario = Scenario::load(path)?;
+    let file: ScenarioFile = platen_io::json::parse_json_file(path)?;
+    if file.table.is_some() {
+        return run_table(args, path, &file);
+    }
+    let mut scenario = Scenario::from_file(path, file)?;
     if let Some(p) = args.pressure_mpa {
         scenario = scenario
             .at_pressure(p * 1e6)
@@ -108,6 +114,52 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         let text =
             platen_report::simulate_report::text(&scenario, &output, &summary, out, &written);
         out!("{text}");
+    }
+    Ok(())
+}
+
+/// `platen simulate` on a scenario of a multi-axis table: the run's columns to `--out`, its
+/// summary, and (with `--plot`) its figures.
+fn run_table(args: &SimulateArgs, path: &std::path::Path, file: &ScenarioFile) -> Result<()> {
+    if args.pressure_mpa.is_some() {
+        anyhow::bail!(
+            "`{}`: --pressure-mpa sets the uniaxial platen's hold-down pressure; a multi-axis \
+             table's struts carry theirs in `table.hold_down_struts[].pressure_pa`",
+            path.display()
+        );
+    }
+    let scenario = TableScenario::from_file(path, file)?;
+    let run = scenario.run()?;
+    let out = args.out.as_deref();
+    if let Some(out) = out {
+        let header: Vec<&str> = run.columns.iter().map(|(n, _)| n.as_str()).collect();
+        let columns: Vec<&[f64]> = run.columns.iter().map(|(_, c)| c.as_slice()).collect();
+        if platen_io::parquet::is_parquet_path(out) {
+            platen_io::parquet::write_parquet_atomic(out, &header, &columns)?;
+        } else {
+            platen_io::csv::write_csv_atomic(out, &header, &columns)?;
+        }
+    }
+    let written = match args.plot.as_deref() {
+        Some(dir) => platen_report::table_figures::write_table_figures(
+            &run,
+            &scenario.table,
+            Some(&scenario.force_limits_n()),
+            dir,
+            args.size.size(),
+        )?,
+        None => Vec::new(),
+    };
+    let summary = scenario.summary(&run, out);
+    if args.json {
+        let figures = args.plot.as_ref().map(|_| written.as_slice());
+        let value = with_outputs(serde_json::to_value(&summary)?, figures, None);
+        outln!("{}", serde_json::to_string_pretty(&value)?);
+    } else {
+        out!(
+            "{}",
+            platen_scenario::multi_axis::summary_text(&summary, &written)
+        );
     }
     Ok(())
 }

@@ -1,0 +1,300 @@
+//! Scenarios of the multi-axis table: the shipped ones run, bad input is refused with its
+//! path before any work, and the inverse agrees with the uniaxial one and with statics.
+
+use std::path::{Path, PathBuf};
+
+use platen_scenario::file::{parse, ScenarioFile};
+use platen_scenario::multi_axis::TableScenario;
+use serde_json::{json, Value};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn shipped(name: &str) -> (PathBuf, ScenarioFile) {
+    let path = root().join("scenarios/multi-axis").join(name);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let file = parse(&path, &text).unwrap();
+    (path, file)
+}
+
+/// A scenario of `table` (and `specimen`) over the motion `csv` (written beside it).
+fn scenario(dir: &Path, mut value: Value, csv: &str) -> Result<TableScenario, String> {
+    std::fs::write(dir.join("motion.csv"), csv).unwrap();
+    value["excitation"] = json!({"motion_csv": "motion.csv"});
+    let path = dir.join("s.json");
+    let text = value.to_string();
+    std::fs::write(&path, &text).unwrap();
+    let file = parse(&path, &text).map_err(|e| e.to_string())?;
+    TableScenario::from_file(&path, &file).map_err(|e| e.to_string())
+}
+
+fn tower_table() -> Value {
+    let (_, file) = shipped("tower-inverse.json");
+    serde_json::to_value(file.table.unwrap()).unwrap()
+}
+
+/// Ten samples at 100 Hz of `columns` (name, value per sample).
+/// A column of a motion: its name and its value at a time.
+type Column<'a> = (&'a str, fn(f64) -> f64);
+
+/// An edit of a table and the text its error must contain.
+type Case = (Box<dyn Fn(&mut Value)>, &'static str);
+
+fn csv(columns: &[Column<'_>]) -> String {
+    let mut s = String::from("t_s");
+    for (n, _) in columns {
+        s += &format!(",{n}");
+    }
+    s += "\n";
+    for i in 0..10 {
+        let t = f64::from(i) * 0.01;
+        s += &format!("{t}");
+        for (_, f) in columns {
+            s += &format!(",{}", f(t));
+        }
+        s += "\n";
+    }
+    s
+}
+
+#[test]
+fn the_shipped_scenarios_run_within_their_limits() {
+    for name in ["tower-inverse.json", "bare-inverse.json"] {
+        let (path, file) = shipped(name);
+        let s = TableScenario::from_file(&path, &file).unwrap();
+        let run = s.run().unwrap();
+        assert_eq!(run.len(), 4001);
+        let summary = s.summary(&run, None);
+        assert!(summary.within_limits, "{name}: {:?}", summary.actuators);
+        assert_eq!(summary.specimen.is_empty(), name == "bare-inverse.json");
+    }
+}
+
+/// At rest, the tower's weight and its eccentricity: the platen holds it up with m·g and
+/// the moment (m·g·e_y, −m·g·e_x) about the reference point (the shipped tower: 2 × 60 t at
+/// (0.9, −0.6) m), to 1e-9 relative (its static deflection is solved, not integrated).
+#[test]
+fn a_tower_at_rest_weighs_with_its_eccentricity() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, file) = shipped("tower-inverse.json");
+    let value = json!({"table": tower_table(), "specimen": serde_json::to_value(file.specimen.unwrap()).unwrap()});
+    let s = scenario(dir.path(), value, &csv(&[("x_m", |_| 0.0)])).unwrap();
+    let run = s.run().unwrap();
+    let w = 120e3 * platen_model::STANDARD_GRAVITY_M_S2;
+    let last = |c: &str| *run.column(c).unwrap().last().unwrap();
+    assert!((last("base_force_z_n") / w - 1.0).abs() < 1e-9);
+    assert!((last("overturning_moment_x_n_m") / (w * -0.6) - 1.0).abs() < 1e-9);
+    assert!((last("overturning_moment_y_n_m") / (-w * 0.9) - 1.0).abs() < 1e-9);
+    assert!(last("base_force_x_n").abs() < 1e-6 * w);
+}
+
+/// Bad tables and motions: each refused with its JSON path or column, before any run.
+#[test]
+fn bad_input_is_refused_with_its_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = csv(&[("x_m", |t| 0.01 * t)]);
+    let cases: Vec<Case> = vec![
+        (
+            Box::new(|t| t["actuators"][2]["platen_m"] = json!([1.0, 2.0])),
+            "actuators[2].platen_m",
+        ),
+        (
+            Box::new(|t| t["actuators"][0]["platen_m"] = t["actuators"][0]["base_m"].clone()),
+            "table.actuators[0].platen_m",
+        ),
+        (
+            Box::new(|t| t["platen"]["inertia_kg_m2"][0][1] = json!(5e5)),
+            "table.platen.inertia_kg_m2",
+        ),
+        (
+            Box::new(|t| t["platen"]["mass_kg"] = json!(-1.0)),
+            "table.platen.mass_kg",
+        ),
+        (
+            Box::new(|t| t["held_dofs"] = json!(["x", "surge"])),
+            "table.held_dofs[1]",
+        ),
+        (Box::new(|t| t["actuators"][0]["bogus"] = json!(1)), "bogus"),
+        (
+            Box::new(|t| {
+                let a = t["actuators"].as_array_mut().unwrap();
+                a.drain(0..4);
+            }),
+            "moves the platen in `x`",
+        ),
+        (
+            Box::new(|t| t["actuators"][5]["pad"]["axis"] = json!([1.0, 0.0, 0.0])),
+            "table.actuators[5].pad.axis",
+        ),
+        (
+            Box::new(|t| t["controller"] = json!({})),
+            "table.controller",
+        ),
+    ];
+    for (edit, expect) in cases {
+        let mut table = tower_table();
+        edit(&mut table);
+        let err = scenario(dir.path(), json!({"table": table}), &good).unwrap_err();
+        assert!(err.contains(expect), "expected `{expect}` in: {err}");
+    }
+    // The motion: no pose column, a non-finite value, time going back.
+    let table = tower_table();
+    let err = scenario(dir.path(), json!({"table": table}), &csv(&[("u_m", |t| t)])).unwrap_err();
+    assert!(err.contains("x_m, y_m"), "{err}");
+    let err = scenario(
+        dir.path(),
+        json!({"table": table}),
+        "t_s,x_m\n0,0\n0.01,nan\n0.02,0\n",
+    )
+    .unwrap_err();
+    assert!(err.contains("line 3") || err.contains("x_m"), "{err}");
+    let err = scenario(
+        dir.path(),
+        json!({"table": table}),
+        "t_s,x_m\n0,0\n0.02,0\n0.01,0\n",
+    )
+    .unwrap_err();
+    assert!(err.contains("line 4"), "{err}");
+    // A uniaxial model beside a table.
+    let err = scenario(
+        dir.path(),
+        json!({"table": table, "model": {"preset": "lhpost-2008"}}),
+        &good,
+    )
+    .unwrap_err();
+    assert!(err.contains("model"), "{err}");
+    // Specimen matrices of the wrong size.
+    let specimen = json!({"mass_matrix": [[1.0]], "stiffness_matrix": [[1.0, 0.0]], "damping_matrix": [[0.0]], "influence": [[1.0, 0, 0, 0, 0, 0]]});
+    let err = scenario(
+        dir.path(),
+        json!({"table": table, "specimen": specimen}),
+        &good,
+    )
+    .unwrap_err();
+    assert!(err.contains("specimen.stiffness_matrix[0]"), "{err}");
+}
+
+/// Storeys on a table held but in x, moving along x: the base shear equals the uniaxial
+/// inverse's (`inverse_specimen`, the same RK4 on the same storeys) to 1e-9 relative.
+#[test]
+fn storeys_on_a_table_held_but_in_x_shear_as_on_the_uniaxial_platen() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut table = tower_table();
+    table["held_dofs"] = json!(["y", "z", "roll", "pitch", "yaw"]);
+    let storeys = json!({"storeys": [
+        {"mass_kg": 20e3, "stiffness_n_per_m": 4e7, "damping_n_s_per_m": 5e4},
+        {"mass_kg": 15e3, "stiffness_n_per_m": 3e7, "damping_n_s_per_m": 4e4}]});
+    let text = {
+        let mut s = String::from("t_s,x_m,x_m_s,x_m_s2\n");
+        for i in 0..2048 {
+            let t = f64::from(i) / 1024.0;
+            let w = std::f64::consts::TAU * 1.3;
+            s += &format!(
+                "{t},{},{},{}\n",
+                0.1 * (w * t).sin(),
+                0.1 * w * (w * t).cos(),
+                -0.1 * w * w * (w * t).sin()
+            );
+        }
+        s
+    };
+    let s = scenario(
+        dir.path(),
+        json!({"table": table, "specimen": storeys}),
+        &text,
+    )
+    .unwrap();
+    let run = s.run().unwrap();
+    let base = run.column("base_force_x_n").unwrap();
+    let frame = platen_model::Specimen::new(vec![
+        platen_model::Storey {
+            mass_kg: 20e3,
+            stiffness_n_per_m: 4e7,
+            damping_n_s_per_m: 5e4,
+        },
+        platen_model::Storey {
+            mass_kg: 15e3,
+            stiffness_n_per_m: 3e7,
+            damping_n_s_per_m: 4e4,
+        },
+    ])
+    .unwrap();
+    let t: Vec<f64> = run.column("t_s").unwrap().to_vec();
+    let motion = platen_integrate::Motion::new(
+        t,
+        run.column("x_m").unwrap().to_vec(),
+        run.column("x_m_s").unwrap().to_vec(),
+        run.column("x_m_s2").unwrap().to_vec(),
+    )
+    .unwrap();
+    let model = platen_model::preset::lhpost_2008_identified(13.8e6)
+        .build()
+        .unwrap();
+    let mut out = platen_integrate::Trajectory::default();
+    platen_integrate::inverse_specimen(&model, &frame, &motion, &mut out);
+    let uni = &out.specimen.as_ref().unwrap().base_shear_n;
+    let peak = uni.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    for (a, b) in base.iter().zip(uni) {
+        assert!((a - b).abs() <= 1e-9 * peak, "{a} against {b}");
+    }
+}
+
+fn numeric_leaves(v: &Value, at: String, out: &mut Vec<String>) {
+    match v {
+        Value::Number(_) => out.push(at),
+        Value::Array(a) => a
+            .iter()
+            .enumerate()
+            .for_each(|(i, x)| numeric_leaves(x, format!("{at}/{i}"), out)),
+        Value::Object(o) => o
+            .iter()
+            .for_each(|(k, x)| numeric_leaves(x, format!("{at}/{k}"), out)),
+        _ => {}
+    }
+}
+
+/// Every number of the tower's table and specimen set to 0, −1, 1e300, −1e-300 or null:
+/// refused with a message or run, never a panic; and a refusal names the key it is about.
+#[test]
+fn no_value_of_a_table_panics() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, file) = shipped("tower-inverse.json");
+    let base = json!({"table": tower_table(), "specimen": serde_json::to_value(file.specimen.unwrap()).unwrap()});
+    let mut leaves = Vec::new();
+    numeric_leaves(&base, String::new(), &mut leaves);
+    assert!(leaves.len() > 150, "{}", leaves.len());
+    let motion = csv(&[("x_m", |t| 0.01 * t), ("roll_rad", |t| 0.001 * t)]);
+    let mut runs = 0;
+    for leaf in &leaves {
+        for v in [
+            json!(0.0),
+            json!(-1.0),
+            json!(1e300),
+            json!(-1e-300),
+            Value::Null,
+        ] {
+            let mut doc = base.clone();
+            *doc.pointer_mut(leaf).unwrap() = v.clone();
+            let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                scenario(dir.path(), doc, &motion)
+                    .and_then(|s| s.run().map(|_| ()).map_err(|e| e.to_string()))
+            }));
+            let Ok(result) = outcome else {
+                panic!("{leaf} = {v}: panicked");
+            };
+            if let Err(e) = result {
+                let key = leaf
+                    .rsplit('/')
+                    .find(|p| p.parse::<usize>().is_err())
+                    .unwrap();
+                assert!(
+                    e.contains(key) || e.contains("moves the platen") || e.contains("rank"),
+                    "{leaf} = {v}: {e}"
+                );
+            }
+            runs += 1;
+        }
+    }
+    assert!(runs > 750);
+}
