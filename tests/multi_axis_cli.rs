@@ -130,3 +130,33 @@ fn a_bad_table_is_refused_before_anything_is_written() {
     assert!(!o.status.success());
     assert!(stderr(&o).contains("multi-axis"), "{}", stderr(&o));
 }
+
+/// The forward scenario: the pose, the actuators' strokes and forces, the work.
+#[test]
+fn the_forward_scenario_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("forward.csv");
+    let o = platen(&[
+        "simulate",
+        &scenario("forward.json"),
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let summary: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(summary["kind"], "forward");
+    assert_eq!(summary["samples"], 2001);
+    let text = std::fs::read_to_string(&out).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    for name in [
+        "x_m",
+        "yaw_rad_s2",
+        "h4_stroke_m",
+        "v1_force_n",
+        "s2_force_n",
+        "actuator_work_j",
+    ] {
+        assert!(header.contains(&name), "{name} in {header:?}");
+    }
+}

@@ -13,13 +13,21 @@ surface, its centre of mass off the platen's centre by (0.9, -0.6) m, with x, y 
 level relative to the platen (a shear frame in x and y, 2 Hz and 1.8 Hz first modes; axial
 columns, about 20 Hz), Rayleigh damping of 2 % at 2 and 10 Hz.
 
+The forward scenario's forces are platen's own: its inverse of the first 10 s of the motion on
+the table with frictionless pads (run with the binary named by PLATEN, default
+target/release/platen: build it first), kept to t_s and the actuator force columns.
+
 Usage (from the repository root, Python 3 only): python3 tools/make_multi_axis_scenarios.py
 The output is deterministic.
 """
 
+import csv
 import json
 import math
 import os
+import subprocess
+import sys
+import tempfile
 
 OUT = "scenarios/multi-axis"
 RATE_HZ = 200
@@ -188,5 +196,49 @@ def main():
         f.write("\n")
 
 
+def write_forward(platen):
+    """The forward scenario: the frictionless table under the actuator forces that its own
+    inverse finds for the first 10 s of the motion (platen's own output, kept to t_s and the
+    force columns), so that its run retraces that motion open loop."""
+    frictionless = table()
+    for a in frictionless["actuators"]:
+        if "pad" in a:
+            a["pad"]["friction_coefficient"] = 0.0
+    with tempfile.TemporaryDirectory() as tmp:
+        inverse = {
+            "name": "frictionless inverse (makes the forward scenario's forces)",
+            "table": frictionless,
+            "excitation": {"motion_csv": os.path.abspath(os.path.join(OUT, "three-component-motion.csv"))},
+        }
+        path = os.path.join(tmp, "inverse.json")
+        with open(path, "w") as f:
+            json.dump(inverse, f)
+        out = os.path.join(tmp, "out.csv")
+        subprocess.run([platen, "simulate", path, "--out", out], check=True, stdout=subprocess.DEVNULL)
+        with open(out, newline="") as f:
+            rows = list(csv.reader(f))
+    header = rows[0]
+    keep = [0] + [i for i, n in enumerate(header) if n.endswith("_force_n") and not n.startswith("s")]
+    end = int(round(10.0 * RATE_HZ)) + 1
+    with open(os.path.join(OUT, "forward-forces.csv"), "w", newline="\n") as f:
+        f.write(",".join(header[i] for i in keep) + "\n")
+        for r in rows[1:end + 1]:
+            f.write(",".join(format(float(r[i]), ".15g") for i in keep) + "\n")
+    forward = {
+        "name": "multi-axis forward: actuator forces, frictionless table",
+        "description": "The LHPOST6-like table, its pads frictionless, under the actuator forces "
+                       "its own inverse finds for the first 10 s of the three-component motion "
+                       "(tools/make_multi_axis_scenarios.py): open loop, it retraces that motion "
+                       "until the force's interpolation error drifts it off.",
+        "table": frictionless,
+        "excitation": {"force_csv": "forward-forces.csv"},
+        "integrator": {"method": "rk4", "step_s": 1.0 / (4 * RATE_HZ)},
+    }
+    with open(os.path.join(OUT, "forward.json"), "w", newline="\n") as f:
+        json.dump(forward, f, indent=2)
+        f.write("\n")
+
+
 if __name__ == "__main__":
     main()
+    write_forward(os.environ.get("PLATEN", "target/release/platen"))

@@ -759,14 +759,14 @@ fn read_ground_acceleration(ctx: &Ctx, g: &GroundMotion, path: &Path) -> Result<
     })
 }
 
-fn forward_run(
+/// The integrator of a forward run on `record` (`integrator`, default RK4 at the sample
+/// interval): the RK4 step must divide the interval fitted over the record.
+pub(crate) fn forward_method(
     ctx: &Ctx,
     file: &ScenarioFile,
-    record: ForceRecord,
-    samples: usize,
-    recorded_state: Option<(f64, f64)>,
-) -> Result<Run> {
-    let integrator = match &file.integrator {
+    record: &ForceRecord,
+) -> Result<Method> {
+    Ok(match &file.integrator {
         None => Method::Rk4(Rk4::with_steps_per_sample(1).expect("k = 1 is valid")),
         Some(IntegratorSpec::Rk4(Rk4Spec { step_s })) => {
             let step = step_s.unwrap_or(record.dt_s());
@@ -793,7 +793,17 @@ fn forward_run(
             })?;
             Method::Dopri5(settings)
         }
-    };
+    })
+}
+
+fn forward_run(
+    ctx: &Ctx,
+    file: &ScenarioFile,
+    record: ForceRecord,
+    samples: usize,
+    recorded_state: Option<(f64, f64)>,
+) -> Result<Run> {
+    let integrator = forward_method(ctx, file, &record)?;
     let initial = file.initial.clone().unwrap_or_default();
     let (u0, v0) = if initial.from_record {
         if initial.u_m.is_some() || initial.v_m_s.is_some() {

@@ -14,10 +14,12 @@ use nalgebra::{DMatrix, Matrix3, Unit, Vector3};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use platen_integrate::{inverse_table, PoseMotion, TableRun};
+use platen_integrate::{
+    forward_table, inverse_table, ActuatorForces, ForceRecord, Method, PoseMotion, TableRun,
+};
 use platen_model::multi_axis::{
-    Actuator, Bearing, BearingLoad, Dof, DofSet, LinearSpecimen, Mount, MultiAxisTable, Pad,
-    RigidPlaten, Strut, TableParts,
+    Actuator, Bearing, BearingLoad, Coords, Dof, DofSet, LinearSpecimen, Mount, MultiAxisTable,
+    Pad, RigidPlaten, Strut, TableParts,
 };
 use platen_model::{ModelError, Specimen, Storey};
 
@@ -190,8 +192,15 @@ pub const ACCELERATION_COLUMNS: [&str; 6] = [
 pub enum TableRunSpec {
     /// The actuator forces a prescribed six-DOF motion needs.
     Inverse {
-        /// The motion.
-        motion: PoseMotion,
+        /// The motion (boxed: six channels of four vectors each).
+        motion: Box<PoseMotion>,
+    },
+    /// The motion recorded actuator forces produce (a frictionless table, for now).
+    Forward {
+        /// One force record per actuator, in the table's order.
+        forces: ActuatorForces,
+        /// The integrator.
+        method: Method,
     },
 }
 
@@ -230,20 +239,23 @@ impl TableScenario {
             ("table_system", file.table_system.is_some()),
             ("limits", file.limits.is_some()),
             ("initial", file.initial.is_some()),
-            ("integrator", file.integrator.is_some()),
+            (
+                "integrator",
+                file.integrator.is_some() && file.excitation.force_csv.is_none(),
+            ),
         ] {
             if given {
                 return Err(ctx.invalid(
                     key,
                     "(given)",
                     "no such key beside a `table` (the table holds its platen and its hydraulics; \
-                     forward runs, their integrator and initial state and per-axis limits come \
-                     with the multi-axis forward run)",
+                     an integrator belongs to a forward run, from `force_csv`; a multi-axis run \
+                     starts at rest at neutral, and per-axis limits are not built yet)",
                 ));
             }
         }
         let table = build_table(&ctx, spec)?;
-        let (run, derived) = build_run(&ctx, file)?;
+        let (run, derived) = build_run(&ctx, file, &table)?;
         let specimen = build_specimen(&ctx, file.specimen.as_ref())?;
         let pressure = |key: &str, v: Option<f64>, default: f64| match v {
             Some(p) => check_positive(&ctx, &format!("table.{key}"), p),
@@ -271,14 +283,23 @@ impl TableScenario {
     /// Runs it.
     ///
     /// # Errors
-    /// [`ScenarioError::TableRun`] when the actuators lose rank at a pose of the motion.
+    /// [`ScenarioError::TableRun`] when the actuators lose rank at a pose of the motion
+    /// (inverse) or the integration fails (forward: a non-finite state, Dopri5 unable to meet
+    /// its tolerance).
     pub fn run(&self) -> Result<TableRun> {
-        match &self.run {
+        let run = match &self.run {
             TableRunSpec::Inverse { motion } => {
                 inverse_table(&self.table, self.specimen.as_ref(), motion)
-                    .map_err(ScenarioError::TableRun)
             }
-        }
+            TableRunSpec::Forward { forces, method } => forward_table(
+                &self.table,
+                forces,
+                *method,
+                Coords::zeros(),
+                Coords::zeros(),
+            ),
+        };
+        run.map_err(ScenarioError::TableRun)
     }
 
     /// Each actuator's force limits `(pull ≤ 0, push ≥ 0)`, N, in the table's order.
@@ -491,8 +512,15 @@ fn build_table(ctx: &Ctx, spec: &TableSpec) -> Result<MultiAxisTable> {
 }
 
 /// `excitation` of a multi-axis scenario: `motion_csv` only, for now.
-fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<(TableRunSpec, Derived)> {
+fn build_run(
+    ctx: &Ctx,
+    file: &ScenarioFile,
+    table: &MultiAxisTable,
+) -> Result<(TableRunSpec, Derived)> {
     let ex = &file.excitation;
+    if let Some(rel) = &ex.force_csv {
+        return forward_run(ctx, file, table, &ctx.resolve(rel)).map(|r| (r, Derived::new()));
+    }
     let Some(rel) = &ex.motion_csv else {
         let given = crate::excitation::named_sources(ex);
         let key = given
@@ -501,8 +529,8 @@ fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<(TableRunSpec, Derived)> 
         return Err(ctx.invalid(
             &key,
             "(given)",
-            "motion_csv: a multi-axis table runs the inverse of a six-DOF motion for now (forward \
-             runs from actuator forces come next)",
+            "motion_csv (the inverse of a six-DOF motion) or force_csv (`t_s` and \
+             `{name}_force_n` per actuator: a forward run)",
         ));
     };
     for (key, given) in [
@@ -564,7 +592,120 @@ fn build_run(ctx: &Ctx, file: &ScenarioFile) -> Result<(TableRunSpec, Derived)> 
     let dofs: [platen_signal::Motion; 6] = dofs.try_into().expect("six DOFs");
     let motion =
         PoseMotion::new(dofs).map_err(|cause| crate::excitation::rejected(&path, cause))?;
-    Ok((TableRunSpec::Inverse { motion }, derived))
+    Ok((
+        TableRunSpec::Inverse {
+            motion: Box::new(motion),
+        },
+        derived,
+    ))
+}
+
+/// `excitation.force_csv` of a multi-axis scenario: `t_s` and `{name}_force_n` per actuator,
+/// cut to `duration_s`; a forward run with the scenario's `integrator`.
+fn forward_run(
+    ctx: &Ctx,
+    file: &ScenarioFile,
+    table: &MultiAxisTable,
+    path: &Path,
+) -> Result<TableRunSpec> {
+    if file.specimen.is_some() {
+        return Err(ctx.invalid(
+            "specimen",
+            "(given)",
+            "no specimen in a forward run of a multi-axis table, for now (the inverse takes one)",
+        ));
+    }
+    for (key, given) in [
+        ("excitation.columns", file.excitation.columns.is_some()),
+        (
+            "excitation.lowpass_hz",
+            file.excitation.lowpass_hz.is_some(),
+        ),
+    ] {
+        if given {
+            return Err(ctx.invalid(
+                key,
+                "(given)",
+                "nothing: not used by a multi-axis forward run",
+            ));
+        }
+    }
+    let friction = table
+        .actuators()
+        .iter()
+        .enumerate()
+        .find_map(|(i, a)| match &a.mount {
+            Mount::Pad(p) if p.friction_coefficient > 0.0 => Some((
+                format!("table.actuators[{i}].pad.friction_coefficient"),
+                p.friction_coefficient,
+            )),
+            _ => None,
+        });
+    let friction = friction.or_else(|| {
+        table
+            .parts()
+            .bearings
+            .iter()
+            .enumerate()
+            .find_map(|(k, b)| {
+                (b.friction_coefficient > 0.0).then(|| {
+                    (
+                        format!("table.bearings[{k}].friction_coefficient"),
+                        b.friction_coefficient,
+                    )
+                })
+            })
+    });
+    if let Some((key, mu)) = friction {
+        return Err(ctx.invalid(
+            &key,
+            mu,
+            "0 in a forward run: the planar stick-slip of the bearings is not built yet (the \
+             inverse takes friction)",
+        ));
+    }
+    let names: Vec<String> = table
+        .actuators()
+        .iter()
+        .map(|a| format!("{}_force_n", a.name))
+        .collect();
+    let mut required: Vec<&str> = vec!["t_s"];
+    required.extend(names.iter().map(String::as_str));
+    let mut cols = platen_io::csv::read_table(path, &required, &[])?;
+    let mut t = cols.take_column("t_s").unwrap_or_default();
+    let mut forces: Vec<Vec<f64>> = names
+        .iter()
+        .map(|n| cols.take_column(n).unwrap_or_default())
+        .collect();
+    if let Some(d) = file.duration_s {
+        check_positive(ctx, "duration_s", d)?;
+        let end = t[0] + d;
+        if t[t.len() - 1] < end - 1e-9 * d {
+            return Err(ScenarioError::RecordTooShort {
+                path: path.to_owned(),
+                span_s: t[t.len() - 1] - t[0],
+                samples: Some(t.len()),
+                duration_s: d,
+            });
+        }
+        let n = t.partition_point(|&x| x <= end + 1e-9 * d);
+        t.truncate(n);
+        for f in &mut forces {
+            f.truncate(n);
+        }
+    }
+    let first = ForceRecord::new(
+        t.clone(),
+        forces
+            .first()
+            .cloned()
+            .unwrap_or_else(|| vec![0.0; t.len()]),
+    )
+    .map_err(|cause| crate::excitation::rejected(path, cause))?;
+    let method = crate::excitation::forward_method(ctx, file, &first)?;
+    let forces =
+        ActuatorForces::new(t, forces).map_err(|cause| crate::excitation::rejected(path, cause))?;
+    Ok(TableRunSpec::Forward { forces, method })
 }
 
 /// `specimen` of a multi-axis scenario: storeys (along x) or the four matrices.
@@ -687,7 +828,7 @@ pub struct StrutPeaks {
 pub struct TableSummary {
     /// The scenario's name.
     pub name: String,
-    /// `"inverse"`.
+    /// `"inverse"` or `"forward"`.
     pub kind: &'static str,
     /// Output samples.
     pub samples: usize,
@@ -781,7 +922,10 @@ impl TableScenario {
         .collect();
         TableSummary {
             name: self.name.clone(),
-            kind: "inverse",
+            kind: match self.run {
+                TableRunSpec::Inverse { .. } => "inverse",
+                TableRunSpec::Forward { .. } => "forward",
+            },
             samples: run.len(),
             duration_s: t.last().zip(t.first()).map_or(0.0, |(b, a)| b - a),
             derived: self.derived.clone(),
@@ -799,9 +943,14 @@ impl TableScenario {
 pub fn summary_text(s: &TableSummary, figures: &[PathBuf]) -> String {
     use std::fmt::Write;
     let mut t = String::new();
+    let what = if s.kind == "forward" {
+        "forward from the actuator forces"
+    } else {
+        "inverse of a six-DOF motion"
+    };
     let _ = writeln!(
         t,
-        "{}: inverse of a six-DOF motion, {} samples over {:.3} s",
+        "{}: {what}, {} samples over {:.3} s",
         s.name, s.samples, s.duration_s
     );
     let _ = writeln!(t, "  axis    peak          rate          acceleration");
