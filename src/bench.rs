@@ -25,6 +25,10 @@
 //!   system (controller at 1024 Hz, valves, single-ended actuators, accumulator) on the
 //!   identified model, commanded with that S9 motion, at its default step (7 RK4 steps per
 //!   controller period, resolving the 246 Hz spool), timed per integration step;
+//! * `six_dof`: [`forward_table`] of the six-DOF table of the shipped forward scenario
+//!   ([`bench_table`]: 10 actuators, 4 struts, 6 frictionless pads) under the forces that
+//!   hold it plus the standard force along x ([`bench_table_forces`]), RK4 at 1/1024 s,
+//!   timed per step;
 //! * `ensemble` and `ensemble_scalar`: [`ENSEMBLE_LANES`] sweep-like cases (the identified
 //!   model at 6.9 and 13.8 MPa under the forward force scaled by 0.9 and 1.1, more cases to
 //!   fill the lanes) run by [`forward_rk4_ensemble`] in SIMD lanes, and the same cases run one
@@ -57,10 +61,12 @@ use std::time::Instant;
 use serde::Serialize;
 
 use platen_integrate::{
-    forward_closed_loop, forward_rk4, forward_rk4_ensemble, forward_rk4_specimen, inverse,
-    Dopri5Settings, EnsembleCase, ForceRecord, ForwardIntegrator, IntegrateError, LoopMethod,
-    LoopRun, Method, Motion, Peaks, Rk4, State, Trajectory, ENSEMBLE_LANES,
+    forward_closed_loop, forward_rk4, forward_rk4_ensemble, forward_rk4_specimen, forward_table,
+    inverse, ActuatorForces, Dopri5Settings, EnsembleCase, ForceRecord, ForwardIntegrator,
+    IntegrateError, LoopMethod, LoopRun, Method, Motion, Peaks, Rk4, State, Trajectory,
+    ENSEMBLE_LANES,
 };
+use platen_model::multi_axis::{Coords, MultiAxisTable};
 use platen_model::{preset, FullModel, IdentifiedModel, IdentifiedParams, Specimen, Storey};
 use platen_system::TableSystem;
 
@@ -112,6 +118,9 @@ pub enum BenchError {
     /// The motion of the inverse and closed-loop workloads was refused.
     #[error("bench motion: {0}")]
     Motion(#[from] platen_signal::SignalError),
+    /// The six-DOF workload's table or forces were refused (a defect).
+    #[error("bench six-DOF table: {0}")]
+    Table(String),
 }
 
 /// The result of the module's functions.
@@ -154,6 +163,8 @@ enum Job {
     TableSystem,
     /// [`forward_rk4_ensemble`] of the ensemble cases; one unit per step per trajectory.
     Ensemble(Rk4),
+    /// [`forward_table`] of the six-DOF table ([`bench_table`]); one unit per step.
+    SixDof(Rk4),
     /// [`forward_rk4`] of each ensemble case in turn; one unit per step per trajectory.
     EnsembleScalar(Rk4),
 }
@@ -270,6 +281,12 @@ pub fn workloads() -> Result<Vec<Workload>> {
             Job::TableSystem,
         ),
         Workload::new(
+            "six_dof",
+            "six_dof: 6-DOF table, 10 actuators, 4 struts, 6 pads, output kept",
+            "step",
+            Job::SixDof(rk4),
+        ),
+        Workload::new(
             "ensemble_scalar",
             "ensemble_scalar: sweep-like cases one by one, peaks",
             "step",
@@ -340,6 +357,9 @@ pub struct Inputs {
     full: FullModel,
     specimen: Specimen,
     system: TableSystem,
+    /// The six-DOF table and its actuator forces.
+    table: MultiAxisTable,
+    table_forces: ActuatorForces,
     /// The models and force records of the ensemble cases.
     ensemble_models: Vec<IdentifiedModel>,
     ensemble_records: Vec<ForceRecord>,
@@ -369,8 +389,12 @@ impl Inputs {
                 ForceRecord::from_rate(RATE_HZ, scaled),
             )?);
         }
+        let table = bench_table()?;
+        let table_forces = bench_table_forces(&table, samples)?;
         Ok(Self {
             samples,
+            table,
+            table_forces,
             force,
             record,
             motion: s9_motion(samples)?,
@@ -423,6 +447,7 @@ impl Job {
             Job::Ensemble(rk4) => time_ensemble(rk4, inputs),
             Job::EnsembleScalar(rk4) => time_ensemble_scalar(rk4, inputs),
             Job::Inverse => Ok(time_inverse(inputs, out)),
+            Job::SixDof(rk4) => time_six_dof(rk4, inputs),
         }
     }
 }
@@ -508,6 +533,71 @@ fn time_table_system(inputs: &Inputs, out: &mut Trajectory) -> Result<Timed> {
     let stats = integrate("closed-loop run", stats)?;
     black_box(&*out);
     Ok((s, stats.run.steps, None))
+}
+
+/// [`Job::SixDof`].
+fn time_six_dof(rk4: Rk4, inputs: &Inputs) -> Result<Timed> {
+    let (table, forces) = (&inputs.table, &inputs.table_forces);
+    let (s, run) = time(|| {
+        forward_table(
+            black_box(table),
+            black_box(forces),
+            Method::Rk4(rk4),
+            Coords::zeros(),
+            Coords::zeros(),
+        )
+    });
+    let run = integrate("six-DOF run", run)?;
+    black_box(&run);
+    Ok((s, (inputs.samples - 1) as u64, None))
+}
+
+/// The six-DOF table of the `six_dof` workload: the shipped forward scenario's
+/// (`scenarios/multi-axis/forward.json`, an LHPOST6-like table with frictionless pads),
+/// compiled in.
+///
+/// # Errors
+/// [`BenchError`] if the compiled-in table is refused (a defect).
+pub fn bench_table() -> Result<MultiAxisTable> {
+    let origin = std::path::Path::new("scenarios/multi-axis/forward.json");
+    let text = include_str!("../scenarios/multi-axis/forward.json");
+    let file =
+        platen_scenario::file::parse(origin, text).map_err(|e| BenchError::Table(e.to_string()))?;
+    let spec = file
+        .table
+        .ok_or_else(|| BenchError::Table("no table".into()))?;
+    spec.build(origin)
+        .map_err(|e| BenchError::Table(e.to_string()))
+}
+
+/// The actuator forces of the `six_dof` workload: those that hold `table` still at neutral
+/// (its weight and the struts' pull, resolved as a force balance does) plus the standard
+/// workload's force as `A·cos(2πft)` along x (from rest, so that the platen oscillates
+/// about an offset instead of drifting), `samples` samples at [`RATE_HZ`].
+///
+/// # Errors
+/// [`BenchError`] if the actuators cannot hold the table (a defect).
+pub fn bench_table_forces(table: &MultiAxisTable, samples: usize) -> Result<ActuatorForces> {
+    let neutral = Coords::zeros();
+    let hold = -(table.gravity_wrench(&neutral) + table.struts_wrench(&neutral));
+    let still = table
+        .resolve_forces(&neutral, &table.generalised_force(&neutral, &hold), None)
+        .ok_or_else(|| BenchError::Table("cannot hold the platen".into()))?;
+    let unit_x = table
+        .resolve_forces(&neutral, &Coords::new(1.0, 0.0, 0.0, 0.0, 0.0, 0.0), None)
+        .ok_or_else(|| BenchError::Table("cannot push along x".into()))?;
+    let w = 2.0 * std::f64::consts::PI * FORCE_FREQUENCY_HZ;
+    let t: Vec<f64> = (0..samples).map(|j| j as f64 / RATE_HZ).collect();
+    let forces = still
+        .iter()
+        .zip(&unit_x)
+        .map(|(f0, fx)| {
+            t.iter()
+                .map(|&t| f0 + fx * FORCE_AMPLITUDE_N * (w * t).cos())
+                .collect()
+        })
+        .collect();
+    integrate("six-DOF forces", ActuatorForces::new(t, forces))
 }
 
 /// [`Job::Ensemble`].
@@ -688,6 +778,10 @@ pub struct BenchReport {
     pub rk4_specimen_ratio_to_baseline: f64,
     /// RK4 steps per second.
     pub rk4_steps_per_s: f64,
+    /// The six-DOF table's forward step (RK4, 10 actuators, 4 struts, 6 pads), ns.
+    pub six_dof_ns_per_step: f64,
+    /// [`BenchReport::six_dof_ns_per_step`] over the baseline's step.
+    pub six_dof_ratio_to_baseline: f64,
     /// Sample rate, Hz.
     pub sample_rate_hz: f64,
     /// Simulated time of every record, s.
@@ -749,6 +843,8 @@ impl Measurement {
             rk4_specimen_ns_per_step: ns("rk4_specimen"),
             rk4_specimen_ratio_to_baseline: ns("rk4_specimen") / base,
             rk4_steps_per_s: 1e9 / ns("rk4"),
+            six_dof_ns_per_step: ns("six_dof"),
+            six_dof_ratio_to_baseline: ns("six_dof") / base,
             sample_rate_hz: RATE_HZ,
             simulated_s,
             table_system_ns_per_step: ns("table_system"),

@@ -347,6 +347,16 @@ fn vector(p: [f64; 3]) -> Vector3<f64> {
     Vector3::from(p)
 }
 
+impl TableSpec {
+    /// The validated table of this spec; errors name `origin` as the scenario file.
+    ///
+    /// # Errors
+    /// As [`TableScenario::from_file`] for the `table` key.
+    pub fn build(&self, origin: &Path) -> Result<MultiAxisTable> {
+        build_table(&Ctx { path: origin }, self)
+    }
+}
+
 /// `table` into a validated table.
 fn build_table(ctx: &Ctx, spec: &TableSpec) -> Result<MultiAxisTable> {
     if let Some(name) = &spec.preset {
