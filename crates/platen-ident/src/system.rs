@@ -483,11 +483,24 @@ pub fn identify_system(
     result.records = held_out(records_c, &periods, &fitted, cols, corner, c);
     // The identified gains on the identified system: still a table system only if they are
     // gains a controller takes (checked again at the same stroke).
+    // If they are not, say so: the result then carries no table system (and no scenario).
     plant.system = plant.system.and_then(|sys| {
         let stroke_m = stroke_limit_m(&sys);
         let mut parts = sys.into_parts();
         set_controller(&mut parts.controller, &gains);
-        platen_system::TableSystem::new(parts, stroke_m).ok()
+        match platen_system::TableSystem::new(parts, stroke_m) {
+            Ok(system) => Some(system),
+            Err(e) => {
+                result.not_identified.push((
+                    "table_system".to_owned(),
+                    format!(
+                        "the identified gains are not gains a controller takes ({e}): no \
+                         identified table system or scenario is given"
+                    ),
+                ));
+                None
+            }
+        }
     });
     if settings.judge {
         result.judgement = judge::judge(records_c, &periods, &fitted, &plant);
