@@ -56,7 +56,7 @@ pub struct ScenarioFile {
     /// A multi-axis (six-DOF) table instead of the uniaxial platen of `model`
     /// ([`crate::multi_axis`]).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub table: Option<crate::multi_axis::TableSpec>,
+    pub table: Option<crate::table_file::TableSpec>,
 }
 
 /// `specimen`: a linear shear building fixed on the platen (`storeys`), or, on a multi-axis
@@ -495,6 +495,11 @@ pub fn json_schema() -> serde_json::Value {
     let mut schema = serde_json::to_value(schemars::schema_for!(ScenarioFile)).unwrap_or_default();
     if let Some(obj) = schema.as_object_mut() {
         obj.insert("title".into(), "platen scenario".into());
+        // The uniaxial platen's `model`, or a multi-axis `table`.
+        obj.insert(
+            "anyOf".into(),
+            serde_json::json!([{"required": ["model"]}, {"required": ["table"]}]),
+        );
         obj.insert(
             "description".into(),
             "A platen scenario: model (preset, identified or full form), excitation, integrator, initial \

@@ -38,6 +38,7 @@ mod summary;
 pub mod sweep;
 pub mod system;
 mod system_file;
+mod table_file;
 pub mod units;
 
 pub use arrays::Arrays;
