@@ -64,6 +64,14 @@ macro_rules! grid_time {
         fn input(&self, at: f64) -> f64 {
             self.grid.force(self.n, at)
         }
+        crate::grid::grid_clock!();
+    };
+}
+
+/// The time hooks alone of [`grid_time!`], for a plant on the grid whose input is its own
+/// (the multi-axis table's several force records).
+macro_rules! grid_clock {
+    () => {
         #[inline(always)]
         fn seconds(&self, len: f64) -> f64 {
             len * self.grid.h
@@ -98,6 +106,7 @@ macro_rules! grid_time {
         }
     };
 }
+pub(crate) use grid_clock;
 pub(crate) use grid_time;
 
 /// A fixed-step integrator on the integer time grid: what [`drive`] runs.

@@ -42,7 +42,7 @@ use crate::creep::{creep_speed_m_s, stiff_speed_m_s};
 use crate::error::{IntegrateError, Result};
 use crate::event::{
     arrive_at_rest, dip_to_zero, just_past, locate_zero_velocity, mode_at_rest, Direction,
-    EventKind, Mode,
+    EventKind, Mode, MAX_EVENTS_PER_STEP,
 };
 use crate::output::{Sample, SpecimenSample};
 use crate::run::{sample_at, Kin, RunStats};
@@ -709,6 +709,29 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         }
         (self.y, self.k, self.a) = (y1, k_end, a1);
         true
+    }
+
+    /// Advances over a whole span of length 1 (a grid step) through every mode and event:
+    /// [`Machine::advance`] until the span ends. Stops the run where Dopri5 gave up
+    /// ([`IntegrateError::AdaptiveFailed`]) or where more than [`MAX_EVENTS_PER_STEP`] events
+    /// happen in one span ([`IntegrateError::EventLoopStalled`], a guard against a defect).
+    pub(crate) fn advance_span(&mut self) -> Result<()> {
+        let mut tau = 0.0;
+        let mut events = 0u32;
+        loop {
+            tau = self.advance(tau, 1.0 - tau)?;
+            if let Some((t_s, reason)) = self.take_failure() {
+                return Err(IntegrateError::failed(t_s, Failure::AdaptiveFailed(reason)));
+            }
+            if tau >= 1.0 {
+                return Ok(());
+            }
+            events += 1;
+            if events > MAX_EVENTS_PER_STEP {
+                let stalled = Failure::EventLoopStalled { events };
+                return Err(IntegrateError::failed(self.plant.time_s(tau), stalled));
+            }
+        }
     }
 
     /// Advances in the current mode from position `tau` over at most `rest`, to the end or to

@@ -43,8 +43,8 @@ use std::collections::VecDeque;
 use platen_model::{PlatenModel, Specimen};
 
 use crate::creep::creep_speed_m_s;
-use crate::error::{IntegrateError, Result};
-use crate::event::{Direction, EventKind, Mode, MAX_EVENTS_PER_STEP};
+use crate::error::Result;
+use crate::event::{Direction, EventKind, Mode};
 use crate::grid::{drive, Grid, GridStep, GridStepper};
 use crate::machine::{direction, Machine, PieceMethod, Plant, DI, SD, U, V, W};
 use crate::method::Method;
@@ -53,7 +53,7 @@ use crate::record::ForceRecord;
 use crate::rk4::Rk4;
 use crate::run::{check_run, EnergyBalance, RunStats, State};
 use crate::steppable::{Samples, Steppable};
-use crate::stop::{Failure, StopReason};
+use crate::stop::StopReason;
 
 const NS: usize = Specimen::MAX_STOREYS;
 /// Positions in the state vector: displacement, velocity, actuator work, platen dissipation,
@@ -542,22 +542,7 @@ impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
     fn step_with_events(&mut self, n: GridStep) -> Result<()> {
         let m = &mut self.machine;
         m.plant.f_rate = m.plant.force_rate(n.j);
-        let mut tau = 0.0;
-        let mut events = 0u32;
-        loop {
-            tau = m.advance(tau, 1.0 - tau)?;
-            if let Some((t_s, reason)) = m.take_failure() {
-                return Err(IntegrateError::failed(t_s, Failure::AdaptiveFailed(reason)));
-            }
-            if tau >= 1.0 {
-                return Ok(());
-            }
-            events += 1;
-            if events > MAX_EVENTS_PER_STEP {
-                let stalled = Failure::EventLoopStalled { events };
-                return Err(IntegrateError::failed(m.plant.grid.time_s(n, tau), stalled));
-            }
-        }
+        m.advance_span()
     }
 }
 

@@ -16,12 +16,11 @@ use platen_model::multi_axis::{angular_velocity, Coords, Dof, Mount, MultiAxisTa
 use platen_model::PlatenModel;
 
 use crate::error::{IntegrateError, Result};
-use crate::event::{Direction, Mode, MAX_EVENTS_PER_STEP};
-use crate::grid::GridStep;
+use crate::event::{Direction, Mode};
+use crate::grid::{Grid, GridStep};
 use crate::machine::{Machine, PieceMethod, Plant, DI, U, V, W, Y};
 use crate::method::Method;
 use crate::multi_axis::TableRun;
-use crate::stop::Failure;
 
 /// Where the pose starts in the state.
 const Q: usize = 5;
@@ -124,10 +123,9 @@ struct At {
 struct TablePlant<'a> {
     table: &'a MultiAxisTable,
     forces: &'a ActuatorForces,
-    /// The reciprocal of the grid steps per sample interval.
-    inv_k: f64,
-    /// The grid step, s.
-    h: f64,
+    /// The time grid (its force is the first actuator's, unused: the input is every
+    /// actuator's, [`TablePlant::forces_at`]).
+    grid: Grid<'a>,
     /// The grid step being taken.
     n: GridStep,
 }
@@ -196,7 +194,7 @@ impl Plant<L> for TablePlant<'_> {
     fn input(&self, at: f64) -> At {
         At {
             j: self.n.j,
-            w: (self.n.i + at) * self.inv_k,
+            w: (self.n.i + at) * self.grid.inv_k,
         }
     }
 
@@ -232,42 +230,7 @@ impl Plant<L> for TablePlant<'_> {
         }
     }
 
-    fn seconds(&self, len: f64) -> f64 {
-        len * self.h
-    }
-
-    fn units(&self, seconds: f64) -> f64 {
-        seconds / self.h
-    }
-
-    fn time_s(&self, at: f64) -> f64 {
-        self.forces.t_s[0] + (self.n.n as f64 + at) * self.h
-    }
-
-    fn tolerance_floor(&self) -> f64 {
-        0.0
-    }
-
-    fn min_progress(&self) -> f64 {
-        4.0 * f64::EPSILON
-    }
-
-    fn land(&self, tau: f64, x: f64, _rest: f64) -> f64 {
-        let at = tau + x;
-        if 1.0 - at < 1e-12 {
-            1.0
-        } else {
-            at
-        }
-    }
-
-    fn reach(&self, tau: f64, len: f64) -> f64 {
-        tau + len
-    }
-
-    fn break_at(&self, tau: f64, x: f64, _rest: f64, _held: bool) -> f64 {
-        (tau + x).min(1.0)
-    }
+    crate::grid::grid_clock!();
 }
 
 /// The forward run of `table` under `forces` from the pose `initial` with rates
@@ -322,8 +285,12 @@ pub fn forward_table(
     let plant = TablePlant {
         table,
         forces,
-        inv_k: 1.0 / k as f64,
-        h,
+        grid: Grid {
+            force: forces.forces_n.first().map_or(&[][..], Vec::as_slice),
+            inv_k: 1.0 / k as f64,
+            h,
+            t0: forces.t_s[0],
+        },
         n: GridStep { n: 0, j: 0, i: 0.0 },
     };
     let mut m = Machine::new(plant, y, h, pieces);
@@ -360,22 +327,7 @@ fn step(m: &mut Machine<TablePlant<'_>, L>, n: GridStep) -> Result<()> {
     if m.is_rk4() && m.slip_fast::<true>(0.0) {
         return Ok(());
     }
-    let mut tau = 0.0;
-    let mut events = 0u32;
-    loop {
-        tau = m.advance(tau, 1.0 - tau)?;
-        if let Some((t_s, reason)) = m.take_failure() {
-            return Err(IntegrateError::failed(t_s, Failure::AdaptiveFailed(reason)));
-        }
-        if tau >= 1.0 {
-            return Ok(());
-        }
-        events += 1;
-        if events > MAX_EVENTS_PER_STEP {
-            let stalled = Failure::EventLoopStalled { events };
-            return Err(IntegrateError::failed(m.plant.time_s(tau), stalled));
-        }
-    }
+    m.advance_span()
 }
 
 /// The run's columns, filled a sample at a time.
