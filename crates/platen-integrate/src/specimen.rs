@@ -98,7 +98,7 @@ pub fn forward_rk4_specimen<M: PlatenModel, S: SampleSink>(
 /// `atol` in metres and m/s), with the same events.
 ///
 /// # Errors
-/// As [`crate::forward_rk4`]; with Dopri5 also [`IntegrateError::AdaptiveFailed`] when it
+/// As [`crate::forward_rk4`]; with Dopri5 also [`crate::IntegrateError::AdaptiveFailed`] when it
 /// cannot meet its tolerance (step budget spent or step underflow), with the time.
 pub fn forward_specimen<M: PlatenModel, S: SampleSink>(
     model: &M,
