@@ -20,7 +20,7 @@ use platen_model::multi_axis::{
     Actuator, Bearing, BearingLoad, Coords, Dof, DofSet, LinearSpecimen, Mount, MultiAxisTable,
     Pad, RigidPlaten, Strut, TableParts,
 };
-use platen_model::{ModelError, Specimen, Storey};
+use platen_model::ModelError;
 
 use crate::ctx::{check_positive, Ctx};
 use crate::error::{Result, ScenarioError};
@@ -594,18 +594,9 @@ fn build_specimen(ctx: &Ctx, given: Option<&SpecimenSpec>) -> Result<Option<Line
         return Ok(None);
     };
     if !s.is_general() {
-        let storeys = s
-            .storeys
-            .iter()
-            .map(|s| Storey {
-                mass_kg: s.mass_kg,
-                stiffness_n_per_m: s.stiffness_n_per_m,
-                damping_n_s_per_m: s.damping_n_s_per_m,
-            })
-            .collect();
-        let frame = Specimen::new(storeys)
-            .map_err(|e| ctx.invalid("specimen.storeys", "", e.to_string()))?;
-        return Ok(Some(LinearSpecimen::from_storeys(&frame)));
+        // The uniaxial rig's reader: the same checks, each storey's value named by its path.
+        let frame = crate::rig::build_specimen(ctx, Some(s))?;
+        return Ok(frame.as_ref().map(LinearSpecimen::from_storeys));
     }
     if !s.storeys.is_empty() {
         return Err(ctx.invalid(

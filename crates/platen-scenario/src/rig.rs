@@ -375,7 +375,7 @@ impl RigStart {
 }
 
 /// The validated `specimen`, with JSON paths in its errors.
-fn build_specimen(ctx: &Ctx, given: Option<&SpecimenSpec>) -> Result<Option<Specimen>> {
+pub(crate) fn build_specimen(ctx: &Ctx, given: Option<&SpecimenSpec>) -> Result<Option<Specimen>> {
     let Some(given) = given else {
         return Ok(None);
     };
