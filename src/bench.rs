@@ -541,6 +541,7 @@ fn time_six_dof(rk4: Rk4, inputs: &Inputs) -> Result<Timed> {
     let (s, run) = time(|| {
         forward_table(
             black_box(table),
+            None,
             black_box(forces),
             Method::Rk4(rk4),
             Coords::zeros(),

@@ -77,10 +77,6 @@ pub enum IntegrateError {
         /// The fitted interval, s.
         interval_s: f64,
     },
-    /// A forward run of a multi-axis table with friction: the planar stick-slip of its
-    /// bearings is not built yet.
-    #[error("a forward run of a multi-axis table needs frictionless bearings for now (every pad's and bearing's friction_coefficient 0): the planar stick-slip of the bearings is not built yet")]
-    TableFriction,
     /// The actuators of a multi-axis table cannot hold its free DOFs at the pose of a
     /// sample (their geometry loses rank there).
     #[error("at t = {t_s} s the actuators cannot hold the platen's free DOFs (their geometry loses rank at that pose)")]

@@ -128,6 +128,18 @@ pub(crate) trait Plant<const L: usize> {
     /// Sets what the state holds that the integrator does not move (the creep velocity
     /// slaved to the force) at the end of a piece. Nothing by default.
     fn settle(&self, _mode: Mode, _w_stiff: f64, _input: Self::Input, _y: &mut Y<L>) {}
+    /// Sets what entering `mode` at state `y` under `input` means to the plant beyond the
+    /// machine's own reset (the direction a planar slide leaves rest in). Nothing by default.
+    #[inline(always)]
+    fn entering(&mut self, _mode: Mode, _input: Self::Input, _y: &mut Y<L>) {}
+    /// At a located end of slip (state `y` there, under `input`), the plant's own reset when
+    /// the machine's (`v = 0`, then stick, a reversal or creep as the net force at rest
+    /// decides) is not what happens: the mode to go on in and the event, with `y` set for it.
+    /// `None` by default: the machine's reset.
+    #[inline(always)]
+    fn arrive(&mut self, _input: Self::Input, _y: &mut Y<L>) -> Option<(Mode, Option<EventKind>)> {
+        None
+    }
     /// A state the plant cannot take (an actuator at its end stop), found at time `t_s`.
     fn check(&self, _y: &Y<L>, _t_s: f64) -> Result<()> {
         Ok(())
@@ -328,6 +340,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
     /// and velocity of a creep phase).
     pub(crate) fn enter(&mut self, mode: Mode, input: P::Input) {
         self.mode = mode;
+        self.plant.entering(mode, input, &mut self.y);
         if !P::RATES_AT_REST && !matches!(mode, Mode::Slip(_)) {
             // At rest with no rates of its own: nothing moves but what the plant's closed
             // forms move.
@@ -812,8 +825,16 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         match self.mode {
             Mode::Slip(from) => {
                 let mut y = y_event;
-                y[V] = 0.0;
                 let input = self.plant.input(at);
+                if let Some((mode, kind)) = self.plant.arrive(input, &mut y) {
+                    self.commit(y, input, self.plant.time_s(at));
+                    self.enter(mode, input);
+                    if let Some(kind) = kind {
+                        self.note(kind, at);
+                    }
+                    return at;
+                }
+                y[V] = 0.0;
                 self.commit(y, input, self.plant.time_s(at));
                 let f_eff = self.plant.effective_force(input, &self.y);
                 let (mode, kind) = arrive_at_rest(self.plant.model(), self.y[U], f_eff, from);

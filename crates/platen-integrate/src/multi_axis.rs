@@ -247,7 +247,7 @@ pub fn inverse_table(
 }
 
 /// Gravity as a spatial acceleration, m/s².
-const GRAVITY: Wrench = Wrench::new(
+pub(crate) const GRAVITY: Wrench = Wrench::new(
     0.0,
     0.0,
     -platen_model::STANDARD_GRAVITY_M_S2,
@@ -257,7 +257,7 @@ const GRAVITY: Wrench = Wrench::new(
 );
 
 /// The platen's acceleration `(ẗ, ω̇)` from its pose, rates and second derivatives.
-fn platen_acceleration((q, qd, qdd): &(Coords, Coords, Coords)) -> Wrench {
+pub(crate) fn platen_acceleration((q, qd, qdd): &(Coords, Coords, Coords)) -> Wrench {
     let e = platen_model::multi_axis::angular_rate_map(q);
     let alpha = e * qdd.fixed_rows::<3>(3) + platen_model::multi_axis::angular_rate_bias(q, qd);
     Wrench::new(qdd[0], qdd[1], qdd[2], alpha[0], alpha[1], alpha[2])

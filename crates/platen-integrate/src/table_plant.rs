@@ -6,34 +6,75 @@
 //! the actuators' forces (each linear between its samples, along its line at its point), the
 //! struts' pull and gravity; the held DOFs stay at zero.
 //!
-//! **Friction.** Only a table without friction runs forward here (every pad's and bearing's
-//! coefficient 0). Such a table has no slide, so the machine's slide speed (`V`) is held at 1
-//! and no `v = 0` event can happen: the machine runs one slip phase and its pieces. The
-//! planar stick-slip of the bearings is not built yet; [`forward_table`] refuses a table
-//! with friction ([`IntegrateError::TableFriction`]).
+//! **Friction: exact planar stick-slip.** The bearings' Coulomb friction (`μᵢ·Nᵢ` at each
+//! contact, `Nᵢ` the force of the actuator that presses it or a constant) acts in the plane
+//! of the in-plane motion (x, y, yaw). The machine sees it through a *gauge*: a speed `V`
+//! along the direction the platen slides in (frozen at breakaway and set again at the start
+//! of every grid step; the velocity of the friction centre and the yaw rate times the
+//! friction radius `M_max/F_max`), integrated with the rest of the state. A slide ends where
+//! `V` reaches zero, located by the machine's root finder:
+//! * if the in-plane motion has stopped there (its speed below 1e-6 of what its
+//!   acceleration gives in one grid step), the in-plane rates are set to exactly zero and the
+//!   platen sticks while the friction that holds it stays within the bearings' limit surface
+//!   ([`MultiAxisTable::stick`]; ratio ≤ 1), or leaves rest at once in the direction that
+//!   surface's normal gives (a reversal);
+//! * if it has not (the slide turned through a right angle inside one step), the gauge is
+//!   aimed along the motion again and the slide goes on.
+//!
+//! In stick the in-plane coordinates are held exactly (their rates are zero, not small) while
+//! z, roll and pitch move; breakaway is the ratio reaching 1, moved just past rounding as in
+//! the uniaxial machine. With y and yaw held the gauge is `±v_x` and this is the uniaxial
+//! exact stick-slip of a Coulomb law (no creep: the planar law does not depend on the speed).
+//! A table without friction has no slide: its gauge is held at 1 and it runs one slip phase.
 
-use platen_model::multi_axis::{angular_velocity, Coords, Dof, Mount, MultiAxisTable, Wrench};
+use nalgebra::DVector;
+use nalgebra::{Vector2, Vector3};
+use platen_model::multi_axis::{
+    angular_velocity, planar_rate, Coords, Dof, FrictionCapacity, LinearSpecimen, MultiAxisTable,
+    PlanarRate, Wrench,
+};
 use platen_model::PlatenModel;
 
 use crate::error::{IntegrateError, Result};
-use crate::event::{Direction, Mode};
+use crate::event::{Direction, EventKind, Mode};
 use crate::grid::{Grid, GridStep};
 use crate::machine::{Machine, PieceMethod, Plant, DI, U, V, W, Y};
 use crate::method::Method;
-use crate::multi_axis::TableRun;
+use crate::multi_axis::{platen_acceleration, TableRun, GRAVITY};
 
 /// Where the pose starts in the state.
 const Q: usize = 5;
 /// Where its rates start.
 const QD: usize = Q + 6;
-/// The state's length.
-const L: usize = QD + 6;
+/// Where the specimen's DOFs start (their rates follow them).
+const Z: usize = QD + 6;
+/// The state's length without a specimen.
+const BARE: usize = Z;
+/// The most DOFs of a specimen a forward run takes.
+pub const MAX_TABLE_SPECIMEN_DOFS: usize = 12;
+/// The state's length with a specimen (its unused DOFs stay at zero).
+const WITH_SPECIMEN: usize = Z + 2 * MAX_TABLE_SPECIMEN_DOFS;
 
-/// The machine's law for a plant without a slide: never consulted (no stick, no creep, no
-/// `v = 0`), here because the machine's plants name one.
-struct NoSlide;
+/// The most actuators a forward run takes (their forces at an instant live on the stack).
+pub const MAX_TABLE_ACTUATORS: usize = 64;
 
-impl PlatenModel for NoSlide {
+/// A slide ends in rest where its in-plane speed is below this share of what its
+/// acceleration gives in one grid step (at a true stop the located speed is rounding, some
+/// 1e-15 of it; a slide that turned instead keeps a speed of the order of that).
+const REST_SHARE: f64 = 1e-6;
+
+/// The friction direction near rest is blended with the slide's known direction over the
+/// speed the friction takes off in this many grid steps: enough that an RK4 stage that
+/// overshoots rest (by less than one step's worth) keeps the direction, and that the stiff
+/// turning of the Coulomb direction near rest takes at least that many steps.
+const BLEND_STEPS: f64 = 4.0;
+
+/// The machine's law for the table: the friction the machine compares is the ratio of the
+/// holding friction to the bearings' limit surface ([`MultiAxisTable::stick`]), so its
+/// threshold is 1 and nothing else of the law is consulted (no elastic force, no creep).
+struct UnitThreshold;
+
+impl PlatenModel for UnitThreshold {
     fn mass_kg(&self, _u_m: f64) -> f64 {
         1.0
     }
@@ -44,10 +85,86 @@ impl PlatenModel for NoSlide {
         0.0
     }
     fn dissipative_magnitude_n(&self, _u_m: f64, _speed_m_s: f64) -> f64 {
-        0.0
+        1.0
     }
     fn elastic_energy_j(&self, _u_m: f64) -> f64 {
         0.0
+    }
+}
+
+/// The slide's gauge: the speed `V` of the in-plane motion along the direction `unit`, in
+/// the metric of the friction centre's velocity and the yaw rate times the friction radius
+/// (both frozen when the gauge is set, so that `V` is linear in the state and integrates
+/// with it).
+#[derive(Debug, Clone, Copy)]
+struct Gauge {
+    /// The friction centre from the reference point, horizontal, m.
+    arm: Vector2<f64>,
+    /// The friction radius `M_max/F_max`, m (1 where there is none).
+    radius_m: f64,
+    /// The slide's direction in that metric (unit).
+    unit: Vector3<f64>,
+}
+
+impl Gauge {
+    /// The gauge of the bearings' `capacity` at the reference point `t`, along `w`.
+    fn new(capacity: &FrictionCapacity, t: &Vector3<f64>, w: &PlanarRate) -> Self {
+        let arm = (capacity.centre_m - t).xy();
+        let radius_m = if capacity.force_n > 0.0 && capacity.moment_n_m > 0.0 {
+            capacity.moment_n_m / capacity.force_n
+        } else {
+            1.0
+        };
+        let mut g = Gauge {
+            arm,
+            radius_m,
+            unit: Vector3::x(),
+        };
+        let s = g.scaled(w);
+        let n = s.norm();
+        if n > 0.0 {
+            g.unit = s / n;
+        }
+        g
+    }
+
+    /// The in-plane motion `w` of the reference point as the friction centre's velocity and
+    /// the yaw rate times the radius.
+    fn scaled(&self, w: &PlanarRate) -> Vector3<f64> {
+        Vector3::new(
+            w[0] - w[2] * self.arm[1],
+            w[1] + w[2] * self.arm[0],
+            w[2] * self.radius_m,
+        )
+    }
+
+    /// The speed along the slide of the in-plane motion `w` (or its rate of an acceleration).
+    fn speed(&self, w: &PlanarRate) -> f64 {
+        self.unit.dot(&self.scaled(w))
+    }
+
+    /// The in-plane motion (of the reference point) that leaves rest held by `holding`
+    /// (force at the friction centre, moment about it) against `capacity`: along the normal
+    /// of the limit surface there, against the holding friction; the metric's unit speed.
+    fn leaving(
+        capacity: &FrictionCapacity,
+        holding: &Vector3<f64>,
+        arm: &Vector2<f64>,
+    ) -> PlanarRate {
+        let per = |value: f64, limit: f64| {
+            if limit > 0.0 {
+                value / (limit * limit)
+            } else {
+                value
+            }
+        };
+        // The friction centre's velocity and the yaw rate.
+        let c = Vector3::new(
+            -per(holding[0], capacity.force_n),
+            -per(holding[1], capacity.force_n),
+            -per(holding[2], capacity.moment_n_m),
+        );
+        PlanarRate::new(c[0] + c[2] * arm[1], c[1] - c[2] * arm[0], c[2])
     }
 }
 
@@ -119,8 +236,11 @@ struct At {
     w: f64,
 }
 
+/// The actuator forces at an instant, N.
+type Forces = [f64; MAX_TABLE_ACTUATORS];
+
 /// The multi-axis platen under its actuator forces: the [`Plant`] of the mode machine.
-struct TablePlant<'a> {
+struct TablePlant<'a, const L: usize> {
     table: &'a MultiAxisTable,
     forces: &'a ActuatorForces,
     /// The time grid (its force is the first actuator's, unused: the input is every
@@ -128,30 +248,41 @@ struct TablePlant<'a> {
     grid: Grid<'a>,
     /// The grid step being taken.
     n: GridStep,
+    /// The specimen on the platen.
+    specimen: Option<&'a LinearSpecimen>,
+    /// Whether any contact has friction (else the gauge is held at 1: one slip phase).
+    friction: bool,
+    /// The slide's gauge.
+    gauge: Gauge,
+    /// The in-plane motion the slide was last known to go along (at breakaway, at the start
+    /// of the grid step): the direction of the friction near rest.
+    leaving: PlanarRate,
+    /// The friction direction's blend with `leaving` ([`MultiAxisTable::sliding_friction`]):
+    /// what the bearings' friction takes off the speed in [`BLEND_STEPS`] grid steps, m/s.
+    blend_m_s: f64,
 }
 
-impl TablePlant<'_> {
-    fn forces_at(&self, at: At) -> impl Iterator<Item = f64> + '_ {
+impl<const L: usize> TablePlant<'_, L> {
+    fn forces_at(&self, at: At) -> Forces {
         let (j, w) = (at.j, at.w);
-        self.forces.forces_n.iter().map(move |f| {
-            if w == 0.0 {
+        let mut out = [0.0; MAX_TABLE_ACTUATORS];
+        for (o, f) in out.iter_mut().zip(&self.forces.forces_n) {
+            *o = if w == 0.0 {
                 f[j]
             } else {
                 f[j] * (1.0 - w) + f[j + 1] * w
-            }
-        })
+            };
+        }
+        out
     }
 
-    /// The actuators' wrench at pose `q` under the forces at `at`, and their power at rates
-    /// `qd` (the wrench on the platen's twist).
-    fn actuators(&self, at: At, q: &Coords, qd: &Coords) -> (Wrench, f64) {
+    /// The actuators' wrench at pose `q` under the forces `f`.
+    fn actuators(&self, f: &Forces, q: &Coords) -> Wrench {
         let mut wrench = Wrench::zeros();
-        for (i, f) in self.forces_at(at).enumerate() {
-            wrench += self.table.actuator_at(i, q).unit_wrench * f;
+        for (i, f) in f.iter().take(self.table.actuators().len()).enumerate() {
+            wrench += self.table.actuator_at(i, q).unit_wrench * *f;
         }
-        let omega = angular_velocity(q, qd);
-        let twist = Wrench::new(qd[0], qd[1], qd[2], omega[0], omega[1], omega[2]);
-        (wrench, wrench.dot(&twist))
+        wrench
     }
 
     fn pose(y: &Y<L>) -> (Coords, Coords) {
@@ -161,33 +292,170 @@ impl TablePlant<'_> {
         )
     }
 
-    fn table_rates(&self, at: At, y: &Y<L>, dy: &mut Y<L>) -> f64 {
+    /// The platen's twist (velocity of the reference point, angular velocity).
+    fn twist(q: &Coords, qd: &Coords) -> Wrench {
+        let omega = angular_velocity(q, qd);
+        Wrench::new(qd[0], qd[1], qd[2], omega[0], omega[1], omega[2])
+    }
+
+    /// The rates in slip (or free flight without friction); returns the gauge's rate.
+    fn slip_rates(&self, at: At, y: &Y<L>, dy: &mut Y<L>) -> f64 {
         let (q, qd) = Self::pose(y);
-        let (wrench, power) = self.actuators(at, &q, &qd);
-        let applied = wrench + self.table.struts_wrench(&q);
+        let f = self.forces_at(at);
+        let wrench = self.actuators(&f, &q);
+        let twist = Self::twist(&q, &qd);
+        let mut applied = wrench + self.table.struts_wrench(&q) + self.specimen_push(y);
+        let mut lost = 0.0;
+        if self.friction {
+            let friction = self
+                .table
+                .sliding_friction(&q, &qd, &f, &self.leaving, self.blend_m_s);
+            applied += friction;
+            lost = -friction.dot(&twist);
+        }
         let qdd = self
             .table
             .accelerations(&q, &qd, &applied)
             .unwrap_or_else(|| Coords::repeat(f64::NAN));
         dy[U] = 0.0;
-        dy[V] = 0.0;
-        dy[W] = power;
-        dy[DI] = 0.0;
+        dy[V] = if self.friction {
+            self.gauge.speed(&planar_rate(&qdd))
+        } else {
+            0.0
+        };
+        dy[W] = wrench.dot(&twist);
+        dy[DI] = lost;
         dy[crate::machine::SD] = 0.0;
         for k in 0..6 {
             dy[Q + k] = qd[k];
             dy[QD + k] = qdd[k];
         }
-        0.0
+        self.specimen_rates(&q, &qd, &qdd, y, dy);
+        dy[V]
+    }
+
+    /// The specimen's DOFs and rates in `y`.
+    fn specimen_state(s: &LinearSpecimen, y: &Y<L>) -> (DVector<f64>, DVector<f64>) {
+        let n = s.len();
+        (
+            DVector::from_fn(n, |i, _| y[Z + i]),
+            DVector::from_fn(n, |i, _| y[Z + n + i]),
+        )
+    }
+
+    /// The specimen's push on the platen at `y` (zero without one).
+    fn specimen_push(&self, y: &Y<L>) -> Wrench {
+        match self.specimen {
+            Some(s) => {
+                let (z, zd) = Self::specimen_state(s, y);
+                s.wrench_on_platen(&z, &zd)
+            }
+            None => Wrench::zeros(),
+        }
+    }
+
+    /// The specimen's rates under the platen moving with `q`, `qd`, `qdd` (it feels the
+    /// platen's acceleration less gravity's), and its dampers' power into `SD`.
+    fn specimen_rates(&self, q: &Coords, qd: &Coords, qdd: &Coords, y: &Y<L>, dy: &mut Y<L>) {
+        let Some(s) = self.specimen else {
+            return;
+        };
+        let n = s.len();
+        let (z, zd) = Self::specimen_state(s, y);
+        let a = platen_acceleration(&(*q, *qd, *qdd)) - GRAVITY;
+        let zdd = s.accelerations(&z, &zd, &a);
+        for i in 0..n {
+            dy[Z + i] = zd[i];
+            dy[Z + n + i] = zdd[i];
+        }
+        dy[crate::machine::SD] = zd.dot(&(s.damping() * &zd));
+    }
+
+    /// The rates at rest in the plane: the in-plane coordinates held by friction.
+    fn stick_rates(&self, at: At, y: &Y<L>, dy: &mut Y<L>) {
+        let (q, qd) = Self::pose(y);
+        let f = self.forces_at(at);
+        let wrench = self.actuators(&f, &q);
+        let twist = Self::twist(&q, &qd);
+        let applied = wrench + self.table.struts_wrench(&q) + self.specimen_push(y);
+        let capacity = self.table.friction_capacity(&q, &f);
+        let (qdd, holding) = match self.table.stick(&q, &qd, &applied, &capacity) {
+            Some(s) => (s.accelerations, s.wrench),
+            None => (Coords::repeat(f64::NAN), Wrench::repeat(f64::NAN)),
+        };
+        dy[U] = 0.0;
+        dy[V] = 0.0;
+        dy[W] = wrench.dot(&twist);
+        dy[DI] = -holding.dot(&twist);
+        dy[crate::machine::SD] = 0.0;
+        for k in 0..6 {
+            dy[Q + k] = qd[k];
+            dy[QD + k] = qdd[k];
+        }
+        self.specimen_rates(&q, &qd, &qdd, y, dy);
+    }
+
+    /// The holding friction's ratio to the limit surface at `y` under the forces at `at`
+    /// (infinite where the equations are singular), and what leaving rest there would mean:
+    /// the in-plane motion and the gauge along it.
+    fn at_rest(&self, at: At, y: &Y<L>) -> (f64, PlanarRate, Gauge) {
+        let (q, qd) = Self::pose(y);
+        let f = self.forces_at(at);
+        let applied = self.actuators(&f, &q) + self.table.struts_wrench(&q) + self.specimen_push(y);
+        let capacity = self.table.friction_capacity(&q, &f);
+        let t = Vector3::new(q[0], q[1], q[2]);
+        let arm = (capacity.centre_m - t).xy();
+        match self.table.stick(&q, &qd, &applied, &capacity) {
+            Some(s) => {
+                let w = Gauge::leaving(&capacity, &s.holding, &arm);
+                (s.ratio, w, Gauge::new(&capacity, &t, &w))
+            }
+            None => (
+                f64::INFINITY,
+                PlanarRate::zeros(),
+                Gauge::new(&capacity, &t, &PlanarRate::zeros()),
+            ),
+        }
+    }
+
+    /// The gauge along the in-plane motion of `y`, with the bearings' capacity under the
+    /// forces at `at`.
+    fn gauge_along(&self, at: At, y: &Y<L>) -> Gauge {
+        let (q, qd) = Self::pose(y);
+        let capacity = self.table.friction_capacity(&q, &self.forces_at(at));
+        Gauge::new(
+            &capacity,
+            &Vector3::new(q[0], q[1], q[2]),
+            &planar_rate(&qd),
+        )
+    }
+
+    /// Aims the slide along the in-plane motion `along` with `gauge`, its blend speed from
+    /// the bearings' capacity at `y` under the forces at `at`.
+    fn aim(&mut self, at: At, y: &Y<L>, gauge: Gauge, along: PlanarRate) {
+        let (q, _) = Self::pose(y);
+        let capacity = self.table.friction_capacity(&q, &self.forces_at(at));
+        self.gauge = gauge;
+        self.leaving = along;
+        self.blend_m_s =
+            BLEND_STEPS * self.grid.h * capacity.force_n / self.table.platen().mass_kg();
     }
 }
 
-impl Plant<L> for TablePlant<'_> {
-    type Model = NoSlide;
+/// Sets the in-plane rates of `y` to zero.
+fn hold_in_plane<const L: usize>(y: &mut Y<L>) {
+    for d in [Dof::X, Dof::Y, Dof::Yaw] {
+        y[QD + d.index()] = 0.0;
+    }
+    y[V] = 0.0;
+}
+
+impl<const L: usize> Plant<L> for TablePlant<'_, L> {
+    type Model = UnitThreshold;
     type Input = At;
 
-    fn model(&self) -> &NoSlide {
-        &NoSlide
+    fn model(&self) -> &UnitThreshold {
+        &UnitThreshold
     }
 
     #[inline(always)]
@@ -198,30 +466,83 @@ impl Plant<L> for TablePlant<'_> {
         }
     }
 
-    fn rates(&self, _mode: Mode, _w_stiff: f64, input: At, y: &Y<L>, dy: &mut Y<L>) -> f64 {
-        self.table_rates(input, y, dy)
+    fn rates(&self, mode: Mode, _w_stiff: f64, input: At, y: &Y<L>, dy: &mut Y<L>) -> f64 {
+        if mode == Mode::Stick {
+            self.stick_rates(input, y, dy);
+            0.0
+        } else {
+            self.slip_rates(input, y, dy)
+        }
     }
 
     fn slip_rates<const POSITIVE: bool>(&self, input: At, y: &Y<L>, dy: &mut Y<L>) -> f64 {
-        self.table_rates(input, y, dy)
+        TablePlant::slip_rates(self, input, y, dy)
     }
 
-    /// No slide: nothing for friction to see.
-    fn effective_force(&self, _input: At, _y: &Y<L>) -> f64 {
-        f64::INFINITY
+    /// The holding friction's ratio to the limit surface (the machine's threshold is 1).
+    fn effective_force(&self, input: At, y: &Y<L>) -> f64 {
+        if self.friction {
+            self.at_rest(input, y).0
+        } else {
+            f64::INFINITY
+        }
     }
 
-    fn net(&self, _input: At, _y: &Y<L>) -> f64 {
-        f64::INFINITY
+    fn net(&self, input: At, y: &Y<L>) -> f64 {
+        self.effective_force(input, y)
     }
 
+    /// Not known from the state's rates alone (the forces move with time): the stick's
+    /// breakaway is found from the ratio at the ends of each piece.
     fn net_rate(&self, _k: &Y<L>) -> f64 {
         0.0
     }
 
+    fn entering(&mut self, mode: Mode, input: At, y: &mut Y<L>) {
+        if !self.friction {
+            return;
+        }
+        match mode {
+            Mode::Stick => hold_in_plane(y),
+            Mode::Slip(_) if y[V] == 0.0 => {
+                let (_, leaving, gauge) = self.at_rest(input, y);
+                self.aim(input, y, gauge, leaving);
+            }
+            _ => {}
+        }
+    }
+
+    fn arrive(&mut self, input: At, y: &mut Y<L>) -> Option<(Mode, Option<EventKind>)> {
+        let w = planar_rate(&Coords::from_fn(|k, _| y[QD + k]));
+        let speed = self.gauge.scaled(&w).norm();
+        let mut dy = [0.0; L];
+        TablePlant::slip_rates(self, input, y, &mut dy);
+        let accel = self
+            .gauge
+            .scaled(&planar_rate(&Coords::from_fn(|k, _| dy[QD + k])))
+            .norm();
+        if speed > REST_SHARE * accel * self.grid.h {
+            // Still sliding, on a path that turned: aim the gauge along it again.
+            let gauge = self.gauge_along(input, y);
+            self.aim(input, y, gauge, w);
+            y[V] = self.gauge.speed(&w);
+            return Some((Mode::Slip(Direction::Positive), None));
+        }
+        hold_in_plane(y);
+        if self.at_rest(input, y).0 <= 1.0 {
+            // The machine's reset: stick, a stop.
+            return None;
+        }
+        Some((Mode::Slip(Direction::Positive), Some(EventKind::Reversal)))
+    }
+
+    fn creeps_from_rest(&self, _dir: Direction, _tau: f64, _y: &Y<L>, _w_stiff: f64) -> bool {
+        false
+    }
+
     const RATES_ON_COMMIT: bool = false;
 
-    /// The pose (m, rad) and its rates are controlled; the slide and the work are not.
+    /// The pose (m, rad) and its rates are controlled; the gauge and the work are not.
     fn error_scale(&self, i: usize, y0: f64, y1: f64, rtol: f64, atol: f64) -> f64 {
         if i >= Q {
             atol + rtol * y0.abs().max(y1.abs())
@@ -235,26 +556,31 @@ impl Plant<L> for TablePlant<'_> {
 
 /// The forward run of `table` under `forces` from the pose `initial` with rates
 /// `initial_rates` (held DOFs must be 0 in both), with fixed-step RK4 or adaptive Dopri5
-/// through the one mode machine, delivering every sample of the record as a row of the
-/// run's columns: `t_s`; the pose, its rates and accelerations; per actuator
-/// `{name}_stroke_m`, `{name}_force_n`; per strut `{name}_force_n`; `actuator_work_j` (the
-/// actuators' work on the platen since the start).
+/// through the one mode machine, the bearings' friction with exact planar stick-slip,
+/// delivering every sample of the record as a row of the run's columns: `t_s`; the pose,
+/// its rates and accelerations; per actuator `{name}_stroke_m`, `{name}_force_n`; per strut
+/// `{name}_force_n`; `actuator_work_j` (the actuators' work on the platen since the start);
+/// with friction `dissipated_j` (the friction's) and `stuck` (1 while the platen rests in
+/// its plane, else 0); with a `specimen` its `base_force_{x,y,z}_n` and
+/// `overturning_moment_{x,y}_n_m` (the force the platen exerts on it, about the reference
+/// point), each of its DOFs `specimen{i}_z` and rate `specimen{i}_zdot` (in the DOF's own
+/// SI unit, m or rad, relative to the platen) and `specimen_damping_j` (its dampers'
+/// dissipation). The specimen starts at rest in its static deflection under its weight and
+/// feels the platen's acceleration less gravity's, as in [`crate::inverse_table`].
 ///
 /// # Errors
-/// [`IntegrateError::TableFriction`] for a table with friction; [`IntegrateError::LengthMismatch`]
-/// when `forces` has not one record per actuator; [`IntegrateError::InvalidStep`] for a step
+/// [`IntegrateError::LengthMismatch`] when `forces` has not one record per actuator (or the
+/// table more than [`MAX_TABLE_ACTUATORS`]); [`IntegrateError::InvalidStep`] for a step
 /// that does not divide the sample interval; [`IntegrateError::NonFiniteState`] and
 /// [`IntegrateError::AdaptiveFailed`] as the other forward runs.
 pub fn forward_table(
     table: &MultiAxisTable,
+    specimen: Option<&LinearSpecimen>,
     forces: &ActuatorForces,
     method: Method,
     initial: Coords,
     initial_rates: Coords,
 ) -> Result<TableRun> {
-    if has_friction(table) {
-        return Err(IntegrateError::TableFriction);
-    }
     if forces.forces_n.len() != table.actuators().len() {
         return Err(IntegrateError::LengthMismatch {
             what: "actuator force records",
@@ -262,6 +588,35 @@ pub fn forward_table(
             expected: table.actuators().len(),
         });
     }
+    if table.actuators().len() > MAX_TABLE_ACTUATORS {
+        return Err(IntegrateError::LengthMismatch {
+            what: "actuators of a forward run (at most MAX_TABLE_ACTUATORS)",
+            found: table.actuators().len(),
+            expected: MAX_TABLE_ACTUATORS,
+        });
+    }
+    let start = (initial, initial_rates);
+    match specimen {
+        None => run::<BARE>(table, None, forces, method, start),
+        Some(s) if s.len() <= MAX_TABLE_SPECIMEN_DOFS => {
+            run::<WITH_SPECIMEN>(table, Some(s), forces, method, start)
+        }
+        Some(s) => Err(IntegrateError::LengthMismatch {
+            what: "specimen DOFs of a forward run (at most MAX_TABLE_SPECIMEN_DOFS)",
+            found: s.len(),
+            expected: MAX_TABLE_SPECIMEN_DOFS,
+        }),
+    }
+}
+
+/// [`forward_table`] with a state of `L` numbers.
+fn run<const L: usize>(
+    table: &MultiAxisTable,
+    specimen: Option<&LinearSpecimen>,
+    forces: &ActuatorForces,
+    method: Method,
+    (initial, initial_rates): (Coords, Coords),
+) -> Result<TableRun> {
     let dt = forces.t_s[1] - forces.t_s[0];
     let (k, pieces) = match method {
         Method::Rk4(rk4) => (u64::from(rk4.steps_per_sample()), PieceMethod::Rk4),
@@ -282,7 +637,18 @@ pub fn forward_table(
         y[Q + i] = if held { 0.0 } else { initial[i] };
         y[QD + i] = if held { 0.0 } else { initial_rates[i] };
     }
-    let plant = TablePlant {
+    if let Some(s) = specimen {
+        // At rest in its static deflection under its weight (undeflected if its stiffness
+        // is singular), as the inverse starts it.
+        let z = s
+            .equilibrium_under(&-GRAVITY)
+            .unwrap_or_else(|| DVector::zeros(s.len()));
+        for (i, zi) in z.iter().enumerate() {
+            y[Z + i] = *zi;
+        }
+    }
+    let friction = table.has_friction();
+    let mut plant = TablePlant {
         table,
         forces,
         grid: Grid {
@@ -292,10 +658,34 @@ pub fn forward_table(
             t0: forces.t_s[0],
         },
         n: GridStep { n: 0, j: 0, i: 0.0 },
+        specimen,
+        friction,
+        gauge: Gauge {
+            arm: Vector2::zeros(),
+            radius_m: 1.0,
+            unit: Vector3::x(),
+        },
+        leaving: PlanarRate::zeros(),
+        blend_m_s: 0.0,
     };
+    let start = At { j: 0, w: 0.0 };
+    let mut mode = Mode::Slip(Direction::Positive);
+    if friction {
+        let w = planar_rate(&TablePlant::<L>::pose(&y).1);
+        if w == PlanarRate::zeros() {
+            y[V] = 0.0;
+            if plant.at_rest(start, &y).0 <= 1.0 {
+                mode = Mode::Stick;
+            }
+        } else {
+            let gauge = plant.gauge_along(start, &y);
+            plant.aim(start, &y, gauge, w);
+            y[V] = plant.gauge.speed(&w);
+        }
+    }
     let mut m = Machine::new(plant, y, h, pieces);
-    m.enter(Mode::Slip(Direction::Positive), At { j: 0, w: 0.0 });
-    let mut out = Output::new(table, forces.len());
+    m.enter(mode, start);
+    let mut out = Output::new(table, specimen, forces.len());
     out.push(&m, 0);
     let mut n = 0u64;
     for j in 0..forces.len() - 1 {
@@ -308,27 +698,37 @@ pub fn forward_table(
     Ok(out.finish())
 }
 
-/// Whether any contact of `table` has friction.
-fn has_friction(table: &MultiAxisTable) -> bool {
-    table.actuators().iter().any(|a| match &a.mount {
-        Mount::Pad(p) => p.friction_coefficient > 0.0,
-        Mount::Swivel { .. } => false,
-    }) || table
-        .parts()
-        .bearings
-        .iter()
-        .any(|b| b.friction_coefficient > 0.0)
-}
-
-/// One grid step: RK4's single piece when it is safe, else the machine's advance.
-fn step(m: &mut Machine<TablePlant<'_>, L>, n: GridStep) -> Result<()> {
+/// One grid step: RK4's single piece when it is safe, else the machine's advance. A slide
+/// with friction has its gauge aimed along its motion first.
+fn step<const L: usize>(m: &mut Machine<TablePlant<'_, L>, L>, n: GridStep) -> Result<()> {
     m.plant.n = n;
     m.stats.steps += 1;
-    if m.is_rk4() && m.slip_fast::<true>(0.0) {
+    let sliding = m.mode == Mode::Slip(Direction::Positive) && m.y[V] > 0.0;
+    if sliding && m.plant.friction {
+        let input = m.plant.input(0.0);
+        let gauge = m.plant.gauge_along(input, &m.y);
+        let w = planar_rate(&TablePlant::<L>::pose(&m.y).1);
+        let y = m.y;
+        m.plant.aim(input, &y, gauge, w);
+        m.y[V] = gauge.speed(&w);
+        m.k[V] = gauge.speed(&planar_rate(&Coords::from_fn(|k, _| m.k[QD + k])));
+        m.a = m.k[V];
+    }
+    if sliding && m.is_rk4() && m.slip_fast::<true>(0.0) {
         return Ok(());
     }
     m.advance_span()
 }
+
+/// The specimen's base force and overturning moments (the force the platen exerts on it,
+/// about the reference point), as the inverse names them.
+const SPECIMEN_COLUMNS: [&str; 5] = [
+    "base_force_x_n",
+    "base_force_y_n",
+    "base_force_z_n",
+    "overturning_moment_x_n_m",
+    "overturning_moment_y_n_m",
+];
 
 /// The run's columns, filled a sample at a time.
 struct Output {
@@ -338,7 +738,7 @@ struct Output {
 }
 
 impl Output {
-    fn new(table: &MultiAxisTable, samples: usize) -> Self {
+    fn new(table: &MultiAxisTable, specimen: Option<&LinearSpecimen>, samples: usize) -> Self {
         let mut names = vec!["t_s".to_string()];
         for suffix in ["", "_s", "_s2"] {
             names.extend(Dof::ALL.map(|d| format!("{}_{}{suffix}", d.name(), d.unit())));
@@ -350,7 +750,21 @@ impl Output {
         for s in table.struts() {
             names.push(format!("{}_force_n", s.name));
         }
+        if specimen.is_some() {
+            names.extend(SPECIMEN_COLUMNS.map(String::from));
+        }
         names.push("actuator_work_j".into());
+        if table.has_friction() {
+            names.push("dissipated_j".into());
+            names.push("stuck".into());
+        }
+        if let Some(s) = specimen {
+            for i in 1..=s.len() {
+                names.push(format!("specimen{i}_z"));
+                names.push(format!("specimen{i}_zdot"));
+            }
+            names.push("specimen_damping_j".into());
+        }
         let data = names.iter().map(|_| Vec::with_capacity(samples)).collect();
         Output {
             names,
@@ -359,9 +773,9 @@ impl Output {
         }
     }
 
-    fn push(&mut self, m: &Machine<TablePlant<'_>, L>, j: usize) {
+    fn push<const L: usize>(&mut self, m: &Machine<TablePlant<'_, L>, L>, j: usize) {
         let p = &m.plant;
-        let (q, qd) = TablePlant::pose(&m.y);
+        let (q, qd) = TablePlant::<L>::pose(&m.y);
         self.row.clear();
         self.row.push(p.forces.t_s[j]);
         self.row.extend(q.iter().chain(qd.iter()));
@@ -373,7 +787,24 @@ impl Output {
         for s in 0..p.table.struts().len() {
             self.row.push(p.table.strut_at(s, &q).force_n);
         }
+        if p.specimen.is_some() {
+            let base = -p.specimen_push(&m.y);
+            self.row
+                .extend([base[0], base[1], base[2], base[3], base[4]]);
+        }
         self.row.push(m.y[W]);
+        if p.friction {
+            self.row.push(m.y[DI]);
+            self.row.push(f64::from(u8::from(m.mode == Mode::Stick)));
+        }
+        if let Some(s) = p.specimen {
+            let n = s.len();
+            for i in 0..n {
+                self.row.push(m.y[Z + i]);
+                self.row.push(m.y[Z + n + i]);
+            }
+            self.row.push(m.y[crate::machine::SD]);
+        }
         for (c, &x) in self.data.iter_mut().zip(&self.row) {
             c.push(x);
         }

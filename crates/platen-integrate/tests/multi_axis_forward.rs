@@ -6,7 +6,7 @@
 use nalgebra::{Matrix3, Unit, Vector3};
 use platen_integrate::{
     forward_table, table_kinetic_energy_j, table_potential_energy_j, ActuatorForces,
-    Dopri5Settings, IntegrateError, Method, Rk4,
+    Dopri5Settings, Method, Rk4,
 };
 use platen_model::multi_axis::{
     Actuator, Coords, DofSet, Mount, MultiAxisTable, Pad, RigidPlaten, Strut, TableParts,
@@ -110,7 +110,7 @@ fn compare(method: Method) -> (f64, f64, f64) {
     let r: Value = serde_json::from_str(&data("multi_axis.json")).unwrap();
     let t = table(&r["table"], Some(0.0));
     let f = forces(&t);
-    let run = forward_table(&t, &f, method, Coords::zeros(), Coords::zeros()).unwrap();
+    let run = forward_table(&t, None, &f, method, Coords::zeros(), Coords::zeros()).unwrap();
     let every = r["forward"]["output_every"].as_u64().unwrap() as usize;
     let names = ["x_m", "y_m", "z_m", "roll_rad", "pitch_rad", "yaw_rad"];
     let (mut dm, mut drad) = (0.0f64, 0.0f64);
@@ -169,20 +169,4 @@ fn dopri5_follows_the_independent_free_flight() {
     eprintln!("Dopri5 rtol 1e-10: {dm:e} m, {drad:e} rad, energy residual {energy:e}");
     assert!(dm < 1e-7 && drad < 1e-7, "{dm} m, {drad} rad");
     assert!(energy < 1e-6, "{energy}");
-}
-
-/// A table with friction is refused (its planar stick-slip is not built yet).
-#[test]
-fn a_table_with_friction_is_refused_forward() {
-    let r: Value = serde_json::from_str(&data("multi_axis.json")).unwrap();
-    let t = table(&r["table"], None);
-    let err = forward_table(
-        &t,
-        &forces(&t),
-        Method::Rk4(Rk4::with_steps_per_sample(1).unwrap()),
-        Coords::zeros(),
-        Coords::zeros(),
-    )
-    .unwrap_err();
-    assert_eq!(err, IntegrateError::TableFriction);
 }

@@ -805,6 +805,13 @@ fn forward_run(
 ) -> Result<Run> {
     let integrator = forward_method(ctx, file, &record)?;
     let initial = file.initial.clone().unwrap_or_default();
+    if let Some((key, _)) = initial.table_values().iter().find(|(_, v)| v.is_some()) {
+        return Err(ctx.invalid(
+            &format!("initial.{key}"),
+            "(given)",
+            "u_m, v_m_s or from_record: the pose names are a multi-axis table's (`table`)",
+        ));
+    }
     let (u0, v0) = if initial.from_record {
         if initial.u_m.is_some() || initial.v_m_s.is_some() {
             return Err(ctx.invalid(

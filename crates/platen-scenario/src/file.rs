@@ -465,7 +465,8 @@ pub struct Rk4Spec {
 
 /// `initial`: the state at the record's first sample, given (`{"u_m": …, "v_m_s": …}`) or
 /// taken from the force record's own `u_m` and `v_m_s` columns (`{"from_record": true}`, for
-/// a recorded test that did not start at rest, like the paper's SR9).
+/// a recorded test that did not start at rest, like the paper's SR9). With a `table`: any of
+/// the pose and rate names (`{"x_m": …, "y_m_s": …}`), the rest at rest at neutral.
 #[derive(Debug, Clone, Default, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct InitialSpec {
@@ -478,6 +479,63 @@ pub struct InitialSpec {
     /// Take the state from the first row of the force CSV's `u_m` and `v_m_s` columns.
     #[serde(default)]
     pub from_record: bool,
+    /// With a `table`: the platen's x, m (default 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub x_m: Option<f64>,
+    /// With a `table`: the platen's y, m (default 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub y_m: Option<f64>,
+    /// With a `table`: the platen's z, m (default 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub z_m: Option<f64>,
+    /// With a `table`: the platen's roll, rad (default 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub roll_rad: Option<f64>,
+    /// With a `table`: the platen's pitch, rad (default 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pitch_rad: Option<f64>,
+    /// With a `table`: the platen's yaw, rad (default 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub yaw_rad: Option<f64>,
+    /// With a `table`: the platen's x rate, m/s (default 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub x_m_s: Option<f64>,
+    /// With a `table`: the platen's y rate, m/s (default 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub y_m_s: Option<f64>,
+    /// With a `table`: the platen's z rate, m/s (default 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub z_m_s: Option<f64>,
+    /// With a `table`: the platen's roll rate, rad/s (default 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub roll_rad_s: Option<f64>,
+    /// With a `table`: the platen's pitch rate, rad/s (default 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pitch_rad_s: Option<f64>,
+    /// With a `table`: the platen's yaw rate, rad/s (default 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub yaw_rad_s: Option<f64>,
+}
+
+impl InitialSpec {
+    /// The multi-axis table's pose and rates, by their names (`x_m` … `yaw_rad`, then
+    /// `x_m_s` … `yaw_rad_s`), as given.
+    pub fn table_values(&self) -> [(&'static str, Option<f64>); 12] {
+        [
+            ("x_m", self.x_m),
+            ("y_m", self.y_m),
+            ("z_m", self.z_m),
+            ("roll_rad", self.roll_rad),
+            ("pitch_rad", self.pitch_rad),
+            ("yaw_rad", self.yaw_rad),
+            ("x_m_s", self.x_m_s),
+            ("y_m_s", self.y_m_s),
+            ("z_m_s", self.z_m_s),
+            ("roll_rad_s", self.roll_rad_s),
+            ("pitch_rad_s", self.pitch_rad_s),
+            ("yaw_rad_s", self.yaw_rad_s),
+        ]
+    }
 }
 
 /// Parses scenario JSON, reporting the JSON path (or line and column) of any error.

@@ -22,7 +22,7 @@ use platen_model::multi_axis::{
 };
 use platen_model::ModelError;
 
-use crate::ctx::{check_positive, Ctx};
+use crate::ctx::{check_finite, check_positive, Ctx};
 use crate::error::{Result, ScenarioError};
 use crate::excitation::{motion_run, read_mapped, Derived};
 use crate::file::{ScenarioFile, SpecimenSpec};
@@ -65,12 +65,15 @@ pub enum TableRunSpec {
         /// The motion (boxed: six channels of four vectors each).
         motion: Box<PoseMotion>,
     },
-    /// The motion recorded actuator forces produce (a frictionless table, for now).
+    /// The motion recorded actuator forces produce.
     Forward {
         /// One force record per actuator, in the table's order.
         forces: ActuatorForces,
         /// The integrator.
         method: Method,
+        /// The pose and its rates at the first sample (`initial`; at rest at neutral by
+        /// default).
+        initial: (Coords, Coords),
     },
 }
 
@@ -108,7 +111,10 @@ impl TableScenario {
             ("model", file.model.is_some()),
             ("table_system", file.table_system.is_some()),
             ("limits", file.limits.is_some()),
-            ("initial", file.initial.is_some()),
+            (
+                "initial",
+                file.initial.is_some() && file.excitation.force_csv.is_none(),
+            ),
             (
                 "integrator",
                 file.integrator.is_some() && file.excitation.force_csv.is_none(),
@@ -119,8 +125,8 @@ impl TableScenario {
                     key,
                     "(given)",
                     "no such key beside a `table` (the table holds its platen and its hydraulics; \
-                     an integrator belongs to a forward run, from `force_csv`; a multi-axis run \
-                     starts at rest at neutral, and per-axis limits are not built yet)",
+                     an integrator and an initial state belong to a forward run, from \
+                     `force_csv`; per-axis limits are not built yet)",
                 ));
             }
         }
@@ -161,12 +167,17 @@ impl TableScenario {
             TableRunSpec::Inverse { motion } => {
                 inverse_table(&self.table, self.specimen.as_ref(), motion)
             }
-            TableRunSpec::Forward { forces, method } => forward_table(
+            TableRunSpec::Forward {
+                forces,
+                method,
+                initial,
+            } => forward_table(
                 &self.table,
+                self.specimen.as_ref(),
                 forces,
                 *method,
-                Coords::zeros(),
-                Coords::zeros(),
+                initial.0,
+                initial.1,
             ),
         };
         run.map_err(ScenarioError::TableRun)
@@ -488,13 +499,6 @@ fn forward_run(
     table: &MultiAxisTable,
     path: &Path,
 ) -> Result<TableRunSpec> {
-    if file.specimen.is_some() {
-        return Err(ctx.invalid(
-            "specimen",
-            "(given)",
-            "no specimen in a forward run of a multi-axis table, for now (the inverse takes one)",
-        ));
-    }
     for (key, given) in [
         ("excitation.columns", file.excitation.columns.is_some()),
         (
@@ -509,40 +513,6 @@ fn forward_run(
                 "nothing: not used by a multi-axis forward run",
             ));
         }
-    }
-    let friction = table
-        .actuators()
-        .iter()
-        .enumerate()
-        .find_map(|(i, a)| match &a.mount {
-            Mount::Pad(p) if p.friction_coefficient > 0.0 => Some((
-                format!("table.actuators[{i}].pad.friction_coefficient"),
-                p.friction_coefficient,
-            )),
-            _ => None,
-        });
-    let friction = friction.or_else(|| {
-        table
-            .parts()
-            .bearings
-            .iter()
-            .enumerate()
-            .find_map(|(k, b)| {
-                (b.friction_coefficient > 0.0).then(|| {
-                    (
-                        format!("table.bearings[{k}].friction_coefficient"),
-                        b.friction_coefficient,
-                    )
-                })
-            })
-    });
-    if let Some((key, mu)) = friction {
-        return Err(ctx.invalid(
-            &key,
-            mu,
-            "0 in a forward run: the planar stick-slip of the bearings is not built yet (the \
-             inverse takes friction)",
-        ));
     }
     let names: Vec<String> = table
         .actuators()
@@ -585,7 +555,58 @@ fn forward_run(
     let method = crate::excitation::forward_method(ctx, file, &first)?;
     let forces =
         ActuatorForces::new(t, forces).map_err(|cause| crate::excitation::rejected(path, cause))?;
-    Ok(TableRunSpec::Forward { forces, method })
+    let initial = build_initial(ctx, file, table)?;
+    Ok(TableRunSpec::Forward {
+        forces,
+        method,
+        initial,
+    })
+}
+
+/// `initial` of a forward run: the pose and rates given by name, the rest zero; a held DOF's
+/// must be 0, and the uniaxial names are refused.
+fn build_initial(
+    ctx: &Ctx,
+    file: &ScenarioFile,
+    table: &MultiAxisTable,
+) -> Result<(Coords, Coords)> {
+    let mut out = (Coords::zeros(), Coords::zeros());
+    let Some(initial) = &file.initial else {
+        return Ok(out);
+    };
+    for (key, given) in [
+        ("u_m", initial.u_m.is_some()),
+        ("v_m_s", initial.v_m_s.is_some()),
+        ("from_record", initial.from_record),
+    ] {
+        if given {
+            return Err(ctx.invalid(
+                &format!("initial.{key}"),
+                "(given)",
+                "the pose and rate names of a multi-axis table (x_m … yaw_rad, x_m_s … \
+                 yaw_rad_s)",
+            ));
+        }
+    }
+    for (k, (key, value)) in initial.table_values().into_iter().enumerate() {
+        let Some(v) = value else { continue };
+        let at = format!("initial.{key}");
+        let v = check_finite(ctx, &at, v)?;
+        let dof = Dof::ALL[k % 6];
+        if table.held().contains(dof) && v != 0.0 {
+            return Err(ctx.invalid(
+                &at,
+                v,
+                format!("0: {} is held (table.held_dofs)", dof.name()),
+            ));
+        }
+        if k < 6 {
+            out.0[k] = v;
+        } else {
+            out.1[k - 6] = v;
+        }
+    }
+    Ok(out)
 }
 
 /// `specimen` of a multi-axis scenario: storeys (along x) or the four matrices.

@@ -1,10 +1,10 @@
 //! Bearing friction and the inverse problem of the multi-axis platen: the actuator forces a
 //! prescribed motion needs, with each term of their decomposition.
 
-use nalgebra::Vector3;
+use nalgebra::{Matrix6, Vector2, Vector3};
 
-use super::dof::{angular_velocity, rotation, translation, Coords};
-use super::table::{BearingLoad, Mount, MultiAxisTable, Point, Wrench};
+use super::dof::{rotation, translation, Coords, Dof};
+use super::table::{pad_point, point_wrench, BearingLoad, Mount, MultiAxisTable, Point, Wrench};
 
 /// What presses a friction contact.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -31,6 +31,11 @@ pub struct Contact {
 impl MultiAxisTable {
     /// The friction contacts at pose `q`: every pad (at its axis point) and every bearing.
     pub fn contacts_at(&self, q: &Coords) -> Vec<Contact> {
+        self.contacts(q).collect()
+    }
+
+    /// The friction contacts at pose `q`, without collecting them.
+    pub(crate) fn contacts(&self, q: &Coords) -> impl Iterator<Item = Contact> + '_ {
         let r = rotation(q);
         let t = translation(q);
         let normal = r * Vector3::z();
@@ -38,16 +43,16 @@ impl MultiAxisTable {
             .actuators()
             .iter()
             .enumerate()
-            .filter_map(|(i, a)| match &a.mount {
+            .filter_map(move |(i, a)| match &a.mount {
                 Mount::Pad(pad) => Some(Contact {
-                    point_m: self.actuator_at(i, q).point_m,
+                    point_m: pad_point(pad, &t, &normal).0,
                     normal,
                     friction_coefficient: pad.friction_coefficient,
                     load: ContactLoad::Actuator(i),
                 }),
                 Mount::Swivel { .. } => None,
             });
-        let bearings = self.parts().bearings.iter().map(|b| Contact {
+        let bearings = self.parts().bearings.iter().map(move |b| Contact {
             point_m: t + r * b.platen_m,
             normal,
             friction_coefficient: b.friction_coefficient,
@@ -56,31 +61,245 @@ impl MultiAxisTable {
                 BearingLoad::Constant(n) => ContactLoad::Constant(n),
             },
         });
-        pads.chain(bearings).collect()
+        pads.chain(bearings)
     }
 
-    /// The platen's sliding velocity at `contact` (its material point's velocity less the
-    /// normal part), m/s, at pose `q` with rates `qd`.
+    /// Whether any contact has friction (a coefficient above zero).
+    pub fn has_friction(&self) -> bool {
+        self.contacts(&Coords::zeros())
+            .any(|c| c.friction_coefficient > 0.0)
+    }
+
+    /// The platen's sliding velocity at `contact`, m/s: the horizontal velocity of its point
+    /// in the platen's in-plane motion ([`planar_rate`]) at pose `q` with rates `qd`.
     pub fn sliding_velocity(&self, contact: &Contact, q: &Coords, qd: &Coords) -> Vector3<f64> {
-        let omega = angular_velocity(q, qd);
-        let v =
-            Vector3::new(qd[0], qd[1], qd[2]) + omega.cross(&(contact.point_m - translation(q)));
-        v - contact.normal * contact.normal.dot(&v)
+        let v = planar_sliding(&contact.point_m, &translation(q), &planar_rate(qd));
+        Vector3::new(v[0], v[1], 0.0)
     }
 
     /// The wrench about the reference point of a contact's friction per newton of normal force
-    /// (`−μ·ŝ` at its point, `ŝ` the sliding direction; zero where it does not slide, as
-    /// `sign(0) = 0` in the uniaxial Eq. 23).
+    /// (`−μ·ŝ` at its point, `ŝ` the horizontal sliding direction; zero where it does not
+    /// slide, as `sign(0) = 0` in the uniaxial Eq. 23).
     pub fn friction_per_newton(&self, contact: &Contact, q: &Coords, qd: &Coords) -> Wrench {
-        let s = self.sliding_velocity(contact, q, qd);
+        let s = planar_sliding(&contact.point_m, &translation(q), &planar_rate(qd));
         let speed = s.norm();
         if speed == 0.0 || contact.friction_coefficient == 0.0 {
             return Wrench::zeros();
         }
-        let f = s * (-contact.friction_coefficient / speed);
-        let m = (contact.point_m - translation(q)).cross(&f);
-        Wrench::new(f[0], f[1], f[2], m[0], m[1], m[2])
+        let f = Vector3::new(s[0], s[1], 0.0) * (-contact.friction_coefficient / speed);
+        point_wrench(&(contact.point_m - translation(q)), &f)
     }
+
+    /// The bearings' Coulomb capacity at pose `q` with the actuator forces `forces_n` (which
+    /// press the pads and the bearings on actuators; a pulling actuator presses nothing).
+    pub fn friction_capacity(&self, q: &Coords, forces_n: &[f64]) -> FrictionCapacity {
+        let (mut total, mut centre) = (0.0, Point::zeros());
+        for c in self.contacts(q) {
+            let mu_n = c.friction_coefficient * normal_force_n(c.load, forces_n);
+            total += mu_n;
+            centre += c.point_m * mu_n;
+        }
+        if total == 0.0 {
+            return FrictionCapacity {
+                force_n: 0.0,
+                moment_n_m: 0.0,
+                centre_m: translation(q),
+            };
+        }
+        centre /= total;
+        let moment = self
+            .contacts(q)
+            .map(|c| {
+                let mu_n = c.friction_coefficient * normal_force_n(c.load, forces_n);
+                mu_n * (c.point_m - centre).xy().norm()
+            })
+            .sum();
+        FrictionCapacity {
+            force_n: total,
+            moment_n_m: moment,
+            centre_m: centre,
+        }
+    }
+
+    /// The bearings' friction on the platen sliding with rates `qd` at pose `q` under the
+    /// actuator forces `forces_n`: `−μᵢ·Nᵢ·ŝᵢ` at each contact, about the reference point.
+    ///
+    /// `ŝᵢ` is the direction of `sᵢ + ε·ĝᵢ`: the contact's horizontal sliding velocity `sᵢ`
+    /// with `ε = blend_m_s` of the unit velocity `ĝᵢ` the in-plane motion `along` gives it
+    /// (the direction the slide was last known to go). A slide along `along` has exactly its
+    /// direction; far above `ε` the direction is the sliding velocity's. Near rest the
+    /// Coulomb direction `sᵢ/|sᵢ|` is stiff across the motion (it turns the velocity in a
+    /// time `m·|s|/(μ·ΣN)`, shorter than any step as `|s| → 0`); the blend bounds that time
+    /// by `m·ε/(μ·ΣN)`, which is what lets an explicit step leave rest and arrive at it
+    /// along the right direction.
+    pub fn sliding_friction(
+        &self,
+        q: &Coords,
+        qd: &Coords,
+        forces_n: &[f64],
+        along: &PlanarRate,
+        blend_m_s: f64,
+    ) -> Wrench {
+        let t = translation(q);
+        let w = planar_rate(qd);
+        let mut out = Wrench::zeros();
+        for c in self.contacts(q) {
+            let mu_n = c.friction_coefficient * normal_force_n(c.load, forces_n);
+            if mu_n == 0.0 {
+                continue;
+            }
+            let mut s = planar_sliding(&c.point_m, &t, &w);
+            let g = planar_sliding(&c.point_m, &t, along);
+            let g_norm = g.norm();
+            if g_norm > 0.0 {
+                s += g * (blend_m_s / g_norm);
+            }
+            let speed = s.norm();
+            if speed == 0.0 {
+                continue;
+            }
+            let f = Vector3::new(s[0], s[1], 0.0) * (-mu_n / speed);
+            out += point_wrench(&(c.point_m - t), &f);
+        }
+        out
+    }
+
+    /// The platen at rest in its plane (x, y and yaw, where free, held by the bearings'
+    /// friction) at pose `q` with rates `qd` (their in-plane ones zero) under the applied
+    /// wrench `applied` (every force but gravity and friction): the accelerations of the other
+    /// DOFs and the friction it takes to hold it, measured against `capacity`. `None` where
+    /// the equations are singular.
+    ///
+    /// The holding friction is a force at the friction centre and a moment about the vertical
+    /// through it; the ratio is the limit surface's ellipsoid,
+    /// `√((F_x² + F_y²)/F_max² + M_z²/M_max²)` (exact for a pure force through the centre and
+    /// for a pure turn about it; an approximation of the exact limit surface in between, as
+    /// in Goyal, Ruina and Papadopoulos 1991).
+    pub fn stick(
+        &self,
+        q: &Coords,
+        qd: &Coords,
+        applied: &Wrench,
+        capacity: &FrictionCapacity,
+    ) -> Option<Stick> {
+        let (mq, rhs) = self.coordinate_dynamics(q, qd, applied);
+        let held = self.held();
+        let arm = capacity.centre_m - translation(q);
+        let basis = [
+            (Dof::X, point_wrench(&arm, &Vector3::x())),
+            (Dof::Y, point_wrench(&arm, &Vector3::y())),
+            (Dof::Yaw, Wrench::new(0.0, 0.0, 0.0, 0.0, 0.0, 1.0)),
+        ];
+        // Unknowns per DOF: a held DOF none (identity), an in-plane DOF its holding
+        // friction, any other its acceleration.
+        let mut a = Matrix6::identity();
+        let mut b = Coords::zeros();
+        for d in Dof::ALL {
+            let k = d.index();
+            if held.contains(d) {
+                continue;
+            }
+            b[k] = rhs[k];
+            let column: Coords = match basis.iter().find(|(s, _)| *s == d) {
+                Some((_, w)) => -self.generalised_force(q, w),
+                None => mq.column(k).into(),
+            };
+            for r in Dof::ALL {
+                a[(r.index(), k)] = if held.contains(r) {
+                    f64::from(r == d)
+                } else {
+                    column[r.index()]
+                };
+            }
+        }
+        let z = a.lu().solve(&b)?;
+        let mut accelerations = Coords::zeros();
+        let mut holding = Vector3::zeros();
+        let mut wrench = Wrench::zeros();
+        for d in self.free().iter() {
+            let k = d.index();
+            match basis.iter().position(|(s, _)| *s == d) {
+                Some(i) => {
+                    holding[i] = z[k];
+                    wrench += basis[i].1 * z[k];
+                }
+                None => accelerations[k] = z[k],
+            }
+        }
+        let part = |value: f64, limit: f64| {
+            if value == 0.0 {
+                0.0
+            } else if limit > 0.0 {
+                (value / limit).powi(2)
+            } else {
+                f64::INFINITY
+            }
+        };
+        let ratio = (part(holding[0], capacity.force_n)
+            + part(holding[1], capacity.force_n)
+            + part(holding[2], capacity.moment_n_m))
+        .sqrt();
+        Some(Stick {
+            accelerations,
+            holding,
+            wrench,
+            ratio,
+        })
+    }
+}
+
+/// The in-plane motion the bearings' friction sees: the reference point's velocity along x
+/// and y (m/s) and the yaw rate (rad/s). The rocking's share of a contact's sliding (the roll
+/// and pitch rates times the contact's depth) is left out, so that a platen whose in-plane
+/// coordinates are still does not slide.
+pub type PlanarRate = Vector3<f64>;
+
+/// The in-plane motion of the rates `qd`.
+pub fn planar_rate(qd: &Coords) -> PlanarRate {
+    Vector3::new(qd[0], qd[1], qd[5])
+}
+
+/// The horizontal sliding velocity of the platen point at `point` (table axes) under the
+/// in-plane motion `w` of the reference point `t`, m/s.
+fn planar_sliding(point: &Point, t: &Vector3<f64>, w: &PlanarRate) -> Vector2<f64> {
+    let r = point - t;
+    Vector2::new(w[0] - w[2] * r[1], w[1] + w[2] * r[0])
+}
+
+/// The normal force of a contact pressed by `load` under the actuator forces `forces_n`, N.
+fn normal_force_n(load: ContactLoad, forces_n: &[f64]) -> f64 {
+    match load {
+        ContactLoad::Actuator(i) => forces_n[i].max(0.0),
+        ContactLoad::Constant(n) => n,
+    }
+}
+
+/// The Coulomb capacity of the bearings at an instant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrictionCapacity {
+    /// The largest in-plane force they hold, `Σ μᵢ·Nᵢ`, N.
+    pub force_n: f64,
+    /// The largest moment about the vertical through the friction centre they hold,
+    /// `Σ μᵢ·Nᵢ·|rᵢ − c|` (horizontal distances), N·m.
+    pub moment_n_m: f64,
+    /// The friction centre `c = Σ μᵢ·Nᵢ·rᵢ / Σ μᵢ·Nᵢ` (table axes), m; the reference point
+    /// when nothing presses.
+    pub centre_m: Point,
+}
+
+/// The platen at rest in its plane ([`MultiAxisTable::stick`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Stick {
+    /// The coordinates' second derivatives (the in-plane and held ones zero).
+    pub accelerations: Coords,
+    /// The holding friction: force along x and y at the friction centre (N), moment about
+    /// the vertical through it (N·m); zero for a held DOF.
+    pub holding: Vector3<f64>,
+    /// The holding friction's wrench about the reference point.
+    pub wrench: Wrench,
+    /// The holding friction on the limit surface's scale: the platen stays at rest while it
+    /// is at most 1.
+    pub ratio: f64,
 }
 
 /// The inverse at one instant: the actuator forces and what they balance.

@@ -31,7 +31,9 @@ pub use dof::{
     angular_rate_bias, angular_rate_map, angular_velocity, rotation, translation, Coords, Dof,
     DofSet,
 };
-pub use friction::{Contact, ContactLoad, InverseSample};
+pub use friction::{
+    planar_rate, Contact, ContactLoad, FrictionCapacity, InverseSample, PlanarRate, Stick,
+};
 pub use modes::Mode;
 pub use specimen::LinearSpecimen;
 pub use table::{

@@ -286,9 +286,17 @@ pub struct StrutPose {
     pub wrench: Wrench,
 }
 
-fn point_wrench(arm: &Vector3<f64>, force: &Vector3<f64>) -> Wrench {
+pub(crate) fn point_wrench(arm: &Vector3<f64>, force: &Vector3<f64>) -> Wrench {
     let m = arm.cross(force);
     Wrench::new(force[0], force[1], force[2], m[0], m[1], m[2])
+}
+
+/// Where a pad's axis meets the underside of the platen whose z axis is `normal` and whose
+/// reference point is at `t`, and how far along the axis from its neutral contact, m.
+pub(crate) fn pad_point(pad: &Pad, t: &Vector3<f64>, normal: &Vector3<f64>) -> (Point, f64) {
+    // The axis point c + s·a on the plane {t + R·p : p_z = c_z}.
+    let s = (pad.contact_m[2] - normal.dot(&(pad.contact_m - t))) / normal.dot(&pad.axis);
+    (pad.contact_m + pad.axis.into_inner() * s, s)
 }
 
 impl MultiAxisTable {
@@ -487,11 +495,7 @@ impl MultiAxisTable {
                 }
             }
             Mount::Pad(pad) => {
-                // The axis point c + s·a on the plane {t + R·p : p_z = c_z}.
-                let normal = r * Vector3::z();
-                let s =
-                    (pad.contact_m[2] - normal.dot(&(pad.contact_m - t))) / normal.dot(&pad.axis);
-                let point = pad.contact_m + pad.axis.into_inner() * s;
+                let (point, s) = pad_point(pad, &t, &(r * Vector3::z()));
                 ActuatorPose {
                     stroke_m: s,
                     unit: pad.axis.into_inner(),
@@ -599,25 +603,37 @@ impl MultiAxisTable {
     /// but gravity, about the reference point) at `q`, `qd`, the held DOFs' at zero. `None`
     /// where the mass matrix is not positive definite (pitch at ±π/2).
     pub fn accelerations(&self, q: &Coords, qd: &Coords, applied: &Wrench) -> Option<Coords> {
+        let (mq, rhs) = self.coordinate_dynamics(q, qd, applied);
+        Cholesky::new(mq).map(|c| c.solve(&rhs))
+    }
+
+    /// The coordinates' mass matrix `Jᵀ·M·J` and right-hand side `Jᵀ·(W + W_g − h − M·J̇·q̇)`
+    /// under the applied wrench `applied`, the held DOFs' rows and columns identity and zero.
+    pub(crate) fn coordinate_dynamics(
+        &self,
+        q: &Coords,
+        qd: &Coords,
+        applied: &Wrench,
+    ) -> (Matrix6<f64>, Coords) {
         let e = angular_rate_map(q);
         let omega = e * qd.fixed_rows::<3>(3);
         let bias = angular_rate_bias(q, qd);
         let m6 = self.spatial_mass_matrix(q);
         let mut j = Matrix6::identity();
         j.fixed_view_mut::<3, 3>(3, 3).copy_from(&e);
-        let mut jdqd = Vector6::zeros();
+        let mut jdqd = Wrench::zeros();
         jdqd.fixed_rows_mut::<3>(3).copy_from(&bias);
         let rhs_w = applied + self.gravity_wrench(q) - self.velocity_wrench(q, &omega) - m6 * jdqd;
         let mut mq = j.transpose() * m6 * j;
         let mut rhs = j.transpose() * rhs_w;
-        for d in self.parts.held.iter() {
+        for d in self.held().iter() {
             let k = d.index();
             mq.row_mut(k).fill(0.0);
             mq.column_mut(k).fill(0.0);
             mq[(k, k)] = 1.0;
             rhs[k] = 0.0;
         }
-        Cholesky::new(mq).map(|c| c.solve(&rhs))
+        (mq, rhs)
     }
 
     /// The actuator forces that exert the generalised force `target` on the free DOFs
