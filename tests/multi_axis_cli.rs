@@ -131,7 +131,8 @@ fn a_bad_table_is_refused_before_anything_is_written() {
     assert!(stderr(&o).contains("multi-axis"), "{}", stderr(&o));
 }
 
-/// The forward scenario: the pose, the actuators' strokes and forces, the work.
+/// The forward scenario (friction, the tower): the pose, the actuators' strokes and forces,
+/// the work, the friction's dissipation and stick flag, the specimen's forces and energy.
 #[test]
 fn the_forward_scenario_runs() {
     let dir = tempfile::tempdir().unwrap();
@@ -156,6 +157,12 @@ fn the_forward_scenario_runs() {
         "v1_force_n",
         "s2_force_n",
         "actuator_work_j",
+        "dissipated_j",
+        "stuck",
+        "base_force_x_n",
+        "overturning_moment_y_n_m",
+        "specimen1_z",
+        "specimen_damping_j",
     ] {
         assert!(header.contains(&name), "{name} in {header:?}");
     }

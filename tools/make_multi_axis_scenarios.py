@@ -14,7 +14,7 @@ level relative to the platen (a shear frame in x and y, 2 Hz and 1.8 Hz first mo
 columns, about 20 Hz), Rayleigh damping of 2 % at 2 and 10 Hz.
 
 The forward scenario's forces are platen's own: its inverse of the first 10 s of the motion on
-the table with frictionless pads (run with the binary named by PLATEN, default
+the table (pads with friction) carrying the tower (run with the binary named by PLATEN, default
 target/release/platen: build it first), kept to t_s and the actuator force columns.
 
 Usage (from the repository root, Python 3 only): python3 tools/make_multi_axis_scenarios.py
@@ -197,17 +197,15 @@ def main():
 
 
 def write_forward(platen):
-    """The forward scenario: the frictionless table under the actuator forces that its own
-    inverse finds for the first 10 s of the motion (platen's own output, kept to t_s and the
-    force columns), so that its run retraces that motion open loop."""
-    frictionless = table()
-    for a in frictionless["actuators"]:
-        if "pad" in a:
-            a["pad"]["friction_coefficient"] = 0.0
+    """The forward scenario: the table (pads with friction) carrying the tower, under the
+    actuator forces that platen's inverse finds for the first 10 s of the motion (its own
+    output, kept to t_s and the force columns), so that its run retraces that motion open
+    loop: friction, stick at the start and the specimen included."""
     with tempfile.TemporaryDirectory() as tmp:
         inverse = {
-            "name": "frictionless inverse (makes the forward scenario's forces)",
-            "table": frictionless,
+            "name": "inverse (makes the forward scenario's forces)",
+            "table": table(),
+            "specimen": tower(),
             "excitation": {"motion_csv": os.path.abspath(os.path.join(OUT, "three-component-motion.csv"))},
         }
         path = os.path.join(tmp, "inverse.json")
@@ -218,19 +216,22 @@ def write_forward(platen):
         with open(out, newline="") as f:
             rows = list(csv.reader(f))
     header = rows[0]
-    keep = [0] + [i for i, n in enumerate(header) if n.endswith("_force_n") and not n.startswith("s")]
+    names = [a["name"] + "_force_n" for a in table()["actuators"]]
+    keep = [0] + [header.index(n) for n in names]
     end = int(round(10.0 * RATE_HZ)) + 1
     with open(os.path.join(OUT, "forward-forces.csv"), "w", newline="\n") as f:
         f.write(",".join(header[i] for i in keep) + "\n")
         for r in rows[1:end + 1]:
             f.write(",".join(format(float(r[i]), ".15g") for i in keep) + "\n")
     forward = {
-        "name": "multi-axis forward: actuator forces, frictionless table",
-        "description": "The LHPOST6-like table, its pads frictionless, under the actuator forces "
-                       "its own inverse finds for the first 10 s of the three-component motion "
+        "name": "multi-axis forward: actuator forces, the tower on the table with friction",
+        "description": "The LHPOST6-like table (pads with the paper's friction) carrying the 12 m "
+                       "eccentric tower, under the actuator forces platen's inverse finds for the "
+                       "first 10 s of the three-component motion "
                        "(tools/make_multi_axis_scenarios.py): open loop, it retraces that motion "
                        "until the force's interpolation error drifts it off.",
-        "table": frictionless,
+        "table": table(),
+        "specimen": tower(),
         "excitation": {"force_csv": "forward-forces.csv"},
         "integrator": {"method": "rk4", "step_s": 1.0 / (4 * RATE_HZ)},
     }

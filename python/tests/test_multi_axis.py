@@ -50,3 +50,18 @@ def test_a_bad_table_raises_a_value_error_naming_its_path():
     doc["table"]["platen"]["inertia_kg_m2"][0][1] = 1e6
     with pytest.raises(ValueError, match=r"table\.platen\.inertia_kg_m2"):
         platen.simulate(doc)
+
+
+def test_the_forward_scenario_equals_the_cli_output(cli, tmp_path):
+    """A forward run (friction, the tower): the same columns and values as the CLI's CSV,
+    the platen at rest at the first sample and the friction dissipating."""
+    scenario = str(SCENARIOS / "multi-axis" / "forward.json")
+    out = tmp_path / "forward.csv"
+    cli("simulate", scenario, "--out", str(out))
+    expected = read_csv(out)
+    run = platen.simulate(scenario)
+    assert list(run.columns) == list(expected)
+    for name, values in expected.items():
+        np.testing.assert_array_equal(run[name], values, err_msg=name)
+    assert run["stuck"][0] == 1.0
+    assert run["dissipated_j"][-1] > 0.0

@@ -103,4 +103,5 @@ pub use stepping::{Step, Stepping};
 pub use stop::{AdaptiveFailure, Failure, StopReason};
 pub use table_plant::{
     forward_table, table_kinetic_energy_j, table_potential_energy_j, ActuatorForces,
+    MAX_TABLE_ACTUATORS, MAX_TABLE_SPECIMEN_DOFS,
 };

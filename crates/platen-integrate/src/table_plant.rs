@@ -7,17 +7,20 @@
 //! struts' pull and gravity; the held DOFs stay at zero.
 //!
 //! **Friction: exact planar stick-slip.** The bearings' Coulomb friction (`μᵢ·Nᵢ` at each
-//! contact, `Nᵢ` the force of the actuator that presses it or a constant) acts in the plane
-//! of the in-plane motion (x, y, yaw). The machine sees it through a *gauge*: a speed `V`
-//! along the direction the platen slides in (frozen at breakaway and set again at the start
-//! of every grid step; the velocity of the friction centre and the yaw rate times the
-//! friction radius `M_max/F_max`), integrated with the rest of the state. A slide ends where
-//! `V` reaches zero, located by the machine's root finder:
+//! contact, `Nᵢ` the force of the actuator that presses it or a constant) holds and resists
+//! the in-plane motion (x, y, yaw) through one limit surface, the ellipsoid of
+//! [`MultiAxisTable::stick`]: inside it the platen sticks, sliding it meets the surface's
+//! point whose normal is its motion ([`MultiAxisTable::sliding_friction`]), leaving rest it
+//! goes along the normal of the point Gauss's principle picks
+//! ([`MultiAxisTable::breakaway`]). The machine sees a slide through a *gauge*: a speed `V`
+//! along the direction the platen slides in (set at breakaway and again at the start of
+//! every grid step; in the metric of the friction centre's velocity and the yaw rate times
+//! the friction radius `M_max/F_max`), integrated with the rest of the state. A slide ends
+//! where `V` reaches zero, located by the machine's root finder:
 //! * if the in-plane motion has stopped there (its speed below 1e-6 of what its
 //!   acceleration gives in one grid step), the in-plane rates are set to exactly zero and the
-//!   platen sticks while the friction that holds it stays within the bearings' limit surface
-//!   ([`MultiAxisTable::stick`]; ratio ≤ 1), or leaves rest at once in the direction that
-//!   surface's normal gives (a reversal);
+//!   platen sticks while the holding friction stays inside the surface (ratio ≤ 1), or leaves
+//!   rest at once (a reversal);
 //! * if it has not (the slide turned through a right angle inside one step), the gauge is
 //!   aimed along the motion again and the slide goes on.
 //!
@@ -26,6 +29,10 @@
 //! the uniaxial machine. With y and yaw held the gauge is `±v_x` and this is the uniaxial
 //! exact stick-slip of a Coulomb law (no creep: the planar law does not depend on the speed).
 //! A table without friction has no slide: its gauge is held at 1 and it runs one slip phase.
+//!
+//! **Specimen.** A general linear specimen's DOFs and rates follow the pose's in the state;
+//! it pushes on the platen with its restoring forces and feels the platen's acceleration less
+//! gravity's, so the coupling is explicit.
 
 use nalgebra::DVector;
 use nalgebra::{Vector2, Vector3};
@@ -141,30 +148,6 @@ impl Gauge {
     /// The speed along the slide of the in-plane motion `w` (or its rate of an acceleration).
     fn speed(&self, w: &PlanarRate) -> f64 {
         self.unit.dot(&self.scaled(w))
-    }
-
-    /// The in-plane motion (of the reference point) that leaves rest held by `holding`
-    /// (force at the friction centre, moment about it) against `capacity`: along the normal
-    /// of the limit surface there, against the holding friction; the metric's unit speed.
-    fn leaving(
-        capacity: &FrictionCapacity,
-        holding: &Vector3<f64>,
-        arm: &Vector2<f64>,
-    ) -> PlanarRate {
-        let per = |value: f64, limit: f64| {
-            if limit > 0.0 {
-                value / (limit * limit)
-            } else {
-                value
-            }
-        };
-        // The friction centre's velocity and the yaw rate.
-        let c = Vector3::new(
-            -per(holding[0], capacity.force_n),
-            -per(holding[1], capacity.force_n),
-            -per(holding[2], capacity.moment_n_m),
-        );
-        PlanarRate::new(c[0] + c[2] * arm[1], c[1] - c[2] * arm[0], c[2])
     }
 }
 
@@ -307,9 +290,10 @@ impl<const L: usize> TablePlant<'_, L> {
         let mut applied = wrench + self.table.struts_wrench(&q) + self.specimen_push(y);
         let mut lost = 0.0;
         if self.friction {
-            let friction = self
-                .table
-                .sliding_friction(&q, &qd, &f, &self.leaving, self.blend_m_s);
+            let capacity = self.table.friction_capacity(&q, &f);
+            let friction =
+                self.table
+                    .sliding_friction(&q, &qd, &capacity, &self.leaving, self.blend_m_s);
             applied += friction;
             lost = -friction.dot(&twist);
         }
@@ -396,26 +380,32 @@ impl<const L: usize> TablePlant<'_, L> {
     }
 
     /// The holding friction's ratio to the limit surface at `y` under the forces at `at`
-    /// (infinite where the equations are singular), and what leaving rest there would mean:
-    /// the in-plane motion and the gauge along it.
-    fn at_rest(&self, at: At, y: &Y<L>) -> (f64, PlanarRate, Gauge) {
+    /// (infinite where the equations are singular).
+    fn ratio(&self, at: At, y: &Y<L>) -> f64 {
+        let (q, qd) = Self::pose(y);
+        let f = self.forces_at(at);
+        let applied = self.actuators(&f, &q) + self.table.struts_wrench(&q) + self.specimen_push(y);
+        let capacity = self.table.friction_capacity(&q, &f);
+        self.table
+            .stick(&q, &qd, &applied, &capacity)
+            .map_or(f64::INFINITY, |s| s.ratio)
+    }
+
+    /// Leaving rest at `y` under the forces at `at`: the in-plane motion
+    /// ([`MultiAxisTable::breakaway`]) and the gauge along it.
+    fn leave(&self, at: At, y: &Y<L>) -> (PlanarRate, Gauge) {
         let (q, qd) = Self::pose(y);
         let f = self.forces_at(at);
         let applied = self.actuators(&f, &q) + self.table.struts_wrench(&q) + self.specimen_push(y);
         let capacity = self.table.friction_capacity(&q, &f);
         let t = Vector3::new(q[0], q[1], q[2]);
-        let arm = (capacity.centre_m - t).xy();
-        match self.table.stick(&q, &qd, &applied, &capacity) {
-            Some(s) => {
-                let w = Gauge::leaving(&capacity, &s.holding, &arm);
-                (s.ratio, w, Gauge::new(&capacity, &t, &w))
-            }
-            None => (
-                f64::INFINITY,
-                PlanarRate::zeros(),
-                Gauge::new(&capacity, &t, &PlanarRate::zeros()),
-            ),
-        }
+        let w = self
+            .table
+            .stick(&q, &qd, &applied, &capacity)
+            .map_or(PlanarRate::zeros(), |s| {
+                self.table.breakaway(&q, &qd, &applied, &capacity, &s)
+            });
+        (w, Gauge::new(&capacity, &t, &w))
     }
 
     /// The gauge along the in-plane motion of `y`, with the bearings' capacity under the
@@ -482,7 +472,7 @@ impl<const L: usize> Plant<L> for TablePlant<'_, L> {
     /// The holding friction's ratio to the limit surface (the machine's threshold is 1).
     fn effective_force(&self, input: At, y: &Y<L>) -> f64 {
         if self.friction {
-            self.at_rest(input, y).0
+            self.ratio(input, y)
         } else {
             f64::INFINITY
         }
@@ -505,7 +495,7 @@ impl<const L: usize> Plant<L> for TablePlant<'_, L> {
         match mode {
             Mode::Stick => hold_in_plane(y),
             Mode::Slip(_) if y[V] == 0.0 => {
-                let (_, leaving, gauge) = self.at_rest(input, y);
+                let (leaving, gauge) = self.leave(input, y);
                 self.aim(input, y, gauge, leaving);
             }
             _ => {}
@@ -529,7 +519,7 @@ impl<const L: usize> Plant<L> for TablePlant<'_, L> {
             return Some((Mode::Slip(Direction::Positive), None));
         }
         hold_in_plane(y);
-        if self.at_rest(input, y).0 <= 1.0 {
+        if self.ratio(input, y) <= 1.0 {
             // The machine's reset: stick, a stop.
             return None;
         }
@@ -674,7 +664,7 @@ fn run<const L: usize>(
         let w = planar_rate(&TablePlant::<L>::pose(&y).1);
         if w == PlanarRate::zeros() {
             y[V] = 0.0;
-            if plant.at_rest(start, &y).0 <= 1.0 {
+            if plant.ratio(start, &y) <= 1.0 {
                 mode = Mode::Stick;
             }
         } else {

@@ -456,10 +456,10 @@ fn the_actuators_work_is_the_energy_plus_the_friction_dissipation() {
     assert!(stuck.contains(&1.0) && stuck.contains(&0.0));
     assert!(lost > 0.0, "friction dissipates: {lost} J");
     eprintln!("energy: {:e} of the work", (work - stored - lost) / work);
-    // Tolerance: measured 2.5e-8 of the work (RK4 at 1/1024 s, the friction's kinks located
-    // at its events); 1e-7.
+    // Tolerance: measured 7.3e-8 of the work (RK4 at 1/1024 s: the friction's kinks are
+    // located at its events, but its direction turns fast near rest); 3e-7.
     assert!(
-        (work - stored - lost).abs() < 1e-7 * work.abs(),
+        (work - stored - lost).abs() < 3e-7 * work.abs(),
         "work {work} J, stored {stored} J, dissipated {lost} J"
     );
 }
@@ -602,9 +602,9 @@ fn the_energy_balances_with_a_specimen() {
         "energy with a specimen: {:e} of the work",
         (work - change) / work
     );
-    // Tolerance: as without a specimen (measured 2.5e-8 of the work there); 1e-7.
+    // Tolerance: as without a specimen (measured 3.6e-8 here); 3e-7.
     assert!(
-        (work - change).abs() < 1e-7 * work.abs(),
+        (work - change).abs() < 3e-7 * work.abs(),
         "work {work} J, energy change {change} J"
     );
 }

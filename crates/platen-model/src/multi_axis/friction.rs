@@ -1,7 +1,7 @@
 //! Bearing friction and the inverse problem of the multi-axis platen: the actuator forces a
 //! prescribed motion needs, with each term of their decomposition.
 
-use nalgebra::{Matrix6, Vector2, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix6, Vector2, Vector3};
 
 use super::dof::{rotation, translation, Coords, Dof};
 use super::table::{pad_point, point_wrench, BearingLoad, Mount, MultiAxisTable, Point, Wrench};
@@ -121,47 +121,161 @@ impl MultiAxisTable {
         }
     }
 
-    /// The bearings' friction on the platen sliding with rates `qd` at pose `q` under the
-    /// actuator forces `forces_n`: `−μᵢ·Nᵢ·ŝᵢ` at each contact, about the reference point.
+    /// The bearings' friction on the platen sliding with rates `qd` at pose `q`, with the
+    /// bearings' `capacity` there: the limit surface's law, a horizontal force at the
+    /// friction centre and a moment about the vertical through it,
+    /// `(F, M/ρ) = −F_max·τ/|τ|`, `τ = (v_c, ρ·ψ̇)`, `ρ = M_max/F_max`, `v_c` the friction
+    /// centre's in-plane velocity: the point of the ellipsoid
+    /// ([`MultiAxisTable::stick`]) whose normal is the motion (maximum dissipation). A slide
+    /// without turning has the contacts' own Coulomb friction `−Σ μᵢ·Nᵢ·v̂` exactly, a pure
+    /// turn about the centre their `−Σ μᵢ·Nᵢ·rᵢ`; in between the ellipsoid approximates the
+    /// contacts' limit surface, and keeps stick and slip one law. The wrench is about the
+    /// reference point.
     ///
-    /// `ŝᵢ` is the direction of `sᵢ + ε·ĝᵢ`: the contact's horizontal sliding velocity `sᵢ`
-    /// with `ε = blend_m_s` of the unit velocity `ĝᵢ` the in-plane motion `along` gives it
-    /// (the direction the slide was last known to go). A slide along `along` has exactly its
-    /// direction; far above `ε` the direction is the sliding velocity's. Near rest the
-    /// Coulomb direction `sᵢ/|sᵢ|` is stiff across the motion (it turns the velocity in a
-    /// time `m·|s|/(μ·ΣN)`, shorter than any step as `|s| → 0`); the blend bounds that time
-    /// by `m·ε/(μ·ΣN)`, which is what lets an explicit step leave rest and arrive at it
-    /// along the right direction.
+    /// `τ` is blended with `blend_m_s` of the unit `τ` of the in-plane motion `along` (the
+    /// direction the slide was last known to go): a slide along `along` has exactly its
+    /// direction, far above the blend the direction is the motion's. Near rest the Coulomb
+    /// direction `τ/|τ|` is stiff across the motion (it turns the velocity in a time
+    /// `m·|τ|/F_max`, shorter than any step as `|τ| → 0`); the blend bounds that time by
+    /// `m·ε/F_max`, which is what lets an explicit step leave rest and arrive at it along the
+    /// right direction.
     pub fn sliding_friction(
         &self,
         q: &Coords,
         qd: &Coords,
-        forces_n: &[f64],
+        capacity: &FrictionCapacity,
         along: &PlanarRate,
         blend_m_s: f64,
     ) -> Wrench {
-        let t = translation(q);
-        let w = planar_rate(qd);
-        let mut out = Wrench::zeros();
-        for c in self.contacts(q) {
-            let mu_n = c.friction_coefficient * normal_force_n(c.load, forces_n);
-            if mu_n == 0.0 {
-                continue;
-            }
-            let mut s = planar_sliding(&c.point_m, &t, &w);
-            let g = planar_sliding(&c.point_m, &t, along);
-            let g_norm = g.norm();
-            if g_norm > 0.0 {
-                s += g * (blend_m_s / g_norm);
-            }
-            let speed = s.norm();
-            if speed == 0.0 {
-                continue;
-            }
-            let f = Vector3::new(s[0], s[1], 0.0) * (-mu_n / speed);
-            out += point_wrench(&(c.point_m - t), &f);
+        if capacity.force_n == 0.0 {
+            return Wrench::zeros();
         }
-        out
+        let t = translation(q);
+        let arm = capacity.centre_m - t;
+        let rho = capacity.moment_n_m / capacity.force_n;
+        let scaled =
+            |w: &PlanarRate| Vector3::new(w[0] - w[2] * arm[1], w[1] + w[2] * arm[0], w[2] * rho);
+        let mut tau = scaled(&planar_rate(qd));
+        let g = scaled(along);
+        let g_norm = g.norm();
+        if g_norm > 0.0 {
+            tau += g * (blend_m_s / g_norm);
+        }
+        let speed = tau.norm();
+        if speed == 0.0 {
+            return Wrench::zeros();
+        }
+        let k = -capacity.force_n / speed;
+        let force = Vector3::new(tau[0] * k, tau[1] * k, 0.0);
+        let mut w = point_wrench(&arm, &force);
+        w[5] += tau[2] * k * rho;
+        w
+    }
+
+    /// The in-plane motion (of the reference point, unit speed in the limit surface's metric)
+    /// in which the platen leaves rest when the friction that would hold it, `stick`, is
+    /// outside the limit surface of `capacity` (ratio > 1), at pose `q` with rates `qd` under
+    /// `applied`. The friction it slides against is the point `b` of the surface nearest to
+    /// the holding friction in the platen's own inertia (Gauss's least constraint: `b`
+    /// minimises `(b − λ)ᵀ·G·(b − λ)`, `G` the in-plane accelerations per unit of friction at
+    /// the centre), and the platen moves along that point's normal, against it. At the
+    /// breakaway itself (ratio → 1) this is the normal at the holding friction; past it, it
+    /// turns with the platen's inertia so that the motion and its friction agree. Zero where
+    /// nothing holds.
+    pub fn breakaway(
+        &self,
+        q: &Coords,
+        qd: &Coords,
+        applied: &Wrench,
+        capacity: &FrictionCapacity,
+        stick: &Stick,
+    ) -> PlanarRate {
+        let limits = [capacity.force_n, capacity.force_n, capacity.moment_n_m];
+        let dofs = [Dof::X, Dof::Y, Dof::Yaw];
+        // The in-plane DOFs the friction holds: free, with a limit.
+        let active: Vec<usize> = (0..3)
+            .filter(|&k| !self.held().contains(dofs[k]) && limits[k] > 0.0)
+            .collect();
+        let n = active.len();
+        if n == 0 {
+            return PlanarRate::zeros();
+        }
+        let arm = capacity.centre_m - translation(q);
+        let basis = [
+            point_wrench(&arm, &Vector3::x()),
+            point_wrench(&arm, &Vector3::y()),
+            Wrench::new(0.0, 0.0, 0.0, 0.0, 0.0, 1.0),
+        ];
+        // G: the friction centre's in-plane accelerations per unit of each friction
+        // component, from the dynamics (the other DOFs free as they are).
+        let Some(base) = self.accelerations(q, qd, applied) else {
+            return PlanarRate::zeros();
+        };
+        let centre = |a: &Coords| Vector3::new(a[0] - a[5] * arm[1], a[1] + a[5] * arm[0], a[5]);
+        let mut g = DMatrix::zeros(n, n);
+        for (c, &k) in active.iter().enumerate() {
+            let Some(a) = self.accelerations(q, qd, &(applied + basis[k])) else {
+                return PlanarRate::zeros();
+            };
+            let response = centre(&(a - base));
+            for (r, &j) in active.iter().enumerate() {
+                g[(r, c)] = response[j];
+            }
+        }
+        let g = (&g + g.transpose()) * 0.5;
+        // In β = S⁻¹·b the surface is the unit ball: minimise βᵀHβ − 2βᵀc, H = S·G·S,
+        // c = S·G·λ, over |β| ≤ 1 (the trust-region problem: β = (H + νI)⁻¹·c with ν ≥ 0
+        // the root of |β(ν)| = 1, by bisection; |β| falls as ν grows).
+        let sv = DVector::from_fn(n, |r, _| limits[active[r]]);
+        let lambda = DVector::from_fn(n, |r, _| stick.holding[active[r]]);
+        let h = DMatrix::from_fn(n, n, |r, c| sv[r] * g[(r, c)] * sv[c]);
+        let cvec = sv.component_mul(&(&g * &lambda));
+        let eig = h.symmetric_eigen();
+        let proj = eig.eigenvectors.transpose() * &cvec;
+        let beta_at = |nu: f64| {
+            let y = DVector::from_fn(n, |i, _| proj[i] / (eig.eigenvalues[i] + nu));
+            &eig.eigenvectors * y
+        };
+        let (mut lo, mut hi) = (0.0, cvec.norm().max(f64::MIN_POSITIVE));
+        if beta_at(lo).norm() <= 1.0 {
+            // Held after all (the surface holds it): leave along the normal at λ.
+            hi = 0.0;
+        }
+        for _ in 0..200 {
+            if hi - lo <= 1e-15 * hi {
+                break;
+            }
+            let mid = 0.5 * (lo + hi);
+            if beta_at(mid).norm() > 1.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let beta = if hi == 0.0 {
+            let l = DVector::from_fn(n, |r, _| lambda[r] / sv[r]);
+            let norm = l.norm();
+            if norm == 0.0 {
+                return PlanarRate::zeros();
+            }
+            l / norm
+        } else {
+            beta_at(hi)
+        };
+        // The motion along the normal at b = S·β, against it: the centre's velocity and the
+        // yaw rate ∝ −S⁻¹·β, then the reference point's.
+        let mut u = Vector3::zeros();
+        for (r, &k) in active.iter().enumerate() {
+            u[k] = -beta[r] / sv[r];
+        }
+        let w = PlanarRate::new(u[0] + u[2] * arm[1], u[1] - u[2] * arm[0], u[2]);
+        let rho = capacity.moment_n_m / capacity.force_n;
+        let size = Vector3::new(u[0], u[1], u[2] * rho).norm();
+        if size > 0.0 {
+            w / size
+        } else {
+            w
+        }
     }
 
     /// The platen at rest in its plane (x, y and yaw, where free, held by the bearings'
