@@ -73,31 +73,29 @@ fn table(actuators: Vec<Actuator>, held: &[Dof]) -> MultiAxisTable {
     .unwrap()
 }
 
-/// Two x actuators and two y actuators, all in the plane of the centre of mass.
-fn planar_table() -> MultiAxisTable {
+/// Two x actuators and two y actuators, all in the plane of the centre of mass, their bases
+/// `base_m` from the platen's centre (their platen ends 3 m from it).
+fn planar_table_of(base_m: f64) -> MultiAxisTable {
     table(
         vec![
-            swivel("x1", [-5.0, 1.0, -0.5], [-3.0, 1.0, -0.5]),
-            swivel("x2", [-5.0, -1.0, -0.5], [-3.0, -1.0, -0.5]),
-            swivel("y1", [2.0, -5.0, -0.5], [2.0, -3.0, -0.5]),
-            swivel("y2", [-2.0, -5.0, -0.5], [-2.0, -3.0, -0.5]),
+            swivel("x1", [-base_m, 1.0, -0.5], [-3.0, 1.0, -0.5]),
+            swivel("x2", [-base_m, -1.0, -0.5], [-3.0, -1.0, -0.5]),
+            swivel("y1", [2.0, -base_m, -0.5], [2.0, -3.0, -0.5]),
+            swivel("y2", [-2.0, -base_m, -0.5], [-2.0, -3.0, -0.5]),
         ],
         &[Dof::Z, Dof::Roll, Dof::Pitch],
     )
 }
 
-/// [`planar_table`] with actuators 10 km long, whose lines do not turn as the platen moves
+/// [`planar_table_of`] with 2 m actuators.
+fn planar_table() -> MultiAxisTable {
+    planar_table_of(5.0)
+}
+
+/// [`planar_table_of`] with actuators 10 km long, whose lines do not turn as the platen moves
 /// (which the closed forms do not know).
 fn long_table() -> MultiAxisTable {
-    table(
-        vec![
-            swivel("x1", [-1e4, 1.0, -0.5], [-3.0, 1.0, -0.5]),
-            swivel("x2", [-1e4, -1.0, -0.5], [-3.0, -1.0, -0.5]),
-            swivel("y1", [2.0, -1e4, -0.5], [2.0, -3.0, -0.5]),
-            swivel("y2", [-2.0, -1e4, -0.5], [-2.0, -3.0, -0.5]),
-        ],
-        &[Dof::Z, Dof::Roll, Dof::Pitch],
-    )
+    planar_table_of(1e4)
 }
 
 /// The bearings' Coulomb force `μ·ΣN`, N.
@@ -364,6 +362,11 @@ fn with_y_and_yaw_held_it_is_the_uniaxial_exact_stick_slip() {
 /// A platen free in all six DOFs on four horizontal actuators and three vertical bearing
 /// actuators (pads with friction), held down by two gas struts.
 fn six_dof_table() -> MultiAxisTable {
+    six_dof_table_holding(&[])
+}
+
+/// [`six_dof_table`] with the `held` DOFs held.
+fn six_dof_table_holding(held: &[Dof]) -> MultiAxisTable {
     let platen = RigidPlaten::new(
         MASS_KG,
         Matrix3::from_diagonal(&Vector3::new(2.0e5, 3.0e5, 4.0e5)),
@@ -402,7 +405,7 @@ fn six_dof_table() -> MultiAxisTable {
         ],
         struts: vec![strut("s1", 0.0, 1.0), strut("s2", 0.0, -1.0)],
         bearings: Vec::new(),
-        held: DofSet::of(&[]),
+        held: DofSet::of(held),
         oil_bulk_modulus_pa: 1.4e9,
     })
     .unwrap()
@@ -607,4 +610,59 @@ fn the_energy_balances_with_a_specimen() {
         (work - change).abs() < 3e-7 * work.abs(),
         "work {work} J, energy change {change} J"
     );
+}
+
+/// Pads whose actuators pull press nothing: the platen (z, roll and pitch held) rests on them
+/// held by nothing, and a push along −x (against the gauge's default direction) that starts
+/// then slides it free of friction, without a stall; pressed again, with the push gone, it
+/// sticks.
+#[test]
+fn a_platen_on_pads_that_press_nothing_slides_free() {
+    let t = six_dof_table_holding(&[Dof::Z, Dof::Roll, Dof::Pitch]);
+    let time = grid(256.0, 1.0);
+    let weight = MASS_KG * STANDARD_GRAVITY_M_S2 + 2.0 * 5.0e6 * 0.01;
+    // The pads pull from 0.3 s to 0.5 s; the x actuators pull 5 kN from 0.35 s to 0.5 s.
+    let lifted = |ti: f64| (0.3..0.5).contains(&ti);
+    let mut records: Vec<Vec<f64>> = (0..4)
+        .map(|k| {
+            time.iter()
+                .map(|&ti| {
+                    if k < 2 && (0.35..0.5).contains(&ti) {
+                        -2_500.0
+                    } else {
+                        0.0
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    for s in [0.25, 0.25, 0.5] {
+        records.push(
+            time.iter()
+                .map(|&ti| if lifted(ti) { -1_000.0 } else { s * weight })
+                .collect(),
+        );
+    }
+    let forces = ActuatorForces::new(time.clone(), records).unwrap();
+    let run = forward_table(&t, None, &forces, rk4(4), Coords::zeros(), Coords::zeros()).unwrap();
+    let (x, stuck, lost) = (
+        col(&run, "x_m"),
+        col(&run, "stuck"),
+        col(&run, "dissipated_j"),
+    );
+    let at = |ts: f64| time.iter().position(|&ti| ti >= ts).unwrap();
+    // Lifted, nothing pushing: at rest.
+    assert_eq!((x[at(0.34)], stuck[at(0.34)]), (0.0, 1.0));
+    // Pushed, pressing nothing: it slides, and the friction takes no work.
+    assert!(
+        x[at(0.45)] < 0.0 && stuck[at(0.45)] == 0.0,
+        "{}",
+        x[at(0.45)]
+    );
+    assert_eq!(lost[at(0.45)], 0.0);
+    // Pressed again, the push gone: friction stops it, and it stays.
+    let last = time.len() - 1;
+    assert_eq!(stuck[last], 1.0);
+    assert_eq!(x[last], x[last - 1]);
+    assert!(lost[last] > 0.0);
 }

@@ -180,8 +180,8 @@ impl MultiAxisTable {
     /// minimises `(b − λ)ᵀ·G·(b − λ)`, `G` the in-plane accelerations per unit of friction at
     /// the centre), and the platen moves along that point's normal, against it. At the
     /// breakaway itself (ratio → 1) this is the normal at the holding friction; past it, it
-    /// turns with the platen's inertia so that the motion and its friction agree. Zero where
-    /// nothing holds.
+    /// turns with the platen's inertia so that the motion and its friction agree. Where
+    /// nothing holds (every contact lifted off), the direction of its in-plane acceleration.
     pub fn breakaway(
         &self,
         q: &Coords,
@@ -198,7 +198,14 @@ impl MultiAxisTable {
             .collect();
         let n = active.len();
         if n == 0 {
-            return PlanarRate::zeros();
+            // Nothing holds (every contact lifted off): the platen flies along its in-plane
+            // acceleration.
+            let a = self
+                .accelerations(q, qd, applied)
+                .unwrap_or_else(Coords::zeros);
+            let w = planar_rate(&a);
+            let size = w.norm();
+            return if size > 0.0 { w / size } else { w };
         }
         let arm = capacity.centre_m - translation(q);
         let basis = [
