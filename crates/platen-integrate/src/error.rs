@@ -108,6 +108,13 @@ pub enum IntegrateError {
         /// The requested step, s.
         step_s: f64,
     },
+    /// A table system that cannot run: the static forces outside what its chambers exert,
+    /// or a controller geometry that does not move every free DOF.
+    #[error("the table's hydraulics cannot hold it at rest: {0}")]
+    InvalidSystem(platen_system::SystemError),
+    /// The servo-valves of a closed-loop table do not share one delay.
+    #[error("the servo-valves of a closed-loop table must share one delay_s")]
+    UnequalValveDelays,
     /// More output samples were requested than the record holds.
     #[error("{requested} samples requested but the record holds only {available}")]
     RecordTooShort {

@@ -50,17 +50,17 @@ use crate::method::Method;
 use crate::multi_axis::{platen_acceleration, TableRun, GRAVITY};
 
 /// Where the pose starts in the state.
-const Q: usize = 5;
+pub(crate) const Q: usize = 5;
 /// Where its rates start.
-const QD: usize = Q + 6;
+pub(crate) const QD: usize = Q + 6;
 /// Where the specimen's DOFs start (their rates follow them).
 const Z: usize = QD + 6;
 /// The state's length without a specimen.
-const BARE: usize = Z;
+pub(crate) const BARE: usize = Z;
 /// The most DOFs of a specimen a forward run takes.
 pub const MAX_TABLE_SPECIMEN_DOFS: usize = 12;
 /// The state's length with a specimen (its unused DOFs stay at zero).
-const WITH_SPECIMEN: usize = Z + 2 * MAX_TABLE_SPECIMEN_DOFS;
+pub(crate) const WITH_SPECIMEN: usize = Z + 2 * MAX_TABLE_SPECIMEN_DOFS;
 
 /// The most actuators a forward run takes (their forces at an instant live on the stack).
 pub const MAX_TABLE_ACTUATORS: usize = 64;
@@ -79,7 +79,7 @@ const BLEND_STEPS: f64 = 4.0;
 /// The machine's law for the table: the friction the machine compares is the ratio of the
 /// holding friction to the bearings' limit surface ([`MultiAxisTable::stick`]), so its
 /// threshold is 1 and nothing else of the law is consulted (no elastic force, no creep).
-struct UnitThreshold;
+pub(crate) struct UnitThreshold;
 
 impl PlatenModel for UnitThreshold {
     fn mass_kg(&self, _u_m: f64) -> f64 {
@@ -214,23 +214,114 @@ impl ActuatorForces {
 
 /// Where a position lands: sample interval `j`, fraction `w` of it.
 #[derive(Debug, Clone, Copy)]
-struct At {
+pub(crate) struct At {
     j: usize,
     w: f64,
 }
 
 /// The actuator forces at an instant, N.
-type Forces = [f64; MAX_TABLE_ACTUATORS];
+pub(crate) type Forces = [f64; MAX_TABLE_ACTUATORS];
 
-/// The multi-axis platen under its actuator forces: the [`Plant`] of the mode machine.
-struct TablePlant<'a, const L: usize> {
-    table: &'a MultiAxisTable,
+/// Where a table's actuator forces come from, with the clock of the run that drives it: a
+/// record ([`Recorded`]) or the actuators' own hydraulics in closed loop
+/// ([`crate::table_loop`]). What the plant's hooks need of it.
+pub(crate) trait Source<const L: usize> {
+    /// What the forces need from outside the state at a position.
+    type Input: Copy;
+    /// As [`Plant::RATES_ON_COMMIT`].
+    const RATES_ON_COMMIT: bool;
+    /// The input at position `at`.
+    fn input(&self, at: f64) -> Self::Input;
+    /// The actuator forces at `input` and state `y`, N.
+    fn forces(&self, input: Self::Input, y: &Y<L>) -> Forces;
+    /// The rates of the source's own states (none for a record) with the platen at pose
+    /// `q`, rates `qd`, into `dy`.
+    #[inline(always)]
+    fn rates(
+        &self,
+        _table: &MultiAxisTable,
+        _input: Self::Input,
+        _y: &Y<L>,
+        _q: &Coords,
+        _qd: &Coords,
+        _dy: &mut Y<L>,
+    ) {
+    }
+    /// As [`Plant::admit`].
+    fn admit(&mut self, _y: &mut Y<L>, _t_s: f64) -> bool {
+        false
+    }
+    /// The error scale of the source's own state `i` (`None`: not the source's).
+    fn error_scale(&self, _i: usize, _y0: f64, _y1: f64, _rtol: f64, _atol: f64) -> Option<f64> {
+        None
+    }
+    /// The grid's step, s.
+    fn step_s(&self) -> f64;
+    /// As [`Plant::seconds`].
+    fn seconds(&self, len: f64) -> f64;
+    /// As [`Plant::units`].
+    fn units(&self, seconds: f64) -> f64;
+    /// As [`Plant::time_s`].
+    fn time_s(&self, at: f64) -> f64;
+    /// As [`Plant::tolerance_floor`].
+    fn tolerance_floor(&self) -> f64;
+    /// As [`Plant::min_progress`].
+    fn min_progress(&self) -> f64;
+    /// As [`Plant::land`].
+    fn land(&self, tau: f64, x: f64, rest: f64) -> f64;
+    /// As [`Plant::reach`].
+    fn reach(&self, tau: f64, len: f64) -> f64;
+    /// As [`Plant::break_at`].
+    fn break_at(&self, tau: f64, x: f64, rest: f64, held: bool) -> f64;
+}
+
+/// Recorded actuator forces on their time grid: the source of a forward run.
+pub(crate) struct Recorded<'a> {
     forces: &'a ActuatorForces,
     /// The time grid (its force is the first actuator's, unused: the input is every
-    /// actuator's, [`TablePlant::forces_at`]).
+    /// actuator's, [`Recorded::forces`]).
     grid: Grid<'a>,
     /// The grid step being taken.
     n: GridStep,
+}
+
+impl<const L: usize> Source<L> for Recorded<'_> {
+    type Input = At;
+    const RATES_ON_COMMIT: bool = false;
+
+    #[inline(always)]
+    fn input(&self, at: f64) -> At {
+        At {
+            j: self.n.j,
+            w: (self.n.i + at) * self.grid.inv_k,
+        }
+    }
+
+    fn forces(&self, at: At, _y: &Y<L>) -> Forces {
+        let (j, w) = (at.j, at.w);
+        let mut out = [0.0; MAX_TABLE_ACTUATORS];
+        for (o, f) in out.iter_mut().zip(&self.forces.forces_n) {
+            *o = if w == 0.0 {
+                f[j]
+            } else {
+                f[j] * (1.0 - w) + f[j + 1] * w
+            };
+        }
+        out
+    }
+
+    fn step_s(&self) -> f64 {
+        self.grid.h
+    }
+
+    crate::grid::grid_clock!();
+}
+
+/// The multi-axis platen under its actuator forces: the [`Plant`] of the mode machine.
+pub(crate) struct TablePlant<'a, S, const L: usize> {
+    pub(crate) table: &'a MultiAxisTable,
+    /// Where the actuator forces come from.
+    pub(crate) source: S,
     /// The specimen on the platen.
     specimen: Option<&'a LinearSpecimen>,
     /// Whether any contact has friction (else the gauge is held at 1: one slip phase).
@@ -245,18 +336,9 @@ struct TablePlant<'a, const L: usize> {
     blend_m_s: f64,
 }
 
-impl<const L: usize> TablePlant<'_, L> {
-    fn forces_at(&self, at: At) -> Forces {
-        let (j, w) = (at.j, at.w);
-        let mut out = [0.0; MAX_TABLE_ACTUATORS];
-        for (o, f) in out.iter_mut().zip(&self.forces.forces_n) {
-            *o = if w == 0.0 {
-                f[j]
-            } else {
-                f[j] * (1.0 - w) + f[j + 1] * w
-            };
-        }
-        out
+impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
+    fn forces_at(&self, at: S::Input, y: &Y<L>) -> Forces {
+        self.source.forces(at, y)
     }
 
     /// The actuators' wrench at pose `q` under the forces `f`.
@@ -268,13 +350,6 @@ impl<const L: usize> TablePlant<'_, L> {
         wrench
     }
 
-    fn pose(y: &Y<L>) -> (Coords, Coords) {
-        (
-            Coords::from_fn(|k, _| y[Q + k]),
-            Coords::from_fn(|k, _| y[QD + k]),
-        )
-    }
-
     /// The platen's twist (velocity of the reference point, angular velocity).
     fn twist(q: &Coords, qd: &Coords) -> Wrench {
         let omega = angular_velocity(q, qd);
@@ -282,9 +357,9 @@ impl<const L: usize> TablePlant<'_, L> {
     }
 
     /// The rates in slip (or free flight without friction); returns the gauge's rate.
-    fn slip_rates(&self, at: At, y: &Y<L>, dy: &mut Y<L>) -> f64 {
-        let (q, qd) = Self::pose(y);
-        let f = self.forces_at(at);
+    fn slip_rates(&self, at: S::Input, y: &Y<L>, dy: &mut Y<L>) -> f64 {
+        let (q, qd) = pose(y);
+        let f = self.forces_at(at, y);
         let wrench = self.actuators(&f, &q);
         let twist = Self::twist(&q, &qd);
         let mut applied = wrench + self.table.struts_wrench(&q) + self.specimen_push(y);
@@ -315,6 +390,7 @@ impl<const L: usize> TablePlant<'_, L> {
             dy[QD + k] = qdd[k];
         }
         self.specimen_rates(&q, &qd, &qdd, y, dy);
+        self.source.rates(self.table, at, y, &q, &qd, dy);
         dy[V]
     }
 
@@ -356,9 +432,9 @@ impl<const L: usize> TablePlant<'_, L> {
     }
 
     /// The rates at rest in the plane: the in-plane coordinates held by friction.
-    fn stick_rates(&self, at: At, y: &Y<L>, dy: &mut Y<L>) {
-        let (q, qd) = Self::pose(y);
-        let f = self.forces_at(at);
+    fn stick_rates(&self, at: S::Input, y: &Y<L>, dy: &mut Y<L>) {
+        let (q, qd) = pose(y);
+        let f = self.forces_at(at, y);
         let wrench = self.actuators(&f, &q);
         let twist = Self::twist(&q, &qd);
         let applied = wrench + self.table.struts_wrench(&q) + self.specimen_push(y);
@@ -377,13 +453,14 @@ impl<const L: usize> TablePlant<'_, L> {
             dy[QD + k] = qdd[k];
         }
         self.specimen_rates(&q, &qd, &qdd, y, dy);
+        self.source.rates(self.table, at, y, &q, &qd, dy);
     }
 
     /// The holding friction's ratio to the limit surface at `y` under the forces at `at`
     /// (infinite where the equations are singular).
-    fn ratio(&self, at: At, y: &Y<L>) -> f64 {
-        let (q, qd) = Self::pose(y);
-        let f = self.forces_at(at);
+    fn ratio(&self, at: S::Input, y: &Y<L>) -> f64 {
+        let (q, qd) = pose(y);
+        let f = self.forces_at(at, y);
         let applied = self.actuators(&f, &q) + self.table.struts_wrench(&q) + self.specimen_push(y);
         let capacity = self.table.friction_capacity(&q, &f);
         self.table
@@ -393,9 +470,9 @@ impl<const L: usize> TablePlant<'_, L> {
 
     /// Leaving rest at `y` under the forces at `at`: the in-plane motion
     /// ([`MultiAxisTable::breakaway`]) and the gauge along it.
-    fn leave(&self, at: At, y: &Y<L>) -> (PlanarRate, Gauge) {
-        let (q, qd) = Self::pose(y);
-        let f = self.forces_at(at);
+    fn leave(&self, at: S::Input, y: &Y<L>) -> (PlanarRate, Gauge) {
+        let (q, qd) = pose(y);
+        let f = self.forces_at(at, y);
         let applied = self.actuators(&f, &q) + self.table.struts_wrench(&q) + self.specimen_push(y);
         let capacity = self.table.friction_capacity(&q, &f);
         let t = Vector3::new(q[0], q[1], q[2]);
@@ -410,9 +487,9 @@ impl<const L: usize> TablePlant<'_, L> {
 
     /// The gauge along the in-plane motion of `y`, with the bearings' capacity under the
     /// forces at `at`.
-    fn gauge_along(&self, at: At, y: &Y<L>) -> Gauge {
-        let (q, qd) = Self::pose(y);
-        let capacity = self.table.friction_capacity(&q, &self.forces_at(at));
+    fn gauge_along(&self, at: S::Input, y: &Y<L>) -> Gauge {
+        let (q, qd) = pose(y);
+        let capacity = self.table.friction_capacity(&q, &self.forces_at(at, y));
         Gauge::new(
             &capacity,
             &Vector3::new(q[0], q[1], q[2]),
@@ -422,14 +499,22 @@ impl<const L: usize> TablePlant<'_, L> {
 
     /// Aims the slide along the in-plane motion `along` with `gauge`, its blend speed from
     /// the bearings' capacity at `y` under the forces at `at`.
-    fn aim(&mut self, at: At, y: &Y<L>, gauge: Gauge, along: PlanarRate) {
-        let (q, _) = Self::pose(y);
-        let capacity = self.table.friction_capacity(&q, &self.forces_at(at));
+    fn aim(&mut self, at: S::Input, y: &Y<L>, gauge: Gauge, along: PlanarRate) {
+        let (q, _) = pose(y);
+        let capacity = self.table.friction_capacity(&q, &self.forces_at(at, y));
         self.gauge = gauge;
         self.leaving = along;
         self.blend_m_s =
-            BLEND_STEPS * self.grid.h * capacity.force_n / self.table.platen().mass_kg();
+            BLEND_STEPS * self.source.step_s() * capacity.force_n / self.table.platen().mass_kg();
     }
+}
+
+/// The pose and its rates in `y`.
+pub(crate) fn pose<const L: usize>(y: &Y<L>) -> (Coords, Coords) {
+    (
+        Coords::from_fn(|k, _| y[Q + k]),
+        Coords::from_fn(|k, _| y[QD + k]),
+    )
 }
 
 /// Sets the in-plane rates of `y` to zero.
@@ -440,23 +525,20 @@ fn hold_in_plane<const L: usize>(y: &mut Y<L>) {
     y[V] = 0.0;
 }
 
-impl<const L: usize> Plant<L> for TablePlant<'_, L> {
+impl<S: Source<L>, const L: usize> Plant<L> for TablePlant<'_, S, L> {
     type Model = UnitThreshold;
-    type Input = At;
+    type Input = S::Input;
 
     fn model(&self) -> &UnitThreshold {
         &UnitThreshold
     }
 
     #[inline(always)]
-    fn input(&self, at: f64) -> At {
-        At {
-            j: self.n.j,
-            w: (self.n.i + at) * self.grid.inv_k,
-        }
+    fn input(&self, at: f64) -> S::Input {
+        self.source.input(at)
     }
 
-    fn rates(&self, mode: Mode, _w_stiff: f64, input: At, y: &Y<L>, dy: &mut Y<L>) -> f64 {
+    fn rates(&self, mode: Mode, _w_stiff: f64, input: S::Input, y: &Y<L>, dy: &mut Y<L>) -> f64 {
         if mode == Mode::Stick {
             self.stick_rates(input, y, dy);
             0.0
@@ -465,12 +547,12 @@ impl<const L: usize> Plant<L> for TablePlant<'_, L> {
         }
     }
 
-    fn slip_rates<const POSITIVE: bool>(&self, input: At, y: &Y<L>, dy: &mut Y<L>) -> f64 {
+    fn slip_rates<const POSITIVE: bool>(&self, input: S::Input, y: &Y<L>, dy: &mut Y<L>) -> f64 {
         TablePlant::slip_rates(self, input, y, dy)
     }
 
     /// The holding friction's ratio to the limit surface (the machine's threshold is 1).
-    fn effective_force(&self, input: At, y: &Y<L>) -> f64 {
+    fn effective_force(&self, input: S::Input, y: &Y<L>) -> f64 {
         if self.friction {
             self.ratio(input, y)
         } else {
@@ -478,7 +560,7 @@ impl<const L: usize> Plant<L> for TablePlant<'_, L> {
         }
     }
 
-    fn net(&self, input: At, y: &Y<L>) -> f64 {
+    fn net(&self, input: S::Input, y: &Y<L>) -> f64 {
         self.effective_force(input, y)
     }
 
@@ -488,7 +570,7 @@ impl<const L: usize> Plant<L> for TablePlant<'_, L> {
         0.0
     }
 
-    fn entering(&mut self, mode: Mode, input: At, y: &mut Y<L>) {
+    fn entering(&mut self, mode: Mode, input: S::Input, y: &mut Y<L>) {
         if !self.friction {
             return;
         }
@@ -502,7 +584,7 @@ impl<const L: usize> Plant<L> for TablePlant<'_, L> {
         }
     }
 
-    fn arrive(&mut self, input: At, y: &mut Y<L>) -> Option<(Mode, Option<EventKind>)> {
+    fn arrive(&mut self, input: S::Input, y: &mut Y<L>) -> Option<(Mode, Option<EventKind>)> {
         let w = planar_rate(&Coords::from_fn(|k, _| y[QD + k]));
         let speed = self.gauge.scaled(&w).norm();
         let mut dy = [0.0; L];
@@ -511,7 +593,7 @@ impl<const L: usize> Plant<L> for TablePlant<'_, L> {
             .gauge
             .scaled(&planar_rate(&Coords::from_fn(|k, _| dy[QD + k])))
             .norm();
-        if speed > REST_SHARE * accel * self.grid.h {
+        if speed > REST_SHARE * accel * self.source.step_s() {
             // Still sliding, on a path that turned: aim the gauge along it again.
             let gauge = self.gauge_along(input, y);
             self.aim(input, y, gauge, w);
@@ -530,18 +612,49 @@ impl<const L: usize> Plant<L> for TablePlant<'_, L> {
         false
     }
 
-    const RATES_ON_COMMIT: bool = false;
+    const RATES_ON_COMMIT: bool = S::RATES_ON_COMMIT;
 
-    /// The pose (m, rad) and its rates are controlled; the gauge and the work are not.
+    fn admit(&mut self, y: &mut Y<L>, t_s: f64) -> bool {
+        self.source.admit(y, t_s)
+    }
+
+    /// The pose (m, rad), its rates and the specimen's are controlled, and the source's own
+    /// states by its scales; the gauge and the work are not.
     fn error_scale(&self, i: usize, y0: f64, y1: f64, rtol: f64, atol: f64) -> f64 {
-        if i >= Q {
+        if let Some(scale) = self.source.error_scale(i, y0, y1, rtol, atol) {
+            scale
+        } else if i >= Q {
             atol + rtol * y0.abs().max(y1.abs())
         } else {
             f64::INFINITY
         }
     }
 
-    crate::grid::grid_clock!();
+    #[inline(always)]
+    fn seconds(&self, len: f64) -> f64 {
+        self.source.seconds(len)
+    }
+    fn units(&self, seconds: f64) -> f64 {
+        self.source.units(seconds)
+    }
+    fn time_s(&self, at: f64) -> f64 {
+        self.source.time_s(at)
+    }
+    fn tolerance_floor(&self) -> f64 {
+        self.source.tolerance_floor()
+    }
+    fn min_progress(&self) -> f64 {
+        self.source.min_progress()
+    }
+    fn land(&self, tau: f64, x: f64, rest: f64) -> f64 {
+        self.source.land(tau, x, rest)
+    }
+    fn reach(&self, tau: f64, len: f64) -> f64 {
+        self.source.reach(tau, len)
+    }
+    fn break_at(&self, tau: f64, x: f64, rest: f64, held: bool) -> f64 {
+        self.source.break_at(tau, x, rest, held)
+    }
 }
 
 /// The forward run of `table` under `forces` from the pose `initial` with rates
@@ -619,6 +732,40 @@ fn run<const L: usize>(
         ),
     };
     let h = dt / k as f64;
+    let source = Recorded {
+        forces,
+        grid: Grid {
+            force: forces.forces_n.first().map_or(&[][..], Vec::as_slice),
+            inv_k: 1.0 / k as f64,
+            h,
+            t0: forces.t_s[0],
+        },
+        n: GridStep { n: 0, j: 0, i: 0.0 },
+    };
+    let y = start_state::<L>(table, specimen, initial, initial_rates);
+    let mut m = start_machine(table, specimen, source, y, h, pieces);
+    let mut out = Output::new(table, specimen, forces.len(), Vec::new());
+    out.push(&m, forces.t_s[0], &recorded_forces(forces, 0), &[]);
+    let mut n = 0u64;
+    for j in 0..forces.len() - 1 {
+        for i in 0..k {
+            step(&mut m, GridStep { n, j, i: i as f64 })?;
+            n += 1;
+        }
+        out.push(&m, forces.t_s[j + 1], &recorded_forces(forces, j + 1), &[]);
+    }
+    Ok(out.finish())
+}
+
+/// The state at the start of a run of `table` carrying `specimen` from the pose `initial`
+/// with rates `initial_rates` (the held DOFs at zero), the specimen at rest in its static
+/// deflection; the rest of the state zero.
+pub(crate) fn start_state<const L: usize>(
+    table: &MultiAxisTable,
+    specimen: Option<&LinearSpecimen>,
+    initial: Coords,
+    initial_rates: Coords,
+) -> Y<L> {
     let mut y = [0.0; L];
     y[V] = 1.0;
     for d in Dof::ALL {
@@ -637,17 +784,24 @@ fn run<const L: usize>(
             y[Z + i] = *zi;
         }
     }
+    y
+}
+
+/// The machine of `table` (carrying `specimen`) driven by `source` from the state `y`, in
+/// its first mode: stuck if the platen rests in its plane and the bearings hold it, else
+/// sliding along its motion (one slip phase without friction).
+pub(crate) fn start_machine<'a, S: Source<L>, const L: usize>(
+    table: &'a MultiAxisTable,
+    specimen: Option<&'a LinearSpecimen>,
+    source: S,
+    mut y: Y<L>,
+    h: f64,
+    pieces: PieceMethod,
+) -> Machine<TablePlant<'a, S, L>, L> {
     let friction = table.has_friction();
     let mut plant = TablePlant {
         table,
-        forces,
-        grid: Grid {
-            force: forces.forces_n.first().map_or(&[][..], Vec::as_slice),
-            inv_k: 1.0 / k as f64,
-            h,
-            t0: forces.t_s[0],
-        },
-        n: GridStep { n: 0, j: 0, i: 0.0 },
+        source,
         specimen,
         friction,
         gauge: Gauge {
@@ -658,10 +812,10 @@ fn run<const L: usize>(
         leaving: PlanarRate::zeros(),
         blend_m_s: 0.0,
     };
-    let start = At { j: 0, w: 0.0 };
+    let start = plant.source.input(0.0);
     let mut mode = Mode::Slip(Direction::Positive);
     if friction {
-        let w = planar_rate(&TablePlant::<L>::pose(&y).1);
+        let w = planar_rate(&pose(&y).1);
         if w == PlanarRate::zeros() {
             y[V] = 0.0;
             if plant.ratio(start, &y) <= 1.0 {
@@ -675,35 +829,42 @@ fn run<const L: usize>(
     }
     let mut m = Machine::new(plant, y, h, pieces);
     m.enter(mode, start);
-    let mut out = Output::new(table, specimen, forces.len());
-    out.push(&m, 0);
-    let mut n = 0u64;
-    for j in 0..forces.len() - 1 {
-        for i in 0..k {
-            step(&mut m, GridStep { n, j, i: i as f64 })?;
-            n += 1;
-        }
-        out.push(&m, j + 1);
-    }
-    Ok(out.finish())
+    m
 }
 
-/// One grid step: RK4's single piece when it is safe, else the machine's advance. A slide
-/// with friction has its gauge aimed along its motion first.
-fn step<const L: usize>(m: &mut Machine<TablePlant<'_, L>, L>, n: GridStep) -> Result<()> {
-    m.plant.n = n;
-    m.stats.steps += 1;
+/// The recorded forces at sample `j`.
+fn recorded_forces(forces: &ActuatorForces, j: usize) -> Vec<f64> {
+    forces.forces_n.iter().map(|f| f[j]).collect()
+}
+
+/// At the start of a grid step: a slide with friction has its gauge aimed along its motion.
+/// Returns whether the platen slides (or moves free of friction).
+pub(crate) fn reaim<S: Source<L>, const L: usize>(
+    m: &mut Machine<TablePlant<'_, S, L>, L>,
+) -> bool {
     let sliding = m.mode == Mode::Slip(Direction::Positive) && m.y[V] > 0.0;
     if sliding && m.plant.friction {
         let input = m.plant.input(0.0);
         let gauge = m.plant.gauge_along(input, &m.y);
-        let w = planar_rate(&TablePlant::<L>::pose(&m.y).1);
+        let w = planar_rate(&pose(&m.y).1);
         let y = m.y;
         m.plant.aim(input, &y, gauge, w);
         m.y[V] = gauge.speed(&w);
         m.k[V] = gauge.speed(&planar_rate(&Coords::from_fn(|k, _| m.k[QD + k])));
         m.a = m.k[V];
     }
+    sliding
+}
+
+/// One grid step: RK4's single piece when it is safe, else the machine's advance. A slide
+/// with friction has its gauge aimed along its motion first.
+fn step<const L: usize>(
+    m: &mut Machine<TablePlant<'_, Recorded<'_>, L>, L>,
+    n: GridStep,
+) -> Result<()> {
+    m.plant.source.n = n;
+    m.stats.steps += 1;
+    let sliding = reaim(m);
     if sliding && m.is_rk4() && m.slip_fast::<true>(0.0) {
         return Ok(());
     }
@@ -721,14 +882,20 @@ const SPECIMEN_COLUMNS: [&str; 5] = [
 ];
 
 /// The run's columns, filled a sample at a time.
-struct Output {
+pub(crate) struct Output {
     names: Vec<String>,
     data: Vec<Vec<f64>>,
     row: Vec<f64>,
 }
 
 impl Output {
-    fn new(table: &MultiAxisTable, specimen: Option<&LinearSpecimen>, samples: usize) -> Self {
+    /// The columns of a run of `table` carrying `specimen`, with `extra` columns last.
+    pub(crate) fn new(
+        table: &MultiAxisTable,
+        specimen: Option<&LinearSpecimen>,
+        samples: usize,
+        extra: Vec<String>,
+    ) -> Self {
         let mut names = vec!["t_s".to_string()];
         for suffix in ["", "_s", "_s2"] {
             names.extend(Dof::ALL.map(|d| format!("{}_{}{suffix}", d.name(), d.unit())));
@@ -755,6 +922,7 @@ impl Output {
             }
             names.push("specimen_damping_j".into());
         }
+        names.extend(extra);
         let data = names.iter().map(|_| Vec::with_capacity(samples)).collect();
         Output {
             names,
@@ -763,16 +931,23 @@ impl Output {
         }
     }
 
-    fn push<const L: usize>(&mut self, m: &Machine<TablePlant<'_, L>, L>, j: usize) {
+    /// A row at time `t_s` with the actuator forces `forces` and the `extra` columns' values.
+    pub(crate) fn push<S: Source<L>, const L: usize>(
+        &mut self,
+        m: &Machine<TablePlant<'_, S, L>, L>,
+        t_s: f64,
+        forces: &[f64],
+        extra: &[f64],
+    ) {
         let p = &m.plant;
-        let (q, qd) = TablePlant::<L>::pose(&m.y);
+        let (q, qd) = pose(&m.y);
         self.row.clear();
-        self.row.push(p.forces.t_s[j]);
+        self.row.push(t_s);
         self.row.extend(q.iter().chain(qd.iter()));
         self.row.extend((0..6).map(|k| m.k[QD + k]));
-        for i in 0..p.table.actuators().len() {
+        for (i, f) in forces.iter().enumerate().take(p.table.actuators().len()) {
             self.row.push(p.table.actuator_at(i, &q).stroke_m);
-            self.row.push(p.forces.forces_n[i][j]);
+            self.row.push(*f);
         }
         for s in 0..p.table.struts().len() {
             self.row.push(p.table.strut_at(s, &q).force_n);
@@ -795,12 +970,13 @@ impl Output {
             }
             self.row.push(m.y[crate::machine::SD]);
         }
+        self.row.extend_from_slice(extra);
         for (c, &x) in self.data.iter_mut().zip(&self.row) {
             c.push(x);
         }
     }
 
-    fn finish(self) -> TableRun {
+    pub(crate) fn finish(self) -> TableRun {
         TableRun {
             columns: self.names.into_iter().zip(self.data).collect(),
         }

@@ -14,6 +14,22 @@ pub enum SystemError {
         /// What a valid value looks like.
         expected: String,
     },
+    /// A rejected value of one actuator of a multi-axis table (its index in the table).
+    #[error("actuator {index}: {source}")]
+    OfActuator {
+        /// The actuator's index.
+        index: usize,
+        /// What was wrong with it.
+        source: Box<SystemError>,
+    },
+    /// A rejected gain of one DOF's loop of a multi-axis controller.
+    #[error("DOF {dof}: {source}")]
+    OfDof {
+        /// The DOF's name (`x`, `roll`, …).
+        dof: &'static str,
+        /// What was wrong with its gains.
+        source: Box<SystemError>,
+    },
     /// An unknown preset name.
     #[error("unknown table-system preset `{name}`: expected one of {known}")]
     UnknownPreset {

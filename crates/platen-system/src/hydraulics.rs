@@ -1,6 +1,6 @@
 //! The continuous part of the loop: spool, valve flows, chambers, supply.
 
-use crate::params::{Supply, TableSystem};
+use crate::params::{ServoValve, Supply, TableSystem};
 
 /// Below this fraction of the rated drop the orifice law turns laminar (linear in the drop)
 /// so that its slope stays finite at zero drop: `q = K·x·Δp/√p_t` for `|Δp| < p_t`, the
@@ -67,9 +67,22 @@ pub struct HydraulicConstants {
     pub spool_rad_s: f64,
 }
 
+impl HydraulicConstants {
+    /// The constants of the servo-valves `valve`.
+    pub fn of_valve(valve: &ServoValve) -> Self {
+        let p_t = LAMINAR_FRACTION * valve.rated_pressure_drop_pa;
+        HydraulicConstants {
+            land_coefficient: valve.land_coefficient(),
+            laminar_drop_pa: p_t,
+            laminar_slope: 1.0 / p_t.sqrt(),
+            spool_rad_s: std::f64::consts::TAU * valve.natural_frequency_hz,
+        }
+    }
+}
+
 /// `sgn(Δp)·√|Δp|` with the laminar transition of [`LAMINAR_FRACTION`] below `p_t`.
 #[inline(always)]
-fn root(dp: f64, c: &HydraulicConstants) -> f64 {
+pub(crate) fn root(dp: f64, c: &HydraulicConstants) -> f64 {
     if dp.abs() >= c.laminar_drop_pa {
         dp.signum() * dp.abs().sqrt()
     } else {
@@ -82,24 +95,12 @@ impl TableSystem {
     /// without one).
     #[inline(always)]
     pub fn supply_pressure_at(&self, oil_m3: f64) -> f64 {
-        match &self.supply {
-            Supply::Constant => self.supply_pressure_pa,
-            Supply::Accumulator(acc) => {
-                let gas = (acc.volume_m3 - oil_m3).max(1e-9 * acc.volume_m3);
-                acc.precharge_pressure_pa * (acc.volume_m3 / gas).powf(acc.polytropic_exponent)
-            }
-        }
+        supply_pressure_at(&self.supply, self.supply_pressure_pa, oil_m3)
     }
 
     /// The accumulator's oil at the supply (set) pressure, m³ (0 without one).
     pub fn charged_oil_m3(&self) -> f64 {
-        match &self.supply {
-            Supply::Constant => 0.0,
-            Supply::Accumulator(acc) => {
-                let ratio = acc.precharge_pressure_pa / self.supply_pressure_pa;
-                acc.volume_m3 * (1.0 - ratio.powf(1.0 / acc.polytropic_exponent))
-            }
-        }
+        charged_oil_m3(&self.supply, self.supply_pressure_pa)
     }
 
     /// The state at rest at `u = 0`: a centred spool, the null pressures, a charged bank.
@@ -124,13 +125,7 @@ impl TableSystem {
 
     /// The constants of the right-hand side.
     pub fn constants(&self) -> HydraulicConstants {
-        let p_t = LAMINAR_FRACTION * self.servo_valve.rated_pressure_drop_pa;
-        HydraulicConstants {
-            land_coefficient: self.land_coefficient(),
-            laminar_drop_pa: p_t,
-            laminar_slope: 1.0 / p_t.sqrt(),
-            spool_rad_s: std::f64::consts::TAU * self.servo_valve.natural_frequency_hz,
-        }
+        HydraulicConstants::of_valve(&self.servo_valve)
     }
 
     /// [`TableSystem::valve_flows_m3_s`] with its constants computed once.
@@ -143,17 +138,7 @@ impl TableSystem {
         p_b: f64,
         p_s: f64,
     ) -> (f64, f64) {
-        let x = x.clamp(-1.0, 1.0);
-        if x == 0.0 {
-            return (0.0, 0.0);
-        }
-        let k = c.land_coefficient;
-        let p_r = self.return_pressure_pa;
-        if x >= 0.0 {
-            (k * x * root(p_s - p_a, c), k * x * root(p_b - p_r, c))
-        } else {
-            (k * x * root(p_a - p_r, c), k * x * root(p_s - p_b, c))
-        }
+        four_way_flows(c, x, p_a, p_b, p_s, self.return_pressure_pa)
     }
 
     /// The rates of the hydraulic state at platen displacement `u_m` and velocity `v_m_s`,
@@ -201,16 +186,13 @@ impl TableSystem {
         let zeta = self.servo_valve.damping_ratio;
         let n = f64::from(act.count);
         let drawn = n * if s.spool >= 0.0 { q_a } else { -q_b };
-        let (oil, d_ps) = match &self.supply {
-            Supply::Constant => (0.0, 0.0),
-            Supply::Accumulator(acc) => {
-                let band = 0.01 * self.supply_pressure_pa;
-                let taper = ((self.supply_pressure_pa - p_s) / band).clamp(0.0, 1.0);
-                let q = acc.pump_flow_m3_s * taper - drawn;
-                let gas = (acc.volume_m3 - s.accumulator_oil_m3).max(1e-9 * acc.volume_m3);
-                (q, acc.polytropic_exponent * p_s * q / gas)
-            }
-        };
+        let (oil, d_ps) = supply_rates(
+            &self.supply,
+            self.supply_pressure_pa,
+            drawn,
+            s.accumulator_oil_m3,
+            p_s,
+        );
         HydraulicRates {
             p_a: dp_a,
             p_b: dp_b,
@@ -222,6 +204,76 @@ impl TableSystem {
             q_b_m3_s: q_b,
             supply_flow_m3_s: drawn,
             hydraulic_power_w: n * (p_a * q_a - p_b * q_b),
+        }
+    }
+}
+
+/// Flows `(q_a, q_b)` of a critically centred four-way valve at spool opening `x` (clamped to
+/// ±1): into chamber `a` and out of chamber `b`, m³/s, between supply `p_s` and return `p_r`.
+#[inline(always)]
+pub(crate) fn four_way_flows(
+    c: &HydraulicConstants,
+    x: f64,
+    p_a: f64,
+    p_b: f64,
+    p_s: f64,
+    p_r: f64,
+) -> (f64, f64) {
+    let x = x.clamp(-1.0, 1.0);
+    if x == 0.0 {
+        return (0.0, 0.0);
+    }
+    let k = c.land_coefficient;
+    if x >= 0.0 {
+        (k * x * root(p_s - p_a, c), k * x * root(p_b - p_r, c))
+    } else {
+        (k * x * root(p_a - p_r, c), k * x * root(p_s - p_b, c))
+    }
+}
+
+/// The supply pressure with `oil_m3` in the accumulator of `supply` (the set pressure
+/// `set_pa` for a constant supply), Pa.
+#[inline(always)]
+pub(crate) fn supply_pressure_at(supply: &Supply, set_pa: f64, oil_m3: f64) -> f64 {
+    match supply {
+        Supply::Constant => set_pa,
+        Supply::Accumulator(acc) => {
+            let gas = (acc.volume_m3 - oil_m3).max(1e-9 * acc.volume_m3);
+            acc.precharge_pressure_pa * (acc.volume_m3 / gas).powf(acc.polytropic_exponent)
+        }
+    }
+}
+
+/// The accumulator's oil at the set pressure `set_pa`, m³ (0 without one).
+pub(crate) fn charged_oil_m3(supply: &Supply, set_pa: f64) -> f64 {
+    match supply {
+        Supply::Constant => 0.0,
+        Supply::Accumulator(acc) => {
+            let ratio = acc.precharge_pressure_pa / set_pa;
+            acc.volume_m3 * (1.0 - ratio.powf(1.0 / acc.polytropic_exponent))
+        }
+    }
+}
+
+/// The rates `(accumulator oil, supply pressure)` of `supply` (set pressure `set_pa`) when
+/// the valves draw `drawn_m3_s`, the bank holding `oil_m3` at pressure `p_s`: the pumps give
+/// their full flow below the set pressure and taper to nothing over the 1 % below it.
+#[inline(always)]
+pub(crate) fn supply_rates(
+    supply: &Supply,
+    set_pa: f64,
+    drawn_m3_s: f64,
+    oil_m3: f64,
+    p_s: f64,
+) -> (f64, f64) {
+    match supply {
+        Supply::Constant => (0.0, 0.0),
+        Supply::Accumulator(acc) => {
+            let band = 0.01 * set_pa;
+            let taper = ((set_pa - p_s) / band).clamp(0.0, 1.0);
+            let q = acc.pump_flow_m3_s * taper - drawn_m3_s;
+            let gas = (acc.volume_m3 - oil_m3).max(1e-9 * acc.volume_m3);
+            (q, acc.polytropic_exponent * p_s * q / gas)
         }
     }
 }

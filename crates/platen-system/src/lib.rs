@@ -19,6 +19,15 @@
 //! * **Supply** ([`Supply`]): constant, or an accumulator bank whose pressure follows its gas
 //!   (`P·V_g^n` constant) as the valves draw oil and the pumps refill it.
 //!
+//! # The multi-axis table
+//!
+//! [`TableHydraulics`] gives each actuator of a multi-axis table its own servo-valves and
+//! chambers (double-acting with a four-way valve, or single-acting with one chamber and a
+//! three-way valve) on one supply, with null pressures that hold the platen at rest.
+//! [`DofController`] is the DOF control of such a table: the three-variable law per DOF
+//! through the geometry at neutral ([`DofGeometry`]), and a force balance on the redundant
+//! actuators. `platen-integrate`'s `forward_table_loop` runs them with the platen.
+//!
 //! # Invariant
 //!
 //! A [`TableSystem`] is always valid: its values are private and the only way to make one,
@@ -46,16 +55,24 @@
 #![warn(missing_docs)]
 
 mod controller;
+mod dof_control;
 mod error;
 mod hydraulics;
 mod linear;
 mod params;
 pub mod preset;
+mod table;
 
 pub use controller::{ControllerInput, ControllerState};
+pub use dof_control::{
+    open_loop, DofCommand, DofController, DofControllerState, DofFeedback, DofGeometry,
+};
 pub use error::{Result, SystemError};
 pub use hydraulics::{HydraulicConstants, HydraulicRates, HydraulicState, LAMINAR_FRACTION};
 pub use linear::{Capacities, Linearisation, Margins, Mechanics, Passband, SECANT_SPEED_M_S};
 pub use params::{
     Accumulator, Actuator, Controller, ServoValve, Supply, TableSystem, TableSystemParts,
+};
+pub use table::{
+    ActuatorHydraulics, ActuatorRates, ActuatorState, TableHydraulics, TableHydraulicsParts,
 };

@@ -143,8 +143,14 @@ impl Actuator {
 }
 
 impl ServoValve {
+    /// `K = m·Q_r/√(Δp_r/2)` of all `m` valves together: the land coefficient, m³/s per √Pa
+    /// at full opening.
+    pub fn land_coefficient(&self) -> f64 {
+        f64::from(self.count) * self.rated_flow_m3_s / (0.5 * self.rated_pressure_drop_pa).sqrt()
+    }
+
     /// Its values.
-    fn validate(&self) -> Result<()> {
+    pub(crate) fn validate(&self) -> Result<()> {
         let v = self;
         if v.count == 0 {
             return Err(invalid("servo_valve.count", 0.0, "at least 1 valve"));
@@ -166,7 +172,7 @@ impl ServoValve {
 
 impl Controller {
     /// Its rate, gains and filter.
-    fn validate(&self) -> Result<()> {
+    pub(crate) fn validate(&self) -> Result<()> {
         let c = self;
         positive("controller.sample_rate_hz", c.sample_rate_hz)?;
         for (path, value) in [
@@ -378,48 +384,18 @@ impl TableSystem {
 
     /// The oil, the supply and return pressures, and the accumulator bank.
     fn validate_supply(&self) -> Result<()> {
-        positive("oil_bulk_modulus_pa", self.oil_bulk_modulus_pa)?;
-        positive("supply_pressure_pa", self.supply_pressure_pa)?;
-        non_negative("return_pressure_pa", self.return_pressure_pa)?;
-        if self.return_pressure_pa >= self.supply_pressure_pa {
-            return Err(invalid(
-                "return_pressure_pa",
-                self.return_pressure_pa,
-                format!("below the supply pressure {} Pa", self.supply_pressure_pa),
-            ));
-        }
-        if let Supply::Accumulator(acc) = &self.supply {
-            positive(
-                "accumulator.precharge_pressure_pa",
-                acc.precharge_pressure_pa,
-            )?;
-            if acc.precharge_pressure_pa >= self.supply_pressure_pa {
-                return Err(invalid(
-                    "accumulator.precharge_pressure_pa",
-                    acc.precharge_pressure_pa,
-                    format!("below the supply pressure {} Pa", self.supply_pressure_pa),
-                ));
-            }
-            positive("accumulator.volume_m3", acc.volume_m3)?;
-            if !(acc.polytropic_exponent.is_finite()
-                && (1.0..=1.7).contains(&acc.polytropic_exponent))
-            {
-                return Err(invalid(
-                    "accumulator.polytropic_exponent",
-                    acc.polytropic_exponent,
-                    "between 1 (isothermal) and 1.7",
-                ));
-            }
-            non_negative("accumulator.pump_flow_m3_s", acc.pump_flow_m3_s)?;
-        }
-        Ok(())
+        validate_supply(
+            self.oil_bulk_modulus_pa,
+            self.supply_pressure_pa,
+            self.return_pressure_pa,
+            &self.supply,
+        )
     }
 
     /// `K = Q_r/√(Δp_r/2)` of all the valves of one actuator together: the land
     /// coefficient, m³/s per √Pa at full opening.
     pub fn land_coefficient(&self) -> f64 {
-        let v = &self.servo_valve;
-        f64::from(v.count) * v.rated_flow_m3_s / (0.5 * v.rated_pressure_drop_pa).sqrt()
+        self.servo_valve.land_coefficient()
     }
 
     /// The null pressures `(p_a0, p_b0)` of a centred valve with no load: equal drops on
@@ -446,4 +422,48 @@ impl TableSystem {
         let a = &self.actuator;
         f64::from(a.count) * (a.cap_area_m2 * p_a_pa - a.rod_area_m2 * p_b_pa)
     }
+}
+
+/// The oil's bulk modulus, the supply and return pressures and the accumulator bank: the
+/// checks shared by the uniaxial and the multi-axis table systems.
+pub(crate) fn validate_supply(
+    oil_bulk_modulus_pa: f64,
+    supply_pressure_pa: f64,
+    return_pressure_pa: f64,
+    supply: &Supply,
+) -> Result<()> {
+    positive("oil_bulk_modulus_pa", oil_bulk_modulus_pa)?;
+    positive("supply_pressure_pa", supply_pressure_pa)?;
+    non_negative("return_pressure_pa", return_pressure_pa)?;
+    if return_pressure_pa >= supply_pressure_pa {
+        return Err(invalid(
+            "return_pressure_pa",
+            return_pressure_pa,
+            format!("below the supply pressure {} Pa", supply_pressure_pa),
+        ));
+    }
+    if let Supply::Accumulator(acc) = supply {
+        positive(
+            "accumulator.precharge_pressure_pa",
+            acc.precharge_pressure_pa,
+        )?;
+        if acc.precharge_pressure_pa >= supply_pressure_pa {
+            return Err(invalid(
+                "accumulator.precharge_pressure_pa",
+                acc.precharge_pressure_pa,
+                format!("below the supply pressure {} Pa", supply_pressure_pa),
+            ));
+        }
+        positive("accumulator.volume_m3", acc.volume_m3)?;
+        if !(acc.polytropic_exponent.is_finite() && (1.0..=1.7).contains(&acc.polytropic_exponent))
+        {
+            return Err(invalid(
+                "accumulator.polytropic_exponent",
+                acc.polytropic_exponent,
+                "between 1 (isothermal) and 1.7",
+            ));
+        }
+        non_negative("accumulator.pump_flow_m3_s", acc.pump_flow_m3_s)?;
+    }
+    Ok(())
 }

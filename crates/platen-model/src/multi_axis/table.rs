@@ -3,7 +3,10 @@
 
 use nalgebra::{Cholesky, DMatrix, Matrix3, Matrix6, Unit, Vector3, Vector6, SVD};
 
-use super::dof::{angular_rate_bias, angular_rate_map, rotation, translation, Coords, Dof, DofSet};
+use super::dof::{
+    angular_rate_bias, angular_rate_map, angular_velocity, rotation, translation, Coords, Dof,
+    DofSet,
+};
 use crate::error::{ModelError, Result};
 use crate::STANDARD_GRAVITY_M_S2;
 
@@ -502,6 +505,29 @@ impl MultiAxisTable {
                     point_m: point,
                     unit_wrench: point_wrench(&(point - t), &pad.axis),
                 }
+            }
+        }
+    }
+
+    /// The rate of actuator `i`'s stroke at pose `q` with rates `qd`, m/s: a swivel's
+    /// `u·(ṫ + ω × (p − t))` (its length's rate); a pad's rate of the axis point's travel
+    /// `ṡ = (n·ṫ − ṅ·(c − t) − s·ṅ·a)/(n·a)`, `n = R·e_z` the underside's normal,
+    /// `ṅ = ω × n` (from `s·(n·a) = c_z − n·(c − t)`), which is the piston's speed.
+    ///
+    /// # Panics
+    /// If `i` is out of range.
+    pub fn stroke_rate_m_s(&self, i: usize, q: &Coords, qd: &Coords) -> f64 {
+        let pose = self.actuator_at(i, q);
+        let omega = angular_velocity(q, qd);
+        let t = translation(q);
+        let td = Vector3::new(qd[0], qd[1], qd[2]);
+        match &self.parts.actuators[i].mount {
+            Mount::Swivel { .. } => pose.unit.dot(&(td + omega.cross(&(pose.point_m - t)))),
+            Mount::Pad(pad) => {
+                let n = rotation(q) * Vector3::z();
+                let nd = omega.cross(&n);
+                let a = pad.axis.into_inner();
+                (n.dot(&td) - nd.dot(&(pad.contact_m - t)) - pose.stroke_m * nd.dot(&a)) / n.dot(&a)
             }
         }
     }
