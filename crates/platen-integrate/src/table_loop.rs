@@ -25,7 +25,10 @@
 
 use std::collections::VecDeque;
 
-use platen_model::multi_axis::{Coords, Dof, LinearSpecimen, MultiAxisTable};
+use nalgebra::Vector3;
+use platen_model::multi_axis::{
+    angular_velocity, Coords, Dof, Frame, LinearSpecimen, MultiAxisTable,
+};
 use platen_system::{
     ActuatorState, DofCommand, DofController, DofControllerState, DofFeedback, Supply,
     TableHydraulics,
@@ -116,6 +119,7 @@ pub struct TableLoopStats {
 
 /// The actuators' hydraulics in the state: the source of the closed loop's forces.
 pub(crate) struct Hydraulic<'a> {
+    table: &'a MultiAxisTable,
     hyd: &'a TableHydraulics,
     /// The valves' inputs (the delayed, held drives).
     drives: [f64; MAX_LOOP_ACTUATORS],
@@ -160,18 +164,22 @@ impl<const L: usize> Source<L> for Hydraulic<'_> {
 
     fn rates(
         &self,
-        table: &MultiAxisTable,
         _input: (),
         y: &Y<L>,
+        frame: &Frame,
         q: &Coords,
         qd: &Coords,
         dy: &mut Y<L>,
     ) {
         let p_s = y[ps::<L>()];
         let (mut drawn, mut power, mut leak) = (0.0, 0.0, 0.0);
+        let omega = angular_velocity(q, qd);
+        let td = Vector3::new(qd[0], qd[1], qd[2]);
+        let table = self.table;
         for i in 0..self.count() {
-            let s = table.actuator_at(i, q).stroke_m;
-            let v = table.stroke_rate_m_s(i, q, qd);
+            let pose = table.actuator_in(i, frame);
+            let s = pose.stroke_m;
+            let v = table.stroke_rate_in(i, frame, &pose, &td, &omega);
             let r = self
                 .hyd
                 .actuator_rates(i, s, v, self.drives[i], &Self::state(y, i), p_s);
@@ -399,6 +407,7 @@ impl<'a, const L: usize> TableLoop<'a, L> {
         y[ps::<L>()] = hyd.supply_pressure_at(y[oil::<L>()]);
         let t0 = run.command.t_s()[0];
         let source = Hydraulic {
+            table,
             hyd,
             drives: [0.0; MAX_LOOP_ACTUATORS],
             t: t0,

@@ -37,8 +37,8 @@
 use nalgebra::DVector;
 use nalgebra::{Vector2, Vector3};
 use platen_model::multi_axis::{
-    angular_velocity, planar_rate, Coords, Dof, FrictionCapacity, LinearSpecimen, MultiAxisTable,
-    PlanarRate, Wrench,
+    angular_velocity, planar_rate, Coords, Dof, Frame, FrictionCapacity, LinearSpecimen,
+    MultiAxisTable, PlanarRate, Wrench,
 };
 use platen_model::PlatenModel;
 
@@ -239,9 +239,9 @@ pub(crate) trait Source<const L: usize> {
     #[inline(always)]
     fn rates(
         &self,
-        _table: &MultiAxisTable,
         _input: Self::Input,
         _y: &Y<L>,
+        _frame: &Frame,
         _q: &Coords,
         _qd: &Coords,
         _dy: &mut Y<L>,
@@ -342,10 +342,10 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
     }
 
     /// The actuators' wrench at pose `q` under the forces `f`.
-    fn actuators(&self, f: &Forces, q: &Coords) -> Wrench {
+    fn actuators(&self, f: &Forces, frame: &Frame) -> Wrench {
         let mut wrench = Wrench::zeros();
         for (i, f) in f.iter().take(self.table.actuators().len()).enumerate() {
-            wrench += self.table.actuator_at(i, q).unit_wrench * *f;
+            wrench += self.table.actuator_in(i, frame).unit_wrench * *f;
         }
         wrench
     }
@@ -360,12 +360,13 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
     fn slip_rates(&self, at: S::Input, y: &Y<L>, dy: &mut Y<L>) -> f64 {
         let (q, qd) = pose(y);
         let f = self.forces_at(at, y);
-        let wrench = self.actuators(&f, &q);
+        let frame = self.table.frame(&q);
+        let wrench = self.actuators(&f, &frame);
         let twist = Self::twist(&q, &qd);
-        let mut applied = wrench + self.table.struts_wrench(&q) + self.specimen_push(y);
+        let mut applied = wrench + self.table.struts_wrench_in(&frame) + self.specimen_push(y);
         let mut lost = 0.0;
         if self.friction {
-            let capacity = self.table.friction_capacity(&q, &f);
+            let capacity = self.table.friction_capacity_in(&frame, &f);
             let friction =
                 self.table
                     .sliding_friction(&q, &qd, &capacity, &self.leaving, self.blend_m_s);
@@ -390,7 +391,7 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
             dy[QD + k] = qdd[k];
         }
         self.specimen_rates(&q, &qd, &qdd, y, dy);
-        self.source.rates(self.table, at, y, &q, &qd, dy);
+        self.source.rates(at, y, &frame, &q, &qd, dy);
         dy[V]
     }
 
@@ -435,10 +436,11 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
     fn stick_rates(&self, at: S::Input, y: &Y<L>, dy: &mut Y<L>) {
         let (q, qd) = pose(y);
         let f = self.forces_at(at, y);
-        let wrench = self.actuators(&f, &q);
+        let frame = self.table.frame(&q);
+        let wrench = self.actuators(&f, &frame);
         let twist = Self::twist(&q, &qd);
-        let applied = wrench + self.table.struts_wrench(&q) + self.specimen_push(y);
-        let capacity = self.table.friction_capacity(&q, &f);
+        let applied = wrench + self.table.struts_wrench_in(&frame) + self.specimen_push(y);
+        let capacity = self.table.friction_capacity_in(&frame, &f);
         let (qdd, holding) = match self.table.stick(&q, &qd, &applied, &capacity) {
             Some(s) => (s.accelerations, s.wrench),
             None => (Coords::repeat(f64::NAN), Wrench::repeat(f64::NAN)),
@@ -453,7 +455,7 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
             dy[QD + k] = qdd[k];
         }
         self.specimen_rates(&q, &qd, &qdd, y, dy);
-        self.source.rates(self.table, at, y, &q, &qd, dy);
+        self.source.rates(at, y, &frame, &q, &qd, dy);
     }
 
     /// The holding friction's ratio to the limit surface at `y` under the forces at `at`
@@ -461,8 +463,11 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
     fn ratio(&self, at: S::Input, y: &Y<L>) -> f64 {
         let (q, qd) = pose(y);
         let f = self.forces_at(at, y);
-        let applied = self.actuators(&f, &q) + self.table.struts_wrench(&q) + self.specimen_push(y);
-        let capacity = self.table.friction_capacity(&q, &f);
+        let frame = self.table.frame(&q);
+        let applied = self.actuators(&f, &frame)
+            + self.table.struts_wrench_in(&frame)
+            + self.specimen_push(y);
+        let capacity = self.table.friction_capacity_in(&frame, &f);
         self.table
             .stick(&q, &qd, &applied, &capacity)
             .map_or(f64::INFINITY, |s| s.ratio)
@@ -473,8 +478,11 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
     fn leave(&self, at: S::Input, y: &Y<L>) -> (PlanarRate, Gauge) {
         let (q, qd) = pose(y);
         let f = self.forces_at(at, y);
-        let applied = self.actuators(&f, &q) + self.table.struts_wrench(&q) + self.specimen_push(y);
-        let capacity = self.table.friction_capacity(&q, &f);
+        let frame = self.table.frame(&q);
+        let applied = self.actuators(&f, &frame)
+            + self.table.struts_wrench_in(&frame)
+            + self.specimen_push(y);
+        let capacity = self.table.friction_capacity_in(&frame, &f);
         let t = Vector3::new(q[0], q[1], q[2]);
         let w = self
             .table

@@ -147,8 +147,8 @@ fn run_table(
     parsed: &file::ScenarioFile,
 ) -> Result<(platen_integrate::TableRun, String), Fail> {
     let scenario = platen_scenario::multi_axis::TableScenario::from_file(path, parsed)?;
-    let run = scenario.run()?;
-    let summary = json_text(&scenario.summary(&run, None))?;
+    let (run, stats) = scenario.run_with_stats()?;
+    let summary = json_text(&scenario.summary_with(&run, stats.as_ref(), None))?;
     Ok((run, summary))
 }
 

@@ -177,7 +177,7 @@ enum Source<'a> {
     SineMotion(&'a SineMotion),
     TriangleMotion(&'a TriangleMotion),
     WhiteNoiseMotion(&'a WhiteNoiseMotion),
-    GroundMotion(&'a GroundMotion),
+    GroundMotion(&'a GroundMotionSpec),
 }
 
 impl<'a> Source<'a> {
@@ -303,7 +303,15 @@ fn build_source(ctx: &Ctx, file: &ScenarioFile, source: Source) -> Result<(Run, 
         .map(|motion| nothing(Run::Inverse { motion })),
         Source::WhiteNoiseMotion(g) => white_noise(&gen, g).map(nothing),
         Source::GroundMotion(g) => {
-            let motion = ground_motion(ctx, g, file.duration_s)?;
+            let here = "excitation.ground_motion";
+            let g = g.single().ok_or_else(|| {
+                ctx.invalid(
+                    here,
+                    "(per axis)",
+                    "one record: records per axis (x, y, z) need a multi-axis `table`",
+                )
+            })?;
+            let motion = ground_motion(ctx, here, g, file.duration_s)?;
             let integral = "exact integral of a_m_s2 (straight lines between the record's samples)";
             let derived = Derived::from([
                 ("v_m_s", integral.to_owned()),
@@ -660,12 +668,16 @@ fn lowpass(
 /// The table motion of an `excitation.ground_motion`: the record scaled, cut to the
 /// duration, baseline-corrected and integrated as PEER integrates it
 /// ([`platen_signal::AccelerogramMotion`]: straight lines between samples, exact integrals).
-fn ground_motion(ctx: &Ctx, g: &GroundMotion, duration_s: Option<f64>) -> Result<Motion> {
-    let here = "excitation.ground_motion";
+pub(crate) fn ground_motion(
+    ctx: &Ctx,
+    here: &str,
+    g: &GroundMotion,
+    duration_s: Option<f64>,
+) -> Result<Motion> {
     let scale = check_finite(ctx, &format!("{here}.scale"), g.scale)?;
     let rate = check_positive(ctx, &format!("{here}.sample_rate_hz"), g.sample_rate_hz)?;
     let path = platen_io::peer::find_record(ctx.path.parent(), &g.record)?;
-    let (acc, dt_s) = read_ground_acceleration(ctx, g, &path)?;
+    let (acc, dt_s) = read_ground_acceleration(ctx, here, g, &path)?;
     let signal = |name: &str, e: platen_signal::SignalError| {
         ctx.invalid(&format!("{here}.{name}"), "", e.to_string())
     };
@@ -727,8 +739,12 @@ fn ground_motion(ctx: &Ctx, g: &GroundMotion, duration_s: Option<f64>) -> Result
 
 /// The ground acceleration of a `ground_motion` record (m/s²) and its sample interval (s):
 /// a PEER `.AT2` file, or a CSV read through the record's `columns`.
-fn read_ground_acceleration(ctx: &Ctx, g: &GroundMotion, path: &Path) -> Result<(Vec<f64>, f64)> {
-    let here = "excitation.ground_motion";
+fn read_ground_acceleration(
+    ctx: &Ctx,
+    here: &str,
+    g: &GroundMotion,
+    path: &Path,
+) -> Result<(Vec<f64>, f64)> {
     let is_csv = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("csv"));

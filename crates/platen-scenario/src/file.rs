@@ -234,9 +234,11 @@ pub struct ExcitationSpec {
     /// Generated band-limited white-noise motion (the paper's WN tests): inverse run.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub white_noise_motion: Option<WhiteNoiseMotion>,
-    /// Table motion from a ground-acceleration record (an earthquake test): inverse run.
+    /// Table motion from a ground-acceleration record (an earthquake test): inverse run, or
+    /// the command of a closed loop. With a multi-axis `table`, per axis:
+    /// `{"x": {…}, "y": {…}, "z": {…}}` (the components of one station).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub ground_motion: Option<GroundMotion>,
+    pub ground_motion: Option<GroundMotionSpec>,
     /// Zero-phase low-pass of a force excitation before it drives the model, Hz (the paper
     /// low-passed the SR9 force at 0.6 Hz). Forward runs only.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -310,6 +312,74 @@ pub struct GroundMotion {
     /// units, e.g. `{"t_s": {"name": "time"}, "a_m_s2": {"name": "acc (g)", "unit": "g"}}`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub columns: Option<BTreeMap<String, ColumnSpec>>,
+}
+
+/// `excitation.ground_motion`: one record (the uniaxial table's axis), or one per axis of a
+/// multi-axis table.
+#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[serde(untagged)]
+pub enum GroundMotionSpec {
+    /// One record.
+    Single(GroundMotion),
+    /// One record per axis (any of x, y, z).
+    PerAxis(AxisGroundMotion),
+}
+
+/// `excitation.ground_motion` per axis: the components of one station.
+#[derive(Debug, Clone, Default, Deserialize, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct AxisGroundMotion {
+    /// The record along x (the table's longitudinal axis).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub x: Option<GroundMotion>,
+    /// The record along y.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub y: Option<GroundMotion>,
+    /// The vertical record.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub z: Option<GroundMotion>,
+}
+
+impl AxisGroundMotion {
+    /// The records along x, y, z.
+    pub fn each(&self) -> [(&'static str, Option<&GroundMotion>); 3] {
+        [
+            ("x", self.x.as_ref()),
+            ("y", self.y.as_ref()),
+            ("z", self.z.as_ref()),
+        ]
+    }
+}
+
+impl<'de> Deserialize<'de> for GroundMotionSpec {
+    /// An object whose keys are axes (`x`, `y`, `z`) is per axis, any other one record (so
+    /// that a typo in either is reported by the shape it was meant for).
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        use serde::de::Error;
+        let value = serde_json::Value::deserialize(d)?;
+        let per_axis = value.as_object().is_some_and(|o| {
+            !o.is_empty() && o.keys().all(|k| matches!(k.as_str(), "x" | "y" | "z"))
+        });
+        if per_axis {
+            serde_json::from_value(value)
+                .map(GroundMotionSpec::PerAxis)
+                .map_err(|e| D::Error::custom(format!("ground_motion per axis: {e}")))
+        } else {
+            serde_json::from_value(value)
+                .map(GroundMotionSpec::Single)
+                .map_err(D::Error::custom)
+        }
+    }
+}
+
+impl GroundMotionSpec {
+    /// The one record, if it is not per axis.
+    pub fn single(&self) -> Option<&GroundMotion> {
+        match self {
+            GroundMotionSpec::Single(g) => Some(g),
+            GroundMotionSpec::PerAxis(_) => None,
+        }
+    }
 }
 
 /// Baseline correction of a ground-motion record.

@@ -2,11 +2,16 @@
 //! contract in `docs/multi-axis.md`). [`TableSpec`] is the key as written; [`TableScenario`]
 //! the validated scenario and its run.
 //!
-//! What runs today: the **inverse** of a prescribed six-DOF motion (`excitation.motion_csv`
-//! with `t_s` and any of `x_m` … `yaw_rad`, absent ones at 0, optional rates `x_m_s` … and
-//! accelerations `x_m_s2` …, derived from the pose where absent), with a storeys or general
-//! linear specimen. Forward runs from actuator forces, the closed loop and the `lhpost6`
-//! preset are refused with their key named.
+//! What runs:
+//! * the **inverse** of a prescribed six-DOF motion (`excitation.motion_csv` with `t_s` and
+//!   any of `x_m` … `yaw_rad`, absent ones at 0, optional rates `x_m_s` … and accelerations
+//!   `x_m_s2` …, derived from the pose where absent; or `excitation.ground_motion` per axis),
+//!   with a storeys or general linear specimen;
+//! * the **forward** run from recorded actuator forces (`excitation.force_csv`);
+//! * the **closed loop** when the table has a `controller`: the same motion excitations are
+//!   the DOF controller's command, and every actuator has its servo-valves.
+//!
+//! `{"preset": "lhpost6"}` lays the given values over the LHPOST6's (see `docs/lhpost6.md`).
 
 use std::path::{Path, PathBuf};
 
@@ -14,20 +19,30 @@ use nalgebra::{DMatrix, Matrix3, Unit, Vector3};
 use serde::Serialize;
 
 use platen_integrate::{
-    forward_table, inverse_table, ActuatorForces, ForceRecord, Method, PoseMotion, TableRun,
+    forward_table, forward_table_loop, inverse_table, ActuatorForces, ForceRecord, LoopMethod,
+    Method, PoseMotion, TableLoopRun, TableLoopStats, TableRun,
 };
 use platen_model::multi_axis::{
     Actuator, Bearing, BearingLoad, Coords, Dof, DofSet, LinearSpecimen, Mount, MultiAxisTable,
     Pad, RigidPlaten, Strut, TableParts,
 };
 use platen_model::ModelError;
+use platen_system::{
+    open_loop, ActuatorHydraulics, DofController, DofGeometry, SystemError, TableHydraulics,
+    TableHydraulicsParts,
+};
 
 use crate::ctx::{check_finite, check_positive, Ctx};
 use crate::error::{Result, ScenarioError};
 use crate::excitation::{motion_run, read_mapped, Derived};
-use crate::file::{ScenarioFile, SpecimenSpec};
+use crate::file::{GroundMotionSpec, ScenarioFile, SpecimenSpec};
 use crate::scenario::Run;
-pub use crate::table_file::{ActuatorSpec, BearingSpec, PadSpec, PlatenSpec, StrutSpec, TableSpec};
+use crate::system::{complete_servo_valve_under, controller_gains, loop_method_at, supply_under};
+use crate::system_file::Overlay;
+pub use crate::table_file::{
+    ActuatorSpec, AxisLimitsSpec, BearingSpec, DofGainsSpec, PadSpec, PlatenSpec,
+    RotationLimitSpec, StrutSpec, TableControllerSpec, TableSpec, TranslationLimitSpec,
+};
 
 /// Default oil bulk modulus, Pa.
 pub const DEFAULT_OIL_BULK_MODULUS_PA: f64 = 1.5e9;
@@ -65,6 +80,11 @@ pub enum TableRunSpec {
         /// The motion (boxed: six channels of four vectors each).
         motion: Box<PoseMotion>,
     },
+    /// The closed loop: the motion is the DOF controller's command.
+    Loop {
+        /// The command (boxed: six channels of four vectors each).
+        command: Box<PoseMotion>,
+    },
     /// The motion recorded actuator forces produce.
     Forward {
         /// One force record per actuator, in the table's order.
@@ -94,6 +114,21 @@ pub struct TableScenario {
     pub run: TableRunSpec,
     /// The motion's channels platen derived, with how.
     pub derived: Derived,
+    /// The closed loop's hydraulics and controller, when the table has a `controller`.
+    pub system: Option<TableLoopSystem>,
+    /// The table's limits per axis (`table.limits`), validated.
+    pub limits: crate::table_file::AxisLimitsSpec,
+}
+
+/// The closed loop around a multi-axis table.
+#[derive(Debug, Clone)]
+pub struct TableLoopSystem {
+    /// Its actuators' hydraulics and supply.
+    pub hydraulics: TableHydraulics,
+    /// Its DOF controller.
+    pub controller: DofController,
+    /// The integrator.
+    pub method: LoopMethod,
 }
 
 impl TableScenario {
@@ -104,35 +139,46 @@ impl TableScenario {
     /// of the motion record (with file and line); a file without `table` is refused.
     pub fn from_file(path: &Path, file: &ScenarioFile) -> Result<Self> {
         let ctx = Ctx { path };
-        let Some(spec) = &file.table else {
+        let Some(given) = &file.table else {
             return Err(ctx.invalid("table", "(absent)", "a multi-axis table"));
         };
-        for (key, given) in [
-            ("model", file.model.is_some()),
-            ("table_system", file.table_system.is_some()),
-            ("limits", file.limits.is_some()),
+        let spec = resolve_preset(&ctx, given)?;
+        let spec = &spec;
+        let closed = spec.controller.is_some();
+        for (key, given, expected) in [
+            ("model", file.model.is_some(), "no such key beside a `table` (the table holds its platen)"),
+            ("table_system", file.table_system.is_some(), "no such key beside a `table` (the table holds its hydraulics and `controller`)"),
+            ("limits", file.limits.is_some(), "no such key beside a `table`: its limits per axis are `table.limits`"),
             (
                 "initial",
                 file.initial.is_some() && file.excitation.force_csv.is_none(),
+                "no such key here: an initial state belongs to a forward run, from `force_csv` (a closed loop starts at rest at neutral)",
             ),
             (
                 "integrator",
-                file.integrator.is_some() && file.excitation.force_csv.is_none(),
+                file.integrator.is_some() && file.excitation.force_csv.is_none() && !closed,
+                "no such key here: an integrator belongs to a forward run (`force_csv`) or a closed loop (a `table.controller`)",
             ),
         ] {
             if given {
-                return Err(ctx.invalid(
-                    key,
-                    "(given)",
-                    "no such key beside a `table` (the table holds its platen and its hydraulics; \
-                     an integrator and an initial state belong to a forward run, from \
-                     `force_csv`; per-axis limits are not built yet)",
-                ));
+                return Err(ctx.invalid(key, "(given)", expected));
             }
         }
         let table = build_table(&ctx, spec)?;
-        let (run, derived) = build_run(&ctx, file, &table)?;
         let specimen = build_specimen(&ctx, file.specimen.as_ref())?;
+        let limits = build_limits(&ctx, spec)?;
+        let system = match &spec.controller {
+            Some(c) => Some(build_system(
+                &ctx,
+                file,
+                spec,
+                c,
+                &table,
+                specimen.as_ref(),
+            )?),
+            None => None,
+        };
+        let (run, derived) = build_run(&ctx, file, &table, closed)?;
         let pressure = |key: &str, v: Option<f64>, default: f64| match v {
             Some(p) => check_positive(&ctx, &format!("table.{key}"), p),
             None => Ok(default),
@@ -153,7 +199,29 @@ impl TableScenario {
             )?,
             run,
             derived,
+            system,
+            limits,
         })
+    }
+
+    /// Runs it, with the closed loop's own figures when it is one.
+    ///
+    /// # Errors
+    /// As [`TableScenario::run`].
+    pub fn run_with_stats(&self) -> Result<(TableRun, Option<TableLoopStats>)> {
+        if let (TableRunSpec::Loop { command }, Some(sys)) = (&self.run, &self.system) {
+            return forward_table_loop(&TableLoopRun {
+                table: &self.table,
+                hydraulics: &sys.hydraulics,
+                controller: &sys.controller,
+                specimen: self.specimen.as_ref(),
+                command,
+                method: sys.method,
+            })
+            .map(|(run, stats)| (run, Some(stats)))
+            .map_err(ScenarioError::TableRun);
+        }
+        self.run().map(|run| (run, None))
     }
 
     /// Runs it.
@@ -179,6 +247,7 @@ impl TableScenario {
                 initial.0,
                 initial.1,
             ),
+            TableRunSpec::Loop { .. } => return self.run_with_stats().map(|(run, _)| run),
         };
         run.map_err(ScenarioError::TableRun)
     }
@@ -240,26 +309,6 @@ impl TableSpec {
 
 /// `table` into a validated table.
 fn build_table(ctx: &Ctx, spec: &TableSpec) -> Result<MultiAxisTable> {
-    if let Some(name) = &spec.preset {
-        return Err(ctx.invalid(
-            "table.preset",
-            format!("{name:?}"),
-            "an explicit table: the lhpost6 preset comes with the multi-axis closed loop",
-        ));
-    }
-    for (key, given) in [
-        ("table.controller", spec.controller.is_some()),
-        ("table.accumulator", spec.accumulator.is_some()),
-    ] {
-        if given {
-            return Err(ctx.invalid(
-                key,
-                "(given)",
-                "nothing yet: the multi-axis closed loop (controller, valves, supply) is not built \
-                 yet; remove the key to run the table's mechanics",
-            ));
-        }
-    }
     let platen = spec.platen.as_ref().ok_or_else(|| {
         ctx.invalid(
             "table.platen",
@@ -276,19 +325,6 @@ fn build_table(ctx: &Ctx, spec: &TableSpec) -> Result<MultiAxisTable> {
     let mut actuators = Vec::with_capacity(spec.actuators.len());
     for (i, a) in spec.actuators.iter().enumerate() {
         let at = |k: &str| format!("table.actuators[{i}].{k}");
-        for (key, given) in [
-            ("servo_valve", a.servo_valve.is_some()),
-            ("leakage_m3_s_per_pa", a.leakage_m3_s_per_pa.is_some()),
-        ] {
-            if given {
-                return Err(ctx.invalid(
-                    &at(key),
-                    "(given)",
-                    "nothing yet: an actuator's valve and leakage belong to the multi-axis closed \
-                     loop, not built yet",
-                ));
-            }
-        }
         let mount = match (&a.platen_m, &a.pad) {
             (Some(p), None) => Mount::Swivel {
                 platen_m: vector(*p),
@@ -402,28 +438,27 @@ fn build_table(ctx: &Ctx, spec: &TableSpec) -> Result<MultiAxisTable> {
     .map_err(|e| table_error(ctx, spec, e))
 }
 
-/// `excitation` of a multi-axis scenario: `motion_csv` only, for now.
+/// `excitation` of a multi-axis scenario: a six-DOF motion (`motion_csv`, or `ground_motion`
+/// per axis), the inverse's prescribed motion or the closed loop's command (`closed`); or
+/// recorded actuator forces (`force_csv`, a forward run, open loop).
 fn build_run(
     ctx: &Ctx,
     file: &ScenarioFile,
     table: &MultiAxisTable,
+    closed: bool,
 ) -> Result<(TableRunSpec, Derived)> {
     let ex = &file.excitation;
     if let Some(rel) = &ex.force_csv {
+        if closed {
+            return Err(ctx.invalid(
+                "excitation.force_csv",
+                "(given)",
+                "a motion (motion_csv or ground_motion): with a `table.controller` the \
+                 excitation is the controller's command, and the actuator forces are the loop's",
+            ));
+        }
         return forward_run(ctx, file, table, &ctx.resolve(rel)).map(|r| (r, Derived::new()));
     }
-    let Some(rel) = &ex.motion_csv else {
-        let given = crate::excitation::named_sources(ex);
-        let key = given
-            .first()
-            .map_or("excitation".to_owned(), |k| format!("excitation.{k}"));
-        return Err(ctx.invalid(
-            &key,
-            "(given)",
-            "motion_csv (the inverse of a six-DOF motion) or force_csv (`t_s` and \
-             `{name}_force_n` per actuator: a forward run)",
-        ));
-    };
     for (key, given) in [
         ("excitation.lowpass_hz", ex.lowpass_hz.is_some()),
         (
@@ -432,20 +467,48 @@ fn build_run(
         ),
     ] {
         if given {
-            return Err(ctx.invalid(key, "(given)", "nothing: not used by a multi-axis inverse"));
+            return Err(ctx.invalid(key, "(given)", "nothing: not used by a multi-axis motion"));
         }
     }
-    let path = ctx.resolve(rel);
+    let (motion, derived) = match (&ex.motion_csv, &ex.ground_motion) {
+        (Some(rel), None) => read_pose_motion(ctx, file, &ctx.resolve(rel))?,
+        (None, Some(GroundMotionSpec::PerAxis(axes))) => axis_ground_motion(ctx, file, axes)?,
+        _ => {
+            let given = crate::excitation::named_sources(ex);
+            let key = given
+                .first()
+                .map_or("excitation".to_owned(), |k| format!("excitation.{k}"));
+            return Err(ctx.invalid(
+                &key,
+                "(given)",
+                "one of motion_csv (a six-DOF motion), ground_motion per axis \
+                 ({\"x\": {\"record\": …}, \"y\": …, \"z\": …}) or force_csv (`t_s` and \
+                 `{name}_force_n` per actuator: a forward run)",
+            ));
+        }
+    };
+    let motion = Box::new(motion);
+    Ok(if closed {
+        (TableRunSpec::Loop { command: motion }, derived)
+    } else {
+        (TableRunSpec::Inverse { motion }, derived)
+    })
+}
+
+/// A six-DOF motion record: `t_s` and any of the pose columns (absent ones 0), their rates
+/// and accelerations derived where absent, cut to `duration_s`.
+fn read_pose_motion(ctx: &Ctx, file: &ScenarioFile, path: &Path) -> Result<(PoseMotion, Derived)> {
+    let ex = &file.excitation;
     let optional: Vec<&'static str> = POSE_COLUMNS
         .iter()
         .chain(&RATE_COLUMNS)
         .chain(&ACCELERATION_COLUMNS)
         .copied()
         .collect();
-    let mut cols = read_mapped(ctx, &path, ex, &["t_s"], &optional)?;
+    let mut cols = read_mapped(ctx, path, ex, &["t_s"], &optional)?;
     if !POSE_COLUMNS.iter().any(|c| cols.contains_key(c)) {
         return Err(ScenarioError::Io(platen_io::IoError::Record {
-            path: path.clone(),
+            path: path.to_owned(),
             message: "a six-DOF motion needs at least one of the columns x_m, y_m, z_m, \
                       roll_rad, pitch_rad, yaw_rad (absent ones are 0)"
                 .into(),
@@ -460,7 +523,7 @@ fn build_run(
         let u = u.unwrap_or_else(|| vec![0.0; t.len()]);
         let v = cols.remove(RATE_COLUMNS[k]);
         let a = cols.remove(ACCELERATION_COLUMNS[k]);
-        let (run, how) = motion_run(ctx, file, &path, t.clone(), u, v, a)?;
+        let (run, how) = motion_run(ctx, file, path, t.clone(), u, v, a)?;
         let Run::Inverse { motion } = run else {
             unreachable!("a motion record makes an inverse run")
         };
@@ -481,14 +544,340 @@ fn build_run(
         dofs.push(motion);
     }
     let dofs: [platen_signal::Motion; 6] = dofs.try_into().expect("six DOFs");
-    let motion =
-        PoseMotion::new(dofs).map_err(|cause| crate::excitation::rejected(&path, cause))?;
-    Ok((
-        TableRunSpec::Inverse {
-            motion: Box::new(motion),
+    let motion = PoseMotion::new(dofs).map_err(|cause| crate::excitation::rejected(path, cause))?;
+    Ok((motion, derived))
+}
+
+/// `excitation.ground_motion` per axis: each record integrated as the uniaxial
+/// `ground_motion` is, the axes on one time grid (the shortest record's, every record at
+/// the same `sample_rate_hz`), the rotations and absent axes held at zero.
+fn axis_ground_motion(
+    ctx: &Ctx,
+    file: &ScenarioFile,
+    axes: &crate::file::AxisGroundMotion,
+) -> Result<(PoseMotion, Derived)> {
+    let here = "excitation.ground_motion";
+    let mut motions: [Option<platen_signal::Motion>; 3] = [None, None, None];
+    let mut rate: Option<(f64, &str)> = None;
+    for (k, (axis, g)) in axes.each().into_iter().enumerate() {
+        let Some(g) = g else { continue };
+        let at = format!("{here}.{axis}");
+        match rate {
+            Some((r, first)) if r != g.sample_rate_hz => {
+                return Err(ctx.invalid(
+                    &format!("{at}.sample_rate_hz"),
+                    g.sample_rate_hz,
+                    format!("the same rate as {here}.{first}.sample_rate_hz ({r} Hz)"),
+                ))
+            }
+            None => rate = Some((g.sample_rate_hz, axis)),
+            _ => {}
+        }
+        motions[k] = Some(crate::excitation::ground_motion(
+            ctx,
+            &at,
+            g,
+            file.duration_s,
+        )?);
+    }
+    let n = motions
+        .iter()
+        .flatten()
+        .map(platen_signal::Motion::len)
+        .min()
+        .ok_or_else(|| ctx.invalid(here, "{}", "a record for at least one of x, y, z"))?;
+    let t: Vec<f64> = motions
+        .iter()
+        .flatten()
+        .next()
+        .map(|m| m.t_s()[..n].to_vec())
+        .unwrap_or_default();
+    let still = || {
+        let z = vec![0.0; n];
+        platen_signal::Motion::new(t.clone(), z.clone(), z.clone(), z)
+    };
+    let mut dofs = Vec::with_capacity(6);
+    let mut derived = Derived::new();
+    let integral =
+        "exact integral of the record's acceleration (straight lines between its samples)";
+    for k in 0..6 {
+        let m = match motions.get(k).and_then(Option::as_ref) {
+            Some(m) => {
+                derived.insert(RATE_COLUMNS[k], integral.to_owned());
+                derived.insert(POSE_COLUMNS[k], format!("{integral}, twice"));
+                m.clone().truncated(n)
+            }
+            None => still(),
+        };
+        dofs.push(m.map_err(|e| ctx.invalid(here, "", e.to_string()))?);
+    }
+    let dofs: [platen_signal::Motion; 6] = dofs.try_into().expect("six DOFs");
+    let motion = PoseMotion::new(dofs).map_err(|e| ctx.invalid(here, "", e.to_string()))?;
+    Ok((motion, derived))
+}
+
+/// The LHPOST6 preset as written (`presets/lhpost6.json`, made by
+/// `tools/make_lhpost6_preset.py`): `{"table": {…}, "limits": {…}}`.
+const LHPOST6: &str = include_str!("../presets/lhpost6.json");
+
+/// The preset file's shape.
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PresetFile {
+    table: TableSpec,
+    limits: Option<crate::table_file::AxisLimitsSpec>,
+}
+
+/// The names of the table presets.
+pub const TABLE_PRESETS: [&str; 1] = ["lhpost6"];
+
+/// The table of preset `name`, limits included.
+///
+/// # Errors
+/// An unknown name.
+pub fn table_preset(name: &str) -> std::result::Result<TableSpec, String> {
+    match name {
+        "lhpost6" => {
+            let file: PresetFile =
+                serde_json::from_str(LHPOST6).expect("the shipped LHPOST6 preset parses");
+            Ok(TableSpec {
+                limits: file.limits.or(file.table.limits.clone()),
+                ..file.table
+            })
+        }
+        other => Err(format!(
+            "one of {} (not {other:?})",
+            TABLE_PRESETS.join(", ")
+        )),
+    }
+}
+
+/// `table` with its preset's values laid under it (values given win, field by field; a list
+/// given replaces the preset's).
+fn resolve_preset(ctx: &Ctx, spec: &TableSpec) -> Result<TableSpec> {
+    let Some(name) = &spec.preset else {
+        return Ok(spec.clone());
+    };
+    let base = table_preset(name)
+        .map_err(|expected| ctx.invalid("table.preset", format!("{name:?}"), expected))?;
+    Ok(spec.clone().overlay(base))
+}
+
+/// `table.limits`, every value given finite and > 0.
+fn build_limits(ctx: &Ctx, spec: &TableSpec) -> Result<crate::table_file::AxisLimitsSpec> {
+    let limits = spec.limits.clone().unwrap_or_default();
+    let names = [
+        ["stroke_m", "velocity_m_s", "acceleration_m_s2"],
+        ["angle_rad", "rate_rad_s", "acceleration_rad_s2"],
+    ];
+    for (d, values) in Dof::ALL.iter().zip(limits.each()) {
+        let keys = names[usize::from(d.is_rotation())];
+        for (key, v) in keys.iter().zip(values) {
+            if let Some(v) = v {
+                check_positive(ctx, &format!("table.limits.{}.{key}", d.name()), v)?;
+            }
+        }
+    }
+    if let Some(m) = limits.overturning_moment_n_m {
+        check_positive(ctx, "table.limits.overturning_moment_n_m", m)?;
+    }
+    Ok(limits)
+}
+
+/// The error of a table system's refusal, at its JSON path under `table`.
+fn system_error(ctx: &Ctx, e: SystemError) -> ScenarioError {
+    match e {
+        SystemError::Invalid {
+            path,
+            value,
+            expected,
+        } => ctx.invalid(&format!("table.{path}"), value, expected),
+        SystemError::OfActuator { index, source } => match *source {
+            SystemError::Invalid {
+                path,
+                value,
+                expected,
+            } => ctx.invalid(&format!("table.actuators[{index}].{path}"), value, expected),
+            other => ctx.invalid(&format!("table.actuators[{index}]"), "", other.to_string()),
         },
-        derived,
-    ))
+        SystemError::OfDof { dof, source } => match *source {
+            SystemError::Invalid {
+                path,
+                value,
+                expected,
+            } => {
+                let key = path.trim_start_matches("controller.");
+                ctx.invalid(
+                    &format!("table.controller.dof.{dof}.{key}"),
+                    value,
+                    expected,
+                )
+            }
+            other => ctx.invalid(
+                &format!("table.controller.dof.{dof}"),
+                "",
+                other.to_string(),
+            ),
+        },
+        other => ctx.invalid("table", "", other.to_string()),
+    }
+}
+
+/// The closed loop of a table with `controller`: every actuator's servo-valves and leakage,
+/// the supply, the DOF controller (gains for every free DOF, none for a held one), the
+/// static forces the chambers must hold at rest, and the integrator (RK4 resolving the
+/// loop's fastest mode by default, or `integrator`).
+fn build_system(
+    ctx: &Ctx,
+    file: &ScenarioFile,
+    spec: &TableSpec,
+    controller: &crate::table_file::TableControllerSpec,
+    table: &MultiAxisTable,
+    specimen: Option<&LinearSpecimen>,
+) -> Result<TableLoopSystem> {
+    let mut actuators = Vec::with_capacity(spec.actuators.len());
+    for (i, a) in spec.actuators.iter().enumerate() {
+        let prefix = format!("table.actuators[{i}]");
+        let valve = a.servo_valve.clone().ok_or_else(|| {
+            ctx.invalid(
+                &format!("{prefix}.servo_valve"),
+                "(missing)",
+                "its servo-valves ({\"count\", \"rated_flow_m3_s\", \"rated_pressure_drop_pa\", \
+                 \"natural_frequency_hz\", \"damping_ratio\", \"delay_s\"}): the table has a \
+                 `controller`",
+            )
+        })?;
+        actuators.push(ActuatorHydraulics {
+            cap_area_m2: a.cap_side_area_m2,
+            rod_area_m2: a.rod_side_area_m2,
+            chamber_volume_m3: a.chamber_volume_m3,
+            leakage_m3_s_per_pa: a.leakage_m3_s_per_pa.unwrap_or(0.0),
+            servo_valve: complete_servo_valve_under(ctx, &prefix, valve)?,
+        });
+    }
+    let strokes: Vec<f64> = table.actuators().iter().map(|a| a.stroke_m).collect();
+    let supply_pressure_pa = spec
+        .supply_pressure_pa
+        .unwrap_or(DEFAULT_SUPPLY_PRESSURE_PA);
+    let hydraulics = TableHydraulics::new(
+        TableHydraulicsParts {
+            actuators,
+            oil_bulk_modulus_pa: table.parts().oil_bulk_modulus_pa,
+            supply_pressure_pa,
+            return_pressure_pa: spec
+                .return_pressure_pa
+                .unwrap_or(DEFAULT_RETURN_PRESSURE_PA),
+            supply: supply_under(ctx, "table", spec.accumulator.as_ref())?,
+        },
+        &strokes,
+    )
+    .map_err(|e| system_error(ctx, e))?;
+    let delay = hydraulics.actuators()[0].servo_valve.delay_s;
+    if let Some(i) = hydraulics
+        .actuators()
+        .iter()
+        .position(|a| a.servo_valve.delay_s != delay)
+    {
+        return Err(ctx.invalid(
+            &format!("table.actuators[{i}].servo_valve.delay_s"),
+            hydraulics.actuators()[i].servo_valve.delay_s,
+            format!("the delay of every other valve ({delay} s): the valves share one delay line"),
+        ));
+    }
+    // The static hold: the chambers must exert it between the return and supply pressures.
+    let extra = specimen.map_or_else(platen_model::multi_axis::Wrench::zeros, |s| {
+        s.rigid_mass()
+            * platen_model::multi_axis::Wrench::new(
+                0.0,
+                0.0,
+                -platen_model::STANDARD_GRAVITY_M_S2,
+                0.0,
+                0.0,
+                0.0,
+            )
+    });
+    TableHydraulics::static_forces_n(table, &extra)
+        .and_then(|f| hydraulics.rest_states(&f))
+        .map_err(|e| system_error(ctx, e))?;
+    let rate = controller.sample_rate_hz.ok_or_else(|| {
+        ctx.invalid(
+            "table.controller.sample_rate_hz",
+            "(missing)",
+            "the controller's sample rate, Hz",
+        )
+    })?;
+    check_positive(ctx, "table.controller.sample_rate_hz", rate)?;
+    let gains = controller.dof.clone().unwrap_or_default();
+    let mut loops = [open_loop(rate); 6];
+    for (d, g) in Dof::ALL.iter().zip(gains.each()) {
+        let at = format!("table.controller.dof.{}", d.name());
+        let free = table.free().contains(*d);
+        match (g, free) {
+            (Some(g), true) => {
+                if let Some(r) = g.sample_rate_hz {
+                    return Err(ctx.invalid(
+                        &format!("{at}.sample_rate_hz"),
+                        r,
+                        "nothing: every DOF's loop runs at table.controller.sample_rate_hz",
+                    ));
+                }
+                loops[d.index()] = controller_gains(rate, g);
+            }
+            (Some(_), false) => {
+                return Err(ctx.invalid(
+                    &at,
+                    "(given)",
+                    format!("nothing: {} is held (table.held_dofs)", d.name()),
+                ))
+            }
+            (None, true) => {
+                return Err(ctx.invalid(
+                    &at,
+                    "(missing)",
+                    "its gains ({\"displacement_gain_per_m\", …}): every free DOF has a loop",
+                ))
+            }
+            (None, false) => {}
+        }
+    }
+    let balance = controller.force_balance_gain.unwrap_or(0.0);
+    let geometry = DofGeometry::of_table(table).map_err(|e| system_error(ctx, e))?;
+    let controller =
+        DofController::new(rate, loops, balance, geometry).map_err(|e| system_error(ctx, e))?;
+    // The fastest mode: the spools' and the oil columns' (the table's modes with the valves
+    // shut, specimen included).
+    let modes = match specimen {
+        Some(s) => table.modes_with(s),
+        None => table.modes(),
+    };
+    let oil = modes
+        .iter()
+        .map(|m| std::f64::consts::TAU * m.frequency_hz)
+        .fold(0.0, f64::max);
+    let spool = hydraulics
+        .actuators()
+        .iter()
+        .map(|a| std::f64::consts::TAU * a.servo_valve.natural_frequency_hz)
+        .fold(0.0, f64::max);
+    let fastest = oil.max(spool);
+    let period = controller.period_s();
+    let k = (period * fastest / 0.25).ceil().clamp(1.0, 1e6) as u32;
+    let method = loop_method_at(ctx, file.integrator.as_ref(), period, fastest, k, || {
+        ctx.invalid(
+            "table.controller.sample_rate_hz",
+            rate,
+            format!(
+                "a rate at which RK4 resolves the loop's fastest mode ({:.1} Hz) within 1e6 \
+                 steps per period, or {{\"method\": \"dopri5\"}}",
+                fastest / std::f64::consts::TAU
+            ),
+        )
+    })?;
+    Ok(TableLoopSystem {
+        hydraulics,
+        controller,
+        method,
+    })
 }
 
 /// `excitation.force_csv` of a multi-axis scenario: `t_s` and `{name}_force_n` per actuator,
@@ -700,8 +1089,76 @@ pub struct ActuatorPeaks {
     pub push_limit_n: f64,
     /// Its pull limit at the supply pressure (≤ 0), N.
     pub pull_limit_n: f64,
+    /// Largest |flow| into chamber `a` (closed loop), m³/s.
+    pub peak_flow_m3_s: Option<f64>,
+    /// Its valves' flow capacity at the supply pressure, `m·Q_r·√((P_s − P_R)/Δp_r)`
+    /// (closed loop), m³/s.
+    pub flow_capacity_m3_s: Option<f64>,
+    /// Time its drive was saturated (`|d| = 1`, counted at the output samples; closed loop),
+    /// s.
+    pub saturated_time_s: Option<f64>,
     /// Whether stroke and force stayed within the limits.
     pub respected: bool,
+}
+
+/// How one DOF of a closed loop followed its command (at the output samples).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AxisTracking {
+    /// RMS of command − achieved, m or rad.
+    pub rms_error: f64,
+    /// Largest |command − achieved|, m or rad.
+    pub peak_error: f64,
+    /// RMS of the error over the RMS of the command (0 for a still command).
+    pub displacement_nrmse: f64,
+    /// RMS of the acceleration error (command's − achieved), m/s² or rad/s².
+    pub rms_acceleration_error: f64,
+    /// Largest |acceleration error|, m/s² or rad/s².
+    pub peak_acceleration_error: f64,
+    /// RMS of the acceleration error over the RMS of the command's acceleration.
+    pub acceleration_nrmse: f64,
+}
+
+/// One axis's peaks against its limits (`table.limits`; `null` where none is given).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AxisLimitCheck {
+    /// Its displacement limit (stroke or angle), m or rad.
+    pub displacement_limit: Option<f64>,
+    /// Its rate limit, m/s or rad/s.
+    pub rate_limit: Option<f64>,
+    /// Its acceleration limit, m/s² or rad/s².
+    pub acceleration_limit: Option<f64>,
+    /// Whether the peaks stayed within the limits given.
+    pub respected: bool,
+}
+
+/// The overturning moment the platen exerted on the specimen against the table's limit.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OverturningSummary {
+    /// Largest `√(M_x² + M_y²)` about the reference point, N·m.
+    pub peak_n_m: f64,
+    /// The limit (`table.limits.overturning_moment_n_m`), N·m.
+    pub limit_n_m: Option<f64>,
+    /// Whether it stayed within the limit (true without one).
+    pub respected: bool,
+}
+
+/// A closed loop's own figures.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TableLoopSummary {
+    /// Time with a drive saturated (at the controller's samples), s.
+    pub saturated_time_s: f64,
+    /// First time a chamber reached the cavitation floor (0 Pa absolute), s.
+    pub cavitation_at_s: Option<f64>,
+    /// Lowest supply pressure, Pa.
+    pub min_supply_pressure_pa: f64,
+    /// Largest warping force (the null-space part of the actuator forces), N.
+    pub max_warping_force_n: f64,
+    /// Hydraulic energy delivered into the chambers, J.
+    pub hydraulic_energy_j: f64,
+    /// Controller samples.
+    pub controller_samples: u64,
+    /// RK4 steps per controller period (or Dopri5 pieces).
+    pub steps_per_period: u32,
 }
 
 /// One strut's range of pull.
@@ -737,7 +1194,18 @@ pub struct TableSummary {
     /// With a specimen: the largest |value| of each base-force and overturning-moment column.
     #[serde(skip_serializing_if = "std::collections::BTreeMap::is_empty")]
     pub specimen: std::collections::BTreeMap<&'static str, f64>,
-    /// Whether every actuator stayed within its limits.
+    /// Per DOF, how it followed its command (closed loop; `null` otherwise).
+    pub tracking: Option<std::collections::BTreeMap<&'static str, AxisTracking>>,
+    /// Per DOF, its peaks against `table.limits` (every DOF; limits `null` where not given).
+    pub limits: std::collections::BTreeMap<&'static str, AxisLimitCheck>,
+    /// The overturning moment against its limit (with a specimen; `null` otherwise).
+    pub overturning_moment: Option<OverturningSummary>,
+    /// The closed loop's own figures (`null` for an open-loop run).
+    #[serde(rename = "loop")]
+    pub loop_figures: Option<TableLoopSummary>,
+    /// What an engineer should look at: limits exceeded, cavitation, saturation.
+    pub warnings: Vec<String>,
+    /// Whether every actuator and axis stayed within its limits.
     pub within_limits: bool,
     /// The CSV written, if any.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -748,9 +1216,44 @@ fn abs_max(x: &[f64]) -> f64 {
     x.iter().fold(0.0, |m: f64, v| m.max(v.abs()))
 }
 
+fn rms(x: impl Iterator<Item = f64>) -> f64 {
+    let (sum, n) = x.fold((0.0, 0usize), |(s, n), v| (s + v * v, n + 1));
+    if n == 0 {
+        0.0
+    } else {
+        (sum / n as f64).sqrt()
+    }
+}
+
+/// The tracking of a command `u_ref`, `a_ref` by the achieved `u`, `a`.
+fn tracking(u_ref: &[f64], u: &[f64], a_ref: &[f64], a: &[f64]) -> AxisTracking {
+    let err = |r: &[f64], x: &[f64]| -> Vec<f64> { r.iter().zip(x).map(|(r, x)| r - x).collect() };
+    let (e, ea) = (err(u_ref, u), err(a_ref, a));
+    let ratio = |num: f64, den: f64| if den > 0.0 { num / den } else { 0.0 };
+    let (rms_e, rms_ea) = (rms(e.iter().copied()), rms(ea.iter().copied()));
+    AxisTracking {
+        rms_error: rms_e,
+        peak_error: abs_max(&e),
+        displacement_nrmse: ratio(rms_e, rms(u_ref.iter().copied())),
+        rms_acceleration_error: rms_ea,
+        peak_acceleration_error: abs_max(&ea),
+        acceleration_nrmse: ratio(rms_ea, rms(a_ref.iter().copied())),
+    }
+}
+
 impl TableScenario {
     /// The summary of `run` (a run of this scenario); `output` the CSV written.
     pub fn summary(&self, run: &TableRun, output: Option<&Path>) -> TableSummary {
+        self.summary_with(run, None, output)
+    }
+
+    /// [`TableScenario::summary`] with the closed loop's figures `stats`.
+    pub fn summary_with(
+        &self,
+        run: &TableRun,
+        stats: Option<&TableLoopStats>,
+        output: Option<&Path>,
+    ) -> TableSummary {
         let col = |name: &str| run.column(name).unwrap_or(&[]);
         let t = col("t_s");
         let axes = Dof::ALL
@@ -777,6 +1280,29 @@ impl TableScenario {
                 let stroke = abs_max(col(&format!("{}_stroke_m", a.name)));
                 let max = force.iter().copied().fold(f64::NEG_INFINITY, f64::max);
                 let min = force.iter().copied().fold(f64::INFINITY, f64::min);
+                let i = self.table.actuators().iter().position(|b| b.name == a.name);
+                let valve = self
+                    .system
+                    .as_ref()
+                    .zip(i)
+                    .map(|(sys, i)| sys.hydraulics.actuators()[i].servo_valve);
+                let capacity = valve.map(|v| {
+                    f64::from(v.count)
+                        * v.rated_flow_m3_s
+                        * ((self.supply_pressure_pa - self.return_pressure_pa)
+                            / v.rated_pressure_drop_pa)
+                            .sqrt()
+                });
+                let flow = run.column(&format!("{}_flow_m3_s", a.name)).map(abs_max);
+                let saturated = run.column(&format!("{}_drive", a.name)).map(|d| {
+                    let n = d.iter().filter(|x| x.abs() >= 1.0).count();
+                    let span = t.last().zip(t.first()).map_or(0.0, |(b, a)| b - a);
+                    if d.len() > 1 {
+                        span * n as f64 / (d.len() - 1) as f64
+                    } else {
+                        0.0
+                    }
+                });
                 ActuatorPeaks {
                     name: a.name.clone(),
                     peak_stroke_m: stroke,
@@ -785,6 +1311,9 @@ impl TableScenario {
                     min_force_n: min,
                     push_limit_n: push,
                     pull_limit_n: pull,
+                    peak_flow_m3_s: flow,
+                    flow_capacity_m3_s: capacity,
+                    saturated_time_s: saturated,
                     respected: stroke <= a.stroke_m && max <= push && min >= pull,
                 }
             })
@@ -812,17 +1341,142 @@ impl TableScenario {
         .into_iter()
         .filter_map(|c| run.column(c).map(|v| (c, abs_max(v))))
         .collect();
+        let tracking = match &self.run {
+            TableRunSpec::Loop { command } => Some(
+                self.table
+                    .free()
+                    .iter()
+                    .map(|d| {
+                        let k = d.index();
+                        let m = command.dof(d);
+                        (
+                            d.name(),
+                            tracking(
+                                &m.u_m()[..run.len().min(m.len())],
+                                col(POSE_COLUMNS[k]),
+                                &m.a_m_s2()[..run.len().min(m.len())],
+                                col(ACCELERATION_COLUMNS[k]),
+                            ),
+                        )
+                    })
+                    .collect(),
+            ),
+            _ => None,
+        };
+        let mut warnings = Vec::new();
+        let limits: std::collections::BTreeMap<&'static str, AxisLimitCheck> = Dof::ALL
+            .iter()
+            .zip(self.limits.each())
+            .map(|(d, [u, v, a])| {
+                let k = d.index();
+                let peaks = [
+                    abs_max(col(POSE_COLUMNS[k])),
+                    abs_max(col(RATE_COLUMNS[k])),
+                    abs_max(col(ACCELERATION_COLUMNS[k])),
+                ];
+                let mut respected = true;
+                for ((limit, peak), what) in
+                    [u, v, a]
+                        .iter()
+                        .zip(peaks)
+                        .zip(["displacement", "rate", "acceleration"])
+                {
+                    if let Some(l) = limit {
+                        if peak > *l {
+                            respected = false;
+                            warnings.push(format!(
+                                "{} {what} {peak:.4e} beyond its limit {l:.4e} (table.limits)",
+                                d.name()
+                            ));
+                        }
+                    }
+                }
+                (
+                    d.name(),
+                    AxisLimitCheck {
+                        displacement_limit: u,
+                        rate_limit: v,
+                        acceleration_limit: a,
+                        respected,
+                    },
+                )
+            })
+            .collect();
+        let overturning_moment = match (
+            run.column("overturning_moment_x_n_m"),
+            run.column("overturning_moment_y_n_m"),
+        ) {
+            (Some(mx), Some(my)) => {
+                let peak = mx
+                    .iter()
+                    .zip(my)
+                    .map(|(a, b)| a.hypot(*b))
+                    .fold(0.0, f64::max);
+                let limit = self.limits.overturning_moment_n_m;
+                let respected = limit.is_none_or(|l| peak <= l);
+                if !respected {
+                    warnings.push(format!(
+                        "overturning moment {peak:.4e} N·m beyond the table's {:.4e} N·m",
+                        limit.unwrap_or_default()
+                    ));
+                }
+                Some(OverturningSummary {
+                    peak_n_m: peak,
+                    limit_n_m: limit,
+                    respected,
+                })
+            }
+            _ => None,
+        };
+        for a in actuators.iter().filter(|a| !a.respected) {
+            warnings.push(format!(
+                "actuator {} beyond its stroke or force limits",
+                a.name
+            ));
+        }
+        let loop_figures = stats.zip(self.system.as_ref()).map(|(st, sys)| {
+            if let Some(at) = st.cavitation_at_s {
+                warnings.push(format!(
+                    "cavitation: a chamber reached 0 Pa (absolute) at t = {at:.4} s"
+                ));
+            }
+            if st.saturated_time_s > 0.0 {
+                warnings.push(format!(
+                    "drives saturated for {:.3} s: the table could not follow its command",
+                    st.saturated_time_s
+                ));
+            }
+            TableLoopSummary {
+                saturated_time_s: st.saturated_time_s,
+                cavitation_at_s: st.cavitation_at_s,
+                min_supply_pressure_pa: st.min_supply_pressure_pa,
+                max_warping_force_n: st.max_warping_force_n,
+                hydraulic_energy_j: st.hydraulic_energy_j,
+                controller_samples: st.controller_samples,
+                steps_per_period: sys.method.steps_per_period(),
+            }
+        });
+        let axes_respected = limits.values().all(|l| l.respected);
+        let overturning_respected = overturning_moment.as_ref().is_none_or(|o| o.respected);
         TableSummary {
+            tracking,
+            limits,
+            overturning_moment,
+            loop_figures,
+            warnings,
             name: self.name.clone(),
             kind: match self.run {
                 TableRunSpec::Inverse { .. } => "inverse",
                 TableRunSpec::Forward { .. } => "forward",
+                TableRunSpec::Loop { .. } => "closed_loop",
             },
             samples: run.len(),
             duration_s: t.last().zip(t.first()).map_or(0.0, |(b, a)| b - a),
             derived: self.derived.clone(),
             axes,
-            within_limits: actuators.iter().all(|a| a.respected),
+            within_limits: actuators.iter().all(|a| a.respected)
+                && axes_respected
+                && overturning_respected,
             actuators,
             struts,
             specimen,
@@ -835,10 +1489,10 @@ impl TableScenario {
 pub fn summary_text(s: &TableSummary, figures: &[PathBuf]) -> String {
     use std::fmt::Write;
     let mut t = String::new();
-    let what = if s.kind == "forward" {
-        "forward from the actuator forces"
-    } else {
-        "inverse of a six-DOF motion"
+    let what = match s.kind {
+        "forward" => "forward from the actuator forces",
+        "closed_loop" => "closed loop: the DOF controller follows a six-DOF command",
+        _ => "inverse of a six-DOF motion",
     };
     let _ = writeln!(
         t,
@@ -858,6 +1512,51 @@ pub fn summary_text(s: &TableSummary, figures: &[PathBuf]) -> String {
             a.peak_acceleration
         );
     }
+    if let Some(tr) = &s.tracking {
+        let _ = writeln!(
+            t,
+            "  tracking  rms error     peak error    nrmse     rms acc. error  peak acc. error  acc. nrmse"
+        );
+        for d in Dof::ALL {
+            let Some(a) = tr.get(d.name()) else { continue };
+            let u = d.unit();
+            let _ = writeln!(
+                t,
+                "  {:<8}  {:>9.3e} {u:<3} {:>9.3e} {u:<3} {:>6.2} %  {:>9.3e} {u}/s²  {:>9.3e} {u}/s²  {:>6.2} %",
+                d.name(),
+                a.rms_error,
+                a.peak_error,
+                100.0 * a.displacement_nrmse,
+                a.rms_acceleration_error,
+                a.peak_acceleration_error,
+                100.0 * a.acceleration_nrmse
+            );
+        }
+    }
+    for d in Dof::ALL {
+        let Some(l) = s.limits.get(d.name()) else {
+            continue;
+        };
+        if l.displacement_limit.is_none()
+            && l.rate_limit.is_none()
+            && l.acceleration_limit.is_none()
+        {
+            continue;
+        }
+        let show = |x: Option<f64>| x.map_or("-".to_owned(), |v| format!("{v:.4}"));
+        let _ = writeln!(
+            t,
+            "  limits {}: {} {}, {} {}/s, {} {}/s²{}",
+            d.name(),
+            show(l.displacement_limit),
+            d.unit(),
+            show(l.rate_limit),
+            d.unit(),
+            show(l.acceleration_limit),
+            d.unit(),
+            if l.respected { "" } else { "  EXCEEDED" }
+        );
+    }
     let _ = writeln!(
         t,
         "  actuator  stroke (limit) m      force min … max (limits) kN"
@@ -875,6 +1574,16 @@ pub fn summary_text(s: &TableSummary, figures: &[PathBuf]) -> String {
             a.push_limit_n / 1e3,
             if a.respected { "" } else { "  OUT OF LIMITS" }
         );
+        if let (Some(q), Some(cap)) = (a.peak_flow_m3_s, a.flow_capacity_m3_s) {
+            let _ = writeln!(
+                t,
+                "            flow {:.4} of {:.4} m³/s ({:.0} %), saturated {:.3} s",
+                q,
+                cap,
+                100.0 * q / cap,
+                a.saturated_time_s.unwrap_or(0.0)
+            );
+        }
     }
     for st in &s.struts {
         let _ = writeln!(
@@ -887,6 +1596,31 @@ pub fn summary_text(s: &TableSummary, figures: &[PathBuf]) -> String {
     }
     for (k, v) in &s.specimen {
         let _ = writeln!(t, "  specimen {k}: peak {v:.1}");
+    }
+    if let Some(o) = &s.overturning_moment {
+        let limit = o
+            .limit_n_m
+            .map_or(String::new(), |l| format!(" of {:.1} MN·m", l / 1e6));
+        let _ = writeln!(
+            t,
+            "  overturning moment: peak {:.3} MN·m{limit}",
+            o.peak_n_m / 1e6
+        );
+    }
+    if let Some(l) = &s.loop_figures {
+        let _ = writeln!(
+            t,
+            "  loop: {} controller samples, {} RK4 steps each; lowest supply {:.2} MPa; \
+             largest warping force {:.1} kN; saturated {:.3} s",
+            l.controller_samples,
+            l.steps_per_period,
+            l.min_supply_pressure_pa / 1e6,
+            l.max_warping_force_n / 1e3,
+            l.saturated_time_s
+        );
+    }
+    for w in &s.warnings {
+        let _ = writeln!(t, "  warning: {w}");
     }
     if let Some(o) = &s.output {
         let _ = writeln!(t, "  wrote {o}");

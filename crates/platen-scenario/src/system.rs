@@ -84,29 +84,11 @@ fn complete_system(ctx: &Ctx, spec: &TableSystemSpec) -> Result<TableSystemParts
         ],
     )?;
     let controller = complete_controller(ctx, spec.controller.clone().unwrap_or_default())?;
-    let supply = match &spec.accumulator {
-        Some(Some(acc)) => {
-            let [precharge_pressure_pa, volume_m3, polytropic_exponent, pump_flow_m3_s] = need_all(
-                ctx,
-                [
-                    (
-                        "accumulator.precharge_pressure_pa",
-                        acc.precharge_pressure_pa,
-                    ),
-                    ("accumulator.volume_m3", acc.volume_m3),
-                    ("accumulator.polytropic_exponent", acc.polytropic_exponent),
-                    ("accumulator.pump_flow_m3_s", acc.pump_flow_m3_s),
-                ],
-            )?;
-            Supply::Accumulator(Accumulator {
-                precharge_pressure_pa,
-                volume_m3,
-                polytropic_exponent,
-                pump_flow_m3_s,
-            })
-        }
-        _ => Supply::Constant,
-    };
+    let supply = supply_under(
+        ctx,
+        "table_system",
+        spec.accumulator.as_ref().and_then(Option::as_ref),
+    )?;
     Ok(TableSystemParts {
         actuator,
         servo_valve,
@@ -118,18 +100,64 @@ fn complete_system(ctx: &Ctx, spec: &TableSystemSpec) -> Result<TableSystemParts
     })
 }
 
+/// The supply of `accumulator` (its values' paths under `prefix`): a bank, or a constant
+/// supply pressure without one.
+pub(crate) fn supply_under(
+    ctx: &Ctx,
+    prefix: &str,
+    accumulator: Option<&AccumulatorSpec>,
+) -> Result<Supply> {
+    let Some(acc) = accumulator else {
+        return Ok(Supply::Constant);
+    };
+    let [precharge_pressure_pa, volume_m3, polytropic_exponent, pump_flow_m3_s] = need_all_under(
+        ctx,
+        prefix,
+        [
+            (
+                "accumulator.precharge_pressure_pa",
+                acc.precharge_pressure_pa,
+            ),
+            ("accumulator.volume_m3", acc.volume_m3),
+            ("accumulator.polytropic_exponent", acc.polytropic_exponent),
+            ("accumulator.pump_flow_m3_s", acc.pump_flow_m3_s),
+        ],
+    )?;
+    Ok(Supply::Accumulator(Accumulator {
+        precharge_pressure_pa,
+        volume_m3,
+        polytropic_exponent,
+        pump_flow_m3_s,
+    }))
+}
+
 /// The error of a value missing at `path` under `table_system`.
 fn missing(ctx: &Ctx, path: &str, expected: &str) -> ScenarioError {
-    ctx.invalid(&format!("table_system.{path}"), "(missing)", expected)
+    missing_under(ctx, "table_system", path, expected)
+}
+
+/// The error of a value missing at `path` under `prefix`.
+fn missing_under(ctx: &Ctx, prefix: &str, path: &str, expected: &str) -> ScenarioError {
+    ctx.invalid(&format!("{prefix}.{path}"), "(missing)", expected)
 }
 
 /// The values of `fields` (their JSON paths under `table_system` and values), in order, or
 /// the error naming the first missing one.
 fn need_all<const N: usize>(ctx: &Ctx, fields: [(&str, Option<f64>); N]) -> Result<[f64; N]> {
+    need_all_under(ctx, "table_system", fields)
+}
+
+/// [`need_all`] under `prefix`.
+pub(crate) fn need_all_under<const N: usize>(
+    ctx: &Ctx,
+    prefix: &str,
+    fields: [(&str, Option<f64>); N],
+) -> Result<[f64; N]> {
     let mut values = [0.0; N];
     for (slot, (path, value)) in values.iter_mut().zip(fields) {
-        *slot =
-            value.ok_or_else(|| missing(ctx, path, "a value (or a `preset` to take it from)"))?;
+        *slot = value.ok_or_else(|| {
+            missing_under(ctx, prefix, path, "a value (or a `preset` to take it from)")
+        })?;
     }
     Ok(values)
 }
@@ -183,21 +211,32 @@ fn complete_actuator(ctx: &Ctx, a: ActuatorSpec) -> Result<platen_system::Actuat
 
 /// The servo-valves of `v`; an absent delay is 0.
 fn complete_servo_valve(ctx: &Ctx, v: ServoValveSpec) -> Result<platen_system::ServoValve> {
+    complete_servo_valve_under(ctx, "table_system", v)
+}
+
+/// [`complete_servo_valve`] with its paths under `prefix`.
+pub(crate) fn complete_servo_valve_under(
+    ctx: &Ctx,
+    prefix: &str,
+    v: ServoValveSpec,
+) -> Result<platen_system::ServoValve> {
     let count = v
         .count
-        .ok_or_else(|| missing(ctx, "servo_valve.count", "a count ≥ 1"))?;
-    let [rated_flow_m3_s, rated_pressure_drop_pa, natural_frequency_hz, damping_ratio] = need_all(
-        ctx,
-        [
-            ("servo_valve.rated_flow_m3_s", v.rated_flow_m3_s),
-            (
-                "servo_valve.rated_pressure_drop_pa",
-                v.rated_pressure_drop_pa,
-            ),
-            ("servo_valve.natural_frequency_hz", v.natural_frequency_hz),
-            ("servo_valve.damping_ratio", v.damping_ratio),
-        ],
-    )?;
+        .ok_or_else(|| missing_under(ctx, prefix, "servo_valve.count", "a count ≥ 1"))?;
+    let [rated_flow_m3_s, rated_pressure_drop_pa, natural_frequency_hz, damping_ratio] =
+        need_all_under(
+            ctx,
+            prefix,
+            [
+                ("servo_valve.rated_flow_m3_s", v.rated_flow_m3_s),
+                (
+                    "servo_valve.rated_pressure_drop_pa",
+                    v.rated_pressure_drop_pa,
+                ),
+                ("servo_valve.natural_frequency_hz", v.natural_frequency_hz),
+                ("servo_valve.damping_ratio", v.damping_ratio),
+            ],
+        )?;
     Ok(platen_system::ServoValve {
         count,
         rated_flow_m3_s,
@@ -217,8 +256,13 @@ fn complete_controller(ctx: &Ctx, c: ControllerSpec) -> Result<Controller> {
             "the controller's sample rate, Hz",
         )
     })?;
+    Ok(controller_gains(sample_rate_hz, &c))
+}
+
+/// The gains of `c` at `sample_rate_hz` (absent gains are 0).
+pub(crate) fn controller_gains(sample_rate_hz: f64, c: &ControllerSpec) -> Controller {
     let gain = |g: Option<f64>| g.unwrap_or(0.0);
-    Ok(Controller {
+    Controller {
         sample_rate_hz,
         displacement_gain_per_m: gain(c.displacement_gain_per_m),
         integral_gain_per_m_s: gain(c.integral_gain_per_m_s),
@@ -228,7 +272,7 @@ fn complete_controller(ctx: &Ctx, c: ControllerSpec) -> Result<Controller> {
         acceleration_feedback_s2_per_m: gain(c.acceleration_feedback_s2_per_m),
         delta_p_gain_per_pa: gain(c.delta_p_gain_per_pa),
         delta_p_highpass_hz: gain(c.delta_p_highpass_hz),
-    })
+    }
 }
 
 /// The most RK4 steps per controller period, as
@@ -282,25 +326,39 @@ pub(crate) fn loop_method(
 ) -> Result<LoopMethod> {
     let period = system.controller().period_s();
     let fastest = system.fastest_rate_rad_s(mass_kg, stroke_m);
+    let k = system.default_steps_per_period(mass_kg, stroke_m);
+    loop_method_at(ctx, integrator, period, fastest, k, || {
+        unresolvable(ctx, system, period, fastest)
+    })
+}
+
+/// The closed loop's integrator for a controller of `period` s whose loop's fastest mode is
+/// `fastest` rad/s: RK4 at `k_default` steps per period by default (`refused` when those do
+/// not resolve it), at `integrator.step_s`, or Dopri5.
+pub(crate) fn loop_method_at(
+    ctx: &Ctx,
+    integrator: Option<&IntegratorSpec>,
+    period: f64,
+    fastest: f64,
+    k_default: u32,
+    refused: impl FnOnce() -> ScenarioError,
+) -> Result<LoopMethod> {
     // The default step: the least `k` with `h·ω_max ≤ 0.25`, but at most
     // `MAX_STEPS_PER_PERIOD`; a loop that this many steps cannot resolve is refused (RK4 at
     // the clamped step would blow up within a few steps).
     let default_rk4 = || -> Result<LoopMethod> {
-        let k = system.default_steps_per_period(mass_kg, stroke_m);
-        if period / f64::from(k) * fastest > 1.0 {
-            return Err(unresolvable(ctx, system, period, fastest));
+        if period / f64::from(k_default) * fastest > 1.0 {
+            return Err(refused());
         }
         Ok(LoopMethod::Rk4 {
-            steps_per_period: k,
+            steps_per_period: k_default,
         })
     };
     match integrator {
         None => default_rk4(),
         Some(IntegratorSpec::Rk4(spec)) => match spec.step_s {
             None => default_rk4(),
-            Some(step) => rk4_at_step(ctx, step, period, fastest, || {
-                system.default_steps_per_period(mass_kg, stroke_m)
-            }),
+            Some(step) => rk4_at_step(ctx, step, period, fastest, || k_default),
         },
         Some(IntegratorSpec::Dopri5(spec)) => dopri5(ctx, spec),
     }

@@ -129,7 +129,7 @@ fn bad_input_is_refused_with_its_path() {
         ),
         (
             Box::new(|t| t["controller"] = json!({})),
-            "table.controller",
+            "table.actuators[0].servo_valve",
         ),
     ];
     for (edit, expect) in cases {
@@ -478,4 +478,124 @@ fn the_pose_names_need_a_table() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("initial.x_m_s"), "{err}");
+}
+
+/// The tower table with servo-valves on every actuator and a DOF controller with gains on
+/// every DOF.
+fn loop_table() -> Value {
+    let mut t = tower_table();
+    for a in t["actuators"].as_array_mut().unwrap() {
+        a["servo_valve"] = json!({"count": 2, "rated_flow_m3_s": 0.1667,
+            "rated_pressure_drop_pa": 7e6, "natural_frequency_hz": 246.0,
+            "damping_ratio": 0.5, "delay_s": 0.0005});
+    }
+    let gains = json!({"displacement_gain_per_m": 16.0, "velocity_feedforward_s_per_m": 0.2,
+        "delta_p_gain_per_pa": 2e-8, "delta_p_highpass_hz": 0.1});
+    t["controller"] = json!({"sample_rate_hz": 2048.0, "force_balance_gain": 1e-8,
+        "dof": {"x": gains, "y": gains, "z": gains, "roll": gains, "pitch": gains, "yaw": gains}});
+    t
+}
+
+/// The closed loop's keys: each bad one refused with its JSON path, before any run.
+#[test]
+fn a_bad_closed_loop_is_refused_with_its_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = csv(&[("x_m", |t| 0.01 * t)]);
+    assert!(scenario(dir.path(), json!({"table": loop_table()}), &good).is_ok());
+    let cases: Vec<Case> = vec![
+        (
+            Box::new(|t| t["actuators"][3]["servo_valve"]["count"] = json!(0)),
+            "table.actuators[3].servo_valve.count",
+        ),
+        (
+            Box::new(|t| {
+                t["actuators"][6]["servo_valve"]
+                    .as_object_mut()
+                    .unwrap()
+                    .remove("rated_flow_m3_s");
+            }),
+            "table.actuators[6].servo_valve.rated_flow_m3_s",
+        ),
+        (
+            Box::new(|t| t["actuators"][2]["servo_valve"]["delay_s"] = json!(0.001)),
+            "table.actuators[2].servo_valve.delay_s",
+        ),
+        (
+            Box::new(|t| t["actuators"][1]["leakage_m3_s_per_pa"] = json!(-1.0)),
+            "table.actuators[1].leakage_m3_s_per_pa",
+        ),
+        (
+            Box::new(|t| {
+                t["controller"]["dof"]
+                    .as_object_mut()
+                    .unwrap()
+                    .remove("pitch");
+            }),
+            "table.controller.dof.pitch",
+        ),
+        (
+            Box::new(|t| t["controller"]["dof"]["y"]["displacement_gain_per_m"] = json!(-3.0)),
+            "table.controller.dof.y.displacement_gain_per_m",
+        ),
+        (
+            Box::new(|t| t["controller"]["dof"]["x"]["sample_rate_hz"] = json!(1024.0)),
+            "table.controller.dof.x.sample_rate_hz",
+        ),
+        (
+            Box::new(|t| t["controller"]["dof"]["surge"] = json!({})),
+            "surge",
+        ),
+        (
+            Box::new(|t| t["held_dofs"] = json!(["yaw"])),
+            "table.controller.dof.yaw",
+        ),
+        (
+            Box::new(|t| t["controller"]["force_balance_gain"] = json!(-1.0)),
+            "table.controller.force_balance_gain",
+        ),
+        (
+            Box::new(|t| {
+                t["controller"]
+                    .as_object_mut()
+                    .unwrap()
+                    .remove("sample_rate_hz");
+            }),
+            "table.controller.sample_rate_hz",
+        ),
+        (
+            Box::new(|t| t["limits"] = json!({"x": {"stroke_m": -0.1}})),
+            "table.limits.x.stroke_m",
+        ),
+        (
+            Box::new(|t| t["accumulator"] = json!({"volume_m3": 1.0})),
+            "table.accumulator.precharge_pressure_pa",
+        ),
+        (
+            Box::new(|t| t["supply_pressure_pa"] = json!(1e6)),
+            "table.actuators[4].cap_side_area_m2",
+        ),
+        (Box::new(|t| t["preset"] = json!("lhpost9")), "table.preset"),
+    ];
+    for (edit, expect) in cases {
+        let mut table = loop_table();
+        edit(&mut table);
+        let err = scenario(dir.path(), json!({"table": table}), &good).unwrap_err();
+        assert!(err.contains(expect), "expected `{expect}` in: {err}");
+    }
+}
+
+/// The LHPOST6 preset loads, and values given are laid over it.
+#[test]
+fn the_lhpost6_preset_loads_and_takes_values_over_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = csv(&[("x_m", |t| 0.01 * t)]);
+    let s = scenario(
+        dir.path(),
+        json!({"table": {"preset": "lhpost6", "supply_pressure_pa": 21e6}}),
+        &good,
+    )
+    .unwrap();
+    assert_eq!(s.table.actuators().len(), 10);
+    assert_eq!(s.supply_pressure_pa, 21e6);
+    assert_eq!(s.limits.x.as_ref().and_then(|x| x.stroke_m), Some(0.89));
 }

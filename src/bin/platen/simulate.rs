@@ -129,7 +129,7 @@ fn run_table(args: &SimulateArgs, path: &std::path::Path, file: &ScenarioFile) -
         );
     }
     let scenario = TableScenario::from_file(path, file)?;
-    let run = scenario.run()?;
+    let (run, stats) = scenario.run_with_stats()?;
     let out = args.out.as_deref();
     if let Some(out) = out {
         let header: Vec<&str> = run.columns.iter().map(|(n, _)| n.as_str()).collect();
@@ -150,7 +150,7 @@ fn run_table(args: &SimulateArgs, path: &std::path::Path, file: &ScenarioFile) -
         )?,
         None => Vec::new(),
     };
-    let summary = scenario.summary(&run, out);
+    let summary = scenario.summary_with(&run, stats.as_ref(), out);
     if args.json {
         let figures = args.plot.as_ref().map(|_| written.as_slice());
         let value = with_outputs(serde_json::to_value(&summary)?, figures, None);

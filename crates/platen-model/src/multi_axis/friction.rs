@@ -3,8 +3,10 @@
 
 use nalgebra::{DMatrix, DVector, Matrix6, Vector2, Vector3};
 
-use super::dof::{rotation, translation, Coords, Dof};
-use super::table::{pad_point, point_wrench, BearingLoad, Mount, MultiAxisTable, Point, Wrench};
+use super::dof::{translation, Coords, Dof};
+use super::table::{
+    pad_point, point_wrench, BearingLoad, Frame, Mount, MultiAxisTable, Point, Wrench,
+};
 
 /// What presses a friction contact.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -36,9 +38,12 @@ impl MultiAxisTable {
 
     /// The friction contacts at pose `q`, without collecting them.
     pub(crate) fn contacts(&self, q: &Coords) -> impl Iterator<Item = Contact> + '_ {
-        let r = rotation(q);
-        let t = translation(q);
-        let normal = r * Vector3::z();
+        self.contacts_in(self.frame(q))
+    }
+
+    /// The friction contacts in the platen's frame `f`.
+    pub(crate) fn contacts_in(&self, f: Frame) -> impl Iterator<Item = Contact> + '_ {
+        let (r, t, normal) = (f.rotation, f.translation, f.normal);
         let pads = self
             .actuators()
             .iter()
@@ -93,8 +98,13 @@ impl MultiAxisTable {
     /// The bearings' Coulomb capacity at pose `q` with the actuator forces `forces_n` (which
     /// press the pads and the bearings on actuators; a pulling actuator presses nothing).
     pub fn friction_capacity(&self, q: &Coords, forces_n: &[f64]) -> FrictionCapacity {
+        self.friction_capacity_in(&self.frame(q), forces_n)
+    }
+
+    /// [`MultiAxisTable::friction_capacity`] in the platen's frame `f`.
+    pub fn friction_capacity_in(&self, f: &Frame, forces_n: &[f64]) -> FrictionCapacity {
         let (mut total, mut centre) = (0.0, Point::zeros());
-        for c in self.contacts(q) {
+        for c in self.contacts_in(*f) {
             let mu_n = c.friction_coefficient * normal_force_n(c.load, forces_n);
             total += mu_n;
             centre += c.point_m * mu_n;
@@ -103,12 +113,12 @@ impl MultiAxisTable {
             return FrictionCapacity {
                 force_n: 0.0,
                 moment_n_m: 0.0,
-                centre_m: translation(q),
+                centre_m: f.translation,
             };
         }
         centre /= total;
         let moment = self
-            .contacts(q)
+            .contacts_in(*f)
             .map(|c| {
                 let mu_n = c.friction_coefficient * normal_force_n(c.load, forces_n);
                 mu_n * (c.point_m - centre).xy().norm()

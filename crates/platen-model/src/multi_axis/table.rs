@@ -276,6 +276,18 @@ pub struct ActuatorPose {
     pub unit_wrench: Wrench,
 }
 
+/// The platen's frame at a pose: its rotation, the reference point's position and the
+/// underside's normal ([`MultiAxisTable::frame`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frame {
+    /// `R = Rz(yaw)·Ry(pitch)·Rx(roll)`.
+    pub rotation: nalgebra::Rotation3<f64>,
+    /// The reference point, table axes, m.
+    pub translation: Vector3<f64>,
+    /// The platen's z axis `R·e_z` (the underside's normal).
+    pub normal: Vector3<f64>,
+}
+
 /// A hold-down strut at a pose.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StrutPose {
@@ -475,17 +487,34 @@ impl MultiAxisTable {
         self.parts.held.complement()
     }
 
+    /// The platen's frame at pose `q`: what every point's position needs, computed once.
+    pub fn frame(&self, q: &Coords) -> Frame {
+        let r = rotation(q);
+        Frame {
+            rotation: r,
+            translation: translation(q),
+            normal: r * Vector3::z(),
+        }
+    }
+
     /// Actuator `i` at pose `q`.
     ///
     /// # Panics
     /// If `i` is out of range.
     pub fn actuator_at(&self, i: usize, q: &Coords) -> ActuatorPose {
+        self.actuator_in(i, &self.frame(q))
+    }
+
+    /// Actuator `i` in the platen's frame `f` ([`MultiAxisTable::frame`]).
+    ///
+    /// # Panics
+    /// If `i` is out of range.
+    pub fn actuator_in(&self, i: usize, f: &Frame) -> ActuatorPose {
         let a = &self.parts.actuators[i];
-        let r = rotation(q);
-        let t = translation(q);
+        let t = f.translation;
         match &a.mount {
             Mount::Swivel { platen_m } => {
-                let arm = r * platen_m;
+                let arm = f.rotation * platen_m;
                 let point = t + arm;
                 let line = point - a.base_m;
                 let length = line.norm();
@@ -498,13 +527,39 @@ impl MultiAxisTable {
                 }
             }
             Mount::Pad(pad) => {
-                let (point, s) = pad_point(pad, &t, &(r * Vector3::z()));
+                let (point, s) = pad_point(pad, &t, &f.normal);
                 ActuatorPose {
                     stroke_m: s,
                     unit: pad.axis.into_inner(),
                     point_m: point,
                     unit_wrench: point_wrench(&(point - t), &pad.axis),
                 }
+            }
+        }
+    }
+
+    /// The rate of actuator `i`'s stroke, m/s, at `pose` (its pose in the frame `f`) with the
+    /// reference point's velocity `td` and the angular velocity `omega` (see
+    /// [`MultiAxisTable::stroke_rate_m_s`]).
+    ///
+    /// # Panics
+    /// If `i` is out of range.
+    pub fn stroke_rate_in(
+        &self,
+        i: usize,
+        f: &Frame,
+        pose: &ActuatorPose,
+        td: &Vector3<f64>,
+        omega: &Vector3<f64>,
+    ) -> f64 {
+        let t = f.translation;
+        match &self.parts.actuators[i].mount {
+            Mount::Swivel { .. } => pose.unit.dot(&(td + omega.cross(&(pose.point_m - t)))),
+            Mount::Pad(pad) => {
+                let n = f.normal;
+                let nd = omega.cross(&n);
+                let a = pad.axis.into_inner();
+                (n.dot(td) - nd.dot(&(pad.contact_m - t)) - pose.stroke_m * nd.dot(&a)) / n.dot(&a)
             }
         }
     }
@@ -517,19 +572,11 @@ impl MultiAxisTable {
     /// # Panics
     /// If `i` is out of range.
     pub fn stroke_rate_m_s(&self, i: usize, q: &Coords, qd: &Coords) -> f64 {
-        let pose = self.actuator_at(i, q);
+        let f = self.frame(q);
+        let pose = self.actuator_in(i, &f);
         let omega = angular_velocity(q, qd);
-        let t = translation(q);
         let td = Vector3::new(qd[0], qd[1], qd[2]);
-        match &self.parts.actuators[i].mount {
-            Mount::Swivel { .. } => pose.unit.dot(&(td + omega.cross(&(pose.point_m - t)))),
-            Mount::Pad(pad) => {
-                let n = rotation(q) * Vector3::z();
-                let nd = omega.cross(&n);
-                let a = pad.axis.into_inner();
-                (n.dot(&td) - nd.dot(&(pad.contact_m - t)) - pose.stroke_m * nd.dot(&a)) / n.dot(&a)
-            }
-        }
+        self.stroke_rate_in(i, &f, &pose, &td, &omega)
     }
 
     /// Strut `j` at pose `q`.
@@ -537,9 +584,17 @@ impl MultiAxisTable {
     /// # Panics
     /// If `j` is out of range.
     pub fn strut_at(&self, j: usize, q: &Coords) -> StrutPose {
+        self.strut_in(j, &self.frame(q))
+    }
+
+    /// Strut `j` in the platen's frame `f`.
+    ///
+    /// # Panics
+    /// If `j` is out of range.
+    pub fn strut_in(&self, j: usize, f: &Frame) -> StrutPose {
         let s = &self.parts.struts[j];
-        let arm = rotation(q) * s.platen_m;
-        let line = translation(q) + arm - s.base_m;
+        let arm = f.rotation * s.platen_m;
+        let line = f.translation + arm - s.base_m;
         let length = line.norm();
         let pressure = s.pressure_at_pa(length, self.strut_neutral_m[j]);
         let force = pressure * s.area_m2;
@@ -553,8 +608,13 @@ impl MultiAxisTable {
 
     /// The struts' wrench on the platen at pose `q`.
     pub fn struts_wrench(&self, q: &Coords) -> Wrench {
+        self.struts_wrench_in(&self.frame(q))
+    }
+
+    /// The struts' wrench on the platen in its frame `f`.
+    pub fn struts_wrench_in(&self, f: &Frame) -> Wrench {
         (0..self.parts.struts.len())
-            .map(|j| self.strut_at(j, q).wrench)
+            .map(|j| self.strut_in(j, f).wrench)
             .sum()
     }
 
