@@ -30,6 +30,17 @@ pub enum SystemError {
         /// What was wrong with its gains.
         source: Box<SystemError>,
     },
+    /// Parts of a multi-axis table that do not fit together (a table, its hydraulics and its
+    /// controller with different actuators or free DOFs).
+    #[error("{what} do not match: {found}, where {expected} was expected")]
+    Mismatch {
+        /// What differs (`actuators of the hydraulics and the table`, …).
+        what: &'static str,
+        /// What was found.
+        found: String,
+        /// What was expected.
+        expected: String,
+    },
     /// An unknown preset name.
     #[error("unknown table-system preset `{name}`: expected one of {known}")]
     UnknownPreset {

@@ -27,6 +27,8 @@
 //! [`DofController`] is the DOF control of such a table: the three-variable law per DOF
 //! through the geometry at neutral ([`DofGeometry`]), and a force balance on the redundant
 //! actuators. `platen-integrate`'s `forward_table_loop` runs them with the platen.
+//! [`TableLinearisation`] is their small-signal model about neutral at rest: the command →
+//! pose transfer matrix, each DOF's loop gain and margins, and the cross-talk.
 //!
 //! # Invariant
 //!
@@ -62,6 +64,7 @@ mod linear;
 mod params;
 pub mod preset;
 mod table;
+mod table_linear;
 
 pub use controller::{ControllerInput, ControllerState};
 pub use dof_control::{
@@ -76,3 +79,4 @@ pub use params::{
 pub use table::{
     ActuatorHydraulics, ActuatorRates, ActuatorState, TableHydraulics, TableHydraulicsParts,
 };
+pub use table_linear::{ActuatorLinearisation, CrossTalk, FlowGains, TableLinearisation};

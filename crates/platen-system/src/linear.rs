@@ -26,7 +26,7 @@
 use num_complex::Complex64 as C64;
 use platen_model::PlatenModel;
 
-use crate::params::TableSystem;
+use crate::params::{ServoValve, TableSystem};
 
 /// The rigid-body mechanics the loop drives, linearised.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -185,10 +185,7 @@ impl TableSystem {
         let act = &self.actuator;
         let m = &lin.mechanics;
         let n = f64::from(act.count);
-        let wv = std::f64::consts::TAU * self.servo_valve.natural_frequency_hz;
-        let zeta = self.servo_valve.damping_ratio;
-        // Spool: X_v = ω²/(s² + 2ζωs + ω²)·D_v.
-        let x_v = wv * wv / (s * s + 2.0 * zeta * wv * s + wv * wv);
+        let x_v = spool_response(&self.servo_valve, s);
         // Unknowns U, P_a, P_b (V = sU) from x_v, by Cramer's rule on the 3 × 3 system:
         //   (M s² + C s + K)·U − n A_a P_a + n A_b P_b = 0
         //   A_a s U + (c_a s + C_L) P_a − C_L P_b      = K_qa X_v
@@ -224,49 +221,31 @@ impl TableSystem {
     /// The loop's parts at `f_hz`: the zero-order hold and delay `Z`, the plant `(G_u, G_Δp)`,
     /// and the controller's error, feedforward, feedback and `Δp` paths.
     fn loop_parts(&self, lin: &Linearisation, f_hz: f64) -> LoopParts {
-        let w = std::f64::consts::TAU * f_hz;
-        let s = C64::new(0.0, w);
+        let s = C64::new(0.0, std::f64::consts::TAU * f_hz);
         let c = &self.controller;
-        let t = c.period_s();
-        let zoh = if w * t < 1e-12 {
-            C64::from(1.0)
-        } else {
-            (1.0 - (-s * t).exp()) / (s * t)
-        };
-        let z = zoh * (-s * self.servo_valve.delay_s).exp();
+        let z = hold_response(s, c.period_s()) * (-s * self.servo_valve.delay_s).exp();
         let (g_u, g_p) = self.plant_response(lin, f_hz);
-        let error = c.displacement_gain_per_m + c.integral_gain_per_m_s / s;
-        let feedforward =
-            c.velocity_feedforward_s_per_m * s + c.acceleration_feedforward_s2_per_m * s * s;
-        let feedback = c.velocity_feedback_s_per_m * s + c.acceleration_feedback_s2_per_m * s * s;
-        let highpass = if c.delta_p_highpass_hz > 0.0 {
-            s / (s + std::f64::consts::TAU * c.delta_p_highpass_hz)
-        } else {
-            C64::from(1.0)
-        };
+        let law = LawTerms::at(c, s);
         LoopParts {
             z,
             g_u,
             g_p,
-            error,
-            feedforward,
-            feedback,
-            dp: c.delta_p_gain_per_pa * highpass,
+            error: law.error,
+            feedforward: law.feedforward,
+            feedback: law.velocity_feedback + law.acceleration_feedback,
+            dp: law.delta_p,
         }
     }
 
     /// The loop gain at `f_hz`, broken at the drive: `L = Z·((K_p + K_i/s + FB)·G_u + K_Δp·HP·G_Δp)`.
     pub fn loop_gain(&self, lin: &Linearisation, f_hz: f64) -> C64 {
-        let p = self.loop_parts(lin, f_hz);
-        p.z * ((p.error + p.feedback) * p.g_u + p.dp * p.g_p)
+        self.loop_parts(lin, f_hz).loop_gain()
     }
 
     /// The closed-loop response command → displacement at `f_hz`:
     /// `U/R = Z·G_u·(K_p + K_i/s + FF)/(1 + L)`. Command → acceleration is `−ω²` times it.
     pub fn closed_loop_response(&self, lin: &Linearisation, f_hz: f64) -> C64 {
-        let p = self.loop_parts(lin, f_hz);
-        let l = p.z * ((p.error + p.feedback) * p.g_u + p.dp * p.g_p);
-        p.z * p.g_u * (p.error + p.feedforward) / (1.0 + l)
+        self.loop_parts(lin, f_hz).closed_loop()
     }
 
     /// The gain and phase margins of [`TableSystem::loop_gain`] (the worst over every
@@ -274,78 +253,13 @@ impl TableSystem {
     /// from 0.001 Hz to the controller's Nyquist frequency on a logarithmic grid of 20 000
     /// points, each crossing refined by bisection.
     pub fn margins(&self, lin: &Linearisation) -> Margins {
-        let f_max = 0.5 * self.controller.sample_rate_hz;
-        let (f_min, n) = (0.001_f64, 20_000);
-        let at = |i: usize| f_min * (f_max / f_min).powf(i as f64 / n as f64);
-        let mag = |f: f64| self.loop_gain(lin, f).norm() - 1.0;
-        let im = |f: f64| self.loop_gain(lin, f).im;
-        let mut out = Margins {
-            gain_margin_db: None,
-            phase_crossover_hz: None,
-            phase_margin_deg: None,
-            gain_crossover_hz: None,
-            stable: true,
-            peak_gain: 0.0,
-            peak_gain_hz: 0.0,
-        };
-        let l0 = self.loop_gain(lin, at(0));
-        let (mut f0, mut m0, mut i0) = (at(0), l0.norm() - 1.0, l0.im);
-        // The winding of 1 + L over 0 < ω < ∞ (the half contour; the other half mirrors it).
-        let mut arg0 = (1.0 + l0).arg();
-        let first_arg = arg0;
-        let mut unwrapped = arg0;
-        for i in 1..=n {
-            let f1 = at(i);
-            let l1 = self.loop_gain(lin, f1);
-            let (m1, i1) = (l1.norm() - 1.0, l1.im);
-            let arg1 = (1.0 + l1).arg();
-            let mut d = arg1 - arg0;
-            while d > std::f64::consts::PI {
-                d -= std::f64::consts::TAU;
-            }
-            while d < -std::f64::consts::PI {
-                d += std::f64::consts::TAU;
-            }
-            unwrapped += d;
-            arg0 = arg1;
-            let h = self.closed_loop_response(lin, f1).norm();
-            if h > out.peak_gain {
-                out.peak_gain = h;
-                out.peak_gain_hz = f1;
-            }
-            if m0.signum() != m1.signum() {
-                let f = bisect(&mag, f0, f1);
-                let l = self.loop_gain(lin, f);
-                // The angle between L and −1 at the crossover.
-                let pm = 180.0 - l.arg().to_degrees().abs();
-                if out.phase_margin_deg.is_none_or(|p| pm < p) {
-                    out.phase_margin_deg = Some(pm);
-                    out.gain_crossover_hz = Some(f);
-                }
-            }
-            if i0.signum() != i1.signum() {
-                let f = bisect(&im, f0, f1);
-                let l = self.loop_gain(lin, f);
-                let gm = -20.0 * l.norm().log10();
-                if l.re < 0.0 && out.gain_margin_db.is_none_or(|g| gm < g) {
-                    out.gain_margin_db = Some(gm);
-                    out.phase_crossover_hz = Some(f);
-                }
-            }
-            (f0, m0, i0) = (f1, m1, i1);
-        }
-        // The full contour is this half, its mirror image and, for each pole of L at s = 0,
-        // the indentation around it, which turns 1 + L by −π.
-        let total = unwrapped - first_arg;
-        // Poles of L at s = 0 (the controller's integrator; the platen's displacement when
-        // nothing restores it): the slope of |L| a decade below the grid.
-        let slope = (self.loop_gain(lin, f_min * 0.01).norm()
-            / self.loop_gain(lin, f_min * 0.1).norm())
-        .log10();
-        let integrators = slope.round().max(0.0);
-        let windings = (2.0 * total - std::f64::consts::PI * integrators) / std::f64::consts::TAU;
-        out.stable = windings.round() == 0.0;
-        out
+        search_margins(
+            |f| {
+                let p = self.loop_parts(lin, f);
+                (p.loop_gain(), p.closed_loop().norm())
+            },
+            0.5 * self.controller.sample_rate_hz,
+        )
     }
 
     /// The [`Passband`] of the closed loop of `lin`, on a logarithmic grid of 4000
@@ -406,6 +320,133 @@ impl TableSystem {
     }
 }
 
+/// The margins search of [`TableSystem::margins`] on any loop: `loop_at(f)` is the loop
+/// gain broken at one point and the closed loop's gain whose peak is reported, from
+/// 0.001 Hz to `f_max` Hz on a logarithmic grid of 20 000 points, each crossing refined by
+/// bisection.
+pub(crate) fn search_margins(loop_at: impl Fn(f64) -> (C64, f64), f_max: f64) -> Margins {
+    let loop_gain = |f: f64| loop_at(f).0;
+    let (f_min, n) = (0.001_f64, 20_000);
+    let at = |i: usize| f_min * (f_max / f_min).powf(i as f64 / n as f64);
+    let mag = |f: f64| loop_gain(f).norm() - 1.0;
+    let im = |f: f64| loop_gain(f).im;
+    let mut out = Margins {
+        gain_margin_db: None,
+        phase_crossover_hz: None,
+        phase_margin_deg: None,
+        gain_crossover_hz: None,
+        stable: true,
+        peak_gain: 0.0,
+        peak_gain_hz: 0.0,
+    };
+    let l0 = loop_gain(at(0));
+    let (mut f0, mut m0, mut i0) = (at(0), l0.norm() - 1.0, l0.im);
+    // The winding of 1 + L over 0 < ω < ∞ (the half contour; the other half mirrors it).
+    let mut arg0 = (1.0 + l0).arg();
+    let first_arg = arg0;
+    let mut unwrapped = arg0;
+    for i in 1..=n {
+        let f1 = at(i);
+        let (l1, h) = loop_at(f1);
+        let (m1, i1) = (l1.norm() - 1.0, l1.im);
+        let arg1 = (1.0 + l1).arg();
+        let mut d = arg1 - arg0;
+        while d > std::f64::consts::PI {
+            d -= std::f64::consts::TAU;
+        }
+        while d < -std::f64::consts::PI {
+            d += std::f64::consts::TAU;
+        }
+        unwrapped += d;
+        arg0 = arg1;
+        if h > out.peak_gain {
+            out.peak_gain = h;
+            out.peak_gain_hz = f1;
+        }
+        if m0.signum() != m1.signum() {
+            let f = bisect(&mag, f0, f1);
+            let l = loop_gain(f);
+            // The angle between L and −1 at the crossover.
+            let pm = 180.0 - l.arg().to_degrees().abs();
+            if out.phase_margin_deg.is_none_or(|p| pm < p) {
+                out.phase_margin_deg = Some(pm);
+                out.gain_crossover_hz = Some(f);
+            }
+        }
+        if i0.signum() != i1.signum() {
+            let f = bisect(&im, f0, f1);
+            let l = loop_gain(f);
+            let gm = -20.0 * l.norm().log10();
+            if l.re < 0.0 && out.gain_margin_db.is_none_or(|g| gm < g) {
+                out.gain_margin_db = Some(gm);
+                out.phase_crossover_hz = Some(f);
+            }
+        }
+        (f0, m0, i0) = (f1, m1, i1);
+    }
+    // The full contour is this half, its mirror image and, for each pole of L at s = 0,
+    // the indentation around it, which turns 1 + L by −π.
+    let total = unwrapped - first_arg;
+    // Poles of L at s = 0 (the controller's integrator; the platen's displacement when
+    // nothing restores it): the slope of |L| a decade below the grid.
+    let slope = (loop_gain(f_min * 0.01).norm() / loop_gain(f_min * 0.1).norm()).log10();
+    let integrators = slope.round().max(0.0);
+    let windings = (2.0 * total - std::f64::consts::PI * integrators) / std::f64::consts::TAU;
+    out.stable = windings.round() == 0.0;
+    out
+}
+
+/// The terms of a DOF's three-variable law ([`crate::Controller`]) at `s`, each per unit of
+/// what it acts on.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LawTerms {
+    /// On the error `r − u`: `K_p + K_i/s`.
+    pub error: C64,
+    /// On the command: `K_vf·s + K_af·s²`.
+    pub feedforward: C64,
+    /// On the displacement fed back: `K_vb·s` (the velocity feedback).
+    pub velocity_feedback: C64,
+    /// On the displacement fed back: `K_ab·s²` (the acceleration feedback).
+    pub acceleration_feedback: C64,
+    /// On the `Δp` fed back: `K_Δp·s/(s + ω_hp)` (`K_Δp` without a high-pass).
+    pub delta_p: C64,
+}
+
+impl LawTerms {
+    /// The terms of `c` at `s`.
+    pub(crate) fn at(c: &crate::Controller, s: C64) -> Self {
+        let highpass = if c.delta_p_highpass_hz > 0.0 {
+            s / (s + std::f64::consts::TAU * c.delta_p_highpass_hz)
+        } else {
+            C64::from(1.0)
+        };
+        LawTerms {
+            error: c.displacement_gain_per_m + c.integral_gain_per_m_s / s,
+            feedforward: c.velocity_feedforward_s_per_m * s
+                + c.acceleration_feedforward_s2_per_m * s * s,
+            velocity_feedback: c.velocity_feedback_s_per_m * s,
+            acceleration_feedback: c.acceleration_feedback_s2_per_m * s * s,
+            delta_p: c.delta_p_gain_per_pa * highpass,
+        }
+    }
+}
+
+/// The zero-order hold's response `(1 − e^{−sT})/(sT)` at `s = jω` for the period `T`.
+pub(crate) fn hold_response(s: C64, period_s: f64) -> C64 {
+    if s.im * period_s < 1e-12 {
+        C64::from(1.0)
+    } else {
+        (1.0 - (-s * period_s).exp()) / (s * period_s)
+    }
+}
+
+/// The spool's response to its input, `ω_v²/(s² + 2ζ_v·ω_v·s + ω_v²)`.
+pub(crate) fn spool_response(valve: &ServoValve, s: C64) -> C64 {
+    let wv = std::f64::consts::TAU * valve.natural_frequency_hz;
+    let zeta = valve.damping_ratio;
+    wv * wv / (s * s + 2.0 * zeta * wv * s + wv * wv)
+}
+
 struct LoopParts {
     z: C64,
     g_u: C64,
@@ -414,6 +455,18 @@ struct LoopParts {
     feedforward: C64,
     feedback: C64,
     dp: C64,
+}
+
+impl LoopParts {
+    /// `L = Z·((K_p + K_i/s + FB)·G_u + K_Δp·HP·G_Δp)`.
+    fn loop_gain(&self) -> C64 {
+        self.z * ((self.error + self.feedback) * self.g_u + self.dp * self.g_p)
+    }
+
+    /// `U/R = Z·G_u·(K_p + K_i/s + FF)/(1 + L)`.
+    fn closed_loop(&self) -> C64 {
+        self.z * self.g_u * (self.error + self.feedforward) / (1.0 + self.loop_gain())
+    }
 }
 
 fn det3(m: &[[C64; 3]; 3]) -> C64 {
