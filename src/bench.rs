@@ -62,12 +62,13 @@ use serde::Serialize;
 
 use platen_integrate::{
     forward_closed_loop, forward_rk4, forward_rk4_ensemble, forward_rk4_specimen, forward_table,
-    inverse, ActuatorForces, Dopri5Settings, EnsembleCase, ForceRecord, ForwardIntegrator,
-    IntegrateError, LoopMethod, LoopRun, Method, Motion, Peaks, Rk4, State, Trajectory,
-    ENSEMBLE_LANES,
+    forward_table_loop, inverse, ActuatorForces, Dopri5Settings, EnsembleCase, ForceRecord,
+    ForwardIntegrator, IntegrateError, LoopMethod, LoopRun, Method, Motion, Peaks, PoseMotion, Rk4,
+    State, TableLoopRun, Trajectory, ENSEMBLE_LANES,
 };
 use platen_model::multi_axis::{Coords, MultiAxisTable};
 use platen_model::{preset, FullModel, IdentifiedModel, IdentifiedParams, Specimen, Storey};
+use platen_scenario::multi_axis::TableLoopSystem;
 use platen_system::TableSystem;
 
 /// Sample rate of every workload, Hz (one RK4 step per sample: h = 1/1024 s).
@@ -165,6 +166,9 @@ enum Job {
     Ensemble(Rk4),
     /// [`forward_table`] of the six-DOF table ([`bench_table`]); one unit per step.
     SixDof(Rk4),
+    /// [`forward_table_loop`] of the LHPOST6 preset commanded with the motion along x; one
+    /// unit per integration step.
+    SixDofClosedLoop,
     /// [`forward_rk4`] of each ensemble case in turn; one unit per step per trajectory.
     EnsembleScalar(Rk4),
 }
@@ -287,6 +291,12 @@ pub fn workloads() -> Result<Vec<Workload>> {
             Job::SixDof(rk4),
         ),
         Workload::new(
+            "six_dof_closed_loop",
+            "six_dof_closed_loop: LHPOST6 preset, closed loop, S9 along x",
+            "step",
+            Job::SixDofClosedLoop,
+        ),
+        Workload::new(
             "ensemble_scalar",
             "ensemble_scalar: sweep-like cases one by one, peaks",
             "step",
@@ -360,6 +370,8 @@ pub struct Inputs {
     /// The six-DOF table and its actuator forces.
     table: MultiAxisTable,
     table_forces: ActuatorForces,
+    /// The LHPOST6 preset, its closed loop, and the motion as its command along x.
+    lhpost6: (MultiAxisTable, TableLoopSystem, PoseMotion),
     /// The models and force records of the ensemble cases.
     ensemble_models: Vec<IdentifiedModel>,
     ensemble_records: Vec<ForceRecord>,
@@ -391,13 +403,15 @@ impl Inputs {
         }
         let table = bench_table()?;
         let table_forces = bench_table_forces(&table, samples)?;
+        let motion = s9_motion(samples)?;
         Ok(Self {
             samples,
             table,
             table_forces,
+            lhpost6: bench_lhpost6(&motion)?,
             force,
             record,
-            motion: s9_motion(samples)?,
+            motion,
             identified: model("identified model", identified_params.build())?,
             identified_params,
             full: model(
@@ -448,6 +462,7 @@ impl Job {
             Job::EnsembleScalar(rk4) => time_ensemble_scalar(rk4, inputs),
             Job::Inverse => Ok(time_inverse(inputs, out)),
             Job::SixDof(rk4) => time_six_dof(rk4, inputs),
+            Job::SixDofClosedLoop => time_six_dof_closed_loop(inputs),
         }
     }
 }
@@ -551,6 +566,56 @@ fn time_six_dof(rk4: Rk4, inputs: &Inputs) -> Result<Timed> {
     let run = integrate("six-DOF run", run)?;
     black_box(&run);
     Ok((s, (inputs.samples - 1) as u64, None))
+}
+
+/// [`Job::SixDofClosedLoop`].
+fn time_six_dof_closed_loop(inputs: &Inputs) -> Result<Timed> {
+    let (table, sys, command) = &inputs.lhpost6;
+    let run = TableLoopRun {
+        table: black_box(table),
+        hydraulics: &sys.hydraulics,
+        controller: &sys.controller,
+        specimen: None,
+        command: black_box(command),
+        method: sys.method,
+    };
+    let (s, out) = time(|| forward_table_loop(&run));
+    let (run, stats) = integrate("six-DOF closed loop", out)?;
+    black_box(&run);
+    Ok((s, stats.steps, None))
+}
+
+/// The `six_dof_closed_loop` workload's table and loop (the `lhpost6` preset, its default
+/// integrator) and its command: `motion` along x, the other DOFs still.
+///
+/// # Errors
+/// [`BenchError`] if the preset is refused or has no controller (a defect).
+pub fn bench_lhpost6(motion: &Motion) -> Result<(MultiAxisTable, TableLoopSystem, PoseMotion)> {
+    let spec = platen_scenario::multi_axis::TableSpec {
+        preset: Some("lhpost6".into()),
+        ..Default::default()
+    };
+    let (table, sys) = spec
+        .build_with_loop(std::path::Path::new("lhpost6"))
+        .map_err(|e| BenchError::Table(e.to_string()))?;
+    let sys =
+        sys.ok_or_else(|| BenchError::Table("the lhpost6 preset has no controller".into()))?;
+    let t = motion.t_s().to_vec();
+    let still = || {
+        let z = vec![0.0; t.len()];
+        Motion::new(t.clone(), z.clone(), z.clone(), z)
+    };
+    let still = || still().map_err(|e| BenchError::Table(e.to_string()));
+    let dofs: [Motion; 6] = [
+        motion.clone(),
+        still()?,
+        still()?,
+        still()?,
+        still()?,
+        still()?,
+    ];
+    let command = integrate("six-DOF command", PoseMotion::new(dofs))?;
+    Ok((table, sys, command))
 }
 
 /// The six-DOF table of the `six_dof` workload: the shipped forward scenario's
@@ -787,6 +852,12 @@ pub struct BenchReport {
     pub six_dof_ns_per_step: f64,
     /// [`BenchReport::six_dof_ns_per_step`] over the baseline's step.
     pub six_dof_ratio_to_baseline: f64,
+    /// The LHPOST6 preset's closed-loop step (RK4, 10 actuators with their hydraulics, the
+    /// DOF controller), ns.
+    pub six_dof_closed_loop_ns_per_step: f64,
+    /// [`BenchReport::six_dof_closed_loop_ns_per_step`] over the uniaxial closed loop's step
+    /// ([`BenchReport::table_system_ns_per_step`]), measured in the same run.
+    pub six_dof_closed_loop_ratio_to_table_system: f64,
     /// The closed loop's time per step, ns.
     pub table_system_ns_per_step: f64,
     /// Its ratio to the baseline's.
@@ -846,6 +917,9 @@ impl Measurement {
             rk4_steps_per_s: 1e9 / ns("rk4"),
             six_dof_ns_per_step: ns("six_dof"),
             six_dof_ratio_to_baseline: ns("six_dof") / base,
+            six_dof_closed_loop_ns_per_step: ns("six_dof_closed_loop"),
+            six_dof_closed_loop_ratio_to_table_system: ns("six_dof_closed_loop")
+                / ns("table_system"),
             sample_rate_hz: RATE_HZ,
             simulated_s,
             table_system_ns_per_step: ns("table_system"),

@@ -21,7 +21,9 @@
 //!   a debug build), when nothing later on its page reads what it writes;
 //! - a program given by its absolute path that this machine lacks (`/usr/bin/time`);
 //! - `platen bench` in a debug build: it times 600 s records five times over (104 s in a debug
-//!   build here), and its numbers are a release build's (`cargo test --release --test docs_commands` runs it).
+//!   build here), and its numbers are a release build's (`cargo test --release --test docs_commands` runs it);
+//! - the LHPOST6 closed loop over Northridge (`lhpost6-northridge.json`) in a debug build:
+//!   minutes there, seconds in release (`cargo test --release --test docs_commands` runs it).
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -55,6 +57,14 @@ fn not_run(command: &str) -> Option<String> {
         return Some(
             "`platen bench` times release builds (600 s records, five repeats): run \
              `cargo test --release --test docs_commands` to include it"
+                .into(),
+        );
+    }
+    if cfg!(debug_assertions) && command.contains("lhpost6-northridge.json") {
+        return Some(
+            "the LHPOST6 closed loop over 40 s of Northridge takes minutes in a debug build \
+             (about 2 s in a release build): run `cargo test --release --test docs_commands` \
+             to include it"
                 .into(),
         );
     }

@@ -194,6 +194,25 @@ def main():
     with open(os.path.join(OUT, "bare-inverse.json"), "w", newline="\n") as f:
         json.dump(bare, f, indent=2)
         f.write("\n")
+    northridge = {
+        "name": "LHPOST6 closed loop: Northridge, Tarzana, three components, tall eccentric tower",
+        "description": "The LHPOST6 preset (docs/lhpost6.md) in closed loop under the three "
+                       "components of Northridge 1994 at Tarzana (090 along x, 360 along y, UP "
+                       "along z, 100 %), carrying the 120 t, 12 m tower with its centre of mass "
+                       "off-centre: will the vertical actuators hold its overturning moment, how "
+                       "far does it pitch, how much of x leaks into pitch and z? Needs the PEER "
+                       "records (PLATEN_RECORDS_DIR).",
+        "table": {"preset": "lhpost6"},
+        "specimen": tower(),
+        "excitation": {"ground_motion": {
+            "x": {"record": "RSN1087_NORTHR_TAR090.AT2", "scale": 1.0},
+            "y": {"record": "RSN1087_NORTHR_TAR360.AT2", "scale": 1.0},
+            "z": {"record": "RSN1087_NORTHR_TAR-UP.AT2", "scale": 1.0},
+        }},
+    }
+    with open(os.path.join(OUT, "lhpost6-northridge.json"), "w", newline="\n") as f:
+        json.dump(northridge, f, indent=2)
+        f.write("\n")
 
 
 def write_forward(platen):

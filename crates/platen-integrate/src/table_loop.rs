@@ -162,15 +162,7 @@ impl<const L: usize> Source<L> for Hydraulic<'_> {
         out
     }
 
-    fn rates(
-        &self,
-        _input: (),
-        y: &Y<L>,
-        frame: &Frame,
-        q: &Coords,
-        qd: &Coords,
-        dy: &mut Y<L>,
-    ) {
+    fn rates(&self, _input: (), y: &Y<L>, frame: &Frame, q: &Coords, qd: &Coords, dy: &mut Y<L>) {
         let p_s = y[ps::<L>()];
         let (mut drawn, mut power, mut leak) = (0.0, 0.0, 0.0);
         let omega = angular_velocity(q, qd);

@@ -52,6 +52,7 @@ pub fn figures(
     run: &TableRun,
     table: &MultiAxisTable,
     force_limits_n: Option<&[(f64, f64)]>,
+    flow_capacity_m3_s: Option<&[f64]>,
 ) -> Vec<Figure> {
     let Some(t) = run.column("t_s").filter(|t| !t.is_empty()) else {
         return Vec::new();
@@ -63,6 +64,9 @@ pub fn figures(
         actuator_forces(&c, table, force_limits_n),
     ];
     out.extend(overturning_moments(&c));
+    out.extend(tracking(&c));
+    out.extend(flows(&c, table, flow_capacity_m3_s));
+    out.extend(supply_pressure(&c));
     // A figure all of whose columns the run lacks is not drawn.
     out.retain(|f| !f.panels.is_empty());
     out
@@ -80,10 +84,11 @@ pub fn write_table_figures(
     run: &TableRun,
     table: &MultiAxisTable,
     force_limits_n: Option<&[(f64, f64)]>,
+    flow_capacity_m3_s: Option<&[f64]>,
     dir: &Path,
     size: FigureSize,
 ) -> Result<Vec<PathBuf>> {
-    let mut figures = figures(run, table, force_limits_n);
+    let mut figures = figures(run, table, force_limits_n, flow_capacity_m3_s);
     for f in &mut figures {
         f.size = size.of(f.size);
     }
@@ -390,5 +395,145 @@ fn overturning_moments(c: &Columns<'_>) -> Option<Figure> {
         columns: 1,
         rows: Vec::new(),
         panels,
+    })
+}
+
+/// A closed loop's tracking: per DOF the command (dashed) and the achieved pose (solid), mm
+/// or mrad; the DOFs commanded still show the cross-talk. `None` without command columns.
+fn tracking(c: &Columns<'_>) -> Option<Figure> {
+    let order = [Dof::X, Dof::Roll, Dof::Y, Dof::Pitch, Dof::Z, Dof::Yaw];
+    let panels: Vec<Panel> = order
+        .iter()
+        .filter_map(|&d| {
+            let name = format!("{}_{}", d.name(), d.unit());
+            let command = c.envelope(&format!("command_{name}"), 1e3)?;
+            let achieved = c.envelope(&name, 1e3)?;
+            let unit = if d.is_rotation() { "mrad" } else { "mm" };
+            let symbol = d.name();
+            let still = peak_magnitude(&command) == 0.0;
+            let title = if still {
+                format!(
+                    "{symbol}, commanded still: peak |{symbol}| {} {unit} (cross-talk)",
+                    significant(peak_magnitude(&achieved), 4)
+                )
+            } else {
+                format!(
+                    "{symbol}: peak command {} {unit}, achieved {} {unit}",
+                    significant(peak_magnitude(&command), 4),
+                    significant(peak_magnitude(&achieved), 4)
+                )
+            };
+            Some(Panel {
+                x_range: Some(c.span_s),
+                ..Panel::new(
+                    title,
+                    "time t (s)",
+                    format!("{symbol} ({unit})"),
+                    vec![
+                        patterned("command", command, MODEL, 1, Dash::Dashed),
+                        line("achieved", achieved, SIMULATED, 1),
+                    ],
+                )
+            })
+        })
+        .collect();
+    if panels.is_empty() {
+        return None;
+    }
+    Some(Figure {
+        name: "tracking".into(),
+        title: "Multi-axis closed loop: command and achieved pose".into(),
+        caption: format!(
+            "Per DOF the DOF controller's command (dashed) and the platen's achieved pose \
+             (solid), translations in mm (left), rotations in mrad (right), over the run ({}). \
+             A DOF commanded still shows the cross-talk from the others.",
+            sampling(c)
+        ),
+        size: (1400, height(panels.len(), 2, 260)),
+        columns: 2,
+        rows: Vec::new(),
+        panels,
+    })
+}
+
+/// A closed loop's valve flows: each actuator's flow into its chamber a (l/s) with its
+/// valves' capacity at the supply pressure dashed. `None` without flow columns.
+fn flows(c: &Columns<'_>, table: &MultiAxisTable, capacity: Option<&[f64]>) -> Option<Figure> {
+    let panels: Vec<Panel> = table
+        .actuators()
+        .iter()
+        .enumerate()
+        .filter_map(|(i, a)| {
+            let points = c.envelope(&format!("{}_flow_m3_s", a.name), 1e3)?;
+            let cap = capacity.and_then(|q| q.get(i)).map(|q| q * 1e3);
+            let title = match cap {
+                Some(q) => format!(
+                    "{}: peak |flow| {} l/s of {} l/s",
+                    a.name,
+                    significant(peak_magnitude(&points), 4),
+                    significant(q, 4)
+                ),
+                None => format!(
+                    "{}: peak |flow| {} l/s",
+                    a.name,
+                    significant(peak_magnitude(&points), 4)
+                ),
+            };
+            Some(time_panel(
+                title,
+                "flow (l/s)".into(),
+                points,
+                c.span_s,
+                SIMULATED,
+                cap.map(|q| ((-q, q), format!("capacity ±{} l/s", significant(q, 4)))),
+            ))
+        })
+        .collect();
+    if panels.is_empty() {
+        return None;
+    }
+    let columns = if panels.len() > 1 { 2 } else { 1 };
+    Some(Figure {
+        name: "valve_flows".into(),
+        title: "Multi-axis closed loop: valve flows".into(),
+        caption: format!(
+            "Each actuator's flow into its cap-side chamber (l/s) over the run ({}), with its \
+             valves' capacity at the supply pressure, m·Q_r·√((P_s − P_R)/Δp_r), dashed.",
+            sampling(c)
+        ),
+        size: (1400, height(panels.len(), columns, 240)),
+        columns,
+        rows: Vec::new(),
+        panels,
+    })
+}
+
+/// A closed loop's supply pressure (MPa). `None` without the column.
+fn supply_pressure(c: &Columns<'_>) -> Option<Figure> {
+    let points = c.envelope("supply_pressure_pa", 1e-6)?;
+    let (lo, hi) = extremes(&points);
+    Some(Figure {
+        name: "supply_pressure".into(),
+        title: "Multi-axis closed loop: supply pressure".into(),
+        caption: format!(
+            "The supply pressure (MPa) the valves draw from over the run ({}): constant, or an \
+             accumulator bank's as the valves draw more oil than the pumps give.",
+            sampling(c)
+        ),
+        panels: vec![time_panel(
+            format!(
+                "supply pressure: {} … {} MPa",
+                significant(lo, 4),
+                significant(hi, 4)
+            ),
+            "p_s (MPa)".into(),
+            points,
+            c.span_s,
+            SIMULATED,
+            None,
+        )],
+        columns: 1,
+        rows: Vec::new(),
+        size: (1400, 500),
     })
 }

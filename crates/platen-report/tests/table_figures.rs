@@ -156,8 +156,15 @@ fn written_figures(specimen: bool) {
     let run = run(&table, 400, 100.0, specimen);
     let limits: Vec<(f64, f64)> = table.actuators().iter().map(|_| (-2.0e6, 2.0e6)).collect();
     let dir = temp_dir(if specimen { "specimen" } else { "bare" });
-    let written =
-        write_table_figures(&run, &table, Some(&limits), &dir, FigureSize::default()).unwrap();
+    let written = write_table_figures(
+        &run,
+        &table,
+        Some(&limits),
+        None,
+        &dir,
+        FigureSize::default(),
+    )
+    .unwrap();
     let mut expected = vec![
         "actuator_forces.png",
         "actuator_forces.svg",
@@ -226,12 +233,26 @@ fn written_figures(specimen: bool) {
 
     // The same bytes again, in the same folder and in another.
     let before: Vec<Vec<u8>> = written.iter().map(|p| fs::read(p).unwrap()).collect();
-    let again =
-        write_table_figures(&run, &table, Some(&limits), &dir, FigureSize::default()).unwrap();
+    let again = write_table_figures(
+        &run,
+        &table,
+        Some(&limits),
+        None,
+        &dir,
+        FigureSize::default(),
+    )
+    .unwrap();
     assert_eq!(again, written);
     let other = temp_dir(if specimen { "specimen-2" } else { "bare-2" });
-    let elsewhere =
-        write_table_figures(&run, &table, Some(&limits), &other, FigureSize::default()).unwrap();
+    let elsewhere = write_table_figures(
+        &run,
+        &table,
+        Some(&limits),
+        None,
+        &other,
+        FigureSize::default(),
+    )
+    .unwrap();
     for ((a, b), bytes) in written.iter().zip(&elsewhere).zip(&before) {
         assert_eq!(&fs::read(a).unwrap(), bytes, "{}", a.display());
         assert_eq!(&fs::read(b).unwrap(), bytes, "{}", b.display());
@@ -257,7 +278,7 @@ fn force_limits_are_optional_and_flag_excess() {
     let table = table();
     let run = run(&table, 300, 100.0, false);
     let forces = |limits: Option<&[(f64, f64)]>| {
-        figures(&run, &table, limits)
+        figures(&run, &table, limits, None)
             .into_iter()
             .find(|f| f.name == "actuator_forces")
             .unwrap()
@@ -280,7 +301,7 @@ fn force_limits_are_optional_and_flag_excess() {
         height_px: Some(600),
         png_scale: 1.0,
     };
-    let written = write_table_figures(&run, &table, None, &dir, size).unwrap();
+    let written = write_table_figures(&run, &table, None, None, &dir, size).unwrap();
     assert_eq!(written.len(), 6);
     let svg = fs::read_to_string(dir.join("pose.svg")).unwrap();
     assert!(svg.contains("width=\"800\" height=\"600\""));
@@ -293,7 +314,7 @@ fn force_limits_are_optional_and_flag_excess() {
 fn long_runs_are_thinned_and_empty_runs_have_no_figures() {
     let table = table();
     let run = run(&table, 40 * 1024, 1024.0, true);
-    let figures_ = figures(&run, &table, None);
+    let figures_ = figures(&run, &table, None, None);
     assert_eq!(figures_.len(), 4);
     for f in &figures_ {
         for p in &f.panels {
@@ -316,11 +337,12 @@ fn long_runs_are_thinned_and_empty_runs_have_no_figures() {
         pose.panels[0].title
     );
 
-    assert!(figures(&TableRun::default(), &table, None).is_empty());
+    assert!(figures(&TableRun::default(), &table, None, None).is_empty());
     let dir = temp_dir("empty");
     let written = write_table_figures(
         &TableRun::default(),
         &table,
+        None,
         None,
         &dir,
         FigureSize::default(),

@@ -23,7 +23,8 @@ pub enum RunKind {
     Forward,
     /// A motion is prescribed and the force computed.
     Inverse,
-    /// A `table_system`: the motion is the controller's displacement command.
+    /// A `table_system` (or a multi-axis table with a controller or a preset): the motion is
+    /// the controller's command.
     ClosedLoop,
     /// A folder of scenarios.
     Group,
@@ -88,7 +89,11 @@ fn entry(dir: &Path, path: &Path) -> Option<ShippedScenario> {
     let text = std::fs::read_to_string(path).ok()?;
     let file = crate::file::parse(path, &text).ok()?;
     let e = &file.excitation;
-    let kind = if file.table_system.is_some() {
+    let table_loop = file
+        .table
+        .as_ref()
+        .is_some_and(|t| t.controller.is_some() || t.preset.is_some());
+    let kind = if file.table_system.is_some() || table_loop {
         RunKind::ClosedLoop
     } else if e.force_csv.is_some() || e.sine_force.is_some() {
         RunKind::Forward

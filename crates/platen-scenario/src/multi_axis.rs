@@ -170,7 +170,7 @@ impl TableScenario {
         let system = match &spec.controller {
             Some(c) => Some(build_system(
                 &ctx,
-                file,
+                file.integrator.as_ref(),
                 spec,
                 c,
                 &table,
@@ -252,6 +252,26 @@ impl TableScenario {
         run.map_err(ScenarioError::TableRun)
     }
 
+    /// Each actuator's valves' flow capacity at the supply pressure,
+    /// `m·Q_r·√((P_s − P_R)/Δp_r)`, m³/s, in the table's order (`None` without a closed loop).
+    pub fn flow_capacities_m3_s(&self) -> Option<Vec<f64>> {
+        let sys = self.system.as_ref()?;
+        Some(
+            sys.hydraulics
+                .actuators()
+                .iter()
+                .map(|a| {
+                    let v = a.servo_valve;
+                    f64::from(v.count)
+                        * v.rated_flow_m3_s
+                        * ((self.supply_pressure_pa - self.return_pressure_pa)
+                            / v.rated_pressure_drop_pa)
+                            .sqrt()
+                })
+                .collect(),
+        )
+    }
+
     /// Each actuator's force limits `(pull ≤ 0, push ≥ 0)`, N, in the table's order.
     pub fn force_limits_n(&self) -> Vec<(f64, f64)> {
         self.table
@@ -304,6 +324,26 @@ impl TableSpec {
     /// As [`TableScenario::from_file`] for the `table` key.
     pub fn build(&self, origin: &Path) -> Result<MultiAxisTable> {
         build_table(&Ctx { path: origin }, self)
+    }
+
+    /// The validated table of this spec (its preset laid under it) and its closed loop
+    /// (`None` without a `controller`), bare, with the default integrator; errors name
+    /// `origin` as the scenario file.
+    ///
+    /// # Errors
+    /// As [`TableScenario::from_file`] for the `table` key.
+    pub fn build_with_loop(
+        &self,
+        origin: &Path,
+    ) -> Result<(MultiAxisTable, Option<TableLoopSystem>)> {
+        let ctx = Ctx { path: origin };
+        let spec = resolve_preset(&ctx, self)?;
+        let table = build_table(&ctx, &spec)?;
+        let system = match &spec.controller {
+            Some(c) => Some(build_system(&ctx, None, &spec, c, &table, None)?),
+            None => None,
+        };
+        Ok((table, system))
     }
 }
 
@@ -729,7 +769,7 @@ fn system_error(ctx: &Ctx, e: SystemError) -> ScenarioError {
 /// loop's fastest mode by default, or `integrator`).
 fn build_system(
     ctx: &Ctx,
-    file: &ScenarioFile,
+    integrator: Option<&crate::file::IntegratorSpec>,
     spec: &TableSpec,
     controller: &crate::table_file::TableControllerSpec,
     table: &MultiAxisTable,
@@ -862,7 +902,7 @@ fn build_system(
     let fastest = oil.max(spool);
     let period = controller.period_s();
     let k = (period * fastest / 0.25).ceil().clamp(1.0, 1e6) as u32;
-    let method = loop_method_at(ctx, file.integrator.as_ref(), period, fastest, k, || {
+    let method = loop_method_at(ctx, integrator, period, fastest, k, || {
         ctx.invalid(
             "table.controller.sample_rate_hz",
             rate,
@@ -1286,13 +1326,9 @@ impl TableScenario {
                     .as_ref()
                     .zip(i)
                     .map(|(sys, i)| sys.hydraulics.actuators()[i].servo_valve);
-                let capacity = valve.map(|v| {
-                    f64::from(v.count)
-                        * v.rated_flow_m3_s
-                        * ((self.supply_pressure_pa - self.return_pressure_pa)
-                            / v.rated_pressure_drop_pa)
-                            .sqrt()
-                });
+                let capacity = valve
+                    .and(i)
+                    .and_then(|i| self.flow_capacities_m3_s().map(|c| c[i]));
                 let flow = run.column(&format!("{}_flow_m3_s", a.name)).map(abs_max);
                 let saturated = run.column(&format!("{}_drive", a.name)).map(|d| {
                     let n = d.iter().filter(|x| x.abs() >= 1.0).count();
@@ -1658,7 +1694,59 @@ pub struct TableDescription {
     pub mass_kg: f64,
     /// The held DOFs.
     pub held_dofs: Vec<&'static str>,
+    /// The closed loop's small-signal figures (a table with a `controller`; `null`
+    /// otherwise).
+    #[serde(rename = "loop")]
+    pub loop_figures: Option<TableLoopDescription>,
 }
+
+/// One DOF's loop, broken at its drive with the others closed.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DofLoopDescription {
+    /// Gain margin, dB (`null`: no phase crossover below the controller's Nyquist
+    /// frequency).
+    pub gain_margin_db: Option<f64>,
+    /// Its phase crossover, Hz.
+    pub phase_crossover_hz: Option<f64>,
+    /// Phase margin, degrees.
+    pub phase_margin_deg: Option<f64>,
+    /// Its gain crossover, Hz.
+    pub gain_crossover_hz: Option<f64>,
+    /// Whether this loop is stable by the Nyquist criterion (the others closed).
+    pub stable: bool,
+    /// Largest |pose/command| of the DOF up to the Nyquist frequency, and where.
+    pub peak_gain: f64,
+    /// Where that peak is, Hz.
+    pub peak_gain_hz: f64,
+}
+
+/// The largest cross-talk of one DOF's command at a frequency.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CrossTalkDescription {
+    /// The frequency, Hz.
+    pub frequency_hz: f64,
+    /// |pose/command| of the commanded DOF itself.
+    pub diagonal: f64,
+    /// The DOF that responds the most to it (`null` with one free DOF).
+    pub largest_dof: Option<&'static str>,
+    /// |that response/command| (m/m, rad/rad, m/rad or rad/m).
+    pub largest: Option<f64>,
+}
+
+/// `platen model` on a table with a controller: the linearised loop about neutral at rest
+/// (mean flow gains, see `platen_system::TableLinearisation`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TableLoopDescription {
+    /// Per free DOF, its loop's margins.
+    pub dofs: std::collections::BTreeMap<&'static str, DofLoopDescription>,
+    /// Per free DOF's command, its largest cross-talk at 1, 2, 5 and 10 Hz.
+    pub cross_talk: std::collections::BTreeMap<&'static str, Vec<CrossTalkDescription>>,
+    /// Per actuator its force at rest (the static hold), N.
+    pub static_forces_n: std::collections::BTreeMap<String, f64>,
+}
+
+/// The frequencies at which `platen model` reports the cross-talk, Hz.
+pub const CROSS_TALK_HZ: [f64; 4] = [1.0, 2.0, 5.0, 10.0];
 
 impl TableScenario {
     /// Its description: modes and capacities.
@@ -1667,6 +1755,7 @@ impl TableScenario {
             Some(s) => self.table.modes_with(s),
             None => self.table.modes(),
         };
+        let rates = self.rate_capacities();
         let axes = self
             .table
             .capacities(self.supply_pressure_pa, self.return_pressure_pa)
@@ -1677,10 +1766,18 @@ impl TableScenario {
                 } else {
                     ["stroke_m", "acceleration_m_s2", "force_n"]
                 };
-                let values = keys
+                let mut values: std::collections::BTreeMap<&'static str, f64> = keys
                     .into_iter()
                     .zip([c.stroke, c.acceleration, c.force])
                     .collect();
+                if let Some(r) = rates.as_ref().and_then(|r| r.get(&c.dof.index())) {
+                    let key = if c.dof.is_rotation() {
+                        "rate_rad_s"
+                    } else {
+                        "velocity_m_s"
+                    };
+                    values.insert(key, *r);
+                }
                 (c.dof.name(), values)
             })
             .collect();
@@ -1696,7 +1793,128 @@ impl TableScenario {
             axes,
             mass_kg: self.table.platen().mass_kg(),
             held_dofs: self.table.held().iter().map(Dof::name).collect(),
+            loop_figures: self.loop_description(),
         }
+    }
+
+    /// The forces that hold the platen (and the specimen's weight) at rest at neutral, N per
+    /// actuator (`None` when the actuators cannot).
+    fn static_forces_n(&self) -> Option<Vec<f64>> {
+        let extra =
+            self.specimen
+                .as_ref()
+                .map_or_else(platen_model::multi_axis::Wrench::zeros, |s| {
+                    s.rigid_mass()
+                        * platen_model::multi_axis::Wrench::new(
+                            0.0,
+                            0.0,
+                            -platen_model::STANDARD_GRAVITY_M_S2,
+                            0.0,
+                            0.0,
+                            0.0,
+                        )
+                });
+        TableHydraulics::static_forces_n(&self.table, &extra).ok()
+    }
+
+    /// Per free DOF (by index) the largest rate the valves give at full opening with no load,
+    /// either way: each actuator's stroke rate `G_ik·v` within its extend or retract velocity
+    /// (a single-acting one's at its static pressure). `None` without a closed loop.
+    fn rate_capacities(&self) -> Option<std::collections::BTreeMap<usize, f64>> {
+        let sys = self.system.as_ref()?;
+        let hyd = &sys.hydraulics;
+        let geo = sys.controller.geometry();
+        let forces = self.static_forces_n()?;
+        let rest = hyd.rest_states(&forces).ok()?;
+        let limits: Vec<(f64, f64)> = rest
+            .iter()
+            .enumerate()
+            .map(|(i, s)| hyd.velocities_m_s(i, s.p_a_pa))
+            .collect();
+        Some(
+            geo.free()
+                .iter()
+                .enumerate()
+                .map(|(k, d)| {
+                    let reach = |sign: f64| {
+                        limits
+                            .iter()
+                            .enumerate()
+                            .map(|(i, &(extend, retract))| {
+                                let per = sign * geo.matrix()[(i, k)];
+                                if per > 0.0 {
+                                    extend / per
+                                } else if per < 0.0 {
+                                    retract / -per
+                                } else {
+                                    f64::INFINITY
+                                }
+                            })
+                            .fold(f64::INFINITY, f64::min)
+                    };
+                    (d.index(), reach(1.0).min(reach(-1.0)))
+                })
+                .collect(),
+        )
+    }
+
+    /// The closed loop's linearisation: margins per DOF and cross-talk (`None` without one,
+    /// or when it cannot be linearised).
+    fn loop_description(&self) -> Option<TableLoopDescription> {
+        let sys = self.system.as_ref()?;
+        let lin = platen_system::TableLinearisation::new(
+            &self.table,
+            &sys.hydraulics,
+            &sys.controller,
+            self.specimen.as_ref(),
+        )
+        .ok()?;
+        let dofs = lin
+            .free()
+            .iter()
+            .filter_map(|&d| {
+                let m = lin.margins(d)?;
+                Some((
+                    d.name(),
+                    DofLoopDescription {
+                        gain_margin_db: m.gain_margin_db,
+                        phase_crossover_hz: m.phase_crossover_hz,
+                        phase_margin_deg: m.phase_margin_deg,
+                        gain_crossover_hz: m.gain_crossover_hz,
+                        stable: m.stable,
+                        peak_gain: m.peak_gain,
+                        peak_gain_hz: m.peak_gain_hz,
+                    },
+                ))
+            })
+            .collect();
+        let mut cross_talk: std::collections::BTreeMap<&'static str, Vec<CrossTalkDescription>> =
+            std::collections::BTreeMap::new();
+        for f in CROSS_TALK_HZ {
+            for c in lin.cross_talk(f) {
+                cross_talk
+                    .entry(c.command.name())
+                    .or_default()
+                    .push(CrossTalkDescription {
+                        frequency_hz: f,
+                        diagonal: c.diagonal.norm(),
+                        largest_dof: c.largest.map(|(d, _)| d.name()),
+                        largest: c.largest.map(|(_, x)| x.norm()),
+                    });
+            }
+        }
+        let static_forces_n = self
+            .table
+            .actuators()
+            .iter()
+            .zip(lin.actuators())
+            .map(|(a, l)| (a.name.clone(), l.static_force_n))
+            .collect();
+        Some(TableLoopDescription {
+            dofs,
+            cross_talk,
+            static_forces_n,
+        })
     }
 }
 
@@ -1733,6 +1951,51 @@ pub fn description_text(d: &TableDescription) -> String {
     for (axis, values) in &d.axes {
         let list: Vec<String> = values.iter().map(|(k, v)| format!("{k} {v:.4e}")).collect();
         let _ = writeln!(t, "    {axis:<6} {}", list.join(", "));
+    }
+    if let Some(l) = &d.loop_figures {
+        let _ = writeln!(
+            t,
+            "  closed loop (linearised at neutral, each DOF's loop broken at its drive):"
+        );
+        let show =
+            |x: Option<f64>, unit: &str| x.map_or("-".to_owned(), |v| format!("{v:.2} {unit}"));
+        for d in Dof::ALL {
+            let Some(m) = l.dofs.get(d.name()) else {
+                continue;
+            };
+            let _ = writeln!(
+                t,
+                "    {:<6} gain margin {} at {}, phase margin {} at {}, peak {:.2} at {:.2} Hz{}",
+                d.name(),
+                show(m.gain_margin_db, "dB"),
+                show(m.phase_crossover_hz, "Hz"),
+                show(m.phase_margin_deg, "°"),
+                show(m.gain_crossover_hz, "Hz"),
+                m.peak_gain,
+                m.peak_gain_hz,
+                if m.stable { "" } else { "  UNSTABLE" }
+            );
+        }
+        let _ = writeln!(
+            t,
+            "  cross-talk (largest other DOF per command, |response/command|):"
+        );
+        for d in Dof::ALL {
+            let Some(list) = l.cross_talk.get(d.name()) else {
+                continue;
+            };
+            let cells: Vec<String> = list
+                .iter()
+                .map(|c| match (c.largest_dof, c.largest) {
+                    (Some(o), Some(x)) => format!(
+                        "{:.0} Hz: {:.3} ({o} {:.2e})",
+                        c.frequency_hz, c.diagonal, x
+                    ),
+                    _ => format!("{:.0} Hz: {:.3}", c.frequency_hz, c.diagonal),
+                })
+                .collect();
+            let _ = writeln!(t, "    {:<6} {}", d.name(), cells.join("; "));
+        }
     }
     t
 }

@@ -229,22 +229,55 @@ fn describe_table(
     path: &Path,
     file: &platen_scenario::file::ScenarioFile,
 ) -> Result<()> {
-    if args.system.is_some() || args.plot.is_some() {
+    if args.system.is_some() {
         bail!(
-            "`{}` has a multi-axis `table`: --system and --plot describe the uniaxial table \
-             system's loop",
+            "`{}` has a multi-axis `table`: --system describes the uniaxial table system's \
+             loop (a table's loop is its `table.controller`)",
             path.display()
         );
     }
     let scenario = platen_scenario::multi_axis::TableScenario::from_file(path, file)?;
+    let written = match (args.plot.as_deref(), &scenario.system) {
+        (None, _) => Vec::new(),
+        (Some(_), None) => bail!(
+            "--plot draws the Bode plots of a table's closed loop, and `{}` has no \
+             `table.controller`",
+            path.display()
+        ),
+        (plot @ Some(_), Some(sys)) => {
+            let lin = platen_system::TableLinearisation::new(
+                &scenario.table,
+                &sys.hydraulics,
+                &sys.controller,
+                scenario.specimen.as_ref(),
+            )?;
+            let rate = sys.controller.sample_rate_hz();
+            platen_report::write_outputs(
+                plot,
+                None,
+                &args.size.size(),
+                || system_figures::table_loop_figures(&scenario.name, &lin, rate),
+                |_, _| String::new(),
+            )?
+        }
+    };
     let description = scenario.describe();
     if args.json {
-        outln!("{}", serde_json::to_string_pretty(&description)?);
+        let figures = args.plot.as_ref().map(|_| written.as_slice());
+        let value = platen_report::simulate_report::with_outputs(
+            serde_json::to_value(&description)?,
+            figures,
+            None,
+        );
+        outln!("{}", serde_json::to_string_pretty(&value)?);
     } else {
         out!(
             "{}",
             platen_scenario::multi_axis::description_text(&description)
         );
+        for f in &written {
+            outln!("  wrote {}", f.display());
+        }
     }
     Ok(())
 }

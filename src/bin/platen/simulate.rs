@@ -145,6 +145,7 @@ fn run_table(args: &SimulateArgs, path: &std::path::Path, file: &ScenarioFile) -
             &run,
             &scenario.table,
             Some(&scenario.force_limits_n()),
+            scenario.flow_capacities_m3_s().as_deref(),
             dir,
             args.size.size(),
         )?,
