@@ -77,6 +77,19 @@ fn the_readme_quick_start_runs_top_to_bottom_and_writes_only_under_out() {
     let commands: Vec<String> = commands(section)
         .into_iter()
         .filter(|c| c.starts_with("platen "))
+        .filter(|c| {
+            // A scenario that reads a PEER record (a `ground_motion`) cannot run here, where
+            // PLATEN_RECORDS_DIR is removed: tests/docs_commands.rs runs it with the records.
+            let needs_record = c.split_whitespace().any(|w| {
+                w.ends_with(".json")
+                    && std::fs::read_to_string(root().join(w))
+                        .is_ok_and(|t| t.contains("\"ground_motion\""))
+            });
+            if needs_record {
+                eprintln!("not run here (needs a PEER record): {c}");
+            }
+            !needs_record
+        })
         .collect();
     assert!(commands.len() >= 4, "{commands:?}");
 

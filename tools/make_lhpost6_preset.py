@@ -1,19 +1,23 @@
 #!/usr/bin/env python3
-"""Writes presets/lhpost6.json, the LHPOST6 multi-axis table preset, and prints its capacity
+"""Writes crates/platen-scenario/presets/lhpost6.json (compiled into platen), the LHPOST6 multi-axis table preset, and prints its capacity
 check: each published LHPOST6 figure against what the preset's geometry and hydraulics give
 through the closed forms platen uses (docs/lhpost6.md has the table of every value and its
 source; this script is the source of both).
 
-Usage (from the repository root, Python 3 with NumPy):
-    python3 tools/make_lhpost6_preset.py            # writes the JSON, prints the check
-    python3 tools/make_lhpost6_preset.py --check    # prints the check, writes nothing
+Usage (from the repository root, Python 3 with NumPy; SciPy for --controller-check):
+    python3 tools/make_lhpost6_preset.py                       # writes the JSON, prints the check
+    python3 tools/make_lhpost6_preset.py --check               # prints the check, writes nothing
+    python3 tools/make_lhpost6_preset.py --controller-check    # the check and the controller's
+                                                               # closed loop, writes nothing
 The output is deterministic (sorted keys, values rounded as below).
 
 Structure: PUBLISHED values (with their source), ASSUMED values (with the reason), then
-derive() solves the remaining values from the published figures (the V angle, the horizontal
-stroke, the new actuators' size, the struts' pressure, the vertical area and valves, the chamber
-volumes) and rounds them; make_table() builds the preset; Capacities computes, from the preset
-dict alone, what platen will compute:
+derive() solves the remaining values from the published figures (the originals' V angle and
+stroke, the new pair's stroke, size and valve, the struts' pressure, the vertical area and
+valves, the chamber volumes) and rounds them; make_table() builds the preset, with the
+controller (CONTROLLER_GAINS, tuned with tools/reference/multi_axis_loop.py, which
+--controller-check runs on the bare table and with a rigid payload); Capacities computes, from
+the preset dict alone, what platen will compute:
 
 * force limits: push A_cap P_s - A_rod P_R, pull A_rod P_s - A_cap P_R (>= 0); single-acting
   (A_rod = 0): push A_cap P_s, pull 0 (no uplift);
@@ -43,7 +47,7 @@ import numpy as np
 
 G = 9.80665
 G_VEC = np.array([0.0, 0.0, -G])
-OUT_JSON = os.path.join("presets", "lhpost6.json")
+OUT_JSON = os.path.join("crates", "platen-scenario", "presets", "lhpost6.json")
 L_PER_MIN = 1.0 / 60000.0          # m^3/s per l/min
 
 # ------------------------------------------------------------------ published values
@@ -86,8 +90,16 @@ ACCUMULATOR = {"precharge_pressure_pa": 13.8e6, "volume_m3": 8.0,
                "polytropic_exponent": 1.4, "pump_flow_m3_s": 0.05}   # the lhpost-2008 preset's
 ORIG_CAP_M2, ORIG_ROD_M2 = 0.2051, 0.1291  # lhpost-2008: A_a P_s - A_b P_R = 4.2 MN, etc.
 DEAD_LENGTH_M = 0.285                      # lhpost-2008: oil column 1.035 m beyond the 0.75 m
-H_LENGTH_M = 4.0                           # swivel to swivel at neutral
-H_APEX_HALF_M = 1.5                        # platen points at y = +-1.5 m on the end faces
+H_LENGTH_M = 4.0                           # the originals: swivel to swivel at neutral
+H_APEX_HALF_M = 1.5                        # the originals' platen points: y = +-1.5 m, end faces
+NEW_ANGLE_DEG = 71.0                       # the new pair: 71 deg from x (19 deg from y), the far
+#                                            arm of each end's V; the y stroke needs >= 70.7 deg
+#                                            at 5 m (min_new_angle_deg(), docs/lhpost6.md)
+NEW_LENGTH_M = 5.0                         # the new pair: swivel to swivel at neutral
+NEW_APEX_Y_M = 0.0                         # the new pair's platen points: mid end faces
+CLEARANCE_M = 0.5                          # wanted: an actuator's axis this far from the platen's
+#                                            outline (its body's radius, about 0.25 m, and as much
+#                                            again) at every x, y stroke corner
 H_HEIGHT_M = -PLATEN_DIMS_M[2] / 2         # horizontal actuators at the centre of mass height
 NEW_VALVES = 1                             # one valve on each (smaller) new actuator
 PAD_X_M = PLATEN_DIMS_M[0] / 2 - PAD_FROM_EDGE_M   # end bearings 0.9 m from the ends too
@@ -99,9 +111,49 @@ STRUT_PIN_DEPTH_M = 0.85                   # platen pins inside the box, 0.85 m 
 #                                            free flight is neutrally stable for 0.65-1.09 m
 
 
+# ------------------------------------------------------------------ the controller
+# At the published rate ([I]). The gains are assumed: tuned with the independent linearised loop
+# tools/reference/multi_axis_loop.py (--controller-check prints its poles, margins and |H|; the
+# reasons are in docs/lhpost6.md, "Controller"). Per DOF, in its own units (per m, or per rad
+# for roll, pitch, yaw: with D = G d and G+ feedback the lever arm cancels, so a per-rad gain
+# means what the same per-m gain means). Absent keys are 0.
+CONTROLLER_RATE_HZ = 2048                  # [I]
+DELTA_P_HIGHPASS_HZ = 0.1                  # the lhpost-2008 preset's
+CONTROLLER_GAINS = {
+    # horizontal DOFs: position, velocity and acceleration feedforward, acceleration feedback
+    "x": {"displacement_gain_per_m": 1.51, "velocity_feedforward_s_per_m": 0.31,
+          "acceleration_feedforward_s2_per_m": 0.0123, "acceleration_feedback_s2_per_m": 0.0138},
+    "y": {"displacement_gain_per_m": 1.43, "velocity_feedforward_s_per_m": 0.349,
+          "acceleration_feedforward_s2_per_m": 0.0114, "acceleration_feedback_s2_per_m": 0.0135},
+    "yaw": {"displacement_gain_per_m": 2.31, "velocity_feedforward_s_per_m": 0.351,
+            "acceleration_feedforward_s2_per_m": 0.00763,
+            "acceleration_feedback_s2_per_m": 0.00936},
+    # vertical DOFs: the same, and delta-p feedback through a high-pass
+    "z": {"displacement_gain_per_m": 57.8, "velocity_feedforward_s_per_m": 0.666,
+          "acceleration_feedforward_s2_per_m": 0.00236, "acceleration_feedback_s2_per_m": 0.00258,
+          "delta_p_gain_per_pa": 3.9e-8, "delta_p_highpass_hz": DELTA_P_HIGHPASS_HZ},
+    "roll": {"displacement_gain_per_m": 71.9, "velocity_feedforward_s_per_m": 0.643,
+             "acceleration_feedforward_s2_per_m": 0.00171,
+             "acceleration_feedback_s2_per_m": 0.00209,
+             "delta_p_gain_per_pa": 4.51e-8, "delta_p_highpass_hz": DELTA_P_HIGHPASS_HZ},
+    "pitch": {"displacement_gain_per_m": 102.0, "velocity_feedforward_s_per_m": 0.541,
+              "acceleration_feedforward_s2_per_m": 0.00267,
+              "acceleration_feedback_s2_per_m": 0.00221,
+              "delta_p_gain_per_pa": 3.98e-8, "delta_p_highpass_hz": DELTA_P_HIGHPASS_HZ},
+}
+FORCE_BALANCE_GAIN = 3e-8                  # force-balance poles at -26.5, -33.3 1/s (30-38 ms)
+CHECK_FREQS_HZ = (0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 40.0, 60.0)
+CHECK_PAYLOAD = {"mass_kg": 200e3,         # the rigid payload of the controller check: a 200 t
+                 "centre_m": (0.5, 0.0, 3.0),   # block 4 x 4 x 6 m (about 2.1 t/m3), its centre
+                 "size_m": (4.0, 4.0, 6.0)}     # 3 m above the reference point, 0.5 m off in x
+GAIN_KEYS = ("displacement_gain_per_m", "integral_gain_per_m_s", "velocity_feedforward_s_per_m",
+             "acceleration_feedforward_s2_per_m", "velocity_feedback_s_per_m",
+             "acceleration_feedback_s2_per_m", "delta_p_gain_per_pa", "delta_p_highpass_hz")
+
+
 def r6(x):
-    """Rounded for the JSON: 6 decimals (um, or 1e-6 of the unit)."""
-    return float(round(float(x), 6))
+    """Rounded for the JSON: 6 decimals (um, or 1e-6 of the unit); no negative zero."""
+    return float(round(float(x), 6)) + 0.0
 
 
 # ------------------------------------------------------------------ kinematics (copied from
@@ -406,19 +458,28 @@ def single_volume(cap, rod, column_m):
     return column_m * (cap * cap + rod * rod) / (cap + rod)
 
 
-def make_table(v):
-    """The preset's `table` from the values `v` (see derive())."""
+def make_table(v, new_angle_deg=NEW_ANGLE_DEG, new_length_m=NEW_LENGTH_M):
+    """The preset's `table` from the values `v` (see derive()); the new pair's angle and length
+    may be varied (the layout check)."""
     half_x = PLATEN_DIMS_M[0] / 2.0
     depth = PLATEN_DIMS_M[2]
-    th = v["v_angle_rad"]
-    c, s = math.cos(th), math.sin(th)
     horizontal = []
-    # (name, end sign, side sign, original?): the originals h1 (+x end, +y) and h3 (-x, -y),
-    # the new pair h2 (+x, -y) and h4 (-x, +y): symmetric under a half turn about z.
+    # (name, end sign, side sign, original?): the originals h1 (+x end, towards +y) and h3 (-x,
+    # towards -y) at the V angle, 4 m long, platen points at y = +-1.5 m; the new pair h2 (+x end,
+    # towards -y) and h4 (-x, towards +y) at NEW_ANGLE_DEG, NEW_LENGTH_M long, platen points in the
+    # middle of the end faces. Symmetric under a half turn about z (not about the x-z or y-z
+    # planes).
     for name, ex, sy, original in (("h1", 1, 1, True), ("h2", 1, -1, False),
                                    ("h3", -1, -1, True), ("h4", -1, 1, False)):
-        platen = [ex * half_x, sy * H_APEX_HALF_M, H_HEIGHT_M]
-        base = [platen[0] + ex * H_LENGTH_M * c, platen[1] + sy * H_LENGTH_M * s, H_HEIGHT_M]
+        if original:
+            th, length, apex_y = v["v_angle_rad"], H_LENGTH_M, sy * H_APEX_HALF_M
+            stroke, valves, flow = v["h_stroke_m"], ORIG_VALVES, VALVE_RATED_FLOW
+        else:
+            th, length, apex_y = math.radians(new_angle_deg), new_length_m, -ex * NEW_APEX_Y_M
+            stroke, valves, flow = v["new_stroke_m"], NEW_VALVES, v["new_valve_flow_m3_s"]
+        platen = [ex * half_x, apex_y, H_HEIGHT_M]
+        base = [platen[0] + ex * length * math.cos(th), platen[1] + sy * length * math.sin(th),
+                H_HEIGHT_M]
         k = 1.0 if original else v["new_scale"]
         cap, rod = v["orig_cap_m2"] * k, v["orig_rod_m2"] * k
         if not original:
@@ -426,9 +487,9 @@ def make_table(v):
         horizontal.append({
             "name": name, "base_m": [r6(x) for x in base], "platen_m": [r6(x) for x in platen],
             "cap_side_area_m2": cap, "rod_side_area_m2": rod,
-            "chamber_volume_m3": round(single_volume(cap, rod, v["h_stroke_m"] + DEAD_LENGTH_M), 4),
-            "stroke_m": v["h_stroke_m"], "leakage_m3_s_per_pa": LEAKAGE,
-            "servo_valve": valve(ORIG_VALVES if original else NEW_VALVES, VALVE_RATED_FLOW),
+            "chamber_volume_m3": round(single_volume(cap, rod, stroke + DEAD_LENGTH_M), 4),
+            "stroke_m": stroke, "leakage_m3_s_per_pa": LEAKAGE,
+            "servo_valve": valve(valves, flow),
         })
     vertical = []
     pad_y = PLATEN_DIMS_M[1] / 2.0 - PAD_FROM_EDGE_M
@@ -473,7 +534,19 @@ def make_table(v):
         "supply_pressure_pa": SUPPLY_PA,
         "return_pressure_pa": RETURN_PA,
         "accumulator": dict(ACCUMULATOR),
+        "controller": controller(),
     }
+
+
+def controller():
+    """The preset's `controller`: every gain key written, absent ones as 0."""
+    dof = {}
+    for name, g in CONTROLLER_GAINS.items():
+        full = {key: 0.0 for key in GAIN_KEYS}
+        full.update(g)
+        dof[name] = full
+    return {"sample_rate_hz": CONTROLLER_RATE_HZ, "dof": dof,
+            "force_balance_gain": FORCE_BALANCE_GAIN}
 
 
 def limits_block():
@@ -500,20 +573,27 @@ def derive():
     """Solves the values the sources do not give from the published figures, and rounds
     them. Each step uses only the values fixed before it."""
     v = {"orig_cap_m2": ORIG_CAP_M2, "orig_rod_m2": ORIG_ROD_M2, "new_scale": 1.0,
+         "new_stroke_m": 1.0, "new_valve_flow_m3_s": VALVE_RATED_FLOW,
          "v_stroke_m": PUBLISHED_AXES["z"][0], "v_area_m2": 0.3, "v_valve_flow_m3_s": 0.1,
          "strut_pressure_pa": 13.8e6}
     notes = {}
-    # 1. The V angle: with a symmetric V the force balance shares an x or y force equally
-    #    over the four actuators, so F_y / F_x = tan(angle) = a_y / a_x (published 1.85/3.7).
+    # 1. The originals' V angle. The new pair sets both horizontal accelerations (step 5). The
+    #    force balance splits a horizontal force between the two pairs, each pair (h1 with h3,
+    #    h2 with h4) acting as one force through the reference point along its own direction
+    #    (angle th from x for the originals, phi for the new pair): each new actuator carries
+    #    F_x sin(th) / (2 sin(th + phi)) of an x force and F_y cos(th) / (2 sin(th + phi)) of a
+    #    y force. With its pull limiting both, a_y / a_x = tan(th) (published 1.85/3.7), whatever
+    #    phi is (a symmetric V, phi = th, gives the same angle).
     v["v_angle_rad"] = math.atan(PUBLISHED_AXES["y"][2] / PUBLISHED_AXES["x"][2])
-    # 2. The horizontal stroke: the published x stroke with the exact kinematics of the V.
+    # 2. The originals' stroke: the published x stroke with the exact kinematics (the new pair,
+    #    with a long stroke for now, does not limit x).
     v["h_stroke_m"] = 1.0
 
-    def x_stroke(s):
-        v["h_stroke_m"] = s
-        return Capacities(make_table(v)).stroke(0)
+    def stroke_capacity(key, k, s):
+        v[key] = s
+        return Capacities(make_table(v)).stroke(k)
 
-    s = bisect(lambda s: x_stroke(s) - PUBLISHED_AXES["x"][0], 0.3, 1.5)
+    s = bisect(lambda s: stroke_capacity("h_stroke_m", 0, s) - PUBLISHED_AXES["x"][0], 0.3, 1.5)
     v["h_stroke_m"] = math.ceil(s * 1000.0) / 1000.0
     notes["h_stroke_exact_m"] = s
     # 3. The struts' pressure: bare, the verticals (single-acting) can pull the platen down
@@ -522,16 +602,32 @@ def derive():
     p = (az - G) * PLATEN_MASS_KG / (N_STRUTS * STRUT_AREA_M2)
     v["strut_pressure_pa"] = round(p, -4)
     notes["strut_pressure_exact_pa"] = p
-    # 4. The new actuators' size: the force balance gives each of the four the same force, so
-    #    the weaker pair sets the x (and y) force; scale the originals' areas by k so that
-    #    a_x = 3.7 g (k = 1: all four like the originals).
+    # 4. The new pair's stroke: the published y stroke, exact kinematics. It does not limit x
+    #    (checked) because the pair is at least 66.9 deg from x: see docs/lhpost6.md.
+    s = bisect(lambda s: stroke_capacity("new_stroke_m", 1, s) - PUBLISHED_AXES["y"][0], 0.05, 1.0)
+    v["new_stroke_m"] = math.ceil(s * 1000.0) / 1000.0
+    notes["new_stroke_exact_m"] = s
+    assert Capacities(make_table(v)).stroke(0) >= PUBLISHED_AXES["x"][0], "the new pair limits x"
+    # 5. The new pair's size: its areas are the originals' scaled by k, so that a_x = 3.7 g;
+    #    the check shows a_y = 1.85 g follows (step 1). k = 1: all four like the originals.
     cap = Capacities(make_table(v))
-    ax1 = cap.acceleration(0)
-    notes["ax_all_original_g"] = ax1 / G
+    notes["ax_all_original_g"] = cap.acceleration(0) / G
     notes["ay_all_original_g"] = cap.acceleration(1) / G
-    v["new_scale"] = PUBLISHED_AXES["x"][2] * G / ax1
-    notes["new_scale_exact"] = v["new_scale"]
-    # 5. The vertical area: the overturning moment with the rated payload (20 MN centred) on
+
+    def ax_of(k):
+        v["new_scale"] = k
+        return Capacities(make_table(v)).acceleration(0) / G - PUBLISHED_AXES["x"][2]
+
+    k = bisect(ax_of, 0.05, 1.0)
+    v["new_scale"] = k
+    notes["new_scale_exact"] = k
+    # 6. The new pair's valve: one valve, rated for the published y velocity (the new pair
+    #    sets it: the originals allow 2.767 m/s / sin(th) = 6.2 m/s), rounded to 100 l/min.
+    cap = Capacities(make_table(v))
+    flow = v["new_valve_flow_m3_s"] * PUBLISHED_AXES["y"][1] / cap.velocity(1)
+    notes["new_valve_flow_exact_l_min"] = flow / L_PER_MIN
+    v["new_valve_flow_m3_s"] = round(flow / L_PER_MIN, -2) * L_PER_MIN
+    # 7. The vertical area: the overturning moment with the rated payload (20 MN centred) on
     #    the pads is the published 50 MN m; the push side of the pads limits it there.
     def overturning(area):
         v["v_area_m2"] = area
@@ -540,7 +636,7 @@ def derive():
     area = bisect(overturning, 0.05, 2.0)
     v["v_area_m2"] = round(area, 4)
     notes["v_area_exact_m2"] = area
-    # 6. The verticals' valves: the z velocity both ways; down (retract) is the slower, driven
+    # 8. The verticals' valves: the z velocity both ways; down (retract) is the slower, driven
     #    by the static pressure p_a0 - P_R only. Two valves per actuator, each rated for the
     #    flow that gives 0.5 m/s, rounded to 100 l/min.
     cap = Capacities(make_table(v))
@@ -624,11 +720,93 @@ def check(table, notes):
     info.append(("open loop at fixed forces: linearised free flight",
                  ("neutrally stable, " if stable else "UNSTABLE, ")
                  + ", ".join(f"{f:.3g}" for f in freqs) + " Hz"))
+    e = np.zeros(6)
+    e[0] = 1.0
+    fx = cap.resolve(cap.M6 @ e) * cap.acceleration(0)
+    info.append(("at a_x: h1 / h2 force, of their pull limits",
+                 f"{abs(fx[0]) / 1e6:.4g} / {abs(fx[1]) / 1e6:.4g} MN, of "
+                 f"{-cap.limits[0][0] / 1e6:.4g} / {-cap.limits[1][0] / 1e6:.4g} MN"))
+    alone = []
+    for pair, axis in ((("h2", "h4"), 0), (("h1", "h3"), 1)):
+        t = json.loads(json.dumps(table))
+        for a in t["actuators"]:
+            if "platen_m" in a and a["name"] not in pair:
+                a["stroke_m"] = 1e3
+        alone.append(Capacities(t).stroke(axis))
+    info.append(("x stroke the new pair allows; y, the originals",
+                 f"{alone[0]:.4g} m; {alone[1]:.4g} m"))
+    cl, sw = clearance(table), swivel_turn_deg(table)
+    info.append(("h1 / h2 axis to the platen, worst stroke corner",
+                 f"{cl['h1']:.3g} / {cl['h2']:.3g} m (wanted >= {CLEARANCE_M:g} m)"))
+    info.append(("h1 / h2 swivel turn, worst stroke corner",
+                 f"{sw['h1']:.3g} / {sw['h2']:.3g} deg"))
     info.append(("if the new pair were like the originals: a_x, a_y",
                  f"{notes['ax_all_original_g']:.4g} g, {notes['ay_all_original_g']:.4g} g"))
     for name, text in info:
         lines.append(f"  {name:<50} {text}")
     return "\n".join(lines), rows
+
+
+def min_new_angle_deg(length=None):
+    """The smallest angle from x of an actuator (horizontal, `length` m swivel to swivel) that
+    reaches its stroke at the published y stroke Y but not at the published x stroke X (exact
+    kinematics: its stroke at a translation q is sqrt(L^2 + 2 L |u.q| + q^2) - L at worst):
+    Y sin(phi) - X cos(phi) >= (X^2 - Y^2) / (2 L)."""
+    length = NEW_LENGTH_M if length is None else length
+    X, Y = PUBLISHED_AXES["x"][0], PUBLISHED_AXES["y"][0]
+    rhs = 0.0 if math.isinf(length) else (X * X - Y * Y) / (2.0 * length)
+    phi = bisect(lambda a: Y * math.sin(a) - X * math.cos(a) - rhs, 0.0, math.pi / 2)
+    return math.degrees(phi)
+
+
+def stroke_corners():
+    X, Y = PUBLISHED_AXES["x"][0], PUBLISHED_AXES["y"][0]
+    return [(dx, dy) for dx in (-X, 0.0, X) for dy in (-Y, 0.0, Y)]
+
+
+def clearance(table):
+    """Per horizontal actuator (plan view): the smallest distance from its axis (platen point to
+    base) to the platen's outline over the nine x, y stroke corners (-1 if the axis enters the
+    platen)."""
+    hx, hy = PLATEN_DIMS_M[0] / 2.0, PLATEN_DIMS_M[1] / 2.0
+    out = {}
+    for a in table["actuators"]:
+        if "platen_m" not in a:
+            continue
+        worst = math.inf
+        for dx, dy in stroke_corners():
+            p = np.array(a["platen_m"][:2]) + [dx, dy]
+            b = np.array(a["base_m"][:2])
+            length = float(np.linalg.norm(b - p))
+            u = (b - p) / length
+            for cx, cy in ((hx, hy), (hx, -hy), (-hx, -hy), (-hx, hy)):
+                w = np.array([cx + dx, cy + dy]) - p
+                t = min(max(float(w @ u), 0.0), length)
+                worst = min(worst, float(np.linalg.norm(w - t * u)))
+            for t in np.linspace(0.05, length, 200):
+                q = p + t * u
+                if abs(q[0] - dx) < hx and abs(q[1] - dy) < hy:
+                    worst = -1.0
+        out[a["name"]] = worst
+    return out
+
+
+def swivel_turn_deg(table):
+    """Per horizontal actuator: the largest turn of its axis (plan view) from neutral over the
+    nine x, y stroke corners, degrees."""
+    out = {}
+    for a in table["actuators"]:
+        if "platen_m" not in a:
+            continue
+        p0, b = np.array(a["platen_m"][:2]), np.array(a["base_m"][:2])
+        u0 = (b - p0) / np.linalg.norm(b - p0)
+        worst = 0.0
+        for dx, dy in stroke_corners():
+            u = b - (p0 + [dx, dy])
+            u = u / np.linalg.norm(u)
+            worst = max(worst, math.degrees(math.acos(min(1.0, float(u @ u0)))))
+        out[a["name"]] = worst
+    return out
 
 
 def z_up_down(cap):
@@ -657,17 +835,197 @@ def z_up_down_payload(cap, payload_n):
     return up / mass / G, down / mass / G
 
 
+# ------------------------------------------------------------------ the controller check
+
+def with_payload(table, payload=None):
+    """A copy of `table` whose platen carries a rigid block (mass, centre, size: its own
+    inertia as a uniform box), merged into the platen's mass, centre of mass and inertia."""
+    payload = CHECK_PAYLOAD if payload is None else payload
+    t = json.loads(json.dumps(table))
+    p = t["platen"]
+    m0, m1 = p["mass_kg"], payload["mass_kg"]
+    c0, c1 = np.array(p["centre_of_mass_m"]), np.array(payload["centre_m"])
+    m = m0 + m1
+    c = (m0 * c0 + m1 * c1) / m
+
+    def about(inertia, mass, d):
+        return np.array(inertia) + mass * (float(d @ d) * np.eye(3) - np.outer(d, d))
+
+    inertia = (about(p["inertia_kg_m2"], m0, c0 - c)
+               + about(box_inertia(m1, payload["size_m"]), m1, c1 - c))
+    p["mass_kg"] = m
+    p["centre_of_mass_m"] = [float(x) for x in c]
+    p["inertia_kg_m2"] = inertia.tolist()
+    return t
+
+
+def loop_report(table, label):
+    """Closed-loop poles, per-DOF margins and diagonal |H| of `table` by
+    tools/reference/multi_axis_loop.py, as lines of text."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    sys.path.insert(0, os.path.join(here, "reference"))
+    import multi_axis_loop as mal   # noqa: E402 (NumPy + SciPy, needed only here)
+
+    lp = mal.Loop(table)
+    stable, maxre, nzero, poles = lp.stability()
+    rest = [z for z in poles if abs(z) >= 1e-6]
+    osc = sorted((z for z in rest if z.imag > 1e-6), key=lambda z: -z.real / abs(z))
+    real = sorted((z.real for z in rest if abs(z.imag) <= 1e-6), reverse=True)
+    zmin = min(-z.real / abs(z) for z in rest)
+    lines = [f"{label}: {len(poles)} closed-loop poles (Pade 4 for the delay and the hold): "
+             f"{'STABLE' if stable else 'NOT STABLE'}",
+             f"  {nzero} at s = 0 (the four double-acting actuators' mean-pressure modes); the "
+             f"others' largest real part {maxre:.4g} 1/s; least damping ratio {zmin:.3f}",
+             "  least damped: " + ", ".join(
+                 f"{z.imag / (2 * math.pi):.1f} Hz (zeta {-z.real / abs(z):.3f})" for z in osc[:5]),
+             "  oscillatory below 60 Hz: " + (", ".join(
+                 f"{z.imag / (2 * math.pi):.1f} Hz (zeta {-z.real / abs(z):.2f})"
+                 for z in sorted(osc, key=lambda z: z.imag) if z.imag < 2 * math.pi * 60)
+                 or "none"),
+             "  slowest real: " + ", ".join(f"{x:.3g}" for x in real[:12]) + " 1/s"]
+    lines.append("  per-DOF loop (broken at the DOF drive, the others closed): phase margin, "
+                 "gain margin, |L| = 1 at")
+    for kk, k in enumerate(lp.free):
+        m = lp.margins(kk)
+        gm = m["gain_margin_db"]
+        lines.append(f"    {mal.DOFS[k]:>5s}: {m['phase_margin_deg']:5.1f} deg, "
+                     + ("   -   " if gm is None else f"{gm:5.1f} dB")
+                     + ", " + ", ".join(f"{c['f_hz']:.3g}" for c in m["gain_crossings"]) + " Hz")
+    lines.append("  diagonal |H| (pose over command) | its phase lag as a delay, ms:")
+    lines.append("    " + f"{'f (Hz)':>7s}" + "".join(f"{d:>7s}" for d in mal.DOFS) + "  |"
+                 + "".join(f"{d:>7s}" for d in mal.DOFS))
+    for f in CHECK_FREQS_HZ:
+        h = np.diag(lp.transfer(f))
+        delay = -np.angle(h) / (2.0 * math.pi * f) * 1e3
+        lines.append("    " + f"{f:>7g}" + "".join(f"{abs(x):7.3f}" for x in h) + "  |"
+                     + "".join(f"{x:7.1f}" for x in delay))
+    return lines
+
+
+def design_quantities(lp):
+    """Per DOF of the reference's loop `lp`: K_v, the DOF's velocity per unit drive (each
+    actuator's no-load K_q (A_a + A_b) / (A_a^2 + A_b^2), or K_q / A_a single-acting, combined
+    by oil-column stiffness); w_h, its oil column with the other DOFs held (rad/s); c, its
+    delta-p per unit acceleration (G+ of the actuators' delta-p under the minimum-norm forces
+    that accelerate it)."""
+    G, Gp = lp.G, lp.Gp
+    kv = np.array([h["Kqa"] * (h["Aa"] + h["Ab"]) / (h["Aa"] ** 2 + h["Ab"] ** 2)
+                   if h["ib"] is not None else h["Kqa"] / h["Aa"] for h in lp.hyd])
+    adp = np.array([(h["Aa"] + h["Ab"]) / 2.0 if h["ib"] is not None else h["Aa"]
+                    for h in lp.hyd])
+    W = np.diag([lp.tab.beta * (h["Aa"] ** 2 + h["Ab"] ** 2) / h["V0"] for h in lp.hyd])
+    Mg, _ = lp.tab.generalised_forces(np.zeros(lp.nf), np.zeros(lp.nf), lp.f0)
+    Kt = G.T @ W @ G
+    out = []
+    for k in range(lp.nf):
+        Kv = np.linalg.solve(Kt, G.T @ W @ (kv * G[:, k]))[k]
+        c = (Gp @ (np.linalg.pinv(G.T) @ Mg[:, k] / adp))[k]
+        out.append((Kv, math.sqrt(Kt[k, k] / Mg[k, k]), c))
+    return out
+
+
+def controller_check(table):
+    p = CHECK_PAYLOAD
+    here = os.path.dirname(os.path.abspath(__file__))
+    sys.path.insert(0, os.path.join(here, "reference"))
+    import multi_axis_loop as mal   # noqa: E402
+
+    lp = mal.Loop(table)
+    print("controller design quantities (bare table) and the gains normalised by them:")
+    print(f"  {'DOF':>5s} {'K_v':>7s} {'w_h':>7s} {'f_h':>6s} {'c':>9s}   {'kappa':>6s} "
+          f"{'alpha_a':>7s} {'alpha_dp':>8s} {'K_vf K_v':>8s} {'K_af/(K_ab+K_dp c)':>18s}")
+    for k, (Kv, wh, c) in enumerate(design_quantities(lp)):
+        g = {key: lp.gain[key][k] for key in mal.GAIN_NAMES}
+        ab = g["kab"] + g["kdp"] * c
+        print(f"  {mal.DOFS[k]:>5s} {Kv:7.4g} {wh:7.4g} {wh / (2 * math.pi):6.3g} {c:9.4g}   "
+              f"{g['kp'] * Kv / wh:6.3f} {g['kab'] * Kv * wh:7.3f} {g['kdp'] * c * Kv * wh:8.3f} "
+              f"{g['kvf'] * Kv:8.3f} {g['kaf'] / ab:18.3f}")
+    print("  (K_v m/s per unit drive, or rad/s; w_h rad/s, f_h Hz; c Pa per m/s2, or per rad/s2)")
+    for name in ("h1", "h2"):
+        a = next(x for x in table["actuators"] if x["name"] == name)
+        A, B = a["cap_side_area_m2"], a["rod_side_area_m2"]
+        k_sum = table["oil_bulk_modulus_pa"] * (A - B) ** 2 / (a["chamber_volume_m3"] * (A + B))
+        print(f"  {name}: delta-p per m of stroke at constant force (the mean-pressure mode), "
+              f"beta (A_a - A_b)^2 / (V (A_a + A_b)) = {k_sum:.3g} Pa/m")
+    alt = json.loads(json.dumps(table))
+    for k, (Kv, wh, c) in enumerate(design_quantities(lp)):
+        g = alt["controller"]["dof"][mal.DOFS[k]]
+        if g["delta_p_gain_per_pa"] == 0.0 and g["acceleration_feedback_s2_per_m"] > 0.0:
+            g["delta_p_gain_per_pa"] = g["acceleration_feedback_s2_per_m"] / c
+            g["delta_p_highpass_hz"] = DELTA_P_HIGHPASS_HZ
+            g["acceleration_feedback_s2_per_m"] = 0.0
+    la = mal.Loop(alt)
+    print("  x, y, yaw damped by delta-p feedback instead (K_dp = K_ab / c, through the "
+          f"{DELTA_P_HIGHPASS_HZ:g} Hz high-pass; K_af kept): stable "
+          f"{la.stability()[0]}, |H| x, y at 0.5, 1, 2, 5 Hz: "
+          + ", ".join(f"{abs(la.transfer(f)[0, 0]):.3f} / {abs(la.transfer(f)[1, 1]):.3f}"
+                      for f in (0.5, 1.0, 2.0, 5.0)))
+    matched = json.loads(json.dumps(table))
+    for k, (Kv, wh, c) in enumerate(design_quantities(lp)):
+        g = matched["controller"]["dof"][mal.DOFS[k]]
+        g["velocity_feedforward_s_per_m"] = 1.0 / Kv
+        g["acceleration_feedforward_s2_per_m"] = (g["acceleration_feedback_s2_per_m"]
+                                                  + g["delta_p_gain_per_pa"] * c)
+    lm = mal.Loop(matched)
+    h5 = np.diag(lm.transfer(5.0))
+    print("  the feedforward matched instead (K_vf = 1/K_v, K_af = K_ab + K_dp c): |H| x, y, z at "
+          "5 Hz " + ", ".join(f"{abs(h5[k]):.3f}" for k in range(3)) + "; lag as a delay, x at "
+          "1, 5 Hz: " + ", ".join(f"{-np.angle(lm.transfer(f)[0, 0]) / (2 * math.pi * f) * 1e3:.1f}"
+                                  for f in (1.0, 5.0)) + " ms")
+    start = json.loads(json.dumps(table))
+    g16 = {"displacement_gain_per_m": 16.0, "velocity_feedforward_s_per_m": 0.2,
+           "acceleration_feedforward_s2_per_m": 0.008, "delta_p_gain_per_pa": 2e-8,
+           "delta_p_highpass_hz": 0.1}
+    start["controller"]["dof"] = {d: dict(g16) for d in mal.DOFS}
+    start["controller"]["force_balance_gain"] = 1e-8
+    ls = mal.Loop(start)
+    st, _, _, poles = ls.stability()
+    zmin = min(-z.real / abs(z) for z in poles if abs(z) >= 1e-6)
+    print("  the uniaxial lhpost-2008 gains on every DOF (K_p 16, K_vf 0.2, K_af 0.008, K_dp 2e-8 "
+          f"through 0.1 Hz; force balance 1e-8): stable {st}, least damping ratio {zmin:.3f}; "
+          "|H| x, y, z at 0.5, 5, 10 Hz: " + "; ".join(
+              ", ".join(f"{abs(ls.transfer(f)[k, k]):.3f}" for k in range(3))
+              for f in (0.5, 5.0, 10.0)))
+    print()
+    print("controller check (tools/reference/multi_axis_loop.py, linearised at neutral, "
+          "frictionless):")
+    for line in loop_report(table, "bare table"):
+        print(line)
+    print()
+    size = " x ".join(f"{x:g}" for x in p["size_m"])
+    centre = ", ".join(f"{x:g}" for x in p["centre_m"])
+    label = f"with a rigid {p['mass_kg'] / 1e3:g} t block ({size} m, centre at ({centre}) m)"
+    for line in loop_report(with_payload(table), label):
+        print(line)
+    print()
+    print("heavier rigid blocks, 8 x 6 x 6 m, centre at "
+          f"({centre}) m: least damping ratio of the closed loop (negative: unstable)")
+    for mass in (500e3, 1000e3, PAYLOAD_N / G):
+        heavy = with_payload(table, {"mass_kg": mass, "centre_m": p["centre_m"],
+                                     "size_m": (8.0, 6.0, 6.0)})
+        poles = mal.Loop(heavy).closed_loop_poles()
+        zeta = min(-z.real / abs(z) for z in poles if abs(z) >= 1e-6)
+        print(f"  {mass / 1e3:6.0f} t: {zeta:.3f}")
+
+
 def main():
     values, notes = derive()
     table = make_table(values)
     report, _ = check(table, notes)
     th = math.degrees(values["v_angle_rad"])
     print("derived values:")
-    print(f"  V angle {th:.3f} deg from x (tan = 1/2); horizontal stroke +-{values['h_stroke_m']} m "
-          f"(exact {notes['h_stroke_exact_m']:.5f})")
-    print(f"  new actuators: {values['new_scale']:.4f} x the originals' areas "
-          f"({table['actuators'][1]['cap_side_area_m2']} / "
-          f"{table['actuators'][1]['rod_side_area_m2']} m2)")
+    print(f"  V angle {th:.3f} deg from x (tan = 1/2); horizontal stroke "
+          f"+-{values['h_stroke_m']} m (exact {notes['h_stroke_exact_m']:.5f})")
+    h2 = table["actuators"][1]
+    print(f"  new pair: {NEW_ANGLE_DEG:g} deg from x, {NEW_LENGTH_M:g} m; "
+          f"stroke +-{values['new_stroke_m']} m (exact {notes['new_stroke_exact_m']:.5f}); "
+          f"{values['new_scale']:.4f} x the originals' areas ({h2['cap_side_area_m2']} / "
+          f"{h2['rod_side_area_m2']} m2); {NEW_VALVES} x "
+          f"{values['new_valve_flow_m3_s'] / L_PER_MIN:.0f} l/min (exact "
+          f"{notes['new_valve_flow_exact_l_min']:.0f})")
+    print("  the y stroke without limiting x needs the new pair at >= "
+          f"{min_new_angle_deg():.2f} deg from x ({min_new_angle_deg(math.inf):.2f} deg for a "
+          "long actuator)")
     print(f"  struts {values['strut_pressure_pa'] / 1e6:.2f} MPa "
           f"(exact {notes['strut_pressure_exact_pa'] / 1e6:.4f}); vertical area "
           f"{values['v_area_m2']} m2 (exact {notes['v_area_exact_m2']:.5f}); vertical valves "
@@ -675,7 +1033,21 @@ def main():
           f"{notes['v_valve_flow_exact_l_min']:.0f})")
     print()
     print(report)
-    if "--check" not in sys.argv[1:]:
+    print()
+    print("the new pair's angle and length (each end's far arm, platen point in the middle of the "
+          "end face):")
+    print(f"  {'length':>6s}  {'y stroke needs':>14s}  "
+          "axis to the platen at the worst stroke corner, m")
+    angles = (68.0, 70.0, 71.0, 72.0, 74.0, 76.0)
+    print(f"  {'m':>6s}  {'deg from x':>14s}  " + "".join(f"{a:>7g} deg" for a in angles))
+    for length in (4.0, 5.0, 6.0):
+        cl = [clearance(make_table(values, a, length))["h2"] for a in angles]
+        print(f"  {length:6g}  {min_new_angle_deg(length):14.2f}  "
+              + "".join(f"{c:11.2f}" for c in cl))
+    if "--controller-check" in sys.argv[1:]:
+        print()
+        controller_check(table)
+    if "--check" not in sys.argv[1:] and "--controller-check" not in sys.argv[1:]:
         doc = {"table": table, "limits": limits_block()}
         os.makedirs(os.path.dirname(OUT_JSON), exist_ok=True)
         with open(OUT_JSON, "w", newline="\n") as f:
