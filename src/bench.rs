@@ -848,16 +848,16 @@ pub struct BenchReport {
     pub sample_rate_hz: f64,
     /// Simulated time of every record, s.
     pub simulated_s: f64,
-    /// The six-DOF table's forward step (RK4, 10 actuators, 4 struts, 6 pads), ns.
-    pub six_dof_ns_per_step: f64,
-    /// [`BenchReport::six_dof_ns_per_step`] over the baseline's step.
-    pub six_dof_ratio_to_baseline: f64,
     /// The LHPOST6 preset's closed-loop step (RK4, 10 actuators with their hydraulics, the
     /// DOF controller), ns.
     pub six_dof_closed_loop_ns_per_step: f64,
     /// [`BenchReport::six_dof_closed_loop_ns_per_step`] over the uniaxial closed loop's step
     /// ([`BenchReport::table_system_ns_per_step`]), measured in the same run.
     pub six_dof_closed_loop_ratio_to_table_system: f64,
+    /// The six-DOF table's forward step (RK4, 10 actuators, 4 struts, 6 pads), ns.
+    pub six_dof_ns_per_step: f64,
+    /// [`BenchReport::six_dof_ns_per_step`] over the baseline's step.
+    pub six_dof_ratio_to_baseline: f64,
     /// The closed loop's time per step, ns.
     pub table_system_ns_per_step: f64,
     /// Its ratio to the baseline's.
@@ -1097,14 +1097,14 @@ mod tests {
         };
         let sorted = serde_json::to_string_pretty(&value).unwrap();
         assert_eq!(keys(&sorted), keys(&text));
-        assert_eq!(report.workloads.len(), 10);
+        assert_eq!(report.workloads.len(), 11);
         assert_eq!(report.workloads["rk4"].units_per_run, 4);
         assert_eq!(report.workloads["inverse"].units_per_run, 5);
         assert_eq!(
             report.workloads["ensemble"].units_per_run,
             4 * ENSEMBLE_LANES as u64
         );
-        assert_eq!(m.text().lines().count(), 3 + 10 + 1);
+        assert_eq!(m.text().lines().count(), 3 + 11 + 1);
         assert!(matches!(
             measure(1.0 / RATE_HZ, 1),
             Err(BenchError::TooShort { samples: 2, .. })
