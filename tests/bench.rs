@@ -23,6 +23,8 @@ fn bench_json_reports_every_figure_as_a_positive_number() {
         "ensemble_ns_per_step_per_trajectory",
         "ensemble_scalar_ns_per_step",
         "ensemble_ratio_to_scalar",
+        "six_dof_closed_loop_ns_per_step",
+        "six_dof_closed_loop_ratio_to_table_system",
     ] {
         let v = b[key]
             .as_f64()
