@@ -38,7 +38,7 @@ use crate::closed_loop::LoopMethod;
 use crate::error::{IntegrateError, Result};
 use crate::event::MAX_EVENTS_PER_STEP;
 use crate::machine::{Machine, PieceMethod, Y};
-use crate::multi_axis::{PoseMotion, TableRun, GRAVITY};
+use crate::multi_axis::{PoseMotion, TableRun};
 use crate::stop::Failure;
 use crate::table_plant::{
     pose, reaim, start_machine, start_state, Forces, Output, Source, TablePlant, BARE,
@@ -382,10 +382,10 @@ impl<'a, const L: usize> TableLoop<'a, L> {
         let (table, hyd) = (run.table, run.hydraulics);
         let h = run.controller.period_s() / f64::from(k);
         // The weight of the specimen on the platen, carried at rest with the platen's.
-        let extra = match run.specimen {
-            Some(s) => s.rigid_mass() * GRAVITY,
-            None => platen_model::multi_axis::Wrench::zeros(),
-        };
+        let extra = run.specimen.map_or_else(
+            platen_model::multi_axis::Wrench::zeros,
+            LinearSpecimen::weight_wrench,
+        );
         let rest = TableHydraulics::static_forces_n(table, &extra)
             .and_then(|f| hyd.rest_states(&f))
             .map_err(IntegrateError::InvalidSystem)?;

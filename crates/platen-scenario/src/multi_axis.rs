@@ -825,17 +825,10 @@ fn build_system(
         ));
     }
     // The static hold: the chambers must exert it between the return and supply pressures.
-    let extra = specimen.map_or_else(platen_model::multi_axis::Wrench::zeros, |s| {
-        s.rigid_mass()
-            * platen_model::multi_axis::Wrench::new(
-                0.0,
-                0.0,
-                -platen_model::STANDARD_GRAVITY_M_S2,
-                0.0,
-                0.0,
-                0.0,
-            )
-    });
+    let extra = specimen.map_or_else(
+        platen_model::multi_axis::Wrench::zeros,
+        LinearSpecimen::weight_wrench,
+    );
     TableHydraulics::static_forces_n(table, &extra)
         .and_then(|f| hydraulics.rest_states(&f))
         .map_err(|e| system_error(ctx, e))?;
@@ -1310,25 +1303,19 @@ impl TableScenario {
                 )
             })
             .collect();
+        let capacities = self.flow_capacities_m3_s();
         let actuators: Vec<ActuatorPeaks> = self
             .table
             .actuators()
             .iter()
             .zip(self.force_limits_n())
-            .map(|(a, (pull, push))| {
+            .enumerate()
+            .map(|(i, (a, (pull, push)))| {
                 let force = col(&format!("{}_force_n", a.name));
                 let stroke = abs_max(col(&format!("{}_stroke_m", a.name)));
                 let max = force.iter().copied().fold(f64::NEG_INFINITY, f64::max);
                 let min = force.iter().copied().fold(f64::INFINITY, f64::min);
-                let i = self.table.actuators().iter().position(|b| b.name == a.name);
-                let valve = self
-                    .system
-                    .as_ref()
-                    .zip(i)
-                    .map(|(sys, i)| sys.hydraulics.actuators()[i].servo_valve);
-                let capacity = valve
-                    .and(i)
-                    .and_then(|i| self.flow_capacities_m3_s().map(|c| c[i]));
+                let capacity = capacities.as_ref().map(|c| c[i]);
                 let flow = run.column(&format!("{}_flow_m3_s", a.name)).map(abs_max);
                 let saturated = run.column(&format!("{}_drive", a.name)).map(|d| {
                     let n = d.iter().filter(|x| x.abs() >= 1.0).count();
@@ -1800,20 +1787,10 @@ impl TableScenario {
     /// The forces that hold the platen (and the specimen's weight) at rest at neutral, N per
     /// actuator (`None` when the actuators cannot).
     fn static_forces_n(&self) -> Option<Vec<f64>> {
-        let extra =
-            self.specimen
-                .as_ref()
-                .map_or_else(platen_model::multi_axis::Wrench::zeros, |s| {
-                    s.rigid_mass()
-                        * platen_model::multi_axis::Wrench::new(
-                            0.0,
-                            0.0,
-                            -platen_model::STANDARD_GRAVITY_M_S2,
-                            0.0,
-                            0.0,
-                            0.0,
-                        )
-                });
+        let extra = self.specimen.as_ref().map_or_else(
+            platen_model::multi_axis::Wrench::zeros,
+            LinearSpecimen::weight_wrench,
+        );
         TableHydraulics::static_forces_n(&self.table, &extra).ok()
     }
 

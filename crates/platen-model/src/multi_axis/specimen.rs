@@ -177,6 +177,12 @@ impl LinearSpecimen {
         self.stiffness.clone().cholesky().map(|c| c.solve(&load))
     }
 
+    /// Its weight as a wrench on the platen at rest about the reference point,
+    /// `Γᵀ·M·Γ·g` with `g = (0, 0, −9.80665, 0, 0, 0)`.
+    pub fn weight_wrench(&self) -> Wrench {
+        self.rigid_mass() * Wrench::new(0.0, 0.0, -crate::STANDARD_GRAVITY_M_S2, 0.0, 0.0, 0.0)
+    }
+
     /// Its rigid-body mass about the reference point, `Γᵀ·M·Γ` (6 × 6).
     pub fn rigid_mass(&self) -> Matrix6<f64> {
         let m = self.influence.transpose() * &self.mass * &self.influence;
