@@ -174,9 +174,9 @@ enum Source<'a> {
     ForceCsv(&'a Path),
     MotionCsv(&'a Path),
     SineForce(&'a SineForce),
-    SineMotion(&'a SineMotion),
-    TriangleMotion(&'a TriangleMotion),
-    WhiteNoiseMotion(&'a WhiteNoiseMotion),
+    SineMotion(&'a PerAxisOr<SineMotion>),
+    TriangleMotion(&'a PerAxisOr<TriangleMotion>),
+    WhiteNoiseMotion(&'a PerAxisOr<WhiteNoiseMotion>),
     GroundMotion(&'a GroundMotionSpec),
 }
 
@@ -266,11 +266,19 @@ pub(crate) fn with_rest_velocity(ctx: &Ctx, file: &ScenarioFile, run: Run) -> Re
 /// The run of the excitation's one source.
 fn build_source(ctx: &Ctx, file: &ScenarioFile, source: Source) -> Result<(Run, Derived)> {
     let ex = &file.excitation;
-    let gen = Generated { ctx, file, source };
     let nothing = |run: Run| (run, Derived::new());
+    let generated = |g: MotionGenerator| {
+        let here = format!("excitation.{}", source.name());
+        generate_motion(ctx, file, &here, g).map(|motion| nothing(Run::Inverse { motion }))
+    };
     match source {
         Source::ForceCsv(rel) => force_csv_run(ctx, file, &ctx.resolve(rel)).map(nothing),
         Source::SineForce(g) => {
+            let gen = Generated {
+                ctx,
+                file,
+                here: "excitation.sine_force".to_owned(),
+            };
             let record = generate::sine_force(
                 g.amplitude_n,
                 g.frequency_hz,
@@ -284,33 +292,14 @@ fn build_source(ctx: &Ctx, file: &ScenarioFile, source: Source) -> Result<(Run, 
             forward_run(ctx, file, record, samples, None).map(nothing)
         }
         Source::MotionCsv(rel) => motion_csv(ctx, file, &ctx.resolve(rel)),
-        Source::SineMotion(g) => generate::sine_motion(
-            g.amplitude_m,
-            g.frequency_hz,
-            g.sample_rate_hz,
-            gen.duration()?,
-        )
-        .map_err(|e| gen.error(e))
-        .map(|motion| nothing(Run::Inverse { motion })),
-        Source::TriangleMotion(g) => generate::triangle_motion(
-            g.amplitude_m,
-            g.velocity_m_s,
-            g.reversal_acceleration_m_s2,
-            g.sample_rate_hz,
-            gen.duration()?,
-        )
-        .map_err(|e| gen.error(e))
-        .map(|motion| nothing(Run::Inverse { motion })),
-        Source::WhiteNoiseMotion(g) => white_noise(&gen, g).map(nothing),
+        Source::SineMotion(g) => generated(MotionGenerator::Sine(single(ctx, source, g)?)),
+        Source::TriangleMotion(g) => generated(MotionGenerator::Triangle(single(ctx, source, g)?)),
+        Source::WhiteNoiseMotion(g) => {
+            generated(MotionGenerator::WhiteNoise(single(ctx, source, g)?))
+        }
         Source::GroundMotion(g) => {
             let here = "excitation.ground_motion";
-            let g = g.single().ok_or_else(|| {
-                ctx.invalid(
-                    here,
-                    "(per axis)",
-                    "one record: records per axis (x, y, z) need a multi-axis `table`",
-                )
-            })?;
+            let g = single(ctx, source, g)?;
             let motion = ground_motion(ctx, here, g, file.duration_s)?;
             let integral = "exact integral of a_m_s2 (straight lines between the record's samples)";
             let derived = Derived::from([
@@ -319,6 +308,93 @@ fn build_source(ctx: &Ctx, file: &ScenarioFile, source: Source) -> Result<(Run, 
             ]);
             Ok((Run::Inverse { motion }, derived))
         }
+    }
+}
+
+/// The one generator or record of a uniaxial excitation; one per axis is refused.
+fn single<'a, T>(ctx: &Ctx, source: Source, given: &'a PerAxisOr<T>) -> Result<&'a T> {
+    given.single().ok_or_else(|| {
+        ctx.invalid(
+            &format!("excitation.{}", source.name()),
+            "(per axis)",
+            "one source: sources per axis (x, y, z) need a multi-axis `table`",
+        )
+    })
+}
+
+/// A generated motion of the excitation (one axis's, on a multi-axis table).
+#[derive(Clone, Copy)]
+pub(crate) enum MotionGenerator<'a> {
+    /// `sine_motion`.
+    Sine(&'a SineMotion),
+    /// `triangle_motion`.
+    Triangle(&'a TriangleMotion),
+    /// `white_noise_motion`.
+    WhiteNoise(&'a WhiteNoiseMotion),
+}
+
+impl<'a> MotionGenerator<'a> {
+    /// The generators of `ex` per axis (x, y, z), with their key, if `ex` has one given
+    /// per axis.
+    pub(crate) fn per_axis(ex: &'a ExcitationSpec) -> Option<(&'static str, [Option<Self>; 3])> {
+        fn each<'a, T>(
+            g: &'a PerAxisOr<T>,
+            wrap: fn(&'a T) -> MotionGenerator<'a>,
+        ) -> Option<[Option<MotionGenerator<'a>>; 3]> {
+            g.per_axis().map(|a| a.each().map(|(_, g)| g.map(wrap)))
+        }
+        if let Some(g) = &ex.sine_motion {
+            return each(g, MotionGenerator::Sine).map(|a| ("sine_motion", a));
+        }
+        if let Some(g) = &ex.triangle_motion {
+            return each(g, MotionGenerator::Triangle).map(|a| ("triangle_motion", a));
+        }
+        if let Some(g) = &ex.white_noise_motion {
+            return each(g, MotionGenerator::WhiteNoise).map(|a| ("white_noise_motion", a));
+        }
+        None
+    }
+
+    /// The generator's sample rate, Hz.
+    pub(crate) fn sample_rate_hz(self) -> f64 {
+        match self {
+            MotionGenerator::Sine(g) => g.sample_rate_hz,
+            MotionGenerator::Triangle(g) => g.sample_rate_hz,
+            MotionGenerator::WhiteNoise(g) => g.sample_rate_hz,
+        }
+    }
+}
+
+/// The motion of generator `g`, over the scenario's `duration_s`; its errors are reported
+/// under `here` (`excitation.sine_motion`, or `excitation.sine_motion.x` per axis).
+pub(crate) fn generate_motion(
+    ctx: &Ctx,
+    file: &ScenarioFile,
+    here: &str,
+    g: MotionGenerator,
+) -> Result<Motion> {
+    let gen = Generated {
+        ctx,
+        file,
+        here: here.to_owned(),
+    };
+    match g {
+        MotionGenerator::Sine(g) => generate::sine_motion(
+            g.amplitude_m,
+            g.frequency_hz,
+            g.sample_rate_hz,
+            gen.duration()?,
+        )
+        .map_err(|e| gen.error(e)),
+        MotionGenerator::Triangle(g) => generate::triangle_motion(
+            g.amplitude_m,
+            g.velocity_m_s,
+            g.reversal_acceleration_m_s2,
+            g.sample_rate_hz,
+            gen.duration()?,
+        )
+        .map_err(|e| gen.error(e)),
+        MotionGenerator::WhiteNoise(g) => white_noise(&gen, g),
     }
 }
 
@@ -370,7 +446,8 @@ pub(crate) fn check_direction_fields(ctx: &Ctx, file: &ScenarioFile, is_force: b
 struct Generated<'a> {
     ctx: &'a Ctx<'a>,
     file: &'a ScenarioFile,
-    source: Source<'a>,
+    /// The generator's JSON path (`excitation.sine_motion`, `excitation.sine_motion.x`).
+    here: String,
 }
 
 impl Generated<'_> {
@@ -380,10 +457,7 @@ impl Generated<'_> {
             self.ctx.invalid(
                 "duration_s",
                 "(missing)",
-                format!(
-                    "a duration in s: excitation.{} has no length of its own",
-                    self.source.name()
-                ),
+                format!("a duration in s: {} has no length of its own", self.here),
             )
         })
     }
@@ -400,11 +474,9 @@ impl Generated<'_> {
                 name,
                 value,
                 expected,
-            } => self.ctx.invalid(
-                &format!("excitation.{}.{name}", self.source.name()),
-                value,
-                expected,
-            ),
+            } => self
+                .ctx
+                .invalid(&format!("{}.{name}", self.here), value, expected),
         }
     }
 }
@@ -551,21 +623,20 @@ fn restamp(t_s: Vec<f64>, m: &Motion) -> std::result::Result<Motion, platen_sign
 }
 
 /// `excitation.white_noise_motion`: band-limited white noise of the given RMS acceleration.
-fn white_noise(gen: &Generated, g: &WhiteNoiseMotion) -> Result<Run> {
+fn white_noise(gen: &Generated, g: &WhiteNoiseMotion) -> Result<Motion> {
     let rms = check_positive(
         gen.ctx,
-        "excitation.white_noise_motion.rms_acceleration_g",
+        &format!("{}.rms_acceleration_g", gen.here),
         g.rms_acceleration_g,
     )?;
-    let motion = generate::white_noise_motion(
+    generate::white_noise_motion(
         rms * STANDARD_GRAVITY_M_S2,
         (g.band_hz[0], g.band_hz[1]),
         g.seed,
         g.sample_rate_hz,
         gen.duration()?,
     )
-    .map_err(|e| gen.error(e))?;
-    Ok(Run::Inverse { motion })
+    .map_err(|e| gen.error(e))
 }
 
 /// A record the integrator's checks reject.

@@ -225,15 +225,19 @@ pub struct ExcitationSpec {
     /// Generated sine force: forward run.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sine_force: Option<SineForce>,
-    /// Generated sine displacement (the paper's S tests): inverse run.
+    /// Generated sine displacement (the paper's S tests): inverse run, or the command of a
+    /// closed loop. With a multi-axis `table`, per axis: `{"x": {…}, "z": {…}}`.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub sine_motion: Option<SineMotion>,
-    /// Generated triangle displacement with rounded reversals (the paper's T tests): inverse run.
+    pub sine_motion: Option<PerAxisOr<SineMotion>>,
+    /// Generated triangle displacement with rounded reversals (the paper's T tests): inverse
+    /// run, or a closed loop's command; per axis with a multi-axis `table`.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub triangle_motion: Option<TriangleMotion>,
-    /// Generated band-limited white-noise motion (the paper's WN tests): inverse run.
+    pub triangle_motion: Option<PerAxisOr<TriangleMotion>>,
+    /// Generated band-limited white-noise motion (the paper's WN tests): inverse run, or a
+    /// closed loop's command; per axis with a multi-axis `table` (give each axis its own
+    /// `seed` for uncorrelated axes).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub white_noise_motion: Option<WhiteNoiseMotion>,
+    pub white_noise_motion: Option<PerAxisOr<WhiteNoiseMotion>>,
     /// Table motion from a ground-acceleration record (an earthquake test): inverse run, or
     /// the command of a closed loop. With a multi-axis `table`, per axis:
     /// `{"x": {…}, "y": {…}, "z": {…}}` (the components of one station).
@@ -316,33 +320,41 @@ pub struct GroundMotion {
 
 /// `excitation.ground_motion`: one record (the uniaxial table's axis), or one per axis of a
 /// multi-axis table.
-#[derive(Debug, Clone, Serialize, JsonSchema)]
-#[serde(untagged)]
-pub enum GroundMotionSpec {
-    /// One record.
-    Single(GroundMotion),
-    /// One record per axis (any of x, y, z).
-    PerAxis(AxisGroundMotion),
-}
+pub type GroundMotionSpec = PerAxisOr<GroundMotion>;
 
 /// `excitation.ground_motion` per axis: the components of one station.
-#[derive(Debug, Clone, Default, Deserialize, Serialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct AxisGroundMotion {
-    /// The record along x (the table's longitudinal axis).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub x: Option<GroundMotion>,
-    /// The record along y.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub y: Option<GroundMotion>,
-    /// The vertical record.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub z: Option<GroundMotion>,
+pub type AxisGroundMotion = Axes<GroundMotion>;
+
+/// An excitation source given once (the uniaxial table's axis), or once per translational
+/// axis of a multi-axis table: `{"x": {…}, "y": {…}, "z": {…}}` (any of them; absent axes are
+/// held at zero). Rotations are commanded by a six-DOF `motion_csv`.
+#[derive(Debug, Clone, Serialize, JsonSchema)]
+#[serde(untagged)]
+pub enum PerAxisOr<T> {
+    /// One source.
+    Single(T),
+    /// One source per axis (any of x, y, z).
+    PerAxis(Axes<T>),
 }
 
-impl AxisGroundMotion {
-    /// The records along x, y, z.
-    pub fn each(&self) -> [(&'static str, Option<&GroundMotion>); 3] {
+/// One source per translational axis of a multi-axis table.
+#[derive(Debug, Clone, Default, Deserialize, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Axes<T> {
+    /// Along x (the table's longitudinal axis).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub x: Option<T>,
+    /// Along y.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub y: Option<T>,
+    /// Vertical.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub z: Option<T>,
+}
+
+impl<T> Axes<T> {
+    /// The sources along x, y, z.
+    pub fn each(&self) -> [(&'static str, Option<&T>); 3] {
         [
             ("x", self.x.as_ref()),
             ("y", self.y.as_ref()),
@@ -351,33 +363,52 @@ impl AxisGroundMotion {
     }
 }
 
-impl<'de> Deserialize<'de> for GroundMotionSpec {
-    /// An object whose keys are axes (`x`, `y`, `z`) is per axis, any other one record (so
-    /// that a typo in either is reported by the shape it was meant for).
+impl<'de, T: serde::de::DeserializeOwned> Deserialize<'de> for PerAxisOr<T> {
+    /// An object with an axis among its keys (`x`, `y`, `z`) is per axis, any other one
+    /// source (no source has a field of those names), so that a typo in either is reported
+    /// by the shape it was meant for.
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
         use serde::de::Error;
         let value = serde_json::Value::deserialize(d)?;
-        let per_axis = value.as_object().is_some_and(|o| {
-            !o.is_empty() && o.keys().all(|k| matches!(k.as_str(), "x" | "y" | "z"))
-        });
+        let per_axis = value
+            .as_object()
+            .is_some_and(|o| o.keys().any(|k| matches!(k.as_str(), "x" | "y" | "z")));
         if per_axis {
             serde_json::from_value(value)
-                .map(GroundMotionSpec::PerAxis)
-                .map_err(|e| D::Error::custom(format!("ground_motion per axis: {e}")))
+                .map(PerAxisOr::PerAxis)
+                .map_err(|e| {
+                    let rotations = ["roll", "pitch", "yaw"]
+                        .iter()
+                        .any(|r| e.to_string().contains(&format!("`{r}`")));
+                    let hint = if rotations {
+                        " (rotations are commanded by a six-DOF motion_csv)"
+                    } else {
+                        ""
+                    };
+                    D::Error::custom(format!("per axis: {e}{hint}"))
+                })
         } else {
             serde_json::from_value(value)
-                .map(GroundMotionSpec::Single)
+                .map(PerAxisOr::Single)
                 .map_err(D::Error::custom)
         }
     }
 }
 
-impl GroundMotionSpec {
-    /// The one record, if it is not per axis.
-    pub fn single(&self) -> Option<&GroundMotion> {
+impl<T> PerAxisOr<T> {
+    /// The one source, if it is not per axis.
+    pub fn single(&self) -> Option<&T> {
         match self {
-            GroundMotionSpec::Single(g) => Some(g),
-            GroundMotionSpec::PerAxis(_) => None,
+            PerAxisOr::Single(g) => Some(g),
+            PerAxisOr::PerAxis(_) => None,
+        }
+    }
+
+    /// The sources per axis, if given per axis.
+    pub fn per_axis(&self) -> Option<&Axes<T>> {
+        match self {
+            PerAxisOr::Single(_) => None,
+            PerAxisOr::PerAxis(axes) => Some(axes),
         }
     }
 }

@@ -34,6 +34,7 @@ use platen_system::{
 
 use crate::ctx::{check_finite, check_positive, Ctx};
 use crate::error::{Result, ScenarioError};
+use crate::excitation::MotionGenerator;
 use crate::excitation::{motion_run, read_mapped, Derived};
 use crate::file::{GroundMotionSpec, ScenarioFile, SpecimenSpec};
 use crate::scenario::Run;
@@ -510,9 +511,13 @@ fn build_run(
             return Err(ctx.invalid(key, "(given)", "nothing: not used by a multi-axis motion"));
         }
     }
-    let (motion, derived) = match (&ex.motion_csv, &ex.ground_motion) {
-        (Some(rel), None) => read_pose_motion(ctx, file, &ctx.resolve(rel))?,
-        (None, Some(GroundMotionSpec::PerAxis(axes))) => axis_ground_motion(ctx, file, axes)?,
+    let generators = MotionGenerator::per_axis(ex);
+    let (motion, derived) = match (&ex.motion_csv, &ex.ground_motion, generators) {
+        (Some(rel), None, None) => read_pose_motion(ctx, file, &ctx.resolve(rel))?,
+        (None, Some(GroundMotionSpec::PerAxis(axes)), None) => axis_ground_motion(ctx, file, axes)?,
+        (None, None, Some((key, axes))) if crate::excitation::named_sources(ex).len() == 1 => {
+            axis_generated_motion(ctx, file, key, axes)?
+        }
         _ => {
             let given = crate::excitation::named_sources(ex);
             let key = given
@@ -522,8 +527,9 @@ fn build_run(
                 &key,
                 "(given)",
                 "one of motion_csv (a six-DOF motion), ground_motion per axis \
-                 ({\"x\": {\"record\": …}, \"y\": …, \"z\": …}) or force_csv (`t_s` and \
-                 `{name}_force_n` per actuator: a forward run)",
+                 ({\"x\": {\"record\": …}, \"y\": …, \"z\": …}), sine_motion, \
+                 triangle_motion or white_noise_motion per axis ({\"x\": {…}, \"z\": {…}}) \
+                 or force_csv (`t_s` and `{name}_force_n` per actuator: a forward run)",
             ));
         }
     };
@@ -598,21 +604,11 @@ fn axis_ground_motion(
 ) -> Result<(PoseMotion, Derived)> {
     let here = "excitation.ground_motion";
     let mut motions: [Option<platen_signal::Motion>; 3] = [None, None, None];
-    let mut rate: Option<(f64, &str)> = None;
+    let mut rates = [None; 3];
     for (k, (axis, g)) in axes.each().into_iter().enumerate() {
         let Some(g) = g else { continue };
+        rates[k] = Some(g.sample_rate_hz);
         let at = format!("{here}.{axis}");
-        match rate {
-            Some((r, first)) if r != g.sample_rate_hz => {
-                return Err(ctx.invalid(
-                    &format!("{at}.sample_rate_hz"),
-                    g.sample_rate_hz,
-                    format!("the same rate as {here}.{first}.sample_rate_hz ({r} Hz)"),
-                ))
-            }
-            None => rate = Some((g.sample_rate_hz, axis)),
-            _ => {}
-        }
         motions[k] = Some(crate::excitation::ground_motion(
             ctx,
             &at,
@@ -620,12 +616,73 @@ fn axis_ground_motion(
             file.duration_s,
         )?);
     }
+    let integral =
+        "exact integral of the record's acceleration (straight lines between its samples)";
+    let derived = |k: usize| {
+        [
+            (RATE_COLUMNS[k], integral.to_owned()),
+            (POSE_COLUMNS[k], format!("{integral}, twice")),
+        ]
+    };
+    axis_motion(ctx, here, motions, rates, derived)
+}
+
+/// A generated motion per axis (`sine_motion`, `triangle_motion` or `white_noise_motion`
+/// under `excitation.{key}`): each axis's generator over the scenario's duration, the axes
+/// on one time grid (every generator at the same `sample_rate_hz`), the rotations and absent
+/// axes held at zero. The generators' velocities and accelerations are exact, not derived.
+fn axis_generated_motion(
+    ctx: &Ctx,
+    file: &ScenarioFile,
+    key: &str,
+    axes: [Option<MotionGenerator>; 3],
+) -> Result<(PoseMotion, Derived)> {
+    let here = format!("excitation.{key}");
+    let mut motions: [Option<platen_signal::Motion>; 3] = [None, None, None];
+    let mut rates = [None; 3];
+    for (k, g) in axes.into_iter().enumerate() {
+        let Some(g) = g else { continue };
+        rates[k] = Some(g.sample_rate_hz());
+        let at = format!("{here}.{}", AXES[k]);
+        motions[k] = Some(crate::excitation::generate_motion(ctx, file, &at, g)?);
+    }
+    axis_motion(ctx, &here, motions, rates, |_| [])
+}
+
+/// The translational axes' names, in order.
+const AXES: [&str; 3] = ["x", "y", "z"];
+
+/// The six-DOF motion of the given translational motions (each sampled at `rates_hz`), on
+/// one grid: the shortest motion's, all at one rate; the rotations and absent axes still.
+/// `derived(k)` names the channels of axis `k` that were derived, not given.
+fn axis_motion<const N: usize>(
+    ctx: &Ctx,
+    here: &str,
+    motions: [Option<platen_signal::Motion>; 3],
+    rates_hz: [Option<f64>; 3],
+    derived: impl Fn(usize) -> [(&'static str, String); N],
+) -> Result<(PoseMotion, Derived)> {
+    let mut first: Option<(f64, &str)> = None;
+    for (k, rate) in rates_hz.iter().enumerate() {
+        let Some(rate) = *rate else { continue };
+        match first {
+            Some((r, axis)) if r != rate => {
+                return Err(ctx.invalid(
+                    &format!("{here}.{}.sample_rate_hz", AXES[k]),
+                    rate,
+                    format!("the same rate as {here}.{axis}.sample_rate_hz ({r} Hz)"),
+                ))
+            }
+            None => first = Some((rate, AXES[k])),
+            _ => {}
+        }
+    }
     let n = motions
         .iter()
         .flatten()
         .map(platen_signal::Motion::len)
         .min()
-        .ok_or_else(|| ctx.invalid(here, "{}", "a record for at least one of x, y, z"))?;
+        .ok_or_else(|| ctx.invalid(here, "{}", "a source for at least one of x, y, z"))?;
     let t: Vec<f64> = motions
         .iter()
         .flatten()
@@ -637,14 +694,11 @@ fn axis_ground_motion(
         platen_signal::Motion::new(t.clone(), z.clone(), z.clone(), z)
     };
     let mut dofs = Vec::with_capacity(6);
-    let mut derived = Derived::new();
-    let integral =
-        "exact integral of the record's acceleration (straight lines between its samples)";
+    let mut notes = Derived::new();
     for k in 0..6 {
         let m = match motions.get(k).and_then(Option::as_ref) {
             Some(m) => {
-                derived.insert(RATE_COLUMNS[k], integral.to_owned());
-                derived.insert(POSE_COLUMNS[k], format!("{integral}, twice"));
+                notes.extend(derived(k));
                 m.clone().truncated(n)
             }
             None => still(),
@@ -653,7 +707,7 @@ fn axis_ground_motion(
     }
     let dofs: [platen_signal::Motion; 6] = dofs.try_into().expect("six DOFs");
     let motion = PoseMotion::new(dofs).map_err(|e| ctx.invalid(here, "", e.to_string()))?;
-    Ok((motion, derived))
+    Ok((motion, notes))
 }
 
 /// The LHPOST6 preset as written (`presets/lhpost6.json`, made by
@@ -1141,14 +1195,16 @@ pub struct AxisTracking {
     pub rms_error: f64,
     /// Largest |command − achieved|, m or rad.
     pub peak_error: f64,
-    /// RMS of the error over the RMS of the command (0 for a still command).
-    pub displacement_nrmse: f64,
+    /// RMS of the error over the RMS of the command (`null` for a still command: the
+    /// error is then absolute, `rms_error`, the cross-talk into that DOF).
+    pub displacement_nrmse: Option<f64>,
     /// RMS of the acceleration error (command's − achieved), m/s² or rad/s².
     pub rms_acceleration_error: f64,
     /// Largest |acceleration error|, m/s² or rad/s².
     pub peak_acceleration_error: f64,
-    /// RMS of the acceleration error over the RMS of the command's acceleration.
-    pub acceleration_nrmse: f64,
+    /// RMS of the acceleration error over the RMS of the command's acceleration (`null`
+    /// for a still command).
+    pub acceleration_nrmse: Option<f64>,
 }
 
 /// One axis's peaks against its limits (`table.limits`; `null` where none is given).
@@ -1259,10 +1315,15 @@ fn rms(x: impl Iterator<Item = f64>) -> f64 {
 }
 
 /// The tracking of a command `u_ref`, `a_ref` by the achieved `u`, `a`.
+/// `x` in percent with two decimals, `—` for none (a still command's relative error).
+fn percent(x: Option<f64>) -> String {
+    x.map_or("—".to_owned(), |x| format!("{:.2} %", 100.0 * x))
+}
+
 fn tracking(u_ref: &[f64], u: &[f64], a_ref: &[f64], a: &[f64]) -> AxisTracking {
     let err = |r: &[f64], x: &[f64]| -> Vec<f64> { r.iter().zip(x).map(|(r, x)| r - x).collect() };
     let (e, ea) = (err(u_ref, u), err(a_ref, a));
-    let ratio = |num: f64, den: f64| if den > 0.0 { num / den } else { 0.0 };
+    let ratio = |num: f64, den: f64| (den > 0.0).then(|| num / den);
     let (rms_e, rms_ea) = (rms(e.iter().copied()), rms(ea.iter().copied()));
     AxisTracking {
         rms_error: rms_e,
@@ -1545,14 +1606,14 @@ pub fn summary_text(s: &TableSummary, figures: &[PathBuf]) -> String {
             let u = d.unit();
             let _ = writeln!(
                 t,
-                "  {:<8}  {:>9.3e} {u:<3} {:>9.3e} {u:<3} {:>6.2} %  {:>9.3e} {u}/s²  {:>9.3e} {u}/s²  {:>6.2} %",
+                "  {:<8}  {:>9.3e} {u:<3} {:>9.3e} {u:<3} {:>8}  {:>9.3e} {u}/s²  {:>9.3e} {u}/s²  {:>8}",
                 d.name(),
                 a.rms_error,
                 a.peak_error,
-                100.0 * a.displacement_nrmse,
+                percent(a.displacement_nrmse),
                 a.rms_acceleration_error,
                 a.peak_acceleration_error,
-                100.0 * a.acceleration_nrmse
+                percent(a.acceleration_nrmse)
             );
         }
     }

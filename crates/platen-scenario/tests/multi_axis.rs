@@ -640,3 +640,194 @@ fn the_lhpost6_preset_meets_its_published_figures() {
         assert!(m.stable, "{dof} unstable");
     }
 }
+
+/// The scenario `doc` (a table and an excitation), written to `dir` and loaded.
+fn scenario_of(dir: &Path, doc: &Value) -> Result<TableScenario, String> {
+    let path = dir.join("s.json");
+    let text = doc.to_string();
+    std::fs::write(&path, &text).unwrap();
+    let file = parse(&path, &text).map_err(|e| e.to_string())?;
+    TableScenario::from_file(&path, &file).map_err(|e| e.to_string())
+}
+
+/// Generated motions per axis: each axis is its generator's closed form (here a sine,
+/// `A·sin(2πft)` with its exact rate and acceleration), the absent axes and the rotations
+/// are still, and the inverse forces are those of the same motion given as a six-DOF
+/// `motion_csv` written here from the closed form (to 1e-9 relative: both are the
+/// inverse of one motion; only the CSV's printed digits, 17 significant, separate them).
+#[test]
+fn generated_motions_per_axis_are_their_closed_forms_on_their_axes() {
+    let dir = tempfile::tempdir().unwrap();
+    let (ax, fx, az, fz, rate) = (0.05, 1.0, 0.004, 2.5, 200.0);
+    let doc = json!({"table": tower_table(), "duration_s": 2.0, "excitation": {"sine_motion": {
+        "x": {"amplitude_m": ax, "frequency_hz": fx, "sample_rate_hz": rate},
+        "z": {"amplitude_m": az, "frequency_hz": fz, "sample_rate_hz": rate}}}});
+    let run = scenario_of(dir.path(), &doc).unwrap().run().unwrap();
+    let t = run.column("t_s").unwrap().to_vec();
+    assert_eq!(t.len(), 401, "2 s at 200 Hz, both ends");
+    let tau = std::f64::consts::TAU;
+    for (name, a, f, order) in [
+        ("x_m", ax, fx, 0),
+        ("x_m_s", ax, fx, 1),
+        ("x_m_s2", ax, fx, 2),
+        ("z_m", az, fz, 0),
+        ("z_m_s2", az, fz, 2),
+    ] {
+        let w = tau * f;
+        for (i, (&ti, &got)) in t.iter().zip(run.column(name).unwrap()).enumerate() {
+            let want = match order {
+                0 => a * (w * ti).sin(),
+                1 => a * w * (w * ti).cos(),
+                _ => -a * w * w * (w * ti).sin(),
+            };
+            let scale = a * w.powi(order);
+            assert!(
+                (got - want).abs() <= 1e-12 * scale,
+                "{name}[{i}] = {got}, closed form {want}"
+            );
+        }
+    }
+    for still in ["y_m", "roll_rad", "pitch_rad", "yaw_rad", "y_m_s2"] {
+        assert!(
+            run.column(still).unwrap().iter().all(|&v| v == 0.0),
+            "{still}"
+        );
+    }
+    // The same motion as a six-DOF CSV, from the closed form.
+    let mut text = String::from("t_s,x_m,x_m_s,x_m_s2,z_m,z_m_s,z_m_s2\n");
+    for &ti in &t {
+        let (wx, wz) = (tau * fx, tau * fz);
+        let row = [
+            ti,
+            ax * (wx * ti).sin(),
+            ax * wx * (wx * ti).cos(),
+            -ax * wx * wx * (wx * ti).sin(),
+            az * (wz * ti).sin(),
+            az * wz * (wz * ti).cos(),
+            -az * wz * wz * (wz * ti).sin(),
+        ];
+        text += &row
+            .iter()
+            .map(|v| format!("{v:.16e}"))
+            .collect::<Vec<_>>()
+            .join(",");
+        text += "\n";
+    }
+    let from_csv = scenario(dir.path(), json!({"table": tower_table()}), &text)
+        .unwrap()
+        .run()
+        .unwrap();
+    let mut compared = 0;
+    for (name, col) in &run.columns {
+        if !name.ends_with("_force_n") {
+            continue;
+        }
+        let other = from_csv.column(name).unwrap();
+        let peak = col.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for (a, b) in col.iter().zip(other) {
+            assert!((a - b).abs() <= 1e-9 * peak, "{name}: {a} against {b}");
+        }
+        compared += 1;
+    }
+    assert!(compared >= 6, "{compared} force columns");
+}
+
+/// Per-axis generators in closed loop: white noise on x and y with their own seeds is the
+/// loop's command, each axis the uniaxial generator's motion of the same values (the
+/// `command_x_m` column equals a uniaxial inverse run's `u_m` of that generator, to the bit),
+/// z and the rotations still.
+#[test]
+fn generated_motions_per_axis_command_the_closed_loop() {
+    let dir = tempfile::tempdir().unwrap();
+    let noise = |seed: u64| {
+        json!({"rms_acceleration_g": 0.05, "band_hz": [1.0, 20.0], "seed": seed,
+            "sample_rate_hz": 1024.0})
+    };
+    let doc = json!({"table": loop_table(), "duration_s": 2.0,
+        "excitation": {"white_noise_motion": {"x": noise(3), "y": noise(4)}}});
+    let run = scenario_of(dir.path(), &doc).unwrap().run().unwrap();
+    let (cx, cy) = (
+        run.column("command_x_m").unwrap(),
+        run.column("command_y_m").unwrap(),
+    );
+    assert!(run.column("command_z_m").unwrap().iter().all(|&v| v == 0.0));
+    // The uniaxial generator of seed 3 and seed 4, as a uniaxial inverse run writes them.
+    for (seed, command) in [(3, cx), (4, cy)] {
+        let path = dir.path().join("u.json");
+        let uni = json!({"model": {"preset": "lhpost-2008"}, "duration_s": 2.0,
+            "excitation": {"white_noise_motion": noise(seed)}});
+        let text = uni.to_string();
+        let file = parse(&path, &text).unwrap();
+        let run = platen_scenario::Scenario::from_file(&path, file)
+            .unwrap()
+            .run;
+        let platen_scenario::Run::Inverse { motion: u } = run else {
+            panic!("a generated motion is an inverse run")
+        };
+        assert_eq!(u.u_m().len(), command.len());
+        assert!(
+            u.u_m().iter().zip(command).all(|(a, b)| a == b),
+            "seed {seed}"
+        );
+    }
+    assert!(
+        cx.iter().zip(cy).any(|(a, b)| a != b),
+        "each axis its own seed"
+    );
+}
+
+/// Per-axis generators refused with their path: a rate that differs between axes, a bad
+/// value on one axis, a rotation (a six-DOF motion_csv commands those), two generators at
+/// once, one generator not given per axis on a table, and per-axis on the uniaxial table.
+#[test]
+fn bad_generated_motions_per_axis_are_refused_with_their_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let sine = |a: f64, f: f64, rate: f64| json!({"amplitude_m": a, "frequency_hz": f, "sample_rate_hz": rate});
+    let cases = [
+        (
+            json!({"sine_motion": {"x": sine(0.01, 1.0, 1024.0), "y": sine(0.01, 1.0, 512.0)}}),
+            "excitation.sine_motion.y.sample_rate_hz",
+        ),
+        (
+            json!({"sine_motion": {"x": sine(0.01, 1.0, 1024.0), "z": sine(0.01, -1.0, 1024.0)}}),
+            "excitation.sine_motion.z.frequency_hz",
+        ),
+        (
+            json!({"white_noise_motion": {"y": {"rms_acceleration_g": -0.1}}}),
+            "excitation.white_noise_motion.y.rms_acceleration_g",
+        ),
+        (
+            json!({"sine_motion": {"x": sine(0.01, 1.0, 1024.0), "roll": sine(0.01, 1.0, 1024.0)}}),
+            "six-DOF motion_csv",
+        ),
+        (
+            json!({"sine_motion": {"x": sine(0.01, 1.0, 1024.0)},
+                "white_noise_motion": {"y": {"rms_acceleration_g": 0.1}}}),
+            "excitation.sine_motion",
+        ),
+        (json!({"sine_motion": sine(0.01, 1.0, 1024.0)}), "per axis"),
+        (
+            json!({"triangle_motion": {"x": {"amplitude_m": 0.01, "velocity_m_s": 1.0,
+                "reversal_acceleration_m_s2": 1.0}}}),
+            "excitation.triangle_motion.x.reversal_acceleration_m_s2",
+        ),
+    ];
+    for (excitation, expect) in cases {
+        let doc = json!({"table": loop_table(), "duration_s": 1.0, "excitation": excitation});
+        let err = scenario_of(dir.path(), &doc).unwrap_err();
+        assert!(err.contains(expect), "expected `{expect}` in: {err}");
+    }
+    // Per axis on the uniaxial table.
+    let path = dir.path().join("u.json");
+    let uni = json!({"model": {"preset": "lhpost-2008"}, "duration_s": 1.0,
+        "excitation": {"sine_motion": {"x": sine(0.01, 1.0, 1024.0)}}});
+    let text = uni.to_string();
+    let file = parse(&path, &text).unwrap();
+    let err = platen_scenario::Scenario::from_file(&path, file)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("excitation.sine_motion") && err.contains("multi-axis"),
+        "{err}"
+    );
+}
