@@ -312,14 +312,14 @@ pub struct Correction {
 
 /// The correction band `w(f)`: 1 inside `hz`, half-cosine roll-offs over its lowest and
 /// highest `edge_fraction`, 0 outside.
-struct Band {
-    hz: (f64, f64),
-    edge_fraction: f64,
+pub(crate) struct Band {
+    pub(crate) hz: (f64, f64),
+    pub(crate) edge_fraction: f64,
 }
 
 impl Band {
     /// `w(f)`.
-    fn weight(&self, f: f64) -> f64 {
+    pub(crate) fn weight(&self, f: f64) -> f64 {
         let (lo, hi) = self.hz;
         let e = self.edge_fraction;
         if f < lo || f > hi {
@@ -392,7 +392,7 @@ impl Band {
 }
 
 /// `n` ones tapered to zero by a half-cosine over `taper_n` samples at both ends.
-fn half_cosine_taper(n: usize, taper_n: usize) -> Vec<f64> {
+pub(crate) fn half_cosine_taper(n: usize, taper_n: usize) -> Vec<f64> {
     let mut taper = vec![1.0; n];
     for j in 0..taper_n {
         let w = 0.5 - 0.5 * (std::f64::consts::PI * j as f64 / taper_n as f64).cos();
@@ -485,12 +485,16 @@ impl DriveCorrection {
 }
 
 /// The settings checked, with the band and padding resolved.
-struct Checked {
-    band_hz: (f64, f64),
-    pad_s: f64,
+pub(crate) struct Checked {
+    pub(crate) band_hz: (f64, f64),
+    pub(crate) pad_s: f64,
 }
 
-fn checked(s: &IterationSettings, sample_rate_hz: f64, samples: usize) -> Result<Checked> {
+pub(crate) fn checked(
+    s: &IterationSettings,
+    sample_rate_hz: f64,
+    samples: usize,
+) -> Result<Checked> {
     check_setting(
         "gain",
         s.gain,
@@ -550,7 +554,7 @@ fn checked(s: &IterationSettings, sample_rate_hz: f64, samples: usize) -> Result
 }
 
 /// The smallest length `≥ n` whose only prime factors are 2, 3 and 5 (fast for the FFT).
-fn fft_size(n: usize) -> usize {
+pub(crate) fn fft_size(n: usize) -> usize {
     let mut m = n.max(1);
     loop {
         let mut r = m;
@@ -584,13 +588,17 @@ pub fn nrmse(x: &[f64], reference: &[f64]) -> f64 {
 }
 
 /// The response spectrum of the error report and the target's own spectrum.
-struct SpectrumCheck {
+pub(crate) struct SpectrumCheck {
     spectrum: ResponseSpectrum,
     target: Vec<f64>,
 }
 
 impl SpectrumCheck {
-    fn new(settings: &SpectrumSettings, sample_rate_hz: f64, target_a: &[f64]) -> Result<Self> {
+    pub(crate) fn new(
+        settings: &SpectrumSettings,
+        sample_rate_hz: f64,
+        target_a: &[f64],
+    ) -> Result<Self> {
         let (lo, hi) = settings.periods_s;
         let periods = ResponseSpectrum::log_periods_s(lo, hi, settings.count)?;
         let spectrum = ResponseSpectrum::new(&periods, settings.damping_ratio, sample_rate_hz)?;
@@ -599,7 +607,7 @@ impl SpectrumCheck {
     }
 
     /// The largest relative error and its period.
-    fn error(&self, achieved_a: &[f64]) -> (f64, f64) {
+    pub(crate) fn error(&self, achieved_a: &[f64]) -> (f64, f64) {
         let psa = self.spectrum.pseudo_acceleration_m_s2(achieved_a);
         let mut worst = (0.0, self.spectrum.oscillators()[0].period_s());
         for ((p, t), o) in psa
@@ -752,28 +760,28 @@ fn acceleration_error(target_a: &[f64], achieved_a: &[f64]) -> Vec<f64> {
 }
 
 /// The best run of [`iterate_with`] so far.
-struct BestRun<R> {
+pub(crate) struct BestRun<R, D = Vec<f64>> {
     /// Its iteration.
-    k: usize,
+    pub(crate) k: usize,
     /// Its drive, m.
-    drive: Vec<f64>,
+    pub(crate) drive: D,
     /// What it achieved.
-    achieved: R,
+    pub(crate) achieved: R,
     /// Its acceleration NRMSE.
-    nrmse: f64,
+    pub(crate) nrmse: f64,
 }
 
 /// How [`iterate_with`] is doing: its best run so far and the iterations since the last
 /// improvement.
-struct Progress<R> {
-    best: Option<BestRun<R>>,
-    without_improvement: usize,
+pub(crate) struct Progress<R, D = Vec<f64>> {
+    pub(crate) best: Option<BestRun<R, D>>,
+    pub(crate) without_improvement: usize,
 }
 
-impl<R> Progress<R> {
+impl<R, D> Progress<R, D> {
     /// Counts a run of acceleration NRMSE `nrmse` as an improvement (on the best by more than
     /// `min_improvement`, relative) or not, and says whether it is the new best.
-    fn judge(&mut self, nrmse: f64, min_improvement: f64) -> bool {
+    pub(crate) fn judge(&mut self, nrmse: f64, min_improvement: f64) -> bool {
         let best = self.best.as_ref();
         let improved = best.is_none_or(|b| nrmse < b.nrmse * (1.0 - min_improvement));
         let is_best = best.is_none_or(|b| nrmse < b.nrmse);
@@ -830,7 +838,7 @@ fn iteration_record<R: Response>(
     }
 }
 
-fn signed_peak(x: &[f64]) -> f64 {
+pub(crate) fn signed_peak(x: &[f64]) -> f64 {
     x.iter()
         .copied()
         .fold(0.0, |m: f64, v| if v.abs() > m.abs() { v } else { m })

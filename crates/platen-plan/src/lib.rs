@@ -76,6 +76,7 @@ mod error;
 pub mod feasibility;
 pub mod frf;
 pub mod iterate;
+pub mod mimo;
 mod plan;
 mod table;
 mod target;
@@ -87,6 +88,10 @@ pub use frf::{FrequencyResponse, FrfSource, NoiseSettings};
 pub use iterate::{
     iterate, iterate_observed, iterate_with, Iteration, IterationRecord, IterationSettings,
     Response, Stop,
+};
+pub use mimo::{
+    iterate_mimo, AxisRecord, AxisTarget, MimoCorrection, MimoIteration, MimoRecord, MimoResponse,
+    TransferMatrix,
 };
 pub use plan::{
     load_rig, plan, plan_observed, plan_table, write_drive, DriveSummary, FrfSummary, Plan,

@@ -139,6 +139,50 @@ impl TableScenario {
     /// Every bad value with its JSON path (`table.actuators[2].platen_m`, …) and every error
     /// of the motion record (with file and line); a file without `table` is refused.
     pub fn from_file(path: &Path, file: &ScenarioFile) -> Result<Self> {
+        Self::build(path, file, None)
+    }
+
+    /// The closed loop of a scenario file that has a `table` with a `controller`, commanded
+    /// by `command` instead of the file's excitation (which is ignored, and may be absent):
+    /// what `platen plan` drives.
+    ///
+    /// # Errors
+    /// As [`TableScenario::from_file`]; a table without a `controller`.
+    pub fn commanded_from_file(
+        path: &Path,
+        file: &ScenarioFile,
+        command: PoseMotion,
+    ) -> Result<Self> {
+        Self::build(path, file, Some(command))
+    }
+
+    /// The same closed loop commanded by `command`.
+    ///
+    /// # Errors
+    /// [`ScenarioError::Invalid`] if this scenario is not a closed loop.
+    pub fn commanded(&self, command: PoseMotion) -> Result<Self> {
+        if self.system.is_none() {
+            let ctx = Ctx {
+                path: Path::new(&self.name),
+            };
+            return Err(ctx.invalid(
+                "table.controller",
+                "(absent)",
+                "a DOF controller: only a closed loop follows a command",
+            ));
+        }
+        Ok(TableScenario {
+            run: TableRunSpec::Loop {
+                command: Box::new(command),
+            },
+            derived: Derived::new(),
+            ..self.clone()
+        })
+    }
+
+    /// [`TableScenario::from_file`], or with `command` as the closed loop's command in
+    /// place of the file's excitation.
+    fn build(path: &Path, file: &ScenarioFile, command: Option<PoseMotion>) -> Result<Self> {
         let ctx = Ctx { path };
         let Some(given) = &file.table else {
             return Err(ctx.invalid("table", "(absent)", "a multi-axis table"));
@@ -179,7 +223,22 @@ impl TableScenario {
             )?),
             None => None,
         };
-        let (run, derived) = build_run(&ctx, file, &table, closed)?;
+        let (run, derived) = match command {
+            None => build_run(&ctx, file, &table, closed)?,
+            Some(_) if !closed => {
+                return Err(ctx.invalid(
+                    "table.controller",
+                    "(absent)",
+                    "a DOF controller: only a closed loop follows a command",
+                ))
+            }
+            Some(command) => (
+                TableRunSpec::Loop {
+                    command: Box::new(command),
+                },
+                Derived::new(),
+            ),
+        };
         let pressure = |key: &str, v: Option<f64>, default: f64| match v {
             Some(p) => check_positive(&ctx, &format!("table.{key}"), p),
             None => Ok(default),
