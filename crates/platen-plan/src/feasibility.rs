@@ -166,7 +166,7 @@ pub struct MaxScale {
     /// The linear estimate `1/max ratio` from the unscaled run.
     pub linear_estimate: f64,
     /// The limits that fail at the bracket's upper end, worst first.
-    pub limiting: Vec<&'static str>,
+    pub limiting: Vec<String>,
     /// Closed-loop runs spent.
     pub runs: usize,
 }
@@ -241,14 +241,42 @@ fn max_scale_from(
     settings: &MaxScaleSettings,
     unscaled: &[LimitUse],
 ) -> Result<MaxScale> {
-    let (tol, lo_bound, hi_bound) = checked(settings)?;
     let worst = unscaled.iter().map(|u| u.ratio).fold(0.0, f64::max);
-    let unscaled_fits = unscaled.iter().all(LimitUse::respected);
+    let unscaled_failing: Vec<String> = failing(unscaled)
+        .iter()
+        .map(|u| u.limit.to_owned())
+        .collect();
+    search_max_scale(settings, worst, unscaled_failing, &mut |s| {
+        let u: Vec<f64> = motion.u_m.iter().map(|x| x * s).collect();
+        match table.run_or_end_stop(&motion.t_s, &u, "a scaled command") {
+            Ok(a) => failing(&limit_uses(table, &a))
+                .iter()
+                .map(|u| u.limit.to_owned())
+                .collect(),
+            Err(_) => vec!["run_failed".to_owned()],
+        }
+    })
+}
+
+/// The search of [`max_scale`] on any plant: `failing_at(s)` runs the command scaled by `s`
+/// and names the limits that fail (none: it fits; `run_failed` for a run that failed);
+/// `worst` is the unscaled run's largest ratio and `unscaled_failing` what fails unscaled
+/// (see the [module documentation](self)). Returns the answer with the runs spent here.
+///
+/// # Errors
+/// [`crate::PlanError::Setting`] for bad [`MaxScaleSettings`].
+pub fn search_max_scale(
+    settings: &MaxScaleSettings,
+    worst: f64,
+    unscaled_failing: Vec<String>,
+    failing_at: &mut dyn FnMut(f64) -> Vec<String>,
+) -> Result<MaxScale> {
+    let (tol, lo_bound, hi_bound) = checked(settings)?;
+    let unscaled_fits = unscaled_failing.is_empty();
     let linear_estimate = if worst > 0.0 { 1.0 / worst } else { hi_bound };
     let start = linear_estimate.clamp(lo_bound, hi_bound);
     let mut search = Search {
-        table,
-        motion,
+        failing_at,
         bounds: (lo_bound, hi_bound),
         linear_estimate,
         lo: f64::NAN,
@@ -261,7 +289,7 @@ fn max_scale_from(
         search.lo = 1.0;
     } else {
         search.hi = 1.0;
-        search.hi_failing = failing(unscaled).iter().map(|u| u.limit).collect();
+        search.hi_failing = unscaled_failing;
     }
     search.around(start);
     if let Some(found) = search.grow() {
@@ -296,34 +324,24 @@ fn checked(settings: &MaxScaleSettings) -> Result<(f64, f64, f64)> {
 
 /// The state of [`max_scale_from`]'s search: the bracket `[lo (fits), hi (fails)]` (NaN
 /// while an end is not known), what fails at `hi`, and the closed-loop runs spent.
-struct Search<'s, 't> {
-    table: &'s Table<'t>,
-    motion: &'s TargetMotion,
+struct Search<'f> {
+    /// The limits that fail at a scale.
+    failing_at: &'f mut dyn FnMut(f64) -> Vec<String>,
     /// `[min_scale, max_scale]`.
     bounds: (f64, f64),
     linear_estimate: f64,
     lo: f64,
     hi: f64,
-    hi_failing: Vec<&'static str>,
+    hi_failing: Vec<String>,
     runs: usize,
 }
 
-impl Search<'_, '_> {
+impl Search<'_> {
     /// Whether the command scaled by `s` fits, and what fails.
-    fn fits(&mut self, s: f64) -> (bool, Vec<&'static str>) {
+    fn fits(&mut self, s: f64) -> (bool, Vec<String>) {
         self.runs += 1;
-        let motion = self.motion;
-        let u: Vec<f64> = motion.u_m.iter().map(|x| x * s).collect();
-        match self
-            .table
-            .run_or_end_stop(&motion.t_s, &u, "a scaled command")
-        {
-            Ok(a) => {
-                let f = failing(&limit_uses(self.table, &a));
-                (f.is_empty(), f.iter().map(|u| u.limit).collect())
-            }
-            Err(_) => (false, vec!["run_failed"]),
-        }
+        let f = (self.failing_at)(s);
+        (f.is_empty(), f)
     }
 
     /// Runs `s` and makes it the lower end if it fits, else the upper end.

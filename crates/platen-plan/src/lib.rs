@@ -78,12 +78,15 @@ pub mod frf;
 pub mod iterate;
 pub mod mimo;
 mod plan;
+pub mod six_dof;
 mod table;
 mod target;
 
 pub use baseline::{command_motion, BaselineSettings, EndCorrection, TargetMotion};
 pub use error::{PlanError, Result};
-pub use feasibility::{max_scale, Feasibility, LimitUse, MaxScale, MaxScaleSettings};
+pub use feasibility::{
+    max_scale, search_max_scale, Feasibility, LimitUse, MaxScale, MaxScaleSettings,
+};
 pub use frf::{FrequencyResponse, FrfSource, NoiseSettings};
 pub use iterate::{
     iterate, iterate_observed, iterate_with, Iteration, IterationRecord, IterationSettings,
@@ -96,6 +99,10 @@ pub use mimo::{
 pub use plan::{
     load_rig, plan, plan_observed, plan_table, write_drive, DriveSummary, FrfSummary, Plan,
     PlanSettings, PlanSummary, PlannedDrive, TargetSummary,
+};
+pub use six_dof::{
+    plan_multi_axis, pose_command, AxisTargets, TableAchieved, TableFeasibility, TableLimitUse,
+    TablePlan, TablePlanSettings, TablePlant,
 };
 pub use table::{Achieved, Table};
 pub use target::{Target, TargetKind, MIN_TARGET_SAMPLES};

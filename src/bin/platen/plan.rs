@@ -25,15 +25,18 @@ use crate::progress::Progress;
 #[derive(clap::Args)]
 pub struct Args {
     /// Scenario JSON file with a `table_system` (its model, table system, specimen and limits
-    /// are used; its excitation, if any, is ignored: the target takes its place).
+    /// are used; its excitation, if any, is ignored: the target takes its place), or with a
+    /// multi-axis `table` and its `controller` (a three-component plan).
     pub scenario: PathBuf,
     /// Target CSV: `t_s` and `a_m_s2` (an acceleration record), or `t_s` and `u_m` (a
     /// displacement), uniformly sampled at most at the controller's rate (a slower target is
-    /// put on the controller's rate).
+    /// put on the controller's rate). On a multi-axis table: `t_s` and any of `x_m_s2`,
+    /// `y_m_s2`, `z_m_s2` (or `x_m`, `y_m`, `z_m`); absent axes are held at zero.
     #[arg(long, value_name = "TARGET.csv")]
     pub target: PathBuf,
     /// Write the drive (`t_s`, `u_m`: the displacement command, at the controller's rate) to
-    /// this CSV file.
+    /// this CSV file; on a multi-axis table the six-DOF command (`t_s`, `x_m` … `yaw_rad`), a
+    /// `motion_csv` that `simulate` replays.
     #[arg(long, value_name = "DRIVE.csv", value_parser = crate::usage::OutFile("drive.csv"))]
     pub out: PathBuf,
     /// Most drive corrections (0: run the target's own command only).
@@ -56,6 +59,10 @@ pub struct Args {
     /// Do not search the largest scale that fits (saves about ten closed-loop runs).
     #[arg(long)]
     pub no_max_scale: bool,
+    /// Multi-axis scenarios: also search the largest scale of each axis, the others as given
+    /// (about ten closed-loop runs per axis).
+    #[arg(long)]
+    pub per_axis_scale: bool,
     /// Print the plan as JSON on stdout.
     #[arg(long)]
     pub json: bool,
@@ -153,6 +160,9 @@ pub fn run(args: &Args) -> Result<()> {
         max_scale: (!args.no_max_scale).then(MaxScaleSettings::default),
         ..Default::default()
     };
+    if let Some(file) = multi_axis_scenario(&args.scenario)? {
+        return run_table(args, &file);
+    }
     // The drive's temporary file first: an unwritable destination fails before any run.
     let mut writer = CsvWriter::create(&args.out, &["t_s", "u_m"])?;
     let rig = load_rig(&args.scenario).map_err(cli_error)?;
@@ -205,5 +215,108 @@ pub fn run(args: &Args) -> Result<()> {
             args.report.as_deref()
         )
     );
+    Ok(())
+}
+
+/// The scenario at `path` if it is a multi-axis one (it has a `table`), parsed, its
+/// `excitation` optional (the target takes its place); `None` for any other file, which the
+/// uniaxial planner reads and reports on.
+fn multi_axis_scenario(
+    path: &std::path::Path,
+) -> Result<Option<platen_scenario::file::ScenarioFile>> {
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return Ok(None);
+    };
+    let Ok(mut value) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return Ok(None);
+    };
+    let Some(object) = value.as_object_mut().filter(|o| o.contains_key("table")) else {
+        return Ok(None);
+    };
+    if object.contains_key("excitation") {
+        return Ok(Some(platen_io::json::parse_json(path, &text)?));
+    }
+    // No excitation: an empty one, which a commanded table does not read.
+    object.insert("excitation".into(), serde_json::json!({}));
+    let pretty = serde_json::to_string_pretty(&value)?;
+    Ok(Some(platen_io::json::parse_json(path, &pretty)?))
+}
+
+/// `platen plan` on a multi-axis scenario (one with a `table` and its `controller`): the
+/// three-component plan ([`platen_plan::six_dof`]).
+fn run_table(args: &Args, file: &platen_scenario::file::ScenarioFile) -> Result<()> {
+    use platen_plan::six_dof::summary_text;
+    use platen_plan::{plan_multi_axis, AxisTargets, TablePlanSettings};
+    if matches!(args.frf, Frf::Measured) {
+        anyhow::bail!(
+            "--frf measured: a multi-axis table's drives are iterated through its linearised \
+             transfer matrix (a measured matrix FRF is not available yet): leave --frf out or \
+             give --frf linearised"
+        );
+    }
+    if args.plot.is_some() || args.report.is_some() {
+        anyhow::bail!(
+            "--plot and --report: the figures of a three-component plan are not drawn yet; \
+             `--json` gives every figure the text reports, per axis and per iteration"
+        );
+    }
+    let settings = TablePlanSettings {
+        iteration: platen_plan::IterationSettings {
+            max_iterations: usize::from(args.iterations),
+            gain: args.gain,
+            target_nrmse: args.target_nrmse,
+            band_hz: args.band_hz,
+            ..Default::default()
+        },
+        max_scale: (!args.no_max_scale).then(MaxScaleSettings::default),
+        per_axis_max_scale: args.per_axis_scale,
+        ..Default::default()
+    };
+    if args.per_axis_scale && args.no_max_scale {
+        anyhow::bail!("--per-axis-scale searches scales: it cannot go with --no-max-scale");
+    }
+    // The drive's temporary file first: an unwritable destination fails before any run.
+    let mut writer = CsvWriter::create(
+        &args.out,
+        &[
+            "t_s",
+            "x_m",
+            "y_m",
+            "z_m",
+            "roll_rad",
+            "pitch_rad",
+            "yaw_rad",
+        ],
+    )?;
+    let targets = AxisTargets::read_csv(&args.target).map_err(cli_error)?;
+    let progress = Progress::new(
+        u64::from(args.iterations) + 1,
+        "{bar:30} {pos}/{len} runs of the drive iteration, {elapsed_precise} elapsed",
+    );
+    let on_run = &mut |k: usize| progress.set_position(k as u64 + 1);
+    let p = plan_multi_axis(&args.scenario, file, &targets, &settings, on_run);
+    progress.finish();
+    let p = p.map_err(cli_error)?;
+    let (_, columns) = p.drive_columns();
+    let mut row = vec![0.0; columns.len()];
+    for j in 0..columns[0].len() {
+        for (r, c) in row.iter_mut().zip(&columns) {
+            *r = c[j];
+        }
+        writer.write_row(&row)?;
+    }
+    writer.finish()?;
+    let summary = p.summary(&settings, Some(&args.out));
+    for warning in &summary.warnings {
+        eprintln!("warning: {warning}");
+    }
+    if args.json {
+        outln!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::to_value(&summary)?)?
+        );
+        return Ok(());
+    }
+    out!("{}", summary_text(&summary));
     Ok(())
 }
