@@ -8,7 +8,9 @@
 //! displacement `x_m`, `y_m`, `z_m` ([`AxisTargets`]); absent axes are held at zero as a
 //! target (their cross-talk is error). Each axis's command is made as the single-axis plan
 //! makes it ([`crate::TargetMotion`]: integrated with a baseline treatment that starts and
-//! ends at rest, within the axis's stroke). The rotations are commanded still and left to the
+//! ends at rest, within the axis's stroke), at the target's own rate (at most the
+//! controller's: the controller interpolates the command between its samples, as it does a
+//! `motion_csv`'s). The rotations are commanded still and left to the
 //! DOF controller (a rotation target is not taken yet).
 //!
 //! # Feasibility
@@ -16,9 +18,11 @@
 //! The table's closed loop runs the target's own commands and its peaks are held against
 //! ([`TableLimitUse`]): per axis its stroke, velocity and acceleration (`table.limits`, where
 //! given); per actuator its stroke, its force against the push and pull it can exert at the
-//! supply pressure (for a single-acting vertical actuator the pull limit is zero: a negative
-//! force is **uplift**, which it cannot resist), and its flow against its valves' capacity at
-//! the supply pressure; the overturning moment on the specimen against
+//! supply pressure, and its flow against its valves' capacity at the supply pressure; for a
+//! single-acting vertical actuator its **uplift**: its force falling from its static share
+//! `F₀` (the first sample's) towards zero, ratio `(F₀ − F_min)/((1 − r)·F₀)` with the residual
+//! `r` = [`UPLIFT_RESIDUAL`] (its chamber cannot pull: unloaded, it nears the cavitation floor
+//! and no longer holds the platen down); the overturning moment on the specimen against
 //! `table.limits.overturning_moment_n_m`. A limit fails when its ratio (peak over allowed)
 //! exceeds 1; `limiting` lists those that fail, worst first, and `binds_first` the one
 //! exceeded earliest, with when. The largest common scale that fits is found by bisection
@@ -206,6 +210,10 @@ impl MimoResponse for TableAchieved {
     }
 }
 
+/// The share of a single-acting actuator's static force below which it counts as lifted off
+/// (`{name}.uplift`): 1 %.
+pub const UPLIFT_RESIDUAL: f64 = 0.01;
+
 /// One limit of a multi-axis table against a run's peak.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct TableLimitUse {
@@ -343,6 +351,23 @@ pub fn limit_uses(scenario: &TableScenario, r: &TableRun) -> Vec<TableLimitUse> 
             pull,
             push,
         ));
+        let force = col(&format!("{name}_force_n"));
+        if a.rod_side_area_m2 == 0.0 && force.first().is_some_and(|&f0| f0 > 0.0) {
+            // Single-acting: its share of the static hold is its preload; losing it all
+            // (below UPLIFT_RESIDUAL of it) the chamber nears the cavitation floor and the
+            // actuator no longer holds the platen down.
+            let f0 = force[0];
+            let mut u = use_of(
+                format!("{name}.uplift"),
+                t,
+                &force.iter().map(|f| f0 - f).collect::<Vec<_>>(),
+                f64::NEG_INFINITY,
+                (1.0 - UPLIFT_RESIDUAL) * f0,
+            );
+            u.peak = f0 - u.peak;
+            u.allowed = UPLIFT_RESIDUAL * f0;
+            uses.push(u);
+        }
         if let (Some(c), Some(flow)) = (&capacities, r.column(&format!("{name}_flow_m3_s"))) {
             uses.push(use_of(format!("{name}.flow_m3_s"), t, flow, -c[i], c[i]));
         }
@@ -503,7 +528,7 @@ pub fn plan_multi_axis(
             controller_hz,
         });
     }
-    // Each axis's command, on the controller's rate (a slower target is put on it).
+    // Each axis's command.
     let mut motions = BTreeMap::new();
     let strokes = scenario.limits.each();
     for (k, target) in targets.axes().iter().enumerate() {
@@ -519,7 +544,11 @@ pub fn plan_multi_axis(
                     .reduce(f64::max)
             })
             .unwrap_or(f64::INFINITY);
-        let motion = TargetMotion::new(target, &settings.baseline, stroke, controller_hz)?;
+        // At the target's own rate: the controller interpolates the command between its
+        // samples (as it does a `motion_csv`'s), and the correction band ends below the
+        // target's Nyquist frequency.
+        let motion =
+            TargetMotion::new(target, &settings.baseline, stroke, target.sample_rate_hz())?;
         motions.insert(AXES[k], motion);
     }
     let t_s: Vec<f64> = motions
@@ -553,6 +582,7 @@ pub fn plan_multi_axis(
     let drives0: Vec<Vec<f64>> = axis_targets.iter().map(|a| a.u_m.clone()).collect();
     // Feasibility of the target's own commands.
     let first = plant.run(&drives0)?;
+    let cavitation_at_first = first.stats.cavitation_at_s;
     let uses = limit_uses(&scenario, &first.run);
     let limiting = failing(&uses);
     let binds_first = limiting
@@ -645,6 +675,12 @@ pub fn plan_multi_axis(
     )?;
     let drive_uses = limit_uses(&scenario, &iteration.achieved.run);
     let mut warnings = Vec::new();
+    if let Some(t) = cavitation_at_first {
+        warnings.push(format!(
+            "the target's own commands cavitate a chamber at {t:.3} s: an actuator unloads \
+             completely there (see the `.uplift` limits)"
+        ));
+    }
     if let Some(w) = feasibility.limiting.first() {
         warnings.push(format!(
             "the target is not feasible: {} reaches {:.3} times its limit at {:.3} s",

@@ -1,9 +1,15 @@
 //! The three-component plan on the LHPOST6 preset with a tall eccentric specimen (the shipped
 //! `scenarios/multi-axis/lhpost6-northridge.json`: 120 t, 12 m tower), the target Northridge
-//! at Tarzana, three components at 50 %: the drives iterated through the transfer matrix
-//! reduce every axis's acceleration NRMSE to below a third of its first within 10
-//! iterations; the drive written to CSV and replayed through `simulate` is the plan's best
-//! run to the bit; `max_scale` agrees with a scan of the simulated loop within 0.5 %.
+//! at Tarzana, three components.
+//!
+//! * At 50 % (the level) the table cannot run it with this tower: the tower's rocking
+//!   unloads vertical actuators to their chambers' cavitation floor. The plan says so (not
+//!   feasible, a vertical actuator's uplift limiting, the cavitation warned of) instead of
+//!   iterating towards a drive the table cannot follow.
+//! * At 25 %, which fits, the drives iterated through the transfer matrix reduce every axis's
+//!   acceleration NRMSE to below a third of its first within 10 iterations; the drive
+//!   written to CSV and replayed through `simulate` is the plan's best run to the bit;
+//!   `max_scale` agrees with a scan of the simulated loop (steps of 0.25 %) within 0.5 %.
 //!
 //! Needs the PEER records (`PLATEN_RECORDS_DIR`); release only: a 40 s closed loop of the
 //! six-DOF table takes minutes unoptimised, so `.ci/run` runs this file with `--release`.
@@ -44,15 +50,46 @@ fn northridge_three_components_on_the_lhpost6_with_a_tower() {
         panic!("a closed loop")
     };
     let t = command.dof(platen_model::multi_axis::Dof::X).t_s().to_vec();
-    let axes = [
-        platen_model::multi_axis::Dof::X,
-        platen_model::multi_axis::Dof::Y,
-        platen_model::multi_axis::Dof::Z,
-    ]
-    .map(|d| {
-        Some(Target::acceleration(&path, t.clone(), command.dof(d).a_m_s2().to_vec()).unwrap())
-    });
-    let targets = AxisTargets::new(Path::new("tarzana-50"), axes).unwrap();
+    let targets_at = |scale: f64| {
+        let axes = [
+            platen_model::multi_axis::Dof::X,
+            platen_model::multi_axis::Dof::Y,
+            platen_model::multi_axis::Dof::Z,
+        ]
+        .map(|d| {
+            let a = command.dof(d).a_m_s2().iter().map(|a| a * scale).collect();
+            Some(Target::acceleration(&path, t.clone(), a).unwrap())
+        });
+        AxisTargets::new(Path::new("tarzana"), axes).unwrap()
+    };
+    // 50 %: not feasible, an actuator lifted off, cavitation warned of.
+    let few = TablePlanSettings {
+        iteration: platen_plan::IterationSettings {
+            max_iterations: 1,
+            ..Default::default()
+        },
+        ..TablePlanSettings::default()
+    };
+    let full = plan_multi_axis(&path, &file, &targets_at(1.0), &few, &mut |_| {}).unwrap();
+    for u in &full.feasibility.limiting {
+        eprintln!("50 %: {} {:.3} at {:.3} s", u.limit, u.ratio, u.t_s);
+    }
+    assert!(!full.feasibility.feasible);
+    assert!(
+        full.feasibility
+            .limiting
+            .iter()
+            .any(|u| u.limit.starts_with('v') && u.limit.ends_with(".uplift")),
+        "{:?}",
+        full.feasibility.limiting
+    );
+    assert!(
+        full.warnings.iter().any(|w| w.contains("cavitate")),
+        "{:?}",
+        full.warnings
+    );
+    // 25 %: iterated, replayed, scaled.
+    let targets = targets_at(0.5);
     let settings = TablePlanSettings {
         max_scale: Some(MaxScaleSettings::default()),
         ..TablePlanSettings::default()
@@ -100,7 +137,7 @@ fn northridge_three_components_on_the_lhpost6_with_a_tower() {
             "{n1} differs"
         );
     }
-    // max_scale against a scan of the loop: every 0.25 % from 2 % below to 2 % above it.
+    // max_scale against a scan of the loop: every 0.25 % from 1 % below to 1 % above it.
     let m = plan.feasibility.max_scale.as_ref().unwrap();
     eprintln!(
         "max_scale {:.5} ({:?}), runs {}",
@@ -115,7 +152,7 @@ fn northridge_three_components_on_the_lhpost6_with_a_tower() {
     let plant = TablePlant::new(&scan_scenario, &t);
     let drives0: Vec<Vec<f64>> = plan.targets.iter().map(|a| a.u_m.clone()).collect();
     let mut largest_fitting = 0.0;
-    for step in -8..=8 {
+    for step in -4..=4 {
         let s = m.scale * (1.0 + 0.0025 * f64::from(step));
         let drives: Vec<Vec<f64>> = drives0
             .iter()
