@@ -643,6 +643,7 @@ def plan(
     frf: str = "auto",
     band_hz: Optional[Tuple[float, float]] = None,
     max_scale: bool = True,
+    per_axis_scale: bool = False,
 ) -> Dict[str, Any]:
     """Plans a test as ``platen plan`` does: can the scenario's table run the target, what
     limits it, the largest scale that fits, and the drive (displacement command) that makes
@@ -665,10 +666,24 @@ def plan(
     drive's; the target's ``file`` is ``"target"`` and the drive's ``out`` is None).
     An infeasible target is an answer (``summary["feasible"]`` is False), not an error.
 
+    **A multi-axis table** (a scenario with a ``table`` and its ``controller``): give the
+    target per axis, ``target_a_m_s2={"x": ..., "y": ..., "z": ...}`` (any of them; absent
+    axes are held at zero; ``target_u_m`` likewise for displacements, for axes without an
+    acceleration). The plan is the three-component one (feasibility per axis and per
+    actuator, the largest common scale, and with ``per_axis_scale=True`` each axis's, the
+    drives iterated through the transfer matrix; ``frf`` must be ``"auto"`` or
+    ``"linearised"``). Returns ``drive_t_s``, ``drive`` (a dict of float64 arrays ``x_m`` …
+    ``yaw_rad``: the six-DOF ``motion_csv`` that ``--out`` writes) and ``summary``.
+
     Raises ScenarioError (a ValueError) for bad input, with the CLI's message;
     SimulationError if a closed-loop run fails.
     """
     path, text, origin = _scenario(scenario)
+    if isinstance(target_a_m_s2, dict) or isinstance(target_u_m, dict):
+        return _plan_table(
+            path, text, origin, target_t_s, target_a_m_s2 or {}, target_u_m or {},
+            iterations, gain, target_nrmse, frf, band_hz, max_scale, per_axis_scale,
+        )
     if (target_a_m_s2 is None) == (target_u_m is None):
         raise ScenarioError("target: give exactly one of target_a_m_s2 and target_u_m")
     t = _array(target_t_s, "target_t_s", "target")
@@ -680,13 +695,32 @@ def plan(
             f"`target`: target_t_s has {len(t)} samples, the target's values {len(values)}: "
             "expected the same number"
         )
+    iterations, gain, target_nrmse, band = _plan_checks(iterations, gain, target_nrmse, band_hz)
+    drive_t, drive_u, summary = _native(
+        _platen.plan,
+        path,
+        text,
+        origin,
+        t,
+        a,
+        u,
+        iterations,
+        gain,
+        target_nrmse,
+        str(frf),
+        band,
+        bool(max_scale),
+    )
+    return {"drive_t_s": drive_t, "drive_u_m": drive_u, "summary": json.loads(summary)}
+
+
+def _plan_checks(iterations, gain, target_nrmse, band_hz):
+    """The iteration's settings, checked as ``plan`` checks them."""
     if isinstance(iterations, bool) or not isinstance(iterations, numbers.Integral) or not (
         0 <= int(iterations) <= 200
     ):
         raise ScenarioError(f"iterations = {iterations!r}: expected a whole number from 0 to 200")
-    if gain is None:
-        gain = 0.7
-    gain = float(gain)
+    gain = 0.7 if gain is None else float(gain)
     if not (0.0 < gain < 2.0):
         raise ScenarioError(f"gain = {gain}: expected a gain in (0, 2)")
     target_nrmse = float(target_nrmse)
@@ -698,22 +732,48 @@ def plan(
         if not (math.isfinite(lo) and math.isfinite(hi) and 0.0 < lo < hi):
             raise ScenarioError(f"band_hz = {band_hz!r}: expected (lo, hi) with 0 < lo < hi, Hz")
         band = (lo, hi)
-    drive_t, drive_u, summary = _native(
-        _platen.plan,
-        path,
-        text,
-        origin,
-        t,
-        a,
-        u,
-        int(iterations),
-        gain,
-        target_nrmse,
-        str(frf),
-        band,
-        bool(max_scale),
+    return int(iterations), gain, target_nrmse, band
+
+
+def _plan_table(path, text, origin, target_t_s, accelerations, displacements, iterations,
+                gain, target_nrmse, frf, band_hz, max_scale, per_axis_scale):
+    """``plan`` with per-axis targets: the three-component plan of a multi-axis table."""
+    if str(frf) not in ("auto", "linearised"):
+        raise ScenarioError(
+            f"frf = {frf!r}: a multi-axis table's drives are iterated through its linearised "
+            "transfer matrix: expected \"auto\" or \"linearised\""
+        )
+    t = _array(target_t_s, "target_t_s", "target")
+    axes = []
+    for kind, given, name in (("acceleration", accelerations, "target_a_m_s2"),
+                              ("displacement", displacements, "target_u_m")):
+        if not isinstance(given, dict):
+            raise ScenarioError(f"{name}: per axis, a dict {{\"x\": ..., \"y\": ..., \"z\": ...}}")
+        for axis, values in given.items():
+            if axis not in ("x", "y", "z"):
+                raise ScenarioError(f"{name}[{axis!r}]: expected an axis among x, y, z")
+            if kind == "displacement" and axis in accelerations:
+                raise ScenarioError(f"{name}[{axis!r}]: axis {axis} has an acceleration already")
+            v = _array(values, f"{name}[{axis!r}]", "target")
+            if len(v) != len(t):
+                raise ScenarioError(
+                    f"`target`: target_t_s has {len(t)} samples, {name}[{axis!r}] {len(v)}: "
+                    "expected the same number"
+                )
+            axes.append((axis, kind, v))
+    if not axes:
+        raise ScenarioError("target: give at least one axis (x, y, z)")
+    iterations, gain, target_nrmse, band = _plan_checks(iterations, gain, target_nrmse, band_hz)
+    drive_t, columns, summary = _native(
+        _platen.plan_table, path, text, origin, t, axes, iterations, gain, target_nrmse, band,
+        bool(max_scale), bool(per_axis_scale),
     )
-    return {"drive_t_s": drive_t, "drive_u_m": drive_u, "summary": json.loads(summary)}
+    names = ["x_m", "y_m", "z_m", "roll_rad", "pitch_rad", "yaw_rad"]
+    return {
+        "drive_t_s": drive_t,
+        "drive": dict(zip(names, columns)),
+        "summary": json.loads(summary),
+    }
 
 
 def schema() -> Dict[str, Any]:

@@ -56,6 +56,32 @@ use crate::iterate::IterationSettings;
 use crate::mimo::{iterate_mimo, AxisTarget, MimoIteration, MimoResponse, TransferMatrix};
 use crate::target::{Target, TargetKind, MIN_TARGET_SAMPLES};
 
+/// The scenario JSON `text` (from `path`, for messages) if it is a multi-axis one (it has a
+/// `table`), parsed, its `excitation` optional (a plan's target takes its place, and a
+/// commanded table does not read it); `None` for any other text (not JSON, or no `table`),
+/// which the single-axis planner reads and reports on.
+///
+/// # Errors
+/// [`PlanError::Io`] for a multi-axis scenario that does not parse (its path and line).
+pub fn table_scenario_file(path: &Path, text: &str) -> Result<Option<ScenarioFile>> {
+    let Ok(mut value) = serde_json::from_str::<serde_json::Value>(text) else {
+        return Ok(None);
+    };
+    let Some(object) = value.as_object_mut().filter(|o| o.contains_key("table")) else {
+        return Ok(None);
+    };
+    if object.contains_key("excitation") {
+        return Ok(Some(platen_io::json::parse_json(path, text)?));
+    }
+    // No excitation: an empty one.
+    object.insert("excitation".into(), serde_json::json!({}));
+    let pretty = serde_json::to_string_pretty(&value).map_err(|e| IoError::Record {
+        path: path.to_owned(),
+        message: e.to_string(),
+    })?;
+    Ok(Some(platen_io::json::parse_json(path, &pretty)?))
+}
+
 /// The translational axes a target gives, in order.
 pub const AXES: [&str; 3] = ["x", "y", "z"];
 const ACCELERATION: [&str; 3] = ["x_m_s2", "y_m_s2", "z_m_s2"];

@@ -112,3 +112,92 @@ pub fn plan<'py>(
         None => (None, None, summary),
     })
 }
+
+/// What `plan_table` hands to Python: the drive's time stamps, its six columns (`x_m` …
+/// `yaw_rad`) and the summary as JSON text.
+type TablePlanParts<'py> = (
+    Bound<'py, PyArray1<f64>>,
+    Vec<Bound<'py, PyArray1<f64>>>,
+    String,
+);
+
+/// Plans a three-component target (per axis `(name, kind, values)` at `t_s`, `kind`
+/// `acceleration` or `displacement`) on a multi-axis scenario file or dict's JSON text:
+/// `platen.plan` with per-axis targets.
+#[pyfunction]
+#[pyo3(signature = (path, text, origin, t_s, axes, iterations, gain, target_nrmse, band_hz, max_scale, per_axis_scale))]
+#[allow(clippy::too_many_arguments)]
+pub fn plan_table<'py>(
+    py: Python<'py>,
+    path: Option<PathBuf>,
+    text: Option<String>,
+    origin: String,
+    t_s: PyReadonlyArray1<'py, f64>,
+    axes: Vec<(String, String, PyReadonlyArray1<'py, f64>)>,
+    iterations: usize,
+    gain: f64,
+    target_nrmse: f64,
+    band_hz: Option<(f64, f64)>,
+    max_scale: bool,
+    per_axis_scale: bool,
+) -> PyResult<TablePlanParts<'py>> {
+    let t_s = vector(&t_s)?;
+    let axes: Vec<(String, String, Vec<f64>)> = axes
+        .iter()
+        .map(|(n, k, v)| Ok((n.clone(), k.clone(), vector(v)?)))
+        .collect::<PyResult<_>>()?;
+    let (t, columns, summary) = detached(py, move || {
+        let (path, text) = match (path, text) {
+            (Some(path), _) => {
+                let text = std::fs::read_to_string(&path).map_err(|e| {
+                    Fail::input(format!("`{}`: cannot be read: {e}", path.display()))
+                })?;
+                (path, text)
+            }
+            (None, Some(text)) => (PathBuf::from(&origin), text),
+            (None, None) => return Err(Fail::input("no scenario: give a path or a dict")),
+        };
+        let file = platen_plan::six_dof::table_scenario_file(&path, &text)?
+            .ok_or_else(|| Fail::input("per-axis targets need a scenario with a `table`"))?;
+        let origin = Path::new("target");
+        let mut given: [Option<Target>; 3] = [None, None, None];
+        for (name, kind, values) in axes {
+            let k = platen_plan::six_dof::AXES
+                .iter()
+                .position(|a| *a == name)
+                .ok_or_else(|| {
+                    Fail::input(format!("target axis `{name}`: expected one of x, y, z"))
+                })?;
+            given[k] = Some(match kind.as_str() {
+                "acceleration" => Target::acceleration(origin, t_s.clone(), values)?,
+                _ => Target::displacement(origin, t_s.clone(), values)?,
+            });
+        }
+        let targets = platen_plan::AxisTargets::new(origin, given)?;
+        let settings = platen_plan::TablePlanSettings {
+            iteration: platen_plan::IterationSettings {
+                max_iterations: iterations,
+                gain,
+                target_nrmse,
+                band_hz,
+                ..Default::default()
+            },
+            max_scale: (max_scale || per_axis_scale).then(MaxScaleSettings::default),
+            per_axis_max_scale: per_axis_scale,
+            ..Default::default()
+        };
+        let p = platen_plan::plan_multi_axis(&path, &file, &targets, &settings, &mut |_| {})
+            .map_err(|e| match e {
+                PlanError::TargetRate { .. } => Fail::input(chain(&e)),
+                e => e.into(),
+            })?;
+        let (_, mut columns) = p.drive_columns();
+        let t = columns.remove(0);
+        Ok((t, columns, json_text(&p.summary(&settings, None))?))
+    })?;
+    Ok((
+        t.into_pyarray(py),
+        columns.into_iter().map(|c| c.into_pyarray(py)).collect(),
+        summary,
+    ))
+}

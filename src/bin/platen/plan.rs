@@ -218,28 +218,16 @@ pub fn run(args: &Args) -> Result<()> {
     Ok(())
 }
 
-/// The scenario at `path` if it is a multi-axis one (it has a `table`), parsed, its
-/// `excitation` optional (the target takes its place); `None` for any other file, which the
-/// uniaxial planner reads and reports on.
+/// The scenario at `path` if it is a multi-axis one (it has a `table`), parsed
+/// ([`platen_plan::six_dof::table_scenario_file`]); `None` for any other file (or one that
+/// cannot be read), which the uniaxial planner reads and reports on.
 fn multi_axis_scenario(
     path: &std::path::Path,
 ) -> Result<Option<platen_scenario::file::ScenarioFile>> {
     let Ok(text) = std::fs::read_to_string(path) else {
         return Ok(None);
     };
-    let Ok(mut value) = serde_json::from_str::<serde_json::Value>(&text) else {
-        return Ok(None);
-    };
-    let Some(object) = value.as_object_mut().filter(|o| o.contains_key("table")) else {
-        return Ok(None);
-    };
-    if object.contains_key("excitation") {
-        return Ok(Some(platen_io::json::parse_json(path, &text)?));
-    }
-    // No excitation: an empty one, which a commanded table does not read.
-    object.insert("excitation".into(), serde_json::json!({}));
-    let pretty = serde_json::to_string_pretty(&value)?;
-    Ok(Some(platen_io::json::parse_json(path, &pretty)?))
+    platen_plan::six_dof::table_scenario_file(path, &text).map_err(cli_error)
 }
 
 /// `platen plan` on a multi-axis scenario (one with a `table` and its `controller`): the
