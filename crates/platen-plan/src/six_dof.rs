@@ -517,6 +517,9 @@ pub struct TablePlan {
     pub feasibility: TableFeasibility,
     /// The drive iteration.
     pub iteration: MimoIteration<TableAchieved>,
+    /// The acceleration the target's own commands achieved (iteration 0), per axis (x, y,
+    /// z), m/s².
+    pub first_a_m_s2: Vec<Vec<f64>>,
     /// The best drive's limits.
     pub drive_uses: Vec<TableLimitUse>,
     /// What an engineer should look at.
@@ -609,6 +612,7 @@ pub fn plan_multi_axis(
     // Feasibility of the target's own commands.
     let first = plant.run(&drives0)?;
     let cavitation_at_first = first.stats.cavitation_at_s;
+    let first_a_m_s2: Vec<Vec<f64>> = (0..3).map(|i| first.a_m_s2(i).to_vec()).collect();
     let uses = limit_uses(&scenario, &first.run);
     let limiting = failing(&uses);
     let binds_first = limiting
@@ -733,6 +737,7 @@ pub fn plan_multi_axis(
         motions,
         feasibility,
         iteration,
+        first_a_m_s2,
         drive_uses,
         warnings,
     })

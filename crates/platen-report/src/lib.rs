@@ -83,6 +83,7 @@ pub mod sweep_report;
 pub mod system_figures;
 pub mod system_identify_report;
 pub mod table_figures;
+pub mod table_plan_figures;
 pub mod text;
 
 pub use error::{ReportError, Result};

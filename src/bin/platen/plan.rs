@@ -242,10 +242,10 @@ fn run_table(args: &Args, file: &platen_scenario::file::ScenarioFile) -> Result<
              give --frf linearised"
         );
     }
-    if args.plot.is_some() || args.report.is_some() {
+    if args.report.is_some() {
         anyhow::bail!(
-            "--plot and --report: the figures of a three-component plan are not drawn yet; \
-             `--json` gives every figure the text reports, per axis and per iteration"
+            "--report: a three-component plan has no HTML report yet; --plot DIR writes its \
+             figures and --json every figure the text reports, per axis and per iteration"
         );
     }
     let settings = TablePlanSettings {
@@ -295,16 +295,26 @@ fn run_table(args: &Args, file: &platen_scenario::file::ScenarioFile) -> Result<
     }
     writer.finish()?;
     let summary = p.summary(&settings, Some(&args.out));
+    let figures = platen_report::write_outputs(
+        args.plot.as_deref(),
+        None,
+        &args.size.size(),
+        || platen_report::table_plan_figures::figures(&p),
+        |_, _| String::new(),
+    )?;
     for warning in &summary.warnings {
         eprintln!("warning: {warning}");
     }
     if args.json {
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&serde_json::to_value(&summary)?)?
-        );
+        let value = serde_json::to_value(&summary)?;
+        let figures = args.plot.as_ref().map(|_| figures.as_slice());
+        let value = with_outputs(value, figures, None);
+        outln!("{}", serde_json::to_string_pretty(&value)?);
         return Ok(());
     }
     out!("{}", summary_text(&summary));
+    for f in &figures {
+        outln!("wrote {}", f.display());
+    }
     Ok(())
 }
