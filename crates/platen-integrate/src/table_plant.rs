@@ -34,7 +34,7 @@
 //! it pushes on the platen with its restoring forces and feels the platen's acceleration less
 //! gravity's, so the coupling is explicit.
 
-use nalgebra::DVector;
+use nalgebra::{DVector, DVectorView};
 use nalgebra::{Vector2, Vector3};
 use platen_model::multi_axis::{
     angular_velocity, planar_rate, Coords, Dof, Frame, FrictionCapacity, LinearSpecimen,
@@ -219,6 +219,9 @@ pub(crate) struct At {
     w: f64,
 }
 
+/// A specimen's restoring forces at an instant (its first `n`), N or N·m.
+type SpecimenForces = [f64; MAX_TABLE_SPECIMEN_DOFS];
+
 /// The actuator forces at an instant, N.
 pub(crate) type Forces = [f64; MAX_TABLE_ACTUATORS];
 
@@ -395,22 +398,24 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
         dy[V]
     }
 
-    /// The specimen's DOFs and rates in `y`.
-    fn specimen_state(s: &LinearSpecimen, y: &Y<L>) -> (DVector<f64>, DVector<f64>) {
+    /// The specimen's DOFs and rates in `y` (`n` each).
+    fn specimen_state<'y>(s: &LinearSpecimen, y: &'y Y<L>) -> (&'y [f64], &'y [f64]) {
         let n = s.len();
-        (
-            DVector::from_fn(n, |i, _| y[Z + i]),
-            DVector::from_fn(n, |i, _| y[Z + n + i]),
-        )
+        (&y[Z..Z + n], &y[Z + n..Z + 2 * n])
+    }
+
+    /// The specimen's restoring forces `C·ż + K·z` at `y`, on the stack (its first `n`).
+    fn specimen_restoring(s: &LinearSpecimen, y: &Y<L>) -> SpecimenForces {
+        let (z, zd) = Self::specimen_state(s, y);
+        let mut r = [0.0; MAX_TABLE_SPECIMEN_DOFS];
+        s.restoring_into(z, zd, &mut r);
+        r
     }
 
     /// The specimen's push on the platen at `y` (zero without one).
     fn specimen_push(&self, y: &Y<L>) -> Wrench {
         match self.specimen {
-            Some(s) => {
-                let (z, zd) = Self::specimen_state(s, y);
-                s.wrench_on_platen(&z, &zd)
-            }
+            Some(s) => s.wrench_from_restoring(&Self::specimen_restoring(s, y)),
             None => Wrench::zeros(),
         }
     }
@@ -422,14 +427,19 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
             return;
         };
         let n = s.len();
-        let (z, zd) = Self::specimen_state(s, y);
+        let (_, zd) = Self::specimen_state(s, y);
         let a = platen_acceleration(&(*q, *qd, *qdd)) - GRAVITY;
-        let zdd = s.accelerations(&z, &zd, &a);
+        let mut zdd = [0.0; MAX_TABLE_SPECIMEN_DOFS];
+        s.accelerations_into(&Self::specimen_restoring(s, y), &a, &mut zdd);
         for i in 0..n {
             dy[Z + i] = zd[i];
             dy[Z + n + i] = zdd[i];
         }
-        dy[crate::machine::SD] = zd.dot(&(s.damping() * &zd));
+        let mut czd = [0.0; MAX_TABLE_SPECIMEN_DOFS];
+        s.damping_forces_into(zd, &mut czd);
+        // `żᵀ·(C·ż)` by nalgebra's dot, as on owned vectors (the same sums in the same order).
+        dy[crate::machine::SD] =
+            DVectorView::from_slice(zd, n).dot(&DVectorView::from_slice(&czd[..n], n));
     }
 
     /// The rates at rest in the plane: the in-plane coordinates held by friction.

@@ -21,6 +21,31 @@ pub struct LinearSpecimen {
     influence: DMatrix<f64>,
     /// The Cholesky factor's inverse product `M⁻¹`, kept for the rates.
     mass_inverse: DMatrix<f64>,
+    /// `Γᵀ` (`6 × n`), kept for the wrench on the platen.
+    influence_transpose: DMatrix<f64>,
+}
+
+/// `out = A·x` for `A` stored column by column (`out.len()` rows, `x.len()` columns), as
+/// nalgebra's `A * x` computes it (its gemv, one column at a time): `outᵢ = Aᵢ₀·x₀`, then
+/// `outᵢ = Aᵢⱼ·xⱼ + outᵢ` for `j` rising. Each number is therefore the same, bit for bit, as
+/// the allocating product's (tested against it).
+#[inline(always)]
+fn product_into(a: &[f64], x: &[f64], out: &mut [f64]) {
+    let rows = out.len();
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = row_product(a, rows, i, x);
+    }
+}
+
+/// Row `i` of `A·x` (`A` stored column by column with `rows` rows, `x.len()` columns) in the
+/// order of [`product_into`].
+#[inline(always)]
+fn row_product(a: &[f64], rows: usize, i: usize, x: &[f64]) -> f64 {
+    let mut sum = a[i] * x[0];
+    for (j, xj) in x.iter().enumerate().skip(1) {
+        sum = a[j * rows + i] * xj + sum;
+    }
+    sum
 }
 
 fn invalid(path: &str, expected: impl Into<String>) -> ModelError {
@@ -94,6 +119,7 @@ impl LinearSpecimen {
         }
         Ok(LinearSpecimen {
             mass_inverse: chol.inverse(),
+            influence_transpose: influence.transpose(),
             mass,
             stiffness,
             damping,
@@ -170,6 +196,70 @@ impl LinearSpecimen {
         -(&self.influence * platen) - &self.mass_inverse * self.restoring(z, zd)
     }
 
+    /// [`restoring`](Self::restoring) into `out` without allocating: `z`, `zd` and `out` are
+    /// `n` long (one per DOF), and every number has the bits [`restoring`](Self::restoring)
+    /// gives (the same products and sums in the same order, see [`product_into`]). For the
+    /// right-hand side of an integrator, which takes it at every stage.
+    ///
+    /// # Panics
+    /// If a slice is shorter than `n`.
+    #[inline]
+    pub fn restoring_into(&self, z: &[f64], zd: &[f64], out: &mut [f64]) {
+        let n = self.len();
+        let (z, zd, out) = (&z[..n], &zd[..n], &mut out[..n]);
+        product_into(self.stiffness.as_slice(), z, out);
+        for (i, o) in out.iter_mut().enumerate() {
+            // `K·z + C·ż` adds `(K·z)ᵢ + (C·ż)ᵢ`, element by element.
+            *o += row_product(self.damping.as_slice(), n, i, zd);
+        }
+    }
+
+    /// [`wrench_on_platen`](Self::wrench_on_platen) from its restoring forces `restoring`
+    /// (`n` long, [`restoring_into`](Self::restoring_into)) without allocating, to the bit.
+    ///
+    /// # Panics
+    /// If `restoring` is shorter than `n`.
+    #[inline]
+    pub fn wrench_from_restoring(&self, restoring: &[f64]) -> Wrench {
+        let n = self.len();
+        let restoring = &restoring[..n];
+        let mut w = Wrench::zeros();
+        product_into(
+            self.influence_transpose.as_slice(),
+            restoring,
+            w.as_mut_slice(),
+        );
+        w
+    }
+
+    /// [`accelerations`](Self::accelerations) from its restoring forces `restoring` (`n`
+    /// long, [`restoring_into`](Self::restoring_into)) into `out` (`n` long) without
+    /// allocating, to the bit.
+    ///
+    /// # Panics
+    /// If a slice is shorter than `n`.
+    #[inline]
+    pub fn accelerations_into(&self, restoring: &[f64], platen: &Wrench, out: &mut [f64]) {
+        let n = self.len();
+        let (restoring, out) = (&restoring[..n], &mut out[..n]);
+        product_into(self.influence.as_slice(), platen.as_slice(), out);
+        for (i, o) in out.iter_mut().enumerate() {
+            // `−(Γ·a) − M⁻¹·(C·ż + K·z)`, element by element.
+            *o = -*o - row_product(self.mass_inverse.as_slice(), n, i, restoring);
+        }
+    }
+
+    /// Its damping forces `C·ż` into `out` without allocating (`zd` and `out` `n` long), to
+    /// the bit of `damping() * ż`.
+    ///
+    /// # Panics
+    /// If a slice is shorter than `n`.
+    #[inline]
+    pub fn damping_forces_into(&self, zd: &[f64], out: &mut [f64]) {
+        let n = self.len();
+        product_into(self.damping.as_slice(), &zd[..n], &mut out[..n]);
+    }
+
     /// Its static deflection under a steady platen acceleration `a` (gravity as the
     /// acceleration `−g`): `K·z = −M·Γ·a`. `None` if the stiffness is singular.
     pub fn equilibrium_under(&self, a: &Wrench) -> Option<DVector<f64>> {
@@ -233,5 +323,76 @@ impl MultiAxisTable {
                 }
             })
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A seeded generator of numbers in [−1, 1) (a 64-bit LCG's top bits).
+    struct Lcg(u64);
+
+    impl Lcg {
+        fn next(&mut self) -> f64 {
+            self.0 = self
+                .0
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (self.0 >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+        }
+
+        fn matrix(&mut self, rows: usize, cols: usize, scale: f64) -> DMatrix<f64> {
+            DMatrix::from_fn(rows, cols, |_, _| scale * self.next())
+        }
+
+        /// A symmetric positive definite `n × n` matrix of the order of `scale`.
+        fn spd(&mut self, n: usize, scale: f64) -> DMatrix<f64> {
+            let a = self.matrix(n, n, 1.0);
+            (&a * a.transpose() + DMatrix::identity(n, n) * n as f64) * scale
+        }
+    }
+
+    fn bits(x: &[f64]) -> Vec<u64> {
+        x.iter().map(|v| v.to_bits()).collect()
+    }
+
+    /// The right-hand side's allocation-free forms against the allocating ones on seeded
+    /// random specimens of 1 to 12 DOFs (past 8, where nalgebra's dot unrolls): every number
+    /// has the same bits.
+    #[test]
+    fn the_allocation_free_forms_give_the_allocating_ones_to_the_bit() {
+        let mut rng = Lcg(0x5eed);
+        for n in 1..=12 {
+            let s = LinearSpecimen::new(
+                rng.spd(n, 6e4),
+                rng.spd(n, 5e7),
+                rng.spd(n, 3e5),
+                rng.matrix(n, 6, 12.0),
+            )
+            .unwrap();
+            for _ in 0..20 {
+                let z = DVector::from_fn(n, |_, _| 0.01 * rng.next());
+                let zd = DVector::from_fn(n, |_, _| 0.3 * rng.next());
+                let a = Wrench::from_fn(|_, _| 9.0 * rng.next());
+                let mut r = [0.0; 12];
+                s.restoring_into(z.as_slice(), zd.as_slice(), &mut r);
+                assert_eq!(bits(&r[..n]), bits(s.restoring(&z, &zd).as_slice()), "{n}");
+                let w = s.wrench_from_restoring(&r);
+                assert_eq!(
+                    bits(w.as_slice()),
+                    bits(s.wrench_on_platen(&z, &zd).as_slice())
+                );
+                let mut zdd = [0.0; 12];
+                s.accelerations_into(&r, &a, &mut zdd);
+                assert_eq!(
+                    bits(&zdd[..n]),
+                    bits(s.accelerations(&z, &zd, &a).as_slice())
+                );
+                let mut czd = [0.0; 12];
+                s.damping_forces_into(zd.as_slice(), &mut czd);
+                assert_eq!(bits(&czd[..n]), bits((s.damping() * &zd).as_slice()));
+            }
+        }
     }
 }
