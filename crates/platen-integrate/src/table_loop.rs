@@ -281,6 +281,9 @@ impl<const L: usize> Source<L> for Hydraulic<'_> {
     }
 }
 
+/// One number per actuator (the first `n`), on the stack.
+type PerActuator = [f64; MAX_LOOP_ACTUATORS];
+
 /// The loop's own output columns per actuator (after the common ones).
 const ACTUATOR_COLUMNS: [&str; 4] = ["drive", "spool_opening", "delta_p_pa", "flow_m3_s"];
 
@@ -366,6 +369,8 @@ struct TableLoop<'a, const L: usize> {
     /// Drives on their way through the valves' delay: (time they arrive, drives).
     queue: VecDeque<(f64, [f64; MAX_LOOP_ACTUATORS])>,
     out: Output,
+    /// The loop's own columns of the row being emitted (kept to reuse its allocation).
+    extra: Vec<f64>,
     stats: TableLoopStats,
     h: f64,
     t0: f64,
@@ -437,6 +442,7 @@ impl<'a, const L: usize> TableLoop<'a, L> {
             state: run.controller.start(),
             queue: VecDeque::with_capacity(slots),
             out,
+            extra: Vec::new(),
             stats: TableLoopStats {
                 min_supply_pressure_pa: y[ps::<L>()],
                 ..TableLoopStats::default()
@@ -486,24 +492,19 @@ impl<'a, const L: usize> TableLoop<'a, L> {
         }
     }
 
-    /// What the controller reads now: strokes and their rates, Δp and forces per actuator.
-    fn feedback(&self) -> (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
+    /// What the controller reads now: strokes and their rates, Δp and forces per actuator
+    /// (the first `n` of each, on the stack).
+    fn feedback(&self) -> [PerActuator; 4] {
         let m = &self.machine;
         let (table, hyd) = (self.run.table, self.run.hydraulics);
         let (q, qd) = pose(&m.y);
-        let n = table.actuators().len();
-        let mut out = (
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
-        );
-        for i in 0..n {
+        let mut out = [[0.0; MAX_LOOP_ACTUATORS]; 4];
+        for i in 0..table.actuators().len() {
             let s = Hydraulic::state(&m.y, i);
-            out.0.push(table.actuator_at(i, &q).stroke_m);
-            out.1.push(table.stroke_rate_m_s(i, &q, &qd));
-            out.2.push(hyd.delta_p_pa(i, &s));
-            out.3.push(hyd.force_n(i, &s));
+            out[0][i] = table.actuator_at(i, &q).stroke_m;
+            out[1][i] = table.stroke_rate_m_s(i, &q, &qd);
+            out[2][i] = hyd.delta_p_pa(i, &s);
+            out[3][i] = hyd.force_n(i, &s);
         }
         out
     }
@@ -511,14 +512,15 @@ impl<'a, const L: usize> TableLoop<'a, L> {
     /// A controller sample now: the new drives enter the valves' delay line.
     fn tick(&mut self) {
         let command = self.command_at(self.t());
-        let (strokes, rates, dp, forces) = self.feedback();
+        let [strokes, rates, dp, forces] = self.feedback();
+        let n = self.run.table.actuators().len();
         let m = &self.machine;
         let fb = DofFeedback {
-            strokes_m: &strokes,
-            stroke_rates_m_s: &rates,
+            strokes_m: &strokes[..n],
+            stroke_rates_m_s: &rates[..n],
             accelerations: Coords::from_fn(|k, _| m.k[QD + k]),
-            delta_p_pa: &dp,
-            forces_n: &forces,
+            delta_p_pa: &dp[..n],
+            forces_n: &forces[..n],
         };
         self.run.controller.update(&mut self.state, &command, &fb);
         self.stats.controller_samples += 1;
@@ -576,10 +578,12 @@ impl<'a, const L: usize> TableLoop<'a, L> {
         let t_s = self.run.command.t_s()[j];
         let n = table.actuators().len();
         let (pose_j, _, _) = self.run.command.at(j);
-        let mut extra: Vec<f64> = pose_j.iter().copied().collect();
-        let mut forces = vec![0.0; n];
+        let extra = &mut self.extra;
+        extra.clear();
+        extra.extend(pose_j.iter().copied());
+        let mut forces = [0.0; MAX_LOOP_ACTUATORS];
         let p_s = y[ps::<L>()];
-        for (i, f) in forces.iter_mut().enumerate() {
+        for (i, f) in forces.iter_mut().enumerate().take(n) {
             let s = Hydraulic::state(y, i);
             *f = hyd.force_n(i, &s);
             let (q_a, _) =
@@ -592,7 +596,7 @@ impl<'a, const L: usize> TableLoop<'a, L> {
             ]);
         }
         extra.extend([p_s, self.state.warping_n, y[eh::<L>()]]);
-        self.out.push(&self.machine, t_s, &forces, &extra);
+        self.out.push(&self.machine, t_s, &forces[..n], &self.extra);
     }
 
     /// Emits every output sample due by now.
