@@ -366,7 +366,8 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
         let frame = self.table.frame(&q);
         let wrench = self.actuators(&f, &frame);
         let twist = Self::twist(&q, &qd);
-        let mut applied = wrench + self.table.struts_wrench_in(&frame) + self.specimen_push(y);
+        let restoring = self.specimen_restoring(y);
+        let mut applied = wrench + self.table.struts_wrench_in(&frame) + self.push_of(&restoring);
         let mut lost = 0.0;
         if self.friction {
             let capacity = self.table.friction_capacity_in(&frame, &f);
@@ -393,7 +394,7 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
             dy[Q + k] = qd[k];
             dy[QD + k] = qdd[k];
         }
-        self.specimen_rates(&q, &qd, &qdd, y, dy);
+        self.specimen_rates((&q, &qd, &qdd), &restoring, y, dy);
         self.source.rates(at, y, &frame, &q, &qd, dy);
         dy[V]
     }
@@ -404,25 +405,41 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
         (&y[Z..Z + n], &y[Z + n..Z + 2 * n])
     }
 
-    /// The specimen's restoring forces `C·ż + K·z` at `y`, on the stack (its first `n`).
-    fn specimen_restoring(s: &LinearSpecimen, y: &Y<L>) -> SpecimenForces {
-        let (z, zd) = Self::specimen_state(s, y);
+    /// The specimen's restoring forces `C·ż + K·z` at `y`, on the stack (its first `n`;
+    /// zero without one): taken once per right-hand side for its push and its rates.
+    fn specimen_restoring(&self, y: &Y<L>) -> SpecimenForces {
         let mut r = [0.0; MAX_TABLE_SPECIMEN_DOFS];
-        s.restoring_into(z, zd, &mut r);
+        if let Some(s) = self.specimen {
+            let (z, zd) = Self::specimen_state(s, y);
+            s.restoring_into(z, zd, &mut r);
+        }
         r
     }
 
-    /// The specimen's push on the platen at `y` (zero without one).
-    fn specimen_push(&self, y: &Y<L>) -> Wrench {
+    /// The specimen's push on the platen of its restoring forces `restoring` (zero without
+    /// one).
+    fn push_of(&self, restoring: &SpecimenForces) -> Wrench {
         match self.specimen {
-            Some(s) => s.wrench_from_restoring(&Self::specimen_restoring(s, y)),
+            Some(s) => s.wrench_from_restoring(restoring),
             None => Wrench::zeros(),
         }
     }
 
+    /// The specimen's push on the platen at `y` (zero without one).
+    fn specimen_push(&self, y: &Y<L>) -> Wrench {
+        self.push_of(&self.specimen_restoring(y))
+    }
+
     /// The specimen's rates under the platen moving with `q`, `qd`, `qdd` (it feels the
-    /// platen's acceleration less gravity's), and its dampers' power into `SD`.
-    fn specimen_rates(&self, q: &Coords, qd: &Coords, qdd: &Coords, y: &Y<L>, dy: &mut Y<L>) {
+    /// platen's acceleration less gravity's) with its restoring forces `restoring` at `y`,
+    /// and its dampers' power into `SD`.
+    fn specimen_rates(
+        &self,
+        (q, qd, qdd): (&Coords, &Coords, &Coords),
+        restoring: &SpecimenForces,
+        y: &Y<L>,
+        dy: &mut Y<L>,
+    ) {
         let Some(s) = self.specimen else {
             return;
         };
@@ -430,7 +447,7 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
         let (_, zd) = Self::specimen_state(s, y);
         let a = platen_acceleration(&(*q, *qd, *qdd)) - GRAVITY;
         let mut zdd = [0.0; MAX_TABLE_SPECIMEN_DOFS];
-        s.accelerations_into(&Self::specimen_restoring(s, y), &a, &mut zdd);
+        s.accelerations_into(restoring, &a, &mut zdd);
         for i in 0..n {
             dy[Z + i] = zd[i];
             dy[Z + n + i] = zdd[i];
@@ -449,7 +466,8 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
         let frame = self.table.frame(&q);
         let wrench = self.actuators(&f, &frame);
         let twist = Self::twist(&q, &qd);
-        let applied = wrench + self.table.struts_wrench_in(&frame) + self.specimen_push(y);
+        let restoring = self.specimen_restoring(y);
+        let applied = wrench + self.table.struts_wrench_in(&frame) + self.push_of(&restoring);
         let capacity = self.table.friction_capacity_in(&frame, &f);
         let (qdd, holding) = match self.table.stick(&q, &qd, &applied, &capacity) {
             Some(s) => (s.accelerations, s.wrench),
@@ -464,7 +482,7 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
             dy[Q + k] = qd[k];
             dy[QD + k] = qdd[k];
         }
-        self.specimen_rates(&q, &qd, &qdd, y, dy);
+        self.specimen_rates((&q, &qd, &qdd), &restoring, y, dy);
         self.source.rates(at, y, &frame, &q, &qd, dy);
     }
 

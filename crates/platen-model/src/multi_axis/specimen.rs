@@ -32,8 +32,16 @@ pub struct LinearSpecimen {
 #[inline(always)]
 fn product_into(a: &[f64], x: &[f64], out: &mut [f64]) {
     let rows = out.len();
-    for (i, o) in out.iter_mut().enumerate() {
-        *o = row_product(a, rows, i, x);
+    let mut columns = a.chunks_exact(rows).zip(x);
+    if let Some((column, &xj)) = columns.next() {
+        for (o, &aij) in out.iter_mut().zip(column) {
+            *o = aij * xj;
+        }
+    }
+    for (column, &xj) in columns {
+        for (o, &aij) in out.iter_mut().zip(column) {
+            *o = aij * xj + *o;
+        }
     }
 }
 
