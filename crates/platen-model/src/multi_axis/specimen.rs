@@ -27,8 +27,9 @@ pub struct LinearSpecimen {
 
 /// `out = A·x` for `A` stored column by column (`out.len()` rows, `x.len()` columns), as
 /// nalgebra's `A * x` computes it (its gemv, one column at a time): `outᵢ = Aᵢ₀·x₀`, then
-/// `outᵢ = Aᵢⱼ·xⱼ + outᵢ` for `j` rising. Each number is therefore the same, bit for bit, as
-/// the allocating product's (tested against it).
+/// `outᵢ = Aᵢⱼ·xⱼ + outᵢ` for `j` rising (a floating-point sum of two numbers does not depend
+/// on their order). Each number is therefore the same, bit for bit, as the allocating
+/// product's (tested against it).
 #[inline(always)]
 fn product_into(a: &[f64], x: &[f64], out: &mut [f64]) {
     let rows = out.len();
@@ -40,7 +41,7 @@ fn product_into(a: &[f64], x: &[f64], out: &mut [f64]) {
     }
     for (column, &xj) in columns {
         for (o, &aij) in out.iter_mut().zip(column) {
-            *o = aij * xj + *o;
+            *o += aij * xj;
         }
     }
 }
@@ -51,7 +52,7 @@ fn product_into(a: &[f64], x: &[f64], out: &mut [f64]) {
 fn row_product(a: &[f64], rows: usize, i: usize, x: &[f64]) -> f64 {
     let mut sum = a[i] * x[0];
     for (j, xj) in x.iter().enumerate().skip(1) {
-        sum = a[j * rows + i] * xj + sum;
+        sum += a[j * rows + i] * xj;
     }
     sum
 }
