@@ -498,15 +498,15 @@ impl<'a, const L: usize> TableLoop<'a, L> {
         let m = &self.machine;
         let (table, hyd) = (self.run.table, self.run.hydraulics);
         let (q, qd) = pose(&m.y);
-        let mut out = [[0.0; MAX_LOOP_ACTUATORS]; 4];
+        let [mut strokes, mut rates, mut dp, mut forces] = [[0.0; MAX_LOOP_ACTUATORS]; 4];
         for i in 0..table.actuators().len() {
             let s = Hydraulic::state(&m.y, i);
-            out[0][i] = table.actuator_at(i, &q).stroke_m;
-            out[1][i] = table.stroke_rate_m_s(i, &q, &qd);
-            out[2][i] = hyd.delta_p_pa(i, &s);
-            out[3][i] = hyd.force_n(i, &s);
+            strokes[i] = table.actuator_at(i, &q).stroke_m;
+            rates[i] = table.stroke_rate_m_s(i, &q, &qd);
+            dp[i] = hyd.delta_p_pa(i, &s);
+            forces[i] = hyd.force_n(i, &s);
         }
-        out
+        [strokes, rates, dp, forces]
     }
 
     /// A controller sample now: the new drives enter the valves' delay line.
