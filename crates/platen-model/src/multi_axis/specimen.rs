@@ -207,7 +207,7 @@ impl LinearSpecimen {
 
     /// [`restoring`](Self::restoring) into `out` without allocating: `z`, `zd` and `out` are
     /// `n` long (one per DOF), and every number has the bits [`restoring`](Self::restoring)
-    /// gives (the same products and sums in the same order, see [`product_into`]). For the
+    /// gives (the same products and sums in the same order as nalgebra's gemv). For the
     /// right-hand side of an integrator, which takes it at every stage.
     ///
     /// # Panics
