@@ -60,7 +60,7 @@ fn not_run(command: &str) -> Option<String> {
                 .into(),
         );
     }
-    if cfg!(debug_assertions) && command.contains("lhpost6-northridge.json") {
+    if cfg!(debug_assertions) && command.contains("lhpost6-northridge") {
         return Some(
             "the LHPOST6 closed loop over 40 s of Northridge takes minutes in a debug build \
              (about 2 s in a release build): run `cargo test --release --test docs_commands` \

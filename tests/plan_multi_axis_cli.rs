@@ -85,7 +85,7 @@ fn a_three_component_plan_writes_its_drive_summary_and_figures() {
     assert!(text.starts_with("t_s,x_m,y_m,z_m,roll_rad,pitch_rad,yaw_rad\n"));
     assert_eq!(text.lines().count(), 66);
     // The drive replayed through `simulate` is the run the plan reports for its best
-    // iteration: each axis's signed peak acceleration is the plan's, to the bit.
+    // iteration: each axis's signed peak acceleration is the plan's.
     let replay = write(
         dir.path(),
         "replay.json",
@@ -123,9 +123,10 @@ fn a_three_component_plan_writes_its_drive_summary_and_figures() {
             .map(|r| r[col])
             .fold(0.0_f64, |m, v| if v.abs() > m.abs() { v } else { m });
         let reported = it[best]["axes"][axis]["peak_a_m_s2"].as_f64().unwrap();
-        assert_eq!(
-            peak.to_bits(),
-            reported.to_bits(),
+        // To the last bit but one: serde_json's default parser may miss the nearest double
+        // by an ulp (the library test replays to the bit).
+        assert!(
+            (peak - reported).abs() <= 2.0 * f64::EPSILON * reported.abs(),
             "{axis}: {peak} against {reported}"
         );
     }

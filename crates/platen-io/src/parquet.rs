@@ -161,6 +161,23 @@ impl ParquetWriter {
 /// [`ColumnLengthMismatch`](IoError::ColumnLengthMismatch),
 /// [`NonFinite`](IoError::NonFinite), or as [`ParquetWriter`]; nothing is left at `path`.
 pub fn write_parquet_atomic(path: &Path, header: &[&str], columns: &[&[f64]]) -> Result<()> {
+    write_parquet_atomic_inner(path, header, columns)
+}
+
+/// Writes `columns` under `header` to `path` atomically: Parquet for a `.parquet` path
+/// ([`is_parquet_path`]), CSV otherwise ([`crate::csv::write_csv_atomic`]).
+///
+/// # Errors
+/// As the writer chosen.
+pub fn write_columns_atomic(path: &Path, header: &[&str], columns: &[&[f64]]) -> Result<()> {
+    if is_parquet_path(path) {
+        write_parquet_atomic(path, header, columns)
+    } else {
+        crate::csv::write_csv_atomic(path, header, columns)
+    }
+}
+
+fn write_parquet_atomic_inner(path: &Path, header: &[&str], columns: &[&[f64]]) -> Result<()> {
     let rows = crate::csv::checked_rows(path, header, columns)?;
     let mut writer = ParquetWriter::create(path, header)?;
     crate::csv::for_each_row(columns, rows, |row| writer.write_row(row))?;

@@ -82,6 +82,29 @@ pub fn table_scenario_file(path: &Path, text: &str) -> Result<Option<ScenarioFil
     Ok(Some(platen_io::json::parse_json(path, &pretty)?))
 }
 
+/// [`table_scenario_file`] of the file at `path`; `None` also for a file that cannot be
+/// read (the single-axis planner reports it).
+///
+/// # Errors
+/// As [`table_scenario_file`].
+pub fn read_table_scenario(path: &Path) -> Result<Option<ScenarioFile>> {
+    match std::fs::read_to_string(path) {
+        Ok(text) => table_scenario_file(path, &text),
+        Err(_) => Ok(None),
+    }
+}
+
+/// The drive CSV's columns: a six-DOF `motion_csv`.
+pub const DRIVE_COLUMNS: [&str; 7] = [
+    "t_s",
+    "x_m",
+    "y_m",
+    "z_m",
+    "roll_rad",
+    "pitch_rad",
+    "yaw_rad",
+];
+
 /// The translational axes a target gives, in order.
 pub const AXES: [&str; 3] = ["x", "y", "z"];
 const ACCELERATION: [&str; 3] = ["x_m_s2", "y_m_s2", "z_m_s2"];
@@ -209,6 +232,34 @@ pub struct TablePlanSettings {
     pub max_scale: Option<MaxScaleSettings>,
     /// The largest scale of each axis too, the others as given.
     pub per_axis_max_scale: bool,
+}
+
+impl TablePlanSettings {
+    /// The settings of `platen plan`'s options (and `platen.plan`'s arguments): at most
+    /// `iterations` corrections at `gain`, stopping at `target_nrmse`, in `band_hz` (default
+    /// band when `None`); the largest common scale searched when `max_scale` or
+    /// `per_axis_scale`, each axis's too with `per_axis_scale`; the rest default.
+    pub fn new(
+        iterations: usize,
+        gain: f64,
+        target_nrmse: f64,
+        band_hz: Option<(f64, f64)>,
+        max_scale: bool,
+        per_axis_scale: bool,
+    ) -> Self {
+        Self {
+            iteration: IterationSettings {
+                max_iterations: iterations,
+                gain,
+                target_nrmse,
+                band_hz,
+                ..Default::default()
+            },
+            max_scale: (max_scale || per_axis_scale).then(MaxScaleSettings::default),
+            per_axis_max_scale: per_axis_scale,
+            ..Default::default()
+        }
+    }
 }
 
 /// What the table achieved for a drive: its run, the loop's figures, and per axis (x, y, z)
@@ -761,6 +812,24 @@ impl TablePlan {
         let mut names = vec!["t_s"];
         names.extend(POSE);
         (names, columns)
+    }
+
+    /// Writes the best drives' rows to `writer` (created with [`DRIVE_COLUMNS`]) and
+    /// finishes it.
+    ///
+    /// # Errors
+    /// [`PlanError::Io`] if it cannot be written.
+    pub fn write_drive_rows(&self, mut writer: platen_io::csv::CsvWriter) -> Result<()> {
+        let (_, columns) = self.drive_columns();
+        let mut row = vec![0.0; columns.len()];
+        for j in 0..self.t_s.len() {
+            for (r, c) in row.iter_mut().zip(&columns) {
+                *r = c[j];
+            }
+            writer.write_row(&row)?;
+        }
+        writer.finish()?;
+        Ok(())
     }
 
     /// Writes the best drives to `path` as a six-DOF `motion_csv` (see

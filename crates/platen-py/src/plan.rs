@@ -174,18 +174,14 @@ pub fn plan_table<'py>(
             });
         }
         let targets = platen_plan::AxisTargets::new(origin, given)?;
-        let settings = platen_plan::TablePlanSettings {
-            iteration: platen_plan::IterationSettings {
-                max_iterations: iterations,
-                gain,
-                target_nrmse,
-                band_hz,
-                ..Default::default()
-            },
-            max_scale: (max_scale || per_axis_scale).then(MaxScaleSettings::default),
-            per_axis_max_scale: per_axis_scale,
-            ..Default::default()
-        };
+        let settings = platen_plan::TablePlanSettings::new(
+            iterations,
+            gain,
+            target_nrmse,
+            band_hz,
+            max_scale,
+            per_axis_scale,
+        );
         let p = platen_plan::plan_multi_axis(&path, &file, &targets, &settings, &mut |_| {})
             .map_err(|e| match e {
                 PlanError::TargetRate { .. } => Fail::input(chain(&e)),

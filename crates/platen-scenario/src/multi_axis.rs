@@ -312,6 +312,41 @@ impl TableScenario {
         run.map_err(ScenarioError::TableRun)
     }
 
+    /// What `platen generate excitation` writes for this scenario: its six-DOF motion (the
+    /// prescribed motion or a closed loop's command: `t_s`, the pose, its rates and
+    /// accelerations, a `motion_csv` that `simulate` takes as it is and a three-component
+    /// target for `platen plan`), or its recorded actuator forces (`t_s`, `{name}_force_n`):
+    /// the column names, the columns, and the kind (`motion` or `force`).
+    pub fn excitation_columns(&self) -> (Vec<String>, Vec<&[f64]>, &'static str) {
+        let mut names = vec!["t_s".to_owned()];
+        match &self.run {
+            TableRunSpec::Inverse { motion } | TableRunSpec::Loop { command: motion } => {
+                let dofs = Dof::ALL.map(|d| motion.dof(d));
+                let mut columns: Vec<&[f64]> = vec![dofs[0].t_s()];
+                for (k, m) in dofs.iter().enumerate() {
+                    names.push(POSE_COLUMNS[k].to_owned());
+                    columns.push(m.u_m());
+                }
+                for (k, m) in dofs.iter().enumerate() {
+                    names.push(RATE_COLUMNS[k].to_owned());
+                    columns.push(m.v_m_s());
+                }
+                for (k, m) in dofs.iter().enumerate() {
+                    names.push(ACCELERATION_COLUMNS[k].to_owned());
+                    columns.push(m.a_m_s2());
+                }
+                (names, columns, "motion")
+            }
+            TableRunSpec::Forward { forces, .. } => {
+                let actuators = self.table.actuators();
+                names.extend(actuators.iter().map(|a| format!("{}_force_n", a.name)));
+                let mut columns: Vec<&[f64]> = vec![forces.t_s()];
+                columns.extend((0..actuators.len()).map(|i| forces.force_n(i)));
+                (names, columns, "force")
+            }
+        }
+    }
+
     /// Each actuator's valves' flow capacity at the supply pressure,
     /// `m·Q_r·√((P_s − P_R)/Δp_r)`, m³/s, in the table's order (`None` without a closed loop).
     pub fn flow_capacities_m3_s(&self) -> Option<Vec<f64>> {

@@ -89,56 +89,19 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     Ok(())
 }
 
-/// `generate excitation` of a multi-axis scenario: its six-DOF motion (the prescribed motion,
-/// or a closed loop's command: `t_s`, the pose, its rates and accelerations: a `motion_csv`
-/// that `simulate` takes as it is, and a three-component target for `platen plan`), or its
-/// recorded actuator forces (`t_s`, `{name}_force_n`).
+/// `generate excitation` of a multi-axis scenario: its six-DOF motion or its forces
+/// ([`platen_scenario::multi_axis::TableScenario::excitation_columns`]).
 fn table_excitation(
     path: &Path,
     file: &platen_scenario::file::ScenarioFile,
     out: &Path,
     json_out: bool,
 ) -> Result<()> {
-    use platen_scenario::multi_axis::{
-        TableRunSpec, TableScenario, ACCELERATION_COLUMNS, POSE_COLUMNS, RATE_COLUMNS,
-    };
-    let scenario = TableScenario::from_file(path, file)?;
-    match &scenario.run {
-        TableRunSpec::Inverse { motion } | TableRunSpec::Loop { command: motion } => {
-            let dofs = platen_model::multi_axis::Dof::ALL.map(|d| motion.dof(d));
-            let mut names = vec!["t_s"];
-            let mut columns: Vec<&[f64]> = vec![dofs[0].t_s()];
-            for (k, m) in dofs.iter().enumerate() {
-                names.push(POSE_COLUMNS[k]);
-                columns.push(m.u_m());
-            }
-            for (k, m) in dofs.iter().enumerate() {
-                names.push(RATE_COLUMNS[k]);
-                columns.push(m.v_m_s());
-            }
-            for (k, m) in dofs.iter().enumerate() {
-                names.push(ACCELERATION_COLUMNS[k]);
-                columns.push(m.a_m_s2());
-            }
-            write_csv_atomic(out, &names, &columns)?;
-            report(json_out, out, dofs[0].len(), "motion", None)
-        }
-        TableRunSpec::Forward { forces, .. } => {
-            let mut names = vec!["t_s".to_owned()];
-            names.extend(
-                scenario
-                    .table
-                    .actuators()
-                    .iter()
-                    .map(|a| format!("{}_force_n", a.name)),
-            );
-            let names: Vec<&str> = names.iter().map(String::as_str).collect();
-            let mut columns: Vec<&[f64]> = vec![forces.t_s()];
-            columns.extend((0..scenario.table.actuators().len()).map(|i| forces.force_n(i)));
-            write_csv_atomic(out, &names, &columns)?;
-            report(json_out, out, forces.t_s().len(), "force", None)
-        }
-    }
+    let scenario = platen_scenario::multi_axis::TableScenario::from_file(path, file)?;
+    let (names, columns, kind) = scenario.excitation_columns();
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    write_csv_atomic(out, &names, &columns)?;
+    report(json_out, out, columns[0].len(), kind, None)
 }
 
 /// Prints what was written: [`GenerateReport`] as JSON or as its text line.

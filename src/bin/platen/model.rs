@@ -262,22 +262,17 @@ fn describe_table(
         }
     };
     let description = scenario.describe();
-    if args.json {
-        let figures = args.plot.as_ref().map(|_| written.as_slice());
-        let value = platen_report::simulate_report::with_outputs(
-            serde_json::to_value(&description)?,
-            figures,
-            None,
-        );
-        outln!("{}", serde_json::to_string_pretty(&value)?);
-    } else {
-        out!(
-            "{}",
-            platen_scenario::multi_axis::description_text(&description)
-        );
-        for f in &written {
-            outln!("  wrote {}", f.display());
-        }
-    }
-    Ok(())
+    crate::plot::print(
+        args.json,
+        args.plot.is_some(),
+        &description,
+        &written,
+        || {
+            let mut t = platen_scenario::multi_axis::description_text(&description);
+            for f in &written {
+                t += &format!("  wrote {}\n", f.display());
+            }
+            t
+        },
+    )
 }

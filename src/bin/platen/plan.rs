@@ -160,18 +160,16 @@ pub fn run(args: &Args) -> Result<()> {
         max_scale: (!args.no_max_scale).then(MaxScaleSettings::default),
         ..Default::default()
     };
-    if let Some(file) = multi_axis_scenario(&args.scenario)? {
+    if let Some(file) =
+        platen_plan::six_dof::read_table_scenario(&args.scenario).map_err(cli_error)?
+    {
         return run_table(args, &file);
     }
     // The drive's temporary file first: an unwritable destination fails before any run.
     let mut writer = CsvWriter::create(&args.out, &["t_s", "u_m"])?;
     let rig = load_rig(&args.scenario).map_err(cli_error)?;
     let target = Target::read_csv(&args.target).map_err(cli_error)?;
-    // A bar of the drive iterations (on a terminal, after a second).
-    let progress = Progress::new(
-        u64::from(args.iterations) + 1,
-        "{bar:30} {pos}/{len} runs of the drive iteration, {elapsed_precise} elapsed",
-    );
+    let progress = iteration_progress(args);
     let on_run = &mut |k: usize| progress.set_position(k as u64 + 1);
     let p = plan_observed(&rig, &args.scenario, &target, &settings, on_run);
     progress.finish();
@@ -218,16 +216,12 @@ pub fn run(args: &Args) -> Result<()> {
     Ok(())
 }
 
-/// The scenario at `path` if it is a multi-axis one (it has a `table`), parsed
-/// ([`platen_plan::six_dof::table_scenario_file`]); `None` for any other file (or one that
-/// cannot be read), which the uniaxial planner reads and reports on.
-fn multi_axis_scenario(
-    path: &std::path::Path,
-) -> Result<Option<platen_scenario::file::ScenarioFile>> {
-    let Ok(text) = std::fs::read_to_string(path) else {
-        return Ok(None);
-    };
-    platen_plan::six_dof::table_scenario_file(path, &text).map_err(cli_error)
+/// A bar of the drive iterations (on a terminal, after a second).
+fn iteration_progress(args: &Args) -> Progress {
+    Progress::new(
+        u64::from(args.iterations) + 1,
+        "{bar:30} {pos}/{len} runs of the drive iteration, {elapsed_precise} elapsed",
+    )
 }
 
 /// `platen plan` on a multi-axis scenario (one with a `table` and its `controller`): the
@@ -248,52 +242,26 @@ fn run_table(args: &Args, file: &platen_scenario::file::ScenarioFile) -> Result<
              figures and --json every figure the text reports, per axis and per iteration"
         );
     }
-    let settings = TablePlanSettings {
-        iteration: platen_plan::IterationSettings {
-            max_iterations: usize::from(args.iterations),
-            gain: args.gain,
-            target_nrmse: args.target_nrmse,
-            band_hz: args.band_hz,
-            ..Default::default()
-        },
-        max_scale: (!args.no_max_scale).then(MaxScaleSettings::default),
-        per_axis_max_scale: args.per_axis_scale,
-        ..Default::default()
-    };
     if args.per_axis_scale && args.no_max_scale {
         anyhow::bail!("--per-axis-scale searches scales: it cannot go with --no-max-scale");
     }
-    // The drive's temporary file first: an unwritable destination fails before any run.
-    let mut writer = CsvWriter::create(
-        &args.out,
-        &[
-            "t_s",
-            "x_m",
-            "y_m",
-            "z_m",
-            "roll_rad",
-            "pitch_rad",
-            "yaw_rad",
-        ],
-    )?;
-    let targets = AxisTargets::read_csv(&args.target).map_err(cli_error)?;
-    let progress = Progress::new(
-        u64::from(args.iterations) + 1,
-        "{bar:30} {pos}/{len} runs of the drive iteration, {elapsed_precise} elapsed",
+    let settings = TablePlanSettings::new(
+        usize::from(args.iterations),
+        args.gain,
+        args.target_nrmse,
+        args.band_hz,
+        !args.no_max_scale,
+        args.per_axis_scale,
     );
+    // The drive's temporary file first: an unwritable destination fails before any run.
+    let writer = CsvWriter::create(&args.out, &platen_plan::six_dof::DRIVE_COLUMNS)?;
+    let targets = AxisTargets::read_csv(&args.target).map_err(cli_error)?;
+    let progress = iteration_progress(args);
     let on_run = &mut |k: usize| progress.set_position(k as u64 + 1);
     let p = plan_multi_axis(&args.scenario, file, &targets, &settings, on_run);
     progress.finish();
     let p = p.map_err(cli_error)?;
-    let (_, columns) = p.drive_columns();
-    let mut row = vec![0.0; columns.len()];
-    for j in 0..columns[0].len() {
-        for (r, c) in row.iter_mut().zip(&columns) {
-            *r = c[j];
-        }
-        writer.write_row(&row)?;
-    }
-    writer.finish()?;
+    p.write_drive_rows(writer).map_err(cli_error)?;
     let summary = p.summary(&settings, Some(&args.out));
     let figures = platen_report::write_outputs(
         args.plot.as_deref(),
@@ -305,16 +273,11 @@ fn run_table(args: &Args, file: &platen_scenario::file::ScenarioFile) -> Result<
     for warning in &summary.warnings {
         eprintln!("warning: {warning}");
     }
-    if args.json {
-        let value = serde_json::to_value(&summary)?;
-        let figures = args.plot.as_ref().map(|_| figures.as_slice());
-        let value = with_outputs(value, figures, None);
-        outln!("{}", serde_json::to_string_pretty(&value)?);
-        return Ok(());
-    }
-    out!("{}", summary_text(&summary));
-    for f in &figures {
-        outln!("wrote {}", f.display());
-    }
-    Ok(())
+    crate::plot::print(args.json, args.plot.is_some(), &summary, &figures, || {
+        let mut t = summary_text(&summary);
+        for f in &figures {
+            t += &format!("wrote {}\n", f.display());
+        }
+        t
+    })
 }

@@ -68,3 +68,26 @@ fn parse_png_scale(s: &str) -> Result<f64, String> {
         _ => Err(format!("`{s}`: expected a factor from 0.25 to 8")),
     }
 }
+
+/// Prints a verb's `summary`: with `json`, as JSON with the figures `written` (when `--plot`
+/// was given, `plotted`), else `text()`.
+pub fn print(
+    json: bool,
+    plotted: bool,
+    summary: &impl serde::Serialize,
+    written: &[std::path::PathBuf],
+    text: impl FnOnce() -> String,
+) -> anyhow::Result<()> {
+    if json {
+        let figures = plotted.then_some(written);
+        let value = platen_report::simulate_report::with_outputs(
+            serde_json::to_value(summary)?,
+            figures,
+            None,
+        );
+        outln!("{}", serde_json::to_string_pretty(&value)?);
+    } else {
+        out!("{}", text());
+    }
+    Ok(())
+}

@@ -134,11 +134,7 @@ fn run_table(args: &SimulateArgs, path: &std::path::Path, file: &ScenarioFile) -
     if let Some(out) = out {
         let header: Vec<&str> = run.columns.iter().map(|(n, _)| n.as_str()).collect();
         let columns: Vec<&[f64]> = run.columns.iter().map(|(_, c)| c.as_slice()).collect();
-        if platen_io::parquet::is_parquet_path(out) {
-            platen_io::parquet::write_parquet_atomic(out, &header, &columns)?;
-        } else {
-            platen_io::csv::write_csv_atomic(out, &header, &columns)?;
-        }
+        platen_io::parquet::write_columns_atomic(out, &header, &columns)?;
     }
     let written = match args.plot.as_deref() {
         Some(dir) => platen_report::table_figures::write_table_figures(
@@ -152,15 +148,7 @@ fn run_table(args: &SimulateArgs, path: &std::path::Path, file: &ScenarioFile) -
         None => Vec::new(),
     };
     let summary = scenario.summary_with(&run, stats.as_ref(), out);
-    if args.json {
-        let figures = args.plot.as_ref().map(|_| written.as_slice());
-        let value = with_outputs(serde_json::to_value(&summary)?, figures, None);
-        outln!("{}", serde_json::to_string_pretty(&value)?);
-    } else {
-        out!(
-            "{}",
-            platen_scenario::multi_axis::summary_text(&summary, &written)
-        );
-    }
-    Ok(())
+    crate::plot::print(args.json, args.plot.is_some(), &summary, &written, || {
+        platen_scenario::multi_axis::summary_text(&summary, &written)
+    })
 }
