@@ -22,7 +22,7 @@
 //!   along directions whose singular value falls to `ε·max‖Ĥ‖_F` it gives half the exact
 //!   inverse and it never exceeds `1/(2ε·max‖Ĥ‖_F)` (`‖·‖_F` the Frobenius norm, the
 //!   largest over the band). For one axis it is the single-axis iteration's inverse exactly
-//!   ([`crate::iterate`]).
+//!   ([`crate::iterate()`]).
 //! * The band `w(f)`, the gain `g`, the padding, the taper at the record's ends and the stop
 //!   criteria are those of [`crate::IterationSettings`], the criteria judged on the **overall**
 //!   acceleration NRMSE, `√(Σ_axes Σ_t (R − T)²/Σ_axes Σ_t T²)`, so that the cross-talk on

@@ -159,7 +159,8 @@ impl TableScenario {
     /// The same closed loop commanded by `command`.
     ///
     /// # Errors
-    /// [`ScenarioError::Invalid`] if this scenario is not a closed loop.
+    /// [`ScenarioError::Io`] (the invalid field `table.controller`) if this scenario is not a
+    /// closed loop.
     pub fn commanded(&self, command: PoseMotion) -> Result<Self> {
         if self.system.is_none() {
             let ctx = Ctx {
