@@ -46,7 +46,9 @@ use serde::Serialize;
 use platen_integrate::{PoseMotion, TableLoopStats, TableRun};
 use platen_io::IoError;
 use platen_scenario::file::ScenarioFile;
-use platen_scenario::multi_axis::TableScenario;
+use platen_scenario::multi_axis::{
+    TableScenario, ACCELERATION_COLUMNS, POSE_COLUMNS, RATE_COLUMNS,
+};
 use platen_system::TableLinearisation;
 
 use crate::baseline::{command_motion, BaselineSettings, TargetMotion};
@@ -107,9 +109,6 @@ pub const DRIVE_COLUMNS: [&str; 7] = [
 
 /// The translational axes a target gives, in order.
 pub const AXES: [&str; 3] = ["x", "y", "z"];
-const ACCELERATION: [&str; 3] = ["x_m_s2", "y_m_s2", "z_m_s2"];
-const DISPLACEMENT: [&str; 3] = ["x_m", "y_m", "z_m"];
-const POSE: [&str; 6] = ["x_m", "y_m", "z_m", "roll_rad", "pitch_rad", "yaw_rad"];
 
 /// A target of up to three axes on one time base.
 #[derive(Debug, Clone)]
@@ -150,15 +149,18 @@ impl AxisTargets {
     /// columns, a bad cell, times that do not increase strictly or are not uniform, fewer
     /// than [`MIN_TARGET_SAMPLES`] rows.
     pub fn read_csv(path: &Path) -> Result<Self> {
-        let optional: Vec<&'static str> =
-            ACCELERATION.iter().chain(&DISPLACEMENT).copied().collect();
+        let optional: Vec<&'static str> = ACCELERATION_COLUMNS[..3]
+            .iter()
+            .chain(&POSE_COLUMNS[..3])
+            .copied()
+            .collect();
         let mut table = platen_io::csv::read_table(path, &["t_s"], &optional)?;
         let t_s = table.take_column("t_s").unwrap_or_default();
         let mut axes: [Option<Target>; 3] = [None, None, None];
         for k in 0..3 {
             let (kind, values) = match (
-                table.take_column(ACCELERATION[k]),
-                table.take_column(DISPLACEMENT[k]),
+                table.take_column(ACCELERATION_COLUMNS[k]),
+                table.take_column(POSE_COLUMNS[k]),
             ) {
                 (Some(a), _) => (TargetKind::Acceleration, a),
                 (None, Some(u)) => (TargetKind::Displacement, u),
@@ -274,10 +276,10 @@ pub struct TableAchieved {
 
 impl MimoResponse for TableAchieved {
     fn u_m(&self, i: usize) -> &[f64] {
-        self.run.column(DISPLACEMENT[i]).unwrap_or(&[])
+        self.run.column(POSE_COLUMNS[i]).unwrap_or(&[])
     }
     fn a_m_s2(&self, i: usize) -> &[f64] {
-        self.run.column(ACCELERATION[i]).unwrap_or(&[])
+        self.run.column(ACCELERATION_COLUMNS[i]).unwrap_or(&[])
     }
     fn saturated_time_s(&self) -> f64 {
         self.stats.saturated_time_s
@@ -362,35 +364,19 @@ pub fn limit_uses(scenario: &TableScenario, r: &TableRun) -> Vec<TableLimitUse> 
     let col = |name: &str| r.column(name).unwrap_or(&[]);
     let t = col("t_s");
     let mut uses = Vec::new();
-    let rates = [
-        "x_m_s",
-        "y_m_s",
-        "z_m_s",
-        "roll_rad_s",
-        "pitch_rad_s",
-        "yaw_rad_s",
-    ];
-    let accelerations = [
-        "x_m_s2",
-        "y_m_s2",
-        "z_m_s2",
-        "roll_rad_s2",
-        "pitch_rad_s2",
-        "yaw_rad_s2",
-    ];
     let names = ["x", "y", "z", "roll", "pitch", "yaw"];
     for (k, limits) in scenario.limits.each().iter().enumerate() {
         let kinds: [(&str, &str); 3] = if k < 3 {
             [
-                ("stroke_m", POSE[k]),
-                ("velocity_m_s", rates[k]),
-                ("acceleration_m_s2", accelerations[k]),
+                ("stroke_m", POSE_COLUMNS[k]),
+                ("velocity_m_s", RATE_COLUMNS[k]),
+                ("acceleration_m_s2", ACCELERATION_COLUMNS[k]),
             ]
         } else {
             [
-                ("angle_rad", POSE[k]),
-                ("rate_rad_s", rates[k]),
-                ("acceleration_rad_s2", accelerations[k]),
+                ("angle_rad", POSE_COLUMNS[k]),
+                ("rate_rad_s", RATE_COLUMNS[k]),
+                ("acceleration_rad_s2", ACCELERATION_COLUMNS[k]),
             ]
         };
         for (limit, (what, column)) in limits.iter().zip(kinds) {
@@ -809,9 +795,7 @@ impl TablePlan {
                     .unwrap_or_else(|| vec![0.0; n]),
             );
         }
-        let mut names = vec!["t_s"];
-        names.extend(POSE);
-        (names, columns)
+        (DRIVE_COLUMNS.to_vec(), columns)
     }
 
     /// Writes the best drives' rows to `writer` (created with [`DRIVE_COLUMNS`]) and
