@@ -56,7 +56,7 @@ use crate::error::{PlanError, Result};
 use crate::feasibility::{search_max_scale, MaxScale, MaxScaleSettings};
 use crate::iterate::IterationSettings;
 use crate::mimo::{iterate_mimo, AxisTarget, MimoIteration, MimoResponse, TransferMatrix};
-use crate::target::{Target, TargetKind, MIN_TARGET_SAMPLES};
+use crate::target::{Target, MIN_TARGET_SAMPLES};
 
 /// The scenario JSON `text` (from `path`, for messages) if it is a multi-axis one (it has a
 /// `table`), parsed, its `excitation` optional (a plan's target takes its place, and a
@@ -156,20 +156,26 @@ impl AxisTargets {
             .collect();
         let mut table = platen_io::csv::read_table(path, &["t_s"], &optional)?;
         let t_s = table.take_column("t_s").unwrap_or_default();
+        // The file's own checks first, so that they name the file and line.
+        if t_s.len() < MIN_TARGET_SAMPLES {
+            return Err(IoError::TooShort {
+                path: path.to_owned(),
+                rows: t_s.len(),
+                needed: MIN_TARGET_SAMPLES,
+            }
+            .into());
+        }
+        platen_scenario::sampling::sampling_grid(path, &t_s)?;
         let mut axes: [Option<Target>; 3] = [None, None, None];
-        for k in 0..3 {
-            let (kind, values) = match (
+        for (k, axis) in axes.iter_mut().enumerate() {
+            *axis = match (
                 table.take_column(ACCELERATION_COLUMNS[k]),
                 table.take_column(POSE_COLUMNS[k]),
             ) {
-                (Some(a), _) => (TargetKind::Acceleration, a),
-                (None, Some(u)) => (TargetKind::Displacement, u),
-                (None, None) => continue,
+                (Some(a), _) => Some(Target::acceleration(path, t_s.clone(), a)?),
+                (None, Some(u)) => Some(Target::displacement(path, t_s.clone(), u)?),
+                (None, None) => None,
             };
-            axes[k] = Some(match kind {
-                TargetKind::Acceleration => Target::acceleration(path, t_s.clone(), values)?,
-                TargetKind::Displacement => Target::displacement(path, t_s.clone(), values)?,
-            });
         }
         if axes.iter().all(Option::is_none) {
             return Err(IoError::Record {
@@ -181,15 +187,6 @@ impl AxisTargets {
             }
             .into());
         }
-        if t_s.len() < MIN_TARGET_SAMPLES {
-            return Err(IoError::TooShort {
-                path: path.to_owned(),
-                rows: t_s.len(),
-                needed: MIN_TARGET_SAMPLES,
-            }
-            .into());
-        }
-        platen_scenario::sampling::sampling_grid(path, &t_s)?;
         Self::new(path, axes)
     }
 
