@@ -25,10 +25,7 @@
 
 use std::collections::VecDeque;
 
-use nalgebra::Vector3;
-use platen_model::multi_axis::{
-    angular_velocity, Coords, Dof, Frame, LinearSpecimen, MultiAxisTable,
-};
+use platen_model::multi_axis::{Coords, Dof, LinearSpecimen, MultiAxisTable};
 use platen_system::{
     ActuatorState, DofCommand, DofController, DofControllerState, DofFeedback, Supply,
     TableHydraulics,
@@ -41,7 +38,7 @@ use crate::machine::{Machine, PieceMethod, Y};
 use crate::multi_axis::{PoseMotion, TableRun};
 use crate::stop::Failure;
 use crate::table_plant::{
-    pose, reaim, start_machine, start_state, Forces, Output, Source, TablePlant, BARE,
+    pose, reaim, start_machine, start_state, Forces, Output, Source, Strokes, TablePlant, BARE,
     MAX_TABLE_ACTUATORS, QD, WITH_SPECIMEN,
 };
 use crate::MAX_TABLE_SPECIMEN_DOFS;
@@ -119,7 +116,6 @@ pub struct TableLoopStats {
 
 /// The actuators' hydraulics in the state: the source of the closed loop's forces.
 pub(crate) struct Hydraulic<'a> {
-    table: &'a MultiAxisTable,
     hyd: &'a TableHydraulics,
     /// The valves' inputs (the delayed, held drives).
     drives: [f64; MAX_LOOP_ACTUATORS],
@@ -150,6 +146,7 @@ impl Hydraulic<'_> {
 impl<const L: usize> Source<L> for Hydraulic<'_> {
     type Input = ();
     const RATES_ON_COMMIT: bool = true;
+    const NEEDS_STROKES: bool = true;
 
     #[inline(always)]
     fn input(&self, _at: f64) {}
@@ -162,16 +159,11 @@ impl<const L: usize> Source<L> for Hydraulic<'_> {
         out
     }
 
-    fn rates(&self, _input: (), y: &Y<L>, frame: &Frame, q: &Coords, qd: &Coords, dy: &mut Y<L>) {
+    fn rates(&self, _input: (), y: &Y<L>, strokes: &Strokes, dy: &mut Y<L>) {
         let p_s = y[ps::<L>()];
         let (mut drawn, mut power, mut leak) = (0.0, 0.0, 0.0);
-        let omega = angular_velocity(q, qd);
-        let td = Vector3::new(qd[0], qd[1], qd[2]);
-        let table = self.table;
         for i in 0..self.count() {
-            let pose = table.actuator_in(i, frame);
-            let s = pose.stroke_m;
-            let v = table.stroke_rate_in(i, frame, &pose, &td, &omega);
+            let (s, v) = (strokes.stroke_m[i], strokes.rate_m_s[i]);
             let r = self
                 .hyd
                 .actuator_rates(i, s, v, self.drives[i], &Self::state(y, i), p_s);
@@ -404,7 +396,6 @@ impl<'a, const L: usize> TableLoop<'a, L> {
         y[ps::<L>()] = hyd.supply_pressure_at(y[oil::<L>()]);
         let t0 = run.command.t_s()[0];
         let source = Hydraulic {
-            table,
             hyd,
             drives: [0.0; MAX_LOOP_ACTUATORS],
             t: t0,

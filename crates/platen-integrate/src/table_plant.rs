@@ -37,8 +37,8 @@
 use nalgebra::{DVector, DVectorView};
 use nalgebra::{Vector2, Vector3};
 use platen_model::multi_axis::{
-    angular_velocity, planar_rate, Coords, Dof, Frame, FrictionCapacity, LinearSpecimen,
-    MultiAxisTable, PlanarRate, Wrench,
+    planar_rate, Coords, Dof, FrictionCapacity, Kinematics, LinearSpecimen, MultiAxisTable,
+    PlanarRate, Wrench,
 };
 use platen_model::PlatenModel;
 
@@ -225,6 +225,14 @@ type SpecimenForces = [f64; MAX_TABLE_SPECIMEN_DOFS];
 /// The actuator forces at an instant, N.
 pub(crate) type Forces = [f64; MAX_TABLE_ACTUATORS];
 
+/// The actuators' strokes from neutral (m) and their rates (m/s) at an instant, the first
+/// `n` of each: what a source's own states need of the platen's motion
+/// ([`Source::NEEDS_STROKES`]), taken from the poses the actuators' wrench is built from.
+pub(crate) struct Strokes {
+    pub(crate) stroke_m: [f64; MAX_TABLE_ACTUATORS],
+    pub(crate) rate_m_s: [f64; MAX_TABLE_ACTUATORS],
+}
+
 /// Where a table's actuator forces come from, with the clock of the run that drives it: a
 /// record ([`Recorded`]) or the actuators' own hydraulics in closed loop
 /// ([`crate::table_loop`]). What the plant's hooks need of it.
@@ -233,23 +241,17 @@ pub(crate) trait Source<const L: usize> {
     type Input: Copy;
     /// As [`Plant::RATES_ON_COMMIT`].
     const RATES_ON_COMMIT: bool;
+    /// Whether [`Source::rates`] reads the actuators' strokes and their rates (else they are
+    /// not computed).
+    const NEEDS_STROKES: bool;
     /// The input at position `at`.
     fn input(&self, at: f64) -> Self::Input;
     /// The actuator forces at `input` and state `y`, N.
     fn forces(&self, input: Self::Input, y: &Y<L>) -> Forces;
-    /// The rates of the source's own states (none for a record) with the platen at pose
-    /// `q`, rates `qd`, into `dy`.
+    /// The rates of the source's own states (none for a record) with the actuators at
+    /// `strokes` (filled where [`Source::NEEDS_STROKES`]), into `dy`.
     #[inline(always)]
-    fn rates(
-        &self,
-        _input: Self::Input,
-        _y: &Y<L>,
-        _frame: &Frame,
-        _q: &Coords,
-        _qd: &Coords,
-        _dy: &mut Y<L>,
-    ) {
-    }
+    fn rates(&self, _input: Self::Input, _y: &Y<L>, _strokes: &Strokes, _dy: &mut Y<L>) {}
     /// As [`Plant::admit`].
     fn admit(&mut self, _y: &mut Y<L>, _t_s: f64) -> bool {
         false
@@ -291,6 +293,7 @@ pub(crate) struct Recorded<'a> {
 impl<const L: usize> Source<L> for Recorded<'_> {
     type Input = At;
     const RATES_ON_COMMIT: bool = false;
+    const NEEDS_STROKES: bool = false;
 
     #[inline(always)]
     fn input(&self, at: f64) -> At {
@@ -344,33 +347,47 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
         self.source.forces(at, y)
     }
 
-    /// The actuators' wrench at pose `q` under the forces `f`.
-    fn actuators(&self, f: &Forces, frame: &Frame) -> Wrench {
+    /// The actuators' wrench with the platen's kinematics `k` under the forces `f`, and
+    /// their strokes and rates where the source needs them: each actuator's pose taken once.
+    fn actuators(&self, f: &Forces, k: &Kinematics) -> (Wrench, Strokes) {
         let mut wrench = Wrench::zeros();
+        let mut strokes = Strokes {
+            stroke_m: [0.0; MAX_TABLE_ACTUATORS],
+            rate_m_s: [0.0; MAX_TABLE_ACTUATORS],
+        };
+        let frame = &k.frame;
         for (i, f) in f.iter().take(self.table.actuators().len()).enumerate() {
-            wrench += self.table.actuator_in(i, frame).unit_wrench * *f;
+            let pose = self.table.actuator_in(i, frame);
+            wrench += pose.unit_wrench * *f;
+            if S::NEEDS_STROKES {
+                strokes.stroke_m[i] = pose.stroke_m;
+                strokes.rate_m_s[i] =
+                    self.table
+                        .stroke_rate_in(i, frame, &pose, &k.velocity_m_s, &k.omega_rad_s);
+            }
         }
-        wrench
+        (wrench, strokes)
     }
 
     /// The platen's twist (velocity of the reference point, angular velocity).
-    fn twist(q: &Coords, qd: &Coords) -> Wrench {
-        let omega = angular_velocity(q, qd);
-        Wrench::new(qd[0], qd[1], qd[2], omega[0], omega[1], omega[2])
+    fn twist(k: &Kinematics) -> Wrench {
+        let (v, omega) = (k.velocity_m_s, k.omega_rad_s);
+        Wrench::new(v[0], v[1], v[2], omega[0], omega[1], omega[2])
     }
 
     /// The rates in slip (or free flight without friction); returns the gauge's rate.
     fn slip_rates(&self, at: S::Input, y: &Y<L>, dy: &mut Y<L>) -> f64 {
         let (q, qd) = pose(y);
         let f = self.forces_at(at, y);
-        let frame = self.table.frame(&q);
-        let wrench = self.actuators(&f, &frame);
-        let twist = Self::twist(&q, &qd);
+        let kin = self.table.kinematics(&q, &qd);
+        let frame = &kin.frame;
+        let (wrench, strokes) = self.actuators(&f, &kin);
+        let twist = Self::twist(&kin);
         let restoring = self.specimen_restoring(y);
-        let mut applied = wrench + self.table.struts_wrench_in(&frame) + self.push_of(&restoring);
+        let mut applied = wrench + self.table.struts_wrench_in(frame) + self.push_of(&restoring);
         let mut lost = 0.0;
         if self.friction {
-            let capacity = self.table.friction_capacity_in(&frame, &f);
+            let capacity = self.table.friction_capacity_in(frame, &f);
             let friction =
                 self.table
                     .sliding_friction(&q, &qd, &capacity, &self.leaving, self.blend_m_s);
@@ -379,7 +396,7 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
         }
         let qdd = self
             .table
-            .accelerations(&q, &qd, &applied)
+            .accelerations_in(&kin, &applied)
             .unwrap_or_else(|| Coords::repeat(f64::NAN));
         dy[U] = 0.0;
         dy[V] = if self.friction {
@@ -395,7 +412,7 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
             dy[QD + k] = qdd[k];
         }
         self.specimen_rates((&q, &qd, &qdd), &restoring, y, dy);
-        self.source.rates(at, y, &frame, &q, &qd, dy);
+        self.source.rates(at, y, &strokes, dy);
         dy[V]
     }
 
@@ -463,12 +480,13 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
     fn stick_rates(&self, at: S::Input, y: &Y<L>, dy: &mut Y<L>) {
         let (q, qd) = pose(y);
         let f = self.forces_at(at, y);
-        let frame = self.table.frame(&q);
-        let wrench = self.actuators(&f, &frame);
-        let twist = Self::twist(&q, &qd);
+        let kin = self.table.kinematics(&q, &qd);
+        let frame = &kin.frame;
+        let (wrench, strokes) = self.actuators(&f, &kin);
+        let twist = Self::twist(&kin);
         let restoring = self.specimen_restoring(y);
-        let applied = wrench + self.table.struts_wrench_in(&frame) + self.push_of(&restoring);
-        let capacity = self.table.friction_capacity_in(&frame, &f);
+        let applied = wrench + self.table.struts_wrench_in(frame) + self.push_of(&restoring);
+        let capacity = self.table.friction_capacity_in(frame, &f);
         let (qdd, holding) = match self.table.stick(&q, &qd, &applied, &capacity) {
             Some(s) => (s.accelerations, s.wrench),
             None => (Coords::repeat(f64::NAN), Wrench::repeat(f64::NAN)),
@@ -483,7 +501,7 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
             dy[QD + k] = qdd[k];
         }
         self.specimen_rates((&q, &qd, &qdd), &restoring, y, dy);
-        self.source.rates(at, y, &frame, &q, &qd, dy);
+        self.source.rates(at, y, &strokes, dy);
     }
 
     /// The holding friction's ratio to the limit surface at `y` under the forces at `at`
@@ -491,11 +509,11 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
     fn ratio(&self, at: S::Input, y: &Y<L>) -> f64 {
         let (q, qd) = pose(y);
         let f = self.forces_at(at, y);
-        let frame = self.table.frame(&q);
-        let applied = self.actuators(&f, &frame)
-            + self.table.struts_wrench_in(&frame)
+        let kin = self.table.kinematics(&q, &qd);
+        let applied = self.actuators(&f, &kin).0
+            + self.table.struts_wrench_in(&kin.frame)
             + self.specimen_push(y);
-        let capacity = self.table.friction_capacity_in(&frame, &f);
+        let capacity = self.table.friction_capacity_in(&kin.frame, &f);
         self.table
             .stick(&q, &qd, &applied, &capacity)
             .map_or(f64::INFINITY, |s| s.ratio)
@@ -506,11 +524,11 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
     fn leave(&self, at: S::Input, y: &Y<L>) -> (PlanarRate, Gauge) {
         let (q, qd) = pose(y);
         let f = self.forces_at(at, y);
-        let frame = self.table.frame(&q);
-        let applied = self.actuators(&f, &frame)
-            + self.table.struts_wrench_in(&frame)
+        let kin = self.table.kinematics(&q, &qd);
+        let applied = self.actuators(&f, &kin).0
+            + self.table.struts_wrench_in(&kin.frame)
             + self.specimen_push(y);
-        let capacity = self.table.friction_capacity_in(&frame, &f);
+        let capacity = self.table.friction_capacity_in(&kin.frame, &f);
         let t = Vector3::new(q[0], q[1], q[2]);
         let w = self
             .table
@@ -1021,9 +1039,10 @@ impl Output {
 
 /// The platen's kinetic energy at pose `q` with rates `qd`, J (for energy balances).
 pub fn table_kinetic_energy_j(table: &MultiAxisTable, q: &Coords, qd: &Coords) -> f64 {
-    let omega = angular_velocity(q, qd);
+    let k = table.kinematics(q, qd);
+    let omega = k.omega_rad_s;
     let twist = Wrench::new(qd[0], qd[1], qd[2], omega[0], omega[1], omega[2]);
-    0.5 * twist.dot(&(table.spatial_mass_matrix(q) * twist))
+    0.5 * twist.dot(&(table.spatial_mass_matrix_in(&k) * twist))
 }
 
 /// The potential energy of gravity and of the struts' gas at pose `q`, J, from neutral: the

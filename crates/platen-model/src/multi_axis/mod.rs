@@ -37,6 +37,6 @@ pub use friction::{
 pub use modes::Mode;
 pub use specimen::LinearSpecimen;
 pub use table::{
-    Actuator, ActuatorPose, AxisCapacity, Bearing, BearingLoad, Frame, Mount, MultiAxisTable, Pad,
-    Point, RigidPlaten, Strut, StrutPose, TableParts, Wrench,
+    Actuator, ActuatorPose, AxisCapacity, Bearing, BearingLoad, Frame, Kinematics, Mount,
+    MultiAxisTable, Pad, Point, RigidPlaten, Strut, StrutPose, TableParts, Wrench,
 };

@@ -288,6 +288,28 @@ pub struct Frame {
     pub normal: Vector3<f64>,
 }
 
+/// The platen's motion at a pose with its rates: its frame and what the equations of motion
+/// need of the angles, each computed once ([`MultiAxisTable::kinematics`]). One right-hand
+/// side of the dynamics needs the rotation, the rate map and the angular velocity in several
+/// places; taking them from here gives the same numbers as computing each afresh.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Kinematics {
+    /// The platen's frame at the pose.
+    pub frame: Frame,
+    /// `E(q)`, with `ω = E·(roll′, pitch′, yaw′)` ([`angular_rate_map`]).
+    pub rate_map: Matrix3<f64>,
+    /// The angular velocity `ω` in table axes, rad/s.
+    pub omega_rad_s: Vector3<f64>,
+    /// The reference point's velocity `ṫ`, m/s.
+    pub velocity_m_s: Vector3<f64>,
+    /// `Ė·θ̇` ([`angular_rate_bias`]), rad/s².
+    pub rate_bias_rad_s2: Vector3<f64>,
+    /// The platen's centre of mass from the reference point, table axes, `R·c`, m.
+    pub centre_of_mass_m: Point,
+    /// The platen's inertia about its centre of mass in table axes, `R·I_c·Rᵀ`, kg·m².
+    pub inertia_kg_m2: Matrix3<f64>,
+}
+
 /// A hold-down strut at a pose.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StrutPose {
@@ -497,6 +519,24 @@ impl MultiAxisTable {
         }
     }
 
+    /// The platen's kinematics at pose `q` with rates `qd`: its frame, rate map, angular
+    /// velocity and its mass's place and inertia in table axes, computed once.
+    pub fn kinematics(&self, q: &Coords, qd: &Coords) -> Kinematics {
+        let frame = self.frame(q);
+        let e = angular_rate_map(q);
+        let p = &self.parts.platen;
+        let r = frame.rotation;
+        Kinematics {
+            frame,
+            rate_map: e,
+            omega_rad_s: e * qd.fixed_rows::<3>(3),
+            velocity_m_s: Vector3::new(qd[0], qd[1], qd[2]),
+            rate_bias_rad_s2: angular_rate_bias(q, qd),
+            centre_of_mass_m: r * p.centre_of_mass_m,
+            inertia_kg_m2: r * p.inertia_kg_m2 * r.transpose(),
+        }
+    }
+
     /// Actuator `i` at pose `q`.
     ///
     /// # Panics
@@ -622,19 +662,20 @@ impl MultiAxisTable {
     /// `[[m·I, −m·[r_c]×], [m·[r_c]×, I_w − m·[r_c]×[r_c]×]]` acting on (ẗ, ω̇), with
     /// `r_c = R·c` and `I_w = R·I_c·Rᵀ`.
     pub fn spatial_mass_matrix(&self, q: &Coords) -> Matrix6<f64> {
-        let p = &self.parts.platen;
-        let r = rotation(q);
-        let rc = r * p.centre_of_mass_m;
-        let iw = r * p.inertia_kg_m2 * r.transpose();
-        let x = rc.cross_matrix();
-        let m = p.mass_kg;
+        self.spatial_mass_matrix_in(&self.kinematics(q, &Coords::zeros()))
+    }
+
+    /// [`MultiAxisTable::spatial_mass_matrix`] with the platen's kinematics `k`.
+    pub fn spatial_mass_matrix_in(&self, k: &Kinematics) -> Matrix6<f64> {
+        let x = k.centre_of_mass_m.cross_matrix();
+        let m = self.parts.platen.mass_kg;
         let mut out = Matrix6::zeros();
         out.fixed_view_mut::<3, 3>(0, 0)
             .copy_from(&(Matrix3::identity() * m));
         out.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-x * m));
         out.fixed_view_mut::<3, 3>(3, 0).copy_from(&(x * m));
         out.fixed_view_mut::<3, 3>(3, 3)
-            .copy_from(&(iw - x * x * m));
+            .copy_from(&(k.inertia_kg_m2 - x * x * m));
         out
     }
 
@@ -642,11 +683,19 @@ impl MultiAxisTable {
     /// `[m·ω×(ω×r_c); ω×(I_w·ω) + m·r_c×(ω×(ω×r_c))]`, so that
     /// `M·(ẗ, ω̇) + h = W_applied + W_gravity`.
     pub fn velocity_wrench(&self, q: &Coords, omega: &Vector3<f64>) -> Wrench {
+        let k = self.kinematics(q, &Coords::zeros());
+        self.velocity_wrench_with(&k.centre_of_mass_m, &k.inertia_kg_m2, omega)
+    }
+
+    /// `h` with the centre of mass `rc` and inertia `iw` in table axes.
+    fn velocity_wrench_with(
+        &self,
+        rc: &Vector3<f64>,
+        iw: &Matrix3<f64>,
+        omega: &Vector3<f64>,
+    ) -> Wrench {
         let p = &self.parts.platen;
-        let r = rotation(q);
-        let rc = r * p.centre_of_mass_m;
-        let iw = r * p.inertia_kg_m2 * r.transpose();
-        let centripetal = omega.cross(&omega.cross(&rc)) * p.mass_kg;
+        let centripetal = omega.cross(&omega.cross(rc)) * p.mass_kg;
         let moment = omega.cross(&(iw * omega)) + rc.cross(&centripetal);
         Wrench::new(
             centripetal[0],
@@ -660,9 +709,13 @@ impl MultiAxisTable {
 
     /// Gravity's wrench on the platen about the reference point at pose `q`.
     pub fn gravity_wrench(&self, q: &Coords) -> Wrench {
-        let p = &self.parts.platen;
-        let weight = Vector3::new(0.0, 0.0, -p.mass_kg * STANDARD_GRAVITY_M_S2);
-        point_wrench(&(rotation(q) * p.centre_of_mass_m), &weight)
+        self.gravity_wrench_with(&(rotation(q) * self.parts.platen.centre_of_mass_m))
+    }
+
+    /// Gravity's wrench with the centre of mass at `rc` from the reference point.
+    fn gravity_wrench_with(&self, rc: &Vector3<f64>) -> Wrench {
+        let weight = Vector3::new(0.0, 0.0, -self.parts.platen.mass_kg * STANDARD_GRAVITY_M_S2);
+        point_wrench(rc, &weight)
     }
 
     /// The wrench about the reference point that every applied force but gravity must exert
@@ -689,7 +742,12 @@ impl MultiAxisTable {
     /// but gravity, about the reference point) at `q`, `qd`, the held DOFs' at zero. `None`
     /// where the mass matrix is not positive definite (pitch at ±π/2).
     pub fn accelerations(&self, q: &Coords, qd: &Coords, applied: &Wrench) -> Option<Coords> {
-        let (mq, rhs) = self.coordinate_dynamics(q, qd, applied);
+        self.accelerations_in(&self.kinematics(q, qd), applied)
+    }
+
+    /// [`MultiAxisTable::accelerations`] with the platen's kinematics `k`.
+    pub fn accelerations_in(&self, k: &Kinematics, applied: &Wrench) -> Option<Coords> {
+        let (mq, rhs) = self.coordinate_dynamics_in(k, applied);
         Cholesky::new(mq).map(|c| c.solve(&rhs))
     }
 
@@ -701,15 +759,20 @@ impl MultiAxisTable {
         qd: &Coords,
         applied: &Wrench,
     ) -> (Matrix6<f64>, Coords) {
-        let e = angular_rate_map(q);
-        let omega = e * qd.fixed_rows::<3>(3);
-        let bias = angular_rate_bias(q, qd);
-        let m6 = self.spatial_mass_matrix(q);
+        self.coordinate_dynamics_in(&self.kinematics(q, qd), applied)
+    }
+
+    /// [`MultiAxisTable::coordinate_dynamics`] with the platen's kinematics `k`.
+    fn coordinate_dynamics_in(&self, k: &Kinematics, applied: &Wrench) -> (Matrix6<f64>, Coords) {
+        let m6 = self.spatial_mass_matrix_in(k);
         let mut j = Matrix6::identity();
-        j.fixed_view_mut::<3, 3>(3, 3).copy_from(&e);
+        j.fixed_view_mut::<3, 3>(3, 3).copy_from(&k.rate_map);
         let mut jdqd = Wrench::zeros();
-        jdqd.fixed_rows_mut::<3>(3).copy_from(&bias);
-        let rhs_w = applied + self.gravity_wrench(q) - self.velocity_wrench(q, &omega) - m6 * jdqd;
+        jdqd.fixed_rows_mut::<3>(3).copy_from(&k.rate_bias_rad_s2);
+        let rc = &k.centre_of_mass_m;
+        let rhs_w = applied + self.gravity_wrench_with(rc)
+            - self.velocity_wrench_with(rc, &k.inertia_kg_m2, &k.omega_rad_s)
+            - m6 * jdqd;
         let mut mq = j.transpose() * m6 * j;
         let mut rhs = j.transpose() * rhs_w;
         for d in self.held().iter() {
