@@ -70,6 +70,15 @@ pub const MAX_TABLE_ACTUATORS: usize = 64;
 /// 1e-15 of it; a slide that turned instead keeps a speed of the order of that).
 const REST_SHARE: f64 = 1e-6;
 
+/// Holding friction up to this share beyond the limit surface still holds: the rounding of
+/// the ratio (found through the platen's mass matrix and the bearings' capacity, some 1e-16
+/// of it). A platen at rest with the ratio a hair above 1 (a decaying motion that ends with
+/// the holding friction on the surface) has no slide to leave in: the slip it would enter
+/// decelerates at once by rounding, arrives at rest again at the same instant, and without
+/// this margin the stick-slip events repeat there without end. Physically nothing: 1e-9 of
+/// the bearings' capacity.
+const RATIO_ROUNDING: f64 = 1e-9;
+
 /// The friction direction near rest is blended with the slide's known direction over the
 /// speed the friction takes off in this many grid steps: enough that an RK4 stage that
 /// overshoots rest (by less than one step's worth) keeps the direction, and that the stiff
@@ -505,7 +514,7 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
     }
 
     /// The holding friction's ratio to the limit surface at `y` under the forces at `at`
-    /// (infinite where the equations are singular).
+    /// (infinite where the equations are singular; 1 within [`RATIO_ROUNDING`] above it).
     fn ratio(&self, at: S::Input, y: &Y<L>) -> f64 {
         let (q, qd) = pose(y);
         let f = self.forces_at(at, y);
@@ -514,9 +523,15 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
             + self.table.struts_wrench_in(&kin.frame)
             + self.specimen_push(y);
         let capacity = self.table.friction_capacity_in(&kin.frame, &f);
-        self.table
+        let ratio = self
+            .table
             .stick(&q, &qd, &applied, &capacity)
-            .map_or(f64::INFINITY, |s| s.ratio)
+            .map_or(f64::INFINITY, |s| s.ratio);
+        if ratio > 1.0 && ratio <= 1.0 + RATIO_ROUNDING {
+            1.0
+        } else {
+            ratio
+        }
     }
 
     /// Leaving rest at `y` under the forces at `at`: the in-plane motion
