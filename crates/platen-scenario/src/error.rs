@@ -36,7 +36,7 @@ pub enum ScenarioError {
     },
 
     /// A multi-axis run failed (the actuators lose rank at a pose of the motion).
-    #[error("the multi-axis run failed: {0}; no output was written")]
+    #[error("the multi-axis run failed; no output was written")]
     TableRun(#[source] IntegrateError),
 
     /// A record is shorter than the scenario's `duration_s`.
@@ -78,4 +78,39 @@ pub enum ScenarioError {
     /// the time. Nothing was written.
     #[error("forward run failed; no output was written")]
     Run(#[source] IntegrateError),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The error and its causes as the CLI (anyhow's `{:#}`) and Python print them.
+    fn chain(e: &(dyn std::error::Error + 'static)) -> String {
+        let mut parts = vec![e.to_string()];
+        let mut cause = e.source();
+        while let Some(c) = cause {
+            parts.push(c.to_string());
+            cause = c.source();
+        }
+        parts.join(": ")
+    }
+
+    /// A failed multi-axis run names its cause once along the chain (its message used to
+    /// carry the cause that its source gives again: "… failed: numerical failure …: numerical
+    /// failure …"), as the uniaxial run's does.
+    #[test]
+    fn a_failed_run_names_its_cause_once() {
+        let cause = IntegrateError::EventLoopStalled {
+            t_s: 37.5,
+            events: 4097,
+        };
+        let cause_text = cause.to_string();
+        for e in [
+            ScenarioError::TableRun(cause.clone()),
+            ScenarioError::Run(cause),
+        ] {
+            let text = chain(&e);
+            assert_eq!(text.matches(&cause_text).count(), 1, "{text}");
+        }
+    }
 }

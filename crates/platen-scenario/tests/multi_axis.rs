@@ -278,7 +278,7 @@ fn no_value_of_a_table_panics() {
             *doc.pointer_mut(leaf).unwrap() = v.clone();
             let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                 scenario(dir.path(), doc, &motion)
-                    .and_then(|s| s.run().map(|_| ()).map_err(|e| e.to_string()))
+                    .and_then(|s| s.run().map(|_| ()).map_err(|e| chain(&e)))
             }));
             let Ok(result) = outcome else {
                 panic!("{leaf} = {v}: panicked");
@@ -830,4 +830,16 @@ fn bad_generated_motions_per_axis_are_refused_with_their_path() {
         err.contains("excitation.sine_motion") && err.contains("multi-axis"),
         "{err}"
     );
+}
+
+/// The error and its causes joined by ": ", as the CLI and Python print them.
+fn chain(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut text = e.to_string();
+    let mut cause = e.source();
+    while let Some(c) = cause {
+        text += ": ";
+        text += &c.to_string();
+        cause = c.source();
+    }
+    text
 }
