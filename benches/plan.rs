@@ -19,8 +19,8 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use platen::integrate::State;
 use platen::model::preset;
 use platen::plan::{
-    iterate, max_scale, BaselineSettings, FrfSource, IterationSettings, MaxScaleSettings, Table,
-    Target, TargetMotion,
+    enveloped_sines_m_s2, iterate, max_scale, BaselineSettings, FrfSource, IterationSettings,
+    MaxScaleSettings, Table, Target, TargetMotion,
 };
 use platen::scenario::LoadedRig;
 
@@ -30,26 +30,20 @@ use common::{report_ratios, sine_force, timed, PRESSURE_PA, RATE_HZ};
 const SAMPLE_SIZE: usize = 10;
 const SECONDS: usize = 40;
 
-/// An earthquake-like acceleration: five sines under a rise–hold–decay envelope, 0.3 g peak.
+/// An earthquake-like acceleration: five sines under a rise–hold–decay envelope, 0.3 g peak
+/// ([`enveloped_sines_m_s2`]).
 fn quake(t: f64) -> f64 {
-    let env = if t < 1.0 {
-        0.0
-    } else if t < 6.0 {
-        ((t - 1.0) / 5.0).powi(2)
-    } else {
-        (-(t - 14.0).max(0.0) / 6.0).exp()
-    };
-    let s: f64 = [
-        (0.7, 0.3, 0.0),
-        (1.9, 1.0, 1.1),
-        (3.3, 0.8, 2.3),
-        (6.1, 0.6, 0.4),
-        (11.0, 0.4, 5.0),
-    ]
-    .iter()
-    .map(|(f, a, p)| a * (std::f64::consts::TAU * f * t + p).sin())
-    .sum();
-    0.3 * 9.806_65 * env * s / 2.0
+    enveloped_sines_m_s2(
+        t,
+        0.3,
+        &[
+            (0.7, 0.3, 0.0),
+            (1.9, 1.0, 1.1),
+            (3.3, 0.8, 2.3),
+            (6.1, 0.6, 0.4),
+            (11.0, 0.4, 5.0),
+        ],
+    )
 }
 
 /// The LHPOST's identified platen in its preset table system's loop.

@@ -29,7 +29,10 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use platen::integrate::State;
 use platen::model::preset;
 use platen::plan::six_dof::table_scenario_file;
-use platen::plan::{plan_multi_axis, AxisTargets, IterationSettings, TablePlanSettings, Target};
+use platen::plan::{
+    plan_multi_axis, synthetic_three_component_m_s2, AxisTargets, IterationSettings,
+    TablePlanSettings, Target,
+};
 use platen::scenario::file::ScenarioFile;
 
 use common::baseline::baseline_rk4;
@@ -38,66 +41,12 @@ use common::{report_ratios, sine_force, timed, PRESSURE_PA, RATE_HZ};
 const SAMPLE_SIZE: usize = 10;
 const SECONDS: usize = 40;
 
-/// An earthquake-like acceleration: five sines (frequency Hz, weight, phase rad) under a
-/// rise–hold–decay envelope, scaled to about `peak_g`.
-fn quake(t: f64, peak_g: f64, sines: &Sines) -> f64 {
-    let env = if t < 1.0 {
-        0.0
-    } else if t < 6.0 {
-        ((t - 1.0) / 5.0).powi(2)
-    } else {
-        (-(t - 14.0).max(0.0) / 6.0).exp()
-    };
-    let s: f64 = sines
-        .iter()
-        .map(|(f, a, p)| a * (std::f64::consts::TAU * f * t + p).sin())
-        .sum();
-    peak_g * 9.806_65 * env * s / 2.0
-}
-
-/// An axis's sines: (frequency Hz, weight, phase rad).
-type Sines = [(f64, f64, f64); 5];
-
-/// The three axes' targets, each with its own spectrum.
+/// The three axes' targets ([`synthetic_three_component_m_s2`]), each with its own spectrum.
 fn targets(origin: &Path) -> AxisTargets {
     let n = SECONDS * RATE_HZ as usize + 1;
     let t_s: Vec<f64> = (0..n).map(|j| j as f64 / RATE_HZ).collect();
-    let axes: [(f64, Sines); 3] = [
-        (
-            0.25,
-            [
-                (0.7, 0.3, 0.0),
-                (1.9, 1.0, 1.1),
-                (3.3, 0.8, 2.3),
-                (6.1, 0.6, 0.4),
-                (11.0, 0.4, 5.0),
-            ],
-        ),
-        (
-            0.2,
-            [
-                (0.9, 0.4, 0.7),
-                (2.3, 1.0, 0.2),
-                (4.1, 0.7, 1.9),
-                (7.3, 0.5, 3.1),
-                (13.0, 0.3, 0.9),
-            ],
-        ),
-        (
-            0.15,
-            [
-                (1.3, 0.3, 2.2),
-                (3.7, 0.8, 0.5),
-                (6.7, 1.0, 1.4),
-                (11.0, 0.6, 2.8),
-                (17.0, 0.4, 0.1),
-            ],
-        ),
-    ];
-    let axes = axes.map(|(peak_g, sines)| {
-        let a = t_s.iter().map(|&t| quake(t, peak_g, &sines)).collect();
-        Some(Target::acceleration(origin, t_s.clone(), a).unwrap())
-    });
+    let axes = synthetic_three_component_m_s2(&t_s)
+        .map(|a| Some(Target::acceleration(origin, t_s.clone(), a).unwrap()));
     AxisTargets::new(origin, axes).unwrap()
 }
 

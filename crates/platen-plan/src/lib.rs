@@ -105,4 +105,6 @@ pub use six_dof::{
     TablePlan, TablePlanSettings, TablePlant,
 };
 pub use table::{Achieved, Table};
-pub use target::{Target, TargetKind, MIN_TARGET_SAMPLES};
+pub use target::{
+    enveloped_sines_m_s2, synthetic_three_component_m_s2, Target, TargetKind, MIN_TARGET_SAMPLES,
+};

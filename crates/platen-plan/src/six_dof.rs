@@ -56,7 +56,7 @@ use crate::error::{PlanError, Result};
 use crate::feasibility::{search_max_scale, MaxScale, MaxScaleSettings};
 use crate::iterate::IterationSettings;
 use crate::mimo::{iterate_mimo, AxisTarget, MimoIteration, MimoResponse, TransferMatrix};
-use crate::target::{Target, MIN_TARGET_SAMPLES};
+use crate::target::Target;
 
 /// The scenario JSON `text` (from `path`, for messages) if it is a multi-axis one (it has a
 /// `table`), parsed, its `excitation` optional (a plan's target takes its place, and a
@@ -147,7 +147,7 @@ impl AxisTargets {
     /// # Errors
     /// [`PlanError::Io`] naming the file and line: unreadable, no `t_s`, none of the axes'
     /// columns, a bad cell, times that do not increase strictly or are not uniform, fewer
-    /// than [`MIN_TARGET_SAMPLES`] rows.
+    /// than [`MIN_TARGET_SAMPLES`](crate::MIN_TARGET_SAMPLES) rows.
     pub fn read_csv(path: &Path) -> Result<Self> {
         let optional: Vec<&'static str> = ACCELERATION_COLUMNS[..3]
             .iter()
@@ -157,15 +157,7 @@ impl AxisTargets {
         let mut table = platen_io::csv::read_table(path, &["t_s"], &optional)?;
         let t_s = table.take_column("t_s").unwrap_or_default();
         // The file's own checks first, so that they name the file and line.
-        if t_s.len() < MIN_TARGET_SAMPLES {
-            return Err(IoError::TooShort {
-                path: path.to_owned(),
-                rows: t_s.len(),
-                needed: MIN_TARGET_SAMPLES,
-            }
-            .into());
-        }
-        platen_scenario::sampling::sampling_grid(path, &t_s)?;
+        crate::target::checked_times(path, &t_s)?;
         let mut axes: [Option<Target>; 3] = [None, None, None];
         for (k, axis) in axes.iter_mut().enumerate() {
             *axis = match (

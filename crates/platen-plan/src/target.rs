@@ -12,6 +12,84 @@ use crate::error::{PlanError, Result};
 /// samples than this carry no usable band.
 pub const MIN_TARGET_SAMPLES: usize = 16;
 
+/// The times `t_s` of the target file at `path` checked as the file's own (so that the
+/// errors name the file and line): at least [`MIN_TARGET_SAMPLES`] rows, a uniform grid.
+pub(crate) fn checked_times(path: &Path, t_s: &[f64]) -> Result<platen_integrate::SamplingGrid> {
+    if t_s.len() < MIN_TARGET_SAMPLES {
+        return Err(IoError::TooShort {
+            path: path.to_owned(),
+            rows: t_s.len(),
+            needed: MIN_TARGET_SAMPLES,
+        }
+        .into());
+    }
+    Ok(platen_scenario::sampling::sampling_grid(path, t_s)?)
+}
+
+/// A synthetic earthquake-like acceleration at `t_s`, m/s², for trying a plan without a
+/// record: `sines` (frequency Hz, weight, phase rad) summed under a rise–hold–decay envelope
+/// (still to 1 s, rising quadratically to 6 s, held to 14 s, then decaying with 6 s), scaled
+/// by `peak_g`·g/2.
+pub fn enveloped_sines_m_s2(t_s: f64, peak_g: f64, sines: &[(f64, f64, f64)]) -> f64 {
+    let env = if t_s < 1.0 {
+        0.0
+    } else if t_s < 6.0 {
+        ((t_s - 1.0) / 5.0).powi(2)
+    } else {
+        (-(t_s - 14.0).max(0.0) / 6.0).exp()
+    };
+    let s: f64 = sines
+        .iter()
+        .map(|(f, a, p)| a * (std::f64::consts::TAU * f * t_s + p).sin())
+        .sum();
+    peak_g * 9.806_65 * env * s / 2.0
+}
+
+/// The synthetic three-component target of the three-component plan's bench and release
+/// test, m/s², at the times `t_s`: per axis (x, y, z) [`enveloped_sines_m_s2`] with five
+/// sines of its own, about 0.25, 0.2 and 0.15 g at the peak (Tarzana's at 25 %).
+pub fn synthetic_three_component_m_s2(t_s: &[f64]) -> [Vec<f64>; 3] {
+    /// Per axis: its peak, g, and its sines (frequency Hz, weight, phase rad).
+    type Axis = (f64, [(f64, f64, f64); 5]);
+    const AXES: [Axis; 3] = [
+        (
+            0.25,
+            [
+                (0.7, 0.3, 0.0),
+                (1.9, 1.0, 1.1),
+                (3.3, 0.8, 2.3),
+                (6.1, 0.6, 0.4),
+                (11.0, 0.4, 5.0),
+            ],
+        ),
+        (
+            0.2,
+            [
+                (0.9, 0.4, 0.7),
+                (2.3, 1.0, 0.2),
+                (4.1, 0.7, 1.9),
+                (7.3, 0.5, 3.1),
+                (13.0, 0.3, 0.9),
+            ],
+        ),
+        (
+            0.15,
+            [
+                (1.3, 0.3, 2.2),
+                (3.7, 0.8, 0.5),
+                (6.7, 1.0, 1.4),
+                (11.0, 0.6, 2.8),
+                (17.0, 0.4, 0.1),
+            ],
+        ),
+    ];
+    AXES.map(|(peak_g, sines)| {
+        t_s.iter()
+            .map(|&t| enveloped_sines_m_s2(t, peak_g, &sines))
+            .collect()
+    })
+}
+
 /// What a target prescribes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TargetKind {
@@ -131,15 +209,7 @@ impl Target {
             }
         };
         let t_s = table.take_column("t_s").unwrap_or_default();
-        if t_s.len() < MIN_TARGET_SAMPLES {
-            return Err(IoError::TooShort {
-                path: path.to_owned(),
-                rows: t_s.len(),
-                needed: MIN_TARGET_SAMPLES,
-            }
-            .into());
-        }
-        let grid = platen_scenario::sampling::sampling_grid(path, &t_s)?;
+        let grid = checked_times(path, &t_s)?;
         Ok(Self {
             origin: path.to_owned(),
             t_s,

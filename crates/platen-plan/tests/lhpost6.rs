@@ -178,24 +178,6 @@ fn northridge_three_components_on_the_lhpost6_with_a_tower() {
     );
 }
 
-/// An earthquake-like acceleration: five sines (frequency Hz, weight, phase rad) under a
-/// rise–hold–decay envelope, about `peak_g` at its peak (the target of
-/// `benches/plan_three_component.rs`).
-fn quake(t: f64, peak_g: f64, sines: &[(f64, f64, f64)]) -> f64 {
-    let env = if t < 1.0 {
-        0.0
-    } else if t < 6.0 {
-        ((t - 1.0) / 5.0).powi(2)
-    } else {
-        (-(t - 14.0).max(0.0) / 6.0).exp()
-    };
-    let s: f64 = sines
-        .iter()
-        .map(|(f, a, p)| a * (std::f64::consts::TAU * f * t + p).sin())
-        .sum();
-    peak_g * 9.806_65 * env * s / 2.0
-}
-
 /// A synthetic three-component target on the 120 t tower, which needs no record: its motion
 /// decays to rest at the end, where an iterated drive left the holding friction on the
 /// limit surface to rounding (a ratio of 1 + 2e-16) and the stick-slip events repeated at one
@@ -215,42 +197,8 @@ fn a_synthetic_target_that_ends_at_rest_iterates_to_the_end() {
         .unwrap()
         .unwrap();
     let t: Vec<f64> = (0..=40 * 1024).map(|j| f64::from(j) / 1024.0).collect();
-    let axes = [
-        (
-            0.25,
-            [
-                (0.7, 0.3, 0.0),
-                (1.9, 1.0, 1.1),
-                (3.3, 0.8, 2.3),
-                (6.1, 0.6, 0.4),
-                (11.0, 0.4, 5.0),
-            ],
-        ),
-        (
-            0.2,
-            [
-                (0.9, 0.4, 0.7),
-                (2.3, 1.0, 0.2),
-                (4.1, 0.7, 1.9),
-                (7.3, 0.5, 3.1),
-                (13.0, 0.3, 0.9),
-            ],
-        ),
-        (
-            0.15,
-            [
-                (1.3, 0.3, 2.2),
-                (3.7, 0.8, 0.5),
-                (6.7, 1.0, 1.4),
-                (11.0, 0.6, 2.8),
-                (17.0, 0.4, 0.1),
-            ],
-        ),
-    ]
-    .map(|(peak_g, sines)| {
-        let a = t.iter().map(|&t| quake(t, peak_g, &sines)).collect();
-        Some(Target::acceleration(Path::new("quake"), t.clone(), a).unwrap())
-    });
+    let axes = platen_plan::synthetic_three_component_m_s2(&t)
+        .map(|a| Some(Target::acceleration(Path::new("quake"), t.clone(), a).unwrap()));
     let targets = AxisTargets::new(Path::new("quake"), axes).unwrap();
     let settings = TablePlanSettings {
         iteration: platen_plan::IterationSettings {
