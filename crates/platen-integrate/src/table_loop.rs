@@ -19,7 +19,12 @@
 //!
 //! After the platen's (and the specimen's) states, per actuator `p_a`, `p_b`, spool and
 //! spool rate (for at most [`MAX_LOOP_ACTUATORS`] actuators), then the accumulator's oil,
-//! the supply pressure, and the hydraulic and leakage energies. The hydraulics start at rest
+//! the supply pressure, and the hydraulic and leakage energies. The spools are not stepped:
+//! between drive changes each follows its valve's exact response to the held drive
+//! ([`platen_system::SpoolResponse`], anchored at the last change), the integrator's stages
+//! read their openings from it, and each accepted state has them written in. The step then
+//! needs to resolve the oil columns and the spool's transient in the flows, not the spool's
+//! own stepping. The hydraulics start at rest
 //! in their null state for the forces that hold the platen (and the specimen's weight) at
 //! neutral, resolved as the force balance does: a platen commanded to stay at neutral stays.
 
@@ -27,8 +32,8 @@ use std::collections::VecDeque;
 
 use platen_model::multi_axis::{Coords, Dof, LinearSpecimen, MultiAxisTable};
 use platen_system::{
-    ActuatorState, DofCommand, DofController, DofControllerState, DofFeedback, Supply,
-    TableHydraulics,
+    ActuatorState, DofCommand, DofController, DofControllerState, DofFeedback, SpoolResponse,
+    Supply, TableHydraulics,
 };
 
 use crate::closed_loop::LoopMethod;
@@ -119,6 +124,8 @@ pub(crate) struct Hydraulic<'a> {
     hyd: &'a TableHydraulics,
     /// The valves' inputs (the delayed, held drives).
     drives: [f64; MAX_LOOP_ACTUATORS],
+    /// The spools' exact motion under the held drives (see [`Spools`]).
+    spools: Spools,
     /// Time at the start of the current advance, s.
     t: f64,
     /// The grid's step, s.
@@ -128,6 +135,18 @@ pub(crate) struct Hydraulic<'a> {
 }
 
 impl Hydraulic<'_> {
+    /// The spools' positions and rates at time `t_s` (≥ the anchor) under the held drives.
+    fn spools_at(&self, t_s: f64) -> (SpoolPositions, SpoolPositions) {
+        self.spools.at(t_s, &self.drives, self.count())
+    }
+
+    /// New drives arrive at `t_s`: the spools' motion is re-anchored there.
+    fn drive(&mut self, t_s: f64, drives: [f64; MAX_LOOP_ACTUATORS]) {
+        let (x, v) = self.spools_at(t_s);
+        self.spools.anchor(t_s, x, v);
+        self.drives = drives;
+    }
+
     fn state<const L: usize>(y: &Y<L>, i: usize) -> ActuatorState {
         let k = hy::<L>() + 4 * i;
         ActuatorState {
@@ -144,14 +163,17 @@ impl Hydraulic<'_> {
 }
 
 impl<const L: usize> Source<L> for Hydraulic<'_> {
-    type Input = ();
+    /// The spools' positions: exact, from [`Spools`], not stepped.
+    type Input = SpoolPositions;
     const RATES_ON_COMMIT: bool = true;
     const NEEDS_STROKES: bool = true;
 
     #[inline(always)]
-    fn input(&self, _at: f64) {}
+    fn input(&self, at: f64) -> SpoolPositions {
+        self.spools_at(self.t + at).0
+    }
 
-    fn forces(&self, _input: (), y: &Y<L>) -> Forces {
+    fn forces(&self, _input: SpoolPositions, y: &Y<L>) -> Forces {
         let mut out = [0.0; MAX_TABLE_ACTUATORS];
         for (i, o) in out.iter_mut().enumerate().take(self.count()) {
             *o = self.hyd.force_n(i, &Self::state(y, i));
@@ -159,19 +181,25 @@ impl<const L: usize> Source<L> for Hydraulic<'_> {
         out
     }
 
-    fn rates(&self, _input: (), y: &Y<L>, strokes: &Strokes, dy: &mut Y<L>) {
+    /// The spools' states are not stepped (their rates are 0 here): the input carries
+    /// their exact positions, and [`Source::admit`] writes them into the state.
+    fn rates(&self, spools: SpoolPositions, y: &Y<L>, strokes: &Strokes, dy: &mut Y<L>) {
         let p_s = y[ps::<L>()];
         let (mut drawn, mut power, mut leak) = (0.0, 0.0, 0.0);
-        for i in 0..self.count() {
+        for (i, &spool) in spools.iter().enumerate().take(self.count()) {
             let (s, v) = (strokes.stroke_m[i], strokes.rate_m_s[i]);
+            let state = ActuatorState {
+                spool,
+                ..Self::state(y, i)
+            };
             let r = self
                 .hyd
-                .actuator_rates(i, s, v, self.drives[i], &Self::state(y, i), p_s);
+                .actuator_rates(i, s, v, self.drives[i], &state, p_s);
             let k = hy::<L>() + 4 * i;
             dy[k] = r.p_a;
             dy[k + 1] = r.p_b;
-            dy[k + 2] = r.spool;
-            dy[k + 3] = r.spool_rate;
+            dy[k + 2] = 0.0;
+            dy[k + 3] = 0.0;
             drawn += r.drawn_m3_s;
             power += r.power_w;
             leak += r.leakage_w;
@@ -184,11 +212,13 @@ impl<const L: usize> Source<L> for Hydraulic<'_> {
     }
 
     /// Pressures are held at the cavitation floor (0 Pa absolute); the lowest supply
-    /// pressure is kept.
+    /// pressure is kept; the spools' exact states at `t_s` are written in.
     fn admit(&mut self, y: &mut Y<L>, t_s: f64) -> bool {
         let mut floored = false;
+        let (x, v) = self.spools_at(t_s);
         for i in 0..self.count() {
             let k = hy::<L>() + 4 * i;
+            (y[k + 2], y[k + 3]) = (x[i], v[i]);
             for j in [k, k + 1] {
                 if y[j] < 0.0 {
                     y[j] = 0.0;
@@ -275,6 +305,70 @@ impl<const L: usize> Source<L> for Hydraulic<'_> {
 
 /// One number per actuator (the first `n`), on the stack.
 type PerActuator = [f64; MAX_LOOP_ACTUATORS];
+
+/// The spools' positions (fractions of full opening), per actuator.
+pub(crate) type SpoolPositions = [f64; MAX_LOOP_ACTUATORS];
+
+/// The spools' motion in closed form: each spool's position and rate at the last change of
+/// the drives (the anchor), carried to any later time by its valve's exact response to the
+/// held drive ([`SpoolResponse`]). The spool is linear between drive changes, so the
+/// integrator does not step it, and its rate does not limit the step.
+pub(crate) struct Spools {
+    /// Per actuator, its valve's response.
+    responses: [SpoolResponse; MAX_LOOP_ACTUATORS],
+    /// Whether actuator `i`'s valve is the same model as `i − 1`'s (their weights shared).
+    same_as_previous: [bool; MAX_LOOP_ACTUATORS],
+    /// The anchor's time, s.
+    anchor_s: f64,
+    /// The positions at the anchor.
+    x0: SpoolPositions,
+    /// The rates at the anchor, 1/s.
+    v0: SpoolPositions,
+}
+
+impl Spools {
+    /// Every spool at rest at neutral at `t0_s`.
+    fn new(hyd: &TableHydraulics, t0_s: f64) -> Self {
+        let mut responses = [SpoolResponse::new(1.0, 1.0); MAX_LOOP_ACTUATORS];
+        let mut same_as_previous = [false; MAX_LOOP_ACTUATORS];
+        for i in 0..hyd.actuators().len() {
+            responses[i] = hyd.spool_response(i);
+            same_as_previous[i] = i > 0 && responses[i] == responses[i - 1];
+        }
+        Spools {
+            responses,
+            same_as_previous,
+            anchor_s: t0_s,
+            x0: [0.0; MAX_LOOP_ACTUATORS],
+            v0: [0.0; MAX_LOOP_ACTUATORS],
+        }
+    }
+
+    /// The first `n` spools' positions and rates at `t_s` under `drives`.
+    #[inline(always)]
+    fn at(
+        &self,
+        t_s: f64,
+        drives: &[f64; MAX_LOOP_ACTUATORS],
+        n: usize,
+    ) -> (SpoolPositions, SpoolPositions) {
+        let dt = (t_s - self.anchor_s).max(0.0);
+        let (mut x, mut v) = ([0.0; MAX_LOOP_ACTUATORS], [0.0; MAX_LOOP_ACTUATORS]);
+        let mut w = self.responses[0].weights(dt);
+        for i in 0..n {
+            if !self.same_as_previous[i] && i > 0 {
+                w = self.responses[i].weights(dt);
+            }
+            (x[i], v[i]) = self.responses[i].at(w, drives[i], self.x0[i], self.v0[i]);
+        }
+        (x, v)
+    }
+
+    /// Re-anchors at `t_s` with positions `x` and rates `v`.
+    fn anchor(&mut self, t_s: f64, x: SpoolPositions, v: SpoolPositions) {
+        (self.anchor_s, self.x0, self.v0) = (t_s, x, v);
+    }
+}
 
 /// The loop's own output columns per actuator (after the common ones).
 const ACTUATOR_COLUMNS: [&str; 4] = ["drive", "spool_opening", "delta_p_pa", "flow_m3_s"];
@@ -398,6 +492,7 @@ impl<'a, const L: usize> TableLoop<'a, L> {
         let source = Hydraulic {
             hyd,
             drives: [0.0; MAX_LOOP_ACTUATORS],
+            spools: Spools::new(hyd, t0),
             t: t0,
             h,
             cavitation_at_s: None,
@@ -527,7 +622,8 @@ impl<'a, const L: usize> TableLoop<'a, L> {
         let mut changed = false;
         while let Some(&(t, d)) = self.queue.front() {
             if t <= self.t() + slack {
-                self.machine.plant.source.drives = d;
+                let now = self.t();
+                self.machine.plant.source.drive(now, d);
                 self.queue.pop_front();
                 changed = true;
             } else {
@@ -536,7 +632,8 @@ impl<'a, const L: usize> TableLoop<'a, L> {
         }
         if changed {
             let mode = self.machine.mode;
-            self.machine.enter(mode, ());
+            let spools = Source::<L>::input(&self.machine.plant.source, 0.0);
+            self.machine.enter(mode, spools);
         }
     }
 

@@ -1026,13 +1026,17 @@ fn build_system(
     let geometry = DofGeometry::of_table(table).map_err(|e| system_error(ctx, e))?;
     let controller =
         DofController::new(rate, loops, balance, geometry).map_err(|e| system_error(ctx, e))?;
-    // The fastest mode: the spools' and the oil columns' (the table's modes with the valves
-    // shut, specimen included).
+    // The fastest mode the integrator steps: the oil columns' (the table's modes with the
+    // valves shut, specimen included), resolved to `h·ω ≤ 0.25`. The spools are not
+    // stepped: the loop carries them in closed form between drive changes
+    // (`platen_system::SpoolResponse`), and RK4 only integrates the flows they open. That
+    // quadrature needs the spool's transient resolved to `h·ω_v ≤ 1`, not 0.25 (measured:
+    // 1.6e-7 of the motion at `h·ω_v` = 0.74; `tests/multi_axis_loop.rs`).
     let modes = match specimen {
         Some(s) => table.modes_with(s),
         None => table.modes(),
     };
-    let oil = modes
+    let fastest = modes
         .iter()
         .map(|m| std::f64::consts::TAU * m.frequency_hz)
         .fold(0.0, f64::max);
@@ -1041,9 +1045,11 @@ fn build_system(
         .iter()
         .map(|a| std::f64::consts::TAU * a.servo_valve.natural_frequency_hz)
         .fold(0.0, f64::max);
-    let fastest = oil.max(spool);
     let period = controller.period_s();
-    let k = (period * fastest / 0.25).ceil().clamp(1.0, 1e6) as u32;
+    let k = (period * fastest / 0.25)
+        .max(period * spool)
+        .ceil()
+        .clamp(1.0, 1e6) as u32;
     let method = loop_method_at(ctx, integrator, period, fastest, k, || {
         ctx.invalid(
             "table.controller.sample_rate_hz",

@@ -63,6 +63,7 @@ mod hydraulics;
 mod linear;
 mod params;
 pub mod preset;
+mod spool;
 mod table;
 mod table_linear;
 
@@ -76,6 +77,7 @@ pub use linear::{Capacities, Linearisation, Margins, Mechanics, Passband, SECANT
 pub use params::{
     Accumulator, Actuator, Controller, ServoValve, Supply, TableSystem, TableSystemParts,
 };
+pub use spool::{SpoolResponse, SpoolWeights};
 pub use table::{
     ActuatorHydraulics, ActuatorRates, ActuatorState, TableHydraulics, TableHydraulicsParts,
 };

@@ -30,6 +30,7 @@ use crate::hydraulics::{
     charged_oil_m3, four_way_flows, root, supply_pressure_at, supply_rates, HydraulicConstants,
 };
 use crate::params::{validate_supply, ServoValve, Supply};
+use crate::spool::SpoolResponse;
 
 /// One actuator's hydraulics on a multi-axis table.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -371,6 +372,12 @@ impl TableHydraulics {
             power_w: p_a * q_a - p_b * q_b,
             leakage_w: a.leakage_m3_s_per_pa * across * across,
         }
+    }
+
+    /// The exact response of actuator `i`'s spool to a held drive (see [`SpoolResponse`]).
+    pub fn spool_response(&self, i: usize) -> SpoolResponse {
+        let v = &self.parts.actuators[i].servo_valve;
+        SpoolResponse::new(v.natural_frequency_hz, v.damping_ratio)
     }
 
     /// The oil-column stiffness of actuator `i` at stroke `s_m` with its valve shut,
