@@ -10,11 +10,28 @@ use std::process::Command;
 
 use serde_json::Value;
 
-/// `cargo metadata` of this workspace (offline: the lock file has every package already).
+/// The host's target triple (`rustc -vV`).
+fn host() -> String {
+    let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
+    let out = Command::new(rustc)
+        .arg("-vV")
+        .output()
+        .expect("rustc -vV runs");
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .find_map(|l| l.strip_prefix("host: "))
+        .expect("rustc -vV names the host")
+        .to_string()
+}
+
+/// `cargo metadata` of this workspace for the host's platform (offline: the build that runs
+/// this test has fetched every package the host needs, though not the other platforms'
+/// dependencies, such as `android_system_properties`, that an unfiltered resolve would read).
 fn metadata(no_deps: bool) -> Value {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let mut cmd = Command::new(cargo);
     cmd.args(["metadata", "--format-version", "1", "--offline"])
+        .args(["--filter-platform", &host()])
         .current_dir(env!("CARGO_MANIFEST_DIR"));
     if no_deps {
         cmd.arg("--no-deps");
