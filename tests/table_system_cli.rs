@@ -219,3 +219,91 @@ fn a_force_excitation_with_a_table_system_is_refused() {
     );
     assert_eq!(listing(dir.path()), ["force.json"]);
 }
+
+/// The CSV at `path` as its header and columns of numbers.
+fn columns(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<String> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(String::from)
+        .collect();
+    let mut cols = vec![Vec::new(); header.len()];
+    for line in lines {
+        for (c, v) in cols.iter_mut().zip(line.split(',')) {
+            c.push(v.parse::<f64>().unwrap());
+        }
+    }
+    (header, cols)
+}
+
+fn column<'a>(csv: &'a (Vec<String>, Vec<Vec<f64>>), name: &str) -> &'a [f64] {
+    let i = csv.0.iter().position(|h| h == name).unwrap();
+    &csv.1[i]
+}
+
+#[test]
+fn the_tracking_summary_gives_the_relative_errors_the_readme_quotes() {
+    // The relative errors recomputed here from the files the CLI writes: the command
+    // (`generate excitation`) and the run (`simulate --out`), sample by sample. The README and
+    // docs/table-system.md quote the acceleration's as 53 %.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scenario = root.join("scenarios/table-system/wn10g-closed-loop.json");
+    let dir = tempfile::tempdir().unwrap();
+    let (cmd, run) = (dir.path().join("command.csv"), dir.path().join("run.csv"));
+    let s = scenario.to_str().unwrap();
+    let o = platen(&["generate", "excitation", s, "--out", cmd.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let o = platen(&["simulate", s, "--out", run.to_str().unwrap(), "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let summary: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let (cmd, run) = (columns(&cmd), columns(&run));
+    let nrmse = |achieved: &[f64], reference: &[f64]| {
+        assert_eq!(achieved.len(), reference.len());
+        let e2: f64 = achieved
+            .iter()
+            .zip(reference)
+            .map(|(a, r)| (a - r).powi(2))
+            .sum();
+        let r2: f64 = reference.iter().map(|r| r * r).sum();
+        (e2 / r2).sqrt()
+    };
+    let ts = &summary["table_system"];
+    for (key, channel) in [
+        ("tracking_displacement_nrmse", "u_m"),
+        ("tracking_acceleration_nrmse", "a_m_s2"),
+    ] {
+        let expected = nrmse(column(&run, channel), column(&cmd, channel));
+        let got = ts[key].as_f64().unwrap_or_else(|| panic!("{key} in {ts}"));
+        eprintln!("{key}: {got} (recomputed {expected})");
+        // Tolerance: the CSV's shortest round-trip decimals give the summary's samples
+        // back exactly; what remains is the order of summation.
+        assert!((got - expected).abs() < 1e-12 * expected, "{key}");
+    }
+    let a = ts["tracking_acceleration_nrmse"].as_f64().unwrap();
+    assert!((0.525..0.535).contains(&a), "the quoted 53 %: {a}");
+    let text = platen(&["simulate", s]);
+    let out = String::from_utf8_lossy(&text.stdout);
+    assert!(out.contains("acceleration error 53.4 % NRMSE"), "{out}");
+}
+
+#[test]
+fn a_command_that_stays_at_zero_has_null_relative_errors() {
+    // No reference to be relative to: null in --json (the key is there), "—" in text.
+    let dir = tempfile::tempdir().unwrap();
+    let mut still = scenario(json!({"preset": "lhpost-2008"}));
+    still["excitation"] = json!({"sine_motion": {"amplitude_m": 0.0, "frequency_hz": 1.0}});
+    let path = write(dir.path(), "still.json", &still);
+    let o = platen(&["simulate", path.to_str().unwrap(), "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let summary: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let ts = summary["table_system"].as_object().unwrap();
+    for key in ["tracking_displacement_nrmse", "tracking_acceleration_nrmse"] {
+        assert!(ts.contains_key(key) && ts[key].is_null(), "{key}: {:?}", ts.get(key));
+    }
+    let o = platen(&["simulate", path.to_str().unwrap()]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("displacement error — NRMSE"), "{out}");
+}

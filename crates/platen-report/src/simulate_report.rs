@@ -212,16 +212,20 @@ fn loop_lines(s: &mut String, summary: &RunSummary) {
         "  closed loop: oil column {f:.2} Hz at mid-stroke; {} controller samples, {} steps each",
         ts.controller_samples, ts.steps_per_controller_period
     );
+    // The relative error (NRMSE) first: it is what an engineer compares across runs.
+    let nrmse = |x: Option<f64>| x.map_or("—".to_string(), |x| format!("{:.1} %", 100.0 * x));
     let _ = writeln!(
         s,
-        "  tracking: displacement error {:.3} mm RMS, {:+.3} mm peak at {:.3} s",
+        "  tracking: displacement error {} NRMSE, {:.3} mm RMS, {:+.3} mm peak at {:.3} s",
+        nrmse(ts.tracking_displacement_nrmse),
         ts.tracking_displacement_rms_m * 1e3,
         ts.tracking_displacement_peak_m * 1e3,
         ts.tracking_displacement_peak_t_s
     );
     let _ = writeln!(
         s,
-        "            acceleration error {:.4} m/s² RMS, {:+.4} m/s² peak at {:.3} s",
+        "            acceleration error {} NRMSE, {:.4} m/s² RMS, {:+.4} m/s² peak at {:.3} s",
+        nrmse(ts.tracking_acceleration_nrmse),
         ts.tracking_acceleration_rms_m_s2,
         ts.tracking_acceleration_peak_m_s2,
         ts.tracking_acceleration_peak_t_s

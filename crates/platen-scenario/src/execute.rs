@@ -44,6 +44,9 @@ pub struct Tracking {
     samples: usize,
     sum_du2: f64,
     sum_da2: f64,
+    /// Sums of the command's own squares (the NRMSEs' denominators).
+    sum_u2: f64,
+    sum_a2: f64,
     /// Signed peak of `u − u_ref`, m.
     pub displacement_peak: Peak,
     /// Signed peak of `a − a_ref`, m/s².
@@ -62,6 +65,17 @@ impl Tracking {
     pub fn acceleration_rms_m_s2(&self) -> f64 {
         (self.sum_da2 / self.samples.max(1) as f64).sqrt()
     }
+
+    /// RMS of `u − u_ref` over the RMS of `u_ref` (`None` for a command that stays at 0).
+    pub fn displacement_nrmse(&self) -> Option<f64> {
+        (self.sum_u2 > 0.0).then(|| (self.sum_du2 / self.sum_u2).sqrt())
+    }
+
+    /// RMS of `a − a_ref` over the RMS of `a_ref` (`None` for a command without
+    /// acceleration): the relative error drive iteration reports.
+    pub fn acceleration_nrmse(&self) -> Option<f64> {
+        (self.sum_a2 > 0.0).then(|| (self.sum_da2 / self.sum_a2).sqrt())
+    }
 }
 
 /// A sink that tracks the platen against `command`.
@@ -72,12 +86,14 @@ struct TrackingSink<'a> {
 
 impl SampleSink for TrackingSink<'_> {
     fn accept(&mut self, s: &Sample) {
-        let du = s.u_m - self.command.u_m()[s.index];
-        let da = s.a_m_s2 - self.command.a_m_s2()[s.index];
+        let (u_ref, a_ref) = (self.command.u_m()[s.index], self.command.a_m_s2()[s.index]);
+        let (du, da) = (s.u_m - u_ref, s.a_m_s2 - a_ref);
         let t = &mut self.tracking;
         t.samples += 1;
         t.sum_du2 += du * du;
         t.sum_da2 += da * da;
+        t.sum_u2 += u_ref * u_ref;
+        t.sum_a2 += a_ref * a_ref;
         update(&mut t.displacement_peak, du, s.t_s);
         update(&mut t.acceleration_peak, da, s.t_s);
         if let Some(sy) = &s.system {

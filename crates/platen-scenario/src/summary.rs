@@ -97,6 +97,11 @@ pub struct SystemSummary {
     pub tracking_acceleration_peak_m_s2: f64,
     /// When, s.
     pub tracking_acceleration_peak_t_s: f64,
+    /// The displacement error's RMS over the command's (`null` for a command that stays at 0).
+    pub tracking_displacement_nrmse: Option<f64>,
+    /// The acceleration error's RMS over the command's acceleration's: the relative error
+    /// `platen plan` iterates down (`null` for a command without acceleration).
+    pub tracking_acceleration_nrmse: Option<f64>,
     /// Time with the drive saturated, s.
     pub valve_saturated_time_s: f64,
     /// Signed peak flow of the valves into the cap-side chambers, m³/s.
@@ -478,6 +483,8 @@ impl RunSummary {
             tracking_acceleration_rms_m_s2: tr.acceleration_rms_m_s2(),
             tracking_acceleration_peak_m_s2: tr.acceleration_peak.value,
             tracking_acceleration_peak_t_s: tr.acceleration_peak.t_s,
+            tracking_displacement_nrmse: tr.displacement_nrmse(),
+            tracking_acceleration_nrmse: tr.acceleration_nrmse(),
             valve_saturated_time_s: st.saturated_time_s,
             peak_flow_m3_s: tr.flow_peak.value,
             peak_flow_t_s: tr.flow_peak.t_s,
