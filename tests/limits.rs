@@ -92,7 +92,11 @@ fn a_scenario_without_overrides_or_limits_reports_the_presets() {
         "--json",
     ])))
     .unwrap();
-    assert!(summary.get("model_overrides").is_none(), "{summary}");
+    assert_eq!(
+        summary["model_overrides"],
+        serde_json::json!({}),
+        "{summary}"
+    );
     assert_eq!(summary["limits"]["stroke_m"]["limit"], 0.75);
     let text = stdout(&platen(&["simulate", path.to_str().unwrap()]));
     assert!(text.contains("lhpost-2008 at 13.80 MPa\n"), "{text}");

@@ -105,6 +105,16 @@ fn the_drive_replayed_by_simulate_is_the_run_the_plan_reports() {
         assert!(p["limits"][key]["limit"].as_f64().unwrap() > 0.0);
     }
     assert!(p["max_scale"].as_f64().unwrap() > 1.0, "{}", p["max_scale"]);
+    // Keys that apply only sometimes are there, null, when they do not (issue 38: a
+    // documented `stall_reason` that was absent): the plan did not stall, and its Ĥ is the
+    // linearised one, with no measured band or coherence.
+    let present_null = |v: &Value, key: &str| {
+        let o = v.as_object().unwrap();
+        assert!(o.contains_key(key) && o[key].is_null(), "{key}: {v}");
+    };
+    present_null(&p, "stall_reason");
+    present_null(&p["frf"], "coherence");
+    present_null(&p["frf"], "measured_band_hz");
     let iterations = p["iterations"].as_array().unwrap();
     assert!(iterations.len() >= 2 && iterations.len() <= 5);
     for it in iterations {
@@ -144,6 +154,8 @@ fn the_drive_replayed_by_simulate_is_the_run_the_plan_reports() {
     ]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let s = json_of(&o);
+    present_null(&s, "specimen");
+    present_null(&s["table_system"], "cavitation_at_s");
     assert_eq!(s["limits"], p["drive"]["limits"]);
     assert_eq!(s["peak_a_m_s2"], achieved["peak_a_m_s2"]);
     assert_eq!(s["peak_u_m"], p["drive"]["run_peak_u_m"]);

@@ -224,12 +224,7 @@ fn a_force_excitation_with_a_table_system_is_refused() {
 fn columns(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
     let text = fs::read_to_string(path).unwrap();
     let mut lines = text.lines();
-    let header: Vec<String> = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(String::from)
-        .collect();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
     let mut cols = vec![Vec::new(); header.len()];
     for line in lines {
         for (c, v) in cols.iter_mut().zip(line.split(',')) {
@@ -301,7 +296,11 @@ fn a_command_that_stays_at_zero_has_null_relative_errors() {
     let summary: Value = serde_json::from_slice(&o.stdout).unwrap();
     let ts = summary["table_system"].as_object().unwrap();
     for key in ["tracking_displacement_nrmse", "tracking_acceleration_nrmse"] {
-        assert!(ts.contains_key(key) && ts[key].is_null(), "{key}: {:?}", ts.get(key));
+        assert!(
+            ts.contains_key(key) && ts[key].is_null(),
+            "{key}: {:?}",
+            ts.get(key)
+        );
     }
     let o = platen(&["simulate", path.to_str().unwrap()]);
     let out = String::from_utf8_lossy(&o.stdout);

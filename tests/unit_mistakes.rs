@@ -123,7 +123,12 @@ fn a_force_in_kn_read_as_n_warns_with_the_peak_and_the_breakaway_force() {
     let sc = write(dir.path(), "kn.json", &scenario("kN"));
     let o = platen(&["simulate", &sc, "--json"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    assert!(json(&o).get("warnings").is_none(), "{}", stderr(&o));
+    assert_eq!(
+        json(&o)["warnings"],
+        serde_json::json!([]),
+        "{}",
+        stderr(&o)
+    );
     assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
 }
 

@@ -234,7 +234,6 @@ pub enum IdentifyOutput {
         /// too) or `both` (forced).
         method: &'static str,
         /// The paper's method on the periodic tests, when run.
-        #[serde(skip_serializing_if = "Option::is_none")]
         periodic: Option<Box<IdentificationSummary>>,
     },
 }

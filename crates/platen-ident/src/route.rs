@@ -105,8 +105,7 @@ pub struct RecordAccount {
     pub method: Method,
     /// Whether it entered the identification.
     pub used: bool,
-    /// Why it was not used (absent when used).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    /// Why it was not used (`null` when used).
     pub reason: Option<String>,
     /// Why it went to its method: the periodic test's fundamental, why it is not a periodic
     /// test, or why the periodic method rejected it.

@@ -287,11 +287,9 @@ pub struct FrfSummary {
     pub source: &'static str,
     /// The correction band, Hz.
     pub band_hz: [f64; 2],
-    /// The measured band, Hz (measured only).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    /// The measured band, Hz (measured only; `null` for a linearised one).
     pub measured_band_hz: Option<[f64; 2]>,
-    /// Mean coherence of the measurement over its band (measured only).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    /// Mean coherence of the measurement over its band (measured only; `null` for a linearised one).
     pub coherence: Option<f64>,
     /// The gain `g`.
     pub gain: f64,
@@ -337,24 +335,22 @@ pub struct PlanSummary {
     pub limiting: Vec<LimitUse>,
     /// Every limit with its peak, allowed value, ratio and time.
     pub margins: Vec<LimitUse>,
-    /// The largest scale of the target that fits (absent when not searched).
+    /// The largest scale of the target that fits (`null` when not searched).
     pub max_scale: Option<f64>,
     /// How it was found.
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub max_scale_search: Option<MaxScale>,
     /// Every iteration's figures, from 0 (the target's own command); empty when not iterated.
     pub iterations: Vec<IterationRecord>,
-    /// The iteration whose drive is written (absent when not iterated).
+    /// The iteration whose drive is written (`null` when not iterated).
     pub best_iteration: Option<usize>,
     /// `converged`, `max_iterations`, `stalled`, or `not_run` (the target's own command
     /// reaches the end of the actuators).
     pub stop: &'static str,
-    /// Why the iteration stalled (absent otherwise).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    /// Why the iteration stalled (`null` otherwise).
     pub stall_reason: Option<String>,
-    /// `Ĥ` and the iteration's settings (absent when not iterated).
+    /// `Ĥ` and the iteration's settings (`null` when not iterated).
     pub frf: Option<FrfSummary>,
-    /// The drive (absent when not iterated).
+    /// The drive (`null` when not iterated).
     pub drive: Option<DriveSummary>,
     /// What the planner wants its user to know.
     pub warnings: Vec<String>,

@@ -99,8 +99,7 @@ pub struct GenerateReport {
     pub out: String,
     /// Its rows.
     pub samples: usize,
-    /// The noise seed of recorded-like data (absent for an excitation).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    /// The noise seed of recorded-like data (`null` for an excitation).
     pub seed: Option<u64>,
 }
 

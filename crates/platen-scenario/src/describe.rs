@@ -58,18 +58,15 @@ pub struct ModelDescription {
     pub low_velocity_decay_s_per_m: f64,
     /// Low-velocity friction force `a` of the selected form, N.
     pub low_velocity_force_n: f64,
-    /// The values a scenario lays over its preset's, by key (absent: none, or no scenario).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    /// The values a scenario lays over its preset's, by key (empty: none, or no scenario).
     pub model_overrides: Option<BTreeMap<String, f64>>,
     /// The physical parameters of the full model, by key (SI, the scenario format's names).
     pub physical: BTreeMap<String, f64>,
     /// The preset's name.
     pub preset: String,
-    /// The scenario file described, as given (absent: a preset).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    /// The scenario file described, as given (`null`: a preset).
     pub scenario: Option<String>,
     /// The scenario's specimen, if any.
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub specimen: Option<SpecimenDescription>,
     /// Stiffness `Kₑ` of the selected form, N/m.
     pub stiffness_n_per_m: f64,
@@ -78,7 +75,6 @@ pub struct ModelDescription {
     /// Strut rotational mass `M̄′ₑ` (Eq. 5c), kg.
     pub strut_rotational_mass_kg: f64,
     /// The table system's closed forms and linearised loop, if one is described.
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub table_system: Option<SystemDescription>,
     /// Viscous coefficient `Cₑ` of the selected form, N/(m/s)^α.
     pub viscous_coefficient: f64,

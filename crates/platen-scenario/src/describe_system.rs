@@ -118,7 +118,6 @@ pub struct SystemDescription {
     /// Oil-column frequency at `u = −stroke` (with the specimen, if any), Hz.
     pub oil_column_frequency_retracted_hz: f64,
     /// Oil-column frequency at mid-stroke with the specimen as a rigid payload, Hz.
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub oil_column_frequency_with_specimen_hz: Option<f64>,
     /// The system's parameters in the scenario format, every value given
     /// ([`TableSystemSpec::from`]; printed with its keys sorted).
@@ -130,7 +129,6 @@ pub struct SystemDescription {
     /// The preset the system came from (`None`, printed `null`: a scenario's own values).
     pub preset: Option<String>,
     /// The specimen's mass, kg.
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub specimen_mass_kg: Option<f64>,
     /// The default RK4 step of closed-loop runs, s.
     pub step_s: f64,

@@ -1382,7 +1382,6 @@ pub struct TableSummary {
     /// Per strut, its range of pull.
     pub struts: Vec<StrutPeaks>,
     /// With a specimen: the largest |value| of each base-force and overturning-moment column.
-    #[serde(skip_serializing_if = "std::collections::BTreeMap::is_empty")]
     pub specimen: std::collections::BTreeMap<&'static str, f64>,
     /// Per DOF, how it followed its command (closed loop; `null` otherwise).
     pub tracking: Option<std::collections::BTreeMap<&'static str, AxisTracking>>,
@@ -1398,7 +1397,6 @@ pub struct TableSummary {
     /// Whether every actuator and axis stayed within its limits.
     pub within_limits: bool,
     /// The CSV written, if any.
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub output: Option<String>,
 }
 

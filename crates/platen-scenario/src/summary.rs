@@ -28,9 +28,8 @@ pub struct RunSummary {
     pub model_form: &'static str,
     /// The preset the model is based on.
     pub preset: &'static str,
-    /// The values the scenario lays over the preset's, by name (absent when the preset's own
+    /// The values the scenario lays over the preset's, by name (empty when the preset's own
     /// values run): the model is the preset's only where this does not name a parameter.
-    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
     pub model_overrides: BTreeMap<&'static str, f64>,
     /// The hold-down pressure, MPa.
     pub hold_down_pressure_mpa: f64,
@@ -61,24 +60,19 @@ pub struct RunSummary {
     pub limit_exceedances: Vec<ExceedanceSummary>,
     /// Every limit with the run's peak against it.
     pub limits: LimitsSummary,
-    /// The excitation's channels that platen derived, with how (absent when the file or
+    /// The excitation's channels that platen derived, with how (empty when the file or
     /// generator gave every channel).
-    #[serde(skip_serializing_if = "Derived::is_empty")]
     pub derived: Derived,
     /// The CSV written, if any.
     pub out: Option<String>,
-    /// The specimen's peaks (absent without a specimen).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    /// The specimen's peaks (`null` without a specimen).
     pub specimen: Option<SpecimenSummary>,
     /// The oil-column frequency of the table system at mid-stroke, linearised, with the
     /// specimen's mass as a rigid payload, Hz (closed-loop runs only).
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub oil_column_frequency_hz: Option<f64>,
     /// The closed loop's figures (closed-loop runs only).
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub table_system: Option<SystemSummary>,
     /// What the run wants its user to know (an unstable loop, cavitation, saturated valves).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
 }
 
@@ -112,8 +106,7 @@ pub struct SystemSummary {
     pub valve_flow_capacity_m3_s: f64,
     /// Lowest supply pressure, Pa.
     pub min_supply_pressure_pa: f64,
-    /// First time a chamber reached the cavitation floor, s (absent: never).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    /// First time a chamber reached the cavitation floor, s (`null`: never).
     pub cavitation_at_s: Option<f64>,
     /// Hydraulic energy delivered into the chambers, J.
     pub hydraulic_energy_j: f64,
@@ -130,11 +123,11 @@ pub struct SystemSummary {
 pub struct MarginsSummary {
     /// Whether the closed loop is stable (Nyquist).
     pub stable: bool,
-    /// Gain margin, dB (absent: no phase crossover).
+    /// Gain margin, dB (`null`: no phase crossover).
     pub gain_margin_db: Option<f64>,
     /// Its frequency, Hz.
     pub phase_crossover_hz: Option<f64>,
-    /// Phase margin, degrees (absent: no gain crossover).
+    /// Phase margin, degrees (`null`: no gain crossover).
     pub phase_margin_deg: Option<f64>,
     /// Its frequency, Hz.
     pub gain_crossover_hz: Option<f64>,
@@ -250,14 +243,11 @@ pub struct EnergySummary {
     pub elastic_end_j: f64,
     /// Energy dissipated, J.
     pub dissipated_j: f64,
-    /// Energy of the specimen at the start, J (absent without a specimen).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    /// Energy of the specimen at the start, J (`null` without a specimen).
     pub specimen_start_j: Option<f64>,
-    /// Energy of the specimen at the end, J (absent without a specimen).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    /// Energy of the specimen at the end, J (`null` without a specimen).
     pub specimen_end_j: Option<f64>,
-    /// Energy dissipated by the specimen's storey dampers, J (absent without a specimen).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    /// Energy dissipated by the specimen's storey dampers, J (`null` without a specimen).
     pub specimen_dissipated_j: Option<f64>,
     /// What the balance leaves, J: an accuracy indicator.
     pub residual_j: f64,

@@ -225,13 +225,10 @@ pub struct RecordInfoSummary {
     #[serde(flatten)]
     pub account: Option<RecordAccount>,
     /// `given` or `crossover` (any-record method).
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub velocity: Option<&'static str>,
     /// Samples fitted by the equation error (any-record method).
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub used_samples: Option<usize>,
     /// Speeds fitted, m/s (any-record method).
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub speed_range_m_s: Option<[f64; 2]>,
     /// The force offset, N.
     pub offset_n: Option<EstimateSummary>,
@@ -243,7 +240,6 @@ pub struct RecordInfoSummary {
     /// and any given with the record. Positive: the channel lags `u_m`. The any-record method
     /// corrects a given delay, and an estimated one when significant; for a record it did not
     /// fit (a periodic test) the delays are reported only.
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub channel_delay_s: Option<BTreeMap<&'static str, f64>>,
 }
 
