@@ -458,8 +458,8 @@ fn simulate_bad(scenario: &str, extra: &[&str]) -> (Option<i32>, String) {
 }
 
 /// The messages read as sentences: the innermost field of a type error, a file that ends
-/// early said so with its line, the field and value said once, a missing output folder
-/// named as such.
+/// early said so with its line, the field and value said once, an output folder that is a
+/// file named as such.
 #[test]
 fn error_messages_name_the_field_once_and_say_what_is_wrong() {
     for (what, scenario, extra, want, not) in [
@@ -533,11 +533,12 @@ fn error_messages_name_the_field_once_and_say_what_is_wrong() {
         }
         assert!(err.matches("expected").count() <= 1, "{what}: {err}");
     }
-    // The output's folder is missing: exit 5 as before, and the message says so.
-    let (code, err) = simulate_bad(&force_scenario(""), &["--out", "no-such-folder/out.csv"]);
+    // The output's folder is a file (a missing one is created, as --plot's): exit 5, and
+    // the message says so.
+    let (code, err) = simulate_bad(&force_scenario(""), &["--out", "f.csv/out.csv"]);
     assert_eq!(code, Some(5), "{err}");
     assert!(
-        err.contains("the output folder `no-such-folder` does not exist"),
+        err.contains("the output folder `f.csv` is a file, not a folder"),
         "{err}"
     );
     assert!(!err.contains("temporary"), "{err}");
@@ -574,9 +575,9 @@ fn with_json_errors_are_json_objects_on_stderr() {
             Some("integrator.step_s"),
         ),
         (
-            "a missing output folder",
+            "an output folder that is a file",
             force_scenario(""),
-            &["--out", "nowhere/out.csv"],
+            &["--out", "f.csv/out.csv"],
             5,
             "output",
             None,

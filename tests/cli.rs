@@ -702,3 +702,25 @@ fn a_closed_standard_output_is_not_a_panic() {
         assert!(stderr.is_empty(), "{args:?}: {stderr}");
     }
 }
+
+#[test]
+fn out_creates_its_missing_folder_as_plot_does() {
+    // issue 38: `--plot out/figs` made its folder where `--out out/run.csv` refused a missing
+    // `out/`. Both create what is missing now, nested folders included.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("results").join("today").join("run.csv");
+    let plot = dir.path().join("figures").join("today");
+    let o = platen(&[
+        "simulate",
+        &scenario("sr9-like-sine-force.json"),
+        "--out",
+        out.to_str().unwrap(),
+        "--plot",
+        plot.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let (header, rows) = read_csv(&out);
+    assert_eq!(header[0], "t_s");
+    assert!(rows.len() > 100);
+    assert!(plot.read_dir().unwrap().count() > 0);
+}

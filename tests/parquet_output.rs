@@ -80,9 +80,11 @@ fn specimen_inverse_and_closed_loop_runs_have_the_csv_columns() {
 }
 
 #[test]
-fn a_parquet_output_in_a_missing_folder_fails_and_leaves_nothing() {
+fn a_parquet_output_in_a_folder_that_is_a_file_fails_and_leaves_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("no_such_dir").join("run.parquet");
+    let file = dir.path().join("a-file");
+    std::fs::write(&file, "x").unwrap();
+    let out = file.join("run.parquet");
     let o = platen(&[
         "simulate",
         &shipped("sr9-like-sine-force.json"),
@@ -92,5 +94,5 @@ fn a_parquet_output_in_a_missing_folder_fails_and_leaves_nothing() {
     assert!(!o.status.success());
     assert!(stderr(&o).contains("run.parquet"), "{}", stderr(&o));
     assert!(!out.exists());
-    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
 }

@@ -27,10 +27,12 @@ pub struct AtomicFile {
 }
 
 impl AtomicFile {
-    /// Creates the temporary file (`.NAME.XXXXXX.tmp`) in the folder of `path`.
+    /// Creates the temporary file (`.NAME.XXXXXX.tmp`) in the folder of `path`, creating that
+    /// folder (and its parents) first when it does not exist, as `--plot DIR` does.
     ///
     /// # Errors
-    /// [`IoError::OutputFolderMissing`] if the folder of `path` does not exist;
+    /// [`IoError::OutputFolderMissing`] if the folder of `path` exists but is not a folder;
+    /// [`IoError::Io`] ([`IoAction::CreatingFolder`]) if it cannot be created;
     /// [`IoError::Io`] ([`IoAction::CreatingTemporary`]) if `path` names no file or the
     /// folder does not take a new file.
     pub fn create(path: &Path) -> Result<Self> {
@@ -41,6 +43,13 @@ impl AtomicFile {
             ));
         };
         let folder = directory_of(path);
+        if !folder.exists() {
+            std::fs::create_dir_all(folder).map_err(|source| IoError::Io {
+                path: folder.to_path_buf(),
+                action: IoAction::CreatingFolder,
+                source,
+            })?;
+        }
         if !folder.is_dir() {
             return Err(IoError::OutputFolderMissing {
                 path: path.to_path_buf(),

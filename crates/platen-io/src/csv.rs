@@ -968,11 +968,20 @@ mod tests {
     }
 
     #[test]
-    fn a_write_into_a_missing_folder_fails_naming_it_and_touches_nothing() {
+    fn a_write_into_a_missing_folder_creates_it_and_a_file_in_the_way_is_named() {
         let dir = tempfile::tempdir().unwrap();
         let existing = dir.path().join("keep.csv");
         fs::write(&existing, "t_s\n0\n").unwrap();
-        let target = dir.path().join("no_such_dir").join("out.csv");
+        // A missing folder (and its parents) is created, as --plot creates its folder.
+        let target = dir
+            .path()
+            .join("no_such_dir")
+            .join("deeper")
+            .join("out.csv");
+        write_csv_atomic(&target, &["t_s"], &[&[1.0]]).unwrap();
+        assert_eq!(fs::read_to_string(&target).unwrap(), "t_s\n1\n");
+        // A file where the folder should be: refused, naming both, nothing written.
+        let target = existing.join("out.csv");
         let error = write_csv_atomic(&target, &["t_s"], &[&[1.0]]).unwrap_err();
         let message = error.to_string();
         assert!(
@@ -983,8 +992,8 @@ mod tests {
         assert!(
             message.contains("out.csv")
                 && message.contains("the output folder")
-                && message.contains("no_such_dir")
-                && message.contains("does not exist"),
+                && message.contains("keep.csv")
+                && message.contains("not a folder"),
             "{message}"
         );
         assert!(!target.exists());

@@ -30,9 +30,10 @@ pub enum IoError {
         source: std::io::Error,
     },
 
-    /// The folder an output is to be written in does not exist (or is not a folder).
+    /// The folder an output is to be written in is not a folder (a file of that name is
+    /// there; a missing folder is created).
     #[error(
-        "cannot write `{}`: the output folder `{}` does not exist (create it first)",
+        "cannot write `{}`: the output folder `{}` is a file, not a folder",
         path.display(),
         folder.display()
     )]
@@ -363,7 +364,7 @@ impl std::fmt::Display for IoAction {
             IoAction::Writing => "writing",
             IoAction::CreatingTemporary => "creating a temporary file next to",
             IoAction::Renaming => "renaming the temporary file onto",
-            IoAction::CreatingFolder => "creating the figure folder",
+            IoAction::CreatingFolder => "creating the output folder",
         })
     }
 }

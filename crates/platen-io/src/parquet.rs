@@ -289,12 +289,15 @@ mod tests {
         assert_eq!(fs::read_to_string(&path).unwrap(), "old");
         assert!(temp_files_in(dir.path()).is_empty());
 
-        let missing = dir.path().join("no_such_dir").join("run.parquet");
-        let error = write_parquet_atomic(&missing, &["t_s"], &[&[0.0]]).unwrap_err();
+        let blocked = path.join("run.parquet");
+        let error = write_parquet_atomic(&blocked, &["t_s"], &[&[0.0]]).unwrap_err();
         assert!(
             matches!(error, IoError::OutputFolderMissing { .. }),
             "{error:?}"
         );
+        let missing = dir.path().join("no_such_dir").join("run.parquet");
+        write_parquet_atomic(&missing, &["t_s"], &[&[0.0]]).unwrap();
+        assert!(missing.is_file());
     }
 
     #[test]

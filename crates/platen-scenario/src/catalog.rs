@@ -39,7 +39,8 @@ pub struct ShippedScenario {
     pub name: String,
     /// What it runs.
     pub kind: RunKind,
-    /// Whether it needs a PEER record (`ground_motion`), which is not shipped.
+    /// Whether it needs a record from the records folder (`ground_motion`: a PEER record, or
+    /// another such as the El Centro digitisation), which is not shipped.
     pub needs_record: bool,
     /// Whether it carries a specimen.
     pub specimen: bool,

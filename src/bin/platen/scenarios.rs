@@ -63,7 +63,7 @@ pub fn run(args: &ScenariosArgs) -> anyhow::Result<()> {
             notes.push("specimen");
         }
         if s.needs_record {
-            notes.push("needs a PEER record");
+            notes.push("needs a record from PLATEN_RECORDS_DIR");
         }
         let notes = if notes.is_empty() {
             String::new()
