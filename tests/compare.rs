@@ -580,7 +580,7 @@ fn a_figure_folder_that_cannot_be_created_is_an_output_error() {
         file.join("figures").to_str().unwrap(),
     ]);
     assert_eq!(o.status.code(), Some(5), "{}", stderr(&o));
-    assert!(stderr(&o).contains("figure folder"), "{}", stderr(&o));
+    assert!(stderr(&o).contains("output folder"), "{}", stderr(&o));
 }
 
 /// A record exported with a lab's own channel names and units (`Time` in ms, `Table disp` in

@@ -507,7 +507,7 @@ fn identify_plot_into_a_file_is_an_output_error_and_writes_nothing() {
         html.to_str().unwrap(),
     ]);
     assert_eq!(o.status.code(), Some(5), "{}", stderr(&o));
-    assert!(stderr(&o).contains("figure folder"), "{}", stderr(&o));
+    assert!(stderr(&o).contains("output folder"), "{}", stderr(&o));
     assert!(!html.exists());
 }
 

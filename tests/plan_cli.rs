@@ -392,6 +392,12 @@ fn plot_and_report_write_the_figures_and_list_them() {
         }
         let svg = fs::read_to_string(figures.join(format!("{stem}.svg"))).unwrap();
         assert!(svg.contains("width=\"800\""), "{stem}: --width");
+        // Titled by the target on the scenario (issue 38: the scenario's name alone, whatever
+        // the target).
+        assert!(
+            svg.contains("target.csv on LHPOST closed loop"),
+            "{stem}: its title names the target"
+        );
     }
     assert_eq!(listed.len(), 8);
     assert_eq!(p["report"], report.to_str().unwrap());
@@ -400,4 +406,144 @@ fn plot_and_report_write_the_figures_and_list_them() {
     assert_eq!(page.matches("<svg").count(), 4);
     assert!(page.contains("Margins") && page.contains("stroke_m"));
     assert!(!page.contains("src=\"http"), "self-contained");
+}
+
+#[test]
+fn a_lab_target_with_its_own_headers_and_g_plans_through_columns() {
+    // issue 38: a lab's `Time (s)`, `Acc [g]` target was refused ("missing required column
+    // t_s"). Through --columns it is the same plan, to the byte, as the SI file written here
+    // by hand (the factor is the standard gravity, as the map's unit `g`).
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scenario = lhpost_scenario(d);
+    let g = platen::model::STANDARD_GRAVITY_M_S2;
+    let n = 6 * 1024 + 1;
+    let (mut lab, mut si) = (
+        String::from("Time (s),Acc [g],Note\n"),
+        String::from("t_s,a_m_s2\n"),
+    );
+    for j in 0..n {
+        let t = j as f64 / 1024.0;
+        let a_g = quake(t) / g;
+        lab.push_str(&format!("{t},{a_g},x\n"));
+        si.push_str(&format!("{t},{}\n", a_g * g));
+    }
+    let lab_csv = write(d, "lab.csv", &lab);
+    let si_csv = write(d, "si.csv", &si);
+    let map = write(
+        d,
+        "map.json",
+        &json!({"t_s": {"name": "Time (s)"}, "a_m_s2": {"name": "Acc [g]", "unit": "g"}})
+            .to_string(),
+    );
+    let plan = |target: &Path, out: &str, columns: Option<&Path>| {
+        let out = d.join(out);
+        let mut args = vec![
+            "plan".to_string(),
+            scenario.to_str().unwrap().into(),
+            "--target".into(),
+            target.to_str().unwrap().into(),
+            "--out".into(),
+            out.to_str().unwrap().into(),
+            "--iterations".into(),
+            "2".into(),
+            "--no-max-scale".into(),
+            "--json".into(),
+        ];
+        if let Some(c) = columns {
+            args.extend(["--columns".into(), c.to_str().unwrap().into()]);
+        }
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = platen(&args);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        (fs::read(&out).unwrap(), json_of(&o))
+    };
+    let (drive_lab, p_lab) = plan(&lab_csv, "lab-drive.csv", Some(&map));
+    let (drive_si, p_si) = plan(&si_csv, "si-drive.csv", None);
+    assert_eq!(drive_lab, drive_si);
+    assert_eq!(p_lab["iterations"], p_si["iterations"]);
+    // Without the map the lab's file is refused, naming the column.
+    let o = platen(&[
+        "plan",
+        scenario.to_str().unwrap(),
+        "--target",
+        lab_csv.to_str().unwrap(),
+        "--out",
+        d.join("none.csv").to_str().unwrap(),
+    ]);
+    assert_ne!(o.status.code(), Some(0));
+    assert!(stderr(&o).contains("t_s"), "{}", stderr(&o));
+    assert!(!d.join("none.csv").exists());
+}
+
+#[test]
+fn a_target_too_short_or_mostly_removed_by_the_baseline_treatment_is_warned_of() {
+    // issue 38: a 49-sample target, most of which the baseline treatment removes, came out
+    // "feasible: yes" without a word. A 0.5 m/s² offset (an accelerometer's, say) under a
+    // small 20 Hz tone, over 49 samples: almost all of it is baseline.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scenario = lhpost_scenario(d);
+    let short = target_csv(d, "short.csv", "a_m_s2", 49, 1024.0, |t| {
+        0.5 + 0.05 * (std::f64::consts::TAU * 20.0 * t).sin()
+    });
+    let o = platen(&[
+        "plan",
+        scenario.to_str().unwrap(),
+        "--target",
+        short.to_str().unwrap(),
+        "--out",
+        d.join("short-drive.csv").to_str().unwrap(),
+        "--iterations",
+        "1",
+        "--no-max-scale",
+        "--json",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let p = json_of(&o);
+    let warnings = p["warnings"].to_string();
+    assert!(warnings.contains("too short to judge"), "{warnings}");
+    assert!(
+        warnings.contains("the baseline treatment removed"),
+        "{warnings}"
+    );
+    let removed = p["target"]["baseline_correction_rms_m_s2"]
+        .as_f64()
+        .unwrap()
+        / p["target"]["rms_a_m_s2"].as_f64().unwrap();
+    assert!(removed > 0.25, "{removed}");
+    // In text too.
+    let o = platen(&[
+        "plan",
+        scenario.to_str().unwrap(),
+        "--target",
+        short.to_str().unwrap(),
+        "--out",
+        d.join("short-drive.csv").to_str().unwrap(),
+        "--iterations",
+        "1",
+        "--no-max-scale",
+    ]);
+    let out = String::from_utf8_lossy(&o.stdout).into_owned() + &stderr(&o);
+    assert!(out.contains("too short to judge"), "{out}");
+    // A real target (8 s of a synthetic quake) is judged without either warning.
+    let quake_csv = target_csv(d, "quake.csv", "a_m_s2", 8 * 1024 + 1, 1024.0, quake);
+    let o = platen(&[
+        "plan",
+        scenario.to_str().unwrap(),
+        "--target",
+        quake_csv.to_str().unwrap(),
+        "--out",
+        d.join("quake-drive.csv").to_str().unwrap(),
+        "--iterations",
+        "0",
+        "--no-max-scale",
+        "--json",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let warnings = json_of(&o)["warnings"].to_string();
+    assert!(
+        !warnings.contains("too short") && !warnings.contains("baseline treatment"),
+        "{warnings}"
+    );
 }

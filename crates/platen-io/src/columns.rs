@@ -508,6 +508,37 @@ impl ColumnMap {
         Ok(table)
     }
 
+    /// The header of `available` that a map example for a missing column of `kind` names:
+    /// never one the map already reads, nor one that is a platen column itself (`t_s` for a
+    /// missing displacement, `force_n`, …); a time-like header (`time`
+    /// in it, or `t`) for the time, another for anything else; else the first free one.
+    fn example_header<'a>(
+        &self,
+        available: &'a [String],
+        required: &[&str],
+        kind: Kind,
+    ) -> &'a str {
+        let taken = |h: &str| {
+            self.entries.values().any(|m| !m.ignored && m.header == h)
+                || required.contains(&h)
+                || kind_of(h).is_some()
+        };
+        let time_like = |h: &str| {
+            let h = h.trim().to_lowercase();
+            h == "t" || h.contains("time")
+        };
+        let free: Vec<&str> = available
+            .iter()
+            .map(String::as_str)
+            .filter(|h| !taken(h))
+            .collect();
+        free.iter()
+            .find(|h| time_like(h) == (kind == Kind::Time))
+            .or_else(|| free.first())
+            .copied()
+            .unwrap_or("…")
+    }
+
     /// A missing column reported with what fixes it: the map's entry that names a header
     /// the file lacks, or for a platen column the map does not name, how a map would.
     fn missing(&self, e: IoError, required: &[&str]) -> IoError {
@@ -537,7 +568,7 @@ impl ColumnMap {
         }
         match kind_of(&column) {
             Some(kind) if required.contains(&column.as_str()) => {
-                let name = available.first().map_or("…", String::as_str);
+                let name = self.example_header(&available, required, kind);
                 let example = match example_unit(kind) {
                     Some(unit) => {
                         format!(r#"{{"{column}": {{"name": "{name}", "unit": "{unit}"}}}}"#)

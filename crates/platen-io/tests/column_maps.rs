@@ -215,9 +215,37 @@ fn a_file_without_t_s_says_a_column_map_fixes_it_with_an_example() {
         matches!(&e, IoError::UnmappedColumn { column, .. } if column == "u_m"),
         "{e:?}"
     );
+    // The hint for the displacement names the other column, never the time the map
+    // already reads (issue 38: it pointed `u_m` at `Time`), and is itself a map that, with
+    // the time's, reads the file.
+    let text = e.to_string();
+    assert!(
+        text.contains(r#"{"u_m": {"name": "disp", "unit": "mm"}}"#),
+        "{text}"
+    );
+    let both =
+        map(r#"{"t_s": {"name": "Time", "unit": "s"}, "u_m": {"name": "disp", "unit": "mm"}}"#)
+            .unwrap();
+    let t = both.read_table(&path, &["t_s", "u_m"], &[]).unwrap();
+    assert_eq!(t.column("u_m").unwrap(), &[0.001, 0.002]);
+    // Under platen's own names: the time column `t_s` is not suggested for `u_m` either.
+    let (_d2, own) = file("own.csv", "t_s,disp\n0,1\n1,2\n");
+    let e = ColumnMap::default()
+        .read_table(&own, &["t_s", "u_m"], &[])
+        .unwrap_err();
     assert!(
         e.to_string()
-            .contains(r#"{"u_m": {"name": "Time", "unit": "mm"}}"#),
+            .contains(r#"{"u_m": {"name": "disp", "unit": "mm"}}"#),
+        "{e}"
+    );
+    // The time is found among later headers too.
+    let (_d3, late) = file("late.csv", "disp,Time (s)\n1,0\n2,1\n");
+    let e = ColumnMap::default()
+        .read_table(&late, &["t_s", "u_m"], &[])
+        .unwrap_err();
+    assert!(
+        e.to_string()
+            .contains(r#"{"t_s": {"name": "Time (s)", "unit": "s"}}"#),
         "{e}"
     );
     // A header that is no platen column (an identification floor's own channel) gets no

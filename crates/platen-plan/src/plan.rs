@@ -161,7 +161,8 @@ pub fn plan_table(
 ) -> Result<Plan> {
     let motion = target_motion(table, target, settings)?;
     let feasibility = feasibility(table, &motion, settings.max_scale.as_ref())?;
-    let mut warnings: Vec<String> = feasibility_warning(&feasibility).into_iter().collect();
+    let mut warnings = target_warnings(&motion);
+    warnings.extend(feasibility_warning(&feasibility));
     let drive = match feasibility.achieved.end_stop {
         Some(_) => None,
         None => Some(planned_drive(
@@ -184,6 +185,41 @@ pub fn plan_table(
         drive,
         warnings,
     })
+}
+
+/// The share of an acceleration target's RMS that the baseline treatment may remove before
+/// the plan warns: beyond it what is planned is mostly the treatment's, not the target's.
+pub const BASELINE_SHARE_WARNED: f64 = 0.25;
+
+/// The shortest target the plan judges without a warning, s: the longest period of the
+/// response-spectrum error it reports (2 s), so that every period of it sees a whole cycle.
+pub const SHORTEST_JUDGED_S: f64 = 2.0;
+
+/// What the plan warns of in the target itself: a baseline treatment that removed more than
+/// [`BASELINE_SHARE_WARNED`] of its RMS, a target shorter than [`SHORTEST_JUDGED_S`].
+fn target_warnings(motion: &TargetMotion) -> Vec<String> {
+    let mut warnings = Vec::new();
+    let duration = motion.t_s.last().unwrap_or(&0.0) - motion.t_s.first().unwrap_or(&0.0);
+    if duration < SHORTEST_JUDGED_S {
+        warnings.push(format!(
+            "the target lasts {duration:.3} s, less than {SHORTEST_JUDGED_S} s: too short to \
+             judge (its response spectrum reaches 2 s periods, and its NRMSE is dominated by \
+             the start)"
+        ));
+    }
+    if motion.target_rms_m_s2 > 0.0 {
+        let share = motion.correction_rms_m_s2 / motion.target_rms_m_s2;
+        if share > BASELINE_SHARE_WARNED {
+            warnings.push(format!(
+                "the baseline treatment removed {:.0} % of the target's RMS acceleration \
+                 (more than {:.0} %): what is planned is mostly the correction, not the \
+                 target; check the target's units, its offset, and its length",
+                100.0 * share,
+                100.0 * BASELINE_SHARE_WARNED
+            ));
+        }
+    }
+    warnings
 }
 
 /// The motion asked of `table` for `target`: at most the controller's rate, not zero.

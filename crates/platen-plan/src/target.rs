@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use platen_io::csv::read_table;
+use platen_io::columns::ColumnMap;
 use platen_io::IoError;
 
 use crate::error::{PlanError, Result};
@@ -188,19 +188,44 @@ impl Target {
     /// strictly or are not uniformly sampled ([`platen_scenario::sampling::sampling_grid`]),
     /// fewer than [`MIN_TARGET_SAMPLES`] rows.
     pub fn read_csv(path: &Path) -> Result<Self> {
+        Self::read_csv_mapped(path, &ColumnMap::default())
+    }
+
+    /// Reads a lab's target CSV through the column map `columns` (its own headers and units,
+    /// `g` or `mm` say, as a scenario's `excitation.columns` and `--columns` of `compare` and
+    /// `identify`): platen's `t_s` and `a_m_s2`, or without `a_m_s2`, `u_m`. The empty map is
+    /// [`Target::read_csv`].
+    ///
+    /// # Errors
+    /// As [`Target::read_csv`]; a missing column is named by its header in the file.
+    pub fn read_csv_mapped(path: &Path, columns: &ColumnMap) -> Result<Self> {
+        let read_table =
+            |required: &[&str], optional: &[&str]| columns.read_table(path, required, optional);
         // The acceleration when the file has one (a displacement column beside it is not
         // read, so it cannot fail the target); else the displacement.
-        let mut table = read_table(path, &["t_s"], &["a_m_s2"])?;
+        let mut table = read_table(&["t_s"], &["a_m_s2"])?;
         let (kind, values) = match table.take_column("a_m_s2") {
             Some(a) => (TargetKind::Acceleration, a),
             None => {
-                table = read_table(path, &["t_s", "u_m"], &[]).map_err(|e| match e {
+                let either = "a_m_s2` or `u_m".to_owned();
+                table = read_table(&["t_s", "u_m"], &[]).map_err(|e| match e {
                     IoError::MissingColumn {
                         path, available, ..
                     } => IoError::MissingColumn {
                         path,
-                        column: "a_m_s2` or `u_m".to_owned(),
+                        column: either,
                         available,
+                    },
+                    IoError::UnmappedColumn {
+                        path,
+                        column,
+                        available,
+                        example,
+                    } if column == "u_m" => IoError::UnmappedColumn {
+                        path,
+                        column: either,
+                        available,
+                        example,
                     },
                     other => other,
                 })?;

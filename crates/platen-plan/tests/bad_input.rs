@@ -221,7 +221,10 @@ fn scenarios_for_planning_need_a_table_system_and_no_excitation() {
 #[test]
 fn a_drive_that_cannot_be_written_leaves_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("missing-folder").join("drive.csv");
+    // A file where the drive's folder should be (a missing folder is created).
+    let file = dir.path().join("a-file");
+    std::fs::write(&file, "x").unwrap();
+    let path = file.join("drive.csv");
     let e = write_drive(&path, &[0.0, 1.0], &[0.0, 0.0]).unwrap_err();
     assert!(matches!(e, PlanError::Io(_)), "{e:?}");
     assert!(!path.exists());
@@ -231,5 +234,5 @@ fn a_drive_that_cannot_be_written_leaves_nothing() {
         fs::read_to_string(&ok).unwrap(),
         "t_s,u_m\n0,0\n0.5,0.001\n"
     );
-    assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1);
+    assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 2);
 }

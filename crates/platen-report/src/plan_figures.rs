@@ -40,6 +40,19 @@ pub fn figures(p: &Plan) -> Vec<Figure> {
 }
 
 /// The drive's iteration and its achieved acceleration, if the drive was iterated.
+/// A plan figure's subject: the target (its file name), on the scenario (its name), since
+/// one scenario plans many targets.
+pub(crate) fn subject(target_origin: &std::path::Path, scenario_name: &str) -> String {
+    format!(
+        "{} on {}",
+        target_origin.file_name().map_or_else(
+            || target_origin.display().to_string(),
+            |n| n.to_string_lossy().into_owned()
+        ),
+        scenario_name
+    )
+}
+
 fn best(p: &Plan) -> Option<(usize, &[f64])> {
     p.iteration()
         .map(|it| (it.best, it.achieved.a_m_s2.as_slice()))
@@ -88,7 +101,7 @@ fn acceleration(p: &Plan) -> Figure {
         name: "plan-acceleration".into(),
         title: format!(
             "{}: target and achieved table acceleration",
-            p.scenario_name
+            subject(&p.target_origin, &p.scenario_name)
         ),
         caption: "The target acceleration against the simulated table's, for the target's own \
                   command (iteration 0) and for the drive."
@@ -141,7 +154,10 @@ fn spectra(p: &Plan) -> Option<Figure> {
     panel.x_log = true;
     Some(Figure {
         name: "plan-spectra".into(),
-        title: format!("{}: response spectra", p.scenario_name),
+        title: format!(
+            "{}: response spectra",
+            subject(&p.target_origin, &p.scenario_name)
+        ),
         caption: "5 %-damped pseudo-acceleration response spectra of the target and of the \
                   achieved acceleration, iteration 0 and the drive's."
             .into(),
@@ -198,7 +214,10 @@ fn convergence(p: &Plan) -> Option<Figure> {
     panel.x_range = Some((-0.2, last + 0.2));
     Some(Figure {
         name: "plan-convergence".into(),
-        title: format!("{}: drive iteration", p.scenario_name),
+        title: format!(
+            "{}: drive iteration",
+            subject(&p.target_origin, &p.scenario_name)
+        ),
         caption: "The acceleration and displacement NRMSE and the largest response-spectrum \
                   error per iteration, in percent on a logarithmic scale (1 = 10 %, 0 = 1 %)."
             .into(),
@@ -263,7 +282,10 @@ fn margins(p: &Plan) -> Figure {
     panel.y_range = Some((0.0, 1.05 * top));
     Figure {
         name: "plan-margins".into(),
-        title: format!("{}: the limits' margins", p.scenario_name),
+        title: format!(
+            "{}: the limits' margins",
+            subject(&p.target_origin, &p.scenario_name)
+        ),
         caption: "Each limit's peak over its allowed value, for the target's own command \
                   (iteration 0) and for the drive; the dashed line is the limit."
             .into(),

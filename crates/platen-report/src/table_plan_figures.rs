@@ -48,14 +48,7 @@ fn history(t: &[f64], y: &[f64]) -> Points {
 
 /// The title's subject: the target, on the scenario.
 fn subject(p: &TablePlan) -> String {
-    format!(
-        "{} on {}",
-        p.target_origin.file_name().map_or_else(
-            || p.target_origin.display().to_string(),
-            |n| n.to_string_lossy().into_owned()
-        ),
-        p.scenario_name
-    )
+    crate::plan_figures::subject(&p.target_origin, &p.scenario_name)
 }
 
 fn acceleration(p: &TablePlan) -> Figure {

@@ -11,6 +11,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::ValueEnum;
 
+use platen_io::columns::ColumnMap;
 use platen_io::csv::CsvWriter;
 use platen_plan::{
     load_rig, plan_observed, FrfSource, MaxScaleSettings, NoiseSettings, PlanError, PlanSettings,
@@ -34,6 +35,11 @@ pub struct Args {
     /// `y_m_s2`, `z_m_s2` (or `x_m`, `y_m`, `z_m`); absent axes are held at zero.
     #[arg(long, value_name = "TARGET.csv")]
     pub target: PathBuf,
+    /// JSON file mapping the target's own column names and units to platen's `t_s`,
+    /// `a_m_s2` or `u_m`, as a scenario's excitation.columns: {"t_s": {"name": "Time (s)"},
+    /// "a_m_s2": {"name": "Acc [g]", "unit": "g"}} (a uniaxial target).
+    #[arg(long, value_name = "MAP.json")]
+    pub columns: Option<PathBuf>,
     /// Write the drive (`t_s`, `u_m`: the displacement command, at the controller's rate) to
     /// this CSV file; on a multi-axis table the six-DOF command (`t_s`, `x_m` … `yaw_rad`), a
     /// `motion_csv` that `simulate` replays.
@@ -160,15 +166,27 @@ pub fn run(args: &Args) -> Result<()> {
         max_scale: (!args.no_max_scale).then(MaxScaleSettings::default),
         ..Default::default()
     };
+    let columns = match &args.columns {
+        Some(map) => ColumnMap::load(map)?,
+        None => ColumnMap::default(),
+    };
     if let Some(file) =
         platen_plan::six_dof::read_table_scenario(&args.scenario).map_err(cli_error)?
     {
+        if let Some(map) = &args.columns {
+            anyhow::bail!(
+                "--columns {}: a three-component target is read under platen's own names \
+                 (t_s, x_m_s2, y_m_s2, z_m_s2 or x_m, y_m, z_m, SI units); --columns maps a \
+                 uniaxial target's",
+                map.display()
+            );
+        }
         return run_table(args, &file);
     }
     // The drive's temporary file first: an unwritable destination fails before any run.
     let mut writer = CsvWriter::create(&args.out, &["t_s", "u_m"])?;
     let rig = load_rig(&args.scenario).map_err(cli_error)?;
-    let target = Target::read_csv(&args.target).map_err(cli_error)?;
+    let target = Target::read_csv_mapped(&args.target, &columns).map_err(cli_error)?;
     let progress = iteration_progress(args);
     let on_run = &mut |k: usize| progress.set_position(k as u64 + 1);
     let p = plan_observed(&rig, &args.scenario, &target, &settings, on_run);
