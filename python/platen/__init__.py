@@ -652,7 +652,9 @@ def plan(
     ``scenario`` is a path or a dict in the scenario format with a ``table_system`` (its
     excitation, if any, is ignored: the target takes its place). The target is
     ``target_a_m_s2`` (an acceleration record, m/s²) or ``target_u_m`` (a displacement, m) at
-    the uniformly spaced time stamps ``target_t_s`` (s), at most at the controller's rate.
+    the uniformly spaced time stamps ``target_t_s`` (s); a target faster than the controller
+    is put on its rate, anti-aliased, with a notice in the summary's ``warnings`` (a
+    three-component one is refused).
     ``iterations`` is the most drive corrections (0: the target's own command only),
     ``gain`` the iteration's gain in (0, 2) (None: the CLI's default, 0.7), ``target_nrmse``
     the acceleration NRMSE (a fraction) that stops it, ``frf`` where the loop's response comes

@@ -110,9 +110,12 @@ def test_bad_settings_and_scenarios_raise_scenario_error():
         platen.plan(SCENARIO, t, target_a_m_s2=a, frf="guessed")
     with pytest.raises(platen.ScenarioError, match="table_system"):
         platen.plan({"name": "bare", "model": {"preset": "lhpost-2008"}}, t, target_a_m_s2=a)
-    with pytest.raises(ValueError, match="2048"):
-        fast = np.arange(1025) / 2048.0
-        platen.plan(SCENARIO, fast, target_a_m_s2=quake(fast))
+    # A target faster than the controller is not refused: it is put on the controller's
+    # rate, anti-aliased, and the summary says so.
+    fast = np.arange(2 * 2048 + 1) / 2048.0
+    p = platen.plan(SCENARIO, fast, target_a_m_s2=quake(fast), iterations=0, max_scale=False)
+    assert any("resampled to 1024 Hz" in w for w in p["summary"]["warnings"])
+    assert p["summary"]["target"]["sample_rate_hz"] == 2048.0
     with pytest.raises(platen.ScenarioError, match="zero"):
         platen.plan(SCENARIO, t, target_a_m_s2=np.zeros_like(t))
 

@@ -110,8 +110,9 @@ pub fn load_rig(path: &Path) -> Result<LoadedRig> {
 /// target's motion, its feasibility and largest scale, then the drive iteration.
 ///
 /// # Errors
-/// [`PlanError::NoTableSystem`]; [`PlanError::TargetRate`] for a target sampled faster than
-/// the controller; bad settings; a closed-loop run that fails.
+/// [`PlanError::NoTableSystem`]; bad settings; a closed-loop run that fails. A target sampled
+/// faster than the controller is resampled to its rate ([`Target::resampled_to`]), with a
+/// notice in the plan's warnings.
 pub fn plan(
     loaded: &LoadedRig,
     scenario_path: &Path,
@@ -159,9 +160,28 @@ pub fn plan_table(
     settings: &PlanSettings,
     on_run: &mut dyn FnMut(usize),
 ) -> Result<Plan> {
-    let motion = target_motion(table, target, settings)?;
+    // A target faster than the controller is put on its rate (anti-aliased), with a notice.
+    let controller_hz = table.controller_rate_hz();
+    let mut warnings = Vec::new();
+    let resampled;
+    let on_controller = if target.sample_rate_hz() > controller_hz * (1.0 + 1e-9) {
+        resampled = target.resampled_to(controller_hz)?;
+        warnings.push(format!(
+            "the target's {:.6} Hz is faster than the controller's {controller_hz} Hz: it was \
+             resampled to {controller_hz} Hz, low-passed at {:.1} Hz (its content below \
+             {:.1} Hz kept within 0.5 %, above {:.1} Hz removed)",
+            target.sample_rate_hz(),
+            0.4 * controller_hz,
+            0.3 * controller_hz,
+            0.5 * controller_hz
+        ));
+        &resampled
+    } else {
+        target
+    };
+    let motion = target_motion(table, on_controller, settings)?;
     let feasibility = feasibility(table, &motion, settings.max_scale.as_ref())?;
-    let mut warnings = target_warnings(&motion);
+    warnings.extend(target_warnings(&motion));
     warnings.extend(feasibility_warning(&feasibility));
     let drive = match feasibility.achieved.end_stop {
         Some(_) => None,

@@ -244,6 +244,32 @@ impl Target {
         })
     }
 
+    /// This target on the grid of `rate_hz`, slower than its own, from its first time stamp:
+    /// low-passed and resampled by [`platen_signal::Resampler`] (a zero-phase windowed-sinc
+    /// anti-alias filter with its −6 dB cut-off at `0.4·rate_hz`: content below
+    /// `0.3·rate_hz` keeps its phase and, within 0.5 %, its amplitude; content at the new
+    /// Nyquist frequency and above is down to −50 dB before it could alias).
+    ///
+    /// # Errors
+    /// [`PlanError::Target`] if the resampled record is not a target (fewer than
+    /// [`MIN_TARGET_SAMPLES`] samples at the new rate).
+    pub fn resampled_to(&self, rate_hz: f64) -> Result<Self> {
+        let bad = |message: String| PlanError::Target {
+            origin: self.origin.display().to_string(),
+            message,
+        };
+        let values = platen_signal::Resampler::new(
+            self.sample_rate_hz(),
+            rate_hz,
+            platen_signal::Interpolation::Cubic,
+        )
+        .and_then(|r| r.apply(&self.values))
+        .map_err(|e| bad(format!("resampling it to {rate_hz} Hz: {e}")))?;
+        let t0 = self.t_s[0];
+        let t_s = (0..values.len()).map(|k| t0 + k as f64 / rate_hz).collect();
+        Self::new(&self.origin, t_s, values, self.kind)
+    }
+
     /// Where the target comes from.
     pub fn origin(&self) -> &Path {
         &self.origin

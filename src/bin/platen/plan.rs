@@ -30,8 +30,9 @@ pub struct Args {
     /// multi-axis `table` and its `controller` (a three-component plan).
     pub scenario: PathBuf,
     /// Target CSV: `t_s` and `a_m_s2` (an acceleration record), or `t_s` and `u_m` (a
-    /// displacement), uniformly sampled at most at the controller's rate (a slower target is
-    /// put on the controller's rate). On a multi-axis table: `t_s` and any of `x_m_s2`,
+    /// displacement), uniformly sampled (a slower or faster target is put on the controller's
+    /// rate, a faster one anti-aliased, with a notice). On a multi-axis table: `t_s` and any
+    /// of `x_m_s2`,
     /// `y_m_s2`, `z_m_s2` (or `x_m`, `y_m`, `z_m`); absent axes are held at zero.
     #[arg(long, value_name = "TARGET.csv")]
     pub target: PathBuf,
