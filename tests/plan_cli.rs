@@ -393,6 +393,19 @@ fn plot_and_report_write_the_figures_and_list_them() {
             "{stem}: its title names the target"
         );
     }
+    // issue 38: the acceleration's close-up, the convergence on a logarithmic axis in percent,
+    // the margins' bars named on their axis.
+    let read = |stem: &str| fs::read_to_string(figures.join(format!("{stem}.svg"))).unwrap();
+    assert!(read("plan-acceleration").contains("Close up:"));
+    assert!(read("plan-convergence").contains("error (%, logarithmic)"));
+    let margins = read("plan-margins");
+    for name in ["stroke_m", "velocity_m_s", "force_n"] {
+        let label = format!(">\n{name}\n</text>");
+        assert!(
+            margins.contains(&label),
+            "plan-margins: no bar label {name}"
+        );
+    }
     assert_eq!(listed.len(), 8);
     assert_eq!(p["report"], report.to_str().unwrap());
     let page = fs::read_to_string(&report).unwrap();

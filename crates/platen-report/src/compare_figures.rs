@@ -84,6 +84,8 @@ impl<'a> Context<'a> {
             shade_x: shade,
             y_range: None,
             x_log: false,
+            y_log: false,
+            x_categories: Vec::new(),
         };
         vec![
             panel(
@@ -193,6 +195,8 @@ fn residuals(ctx: &Context<'_>) -> Figure {
             shade_x: c.window.map(|w| (w.start_s, w.end_s)),
             y_range: None,
             x_log: false,
+            y_log: false,
+            x_categories: Vec::new(),
         }
     };
     Figure {

@@ -124,6 +124,13 @@ pub struct Panel {
     /// line at every 1…9 × 10^k and labels at 1, 2 and 5 × 10^k (only at 10^k when those
     /// would crowd).
     pub x_log: bool,
+    /// A logarithmic vertical axis (errors over iterations): the points' y and `y_range` stay
+    /// in the data's units (points at y ≤ 0 are not drawn), with the grid and labels of
+    /// `x_log`.
+    pub y_log: bool,
+    /// Names of categories at x = 1, 2, … (bars): the horizontal axis is labelled with them,
+    /// one tick each, instead of numbers (empty: a numeric axis).
+    pub x_categories: Vec<String>,
 }
 
 impl Panel {

@@ -68,9 +68,10 @@ fn history(t: &[f64], y: &[f64]) -> Points {
 
 fn acceleration(p: &Plan) -> Figure {
     let m = &p.motion;
+    let zoom = crate::run_figures::zoom_window(&m.t_s, &m.a_m_s2);
     let target = history(&m.t_s, &m.a_m_s2);
     let zero = history(&m.t_s, &p.feasibility.achieved.a_m_s2);
-    let mut panels = vec![Panel::new(
+    let mut whole = Panel::new(
         "Target and achieved, iteration 0 (the target's own command)",
         "t (s)",
         "a (m/s²)",
@@ -78,9 +79,12 @@ fn acceleration(p: &Plan) -> Figure {
             patterned("target", target.clone(), RECORDED, 1, Dash::Solid),
             patterned("iteration 0", zero, RESIDUAL, 1, Dash::Dotted),
         ],
-    )];
-    if let Some((k, a)) = best(p) {
-        panels.push(Panel::new(
+    );
+    whole.shade_x = zoom;
+    let mut panels = vec![whole];
+    let drive = best(p);
+    if let Some((k, a)) = drive {
+        let mut whole = Panel::new(
             format!("Target and achieved, iteration {k} (the drive)"),
             "t (s)",
             "a (m/s²)",
@@ -94,7 +98,47 @@ fn acceleration(p: &Plan) -> Figure {
                     Dash::Dashed,
                 ),
             ],
-        ));
+        );
+        whole.shade_x = zoom;
+        panels.push(whole);
+    }
+    // The shaded interval close up (around the target's largest |a|), every trace at its
+    // own samples' resolution.
+    if let Some(range) = zoom {
+        let close = |y: &[f64]| {
+            let n = m.t_s.len().min(y.len());
+            envelope(&m.t_s[..n], &y[..n], range, BUCKETS)
+        };
+        let mut series = vec![
+            patterned("target", close(&m.a_m_s2), RECORDED, 2, Dash::Solid),
+            patterned(
+                "iteration 0",
+                close(&p.feasibility.achieved.a_m_s2),
+                RESIDUAL,
+                1,
+                Dash::Dotted,
+            ),
+        ];
+        if let Some((k, a)) = drive {
+            series.push(patterned(
+                format!("iteration {k}"),
+                close(a),
+                SIMULATED,
+                2,
+                Dash::Dashed,
+            ));
+        }
+        let mut zoomed = Panel::new(
+            format!(
+                "Close up: {:.2}–{:.2} s, around the target's largest |a|",
+                range.0, range.1
+            ),
+            "t (s)",
+            "a (m/s²)",
+            series,
+        );
+        zoomed.x_range = Some(range);
+        panels.push(zoomed);
     }
     let rows = panels.len() as u32;
     Figure {
@@ -104,7 +148,7 @@ fn acceleration(p: &Plan) -> Figure {
             subject(&p.target_origin, &p.scenario_name)
         ),
         caption: "The target acceleration against the simulated table's, for the target's own \
-                  command (iteration 0) and for the drive."
+                  command (iteration 0) and for the drive; the shaded interval close up below."
             .into(),
         panels,
         columns: 1,
@@ -173,7 +217,7 @@ fn convergence(p: &Plan) -> Option<Figure> {
     let pick = |f: fn(&platen_plan::IterationRecord) -> f64| -> Points {
         it.records
             .iter()
-            .map(|r| (r.iteration as f64, (100.0 * f(r)).max(1e-6).log10()))
+            .map(|r| (r.iteration as f64, 100.0 * f(r)))
             .collect()
     };
     let mut series = Vec::new();
@@ -208,10 +252,11 @@ fn convergence(p: &Plan) -> Option<Figure> {
             it.stop.name()
         ),
         "iteration",
-        "log10 of the error (%)",
+        "error (%, logarithmic)",
         series,
     );
     panel.x_range = Some((-0.2, last + 0.2));
+    panel.y_log = true;
     Some(Figure {
         name: "plan-convergence".into(),
         title: format!(
@@ -219,7 +264,7 @@ fn convergence(p: &Plan) -> Option<Figure> {
             subject(&p.target_origin, &p.scenario_name)
         ),
         caption: "The acceleration and displacement NRMSE and the largest response-spectrum \
-                  error per iteration, in percent on a logarithmic scale (1 = 10 %, 0 = 1 %)."
+                  error per iteration, in percent on a logarithmic axis."
             .into(),
         panels: vec![panel],
         columns: 1,
@@ -262,17 +307,8 @@ fn margins(p: &Plan) -> Figure {
             *width = 14;
         }
     }
-    let names: Vec<String> = uses
-        .iter()
-        .enumerate()
-        .map(|(i, u)| format!("{} {}", i + 1, u.limit))
-        .collect();
-    let mut panel = Panel::new(
-        "Peak over allowed, per limit",
-        names.join(", "),
-        "use (%)",
-        series,
-    );
+    let mut panel = Panel::new("Peak over allowed, per limit", "limit", "use (%)", series);
+    panel.x_categories = uses.iter().map(|u| u.limit.to_string()).collect();
     panel.x_range = Some((0.5, n + 0.5));
     let top = uses
         .iter()

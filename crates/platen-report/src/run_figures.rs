@@ -133,25 +133,31 @@ struct Command<'a> {
 
 impl<'a> Command<'a> {
     fn new(t_s: &[f64], a_m_s2: &'a [f64]) -> Option<Self> {
-        let (&t0, &t1) = (t_s.first()?, t_s.last()?);
-        let peak = a_m_s2
-            .iter()
-            .enumerate()
-            .fold((0, f64::NEG_INFINITY), |best, (i, a)| {
-                if a.abs() > best.1 {
-                    (i, a.abs())
-                } else {
-                    best
-                }
-            })
-            .0;
-        let width = ZOOM_S.min(0.25 * (t1 - t0));
-        let start = (t_s.get(peak).copied().unwrap_or(t0) - 0.5 * width).clamp(t0, t1 - width);
         Some(Self {
             a_m_s2,
-            zoom_s: (start, start + width),
+            zoom_s: zoom_window(t_s, a_m_s2)?,
         })
     }
+}
+
+/// The interval a figure zooms on: at most [`ZOOM_S`] (a quarter of the record) around the
+/// largest |`a`|, inside the record of times `t_s` (`None` for an empty one).
+pub(crate) fn zoom_window(t_s: &[f64], a: &[f64]) -> Option<(f64, f64)> {
+    let (&t0, &t1) = (t_s.first()?, t_s.last()?);
+    let peak = a
+        .iter()
+        .enumerate()
+        .fold((0, f64::NEG_INFINITY), |best, (i, a)| {
+            if a.abs() > best.1 {
+                (i, a.abs())
+            } else {
+                best
+            }
+        })
+        .0;
+    let width = ZOOM_S.min(0.25 * (t1 - t0));
+    let start = (t_s.get(peak).copied().unwrap_or(t0) - 0.5 * width).clamp(t0, t1 - width);
+    Some((start, start + width))
 }
 
 /// Collects, while a run goes, what its figures draw (see the module's documentation). It

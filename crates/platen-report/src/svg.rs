@@ -26,11 +26,9 @@ use crate::figure::{
 
 /// The SVG drawing area of a panel.
 type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
-/// The axes of a panel, ready to draw series on.
-type Chart<'a, 'b> = AnyChart<'a, 'b, RangedCoordf64>;
-/// The axes of a panel with the horizontal coordinate `X` (linear, or logarithmic in
+/// The axes of a panel with the coordinates `X` and `Y` (each linear, or logarithmic in
 /// decades with its own ticks).
-type AnyChart<'a, 'b, X> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<X, RangedCoordf64>>;
+type AnyChart<'a, 'b, X, Y> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<X, Y>>;
 
 /// Width of a character of the title font, in em: an estimate for sans-serif text, a little
 /// generous (0.47 em measured on a rendered 94-character title) so that a title that fits the
@@ -307,20 +305,118 @@ fn draw_panel(panel: &Panel, area: &Area<'_>, y_area: u32, legend: bool) -> Resu
         .map_err(draw_error)?;
     }
     draw_legend(&head, &legend, left, caption_px as i32)?;
-    if panel.x_log {
-        let panel = &log_panel(panel);
-        let layout = Layout::new(panel, &body, y_area);
-        let mut chart = draw_log_axes(panel, &body, y_area, &layout)?;
-        return draw_data(&mut chart, panel, &layout);
-    }
+    let (x_log, y_log) = (panel.x_log, panel.y_log);
+    let logged;
+    let panel = if x_log || y_log {
+        logged = log_panel(panel);
+        &logged
+    } else {
+        panel
+    };
     let layout = Layout::new(panel, &body, y_area);
-    let mut chart = draw_axes(panel, &body, y_area, &layout)?;
-    draw_data(&mut chart, panel, &layout)
+    let (x, y) = (layout.x, layout.y);
+    let (x_dec, y_dec) = layout.decimals;
+    let linear = |r: (f64, f64)| -> RangedCoordf64 { (r.0..r.1).into() };
+    let x_fmt = move |v: &f64| format_tick(*v, x_dec);
+    let y_fmt = move |v: &f64| format_tick(*v, y_dec);
+    let log_fmt = |v: &f64| log_tick_label(*v);
+    if !panel.x_categories.is_empty() {
+        let names = &panel.x_categories;
+        let name = |v: &f64| {
+            let i = v.round();
+            match (i >= 1.0 && (v - i).abs() < 1e-9).then(|| names.get(i as usize - 1)) {
+                Some(Some(n)) => n.clone(),
+                _ => String::new(),
+            }
+        };
+        let x_axis = CategoryAxis {
+            range: linear(x),
+            count: names.len(),
+        };
+        let y_fmt_ref: &dyn Fn(&f64) -> String = if y_log { &log_fmt } else { &y_fmt };
+        return if y_log {
+            let (y_axis, minor) = LogAxis::over(y, layout.labels.1);
+            let axes = Axes::new(x_axis, y_axis, &name, y_fmt_ref).minor_y(minor);
+            let mut chart = draw_axes(panel, &body, y_area, &layout, axes)?;
+            draw_data(&mut chart, panel, &layout)
+        } else {
+            let axes = Axes::new(x_axis, linear(y), &name, y_fmt_ref);
+            let mut chart = draw_axes(panel, &body, y_area, &layout, axes)?;
+            draw_data(&mut chart, panel, &layout)
+        };
+    }
+    match (x_log, y_log) {
+        (false, false) => {
+            let axes = Axes::new(linear(x), linear(y), &x_fmt, &y_fmt);
+            let mut chart = draw_axes(panel, &body, y_area, &layout, axes)?;
+            draw_data(&mut chart, panel, &layout)
+        }
+        (true, false) => {
+            let (x_axis, minor) = LogAxis::over(x, layout.labels.0);
+            let axes = Axes::new(x_axis, linear(y), &log_fmt, &y_fmt).minor_x(minor);
+            let mut chart = draw_axes(panel, &body, y_area, &layout, axes)?;
+            draw_data(&mut chart, panel, &layout)
+        }
+        (false, true) => {
+            let (y_axis, minor) = LogAxis::over(y, layout.labels.1);
+            let axes = Axes::new(linear(x), y_axis, &x_fmt, &log_fmt).minor_y(minor);
+            let mut chart = draw_axes(panel, &body, y_area, &layout, axes)?;
+            draw_data(&mut chart, panel, &layout)
+        }
+        (true, true) => {
+            let (x_axis, minor_x) = LogAxis::over(x, layout.labels.0);
+            let (y_axis, minor_y) = LogAxis::over(y, layout.labels.1);
+            let axes = Axes::new(x_axis, y_axis, &log_fmt, &log_fmt)
+                .minor_x(minor_x)
+                .minor_y(minor_y);
+            let mut chart = draw_axes(panel, &body, y_area, &layout, axes)?;
+            draw_data(&mut chart, panel, &layout)
+        }
+    }
+}
+
+/// A panel's two axes with their tick labels' formats and their minor grid lines (the
+/// logarithmic axes' 1…9 × 10^k, in decades).
+struct Axes<'f, X, Y> {
+    x: X,
+    y: Y,
+    x_fmt: &'f dyn Fn(&f64) -> String,
+    y_fmt: &'f dyn Fn(&f64) -> String,
+    minor_x: Vec<f64>,
+    minor_y: Vec<f64>,
+}
+
+impl<'f, X, Y> Axes<'f, X, Y> {
+    fn new(
+        x: X,
+        y: Y,
+        x_fmt: &'f dyn Fn(&f64) -> String,
+        y_fmt: &'f dyn Fn(&f64) -> String,
+    ) -> Self {
+        Self {
+            x,
+            y,
+            x_fmt,
+            y_fmt,
+            minor_x: Vec::new(),
+            minor_y: Vec::new(),
+        }
+    }
+
+    fn minor_x(mut self, minor: Vec<f64>) -> Self {
+        self.minor_x = minor;
+        self
+    }
+
+    fn minor_y(mut self, minor: Vec<f64>) -> Self {
+        self.minor_y = minor;
+        self
+    }
 }
 
 /// The shaded interval and the series of a panel, on its axes.
-fn draw_data<X: Ranged<ValueType = f64>>(
-    chart: &mut AnyChart<'_, '_, X>,
+fn draw_data<X: Ranged<ValueType = f64>, Y: Ranged<ValueType = f64>>(
+    chart: &mut AnyChart<'_, '_, X, Y>,
     panel: &Panel,
     layout: &Layout,
 ) -> Result<()> {
@@ -339,11 +435,15 @@ fn draw_data<X: Ranged<ValueType = f64>>(
     Ok(())
 }
 
-/// A logarithmic panel in decades: every x (and the ranges) replaced by its `log10`, points
-/// at x ≤ 0 dropped.
+/// A panel with its logarithmic axes in decades: every x of a logarithmic x axis (and its
+/// range and shade), every y of a logarithmic y axis (and its range), replaced by its
+/// `log10`, points at values ≤ 0 there dropped. A linear panel is returned as it is.
 fn log_panel(panel: &Panel) -> Panel {
+    let (x_log, y_log) = (panel.x_log, panel.y_log);
     let log = |(a, b): (f64, f64)| (a.log10(), b.log10());
     let positive = |(a, b): &(f64, f64)| *a > 0.0 && *b > 0.0;
+    let kept = |v: f64, on: bool| !on || (v > 0.0 && v.is_finite());
+    let to = |v: f64, on: bool| if on { v.log10() } else { v };
     Panel {
         series: panel
             .series
@@ -353,15 +453,24 @@ fn log_panel(panel: &Panel) -> Panel {
                 points: s
                     .points
                     .iter()
-                    .filter(|p| p.0 > 0.0 && p.0.is_finite())
-                    .map(|&(x, y)| (x.log10(), y))
+                    .filter(|p| kept(p.0, x_log) && kept(p.1, y_log))
+                    .map(|&(x, y)| (to(x, x_log), to(y, y_log)))
                     .collect(),
                 style: s.style,
             })
             .collect(),
-        x_range: panel.x_range.filter(positive).map(log),
-        shade_x: panel.shade_x.filter(positive).map(log),
-        x_log: false,
+        x_range: match x_log {
+            true => panel.x_range.filter(positive).map(log),
+            false => panel.x_range,
+        },
+        y_range: match y_log {
+            true => panel.y_range.filter(positive).map(log),
+            false => panel.y_range,
+        },
+        shade_x: match x_log {
+            true => panel.shade_x.filter(positive).map(log),
+            false => panel.shade_x,
+        },
         ..panel.clone()
     }
 }
@@ -453,59 +562,53 @@ impl ValueFormatter<f64> for LogAxis {
     }
 }
 
-/// The axes of a panel with a logarithmic horizontal axis (after [`log_panel`]): labels
-/// and grid lines at [`log_ticks`]' labelled ticks, the minor grid lighter.
-fn draw_log_axes<'a, 'b>(
-    panel: &Panel,
-    area: &'a Area<'b>,
-    y_area: u32,
-    layout: &Layout,
-) -> Result<AnyChart<'a, 'b, LogAxis>> {
-    let (margin_top, margin_bottom, margin_left, margin_right) = MARGINS;
-    let (x, y) = (layout.x, layout.y);
-    let (labelled, minor) = log_ticks(x, layout.labels.0);
-    let mut chart = ChartBuilder::on(area)
-        .margin_top(margin_top)
-        .margin_bottom(margin_bottom)
-        .margin_left(margin_left)
-        .margin_right(margin_right)
-        .x_label_area_size(layout.x_area)
-        .y_label_area_size(y_area)
-        .build_cartesian_2d(
+/// A linear axis whose ticks are the categories' places, 1 … `count` (each labelled with its
+/// name by the panel's formatter).
+struct CategoryAxis {
+    range: RangedCoordf64,
+    count: usize,
+}
+
+impl Ranged for CategoryAxis {
+    type ValueType = f64;
+    type FormatOption = NoDefaultFormatting;
+
+    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
+        self.range.map(value, limit)
+    }
+
+    fn key_points<Hint: KeyPointHint>(&self, hint: Hint) -> Vec<f64> {
+        if hint.weight().allow_light_points() {
+            Vec::new()
+        } else {
+            (1..=self.count).map(|i| i as f64).collect()
+        }
+    }
+
+    fn range(&self) -> std::ops::Range<f64> {
+        self.range.range()
+    }
+}
+
+impl ValueFormatter<f64> for CategoryAxis {
+    fn format(value: &f64) -> String {
+        format!("{value}")
+    }
+}
+
+impl LogAxis {
+    /// A logarithmic axis over `range` (decades) with at most about `max_labels` labels, and
+    /// its minor grid's ticks ([`log_ticks`]).
+    fn over(range: (f64, f64), max_labels: usize) -> (Self, Vec<f64>) {
+        let (labelled, minor) = log_ticks(range, max_labels);
+        (
             LogAxis {
-                decades: (x.0..x.1).into(),
+                decades: (range.0..range.1).into(),
                 labelled,
             },
-            y.0..y.1,
+            minor,
         )
-        .map_err(draw_error)?;
-    let y_dec = layout.decimals.1;
-    let x_fmt = |v: &f64| log_tick_label(*v);
-    let y_fmt = move |v: &f64| format_tick(*v, y_dec);
-    chart
-        .configure_mesh()
-        .x_desc(panel.x_label.as_str())
-        .y_desc(panel.y_label.as_str())
-        .x_labels(layout.labels.0)
-        .y_labels(layout.labels.1)
-        .x_label_formatter(&x_fmt)
-        .y_label_formatter(&y_fmt)
-        .label_style((FONT, TICK_SIZE))
-        .axis_desc_style((FONT, AXIS_DESC_SIZE))
-        .bold_line_style(RGBColor(225, 225, 225))
-        .light_line_style(TRANSPARENT)
-        .axis_style(RGBColor(90, 90, 90))
-        .draw()
-        .map_err(draw_error)?;
-    let style = RGBColor(242, 242, 242).stroke_width(1);
-    chart
-        .draw_series(
-            minor
-                .into_iter()
-                .map(move |v| PathElement::new(vec![(v, y.0), (v, y.1)], style)),
-        )
-        .map_err(draw_error)?;
-    Ok(chart)
+    }
 }
 
 /// Legend rows (from [`legend_rows`]) from `left` px across and `top` px down `area`.
@@ -557,13 +660,19 @@ fn draw_legend_entry(area: &Area<'_>, series: &Series, (x, y): (i32, i32)) -> Re
     .map_err(draw_error)
 }
 
-/// The panel's caption, axes, grid, tick labels and axis descriptions.
-fn draw_axes<'a, 'b>(
+/// The axes of a panel: labels and grid lines at each axis's ticks (a logarithmic axis's
+/// labelled ones, [`log_ticks`], with its minor grid lighter), and the axis descriptions.
+fn draw_axes<'a, 'b, X, Y>(
     panel: &Panel,
     area: &'a Area<'b>,
     y_area: u32,
     layout: &Layout,
-) -> Result<Chart<'a, 'b>> {
+    axes: Axes<'_, X, Y>,
+) -> Result<AnyChart<'a, 'b, X, Y>>
+where
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
     let (margin_top, margin_bottom, margin_left, margin_right) = MARGINS;
     let (x, y) = (layout.x, layout.y);
     let mut chart = ChartBuilder::on(area)
@@ -573,19 +682,16 @@ fn draw_axes<'a, 'b>(
         .margin_right(margin_right)
         .x_label_area_size(layout.x_area)
         .y_label_area_size(y_area)
-        .build_cartesian_2d(x.0..x.1, y.0..y.1)
+        .build_cartesian_2d(axes.x, axes.y)
         .map_err(draw_error)?;
-    let (x_dec, y_dec) = layout.decimals;
-    let x_fmt = move |v: &f64| format_tick(*v, x_dec);
-    let y_fmt = move |v: &f64| format_tick(*v, y_dec);
     chart
         .configure_mesh()
         .x_desc(panel.x_label.as_str())
         .y_desc(panel.y_label.as_str())
         .x_labels(layout.labels.0)
         .y_labels(layout.labels.1)
-        .x_label_formatter(&x_fmt)
-        .y_label_formatter(&y_fmt)
+        .x_label_formatter(axes.x_fmt)
+        .y_label_formatter(axes.y_fmt)
         .label_style((FONT, TICK_SIZE))
         .axis_desc_style((FONT, AXIS_DESC_SIZE))
         .bold_line_style(RGBColor(225, 225, 225))
@@ -593,12 +699,31 @@ fn draw_axes<'a, 'b>(
         .axis_style(RGBColor(90, 90, 90))
         .draw()
         .map_err(draw_error)?;
+    let style = RGBColor(242, 242, 242).stroke_width(1);
+    if !axes.minor_x.is_empty() {
+        chart
+            .draw_series(
+                axes.minor_x
+                    .into_iter()
+                    .map(move |v| PathElement::new(vec![(v, y.0), (v, y.1)], style)),
+            )
+            .map_err(draw_error)?;
+    }
+    if !axes.minor_y.is_empty() {
+        chart
+            .draw_series(
+                axes.minor_y
+                    .into_iter()
+                    .map(move |v| PathElement::new(vec![(x.0, v), (x.1, v)], style)),
+            )
+            .map_err(draw_error)?;
+    }
     Ok(chart)
 }
 
 /// One series (its legend entry is drawn above the axes, by [`draw_legend_entry`]).
-fn draw_series<X: Ranged<ValueType = f64>>(
-    chart: &mut AnyChart<'_, '_, X>,
+fn draw_series<X: Ranged<ValueType = f64>, Y: Ranged<ValueType = f64>>(
+    chart: &mut AnyChart<'_, '_, X, Y>,
     series: &Series,
 ) -> Result<()> {
     match series.style {
@@ -697,6 +822,123 @@ mod tests {
                 Some((x.parse().ok()?, y.parse().ok()?))
             })
             .collect()
+    }
+
+    /// A logarithmic y axis (issue 38: the convergence figure's "log10 of the error (%)"
+    /// read 0.47 where the value was 2.9 %): labelled in the data's own units at 1, 2, 5 ×
+    /// 10^k, and a point at 2.9 drawn log-proportionally between the labels 2 and 5.
+    #[test]
+    fn a_logarithmic_y_axis_is_labelled_in_the_data_units_and_places_points_by_log() {
+        let mut panel = Panel::new(
+            "",
+            "iteration",
+            "error (%)",
+            vec![crate::series::points(
+                "",
+                vec![(0.0, 60.0), (1.0, 2.9), (2.0, 1.2)],
+                RECORDED,
+                4,
+            )],
+        );
+        panel.y_log = true;
+        let fig = Figure {
+            name: "log-y".into(),
+            title: "log y".into(),
+            caption: String::new(),
+            panels: vec![panel],
+            columns: 1,
+            rows: Vec::new(),
+            size: (800, 600),
+        };
+        let svg = fig.to_svg().unwrap();
+        let doc = roxmltree::Document::parse(&svg).unwrap();
+        let label_y = |text: &str| -> f64 {
+            doc.descendants()
+                .find(|n| n.has_tag_name("text") && n.text().map(str::trim) == Some(text))
+                .and_then(|n| n.attribute("y"))
+                .and_then(|y| y.parse().ok())
+                .unwrap_or_else(|| panic!("no tick label {text:?} in the SVG"))
+        };
+        let (y2, y5, y10) = (label_y("2"), label_y("5"), label_y("10"));
+        // Equal ratios, equal distances: 2 → 5 is log10(2.5) of a decade, 5 → 10 log10(2).
+        let decade_px = (y2 - y5) / 2.5_f64.log10();
+        assert!(
+            ((y5 - y10) - decade_px * 2.0_f64.log10()).abs() < 1.5,
+            "{y2} {y5} {y10}"
+        );
+        // Labels in the data's units up to its 60 (the old axis in decades ended at 1.8).
+        assert!(label_y("50") < y10);
+        let cy: Vec<f64> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("circle"))
+            .filter_map(|n| n.attribute("cy")?.parse().ok())
+            .collect();
+        assert_eq!(cy.len(), 3, "{cy:?}");
+        // Text baselines sit a few px below the tick; the same offset for every label, so
+        // the point's place between labels 2 and 5 is its place between the ticks.
+        let at = (y2 - cy[1]) / (y2 - y5);
+        let want = (2.9_f64 / 2.0).log10() / 2.5_f64.log10();
+        assert!((at - want).abs() < 0.02, "{at} against {want}");
+    }
+
+    /// Bars named on the axis (issue 38: plan-margins had a numeric axis 0.5 … 6.5 with the
+    /// names in its description): one label per bar, under it, and no numbers.
+    #[test]
+    fn category_bars_are_labelled_with_their_names_under_each_bar() {
+        let mut panel = Panel::new(
+            "",
+            "limit",
+            "use (%)",
+            vec![crate::series::line(
+                "",
+                vec![(1.0, 0.0), (1.0, 40.0), (2.0, 0.0), (2.0, 90.0)],
+                RECORDED,
+                2,
+            )],
+        );
+        panel.x_categories = vec!["stroke_m".into(), "force_n".into()];
+        panel.x_range = Some((0.5, 2.5));
+        let fig = Figure {
+            name: "bars".into(),
+            title: "bars".into(),
+            caption: String::new(),
+            panels: vec![panel],
+            columns: 1,
+            rows: Vec::new(),
+            size: (800, 500),
+        };
+        let svg = fig.to_svg().unwrap();
+        let doc = roxmltree::Document::parse(&svg).unwrap();
+        let texts: Vec<(String, f64)> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("text"))
+            .filter_map(|n| {
+                let x = n.attribute("x")?.parse().ok()?;
+                Some((n.text()?.trim().to_owned(), x))
+            })
+            .collect();
+        let at = |name: &str| {
+            texts
+                .iter()
+                .find(|(t, _)| t == name)
+                .map(|p| p.1)
+                .unwrap_or_else(|| panic!("no {name:?} in {texts:?}"))
+        };
+        let (x1, x2) = (at("stroke_m"), at("force_n"));
+        let line: Vec<(f64, f64)> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("polyline") && n.attribute("stroke") == Some("#1F77B4"))
+            .flat_map(points)
+            .collect();
+        // Under its bar (the bar's x to a pixel).
+        assert!(
+            (line[0].0 - x1).abs() <= 1.0 && (line[2].0 - x2).abs() <= 1.0,
+            "{line:?}"
+        );
+        assert!(
+            !texts.iter().any(|(t, _)| t == "1.5" || t == "0.5"),
+            "{texts:?}"
+        );
     }
 
     /// Recorded is a solid polyline, simulated a dashed one (in the data and in the legend),

@@ -179,8 +179,8 @@ fn spectra(p: &TablePlan) -> Option<Figure> {
 fn convergence(p: &TablePlan) -> Figure {
     let it = &p.iteration;
     let last = it.records.len().saturating_sub(1).max(1) as f64;
-    // Log-scaled by hand: the axis is labelled in log10 of the percent.
-    let log = |x: f64| (100.0 * x).max(1e-6).log10();
+    // In percent on a logarithmic axis (`y_log`), labelled in percent.
+    let log = |x: f64| 100.0 * x;
     let mut nrmse = Vec::new();
     let overall: Points = it
         .records
@@ -227,10 +227,11 @@ fn convergence(p: &TablePlan) -> Figure {
             it.stop.name()
         ),
         "iteration",
-        "log10 of the NRMSE in % (1 = 10 %, 0 = 1 %)",
+        "NRMSE (%, logarithmic)",
         nrmse,
     );
     panel.x_range = Some((-0.2, last + 0.2));
+    panel.y_log = true;
     let mut panels = vec![panel];
     if !cross.is_empty() {
         let mut c = Panel::new(
@@ -246,7 +247,8 @@ fn convergence(p: &TablePlan) -> Figure {
         name: "table-plan-convergence".into(),
         title: format!("{}: drive iteration", subject(p)),
         caption: "The acceleration NRMSE per axis and overall (all axes' errors over all axes' \
-                  targets) per iteration, in log10 of the percent; the RMS acceleration of the \
+                  targets) per iteration, in percent on a logarithmic axis; the RMS \
+                  acceleration of the \
                   axes held at zero (their cross-talk)."
             .into(),
         panels,
@@ -296,20 +298,16 @@ fn margins(p: &TablePlan) -> Figure {
             *width = 12;
         }
     }
-    let names: Vec<String> = closest
-        .iter()
-        .enumerate()
-        .map(|(i, u)| format!("{} {}", i + 1, u.limit))
-        .collect();
     let mut panel = Panel::new(
         format!(
             "Peak over allowed, the {} limits closest to failing",
             closest.len()
         ),
-        names.join(", "),
+        "limit",
         "use (%, bars cut at 1000)",
         series,
     );
+    panel.x_categories = closest.iter().map(|u| u.limit.to_string()).collect();
     panel.x_range = Some((0.5, n + 0.5));
     let top = closest
         .iter()
