@@ -658,3 +658,14 @@ fn columns_map_a_labs_channel_names_and_units() {
         assert!(stderr(&o).contains(needle), "`{needle}` in {}", stderr(&o));
     }
 }
+
+#[test]
+fn the_recorded_limits_are_printed_in_the_format_of_every_other_number() {
+    // issue 38: the acceleration limit (4.2 g) was printed as 41.18793 m/s² beside 4-digit
+    // peaks.
+    let o = platen(&["compare", &sr9_forward(), "--recorded", &sr9_recorded()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("of 41.19 m/s²"), "{out}");
+    assert!(!out.contains("41.18793"), "{out}");
+}

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use platen_model::STANDARD_GRAVITY_M_S2;
 use platen_plan::PlanSummary;
 
-use crate::text::{rounded, significant};
+use crate::text::{engineering_unit, rounded, significant};
 
 /// The unit of a limit, from its name.
 fn unit(limit: &str) -> &'static str {
@@ -90,13 +90,16 @@ fn summary_lines(o: &mut String, s: &PlanSummary) {
         "limit", "peak", "allowed", "", "use", "at"
     );
     for l in &s.margins {
+        // Peak and allowed in one engineering format, the allowed value's unit (0.6593
+        // against 6.800 MN, not 659293 against 6.800e6 N).
+        let (factor, unit) = engineering_unit(unit(l.limit), l.allowed);
         let _ = writeln!(
             o,
             "    {:<20} {:>12} {:>12} {:<5} {:>6.1}% {:>8.3} s",
             l.limit,
-            significant(l.peak, 4),
-            significant(l.allowed, 4),
-            unit(l.limit),
+            significant(factor * l.peak, 4),
+            significant(factor * l.allowed, 4),
+            unit,
             100.0 * l.ratio,
             l.t_s
         );

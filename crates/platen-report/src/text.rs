@@ -73,6 +73,18 @@ pub fn significant(x: f64, digits: usize) -> String {
     }
 }
 
+/// One engineering format for a table's values: forces, moments and pressures (`N`, `N·m`,
+/// `Pa`) in the SI prefix that puts `reference` between 1 and 1000 (kN, MN, MPa, as labs read
+/// them), other units as they are. Returns the factor to multiply values by and the unit.
+pub fn engineering_unit(unit: &str, reference: f64) -> (f64, String) {
+    if !matches!(unit, "N" | "N·m" | "Pa") || reference == 0.0 || !reference.is_finite() {
+        return (1.0, unit.to_owned());
+    }
+    let thousands = ((reference.abs().log10() / 3.0).floor() as i32).clamp(0, 3);
+    let prefix = ["", "k", "M", "G"][thousands as usize];
+    (10f64.powi(-3 * thousands), format!("{prefix}{unit}"))
+}
+
 /// `x` to `digits` significant digits without trailing zeros: a sample rate measured from
 /// rounded stamps, 204.79999998958843 Hz, reads 204.8 (at 9 digits), and 1024 reads 1024.
 pub fn rounded(x: f64, digits: usize) -> String {
@@ -161,7 +173,9 @@ fn limit_value(kind: TableLimit, x: f64, as_given: bool) -> String {
         _ => (x, kind.unit()),
     };
     if as_given {
-        format!("{x} {unit}")
+        // The limit as the table's record gives it, in the same format as every other
+        // number here (4.2 g is 41.19 m/s², not 41.18793).
+        format!("{} {unit}", rounded(x, 4))
     } else {
         format!("{} {unit}", significant(x, 4))
     }
@@ -278,5 +292,35 @@ mod tests {
         assert_eq!(rounded(1023.9999996, 9), "1024");
         assert_eq!(rounded(0.5, 9), "0.5");
         assert_eq!(rounded(2.5e7, 3), "2.50e7");
+    }
+}
+
+#[cfg(test)]
+mod engineering_tests {
+    use super::*;
+
+    #[test]
+    fn forces_and_pressures_take_the_prefix_of_their_reference_and_others_keep_their_unit() {
+        // issue 38: a plan table read `-589683` against `6.800e6 N` and `2.060e7 Pa`.
+        let (f, u) = engineering_unit("N", 6.8e6);
+        assert_eq!(
+            (significant(f * 659_293.0, 4), u.as_str()),
+            ("0.6593".into(), "MN")
+        );
+        assert_eq!(significant(f * 6.8e6, 4), "6.800");
+        let (f, u) = engineering_unit("Pa", 13.8e6);
+        assert_eq!(
+            (significant(f * 2.0607e7, 4), u.as_str()),
+            ("20.61".into(), "MPa")
+        );
+        let (f, u) = engineering_unit("N", 37_500.0);
+        assert_eq!(
+            (significant(f * 37_500.0, 4), u.as_str()),
+            ("37.50".into(), "kN")
+        );
+        // Below 1 in its base unit, and every non-force unit, as they are.
+        assert_eq!(engineering_unit("N", 12.0), (1.0, "N".into()));
+        assert_eq!(engineering_unit("m/s²", 41.18793), (1.0, "m/s²".into()));
+        assert_eq!(engineering_unit("m", 0.75), (1.0, "m".into()));
     }
 }
