@@ -162,11 +162,11 @@ pub fn plan_table(
 ) -> Result<Plan> {
     // A target faster than the controller is put on its rate (anti-aliased), with a notice.
     let controller_hz = table.controller_rate_hz();
-    let mut warnings = Vec::new();
+    let mut notices = Vec::new();
     let resampled;
     let on_controller = if target.sample_rate_hz() > controller_hz * (1.0 + 1e-9) {
         resampled = target.resampled_to(controller_hz)?;
-        warnings.push(format!(
+        notices.push(format!(
             "the target's {:.6} Hz is faster than the controller's {controller_hz} Hz: it was \
              resampled to {controller_hz} Hz, low-passed at {:.1} Hz (its content below \
              {:.1} Hz kept within 0.5 %, above {:.1} Hz removed)",
@@ -181,8 +181,11 @@ pub fn plan_table(
     };
     let motion = target_motion(table, on_controller, settings)?;
     let feasibility = feasibility(table, &motion, settings.max_scale.as_ref())?;
+    // The most serious first: the feasibility's answer, then what was done to the target and
+    // what is doubtful in it, then the drive's.
+    let mut warnings: Vec<String> = feasibility_warning(&feasibility).into_iter().collect();
+    warnings.extend(notices);
     warnings.extend(target_warnings(&motion));
-    warnings.extend(feasibility_warning(&feasibility));
     let drive = match feasibility.achieved.end_stop {
         Some(_) => None,
         None => Some(planned_drive(
