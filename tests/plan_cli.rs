@@ -494,18 +494,21 @@ fn a_target_too_short_or_mostly_removed_by_the_baseline_treatment_is_warned_of()
     let short = target_csv(d, "short.csv", "a_m_s2", 49, 1024.0, |t| {
         0.5 + 0.05 * (std::f64::consts::TAU * 20.0 * t).sin()
     });
-    let o = platen(&[
-        "plan",
-        scenario.to_str().unwrap(),
-        "--target",
-        short.to_str().unwrap(),
-        "--out",
-        d.join("short-drive.csv").to_str().unwrap(),
-        "--iterations",
-        "1",
-        "--no-max-scale",
-        "--json",
-    ]);
+    let run = |target: &Path, extra: &[&str]| {
+        let out = d.join("drive.csv");
+        let mut args = vec![
+            "plan",
+            scenario.to_str().unwrap(),
+            "--target",
+            target.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--no-max-scale",
+        ];
+        args.extend(extra);
+        platen(&args)
+    };
+    let o = run(&short, &["--iterations", "1", "--json"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let p = json_of(&o);
     let warnings = p["warnings"].to_string();
@@ -520,33 +523,12 @@ fn a_target_too_short_or_mostly_removed_by_the_baseline_treatment_is_warned_of()
         / p["target"]["rms_a_m_s2"].as_f64().unwrap();
     assert!(removed > 0.25, "{removed}");
     // In text too.
-    let o = platen(&[
-        "plan",
-        scenario.to_str().unwrap(),
-        "--target",
-        short.to_str().unwrap(),
-        "--out",
-        d.join("short-drive.csv").to_str().unwrap(),
-        "--iterations",
-        "1",
-        "--no-max-scale",
-    ]);
+    let o = run(&short, &["--iterations", "1"]);
     let out = String::from_utf8_lossy(&o.stdout).into_owned() + &stderr(&o);
     assert!(out.contains("too short to judge"), "{out}");
     // A real target (8 s of a synthetic quake) is judged without either warning.
     let quake_csv = target_csv(d, "quake.csv", "a_m_s2", 8 * 1024 + 1, 1024.0, quake);
-    let o = platen(&[
-        "plan",
-        scenario.to_str().unwrap(),
-        "--target",
-        quake_csv.to_str().unwrap(),
-        "--out",
-        d.join("quake-drive.csv").to_str().unwrap(),
-        "--iterations",
-        "0",
-        "--no-max-scale",
-        "--json",
-    ]);
+    let o = run(&quake_csv, &["--iterations", "0", "--json"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let warnings = json_of(&o)["warnings"].to_string();
     assert!(
