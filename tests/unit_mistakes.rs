@@ -297,3 +297,35 @@ fn a_displacement_record_a_hundred_strokes_long_is_refused() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(json(&o)["limits"]["stroke_m"]["respected"], false);
 }
+
+#[test]
+fn a_supply_pressure_in_mpa_or_far_beyond_any_table_is_refused_as_such() {
+    // issue 38: `supply_pressure_pa: 20.7` (MPa) was blamed on the return pressure, and
+    // 2.07e9 ran (at 20 g, "lowest 560 MPa").
+    let dir = tempfile::tempdir().unwrap();
+    for (value, says) in [
+        ("20.7", "20.7 looks like MPa, which is 20.7e6 Pa"),
+        ("20700", "looks like kPa"),
+        ("2.07e9", "2070 MPa is beyond any servo-hydraulic supply"),
+    ] {
+        let path = dir.path().join(format!("supply-{value}.json"));
+        std::fs::write(
+            &path,
+            format!(
+                r#"{{"model": {{"preset": "lhpost-2008"}},
+                    "table_system": {{"preset": "lhpost-2008", "supply_pressure_pa": {value}}},
+                    "excitation": {{"sine_motion": {{"amplitude_m": 0.02, "frequency_hz": 1.0}}}},
+                    "duration_s": 0.5}}"#
+            ),
+        )
+        .unwrap();
+        let o = platen(&["simulate", path.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(3), "{value}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(
+            e.contains("table_system.supply_pressure_pa") && e.contains(says),
+            "{value}: {e}"
+        );
+        assert!(!e.contains("return_pressure_pa"), "{value}: {e}");
+    }
+}

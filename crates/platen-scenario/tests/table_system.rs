@@ -206,9 +206,11 @@ fn a_return_pressure_at_or_above_the_supply_is_refused() {
             "below the supply pressure 20700000 Pa",
         );
     }
-    // Explicit system, supply lowered under the return.
+    // Explicit system, the supply (1 MPa, low but a supply) under the return (2 MPa). A
+    // supply below 0.5 MPa is refused as such first (a unit slip; `tests/unit_mistakes.rs`).
     let mut ts = explicit();
-    ts["supply_pressure_pa"] = json!(2e5);
+    ts["supply_pressure_pa"] = json!(1e6);
+    ts["return_pressure_pa"] = json!(2e6);
     refused(
         &scenario_with(ts),
         "table_system.return_pressure_pa",

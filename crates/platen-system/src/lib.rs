@@ -76,6 +76,7 @@ pub use hydraulics::{HydraulicConstants, HydraulicRates, HydraulicState, LAMINAR
 pub use linear::{Capacities, Linearisation, Margins, Mechanics, Passband, SECANT_SPEED_M_S};
 pub use params::{
     Accumulator, Actuator, Controller, ServoValve, Supply, TableSystem, TableSystemParts,
+    PLAUSIBLE_SUPPLY_PA,
 };
 pub use spool::{SpoolResponse, SpoolWeights};
 pub use table::{

@@ -426,6 +426,38 @@ impl TableSystem {
 
 /// The oil's bulk modulus, the supply and return pressures and the accumulator bank: the
 /// checks shared by the uniaxial and the multi-axis table systems.
+/// The supply pressures a servo-hydraulic table runs at, Pa: a few MPa to a few tens (21 MPa
+/// is the norm, 35 MPa the highest lab systems); a value outside is a unit slip (an MPa value
+/// written in Pa, or one multiplied twice), refused before it is blamed on another value or
+/// runs at 20 g.
+pub const PLAUSIBLE_SUPPLY_PA: (f64, f64) = (0.5e6, 70e6);
+
+/// Refuses a supply pressure outside [`PLAUSIBLE_SUPPLY_PA`], naming what it looks like.
+fn plausible_supply(p: f64) -> Result<()> {
+    let (lo, hi) = PLAUSIBLE_SUPPLY_PA;
+    if (lo..=hi).contains(&p) {
+        return Ok(());
+    }
+    let hint = if (lo * 1e-6..=hi * 1e-6).contains(&p) {
+        format!(": {p} looks like MPa, which is {p}e6 Pa")
+    } else if (lo * 1e-3..=hi * 1e-3).contains(&p) {
+        format!(": {p} looks like kPa, which is {p}e3 Pa")
+    } else if p > hi {
+        format!(": {} MPa is beyond any servo-hydraulic supply", p * 1e-6)
+    } else {
+        String::new()
+    };
+    Err(invalid(
+        "supply_pressure_pa",
+        p,
+        format!(
+            "an absolute supply pressure in Pa between {} and {} MPa{hint}",
+            lo * 1e-6,
+            hi * 1e-6
+        ),
+    ))
+}
+
 pub(crate) fn validate_supply(
     oil_bulk_modulus_pa: f64,
     supply_pressure_pa: f64,
@@ -434,6 +466,7 @@ pub(crate) fn validate_supply(
 ) -> Result<()> {
     positive("oil_bulk_modulus_pa", oil_bulk_modulus_pa)?;
     positive("supply_pressure_pa", supply_pressure_pa)?;
+    plausible_supply(supply_pressure_pa)?;
     non_negative("return_pressure_pa", return_pressure_pa)?;
     if return_pressure_pa >= supply_pressure_pa {
         return Err(invalid(
