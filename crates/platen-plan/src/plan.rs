@@ -245,16 +245,10 @@ fn target_warnings(motion: &TargetMotion) -> Vec<String> {
     warnings
 }
 
-/// The motion asked of `table` for `target`: at most the controller's rate, not zero.
+/// The motion asked of `table` for `target` (already at most the controller's rate: a faster
+/// one is resampled by [`plan_table`] first), not zero.
 fn target_motion(table: &Table, target: &Target, settings: &PlanSettings) -> Result<TargetMotion> {
     let controller_hz = table.controller_rate_hz();
-    if target.sample_rate_hz() > controller_hz * (1.0 + 1e-9) {
-        return Err(PlanError::TargetRate {
-            origin: target.origin().to_owned(),
-            rate_hz: target.sample_rate_hz(),
-            controller_hz,
-        });
-    }
     let motion = TargetMotion::new(
         target,
         &settings.baseline,

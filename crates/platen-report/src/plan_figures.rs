@@ -58,19 +58,20 @@ fn best(p: &Plan) -> Option<(usize, &[f64])> {
         .map(|it| (it.best, it.achieved.a_m_s2.as_slice()))
 }
 
-fn history(t: &[f64], y: &[f64]) -> Points {
+/// `y` at the times `t` over `range` (the whole record when `None`), enveloped for drawing.
+fn history(t: &[f64], y: &[f64], range: Option<(f64, f64)>) -> Points {
     let n = t.len().min(y.len());
     if n == 0 {
         return Vec::new();
     }
-    envelope(&t[..n], &y[..n], (t[0], t[n - 1]), BUCKETS)
+    envelope(&t[..n], &y[..n], range.unwrap_or((t[0], t[n - 1])), BUCKETS)
 }
 
 fn acceleration(p: &Plan) -> Figure {
     let m = &p.motion;
     let zoom = crate::run_figures::zoom_window(&m.t_s, &m.a_m_s2);
-    let target = history(&m.t_s, &m.a_m_s2);
-    let zero = history(&m.t_s, &p.feasibility.achieved.a_m_s2);
+    let target = history(&m.t_s, &m.a_m_s2, None);
+    let zero = history(&m.t_s, &p.feasibility.achieved.a_m_s2, None);
     let mut whole = Panel::new(
         "Target and achieved, iteration 0 (the target's own command)",
         "t (s)",
@@ -92,7 +93,7 @@ fn acceleration(p: &Plan) -> Figure {
                 patterned("target", target, RECORDED, 1, Dash::Solid),
                 patterned(
                     format!("iteration {k}"),
-                    history(&m.t_s, a),
+                    history(&m.t_s, a, None),
                     SIMULATED,
                     1,
                     Dash::Dashed,
@@ -105,10 +106,7 @@ fn acceleration(p: &Plan) -> Figure {
     // The shaded interval close up (around the target's largest |a|), every trace at its
     // own samples' resolution.
     if let Some(range) = zoom {
-        let close = |y: &[f64]| {
-            let n = m.t_s.len().min(y.len());
-            envelope(&m.t_s[..n], &y[..n], range, BUCKETS)
-        };
+        let close = |y: &[f64]| history(&m.t_s, y, Some(range));
         let mut series = vec![
             patterned("target", close(&m.a_m_s2), RECORDED, 2, Dash::Solid),
             patterned(
