@@ -265,6 +265,12 @@ pub(crate) trait Source<const L: usize> {
     fn admit(&mut self, _y: &mut Y<L>, _t_s: f64) -> bool {
         false
     }
+    /// As [`Plant::stiff_rate`], the source's own states' at the actuators' `strokes`
+    /// (`None`: a bound over every stroke). 0 by default.
+    #[inline(always)]
+    fn stiff_rate(&self, _y: &Y<L>, _strokes: Option<&Strokes>) -> f64 {
+        0.0
+    }
     /// The error scale of the source's own state `i` (`None`: not the source's).
     fn error_scale(&self, _i: usize, _y0: f64, _y1: f64, _rtol: f64, _atol: f64) -> Option<f64> {
         None
@@ -689,6 +695,20 @@ impl<S: Source<L>, const L: usize> Plant<L> for TablePlant<'_, S, L> {
 
     /// The pose (m, rad), its rates and the specimen's are controlled, and the source's own
     /// states by its scales; the gauge and the work are not.
+    /// The source's: its bound over every stroke, and the rate at the actuators' strokes
+    /// (the platen's kinematics taken once more) only where that bound is not resolved by
+    /// the step.
+    fn stiff_rate(&self, y: &Y<L>) -> f64 {
+        let bound = self.source.stiff_rate(y, None);
+        if bound * self.source.step_s() <= 1.0 {
+            return bound;
+        }
+        let (q, qd) = pose(y);
+        let kin = self.table.kinematics(&q, &qd);
+        let (_, strokes) = self.actuators(&[0.0; MAX_TABLE_ACTUATORS], &kin);
+        self.source.stiff_rate(y, Some(&strokes))
+    }
+
     fn error_scale(&self, i: usize, y0: f64, y1: f64, rtol: f64, atol: f64) -> f64 {
         if let Some(scale) = self.source.error_scale(i, y0, y1, rtol, atol) {
             scale

@@ -831,3 +831,69 @@ fn a_stiff_specimen_lowers_the_oil_column_like_a_rigid_payload() {
         .iter()
         .all(|s| s.specimen.is_some() && s.system.is_some()));
 }
+
+/// A loop whose orifice is the stiffest mode (the fuzzing find of issue 38): stiff oil
+/// (10 GPa) in small chambers, four valves, a 1024 Hz controller, and a platen locked by
+/// friction against a command it cannot follow. The valve opens fully and the cap chamber
+/// fills to within the orifice's laminar drop of the supply, where the pressure's own rate
+/// `β/V·K/√p_t` is some 1e5 1/s: at the default step (set by the spool and the oil column,
+/// 3 per period) RK4 is 200 times past its stability bound there and the state used to go
+/// non-finite. The step is now cut to that rate where the state reaches it: the stall force
+/// `A·(P_s − P_R)` within 1e-4 (the locked-platen bound above), the rod chamber at the
+/// return, and pieces only while the stall lasts.
+#[test]
+fn a_stiff_orifice_at_stall_is_integrated_where_the_default_step_would_blow_up() {
+    let mut parts = symmetric_parts(4, 0.0);
+    parts.oil_bulk_modulus_pa = 1e10;
+    parts.supply_pressure_pa = 47e6;
+    parts.controller.sample_rate_hz = 1024.0;
+    parts.controller.displacement_gain_per_m = 100.0;
+    let sys = TableSystem::new(parts, 0.0).unwrap();
+    let model = IdentifiedParams {
+        effective_mass_kg: 20_000.0,
+        stiffness_n_per_m: 0.0,
+        coulomb_force_n: 1e7,
+        viscous_coefficient: 0.0,
+        viscous_exponent: 1.0,
+        low_velocity_force_n: 0.0,
+        low_velocity_decay_s_per_m: 0.0,
+    }
+    .build()
+    .unwrap();
+    let k = sys.default_steps_per_period(20_000.0, 0.3);
+    let h = sys.controller().period_s() / f64::from(k);
+    // The laminar rate of the cap chamber at full opening, the stiffest the law gets.
+    let c = sys.constants();
+    let laminar = 1e10 / 0.012 * c.land_coefficient * c.laminar_slope;
+    println!(
+        "default {k} steps per period: h·λ_laminar = {:.0}",
+        h * laminar
+    );
+    assert!(
+        h * laminar > 100.0,
+        "the case must be far past RK4's bound 2.8"
+    );
+    let cmd = command(1024.0, 0.5, |_| (0.1, 0.0, 0.0));
+    let (s, stats) = run(
+        &model,
+        &sys,
+        &cmd,
+        LoopMethod::Rk4 {
+            steps_per_period: k,
+        },
+        State::default(),
+    );
+    assert_eq!(s.len(), cmd.len());
+    let last = s.last().unwrap();
+    let f = last.terms.actuator_n;
+    let expected = 0.02 * (47e6 - 0.3e6);
+    let rel = (f / expected - 1.0).abs();
+    let system = last.system.unwrap();
+    println!(
+        "stall: {f:.1} N, closed form {expected:.1} N, {rel:.2e}; p_b {:.1} Pa; \
+         {} rhs evaluations for {} grid steps",
+        system.p_b_pa, stats.run.rhs_evaluations, stats.run.steps
+    );
+    assert!(rel < 1e-4, "{f} vs {expected}");
+    assert!((system.p_b_pa - 0.3e6).abs() < 1e-4 * 0.3e6);
+}

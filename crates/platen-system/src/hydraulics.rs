@@ -90,6 +90,112 @@ pub(crate) fn root(dp: f64, c: &HydraulicConstants) -> f64 {
     }
 }
 
+/// The slope of [`root`], `d root/dΔp`, 1/√Pa: `1/(2√|Δp|)` above the laminar drop, the
+/// laminar slope `1/√p_t` below it (the steepest the law gets).
+#[inline(always)]
+pub(crate) fn root_slope(dp: f64, c: &HydraulicConstants) -> f64 {
+    let a = dp.abs();
+    if a >= c.laminar_drop_pa {
+        0.5 / a.sqrt()
+    } else {
+        c.laminar_slope
+    }
+}
+
+/// The orifice conductances `(g_a, g_b)` of a four-way valve at opening `x` (clamped to ±1),
+/// m³/(s·Pa): `|∂q_a/∂p_a|` and `|∂q_b/∂p_b|`, the lands' flows' slopes against their own
+/// chamber's pressure. The land open to the supply is the first for `x ≥ 0`, the second
+/// below.
+#[inline(always)]
+pub(crate) fn four_way_conductances(
+    c: &HydraulicConstants,
+    x: f64,
+    p_a: f64,
+    p_b: f64,
+    p_s: f64,
+    p_r: f64,
+) -> (f64, f64) {
+    let x = x.clamp(-1.0, 1.0);
+    let k = c.land_coefficient * x.abs();
+    if x >= 0.0 {
+        (k * root_slope(p_s - p_a, c), k * root_slope(p_b - p_r, c))
+    } else {
+        (k * root_slope(p_a - p_r, c), k * root_slope(p_s - p_b, c))
+    }
+}
+
+/// The rate at which an accumulator bank's pressure answers its own change, 1/s: the
+/// magnitude of `∂Ṗ/∂P` for `Ṗ = n·P·q/V_g`, with `q` the pump's tapered flow less
+/// `drawn_m3_s` (all actuators) and `g_supply_m3_s_pa` the lands' conductance to the supply
+/// (`∂drawn/∂P`). 0 for a constant supply.
+pub(crate) fn supply_stiffness_1_s(
+    supply: &Supply,
+    set_pa: f64,
+    drawn_m3_s: f64,
+    g_supply_m3_s_pa: f64,
+    oil_m3: f64,
+    p_s: f64,
+) -> f64 {
+    match supply {
+        Supply::Constant => 0.0,
+        Supply::Accumulator(acc) => {
+            let band = 0.01 * set_pa;
+            let taper = ((set_pa - p_s) / band).clamp(0.0, 1.0);
+            let taper_slope = if taper > 0.0 && taper < 1.0 {
+                acc.pump_flow_m3_s / band
+            } else {
+                0.0
+            };
+            let q = acc.pump_flow_m3_s * taper - drawn_m3_s;
+            let gas = (acc.volume_m3 - oil_m3).max(1e-9 * acc.volume_m3);
+            (acc.polytropic_exponent / gas * (q - p_s * (g_supply_m3_s_pa + taper_slope))).abs()
+        }
+    }
+}
+
+impl TableSystem {
+    /// The stiffest local rate of the loop's pressures at platen displacement `u_m` and
+    /// state `s`, 1/s: the largest of `β/V·(g + C_leak)` for either chamber, with `g` the
+    /// conductance of the valve's land to it (`|∂q/∂p|`, the orifice law's slope at the
+    /// land's drop and the spool's opening), and the accumulator's `n·P/V_g` over the lands
+    /// open to it. Near a land's laminar drop at full opening (a chamber pressed to the
+    /// supply or the return by a saturated, unstable loop) this is far faster than the oil
+    /// column: the integrator shortens its steps to it ([`TableSystem::default_steps_per_period`]
+    /// covers the working point only).
+    pub fn pressure_rate_1_s(&self, c: &HydraulicConstants, u_m: f64, s: &HydraulicState) -> f64 {
+        let act = &self.actuator;
+        let (p_a, p_b) = (s.p_a_pa.max(0.0), s.p_b_pa.max(0.0));
+        let p_s = s.supply_pressure_pa;
+        let (g_a, g_b) = four_way_conductances(c, s.spool, p_a, p_b, p_s, self.return_pressure_pa);
+        let (v_a, v_b) = self.chamber_volumes_m3(u_m);
+        let beta = self.oil_bulk_modulus_pa;
+        let leak = act.leakage_m3_s_per_pa;
+        let n = f64::from(act.count);
+        let supply = match self.supply {
+            Supply::Constant => 0.0,
+            Supply::Accumulator(_) => {
+                let (q_a, q_b) = self.valve_flows_with(c, s.spool, p_a, p_b, p_s);
+                let (drawn, g) = if s.spool >= 0.0 {
+                    (q_a, g_a)
+                } else {
+                    (-q_b, g_b)
+                };
+                supply_stiffness_1_s(
+                    &self.supply,
+                    self.supply_pressure_pa,
+                    n * drawn,
+                    n * g,
+                    s.accumulator_oil_m3,
+                    p_s,
+                )
+            }
+        };
+        (beta / v_a * (g_a + leak))
+            .max(beta / v_b * (g_b + leak))
+            .max(supply)
+    }
+}
+
 impl TableSystem {
     /// The supply pressure, Pa, with `oil_m3` in the accumulator (the constant pressure
     /// without one).
@@ -275,5 +381,130 @@ pub(crate) fn supply_rates(
             let gas = (acc.volume_m3 - oil_m3).max(1e-9 * acc.volume_m3);
             (q, acc.polytropic_exponent * p_s * q / gas)
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::preset;
+
+    /// `|∂ṗ/∂p|` of chamber `a`, chamber `b` and the supply by central differences of
+    /// [`TableSystem::hydraulic_rates_with`] (steps of `δ` Pa, inside one branch of the law).
+    fn jacobian_diagonal(sys: &TableSystem, u: f64, s: &HydraulicState, d: f64) -> [f64; 3] {
+        let c = sys.constants();
+        let rates = |s: HydraulicState| sys.hydraulic_rates_with(&c, u, 0.1, 0.0, &s);
+        let da = (rates(HydraulicState {
+            p_a_pa: s.p_a_pa + d,
+            ..*s
+        })
+        .p_a - rates(HydraulicState {
+            p_a_pa: s.p_a_pa - d,
+            ..*s
+        })
+        .p_a)
+            / (2.0 * d);
+        let db = (rates(HydraulicState {
+            p_b_pa: s.p_b_pa + d,
+            ..*s
+        })
+        .p_b - rates(HydraulicState {
+            p_b_pa: s.p_b_pa - d,
+            ..*s
+        })
+        .p_b)
+            / (2.0 * d);
+        let ds = (rates(HydraulicState {
+            supply_pressure_pa: s.supply_pressure_pa + d,
+            ..*s
+        })
+        .supply_pressure
+            - rates(HydraulicState {
+                supply_pressure_pa: s.supply_pressure_pa - d,
+                ..*s
+            })
+            .supply_pressure)
+            / (2.0 * d);
+        [da.abs(), db.abs(), ds.abs()]
+    }
+
+    /// The stiffest pressure rate is the largest diagonal entry of the pressures' Jacobian,
+    /// checked against central differences of the right-hand side itself: at the working
+    /// point (a drop of MPa: some hundred 1/s), near the supply at full opening (a few kPa of
+    /// drop) and inside the laminar drop (the steepest the law gets, `β/V·K/√p_t`, with
+    /// `p_t` 700 Pa on the LHPOST: tens of thousands 1/s, far beyond its 7 steps of 0.14 ms),
+    /// for either sign of the opening, with a constant supply and with the accumulator.
+    /// Bound 1e-6 relative: the differences' truncation and rounding at these steps.
+    #[test]
+    fn the_stiffest_pressure_rate_is_the_jacobians_largest_diagonal_entry() {
+        let bank = preset::lhpost_2008();
+        let mut constant = bank;
+        constant.supply = Supply::Constant;
+        // Inside the pump's taper (its corner at the set pressure has no derivative).
+        let set = bank.supply_pressure_pa;
+        let p_s = set - 0.5e-2 * set;
+        let p_t = LAMINAR_FRACTION * bank.servo_valve.rated_pressure_drop_pa;
+        let oil = bank.charged_oil_m3();
+        for sys in [&bank, &constant] {
+            let cases = [
+                // (u, p_a, p_b, spool, finite-difference step)
+                (0.0, 12e6, 9e6, 0.3, 10.0),
+                (0.2, p_s - 4e3, 1e6, 1.0, 1.0),
+                (-0.5, p_s - 0.3 * p_t, 2e6, 0.9, 0.01),
+                (0.4, 5e6, p_s - 0.5 * p_t, -1.0, 0.01),
+                (0.1, 2e6, 8e6, -0.02, 10.0),
+            ];
+            for (u, p_a, p_b, spool, d) in cases {
+                let s = HydraulicState {
+                    p_a_pa: p_a,
+                    p_b_pa: p_b,
+                    spool,
+                    spool_rate_1_s: 0.0,
+                    accumulator_oil_m3: if sys.supply == Supply::Constant {
+                        0.0
+                    } else {
+                        oil
+                    },
+                    supply_pressure_pa: p_s,
+                };
+                let rate = sys.pressure_rate_1_s(&sys.constants(), u, &s);
+                let fd = jacobian_diagonal(sys, u, &s, d);
+                let expected = fd.iter().copied().fold(0.0, f64::max);
+                if let Supply::Accumulator(_) = sys.supply {
+                    // The bank's own rate, which the chambers' hide, against its difference.
+                    let c = sys.constants();
+                    let r = sys.return_pressure_pa;
+                    let (g_a, g_b) = four_way_conductances(&c, spool, p_a, p_b, p_s, r);
+                    let (q_a, q_b) = sys.valve_flows_with(&c, spool, p_a, p_b, p_s);
+                    let n = f64::from(sys.actuator.count);
+                    let (drawn, g) = if spool >= 0.0 {
+                        (q_a, g_a)
+                    } else {
+                        (-q_b, g_b)
+                    };
+                    let bank = supply_stiffness_1_s(&sys.supply, set, n * drawn, n * g, oil, p_s);
+                    println!("  bank {bank:.6e} 1/s, difference {:.6e}", fd[2]);
+                    assert!((bank / fd[2] - 1.0).abs() < 1e-6, "{bank} vs {}", fd[2]);
+                }
+                println!("u {u}, spool {spool}: {rate:.6e} 1/s, differences {fd:?}");
+                assert!((rate / expected - 1.0).abs() < 1e-6, "{rate} vs {expected}");
+            }
+        }
+        // Inside the laminar drop at full opening: the closed form.
+        let c = constant.constants();
+        let (v_a, _) = constant.chamber_volumes_m3(0.0);
+        let s = HydraulicState {
+            p_a_pa: p_s - 0.5 * p_t,
+            p_b_pa: 1e6,
+            spool: 1.0,
+            spool_rate_1_s: 0.0,
+            accumulator_oil_m3: 0.0,
+            supply_pressure_pa: p_s,
+        };
+        let laminar = constant.oil_bulk_modulus_pa / v_a
+            * (c.land_coefficient / p_t.sqrt() + constant.actuator.leakage_m3_s_per_pa);
+        let rate = constant.pressure_rate_1_s(&c, 0.0, &s);
+        assert!((rate / laminar - 1.0).abs() < 1e-12, "{rate} vs {laminar}");
+        assert!(rate * constant.controller.period_s() / 7.0 > 2.8, "{rate}");
     }
 }

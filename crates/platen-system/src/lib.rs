@@ -80,6 +80,7 @@ pub use params::{
 };
 pub use spool::{SpoolResponse, SpoolWeights};
 pub use table::{
-    ActuatorHydraulics, ActuatorRates, ActuatorState, TableHydraulics, TableHydraulicsParts,
+    ActuatorHydraulics, ActuatorRates, ActuatorState, StiffRate, TableHydraulics,
+    TableHydraulicsParts,
 };
 pub use table_linear::{ActuatorLinearisation, CrossTalk, FlowGains, TableLinearisation};

@@ -27,7 +27,8 @@ use platen_model::multi_axis::{Coords, MultiAxisTable};
 
 use crate::error::{invalid, non_negative, positive, Result, SystemError};
 use crate::hydraulics::{
-    charged_oil_m3, four_way_flows, root, supply_pressure_at, supply_rates, HydraulicConstants,
+    charged_oil_m3, four_way_conductances, four_way_flows, root, root_slope, supply_pressure_at,
+    supply_rates, supply_stiffness_1_s, HydraulicConstants,
 };
 use crate::params::{validate_supply, ServoValve, Supply};
 use crate::spool::SpoolResponse;
@@ -111,6 +112,8 @@ pub struct TableHydraulicsParts {
 pub struct TableHydraulics {
     parts: TableHydraulicsParts,
     constants: Vec<HydraulicConstants>,
+    /// Each actuator's smallest chamber volumes over its stroke `(V_a, V_b)`, m³.
+    smallest_volumes_m3: Vec<(f64, f64)>,
 }
 
 /// One actuator's hydraulic state.
@@ -147,6 +150,18 @@ pub struct ActuatorRates {
     pub leakage_w: f64,
 }
 
+/// An actuator's stiffest local pressure rate and what it draws from the supply
+/// ([`TableHydraulics::pressure_rate_1_s`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StiffRate {
+    /// The stiffest rate of its chambers' pressures, 1/s.
+    pub rate_1_s: f64,
+    /// The flow its valves draw from the supply, m³/s (negative: pushed back).
+    pub drawn_m3_s: f64,
+    /// Its valves' conductance to the supply, `∂drawn/∂P_s`, m³/(s·Pa).
+    pub supply_conductance_m3_s_pa: f64,
+}
+
 impl TableHydraulics {
     /// The hydraulics of `parts` for actuators of strokes `strokes_m` (± from neutral).
     ///
@@ -171,7 +186,20 @@ impl TableHydraulics {
             .iter()
             .map(|a| HydraulicConstants::of_valve(&a.servo_valve))
             .collect();
-        Ok(TableHydraulics { parts, constants })
+        let smallest_volumes_m3 = parts
+            .actuators
+            .iter()
+            .zip(strokes_m)
+            .map(|(a, &stroke)| {
+                let (ends, starts) = (a.chamber_volumes_m3(stroke), a.chamber_volumes_m3(-stroke));
+                (ends.0.min(starts.0), ends.1.min(starts.1))
+            })
+            .collect();
+        Ok(TableHydraulics {
+            parts,
+            constants,
+            smallest_volumes_m3,
+        })
     }
 
     /// Its values.
@@ -372,6 +400,73 @@ impl TableHydraulics {
             power_w: p_a * q_a - p_b * q_b,
             leakage_w: a.leakage_m3_s_per_pa * across * across,
         }
+    }
+
+    /// The stiffest local rate of actuator `i`'s chamber pressures at stroke `s_m` (`None`:
+    /// its smallest chambers over the stroke, a bound over every stroke), state `s` and
+    /// supply pressure `p_s`, 1/s: `β/V·(g + C_leak)` for either chamber, `g` the land's
+    /// `|∂q/∂p|` at its drop and the spool's opening (see
+    /// [`crate::TableSystem::pressure_rate_1_s`]). With the flow its valves draw from the
+    /// supply, m³/s, and their conductance to it, m³/(s·Pa), for
+    /// [`TableHydraulics::supply_rate_1_s`].
+    pub fn pressure_rate_1_s(
+        &self,
+        i: usize,
+        s_m: Option<f64>,
+        s: &ActuatorState,
+        p_s: f64,
+    ) -> StiffRate {
+        let a = &self.parts.actuators[i];
+        let c = &self.constants[i];
+        let p_r = self.parts.return_pressure_pa;
+        let (p_a, p_b) = (s.p_a_pa.max(0.0), s.p_b_pa.max(0.0));
+        let beta = self.parts.oil_bulk_modulus_pa;
+        let leak = a.leakage_m3_s_per_pa;
+        let (v_a, v_b) = s_m.map_or(self.smallest_volumes_m3[i], |s_m| a.chamber_volumes_m3(s_m));
+        let (q_a, q_b) = self.valve_flows_m3_s(i, s.spool, p_a, p_b, p_s);
+        if a.is_single_acting() {
+            let x = s.spool.clamp(-1.0, 1.0);
+            let drop = if x >= 0.0 { p_s - p_a } else { p_a - p_r };
+            let g = c.land_coefficient * x.abs() * root_slope(drop, c);
+            StiffRate {
+                rate_1_s: beta / v_a * (g + leak),
+                drawn_m3_s: q_a,
+                supply_conductance_m3_s_pa: if x > 0.0 { g } else { 0.0 },
+            }
+        } else {
+            let (g_a, g_b) = four_way_conductances(c, s.spool, p_a, p_b, p_s, p_r);
+            let (drawn, g) = if s.spool >= 0.0 {
+                (q_a, g_a)
+            } else {
+                (-q_b, g_b)
+            };
+            StiffRate {
+                rate_1_s: (beta / v_a * (g_a + leak)).max(beta / v_b * (g_b + leak)),
+                drawn_m3_s: drawn,
+                supply_conductance_m3_s_pa: g,
+            }
+        }
+    }
+
+    /// The accumulator's local rate, 1/s (`|∂Ṗ/∂P|`), with the valves drawing `drawn_m3_s`
+    /// from it through a conductance `g_supply_m3_s_pa` (the sums of
+    /// [`TableHydraulics::pressure_rate_1_s`]'s), `oil_m3` in the bank at pressure `p_s`; 0
+    /// for a constant supply.
+    pub fn supply_rate_1_s(
+        &self,
+        drawn_m3_s: f64,
+        g_supply_m3_s_pa: f64,
+        oil_m3: f64,
+        p_s: f64,
+    ) -> f64 {
+        supply_stiffness_1_s(
+            &self.parts.supply,
+            self.parts.supply_pressure_pa,
+            drawn_m3_s,
+            g_supply_m3_s_pa,
+            oil_m3,
+            p_s,
+        )
     }
 
     /// The exact response of actuator `i`'s spool to a held drive (see [`SpoolResponse`]).

@@ -9,9 +9,9 @@ use platen_model::multi_axis::{
     Actuator, Dof, DofSet, LinearSpecimen, Mount, MultiAxisTable, RigidPlaten, TableParts,
 };
 use platen_system::{
-    open_loop, ActuatorHydraulics, Controller, DofController, DofGeometry, FlowGains, Mechanics,
-    ServoValve, Supply, SystemError, TableHydraulics, TableHydraulicsParts, TableLinearisation,
-    TableSystem, TableSystemParts,
+    open_loop, ActuatorHydraulics, ActuatorState, Controller, DofController, DofGeometry,
+    FlowGains, HydraulicState, Mechanics, ServoValve, Supply, SystemError, TableHydraulics,
+    TableHydraulicsParts, TableLinearisation, TableSystem, TableSystemParts,
 };
 
 const MASS_KG: f64 = 30_000.0;
@@ -313,4 +313,87 @@ fn hydraulics_of_another_table_are_refused() {
     let one = TableHydraulics::new(parts, &[0.3]).unwrap();
     let err = TableLinearisation::new(&table, &one, &controller_of(&table), None).unwrap_err();
     assert!(matches!(err, SystemError::Mismatch { .. }), "{err}");
+}
+
+/// A multi-axis actuator's stiffest pressure rate (the step the integrator cuts to near an
+/// orifice's laminar drop) is the largest diagonal entry of its pressures' Jacobian, by
+/// central differences of its own right-hand side: double-acting and single-acting
+/// (a cap chamber alone), either sign of the opening, at the working point and within a
+/// few kPa of the supply or the return. The double-acting one equals the uniaxial loop's
+/// rate with the same values to 1e-12, and the bound over the stroke (`None`) is at least
+/// the rate at any stroke. Bound 1e-6: the differences' truncation and rounding.
+#[test]
+fn the_stiffest_pressure_rate_is_the_jacobians_diagonal_on_a_multi_axis_actuator() {
+    let p_t = platen_system::LAMINAR_FRACTION * valve().rated_pressure_drop_pa;
+    for (cap, rod) in [(0.02, 0.02), (0.02, 0.012), (0.02, 0.0)] {
+        let hyd = hydraulics_of(&x_table(cap, rod));
+        let cases = [
+            (0.0, 12e6, 9e6, 0.3, 10.0),
+            (0.2, SUPPLY_PA - 4e3, 1e6, 1.0, 1.0),
+            (-0.25, SUPPLY_PA - 0.3 * p_t, 2e6, 0.9, 0.01),
+            (0.1, RETURN_PA + 0.4 * p_t, 8e6, -1.0, 0.01),
+            (0.1, 2e6, SUPPLY_PA - 0.5 * p_t, -1.0, 0.01),
+        ];
+        for (s_m, p_a, p_b, spool, d) in cases {
+            let p_b = if rod == 0.0 { RETURN_PA } else { p_b };
+            let state = ActuatorState {
+                p_a_pa: p_a,
+                p_b_pa: p_b,
+                spool,
+                spool_rate_1_s: 0.0,
+            };
+            let rates = |s: ActuatorState| hyd.actuator_rates(0, s_m, 0.05, 0.0, &s, SUPPLY_PA);
+            let fd_a = (rates(ActuatorState {
+                p_a_pa: p_a + d,
+                ..state
+            })
+            .p_a - rates(ActuatorState {
+                p_a_pa: p_a - d,
+                ..state
+            })
+            .p_a)
+                / (2.0 * d);
+            let fd_b = (rates(ActuatorState {
+                p_b_pa: p_b + d,
+                ..state
+            })
+            .p_b - rates(ActuatorState {
+                p_b_pa: p_b - d,
+                ..state
+            })
+            .p_b)
+                / (2.0 * d);
+            let expected = fd_a.abs().max(fd_b.abs());
+            let r = hyd.pressure_rate_1_s(0, Some(s_m), &state, SUPPLY_PA);
+            println!(
+                "cap {cap}, rod {rod}, stroke {s_m}, spool {spool}: {:.6e} 1/s, differences \
+                 {fd_a:.6e} {fd_b:.6e}",
+                r.rate_1_s
+            );
+            assert!(
+                (r.rate_1_s / expected - 1.0).abs() < 1e-6,
+                "{} vs {expected}",
+                r.rate_1_s
+            );
+            let bound = hyd.pressure_rate_1_s(0, None, &state, SUPPLY_PA).rate_1_s;
+            assert!(bound >= r.rate_1_s, "{bound} < {}", r.rate_1_s);
+            if cap == rod {
+                let sys = uniaxial(cap, rod);
+                let h = HydraulicState {
+                    p_a_pa: p_a,
+                    p_b_pa: p_b,
+                    spool,
+                    spool_rate_1_s: 0.0,
+                    accumulator_oil_m3: 0.0,
+                    supply_pressure_pa: SUPPLY_PA,
+                };
+                let uni = sys.pressure_rate_1_s(&sys.constants(), s_m, &h);
+                assert!(
+                    (uni / r.rate_1_s - 1.0).abs() < 1e-12,
+                    "{uni} vs {}",
+                    r.rate_1_s
+                );
+            }
+        }
+    }
 }
