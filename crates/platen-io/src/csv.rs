@@ -481,26 +481,163 @@ pub(crate) fn for_each_row(
 
 /// A time-series CSV written row by row as a run produces it, atomically (see
 /// [`AtomicFile`]): the header at creation, one [`CsvWriter::write_row`] per sample, then
-/// [`CsvWriter::finish`]. Numbers are formatted by [`write_number`], so the bytes are those
-/// [`write_csv_atomic`] writes for the same columns. Dropped unfinished, it removes its
-/// temporary file.
+/// [`CsvWriter::finish`]. Numbers are formatted by [`write_number`]'s formatter, so the bytes
+/// are those [`write_csv_atomic`] writes for the same columns. Dropped unfinished, it removes
+/// its temporary file.
+///
+/// The rows' text is made on threads of their own: [`CsvWriter::write_row`] checks the
+/// values and copies them into a block of [`BLOCK_ROWS`] rows; full blocks are formatted by
+/// two threads side by side and written in order by a third. A run that produces its samples
+/// on one core so pays for its output only what the other core cannot hide (see
+/// `benches/writer.rs` and `docs/performance.md`).
 #[derive(Debug)]
 pub struct CsvWriter {
-    file: AtomicFile,
+    /// The destination, for the messages.
+    path: PathBuf,
     /// The column names, kept for the messages of [`CsvWriter::write_row`].
     header: Vec<String>,
     rows: u64,
-    /// Rows formatted and not yet handed to the file, written in blocks of
-    /// [`WRITE_BLOCK_BYTES`] (allocated once).
-    text: Vec<u8>,
-    number: NumberBuffer,
+    /// Values of the rows not yet handed to the formatter, row after row.
+    block: Vec<f64>,
+    /// The thread that formats and writes (`None` once finished or failed).
+    worker: Option<Worker>,
 }
 
-/// The formatted text [`CsvWriter`] gathers before one write to its file, bytes.
-const WRITE_BLOCK_BYTES: usize = 1 << 20;
+/// Rows [`CsvWriter`] gathers before handing them to its formatting thread.
+pub const BLOCK_ROWS: usize = 4096;
+
+/// Blocks that may wait for a formatting thread (a run faster than its formatting waits
+/// there, with this much memory held).
+const BLOCKS_IN_FLIGHT: usize = 4;
+
+/// Threads that format blocks side by side (their texts are written in the rows' order): two,
+/// so that on a 2-core machine the formatting uses the core the run leaves idle while it waits.
+const FORMATTERS: usize = 2;
+
+/// [`CsvWriter`]'s threads: [`FORMATTERS`] that turn numbered blocks of values into text, and
+/// one that writes the texts to the file in the blocks' order and ends with the file (to
+/// commit) or the first write error. Emptied blocks come back for reuse.
+#[derive(Debug)]
+struct Worker {
+    blocks: std::sync::mpsc::SyncSender<(u64, Vec<f64>)>,
+    emptied: std::sync::mpsc::Receiver<Vec<f64>>,
+    formatters: Vec<std::thread::JoinHandle<()>>,
+    writer: std::thread::JoinHandle<Result<AtomicFile>>,
+    /// The next block's number.
+    next: u64,
+}
+
+impl Worker {
+    /// Starts the threads on `file` for rows of `width` values.
+    fn start(mut file: AtomicFile, width: usize) -> Self {
+        use std::sync::mpsc::{channel, sync_channel};
+        use std::sync::{Arc, Mutex};
+        let (blocks, incoming) = sync_channel::<(u64, Vec<f64>)>(BLOCKS_IN_FLIGHT);
+        let incoming = Arc::new(Mutex::new(incoming));
+        let (give_back, emptied) = channel::<Vec<f64>>();
+        let (texts, formatted) = channel::<(u64, Vec<u8>)>();
+        // Written texts come back to be filled again (fresh buffers would cost page faults).
+        let (written, reusable) = channel::<Vec<u8>>();
+        let reusable = Arc::new(Mutex::new(reusable));
+        let formatters = (0..FORMATTERS)
+            .map(|_| {
+                let (incoming, give_back, texts, reusable) = (
+                    Arc::clone(&incoming),
+                    give_back.clone(),
+                    texts.clone(),
+                    Arc::clone(&reusable),
+                );
+                std::thread::spawn(move || {
+                    let mut number = NumberBuffer::new();
+                    loop {
+                        // The lock is held only to take the next block.
+                        let next = incoming.lock().map(|queue| queue.recv());
+                        let Ok(Ok((seq, mut block))) = next else {
+                            return;
+                        };
+                        let mut text = reusable
+                            .lock()
+                            .ok()
+                            .and_then(|r| r.try_recv().ok())
+                            .unwrap_or_else(|| Vec::with_capacity(block.len() * 24));
+                        for row in block.chunks_exact(width.max(1)) {
+                            for (j, &value) in row.iter().enumerate() {
+                                if j > 0 {
+                                    text.push(b',');
+                                }
+                                format_number(&mut number, &mut text, value);
+                            }
+                            text.push(b'\n');
+                        }
+                        block.clear();
+                        // The writer may be gone (dropped unfinished): nothing to give back to.
+                        let _ = give_back.send(block);
+                        if texts.send((seq, text)).is_err() {
+                            return;
+                        }
+                    }
+                })
+            })
+            .collect();
+        drop(texts);
+        let writer = std::thread::spawn(move || {
+            let mut waiting = std::collections::BTreeMap::new();
+            let mut due = 0u64;
+            for (seq, text) in formatted {
+                waiting.insert(seq, text);
+                while let Some(mut text) = waiting.remove(&due) {
+                    write_text(&mut file, &mut text)?;
+                    let _ = written.send(text);
+                    due += 1;
+                }
+            }
+            Ok(file)
+        });
+        Self {
+            blocks,
+            emptied,
+            formatters,
+            writer,
+            next: 0,
+        }
+    }
+
+    /// Queues `block` for formatting; `false` when the threads have stopped (a write error).
+    fn send(&mut self, block: Vec<f64>) -> bool {
+        let seq = self.next;
+        self.next += 1;
+        self.blocks.send((seq, block)).is_ok()
+    }
+
+    /// Waits for the threads to end (the queue closed) and returns what the writing thread
+    /// ended with.
+    fn join(self, path: &Path) -> Result<AtomicFile> {
+        drop(self.blocks);
+        let panicked = || {
+            Err(write_error(
+                path,
+                io::Error::other("a CSV formatting thread panicked"),
+            ))
+        };
+        for formatter in self.formatters {
+            if formatter.join().is_err() {
+                return panicked();
+            }
+        }
+        self.writer.join().unwrap_or_else(|_| panicked())
+    }
+}
+
+/// Hands the gathered `text` to `file` (a write this large bypasses its buffer).
+fn write_text(file: &mut AtomicFile, text: &mut Vec<u8>) -> Result<()> {
+    let written = file.writer().write_all(text);
+    text.clear();
+    written.map_err(|source| write_error(file.path(), source))
+}
 
 impl CsvWriter {
-    /// Creates the temporary file next to `path` and writes the header.
+    /// Creates the temporary file next to `path`, writes the header and starts the
+    /// formatting thread.
     ///
     /// # Errors
     /// [`InvalidColumnName`](IoError::InvalidColumnName) for a name that is empty or needs
@@ -518,58 +655,94 @@ impl CsvWriter {
         out.write_all(header.join(",").as_bytes())
             .and_then(|()| out.write_all(b"\n"))
             .map_err(|source| write_error(path, source))?;
+        let width = header.len();
         Ok(Self {
-            file,
+            path: path.to_path_buf(),
             header,
             rows: 0,
-            text: Vec::with_capacity(WRITE_BLOCK_BYTES + 64 * 32),
-            number: NumberBuffer::new(),
+            block: Vec::with_capacity(BLOCK_ROWS * width),
+            worker: Some(Worker::start(file, width)),
         })
     }
 
-    /// Writes one row, `values[j]` under `header[j]`. Rows are gathered in memory and
-    /// written to the file a megabyte at a time.
+    /// Writes one row, `values[j]` under `header[j]`. Rows are gathered in blocks and
+    /// formatted and written by the writer's own thread.
     ///
     /// # Errors
     /// [`NonFinite`](IoError::NonFinite) naming the line the value would have had, or
-    /// [`IoError::Io`] for a failed write (of this row or of rows gathered before it).
+    /// [`IoError::Io`] for a failed write (of rows gathered before this one); after an error
+    /// the writer takes no more rows.
     pub fn write_row(&mut self, values: &[f64]) -> Result<()> {
         if let Some(j) = values.iter().position(|v| !v.is_finite()) {
             return Err(IoError::NonFinite {
-                path: self.file.path().to_path_buf(),
+                path: self.path.clone(),
                 line: self.rows + 2,
                 column: self.header[j].to_owned(),
                 value: values[j].to_string(),
             });
         }
-        for (j, &value) in values.iter().enumerate() {
-            if j > 0 {
-                self.text.push(b',');
-            }
-            format_number(&mut self.number, &mut self.text, value);
-        }
-        self.text.push(b'\n');
+        debug_assert_eq!(values.len(), self.header.len());
+        self.block.extend_from_slice(values);
         self.rows += 1;
-        if self.text.len() >= WRITE_BLOCK_BYTES {
-            self.write_text()?;
+        if self.block.len() >= BLOCK_ROWS * self.header.len() {
+            self.hand_over()?;
         }
         Ok(())
     }
 
-    /// Hands the gathered text to the file (a write this large bypasses its buffer).
-    fn write_text(&mut self) -> Result<()> {
-        let written = self.file.writer().write_all(&self.text);
-        self.text.clear();
-        written.map_err(|source| write_error(self.file.path(), source))
+    /// Hands the gathered block to the formatting thread and takes an emptied one back (or a
+    /// new one while the first blocks are in flight).
+    fn hand_over(&mut self) -> Result<()> {
+        let Some(worker) = self.worker.as_ref() else {
+            return Err(write_error(
+                &self.path,
+                io::Error::other("the output was not written: an earlier write failed"),
+            ));
+        };
+        let next = worker
+            .emptied
+            .try_recv()
+            .unwrap_or_else(|_| Vec::with_capacity(self.block.capacity()));
+        let full = std::mem::replace(&mut self.block, next);
+        if !self.worker.as_mut().expect("checked above").send(full) {
+            // The thread stopped at a write error: report it.
+            let worker = self.worker.take().expect("checked above");
+            return match worker.join(&self.path) {
+                Err(error) => Err(error),
+                Ok(_) => Err(write_error(
+                    &self.path,
+                    io::Error::other("the CSV formatting thread stopped"),
+                )),
+            };
+        }
+        Ok(())
     }
 
-    /// Flushes and syncs the file and renames it over the destination.
+    /// Formats and writes the last rows, flushes and syncs the file and renames it over the
+    /// destination.
     ///
     /// # Errors
-    /// As [`AtomicFile::commit`].
+    /// A write error met on the way, or as [`AtomicFile::commit`].
     pub fn finish(mut self) -> Result<()> {
-        self.write_text()?;
-        self.file.commit()
+        if !self.block.is_empty() {
+            self.hand_over()?;
+        }
+        let worker = self.worker.take().ok_or_else(|| {
+            write_error(
+                &self.path,
+                io::Error::other("the output was not written: an earlier write failed"),
+            )
+        })?;
+        worker.join(&self.path)?.commit()
+    }
+}
+
+impl Drop for CsvWriter {
+    /// Unfinished: stops the thread, whose file is then dropped and its temporary removed.
+    fn drop(&mut self) {
+        if let Some(worker) = self.worker.take() {
+            let _ = worker.join(&self.path);
+        }
     }
 }
 
