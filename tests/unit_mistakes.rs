@@ -329,3 +329,117 @@ fn a_supply_pressure_in_mpa_or_far_beyond_any_table_is_refused_as_such() {
         assert!(!e.contains("return_pressure_pa"), "{value}: {e}");
     }
 }
+
+/// A time column declared in ms whose values are seconds (the issue 38 case: 5121 samples
+/// over "0.020 s", a 256 kHz record) is refused before any work by every reader that maps
+/// columns: `simulate`'s force record and `plan`'s target, with the rate it would read at,
+/// the unit declared, and the map that reads it as seconds. The same file mapped in seconds
+/// runs.
+#[test]
+fn a_time_in_seconds_declared_as_ms_is_refused_by_simulate_and_plan() {
+    let dir = tempfile::tempdir().unwrap();
+    // 20 s at 256 Hz: declared ms, it reads as 5121 samples over 0.02 s (256 kHz).
+    let mut text = String::from("Time,F,Acc\n");
+    for i in 0..=5120 {
+        let t = i as f64 / 256.0;
+        let s = (std::f64::consts::PI * t).sin();
+        text.push_str(&format!("{t},{},{}\n", 200e3 * s, 0.1 * s));
+    }
+    write(dir.path(), "rec.csv", &text);
+    let scenario = |unit: &str| {
+        format!(
+            r#"{{"model": {{"preset": "lhpost-2008"}},
+                 "excitation": {{"force_csv": "rec.csv",
+                                 "columns": {{"t_s": {{"name": "Time", "unit": "{unit}"}},
+                                             "force_n": {{"name": "F"}}}}}}}}"#
+        )
+    };
+    let ms = write(dir.path(), "ms.json", &scenario("ms"));
+    let out = dir.path().join("out.csv");
+    let o = platen(&["simulate", &ms, "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    let err = stderr(&o);
+    for part in [
+        "rec.csv",
+        "column t_s: 5121 samples over 0.02 s",
+        "2.5600e5 Hz",
+        "declared as ms",
+        r#""t_s": {"unit": "s"}"#,
+        "(a rate of 256.0000 Hz)",
+    ] {
+        assert!(err.contains(part), "{part:?} not in {err}");
+    }
+    assert!(!out.exists() && o.stdout.is_empty());
+    let s = write(dir.path(), "s.json", &scenario("s"));
+    let o = platen(&["simulate", &s]);
+    assert!(o.status.success(), "{}", stderr(&o));
+
+    // The same slip in a plan's target (acceleration in g, time declared ms).
+    let map = |unit: &str| {
+        format!(
+            r#"{{"t_s": {{"name": "Time", "unit": "{unit}"}}, "a_m_s2": {{"name": "Acc", "unit": "g"}}}}"#
+        )
+    };
+    write(dir.path(), "ms-map.json", &map("ms"));
+    let drive = dir.path().join("drive.csv");
+    let o = platen(&[
+        "plan",
+        "scenarios/table-system/wn10g-closed-loop.json",
+        "--target",
+        dir.path().join("rec.csv").to_str().unwrap(),
+        "--columns",
+        dir.path().join("ms-map.json").to_str().unwrap(),
+        "--out",
+        drive.to_str().unwrap(),
+    ]);
+    assert_ne!(o.status.code(), Some(0), "{}", stderr(&o));
+    let err = stderr(&o);
+    for part in [
+        "rec.csv",
+        "2.5600e5 Hz",
+        "declared as ms",
+        r#""t_s": {"unit": "s"}"#,
+    ] {
+        assert!(err.contains(part), "{part:?} not in {err}");
+    }
+    assert!(!drive.exists());
+}
+
+/// A displacement target written in mm under `u_m` (a 195 mm peak read as 195 m, 260 times
+/// the LHPOST's stroke) is refused by `plan` with the hint `simulate` gives for the same
+/// record, not planned.
+#[test]
+fn a_displacement_target_in_mm_read_as_m_is_refused_by_plan_with_the_mm_hint() {
+    let dir = tempfile::tempdir().unwrap();
+    // 195 mm of a 0.5 Hz sine at 100 Hz for 8 s, written in mm under u_m.
+    let mut text = String::from("t_s,u_m\n");
+    for i in 0..=800 {
+        let t = i as f64 * 0.01;
+        text.push_str(&format!(
+            "{t},{}\n",
+            195.0 * (std::f64::consts::PI * t).sin()
+        ));
+    }
+    write(dir.path(), "target.csv", &text);
+    let drive = dir.path().join("drive.csv");
+    let o = platen(&[
+        "plan",
+        "scenarios/table-system/wn10g-closed-loop.json",
+        "--target",
+        dir.path().join("target.csv").to_str().unwrap(),
+        "--out",
+        drive.to_str().unwrap(),
+    ]);
+    assert_ne!(o.status.code(), Some(0), "{}", stderr(&o));
+    let err = stderr(&o);
+    for part in [
+        "target.csv",
+        "column u_m",
+        "times the table's stroke of ±0.75 m",
+        "mm read as m",
+        r#""u_m": {"unit": "mm"}"#,
+    ] {
+        assert!(err.contains(part), "{part:?} not in {err}");
+    }
+    assert!(!drive.exists() && o.stdout.is_empty());
+}

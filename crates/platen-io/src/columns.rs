@@ -505,6 +505,9 @@ impl ColumnMap {
                 None => table.rename_with(ours, ours, |_| ()),
             }
         }
+        if let Some(t) = table.column("t_s") {
+            check_record_rate(path, t, self.factor("t_s"))?;
+        }
         Ok(table)
     }
 
@@ -645,6 +648,58 @@ impl ColumnMap {
     pub fn delay_s(&self, ours: &str) -> Option<f64> {
         self.entries.get(ours).and_then(|m| m.delay_s)
     }
+}
+
+/// The fastest sample rate a record is read at, Hz: ten times the 10 kHz of a fast
+/// shake-table controller or data system. A time column faster than this is a unit slip
+/// (seconds declared as ms give a thousand times the rate).
+pub const MAX_RECORD_RATE_HZ: f64 = 100e3;
+
+/// Refuses a time column `t_s` (s, increasing) whose mean sample rate is above
+/// [`MAX_RECORD_RATE_HZ`], naming what it reads as and the likely slip: the file's time
+/// unit (`factor_to_s`, 1e-3 for `ms`) applied to values that are already seconds.
+///
+/// # Errors
+/// [`IoError::Record`] naming `path`, the samples, span and rate, and the map that reads
+/// the time as seconds.
+pub fn check_record_rate(path: &Path, t_s: &[f64], factor_to_s: f64) -> Result<()> {
+    let (Some(first), Some(last)) = (t_s.first(), t_s.last()) else {
+        return Ok(());
+    };
+    let span = last - first;
+    if t_s.len() < 2 || span.is_nan() || span <= 0.0 {
+        return Ok(());
+    }
+    let rate = (t_s.len() - 1) as f64 / span;
+    if rate <= MAX_RECORD_RATE_HZ {
+        return Ok(());
+    }
+    let slip = if factor_to_s < 1.0 {
+        let unit = if factor_to_s == 1e-3 {
+            "ms".to_owned()
+        } else {
+            format!("{factor_to_s} s")
+        };
+        format!(
+            "Its unit is declared as {unit}: are its values seconds already? Then map it \
+             \"columns\": {{\"t_s\": {{\"unit\": \"s\"}}}} (a rate of {:.4} Hz)",
+            rate * factor_to_s
+        )
+    } else {
+        "Is the time in another unit than seconds (samples, µs)? Map its unit, e.g. \
+         \"columns\": {\"t_s\": {\"unit\": \"ms\"}}"
+            .to_owned()
+    };
+    Err(IoError::Record {
+        path: path.to_owned(),
+        message: format!(
+            "column t_s: {} samples over {} s, a sample rate of {:.4e} Hz, beyond any \
+             shake-table record (at most {MAX_RECORD_RATE_HZ:e} Hz is read). {slip}",
+            t_s.len(),
+            span,
+            rate
+        ),
+    })
 }
 
 enum UnitKind {

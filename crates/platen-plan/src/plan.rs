@@ -249,6 +249,16 @@ fn target_warnings(motion: &TargetMotion) -> Vec<String> {
 /// one is resampled by [`plan_table`] first), not zero.
 fn target_motion(table: &Table, target: &Target, settings: &PlanSettings) -> Result<TargetMotion> {
     let controller_hz = table.controller_rate_hz();
+    if target.kind() == crate::target::TargetKind::Displacement {
+        // Beyond ten strokes no table reading exists (mm read as m): refused with the hint
+        // `simulate` gives for the same record.
+        platen_scenario::units::check_displacement_record(
+            target.origin(),
+            target.t_s(),
+            target.values(),
+            table.rig().limits.stroke_m,
+        )?;
+    }
     let motion = TargetMotion::new(
         target,
         &settings.baseline,

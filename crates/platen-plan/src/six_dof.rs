@@ -158,6 +158,7 @@ impl AxisTargets {
         let t_s = table.take_column("t_s").unwrap_or_default();
         // The file's own checks first, so that they name the file and line.
         crate::target::checked_times(path, &t_s)?;
+        platen_io::columns::check_record_rate(path, &t_s, 1.0)?;
         let mut axes: [Option<Target>; 3] = [None, None, None];
         for (k, axis) in axes.iter_mut().enumerate() {
             *axis = match (
