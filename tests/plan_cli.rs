@@ -127,6 +127,12 @@ fn the_drive_replayed_by_simulate_is_the_run_the_plan_reports() {
     let best = achieved["acceleration_nrmse"].as_f64().unwrap();
     assert!(best < 0.5 * first, "{first} → {best}");
     assert_eq!(p["drive"]["out"], drive.to_str().unwrap());
+    // The response-spectrum acceptance: the band, and a verdict that agrees with its list.
+    let acceptance = &p["drive"]["spectrum_acceptance"];
+    assert_eq!(acceptance["band"], json!([-0.1, 0.3]));
+    assert_eq!(acceptance["count"], 50);
+    let outside = acceptance["outside"].as_array().unwrap();
+    assert_eq!(acceptance["within"].as_bool().unwrap(), outside.is_empty());
 
     // The drive: t_s, u_m at 1024 Hz.
     let text = fs::read_to_string(&drive).unwrap();

@@ -606,6 +606,22 @@ impl SpectrumCheck {
         Ok(Self { spectrum, target })
     }
 
+    /// The periods where the achieved spectrum's ratio to the target's is outside
+    /// `1 + band.0 … 1 + band.1` (a period whose target spectrum is 0 is left out).
+    pub(crate) fn outside(&self, achieved_a: &[f64], band: (f64, f64)) -> Vec<SpectrumMiss> {
+        let psa = self.spectrum.pseudo_acceleration_m_s2(achieved_a);
+        psa.iter()
+            .zip(&self.target)
+            .zip(self.spectrum.oscillators())
+            .filter(|((_, t), _)| **t > 0.0)
+            .map(|((p, t), o)| SpectrumMiss {
+                period_s: o.period_s(),
+                ratio: p / t,
+            })
+            .filter(|m| !(1.0 + band.0..=1.0 + band.1).contains(&m.ratio))
+            .collect()
+    }
+
     /// The largest relative error and its period.
     pub(crate) fn error(&self, achieved_a: &[f64]) -> (f64, f64) {
         let psa = self.spectrum.pseudo_acceleration_m_s2(achieved_a);
@@ -622,6 +638,63 @@ impl SpectrumCheck {
         }
         worst
     }
+}
+
+/// The band of a response-spectrum acceptance check, as fractions of the required
+/// spectrum: −10 % / +30 %, the tolerance AC156-style qualification tests put on the test
+/// response spectrum against the required one.
+pub const ACCEPTANCE_BAND: (f64, f64) = (-0.10, 0.30);
+
+/// A response-spectrum acceptance check of an achieved acceleration against the target's
+/// spectrum taken as the required one (RRS): the periods where the achieved spectrum falls
+/// outside the band.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SpectrumAcceptance {
+    /// Damping ratio of the spectra.
+    pub damping_ratio: f64,
+    /// Shortest and longest period checked, s.
+    pub periods_s: (f64, f64),
+    /// Periods checked (evenly spaced in logarithm).
+    pub count: usize,
+    /// The band, fractions of the required spectrum (`(-0.1, 0.3)`: 90 % to 130 %).
+    pub band: (f64, f64),
+    /// Whether the achieved spectrum is inside the band at every period.
+    pub within: bool,
+    /// The periods outside the band, shortest first.
+    pub outside: Vec<SpectrumMiss>,
+}
+
+/// One period where an achieved spectrum is outside its acceptance band.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SpectrumMiss {
+    /// The period, s.
+    pub period_s: f64,
+    /// Achieved over required pseudo-acceleration.
+    pub ratio: f64,
+}
+
+/// The acceptance check of `achieved_a` against `target_a` (both at `sample_rate_hz`) on the
+/// spectrum of `settings`, with the band `band`.
+///
+/// # Errors
+/// Bad spectrum settings.
+pub fn spectrum_acceptance(
+    settings: &SpectrumSettings,
+    sample_rate_hz: f64,
+    target_a: &[f64],
+    achieved_a: &[f64],
+    band: (f64, f64),
+) -> Result<SpectrumAcceptance> {
+    let check = SpectrumCheck::new(settings, sample_rate_hz, target_a)?;
+    let outside = check.outside(achieved_a, band);
+    Ok(SpectrumAcceptance {
+        damping_ratio: settings.damping_ratio,
+        periods_s: settings.periods_s,
+        count: settings.count,
+        band,
+        within: outside.is_empty(),
+        outside,
+    })
 }
 
 /// Iterates the drive for `motion` on `table` (see the [module documentation](self)).
@@ -887,6 +960,44 @@ fn stall_reason<R: Response>(r: &R, in_band_fraction: f64, band_hz: (f64, f64)) 
 
 #[cfg(test)]
 mod tests {
+
+    /// The acceptance check against an independent truth: response spectra are linear in
+    /// the record, so an achieved acceleration `c` times the target's has the ratio `c` at
+    /// every period (to rounding, 1e-12). 0.91, 1.2 and 1.29 are inside −10/+30 %, 0.85 and 1.35
+    /// outside at all 50 periods; a record whose short-period content alone is doubled is
+    /// outside only at the short periods.
+    #[test]
+    fn the_spectrum_acceptance_check_finds_the_periods_outside_its_band() {
+        let fs = 200.0;
+        let n = 4000;
+        let wave = |t: f64, hf: f64| {
+            (std::f64::consts::TAU * 1.3 * t).sin() + hf * (std::f64::consts::TAU * 15.0 * t).sin()
+        };
+        let target: Vec<f64> = (0..n).map(|i| wave(i as f64 / fs, 0.3)).collect();
+        let settings = SpectrumSettings::default();
+        for (c, within) in [
+            (1.2, true),
+            (0.91, true),
+            (1.29, true),
+            (0.85, false),
+            (1.35, false),
+        ] {
+            let achieved: Vec<f64> = target.iter().map(|a| c * a).collect();
+            let r =
+                spectrum_acceptance(&settings, fs, &target, &achieved, ACCEPTANCE_BAND).unwrap();
+            assert_eq!(r.within, within, "{c}");
+            assert_eq!(r.outside.len(), if within { 0 } else { 50 }, "{c}");
+            for m in &r.outside {
+                assert!((m.ratio - c).abs() < 1e-12, "{c}: {m:?}");
+            }
+        }
+        let achieved: Vec<f64> = (0..n).map(|i| wave(i as f64 / fs, 0.9)).collect();
+        let r = spectrum_acceptance(&settings, fs, &target, &achieved, ACCEPTANCE_BAND).unwrap();
+        assert!(!r.within && !r.outside.is_empty() && r.outside.len() < 50);
+        println!("short periods outside: {:?}", r.outside);
+        assert!(r.outside.iter().all(|m| m.period_s < 0.3 && m.ratio > 1.3));
+        assert!(r.outside.windows(2).all(|w| w[0].period_s < w[1].period_s));
+    }
     use super::*;
 
     #[test]

@@ -89,8 +89,8 @@ pub use feasibility::{
 };
 pub use frf::{FrequencyResponse, FrfSource, NoiseSettings};
 pub use iterate::{
-    iterate, iterate_observed, iterate_with, Iteration, IterationRecord, IterationSettings,
-    Response, Stop,
+    iterate, iterate_observed, iterate_with, spectrum_acceptance, Iteration, IterationRecord,
+    IterationSettings, Response, SpectrumAcceptance, SpectrumMiss, Stop, ACCEPTANCE_BAND,
 };
 pub use mimo::{
     iterate_mimo, AxisRecord, AxisTarget, MimoCorrection, MimoIteration, MimoRecord, MimoResponse,

@@ -14,7 +14,10 @@ use crate::feasibility::{
     failing, feasibility, limit_uses, limits_summary, Feasibility, LimitUse, MaxScale,
     MaxScaleSettings,
 };
-use crate::iterate::{iterate_observed, IterationRecord, IterationSettings, Stop};
+use crate::iterate::{
+    iterate_observed, spectrum_acceptance, IterationRecord, IterationSettings, Response,
+    SpectrumAcceptance, Stop, ACCEPTANCE_BAND,
+};
 use crate::table::{Achieved, Table};
 use crate::target::Target;
 use crate::Iteration;
@@ -76,6 +79,9 @@ pub struct PlannedDrive {
     pub limits: LimitsSummary,
     /// Where `Ĥ` came from, its measured band and mean coherence.
     pub frf: FrfSummary,
+    /// The best drive's achieved response spectrum against the target's
+    /// ([`crate::iterate::ACCEPTANCE_BAND`]).
+    pub spectrum_acceptance: SpectrumAcceptance,
 }
 
 impl Plan {
@@ -327,9 +333,30 @@ fn planned_drive(
              run"
         ));
     }
+    let spectrum_acceptance = spectrum_acceptance(
+        &settings.spectrum,
+        1.0 / motion.interval_s(),
+        &motion.a_m_s2,
+        iteration.achieved.a_m_s2(),
+        ACCEPTANCE_BAND,
+    )?;
+    if !spectrum_acceptance.within {
+        let miss = &spectrum_acceptance.outside;
+        let (lo, hi) = (miss[0].period_s, miss[miss.len() - 1].period_s);
+        warnings.push(format!(
+            "the drive's achieved response spectrum ({:.0} % damped) is outside \
+             {:+.0}/{:+.0} % of the target's at {} of {} periods, from {lo:.3} to {hi:.3} s",
+            100.0 * spectrum_acceptance.damping_ratio,
+            100.0 * ACCEPTANCE_BAND.0,
+            100.0 * ACCEPTANCE_BAND.1,
+            miss.len(),
+            spectrum_acceptance.count
+        ));
+    }
     Ok(PlannedDrive {
         limits: limits_summary(table, &iteration.achieved),
         frf: FrfSummary::new(settings, &iteration),
+        spectrum_acceptance,
         uses,
         iteration,
     })
@@ -469,6 +496,8 @@ pub struct DriveSummary {
     pub limits: LimitsSummary,
     /// The limits the drive's run exceeds, worst first.
     pub limiting: Vec<LimitUse>,
+    /// Its achieved response spectrum against the target's as the required one.
+    pub spectrum_acceptance: SpectrumAcceptance,
 }
 
 impl Plan {
@@ -521,6 +550,7 @@ impl Plan {
                     run_peak_force_n: p.force_n.value,
                     limits: d.limits.clone(),
                     limiting: failing(&d.uses),
+                    spectrum_acceptance: d.spectrum_acceptance.clone(),
                 }
             }),
             warnings: self.warnings.clone(),
