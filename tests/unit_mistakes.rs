@@ -443,3 +443,63 @@ fn a_displacement_target_in_mm_read_as_m_is_refused_by_plan_with_the_mm_hint() {
     }
     assert!(!drive.exists() && o.stdout.is_empty());
 }
+
+/// A bulk modulus or a chamber volume in the wrong unit is refused with what it looks like:
+/// 1.5 (GPa) and 1500 (MPa) as Pa, 1e24 beyond any oil; a chamber of 212.2 "m³" (litres).
+/// The preset's own values run. (The multi-axis tables' actuators go through the same check,
+/// `platen_system::PLAUSIBLE_CHAMBER_M3`.)
+#[test]
+fn a_bulk_modulus_or_a_chamber_volume_in_another_unit_is_refused_as_such() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        (
+            r#""oil_bulk_modulus_pa": 1.5"#,
+            "table_system.oil_bulk_modulus_pa",
+            "1.5 looks like GPa, which is 1.5e9 Pa",
+        ),
+        (
+            r#""oil_bulk_modulus_pa": 1500"#,
+            "table_system.oil_bulk_modulus_pa",
+            "1500 looks like MPa, which is 1500e6 Pa",
+        ),
+        (
+            r#""oil_bulk_modulus_pa": 1e24"#,
+            "table_system.oil_bulk_modulus_pa",
+            "stiffer than any oil",
+        ),
+        (
+            r#""actuator": {"chamber_volume_m3": 212.2}"#,
+            "table_system.actuator.chamber_volume_m3",
+            "212.2 looks like litres, which is 0.2122 m³",
+        ),
+    ];
+    for (i, (value, path, says)) in cases.into_iter().enumerate() {
+        let file = dir.path().join(format!("case-{i}.json"));
+        std::fs::write(
+            &file,
+            format!(
+                r#"{{"model": {{"preset": "lhpost-2008"}},
+                    "table_system": {{"preset": "lhpost-2008", {value}}},
+                    "excitation": {{"sine_motion": {{"amplitude_m": 0.02, "frequency_hz": 1.0}}}},
+                    "duration_s": 0.5}}"#
+            ),
+        )
+        .unwrap();
+        let o = platen(&["simulate", file.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(3), "{value}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains(path) && e.contains(says), "{value}: {e}");
+    }
+    let fine = dir.path().join("fine.json");
+    std::fs::write(
+        &fine,
+        r#"{"model": {"preset": "lhpost-2008"},
+            "table_system": {"preset": "lhpost-2008", "oil_bulk_modulus_pa": 1.5e9,
+                             "actuator": {"chamber_volume_m3": 0.2122}},
+            "excitation": {"sine_motion": {"amplitude_m": 0.02, "frequency_hz": 1.0}},
+            "duration_s": 0.5}"#,
+    )
+    .unwrap();
+    let o = platen(&["simulate", fine.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}

@@ -903,11 +903,11 @@ fn a_loop_too_fast_for_rk4_is_refused_instead_of_run_at_a_clamped_step() {
     // Dopri5 takes it.
     let dopri = with(fast_valve, "integrator", json!({"method": "dopri5"}));
     assert!(load(&dopri).unwrap().rig.table_system.is_some());
-    // An oil column that stiff (β = 1e24 Pa) is refused under `table_system`.
+    // Oil that stiff (β = 1e24 Pa) is refused as no oil, before the step is chosen.
     refused(
         &scenario_with(lhpost(json!({"oil_bulk_modulus_pa": 1e24}))),
-        "table_system",
-        "a loop RK4 can resolve",
+        "table_system.oil_bulk_modulus_pa",
+        "is stiffer than any oil",
     );
     // 100 MHz still fits in 1e6 steps per period (h·ω = 0.61).
     let s = scenario_with(lhpost(

@@ -76,7 +76,7 @@ pub use hydraulics::{HydraulicConstants, HydraulicRates, HydraulicState, LAMINAR
 pub use linear::{Capacities, Linearisation, Margins, Mechanics, Passband, SECANT_SPEED_M_S};
 pub use params::{
     Accumulator, Actuator, Controller, ServoValve, Supply, TableSystem, TableSystemParts,
-    PLAUSIBLE_SUPPLY_PA,
+    PLAUSIBLE_BULK_MODULUS_PA, PLAUSIBLE_CHAMBER_M3, PLAUSIBLE_SUPPLY_PA,
 };
 pub use spool::{SpoolResponse, SpoolWeights};
 pub use table::{

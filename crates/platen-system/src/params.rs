@@ -111,6 +111,8 @@ impl Actuator {
         positive("actuator.rod_side_area_m2", a.rod_area_m2)?;
         positive("actuator.chamber_volume_m3", a.cap_volume_m3)?;
         positive("actuator.chamber_volume_m3", a.rod_volume_m3)?;
+        plausible_chamber("actuator.chamber_volume_m3", a.cap_volume_m3)?;
+        plausible_chamber("actuator.chamber_volume_m3", a.rod_volume_m3)?;
         non_negative("actuator.leakage_m3_s_per_pa", a.leakage_m3_s_per_pa)?;
         if stroke_m.is_finite() && stroke_m > 0.0 {
             let left_a = a.cap_volume_m3 - a.cap_area_m2 * stroke_m;
@@ -424,8 +426,6 @@ impl TableSystem {
     }
 }
 
-/// The oil's bulk modulus, the supply and return pressures and the accumulator bank: the
-/// checks shared by the uniaxial and the multi-axis table systems.
 /// The supply pressures a servo-hydraulic table runs at, Pa: a few MPa to a few tens (21 MPa
 /// is the norm, 35 MPa the highest lab systems); a value outside is a unit slip (an MPa value
 /// written in Pa, or one multiplied twice), refused before it is blamed on another value or
@@ -458,6 +458,60 @@ fn plausible_supply(p: f64) -> Result<()> {
     ))
 }
 
+/// The effective bulk moduli of a table's oil, Pa: 10 MPa (oil full of air) to 20 GPa (beyond
+/// any oil; mineral oil is 1.4–2 GPa, less with hoses and air). A value outside is a unit
+/// slip (a GPa or MPa value written in Pa), refused with what it looks like.
+pub const PLAUSIBLE_BULK_MODULUS_PA: (f64, f64) = (1e7, 2e10);
+
+/// The largest oil volume of one chamber, lines included, m³: an actuator of a large table
+/// holds some 0.2 m³ a side (the LHPOST's 0.21 and 0.13 m³); a volume above this is one in
+/// litres (or cm³) written as m³.
+pub const PLAUSIBLE_CHAMBER_M3: f64 = 10.0;
+
+/// Refuses a bulk modulus outside [`PLAUSIBLE_BULK_MODULUS_PA`], naming what it looks like.
+fn plausible_bulk_modulus(path: &'static str, beta: f64) -> Result<()> {
+    let (lo, hi) = PLAUSIBLE_BULK_MODULUS_PA;
+    if (lo..=hi).contains(&beta) {
+        return Ok(());
+    }
+    let hint = if beta <= 20.0 {
+        format!(": {beta} looks like GPa, which is {beta}e9 Pa")
+    } else if beta <= 20e3 {
+        format!(": {beta} looks like MPa, which is {beta}e6 Pa")
+    } else if beta < lo {
+        format!(": {beta} looks like kPa, which is {beta}e3 Pa")
+    } else {
+        format!(": {} GPa is stiffer than any oil", beta * 1e-9)
+    };
+    Err(invalid(
+        path,
+        beta,
+        format!(
+            "an oil bulk modulus in Pa between {} MPa and {} GPa{hint}",
+            lo * 1e-6,
+            hi * 1e-9
+        ),
+    ))
+}
+
+/// Refuses a chamber volume above [`PLAUSIBLE_CHAMBER_M3`] (litres written as m³).
+pub(crate) fn plausible_chamber(path: &'static str, v: f64) -> Result<()> {
+    if v <= PLAUSIBLE_CHAMBER_M3 {
+        return Ok(());
+    }
+    Err(invalid(
+        path,
+        v,
+        format!(
+            "one chamber's oil in m³, at most {PLAUSIBLE_CHAMBER_M3} m³ (a large table's \
+             actuator holds some 0.2 m³ a side): {v} looks like litres, which is {} m³",
+            v * 1e-3
+        ),
+    ))
+}
+
+/// The oil's bulk modulus, the supply and return pressures and the accumulator bank: the
+/// checks shared by the uniaxial and the multi-axis table systems.
 pub(crate) fn validate_supply(
     oil_bulk_modulus_pa: f64,
     supply_pressure_pa: f64,
@@ -465,6 +519,7 @@ pub(crate) fn validate_supply(
     supply: &Supply,
 ) -> Result<()> {
     positive("oil_bulk_modulus_pa", oil_bulk_modulus_pa)?;
+    plausible_bulk_modulus("oil_bulk_modulus_pa", oil_bulk_modulus_pa)?;
     positive("supply_pressure_pa", supply_pressure_pa)?;
     plausible_supply(supply_pressure_pa)?;
     non_negative("return_pressure_pa", return_pressure_pa)?;

@@ -75,6 +75,7 @@ impl ActuatorHydraulics {
         positive("cap_side_area_m2", self.cap_area_m2)?;
         non_negative("rod_side_area_m2", self.rod_area_m2)?;
         positive("chamber_volume_m3", self.chamber_volume_m3)?;
+        crate::params::plausible_chamber("chamber_volume_m3", self.chamber_volume_m3)?;
         non_negative("leakage_m3_s_per_pa", self.leakage_m3_s_per_pa)?;
         let largest = self.cap_area_m2.max(self.rod_area_m2);
         if stroke_m.is_finite() && self.chamber_volume_m3 - largest * stroke_m <= 0.0 {
