@@ -212,15 +212,10 @@ fn a_full_opening_runs_at_the_valve_limited_velocity() {
     assert!((cap.extend_velocity_m_s / expected - 1.0).abs() < 1e-12);
 }
 
-/// Against a locked platen (friction far above the force capacity) a full opening builds the
-/// force `A·(P_s − P_R)` (`p_a → P_s`, `p_b → P_R`), within 1e-4; the platen never moves.
-#[test]
-fn a_locked_platen_feels_the_stall_force() {
-    let mut parts = symmetric_parts(1, 0.0);
-    parts.controller.displacement_gain_per_m = 100.0;
-    let sys = TableSystem::new(parts, 0.0).unwrap();
-    let model = IdentifiedParams {
-        effective_mass_kg: 20_000.0,
+/// A platen of `mass_kg` that friction locks (10 MN, far above any force of these loops).
+fn locked(mass_kg: f64) -> IdentifiedModel {
+    IdentifiedParams {
+        effective_mass_kg: mass_kg,
         stiffness_n_per_m: 0.0,
         coulomb_force_n: 1e7,
         viscous_coefficient: 0.0,
@@ -229,7 +224,17 @@ fn a_locked_platen_feels_the_stall_force() {
         low_velocity_decay_s_per_m: 0.0,
     }
     .build()
-    .unwrap();
+    .unwrap()
+}
+
+/// Against a locked platen (friction far above the force capacity) a full opening builds the
+/// force `A·(P_s − P_R)` (`p_a → P_s`, `p_b → P_R`), within 1e-4; the platen never moves.
+#[test]
+fn a_locked_platen_feels_the_stall_force() {
+    let mut parts = symmetric_parts(1, 0.0);
+    parts.controller.displacement_gain_per_m = 100.0;
+    let sys = TableSystem::new(parts, 0.0).unwrap();
+    let model = locked(20_000.0);
     let cmd = command(4096.0, 0.5, |_| (0.1, 0.0, 0.0));
     let (s, _) = run(&model, &sys, &cmd, RK4_4, State::default());
     assert!(s.iter().all(|s| s.u_m == 0.0 && s.v_m_s == 0.0 && s.stuck));
@@ -849,17 +854,7 @@ fn a_stiff_orifice_at_stall_is_integrated_where_the_default_step_would_blow_up()
     parts.controller.sample_rate_hz = 1024.0;
     parts.controller.displacement_gain_per_m = 100.0;
     let sys = TableSystem::new(parts, 0.0).unwrap();
-    let model = IdentifiedParams {
-        effective_mass_kg: 20_000.0,
-        stiffness_n_per_m: 0.0,
-        coulomb_force_n: 1e7,
-        viscous_coefficient: 0.0,
-        viscous_exponent: 1.0,
-        low_velocity_force_n: 0.0,
-        low_velocity_decay_s_per_m: 0.0,
-    }
-    .build()
-    .unwrap();
+    let model = locked(20_000.0);
     let k = sys.default_steps_per_period(20_000.0, 0.3);
     let h = sys.controller().period_s() / f64::from(k);
     // The laminar rate of the cap chamber at full opening, the stiffest the law gets.
