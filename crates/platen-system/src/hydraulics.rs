@@ -394,37 +394,18 @@ mod tests {
     fn jacobian_diagonal(sys: &TableSystem, u: f64, s: &HydraulicState, d: f64) -> [f64; 3] {
         let c = sys.constants();
         let rates = |s: HydraulicState| sys.hydraulic_rates_with(&c, u, 0.1, 0.0, &s);
-        let da = (rates(HydraulicState {
-            p_a_pa: s.p_a_pa + d,
-            ..*s
-        })
-        .p_a - rates(HydraulicState {
-            p_a_pa: s.p_a_pa - d,
-            ..*s
-        })
-        .p_a)
-            / (2.0 * d);
-        let db = (rates(HydraulicState {
-            p_b_pa: s.p_b_pa + d,
-            ..*s
-        })
-        .p_b - rates(HydraulicState {
-            p_b_pa: s.p_b_pa - d,
-            ..*s
-        })
-        .p_b)
-            / (2.0 * d);
-        let ds = (rates(HydraulicState {
-            supply_pressure_pa: s.supply_pressure_pa + d,
-            ..*s
-        })
-        .supply_pressure
-            - rates(HydraulicState {
-                supply_pressure_pa: s.supply_pressure_pa - d,
-                ..*s
-            })
-            .supply_pressure)
-            / (2.0 * d);
+        // The central difference of one rate against one pressure of the state.
+        let central = |set: fn(&mut HydraulicState, f64), rate: fn(&HydraulicRates) -> f64| {
+            let at = |sign: f64| {
+                let mut t = *s;
+                set(&mut t, sign * d);
+                rate(&rates(t))
+            };
+            (at(1.0) - at(-1.0)) / (2.0 * d)
+        };
+        let da = central(|t, d| t.p_a_pa += d, |r| r.p_a);
+        let db = central(|t, d| t.p_b_pa += d, |r| r.p_b);
+        let ds = central(|t, d| t.supply_pressure_pa += d, |r| r.supply_pressure);
         [da.abs(), db.abs(), ds.abs()]
     }
 
