@@ -542,3 +542,146 @@ fn a_target_too_short_or_mostly_removed_by_the_baseline_treatment_is_warned_of()
         "{warnings}"
     );
 }
+
+/// The 5 %-damped pseudo-acceleration `ω²·max|u|` of `a` (m/s², at `rate_hz`) at `period_s`,
+/// integrated here independently of platen: RK4 on `u'' + 2ζωu' + ω²u = −a(t)` with `a`
+/// linear between samples, 20 steps a sample (h·ω ≤ 0.006 at 0.05 s: RK4's relative error is
+/// below 1e-9 there), the peak taken at the samples (as a spectrum of a sampled record is
+/// read, and as platen reads it at periods of ten samples and more).
+fn independent_psa_m_s2(a: &[f64], rate_hz: f64, period_s: f64, zeta: f64) -> f64 {
+    let w = std::f64::consts::TAU / period_s;
+    let sub = 20;
+    let h = 1.0 / rate_hz / sub as f64;
+    let f = |y: [f64; 2], acc: f64| [y[1], -acc - 2.0 * zeta * w * y[1] - w * w * y[0]];
+    let (mut y, mut peak) = ([0.0, 0.0], 0.0_f64);
+    for k in 0..a.len() - 1 {
+        for j in 0..sub {
+            let at = |s: f64| a[k] + (a[k + 1] - a[k]) * (j as f64 + s) / sub as f64;
+            let k1 = f(y, at(0.0));
+            let k2 = f([y[0] + 0.5 * h * k1[0], y[1] + 0.5 * h * k1[1]], at(0.5));
+            let k3 = f([y[0] + 0.5 * h * k2[0], y[1] + 0.5 * h * k2[1]], at(0.5));
+            let k4 = f([y[0] + h * k3[0], y[1] + h * k3[1]], at(1.0));
+            for i in 0..2 {
+                y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+            }
+        }
+        peak = peak.max(y[0].abs());
+    }
+    w * w * peak
+}
+
+#[test]
+fn a_required_spectrum_csv_in_g_against_frequency_is_the_acceptance_reference() {
+    // issue 38: the acceptance check took only the target's own spectrum as the required
+    // one; qualification tests give the RRS as its own table, often in g against frequency.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scenario = lhpost_scenario(d);
+    let target = target_csv(d, "quake.csv", "a_m_s2", 8 * 1024 + 1, 1024.0, quake);
+    // The target's own spectrum at the default check's 50 periods, computed here, as an RRS
+    // four times too small: the achieved spectrum is then about 4 times it at every period,
+    // and every period is listed with its ratio.
+    let t = Target::read_csv(&target).unwrap();
+    let motion = TargetMotion::new(&t, &BaselineSettings::default(), 0.75, 1024.0).unwrap();
+    let periods: Vec<f64> = (0..50)
+        .map(|k| 0.05 * (2.0_f64 / 0.05).powf(k as f64 / 49.0))
+        .collect();
+    let mut rrs = String::from("frequency_hz,psa_g,note\n");
+    // Longest period first, as a table against frequency is written.
+    for p in periods.iter().rev() {
+        let psa = independent_psa_m_s2(&motion.a_m_s2, 1024.0, *p, 0.05);
+        rrs.push_str(&format!("{},{},x\n", 1.0 / p, 0.25 * psa / 9.806_65));
+    }
+    let rrs = write(d, "rrs.csv", &rrs);
+    let out = d.join("drive.csv");
+    let plan = |extra: &[&str]| {
+        let mut args = vec![
+            "plan",
+            scenario.to_str().unwrap(),
+            "--target",
+            target.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--no-max-scale",
+            "--iterations",
+            "0",
+        ];
+        args.extend(extra);
+        platen(&args)
+    };
+    let o = plan(&["--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let own = json_of(&o)["drive"]["spectrum_acceptance"].clone();
+    assert_eq!(own["rrs"], Value::Null);
+    let o = plan(&["--json", "--rrs", rrs.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let p = json_of(&o);
+    let given = &p["drive"]["spectrum_acceptance"];
+    assert_eq!(given["rrs"], rrs.to_str().unwrap());
+    assert_eq!(given["count"], 50);
+    assert_eq!(given["within"], false);
+    let listed = given["outside"].as_array().unwrap();
+    assert_eq!(listed.len(), 50, "{given}");
+    let own_misses = own["outside"].as_array().unwrap();
+    for (m, expected_period) in listed.iter().zip(&periods) {
+        let period = m["period_s"].as_f64().unwrap();
+        // Shortest first; 1/(1/T) is T to a few ulps.
+        assert!((period / expected_period - 1.0).abs() < 1e-12, "{period}");
+        let ratio = m["ratio"].as_f64().unwrap() / 4.0;
+        match own_misses
+            .iter()
+            .find(|o| (o["period_s"].as_f64().unwrap() / period - 1.0).abs() < 1e-9)
+        {
+            // Where the target's own check lists the period, the same ratio: 1e-6 is far
+            // above the two integrations' difference (exact steps there, RK4 at h·ω ≤ 0.006
+            // here, both read at the samples) and far below any unit or period slip (g: 9.8;
+            // a period off by one of the 50 steps: ~8 %).
+            Some(o) => {
+                let r = o["ratio"].as_f64().unwrap();
+                assert!((ratio / r - 1.0).abs() < 1e-6, "{period}: {ratio} vs {r}");
+            }
+            None => assert!(
+                (0.9 - 1e-6..=1.3 + 1e-6).contains(&ratio),
+                "{period}: {ratio}"
+            ),
+        }
+    }
+    let warnings = p["warnings"].to_string();
+    assert!(warnings.contains("the required spectrum"), "{warnings}");
+    // In text: the check names the file.
+    let o = plan(&["--rrs", rrs.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("against the required spectrum") && text.contains("OUTSIDE at 50 of 50"),
+        "{text}"
+    );
+
+    // Bad RRS files are refused before any run, naming the file (and line); nothing written.
+    fs::remove_file(&out).unwrap();
+    for (name, body, expected) in [
+        (
+            "both.csv",
+            "period_s,frequency_hz,psa_g\n1,1,0.5\n",
+            "both `period_s` and `frequency_hz`",
+        ),
+        ("none.csv", "period_s\n1\n", "`psa_m_s2`"),
+        ("zero.csv", "period_s,psa_g\n0.5,0.2\n1,0\n", "line 3"),
+        (
+            "same.csv",
+            "period_s,psa_g\n0.5,0.2\n0.5,0.3\n",
+            "lines 2 and 3",
+        ),
+        (
+            "short.csv",
+            "period_s,psa_g\n0.001,0.2\n1,0.3\n",
+            "shorter than two samples",
+        ),
+    ] {
+        let bad = write(d, name, body);
+        let o = plan(&["--rrs", bad.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(3), "{name}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains(name) && e.contains(expected), "{name}: {e}");
+        assert!(!out.exists(), "{name}");
+    }
+}

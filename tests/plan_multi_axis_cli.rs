@@ -164,3 +164,113 @@ fn what_a_three_component_plan_cannot_take_is_refused() {
         assert!(!drive.exists(), "nothing written");
     }
 }
+
+#[test]
+fn a_fast_three_component_target_is_resampled_and_each_axis_accepted_against_its_spectrum() {
+    // issue 38: a three-component target sampled faster than the controller was refused
+    // where a uniaxial one is resampled; and its acceptance check took no required spectrum.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scenario = write(d, "l6.json", r#"{"table": {"preset": "lhpost6"}}"#);
+    // 0.5 s at 4096 Hz (the LHPOST6's controller runs at 2048 Hz): the 3 Hz sine of
+    // `target` on x, half of it at 5 Hz on z.
+    let mut text = String::from("t_s,x_m_s2,z_m_s2\n");
+    for j in 0..=2048 {
+        let t = f64::from(j) / 4096.0;
+        let ramp = |x: f64| 0.5 - 0.5 * (std::f64::consts::PI * (x / 0.15).clamp(0.0, 1.0)).cos();
+        let env = ramp(t) * ramp(0.5 - t);
+        let x = 1.5 * env * (std::f64::consts::TAU * 3.0 * t).sin();
+        let z = 0.75 * env * (std::f64::consts::TAU * 5.0 * t).sin();
+        text += &format!("{t},{x:e},{z:e}\n");
+    }
+    let target = write(d, "fast.csv", &text);
+    // An RRS for x only, far below anything achieved: every one of its periods is outside.
+    let rrs = write(
+        d,
+        "rrs.csv",
+        "period_s,x_psa_g\n0.1,1e-6\n0.2,1e-6\n0.5,1e-6\n1,1e-6\n",
+    );
+    let drive = d.join("drive.csv");
+    let o = platen(&[
+        "plan",
+        scenario.to_str().unwrap(),
+        "--target",
+        target.to_str().unwrap(),
+        "--rrs",
+        rrs.to_str().unwrap(),
+        "--out",
+        drive.to_str().unwrap(),
+        "--iterations",
+        "0",
+        "--no-max-scale",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(s["target"]["sample_rate_hz"], 4096.0);
+    assert_eq!(s["target"]["drive_sample_rate_hz"], 2048.0);
+    let warnings = s["warnings"].to_string();
+    assert!(warnings.contains("resampled to 2048 Hz"), "{warnings}");
+    // The drive at the controller's rate: 0.5 s at 2048 Hz.
+    let text = fs::read_to_string(&drive).unwrap();
+    assert_eq!(text.lines().count(), 1 + 1025);
+    let acceptance = s["drive"]["spectrum_acceptance"].as_object().unwrap();
+    let axes: Vec<&str> = acceptance.keys().map(String::as_str).collect();
+    assert_eq!(axes, ["x", "z"], "the axes given, y held");
+    let x = &acceptance["x"];
+    assert_eq!(x["rrs"], rrs.to_str().unwrap());
+    assert_eq!(x["count"], 4);
+    assert_eq!(x["within"], false);
+    let periods: Vec<f64> = x["outside"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["period_s"].as_f64().unwrap())
+        .collect();
+    assert_eq!(periods, [0.1, 0.2, 0.5, 1.0]);
+    assert!(acceptance["z"]["rrs"].is_null());
+    assert_eq!(acceptance["z"]["count"], 50);
+    assert!(
+        warnings.contains("achieved x response spectrum"),
+        "{warnings}"
+    );
+    // In text, one line per axis.
+    let o = platen(&[
+        "plan",
+        scenario.to_str().unwrap(),
+        "--target",
+        target.to_str().unwrap(),
+        "--rrs",
+        rrs.to_str().unwrap(),
+        "--out",
+        drive.to_str().unwrap(),
+        "--iterations",
+        "0",
+        "--no-max-scale",
+    ]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("x response spectrum") && out.contains("z response spectrum"),
+        "{out}"
+    );
+    // An RRS without any axis's column is refused naming the file, nothing run.
+    let none = write(d, "none.csv", "period_s,psa_g\n0.5,0.2\n");
+    fs::remove_file(&drive).unwrap();
+    let o = platen(&[
+        "plan",
+        scenario.to_str().unwrap(),
+        "--target",
+        target.to_str().unwrap(),
+        "--rrs",
+        none.to_str().unwrap(),
+        "--out",
+        drive.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(3));
+    assert!(
+        stderr(&o).contains("none.csv") && stderr(&o).contains("x_psa_m_s2"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!drive.exists());
+}

@@ -644,6 +644,8 @@ def plan(
     band_hz: Optional[Tuple[float, float]] = None,
     max_scale: bool = True,
     per_axis_scale: bool = False,
+    rrs: Optional[Union[str, "os.PathLike[str]"]] = None,
+    rrs_damping: float = 0.05,
 ) -> Dict[str, Any]:
     """Plans a test as ``platen plan`` does: can the scenario's table run the target, what
     limits it, the largest scale that fits, and the drive (displacement command) that makes
@@ -653,13 +655,16 @@ def plan(
     excitation, if any, is ignored: the target takes its place). The target is
     ``target_a_m_s2`` (an acceleration record, m/s²) or ``target_u_m`` (a displacement, m) at
     the uniformly spaced time stamps ``target_t_s`` (s); a target faster than the controller
-    is put on its rate, anti-aliased, with a notice in the summary's ``warnings`` (a
-    three-component one is refused).
+    is put on its rate, anti-aliased, with a notice in the summary's ``warnings``.
     ``iterations`` is the most drive corrections (0: the target's own command only),
     ``gain`` the iteration's gain in (0, 2) (None: the CLI's default, 0.7), ``target_nrmse``
     the acceleration NRMSE (a fraction) that stops it, ``frf`` where the loop's response comes
     from (``"auto"``, ``"linearised"`` or ``"measured"``), ``band_hz`` the correction band
     ``(lo, hi)``, and ``max_scale=False`` skips the search of the largest scale that fits.
+    ``rrs`` is a required response spectrum CSV (``period_s`` or ``frequency_hz``, and
+    ``psa_m_s2`` or ``psa_g``; per axis ``x_psa_m_s2`` … on a multi-axis table) the drive's
+    run is accepted against (band −10/+30 %, ``summary["drive"]["spectrum_acceptance"]``),
+    of damping ratio ``rrs_damping``; None: the target's own spectrum.
 
     Returns a dict: ``drive_t_s`` and ``drive_u_m`` (float64 arrays: the drive at the
     controller's rate, what ``--out`` writes; None when there is no drive, for a target whose
@@ -685,6 +690,7 @@ def plan(
         return _plan_table(
             path, text, origin, target_t_s, target_a_m_s2 or {}, target_u_m or {},
             iterations, gain, target_nrmse, frf, band_hz, max_scale, per_axis_scale,
+            rrs, rrs_damping,
         )
     if (target_a_m_s2 is None) == (target_u_m is None):
         raise ScenarioError("target: give exactly one of target_a_m_s2 and target_u_m")
@@ -712,8 +718,19 @@ def plan(
         str(frf),
         band,
         bool(max_scale),
+        *_rrs_args(rrs, rrs_damping),
     )
     return {"drive_t_s": drive_t, "drive_u_m": drive_u, "summary": json.loads(summary)}
+
+
+def _rrs_args(rrs, rrs_damping):
+    """``rrs`` as a path (or None) and its damping ratio, checked as ``plan`` checks them."""
+    damping = float(rrs_damping)
+    if not (0.0 <= damping < 1.0):
+        raise ScenarioError(
+            f"rrs_damping = {rrs_damping!r}: expected a damping ratio in [0, 1) (0.05 for 5 %)"
+        )
+    return (None if rrs is None else os.fspath(rrs)), damping
 
 
 def _plan_checks(iterations, gain, target_nrmse, band_hz):
@@ -738,7 +755,7 @@ def _plan_checks(iterations, gain, target_nrmse, band_hz):
 
 
 def _plan_table(path, text, origin, target_t_s, accelerations, displacements, iterations,
-                gain, target_nrmse, frf, band_hz, max_scale, per_axis_scale):
+                gain, target_nrmse, frf, band_hz, max_scale, per_axis_scale, rrs, rrs_damping):
     """``plan`` with per-axis targets: the three-component plan of a multi-axis table."""
     if str(frf) not in ("auto", "linearised"):
         raise ScenarioError(
@@ -768,7 +785,7 @@ def _plan_table(path, text, origin, target_t_s, accelerations, displacements, it
     iterations, gain, target_nrmse, band = _plan_checks(iterations, gain, target_nrmse, band_hz)
     drive_t, columns, summary = _native(
         _platen.plan_table, path, text, origin, t, axes, iterations, gain, target_nrmse, band,
-        bool(max_scale), bool(per_axis_scale),
+        bool(max_scale), bool(per_axis_scale), *_rrs_args(rrs, rrs_damping),
     )
     names = ["x_m", "y_m", "z_m", "roll_rad", "pitch_rad", "yaw_rad"]
     return {

@@ -169,3 +169,38 @@ def test_bad_three_component_targets_raise_scenario_error():
         platen.plan(scenario, t[:-1], target_a_m_s2=a)
     with pytest.raises(platen.ScenarioError, match="table"):
         platen.plan({"model": {"preset": "lhpost-2008"}}, t, target_a_m_s2=a)
+
+
+def test_a_required_spectrum_csv_is_the_acceptance_reference(tmp_path):
+    """``rrs``: the drive's run is judged against a required response spectrum CSV (here in
+    g against frequency, far below anything achieved: every point is outside), as
+    ``platen plan --rrs`` does; a bad file raises naming it."""
+    t, a = target(4.0)
+    rrs = tmp_path / "rrs.csv"
+    rrs.write_text("frequency_hz,psa_g\n1,1e-6\n2,1e-6\n5,1e-6\n")
+    p = platen.plan(SCENARIO, t, target_a_m_s2=a, iterations=0, max_scale=False, rrs=rrs)
+    acc = p["summary"]["drive"]["spectrum_acceptance"]
+    assert acc["rrs"] == str(rrs) and acc["count"] == 3 and acc["within"] is False
+    assert [m["period_s"] for m in acc["outside"]] == [0.2, 0.5, 1.0]
+    own = platen.plan(SCENARIO, t, target_a_m_s2=a, iterations=0, max_scale=False)
+    assert own["summary"]["drive"]["spectrum_acceptance"]["rrs"] is None
+    bad = tmp_path / "bad.csv"
+    bad.write_text("period_s,psa_g\n0.5,0\n")
+    with pytest.raises(platen.ScenarioError, match="bad.csv"):
+        platen.plan(SCENARIO, t, target_a_m_s2=a, iterations=0, max_scale=False, rrs=bad)
+    with pytest.raises(platen.ScenarioError, match="rrs_damping"):
+        platen.plan(SCENARIO, t, target_a_m_s2=a, rrs=rrs, rrs_damping=5)
+
+
+def test_a_fast_three_component_target_is_resampled_with_a_notice():
+    """A three-component target faster than the LHPOST6's 2048 Hz controller is put on its
+    rate with a notice, as a uniaxial one (it was refused)."""
+    t = np.arange(2049) / 4096.0
+    ramp = lambda x: 0.5 - 0.5 * np.cos(np.pi * np.clip(x / 0.15, 0.0, 1.0))  # noqa: E731
+    x = 1.5 * ramp(t) * ramp(0.5 - t) * np.sin(2 * np.pi * 3 * t)
+    p = platen.plan({"table": {"preset": "lhpost6"}}, t, target_a_m_s2={"x": x},
+                    iterations=0, max_scale=False)
+    s = p["summary"]
+    assert any("resampled to 2048 Hz" in w for w in s["warnings"])
+    assert s["target"]["sample_rate_hz"] == 4096.0 and len(p["drive_t_s"]) == 1025
+    assert set(s["drive"]["spectrum_acceptance"]) == {"x"}

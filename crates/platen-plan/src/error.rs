@@ -1,8 +1,8 @@
 //! Errors of the `platen-plan` crate.
 //!
 //! An infeasible target is **not** an error: it is an answer ([`crate::Feasibility`]). Errors
-//! are inputs that cannot be planned (a target too short, not finite, not uniformly sampled
-//! or faster than the controller; a scenario without a `table_system`), settings out of
+//! are inputs that cannot be planned (a target too short, not finite, not uniformly sampled;
+//! a scenario without a `table_system`), settings out of
 //! range, and closed-loop runs that fail numerically.
 
 use std::path::PathBuf;
@@ -34,24 +34,6 @@ pub enum PlanError {
         origin: String,
         /// What is wrong, with the sample's index.
         message: String,
-    },
-
-    /// The target is sampled faster than the controller reads its command.
-    #[error(
-        "`{}`: the target is sampled at {rate_hz} Hz, faster than the controller's \
-         {controller_hz} Hz: the controller reads the command once a period, so a drive at this \
-         rate cannot carry the target's content above {nyquist_hz} Hz (resample the target to \
-         at most {controller_hz} Hz)",
-        origin.display(),
-        nyquist_hz = 0.5 * controller_hz
-    )]
-    TargetRate {
-        /// The target's origin.
-        origin: PathBuf,
-        /// Its sample rate, Hz.
-        rate_hz: f64,
-        /// The controller's sample rate, Hz.
-        controller_hz: f64,
     },
 
     /// The scenario has no `table_system`: there is no loop to plan a drive for.
@@ -100,26 +82,11 @@ pub enum PlanError {
 impl PlanError {
     /// The error as a file error when it is one, so that callers that report errors by file,
     /// line and field (the CLI's exit codes and JSON error object) see it as such: a file that
-    /// cannot be read or written, a target sampled faster than the controller (a bad record,
-    /// [`IoError::Record`]) and a scenario without a `table_system` (a missing field,
+    /// cannot be read or written and a scenario without a `table_system` (a missing field,
     /// [`IoError::InvalidField`]). Any other error is returned as it is.
     pub fn into_io(self) -> std::result::Result<IoError, Self> {
         match self {
             PlanError::Io(io) => Ok(io),
-            PlanError::TargetRate {
-                origin,
-                rate_hz,
-                controller_hz,
-            } => Ok(IoError::Record {
-                path: origin,
-                message: format!(
-                    "sampled at {rate_hz} Hz, faster than the controller's {controller_hz} Hz: \
-                     the controller reads its command once a period, so the drive is at its \
-                     rate and cannot carry the target's content above {} Hz (resample the \
-                     target to at most {controller_hz} Hz)",
-                    0.5 * controller_hz
-                ),
-            }),
             PlanError::NoTableSystem { scenario } => Ok(IoError::InvalidField {
                 path: scenario,
                 json_path: "table_system".to_owned(),
@@ -153,28 +120,16 @@ pub(crate) fn check_setting(
 
 #[cfg(test)]
 mod tests {
-    use std::path::{Path, PathBuf};
+    use std::path::PathBuf;
 
     use platen_io::IoError;
 
     use super::PlanError;
 
-    /// A fast target is a bad record of its file, a scenario without a loop a missing field;
+    /// A scenario without a loop is a missing field;
     /// other errors stay plan errors.
     #[test]
     fn file_errors_become_io_errors_and_the_others_stay() {
-        let fast = PlanError::TargetRate {
-            origin: PathBuf::from("t.csv"),
-            rate_hz: 2048.0,
-            controller_hz: 1024.0,
-        };
-        match fast.into_io() {
-            Ok(IoError::Record { path, message }) => {
-                assert_eq!(path, Path::new("t.csv"));
-                assert!(message.contains("above 512 Hz"), "{message}");
-            }
-            other => panic!("{other:?}"),
-        }
         let bare = PlanError::NoTableSystem {
             scenario: PathBuf::from("s.json"),
         };

@@ -645,9 +645,10 @@ impl SpectrumCheck {
 /// response spectrum against the required one.
 pub const ACCEPTANCE_BAND: (f64, f64) = (-0.10, 0.30);
 
-/// A response-spectrum acceptance check of an achieved acceleration against the target's
-/// spectrum taken as the required one (RRS): the periods where the achieved spectrum falls
-/// outside the band.
+/// A response-spectrum acceptance check of an achieved acceleration against a required
+/// response spectrum (RRS): the target's own spectrum, or one given as its own CSV
+/// ([`crate::RequiredSpectrum`]); the periods where the achieved spectrum falls outside the
+/// band.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SpectrumAcceptance {
     /// Damping ratio of the spectra.
@@ -662,6 +663,52 @@ pub struct SpectrumAcceptance {
     pub within: bool,
     /// The periods outside the band, shortest first.
     pub outside: Vec<SpectrumMiss>,
+    /// The required spectrum's file (`null`: the target's own spectrum is the required one).
+    pub rrs: Option<String>,
+}
+
+impl SpectrumAcceptance {
+    /// What the achieved spectrum was held against, in words: "the target's" or "the
+    /// required spectrum `file`".
+    pub fn required_name(&self) -> String {
+        match &self.rrs {
+            Some(file) => format!("the required spectrum `{file}`"),
+            None => "the target's".to_owned(),
+        }
+    }
+
+    /// The check in one line, `label` naming the spectrum: its damping, periods, required
+    /// spectrum and band, then "within at every period" or the periods outside with their
+    /// ratios.
+    pub fn line(&self, label: &str) -> String {
+        // Periods to four decimals: 0.05 and 2 as given, an RRS's 1/33 Hz as 0.0303.
+        let round = |p: f64| (p * 1e4).round() / 1e4;
+        let head = format!(
+            "{label} ({:.0} %, {} periods {}–{} s) against {}, band {:+.0}/{:+.0} %:",
+            100.0 * self.damping_ratio,
+            self.count,
+            round(self.periods_s.0),
+            round(self.periods_s.1),
+            self.required_name(),
+            100.0 * self.band.0,
+            100.0 * self.band.1
+        );
+        if self.within {
+            format!("{head} within at every period")
+        } else {
+            let list: Vec<String> = self
+                .outside
+                .iter()
+                .map(|m| format!("{:.3} s ({:.0} %)", m.period_s, 100.0 * m.ratio))
+                .collect();
+            format!(
+                "{head} OUTSIDE at {} of {}: {}",
+                self.outside.len(),
+                self.count,
+                list.join(", ")
+            )
+        }
+    }
 }
 
 /// One period where an achieved spectrum is outside its acceptance band.
@@ -694,6 +741,7 @@ pub fn spectrum_acceptance(
         band,
         within: outside.is_empty(),
         outside,
+        rrs: None,
     })
 }
 

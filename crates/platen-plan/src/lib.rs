@@ -78,6 +78,7 @@ pub mod frf;
 pub mod iterate;
 pub mod mimo;
 mod plan;
+pub mod rrs;
 pub mod six_dof;
 mod table;
 mod target;
@@ -100,6 +101,7 @@ pub use plan::{
     load_rig, plan, plan_observed, plan_table, write_drive, DriveSummary, FrfSummary, Plan,
     PlanSettings, PlanSummary, PlannedDrive, TargetSummary,
 };
+pub use rrs::{RequiredSpectrum, DEFAULT_RRS_DAMPING};
 pub use six_dof::{
     plan_multi_axis, pose_command, AxisTargets, TableAchieved, TableFeasibility, TableLimitUse,
     TablePlan, TablePlanSettings, TablePlant,

@@ -18,12 +18,13 @@ use crate::iterate::{
     iterate_observed, spectrum_acceptance, IterationRecord, IterationSettings, Response,
     SpectrumAcceptance, Stop, ACCEPTANCE_BAND,
 };
+use crate::rrs::RequiredSpectrum;
 use crate::table::{Achieved, Table};
 use crate::target::Target;
 use crate::Iteration;
 
 /// Everything a plan can be told.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct PlanSettings {
     /// How an acceleration target becomes a displacement command.
     pub baseline: BaselineSettings,
@@ -31,6 +32,9 @@ pub struct PlanSettings {
     pub iteration: IterationSettings,
     /// The search of the largest scale (`None`: not searched).
     pub max_scale: Option<MaxScaleSettings>,
+    /// The required response spectrum the drive's run is accepted against (`None`: the
+    /// target's own spectrum, [`ACCEPTANCE_BAND`] either way).
+    pub rrs: Option<RequiredSpectrum>,
 }
 
 impl PlanSettings {
@@ -172,20 +176,15 @@ pub fn plan_table(
     let resampled;
     let on_controller = if target.sample_rate_hz() > controller_hz * (1.0 + 1e-9) {
         resampled = target.resampled_to(controller_hz)?;
-        notices.push(format!(
-            "the target's {:.6} Hz is faster than the controller's {controller_hz} Hz: it was \
-             resampled to {controller_hz} Hz, low-passed at {:.1} Hz (its content below \
-             {:.1} Hz kept within 0.5 %, above {:.1} Hz removed)",
-            target.sample_rate_hz(),
-            0.4 * controller_hz,
-            0.3 * controller_hz,
-            0.5 * controller_hz
-        ));
+        notices.push(resample_notice(target.sample_rate_hz(), controller_hz));
         &resampled
     } else {
         target
     };
     let motion = target_motion(table, on_controller, settings)?;
+    if let Some(rrs) = &settings.rrs {
+        rrs.check_rate(1.0 / motion.interval_s())?;
+    }
     let feasibility = feasibility(table, &motion, settings.max_scale.as_ref())?;
     // The most serious first: the feasibility's answer, then what was done to the target and
     // what is doubtful in it, then the drive's.
@@ -198,7 +197,7 @@ pub fn plan_table(
             table,
             &motion,
             &feasibility,
-            &settings.iteration,
+            settings,
             on_run,
             &mut warnings,
         )?),
@@ -214,6 +213,39 @@ pub fn plan_table(
         drive,
         warnings,
     })
+}
+
+/// The notice of a target sampled at `from_hz`, faster than the controller's `to_hz`, put
+/// on the controller's rate ([`Target::resampled_to`]).
+pub(crate) fn resample_notice(from_hz: f64, to_hz: f64) -> String {
+    format!(
+        "the target's {from_hz:.6} Hz is faster than the controller's {to_hz} Hz: it was \
+         resampled to {to_hz} Hz, low-passed at {:.1} Hz (its content below {:.1} Hz kept \
+         within 0.5 %, above {:.1} Hz removed)",
+        0.4 * to_hz,
+        0.3 * to_hz,
+        0.5 * to_hz
+    )
+}
+
+/// The warning of a spectrum acceptance check that fails (`None` when within), `what` naming
+/// the spectrum ("the drive's achieved response spectrum", with its axis on a multi-axis
+/// table).
+pub(crate) fn acceptance_warning(what: &str, acceptance: &SpectrumAcceptance) -> Option<String> {
+    let miss = &acceptance.outside;
+    let (first, last) = (miss.first()?, miss.last()?);
+    Some(format!(
+        "{what} ({:.0} % damped) is outside {:+.0}/{:+.0} % of {} at {} of {} periods, from \
+         {:.3} to {:.3} s",
+        100.0 * acceptance.damping_ratio,
+        100.0 * acceptance.band.0,
+        100.0 * acceptance.band.1,
+        acceptance.required_name(),
+        miss.len(),
+        acceptance.count,
+        first.period_s,
+        last.period_s
+    ))
 }
 
 /// The share of an acceleration target's RMS that the baseline treatment may remove before
@@ -309,10 +341,11 @@ fn planned_drive(
     table: &Table,
     motion: &TargetMotion,
     feasibility: &Feasibility,
-    settings: &IterationSettings,
+    plan_settings: &PlanSettings,
     on_run: &mut dyn FnMut(usize),
     warnings: &mut Vec<String>,
 ) -> Result<PlannedDrive> {
+    let settings = &plan_settings.iteration;
     let iteration = iterate_observed(table, motion, settings, on_run)?;
     let uses = limit_uses(table, &iteration.achieved);
     if feasibility.feasible {
@@ -333,26 +366,22 @@ fn planned_drive(
              run"
         ));
     }
-    let spectrum_acceptance = spectrum_acceptance(
-        &settings.spectrum,
-        1.0 / motion.interval_s(),
-        &motion.a_m_s2,
-        iteration.achieved.a_m_s2(),
-        ACCEPTANCE_BAND,
-    )?;
-    if !spectrum_acceptance.within {
-        let miss = &spectrum_acceptance.outside;
-        let (lo, hi) = (miss[0].period_s, miss[miss.len() - 1].period_s);
-        warnings.push(format!(
-            "the drive's achieved response spectrum ({:.0} % damped) is outside \
-             {:+.0}/{:+.0} % of the target's at {} of {} periods, from {lo:.3} to {hi:.3} s",
-            100.0 * spectrum_acceptance.damping_ratio,
-            100.0 * ACCEPTANCE_BAND.0,
-            100.0 * ACCEPTANCE_BAND.1,
-            miss.len(),
-            spectrum_acceptance.count
-        ));
-    }
+    let fs = 1.0 / motion.interval_s();
+    let achieved_a = iteration.achieved.a_m_s2();
+    let spectrum_acceptance = match &plan_settings.rrs {
+        Some(rrs) => rrs.acceptance(fs, achieved_a, ACCEPTANCE_BAND)?,
+        None => spectrum_acceptance(
+            &settings.spectrum,
+            fs,
+            &motion.a_m_s2,
+            achieved_a,
+            ACCEPTANCE_BAND,
+        )?,
+    };
+    warnings.extend(acceptance_warning(
+        "the drive's achieved response spectrum",
+        &spectrum_acceptance,
+    ));
     Ok(PlannedDrive {
         limits: limits_summary(table, &iteration.achieved),
         frf: FrfSummary::new(settings, &iteration),

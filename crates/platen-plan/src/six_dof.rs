@@ -54,8 +54,12 @@ use platen_system::TableLinearisation;
 use crate::baseline::{command_motion, BaselineSettings, TargetMotion};
 use crate::error::{PlanError, Result};
 use crate::feasibility::{search_max_scale, MaxScale, MaxScaleSettings};
-use crate::iterate::IterationSettings;
+use crate::iterate::{
+    spectrum_acceptance as spectrum_acceptance_of, IterationSettings, SpectrumAcceptance,
+    ACCEPTANCE_BAND,
+};
 use crate::mimo::{iterate_mimo, AxisTarget, MimoIteration, MimoResponse, TransferMatrix};
+use crate::rrs::RequiredSpectrum;
 use crate::target::Target;
 
 /// The scenario JSON `text` (from `path`, for messages) if it is a multi-axis one (it has a
@@ -183,6 +187,18 @@ impl AxisTargets {
         Self::new(path, axes)
     }
 
+    /// Every axis put on `rate_hz` ([`Target::resampled_to`]: anti-aliased when slower).
+    ///
+    /// # Errors
+    /// As [`Target::resampled_to`].
+    pub fn resampled_to(&self, rate_hz: f64) -> Result<Self> {
+        let mut axes: [Option<Target>; 3] = [None, None, None];
+        for (to, from) in axes.iter_mut().zip(&self.axes) {
+            *to = from.as_ref().map(|t| t.resampled_to(rate_hz)).transpose()?;
+        }
+        Self::new(&self.origin, axes)
+    }
+
     /// Where the target comes from.
     pub fn origin(&self) -> &Path {
         &self.origin
@@ -224,6 +240,9 @@ pub struct TablePlanSettings {
     pub max_scale: Option<MaxScaleSettings>,
     /// The largest scale of each axis too, the others as given.
     pub per_axis_max_scale: bool,
+    /// Per axis (x, y, z), the required response spectrum its achieved acceleration is
+    /// accepted against (`None`: its target's own spectrum).
+    pub rrs: [Option<RequiredSpectrum>; 3],
 }
 
 impl TablePlanSettings {
@@ -549,6 +568,9 @@ pub struct TablePlan {
     pub first_a_m_s2: Vec<Vec<f64>>,
     /// The best drive's limits.
     pub drive_uses: Vec<TableLimitUse>,
+    /// Per axis given, the best drive's achieved response spectrum against its required one
+    /// (its RRS, or its target's own spectrum).
+    pub spectrum_acceptance: BTreeMap<&'static str, SpectrumAcceptance>,
     /// What an engineer should look at.
     pub warnings: Vec<String>,
 }
@@ -577,13 +599,21 @@ pub fn plan_multi_axis(
         .as_ref()
         .expect("a commanded scenario has a closed loop");
     let controller_hz = system.controller.sample_rate_hz();
-    if targets.sample_rate_hz() > controller_hz * (1.0 + 1e-9) {
-        return Err(PlanError::TargetRate {
-            origin: targets.origin().to_owned(),
-            rate_hz: targets.sample_rate_hz(),
+    // A target faster than the controller is put on its rate (anti-aliased), with a notice,
+    // as a uniaxial one.
+    let given = targets;
+    let resampled;
+    let mut notices = Vec::new();
+    let targets = if given.sample_rate_hz() > controller_hz * (1.0 + 1e-9) {
+        resampled = given.resampled_to(controller_hz)?;
+        notices.push(crate::plan::resample_notice(
+            given.sample_rate_hz(),
             controller_hz,
-        });
-    }
+        ));
+        &resampled
+    } else {
+        given
+    };
     // Each axis's command.
     let mut motions = BTreeMap::new();
     let strokes = scenario.limits.each();
@@ -633,6 +663,9 @@ pub fn plan_multi_axis(
             origin: targets.origin().display().to_string(),
             message: "the target's acceleration is zero on every axis: nothing to reproduce".into(),
         });
+    }
+    for rrs in settings.rrs.iter().flatten() {
+        rrs.check_rate(1.0 / interval_s)?;
     }
     let plant = TablePlant::new(&scenario, &t_s);
     let drives0: Vec<Vec<f64>> = axis_targets.iter().map(|a| a.u_m.clone()).collect();
@@ -744,6 +777,7 @@ pub fn plan_multi_axis(
             w.limit, w.ratio, w.t_s
         ));
     }
+    warnings.extend(notices);
     for u in failing(&drive_uses) {
         warnings.push(format!(
             "the best drive exceeds {}: {:.3} times its limit at {:.3} s",
@@ -753,12 +787,35 @@ pub fn plan_multi_axis(
     if let Some(t) = iteration.achieved.stats.cavitation_at_s {
         warnings.push(format!("the best drive cavitates a chamber at {t:.3} s"));
     }
+    // Each axis given, its achieved spectrum against its RRS (or its target's).
+    let mut spectrum_acceptance = BTreeMap::new();
+    for (k, axis) in AXES.iter().enumerate() {
+        let Some(motion) = motions.get(axis) else {
+            continue;
+        };
+        let achieved_a = iteration.achieved.a_m_s2(k);
+        let acceptance = match &settings.rrs[k] {
+            Some(rrs) => rrs.acceptance(1.0 / interval_s, achieved_a, ACCEPTANCE_BAND)?,
+            None => spectrum_acceptance_of(
+                &settings.iteration.spectrum,
+                1.0 / interval_s,
+                &motion.a_m_s2,
+                achieved_a,
+                ACCEPTANCE_BAND,
+            )?,
+        };
+        warnings.extend(crate::plan::acceptance_warning(
+            &format!("the best drive's achieved {axis} response spectrum"),
+            &acceptance,
+        ));
+        spectrum_acceptance.insert(*axis, acceptance);
+    }
     Ok(TablePlan {
         scenario_name: scenario.name.clone(),
         scenario_path: path.to_owned(),
-        target_origin: targets.origin().to_owned(),
-        target_samples: targets.t_s().len(),
-        target_rate_hz: targets.sample_rate_hz(),
+        target_origin: given.origin().to_owned(),
+        target_samples: given.t_s().len(),
+        target_rate_hz: given.sample_rate_hz(),
         targets: axis_targets,
         t_s,
         motions,
@@ -766,6 +823,7 @@ pub fn plan_multi_axis(
         iteration,
         first_a_m_s2,
         drive_uses,
+        spectrum_acceptance,
         warnings,
     })
 }
@@ -883,6 +941,8 @@ pub struct TableDriveSummary {
     pub achieved: crate::mimo::MimoRecord,
     /// The limits the drives' run exceeds, worst first.
     pub limiting: Vec<TableLimitUse>,
+    /// Per axis given, its achieved response spectrum against its required one.
+    pub spectrum_acceptance: BTreeMap<&'static str, SpectrumAcceptance>,
 }
 
 /// What `platen plan --json` prints for a multi-axis scenario.
@@ -998,6 +1058,7 @@ impl TablePlan {
                     .collect(),
                 achieved: it.best_record().clone(),
                 limiting: failing(&self.drive_uses),
+                spectrum_acceptance: self.spectrum_acceptance.clone(),
             },
             warnings: self.warnings.clone(),
         }
@@ -1108,6 +1169,9 @@ pub fn summary_text(s: &TablePlanSummary) -> String {
             .map_or(String::new(), |r| format!(" ({r})")),
         s.best_iteration
     );
+    for (axis, a) in &s.drive.spectrum_acceptance {
+        let _ = writeln!(t, "  {}", a.line(&format!("{axis} response spectrum")));
+    }
     if let Some(out) = &s.drive.out {
         let _ = writeln!(
             t,

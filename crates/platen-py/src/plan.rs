@@ -6,10 +6,12 @@ use std::path::{Path, PathBuf};
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 
-use platen_plan::{FrfSource, MaxScaleSettings, NoiseSettings, PlanError, PlanSettings, Target};
+use platen_plan::{
+    FrfSource, MaxScaleSettings, NoiseSettings, PlanError, PlanSettings, RequiredSpectrum, Target,
+};
 use platen_scenario::LoadedRig;
 
-use crate::error::{chain, detached, Fail, Kind};
+use crate::error::{detached, Fail, Kind};
 use crate::{json_text, vector};
 
 /// What `plan` hands to Python: the drive's time stamps and displacement (`None` without a
@@ -34,7 +36,7 @@ impl From<PlanError> for Fail {
 /// Plans the target (`a_m_s2` or `u_m` at `t_s`) on a scenario file or a scenario dict's
 /// JSON text: `platen.plan`.
 #[pyfunction]
-#[pyo3(signature = (path, text, origin, t_s, a_m_s2, u_m, iterations, gain, target_nrmse, frf, band_hz, max_scale))]
+#[pyo3(signature = (path, text, origin, t_s, a_m_s2, u_m, iterations, gain, target_nrmse, frf, band_hz, max_scale, rrs, rrs_damping))]
 #[allow(clippy::too_many_arguments)]
 pub fn plan<'py>(
     py: Python<'py>,
@@ -50,6 +52,8 @@ pub fn plan<'py>(
     frf: String,
     band_hz: Option<(f64, f64)>,
     max_scale: bool,
+    rrs: Option<PathBuf>,
+    rrs_damping: f64,
 ) -> PyResult<PlanParts<'py>> {
     let t_s = vector(&t_s)?;
     let a_m_s2 = a_m_s2.as_ref().map(vector).transpose()?;
@@ -98,12 +102,12 @@ pub fn plan<'py>(
                 ..Default::default()
             },
             max_scale: max_scale.then(MaxScaleSettings::default),
+            rrs: rrs
+                .map(|f| RequiredSpectrum::read_csv(&f, rrs_damping))
+                .transpose()?,
             ..Default::default()
         };
-        let p = platen_plan::plan(&rig, &path, &target, &settings).map_err(|e| match e {
-            PlanError::TargetRate { .. } => Fail::input(chain(&e)),
-            e => e.into(),
-        })?;
+        let p = platen_plan::plan(&rig, &path, &target, &settings)?;
         let drive = p.drive().map(|(t, u)| (t.to_vec(), u.to_vec()));
         Ok((drive, json_text(&p.summary(None))?))
     })?;
@@ -125,7 +129,7 @@ type TablePlanParts<'py> = (
 /// `acceleration` or `displacement`) on a multi-axis scenario file or dict's JSON text:
 /// `platen.plan` with per-axis targets.
 #[pyfunction]
-#[pyo3(signature = (path, text, origin, t_s, axes, iterations, gain, target_nrmse, band_hz, max_scale, per_axis_scale))]
+#[pyo3(signature = (path, text, origin, t_s, axes, iterations, gain, target_nrmse, band_hz, max_scale, per_axis_scale, rrs, rrs_damping))]
 #[allow(clippy::too_many_arguments)]
 pub fn plan_table<'py>(
     py: Python<'py>,
@@ -140,6 +144,8 @@ pub fn plan_table<'py>(
     band_hz: Option<(f64, f64)>,
     max_scale: bool,
     per_axis_scale: bool,
+    rrs: Option<PathBuf>,
+    rrs_damping: f64,
 ) -> PyResult<TablePlanParts<'py>> {
     let t_s = vector(&t_s)?;
     let axes: Vec<(String, String, Vec<f64>)> = axes
@@ -174,7 +180,7 @@ pub fn plan_table<'py>(
             });
         }
         let targets = platen_plan::AxisTargets::new(origin, given)?;
-        let settings = platen_plan::TablePlanSettings::new(
+        let mut settings = platen_plan::TablePlanSettings::new(
             iterations,
             gain,
             target_nrmse,
@@ -182,11 +188,10 @@ pub fn plan_table<'py>(
             max_scale,
             per_axis_scale,
         );
-        let p = platen_plan::plan_multi_axis(&path, &file, &targets, &settings, &mut |_| {})
-            .map_err(|e| match e {
-                PlanError::TargetRate { .. } => Fail::input(chain(&e)),
-                e => e.into(),
-            })?;
+        if let Some(f) = rrs {
+            settings.rrs = RequiredSpectrum::read_csv_axes(&f, rrs_damping)?;
+        }
+        let p = platen_plan::plan_multi_axis(&path, &file, &targets, &settings, &mut |_| {})?;
         let (_, mut columns) = p.drive_columns();
         let t = columns.remove(0);
         Ok((t, columns, json_text(&p.summary(&settings, None))?))

@@ -173,33 +173,7 @@ fn iteration_lines(o: &mut String, s: &PlanSummary) {
         None => writeln!(o, "  drive: none (nothing written)"),
     };
     if let Some(d) = &s.drive {
-        let a = &d.spectrum_acceptance;
-        let head = format!(
-            "  response spectrum ({:.0} %, {} periods {}–{} s) against the target's, band \
-             {:+.0}/{:+.0} %:",
-            100.0 * a.damping_ratio,
-            a.count,
-            a.periods_s.0,
-            a.periods_s.1,
-            100.0 * a.band.0,
-            100.0 * a.band.1
-        );
-        let _ = if a.within {
-            writeln!(o, "{head} within at every period")
-        } else {
-            let list: Vec<String> = a
-                .outside
-                .iter()
-                .map(|m| format!("{:.3} s ({:.0} %)", m.period_s, 100.0 * m.ratio))
-                .collect();
-            writeln!(
-                o,
-                "{head} OUTSIDE at {} of {}: {}",
-                a.outside.len(),
-                a.count,
-                list.join(", ")
-            )
-        };
+        let _ = writeln!(o, "  {}", d.spectrum_acceptance.line("response spectrum"));
     }
 }
 

@@ -15,7 +15,7 @@ use platen_io::columns::ColumnMap;
 use platen_io::csv::CsvWriter;
 use platen_plan::{
     load_rig, plan_observed, FrfSource, MaxScaleSettings, NoiseSettings, PlanError, PlanSettings,
-    Target,
+    RequiredSpectrum, Target,
 };
 use platen_report::plan_figures;
 use platen_report::simulate_report::with_outputs;
@@ -46,6 +46,15 @@ pub struct Args {
     /// `motion_csv` that `simulate` replays.
     #[arg(long, value_name = "DRIVE.csv", value_parser = crate::usage::OutFile("drive.csv"))]
     pub out: PathBuf,
+    /// Required response spectrum CSV to accept the drive's run against (AC156-style band
+    /// -10/+30 %): `period_s` (or `frequency_hz`) and `psa_m_s2` (or `psa_g`); on a
+    /// multi-axis table `x_psa_m_s2`, `y_psa_m_s2`, `z_psa_m_s2` (or `…_psa_g`), an axis
+    /// without one judged against its target. Default: the target's own spectrum.
+    #[arg(long, value_name = "RRS.csv")]
+    pub rrs: Option<PathBuf>,
+    /// Damping ratio of the required response spectrum (a fraction).
+    #[arg(long, value_name = "ZETA", default_value_t = platen_plan::DEFAULT_RRS_DAMPING, value_parser = parse_damping)]
+    pub rrs_damping: f64,
     /// Most drive corrections (0: run the target's own command only).
     #[arg(long, value_name = "N", default_value_t = 10, value_parser = clap::value_parser!(u16).range(0..=200))]
     pub iterations: u16,
@@ -119,6 +128,15 @@ fn parse_gain(s: &str) -> std::result::Result<f64, String> {
     parse_checked(s, |g| g > 0.0 && g < 2.0, "a gain in (0, 2)")
 }
 
+/// `--rrs-damping`: a fraction in [0, 1).
+fn parse_damping(s: &str) -> std::result::Result<f64, String> {
+    parse_checked(
+        s,
+        |z| (0.0..1.0).contains(&z),
+        "a damping ratio in [0, 1) (0.05 for 5 %)",
+    )
+}
+
 /// `--target-nrmse`: a fraction >= 0.
 fn parse_nrmse(s: &str) -> std::result::Result<f64, String> {
     parse_checked(s, |e| e >= 0.0, "an NRMSE >= 0 (a fraction)")
@@ -151,7 +169,7 @@ fn cli_error(e: PlanError) -> anyhow::Error {
 }
 
 pub fn run(args: &Args) -> Result<()> {
-    let settings = PlanSettings {
+    let mut settings = PlanSettings {
         iteration: platen_plan::IterationSettings {
             max_iterations: usize::from(args.iterations),
             gain: args.gain,
@@ -188,6 +206,9 @@ pub fn run(args: &Args) -> Result<()> {
     let mut writer = CsvWriter::create(&args.out, &["t_s", "u_m"])?;
     let rig = load_rig(&args.scenario).map_err(cli_error)?;
     let target = Target::read_csv_mapped(&args.target, &columns).map_err(cli_error)?;
+    if let Some(rrs) = &args.rrs {
+        settings.rrs = Some(RequiredSpectrum::read_csv(rrs, args.rrs_damping).map_err(cli_error)?);
+    }
     let progress = iteration_progress(args);
     let on_run = &mut |k: usize| progress.set_position(k as u64 + 1);
     let p = plan_observed(&rig, &args.scenario, &target, &settings, on_run);
@@ -264,7 +285,7 @@ fn run_table(args: &Args, file: &platen_scenario::file::ScenarioFile) -> Result<
     if args.per_axis_scale && args.no_max_scale {
         anyhow::bail!("--per-axis-scale searches scales: it cannot go with --no-max-scale");
     }
-    let settings = TablePlanSettings::new(
+    let mut settings = TablePlanSettings::new(
         usize::from(args.iterations),
         args.gain,
         args.target_nrmse,
@@ -275,6 +296,9 @@ fn run_table(args: &Args, file: &platen_scenario::file::ScenarioFile) -> Result<
     // The drive's temporary file first: an unwritable destination fails before any run.
     let writer = CsvWriter::create(&args.out, &platen_plan::six_dof::DRIVE_COLUMNS)?;
     let targets = AxisTargets::read_csv(&args.target).map_err(cli_error)?;
+    if let Some(rrs) = &args.rrs {
+        settings.rrs = RequiredSpectrum::read_csv_axes(rrs, args.rrs_damping).map_err(cli_error)?;
+    }
     let progress = iteration_progress(args);
     let on_run = &mut |k: usize| progress.set_position(k as u64 + 1);
     let p = plan_multi_axis(&args.scenario, file, &targets, &settings, on_run);
