@@ -646,6 +646,7 @@ def plan(
     per_axis_scale: bool = False,
     rrs: Optional[Union[str, "os.PathLike[str]"]] = None,
     rrs_damping: float = 0.05,
+    iterate_at: Optional[float] = None,
 ) -> Dict[str, Any]:
     """Plans a test as ``platen plan`` does: can the scenario's table run the target, what
     limits it, the largest scale that fits, and the drive (displacement command) that makes
@@ -664,7 +665,11 @@ def plan(
     ``rrs`` is a required response spectrum CSV (``period_s`` or ``frequency_hz``, and
     ``psa_m_s2`` or ``psa_g``; per axis ``x_psa_m_s2`` … on a multi-axis table) the drive's
     run is accepted against (band −10/+30 %, ``summary["drive"]["spectrum_acceptance"]``),
-    of damping ratio ``rrs_damping``; None: the target's own spectrum.
+    of damping ratio ``rrs_damping``; None: the target's own spectrum. ``iterate_at`` (a
+    fraction in (0, 1], say 0.25) iterates the drive at that level of the target, then scales
+    it up and runs it once at full level: the drive returned is the scaled-up one, and
+    ``summary["drive"]["achieved"]`` its full-level run (the predicted full-level error;
+    ``summary["drive"]["at_iteration_level"]`` what it achieved at the level).
 
     Returns a dict: ``drive_t_s`` and ``drive_u_m`` (float64 arrays: the drive at the
     controller's rate, what ``--out`` writes; None when there is no drive, for a target whose
@@ -690,7 +695,7 @@ def plan(
         return _plan_table(
             path, text, origin, target_t_s, target_a_m_s2 or {}, target_u_m or {},
             iterations, gain, target_nrmse, frf, band_hz, max_scale, per_axis_scale,
-            rrs, rrs_damping,
+            rrs, rrs_damping, iterate_at,
         )
     if (target_a_m_s2 is None) == (target_u_m is None):
         raise ScenarioError("target: give exactly one of target_a_m_s2 and target_u_m")
@@ -719,8 +724,22 @@ def plan(
         band,
         bool(max_scale),
         *_rrs_args(rrs, rrs_damping),
+        _level(iterate_at),
     )
     return {"drive_t_s": drive_t, "drive_u_m": drive_u, "summary": json.loads(summary)}
+
+
+def _level(iterate_at):
+    """``iterate_at`` checked as ``plan`` checks it: None or a fraction in (0, 1]."""
+    if iterate_at is None:
+        return None
+    level = float(iterate_at)
+    if not (0.0 < level <= 1.0):
+        raise ScenarioError(
+            f"iterate_at = {iterate_at!r}: expected a fraction of the target in (0, 1] "
+            "(0.25 for 25 %)"
+        )
+    return level
 
 
 def _rrs_args(rrs, rrs_damping):
@@ -755,7 +774,8 @@ def _plan_checks(iterations, gain, target_nrmse, band_hz):
 
 
 def _plan_table(path, text, origin, target_t_s, accelerations, displacements, iterations,
-                gain, target_nrmse, frf, band_hz, max_scale, per_axis_scale, rrs, rrs_damping):
+                gain, target_nrmse, frf, band_hz, max_scale, per_axis_scale, rrs, rrs_damping,
+                iterate_at):
     """``plan`` with per-axis targets: the three-component plan of a multi-axis table."""
     if str(frf) not in ("auto", "linearised"):
         raise ScenarioError(
@@ -786,6 +806,7 @@ def _plan_table(path, text, origin, target_t_s, accelerations, displacements, it
     drive_t, columns, summary = _native(
         _platen.plan_table, path, text, origin, t, axes, iterations, gain, target_nrmse, band,
         bool(max_scale), bool(per_axis_scale), *_rrs_args(rrs, rrs_damping),
+        _level(iterate_at),
     )
     names = ["x_m", "y_m", "z_m", "roll_rad", "pitch_rad", "yaw_rad"]
     return {

@@ -204,3 +204,19 @@ def test_a_fast_three_component_target_is_resampled_with_a_notice():
     assert any("resampled to 2048 Hz" in w for w in s["warnings"])
     assert s["target"]["sample_rate_hz"] == 4096.0 and len(p["drive_t_s"]) == 1025
     assert set(s["drive"]["spectrum_acceptance"]) == {"x"}
+
+
+def test_iterate_at_a_low_level_returns_the_scaled_up_drive_and_its_full_level_run():
+    """``iterate_at=0.5``: the drive is iterated at half the target and doubled; the drive
+    returned is the doubled one (exactly: a power of two), and the summary reports both the
+    level's error and the full-level run's."""
+    t, a = target(4.0)
+    p = platen.plan(SCENARIO, t, target_a_m_s2=a, iterations=1, max_scale=False, iterate_at=0.5)
+    s = p["summary"]
+    assert s["iterate_at"] == 0.5
+    low = s["drive"]["at_iteration_level"]
+    assert low == s["iterations"][s["best_iteration"]]
+    assert np.max(np.abs(p["drive_u_m"])) == 2.0 * low["peak_drive_u_m"]
+    assert s["drive"]["achieved"]["peak_drive_u_m"] == 2.0 * low["peak_drive_u_m"]
+    with pytest.raises(platen.ScenarioError, match="iterate_at"):
+        platen.plan(SCENARIO, t, target_a_m_s2=a, iterate_at=0.0)

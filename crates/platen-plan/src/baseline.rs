@@ -95,6 +95,23 @@ pub struct TargetMotion {
 }
 
 impl TargetMotion {
+    /// The same motion at `level` times its size (displacement, velocity, acceleration and
+    /// the treatment's figures): what a lab iterates on at a low level before scaling up.
+    pub fn scaled(&self, level: f64) -> Self {
+        let scale = |x: &[f64]| x.iter().map(|v| v * level).collect();
+        Self {
+            t_s: self.t_s.clone(),
+            u_m: scale(&self.u_m),
+            v_m_s: scale(&self.v_m_s),
+            a_m_s2: scale(&self.a_m_s2),
+            kind: self.kind,
+            end_degree: self.end_degree,
+            correction_rms_m_s2: self.correction_rms_m_s2 * level.abs(),
+            correction_peak_m_s2: self.correction_peak_m_s2 * level.abs(),
+            target_rms_m_s2: self.target_rms_m_s2 * level.abs(),
+        }
+    }
+
     /// The motion of `target` at `rate_hz` (the controller's rate: at least the target's):
     /// for an acceleration, integrated with `settings` (the auto degree aims at `stroke_m`);
     /// for a displacement, as it is. A target sampled slower than `rate_hz` is put on that

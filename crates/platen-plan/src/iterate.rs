@@ -959,6 +959,22 @@ fn iteration_record<R: Response>(
     }
 }
 
+/// The record of a run `r` of `drive` against `motion` (as iteration `k`'s), its spectrum
+/// error on `spectrum`: for a run made outside the iteration (a drive scaled up).
+///
+/// # Errors
+/// Bad spectrum settings.
+pub(crate) fn record_of<R: Response>(
+    k: usize,
+    r: &R,
+    drive: &[f64],
+    motion: &TargetMotion,
+    spectrum: &SpectrumSettings,
+) -> Result<IterationRecord> {
+    let check = SpectrumCheck::new(spectrum, 1.0 / motion.interval_s(), &motion.a_m_s2)?;
+    Ok(iteration_record(k, r, drive, motion, &check))
+}
+
 pub(crate) fn signed_peak(x: &[f64]) -> f64 {
     x.iter()
         .copied()

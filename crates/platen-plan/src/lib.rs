@@ -98,8 +98,8 @@ pub use mimo::{
     TransferMatrix,
 };
 pub use plan::{
-    load_rig, plan, plan_observed, plan_table, write_drive, DriveSummary, FrfSummary, Plan,
-    PlanSettings, PlanSummary, PlannedDrive, TargetSummary,
+    load_rig, plan, plan_observed, plan_table, write_drive, DriveSummary, FrfSummary, IteratedAt,
+    Plan, PlanSettings, PlanSummary, PlannedDrive, TargetSummary,
 };
 pub use rrs::{RequiredSpectrum, DEFAULT_RRS_DAMPING};
 pub use six_dof::{

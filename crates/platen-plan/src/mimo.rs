@@ -48,7 +48,7 @@ use crate::baseline::{peak, rms};
 use crate::error::{PlanError, Result};
 use crate::iterate::{
     checked, fft_size, half_cosine_taper, nrmse, signed_peak, Band, BestRun, IterationSettings,
-    Progress, SpectrumCheck, Stop,
+    Progress, SpectrumCheck, SpectrumSettings, Stop,
 };
 
 /// One axis of a multi-axis target: its name and its target motion at the common samples.
@@ -69,6 +69,15 @@ impl AxisTarget {
             name,
             u_m: vec![0.0; samples],
             a_m_s2: vec![0.0; samples],
+        }
+    }
+
+    /// The same axis at `level` times its size.
+    pub fn scaled(&self, level: f64) -> Self {
+        Self {
+            name: self.name,
+            u_m: self.u_m.iter().map(|u| u * level).collect(),
+            a_m_s2: self.a_m_s2.iter().map(|a| a * level).collect(),
         }
     }
 
@@ -526,14 +535,7 @@ pub fn iterate_mimo<R: MimoResponse>(
     let fs = 1.0 / interval_s;
     let correction = MimoCorrection::new(p, n, fs, frf, settings)?;
     let band_hz = checked(settings, fs, n)?.band_hz;
-    let spectra: Vec<Option<SpectrumCheck>> = targets
-        .iter()
-        .map(|t| {
-            (!t.is_still())
-                .then(|| SpectrumCheck::new(&settings.spectrum, fs, &t.a_m_s2))
-                .transpose()
-        })
-        .collect::<Result<_>>()?;
+    let spectra = spectrum_checks(targets, fs, &settings.spectrum)?;
     let mut drives: Vec<Vec<f64>> = targets.iter().map(|t| t.u_m.clone()).collect();
     let mut records = Vec::new();
     let mut progress = Progress::<R, Vec<Vec<f64>>> {
@@ -544,16 +546,7 @@ pub fn iterate_mimo<R: MimoResponse>(
     let stop = loop {
         let r = plant(&drives, k)?;
         let overall = overall_nrmse(targets, &r);
-        records.push(MimoRecord {
-            iteration: k,
-            acceleration_nrmse: overall,
-            axes: targets
-                .iter()
-                .enumerate()
-                .map(|(i, t)| (t.name, axis_record(t, &r, i, &drives[i], &spectra[i])))
-                .collect(),
-            valve_saturated_time_s: r.saturated_time_s(),
-        });
+        records.push(mimo_record(k, targets, &r, &drives, &spectra));
         let errors: Vec<Vec<f64>> = targets
             .iter()
             .enumerate()
@@ -614,6 +607,60 @@ pub fn iterate_mimo<R: MimoResponse>(
         fft_len: correction.fft_len(),
         max_condition: correction.max_condition(),
     })
+}
+
+/// The response-spectrum checks of `targets` at `sample_rate_hz` (`None` for an axis held
+/// still).
+fn spectrum_checks(
+    targets: &[AxisTarget],
+    sample_rate_hz: f64,
+    spectrum: &SpectrumSettings,
+) -> Result<Vec<Option<SpectrumCheck>>> {
+    targets
+        .iter()
+        .map(|t| {
+            (!t.is_still())
+                .then(|| SpectrumCheck::new(spectrum, sample_rate_hz, &t.a_m_s2))
+                .transpose()
+        })
+        .collect()
+}
+
+/// The record of a run `r` of `drives` against `targets` (as iteration `k`'s).
+fn mimo_record<R: MimoResponse>(
+    k: usize,
+    targets: &[AxisTarget],
+    r: &R,
+    drives: &[Vec<f64>],
+    spectra: &[Option<SpectrumCheck>],
+) -> MimoRecord {
+    MimoRecord {
+        iteration: k,
+        acceleration_nrmse: overall_nrmse(targets, r),
+        axes: targets
+            .iter()
+            .enumerate()
+            .map(|(i, t)| (t.name, axis_record(t, r, i, &drives[i], &spectra[i])))
+            .collect(),
+        valve_saturated_time_s: r.saturated_time_s(),
+    }
+}
+
+/// The record of a run `r` of `drives` against `targets` at `interval_s` (as iteration
+/// `k`'s), made outside the iteration (drives scaled up).
+///
+/// # Errors
+/// Bad spectrum settings.
+pub(crate) fn record_of_run<R: MimoResponse>(
+    k: usize,
+    targets: &[AxisTarget],
+    interval_s: f64,
+    r: &R,
+    drives: &[Vec<f64>],
+    spectrum: &SpectrumSettings,
+) -> Result<MimoRecord> {
+    let spectra = spectrum_checks(targets, 1.0 / interval_s, spectrum)?;
+    Ok(mimo_record(k, targets, r, drives, &spectra))
 }
 
 /// Axis `i`'s figures: target `t`, achieved `r`, drive `drive`.

@@ -9,13 +9,13 @@ use platen_io::csv::write_csv_atomic;
 use platen_scenario::{LimitsSummary, LoadedRig};
 
 use crate::baseline::{peak, rms, BaselineSettings, TargetMotion};
-use crate::error::{PlanError, Result};
+use crate::error::{check_setting, PlanError, Result};
 use crate::feasibility::{
     failing, feasibility, limit_uses, limits_summary, Feasibility, LimitUse, MaxScale,
     MaxScaleSettings,
 };
 use crate::iterate::{
-    iterate_observed, spectrum_acceptance, IterationRecord, IterationSettings, Response,
+    iterate_observed, record_of, spectrum_acceptance, IterationRecord, IterationSettings, Response,
     SpectrumAcceptance, Stop, ACCEPTANCE_BAND,
 };
 use crate::rrs::RequiredSpectrum;
@@ -35,6 +35,12 @@ pub struct PlanSettings {
     /// The required response spectrum the drive's run is accepted against (`None`: the
     /// target's own spectrum, [`ACCEPTANCE_BAND`] either way).
     pub rrs: Option<RequiredSpectrum>,
+    /// The level the drive is iterated at, a fraction of the target in `(0, 1]` (`None` or 1:
+    /// at full level). Below 1 the drive is iterated on the target scaled by it, as labs
+    /// iterate so that the specimen does not see full-level shaking while the drive
+    /// converges, then scaled up by its inverse and run once at full level: that run is the
+    /// drive's (its error is the predicted full-level error, [`IteratedAt`]).
+    pub iterate_at: Option<f64>,
 }
 
 impl PlanSettings {
@@ -86,6 +92,21 @@ pub struct PlannedDrive {
     /// The best drive's achieved response spectrum against the target's
     /// ([`crate::iterate::ACCEPTANCE_BAND`]).
     pub spectrum_acceptance: SpectrumAcceptance,
+    /// Where the drive was iterated at a low level and scaled up (`None`: at full level).
+    pub iterated_at: Option<IteratedAt>,
+}
+
+/// A drive iterated at a low level and scaled up ([`PlanSettings::iterate_at`]). The
+/// iteration's `drive_u_m` and `achieved` are then the scaled-up drive and its full-level run;
+/// its records are the low-level runs' (their NRMSEs are relative, so they compare).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct IteratedAt {
+    /// The level, a fraction of the target.
+    pub level: f64,
+    /// The best iteration's record at that level.
+    pub at_level: IterationRecord,
+    /// The scaled-up drive's run at full level: the predicted full-level error.
+    pub full_level: IterationRecord,
 }
 
 impl Plan {
@@ -170,6 +191,14 @@ pub fn plan_table(
     settings: &PlanSettings,
     on_run: &mut dyn FnMut(usize),
 ) -> Result<Plan> {
+    if let Some(level) = settings.iterate_at {
+        check_setting(
+            "iterate_at",
+            level,
+            level > 0.0 && level <= 1.0,
+            "a fraction of the target in (0, 1]",
+        )?;
+    }
     // A target faster than the controller is put on its rate (anti-aliased), with a notice.
     let controller_hz = table.controller_rate_hz();
     let mut notices = Vec::new();
@@ -246,6 +275,25 @@ pub(crate) fn acceptance_warning(what: &str, acceptance: &SpectrumAcceptance) ->
         first.period_s,
         last.period_s
     ))
+}
+
+/// How many times the low-level error a drive iterated at a low level and scaled up may
+/// reach at full level before the plan warns: beyond it the table does not scale between the
+/// levels, and the low-level iteration did not converge on the full-level drive.
+pub const SCALED_UP_ERROR_WARNED: f64 = 1.5;
+
+/// The warning of a drive iterated at `level` whose full-level run's acceleration NRMSE
+/// `full` exceeds [`SCALED_UP_ERROR_WARNED`] times its low-level one `low`.
+pub(crate) fn scaled_up_warning(level: f64, full: f64, low: f64) -> String {
+    format!(
+        "the drive iterated at {:.0} % predicts {:.2} % acceleration NRMSE at full level, \
+         against {:.2} % at its level: the table does not scale between the two (friction \
+         weighs more at a low level, the valves' orifice law is not linear); iterate at a \
+         higher level",
+        100.0 * level,
+        100.0 * full,
+        100.0 * low
+    )
 }
 
 /// The share of an acceleration target's RMS that the baseline treatment may remove before
@@ -346,7 +394,42 @@ fn planned_drive(
     warnings: &mut Vec<String>,
 ) -> Result<PlannedDrive> {
     let settings = &plan_settings.iteration;
-    let iteration = iterate_observed(table, motion, settings, on_run)?;
+    // Checked by `plan_table` before any run.
+    let level = plan_settings.iterate_at.unwrap_or(1.0);
+    let mut iteration;
+    let iterated_at = if level < 1.0 {
+        iteration = iterate_observed(table, &motion.scaled(level), settings, on_run)?;
+        let at_level = *iteration.best_record();
+        let drive: Vec<f64> = iteration.drive_u_m.iter().map(|d| d / level).collect();
+        let full = table.run_or_end_stop(&motion.t_s, &drive, "the full-level drive")?;
+        let full_level = record_of(iteration.best, &full, &drive, motion, &settings.spectrum)?;
+        if let Some(stop) = full.end_stop() {
+            warnings.push(format!(
+                "the drive iterated at {:.0} % and scaled up drives the platen to the end of \
+                 its actuators at {:.3} s (u = {:.3} m): its full-level figures end there",
+                100.0 * level,
+                stop.0,
+                stop.1
+            ));
+        }
+        if full_level.acceleration_nrmse > SCALED_UP_ERROR_WARNED * at_level.acceleration_nrmse {
+            warnings.push(scaled_up_warning(
+                level,
+                full_level.acceleration_nrmse,
+                at_level.acceleration_nrmse,
+            ));
+        }
+        iteration.drive_u_m = drive;
+        iteration.achieved = full;
+        Some(IteratedAt {
+            level,
+            at_level,
+            full_level,
+        })
+    } else {
+        iteration = iterate_observed(table, motion, settings, on_run)?;
+        None
+    };
     let uses = limit_uses(table, &iteration.achieved);
     if feasibility.feasible {
         if let Some(worst) = failing(&uses).first() {
@@ -388,6 +471,7 @@ fn planned_drive(
         spectrum_acceptance,
         uses,
         iteration,
+        iterated_at,
     })
 }
 
@@ -456,6 +540,8 @@ pub struct PlanSummary {
     pub margins: Vec<LimitUse>,
     /// The largest scale of the target that fits (`null` when not searched).
     pub max_scale: Option<f64>,
+    /// The level the drive was iterated at, a fraction of the target (`null`: full level).
+    pub iterate_at: Option<f64>,
     /// How it was found.
     pub max_scale_search: Option<MaxScale>,
     /// Every iteration's figures, from 0 (the target's own command); empty when not iterated.
@@ -513,8 +599,11 @@ pub struct DriveSummary {
     pub samples: usize,
     /// Largest displacement of the drive, m.
     pub peak_u_m: f64,
-    /// What the drive achieves (the best iteration).
+    /// What the drive achieves at full level (the best iteration's run; with `iterate_at`,
+    /// the scaled-up drive's run: the predicted full-level error).
     pub achieved: IterationRecord,
+    /// With `iterate_at`, what the best iteration achieved at that level (`null` otherwise).
+    pub at_iteration_level: Option<IterationRecord>,
     /// The run's signed peak displacement, m.
     pub run_peak_u_m: f64,
     /// The run's signed peak velocity, m/s.
@@ -557,6 +646,10 @@ impl Plan {
             limiting: f.limiting.clone(),
             margins: f.uses.clone(),
             max_scale: f.max_scale.as_ref().map(|s| s.scale),
+            iterate_at: self
+                .drive
+                .as_ref()
+                .and_then(|d| d.iterated_at.map(|i| i.level)),
             max_scale_search: f.max_scale.clone(),
             iterations: it.map_or_else(Vec::new, |it| it.records.clone()),
             best_iteration: it.map(|it| it.best),
@@ -573,7 +666,8 @@ impl Plan {
                     out: out.map(|p| p.display().to_string()),
                     samples: it.drive_u_m.len(),
                     peak_u_m: peak(&it.drive_u_m),
-                    achieved: *it.best_record(),
+                    achieved: d.iterated_at.map_or(*it.best_record(), |i| i.full_level),
+                    at_iteration_level: d.iterated_at.map(|i| i.at_level),
                     run_peak_u_m: p.u_m.value,
                     run_peak_v_m_s: p.v_m_s.value,
                     run_peak_force_n: p.force_n.value,

@@ -52,7 +52,7 @@ use platen_scenario::multi_axis::{
 use platen_system::TableLinearisation;
 
 use crate::baseline::{command_motion, BaselineSettings, TargetMotion};
-use crate::error::{PlanError, Result};
+use crate::error::{check_setting, PlanError, Result};
 use crate::feasibility::{search_max_scale, MaxScale, MaxScaleSettings};
 use crate::iterate::{
     spectrum_acceptance as spectrum_acceptance_of, IterationSettings, SpectrumAcceptance,
@@ -243,6 +243,10 @@ pub struct TablePlanSettings {
     /// Per axis (x, y, z), the required response spectrum its achieved acceleration is
     /// accepted against (`None`: its target's own spectrum).
     pub rrs: [Option<RequiredSpectrum>; 3],
+    /// The level the drives are iterated at, a fraction of the target in `(0, 1]` (`None` or
+    /// 1: full level), then scaled up and run once at full level, as the single-axis plan's
+    /// ([`crate::PlanSettings::iterate_at`]).
+    pub iterate_at: Option<f64>,
 }
 
 impl TablePlanSettings {
@@ -540,6 +544,17 @@ pub fn pose_command(t_s: &[f64], u_m: &[Vec<f64>]) -> Result<PoseMotion> {
     })
 }
 
+/// Drives iterated at a low level and scaled up ([`TablePlanSettings::iterate_at`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TableIteratedAt {
+    /// The level, a fraction of the target.
+    pub level: f64,
+    /// The best iteration's record at that level.
+    pub at_level: crate::mimo::MimoRecord,
+    /// The scaled-up drives' run at full level: the predicted full-level error.
+    pub full_level: crate::mimo::MimoRecord,
+}
+
 /// The plan of a three-component test.
 #[derive(Debug, Clone)]
 pub struct TablePlan {
@@ -571,6 +586,9 @@ pub struct TablePlan {
     /// Per axis given, the best drive's achieved response spectrum against its required one
     /// (its RRS, or its target's own spectrum).
     pub spectrum_acceptance: BTreeMap<&'static str, SpectrumAcceptance>,
+    /// Where the drives were iterated at a low level and scaled up (`None`: at full level);
+    /// the iteration's drives and `achieved` are then the scaled-up ones and their run.
+    pub iterated_at: Option<TableIteratedAt>,
     /// What an engineer should look at.
     pub warnings: Vec<String>,
 }
@@ -591,6 +609,15 @@ pub fn plan_multi_axis(
     settings: &TablePlanSettings,
     on_run: &mut dyn FnMut(usize),
 ) -> Result<TablePlan> {
+    if let Some(level) = settings.iterate_at {
+        check_setting(
+            "iterate_at",
+            level,
+            level > 0.0 && level <= 1.0,
+            "a fraction of the target in (0, 1]",
+        )?;
+    }
+    let level = settings.iterate_at.unwrap_or(1.0);
     // The closed loop, first commanded still (its controller's rate bounds the target's).
     let scenario =
         TableScenario::commanded_from_file(path, file, pose_command(targets.t_s(), &[])?)?;
@@ -746,9 +773,15 @@ pub fn plan_multi_axis(
         let h = lin.transfer_matrix(f);
         (0..3).map(|i| (0..3).map(|j| h[i][j]).collect()).collect()
     };
-    let mut first = Some(first);
-    let iteration = iterate_mimo(
-        &axis_targets,
+    // At a low level, the iteration's first run is its own (the feasibility's is at full).
+    let iterated: Vec<AxisTarget> = axis_targets.iter().map(|t| t.scaled(level)).collect();
+    let mut first = (level == 1.0).then_some(first);
+    let mut iteration = iterate_mimo(
+        if level < 1.0 {
+            &iterated
+        } else {
+            &axis_targets
+        },
         interval_s,
         &frf,
         &settings.iteration,
@@ -763,8 +796,43 @@ pub fn plan_multi_axis(
             Ok(r)
         },
     )?;
-    let drive_uses = limit_uses(&scenario, &iteration.achieved.run);
     let mut warnings = Vec::new();
+    let iterated_at = if level < 1.0 {
+        let at_level = iteration.best_record().clone();
+        let drives: Vec<Vec<f64>> = iteration
+            .drive_u_m
+            .iter()
+            .map(|d| d.iter().map(|x| x / level).collect())
+            .collect();
+        let full = plant.run(&drives)?;
+        let full_level = crate::mimo::record_of_run(
+            iteration.best,
+            &axis_targets,
+            interval_s,
+            &full,
+            &drives,
+            &settings.iteration.spectrum,
+        )?;
+        if full_level.acceleration_nrmse
+            > crate::plan::SCALED_UP_ERROR_WARNED * at_level.acceleration_nrmse
+        {
+            warnings.push(crate::plan::scaled_up_warning(
+                level,
+                full_level.acceleration_nrmse,
+                at_level.acceleration_nrmse,
+            ));
+        }
+        iteration.drive_u_m = drives;
+        iteration.achieved = full;
+        Some(TableIteratedAt {
+            level,
+            at_level,
+            full_level,
+        })
+    } else {
+        None
+    };
+    let drive_uses = limit_uses(&scenario, &iteration.achieved.run);
     if let Some(t) = cavitation_at_first {
         warnings.push(format!(
             "the target's own commands cavitate a chamber at {t:.3} s: an actuator unloads \
@@ -824,6 +892,7 @@ pub fn plan_multi_axis(
         first_a_m_s2,
         drive_uses,
         spectrum_acceptance,
+        iterated_at,
         warnings,
     })
 }
@@ -937,8 +1006,11 @@ pub struct TableDriveSummary {
     pub samples: usize,
     /// Per axis, the drive's largest displacement, m.
     pub peak_u_m: BTreeMap<&'static str, f64>,
-    /// What the drives achieve (the best iteration).
+    /// What the drives achieve at full level (the best iteration's run; with `iterate_at`,
+    /// the scaled-up drives' run: the predicted full-level error).
     pub achieved: crate::mimo::MimoRecord,
+    /// With `iterate_at`, what the best iteration achieved at that level (`null` otherwise).
+    pub at_iteration_level: Option<crate::mimo::MimoRecord>,
     /// The limits the drives' run exceeds, worst first.
     pub limiting: Vec<TableLimitUse>,
     /// Per axis given, its achieved response spectrum against its required one.
@@ -969,6 +1041,8 @@ pub struct TablePlanSummary {
     /// Per axis, the largest scale of that axis with the others as given (empty unless
     /// asked for).
     pub per_axis_max_scale: BTreeMap<&'static str, f64>,
+    /// The level the drives were iterated at, a fraction of the target (`null`: full level).
+    pub iterate_at: Option<f64>,
     /// Every iteration's figures, from 0 (the target's own commands).
     pub iterations: Vec<crate::mimo::MimoRecord>,
     /// The iteration whose drives are written.
@@ -1033,6 +1107,7 @@ impl TablePlan {
                 .iter()
                 .map(|(k, m)| (*k, m.scale))
                 .collect(),
+            iterate_at: self.iterated_at.as_ref().map(|i| i.level),
             iterations: it.records.clone(),
             best_iteration: it.best,
             stop: it.stop.name(),
@@ -1056,7 +1131,11 @@ impl TablePlan {
                     .zip(&it.drive_u_m)
                     .map(|(a, d)| (*a, crate::baseline::peak(d)))
                     .collect(),
-                achieved: it.best_record().clone(),
+                achieved: self
+                    .iterated_at
+                    .as_ref()
+                    .map_or_else(|| it.best_record().clone(), |i| i.full_level.clone()),
+                at_iteration_level: self.iterated_at.as_ref().map(|i| i.at_level.clone()),
                 limiting: failing(&self.drive_uses),
                 spectrum_acceptance: self.spectrum_acceptance.clone(),
             },
@@ -1169,6 +1248,17 @@ pub fn summary_text(s: &TablePlanSummary) -> String {
             .map_or(String::new(), |r| format!(" ({r})")),
         s.best_iteration
     );
+    if let (Some(level), Some(low)) = (s.iterate_at, &s.drive.at_iteration_level) {
+        let _ = writeln!(
+            t,
+            "  iterated at {:.0} % of the target ({:.2} % overall acceleration NRMSE there), \
+             scaled up by {:.4}: predicted full-level error {:.2} % overall acceleration NRMSE",
+            100.0 * level,
+            100.0 * low.acceleration_nrmse,
+            1.0 / level,
+            100.0 * s.drive.achieved.acceleration_nrmse
+        );
+    }
     for (axis, a) in &s.drive.spectrum_acceptance {
         let _ = writeln!(t, "  {}", a.line(&format!("{axis} response spectrum")));
     }

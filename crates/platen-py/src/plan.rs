@@ -36,7 +36,7 @@ impl From<PlanError> for Fail {
 /// Plans the target (`a_m_s2` or `u_m` at `t_s`) on a scenario file or a scenario dict's
 /// JSON text: `platen.plan`.
 #[pyfunction]
-#[pyo3(signature = (path, text, origin, t_s, a_m_s2, u_m, iterations, gain, target_nrmse, frf, band_hz, max_scale, rrs, rrs_damping))]
+#[pyo3(signature = (path, text, origin, t_s, a_m_s2, u_m, iterations, gain, target_nrmse, frf, band_hz, max_scale, rrs, rrs_damping, iterate_at))]
 #[allow(clippy::too_many_arguments)]
 pub fn plan<'py>(
     py: Python<'py>,
@@ -54,6 +54,7 @@ pub fn plan<'py>(
     max_scale: bool,
     rrs: Option<PathBuf>,
     rrs_damping: f64,
+    iterate_at: Option<f64>,
 ) -> PyResult<PlanParts<'py>> {
     let t_s = vector(&t_s)?;
     let a_m_s2 = a_m_s2.as_ref().map(vector).transpose()?;
@@ -105,6 +106,7 @@ pub fn plan<'py>(
             rrs: rrs
                 .map(|f| RequiredSpectrum::read_csv(&f, rrs_damping))
                 .transpose()?,
+            iterate_at,
             ..Default::default()
         };
         let p = platen_plan::plan(&rig, &path, &target, &settings)?;
@@ -129,7 +131,7 @@ type TablePlanParts<'py> = (
 /// `acceleration` or `displacement`) on a multi-axis scenario file or dict's JSON text:
 /// `platen.plan` with per-axis targets.
 #[pyfunction]
-#[pyo3(signature = (path, text, origin, t_s, axes, iterations, gain, target_nrmse, band_hz, max_scale, per_axis_scale, rrs, rrs_damping))]
+#[pyo3(signature = (path, text, origin, t_s, axes, iterations, gain, target_nrmse, band_hz, max_scale, per_axis_scale, rrs, rrs_damping, iterate_at))]
 #[allow(clippy::too_many_arguments)]
 pub fn plan_table<'py>(
     py: Python<'py>,
@@ -146,6 +148,7 @@ pub fn plan_table<'py>(
     per_axis_scale: bool,
     rrs: Option<PathBuf>,
     rrs_damping: f64,
+    iterate_at: Option<f64>,
 ) -> PyResult<TablePlanParts<'py>> {
     let t_s = vector(&t_s)?;
     let axes: Vec<(String, String, Vec<f64>)> = axes
@@ -191,6 +194,7 @@ pub fn plan_table<'py>(
         if let Some(f) = rrs {
             settings.rrs = RequiredSpectrum::read_csv_axes(&f, rrs_damping)?;
         }
+        settings.iterate_at = iterate_at;
         let p = platen_plan::plan_multi_axis(&path, &file, &targets, &settings, &mut |_| {})?;
         let (_, mut columns) = p.drive_columns();
         let t = columns.remove(0);

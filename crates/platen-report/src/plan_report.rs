@@ -172,6 +172,22 @@ fn iteration_lines(o: &mut String, s: &PlanSummary) {
         ),
         None => writeln!(o, "  drive: none (nothing written)"),
     };
+    if let (Some(d), Some(level)) = (&s.drive, s.iterate_at) {
+        if let Some(low) = &d.at_iteration_level {
+            let _ = writeln!(
+                o,
+                "  iterated at {:.0} % of the target ({:.2} % acceleration NRMSE there), scaled \
+                 up by {:.4}: predicted full-level error {:.2} % acceleration NRMSE, {:.2} % \
+                 displacement NRMSE, {:.2} % spectrum error",
+                100.0 * level,
+                100.0 * low.acceleration_nrmse,
+                1.0 / level,
+                100.0 * d.achieved.acceleration_nrmse,
+                100.0 * d.achieved.displacement_nrmse,
+                100.0 * d.achieved.spectrum_error
+            );
+        }
+    }
     if let Some(d) = &s.drive {
         let _ = writeln!(o, "  {}", d.spectrum_acceptance.line("response spectrum"));
     }

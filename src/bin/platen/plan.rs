@@ -55,6 +55,12 @@ pub struct Args {
     /// Damping ratio of the required response spectrum (a fraction).
     #[arg(long, value_name = "ZETA", default_value_t = platen_plan::DEFAULT_RRS_DAMPING, value_parser = parse_damping)]
     pub rrs_damping: f64,
+    /// Iterate the drive at this fraction of the target (say 0.25), so that the specimen
+    /// does not see full-level shaking while the drive converges; the best drive is scaled up
+    /// by its inverse and run once at full level, which gives the predicted full-level error
+    /// (the drive written is the scaled-up one).
+    #[arg(long, value_name = "LEVEL", value_parser = parse_level)]
+    pub iterate_at: Option<f64>,
     /// Most drive corrections (0: run the target's own command only).
     #[arg(long, value_name = "N", default_value_t = 10, value_parser = clap::value_parser!(u16).range(0..=200))]
     pub iterations: u16,
@@ -128,6 +134,15 @@ fn parse_gain(s: &str) -> std::result::Result<f64, String> {
     parse_checked(s, |g| g > 0.0 && g < 2.0, "a gain in (0, 2)")
 }
 
+/// `--iterate-at`: a fraction in (0, 1].
+fn parse_level(s: &str) -> std::result::Result<f64, String> {
+    parse_checked(
+        s,
+        |l| l > 0.0 && l <= 1.0,
+        "a fraction of the target in (0, 1] (0.25 for 25 %)",
+    )
+}
+
 /// `--rrs-damping`: a fraction in [0, 1).
 fn parse_damping(s: &str) -> std::result::Result<f64, String> {
     parse_checked(
@@ -183,6 +198,7 @@ pub fn run(args: &Args) -> Result<()> {
             ..Default::default()
         },
         max_scale: (!args.no_max_scale).then(MaxScaleSettings::default),
+        iterate_at: args.iterate_at,
         ..Default::default()
     };
     let columns = match &args.columns {
@@ -299,6 +315,7 @@ fn run_table(args: &Args, file: &platen_scenario::file::ScenarioFile) -> Result<
     if let Some(rrs) = &args.rrs {
         settings.rrs = RequiredSpectrum::read_csv_axes(rrs, args.rrs_damping).map_err(cli_error)?;
     }
+    settings.iterate_at = args.iterate_at;
     let progress = iteration_progress(args);
     let on_run = &mut |k: usize| progress.set_position(k as u64 + 1);
     let p = plan_multi_axis(&args.scenario, file, &targets, &settings, on_run);
