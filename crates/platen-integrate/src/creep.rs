@@ -64,6 +64,12 @@ const MIN_PROGRESS_S: f64 = 4.0 * f64::EPSILON;
 /// sense over any time a record can last (1e-300 m/s × 1e9 s).
 const SPEED_FLOOR_M_S: f64 = 1e-300;
 
+/// Whether the speed `w` (≥ 0; 0 is below any) is below the stiff speed of a step of length `h_s` at
+/// displacement `u` ([`stiff_speed_m_s`]): one evaluation of the law instead of a search.
+pub(crate) fn below_stiff_speed<M: PlatenModel>(model: &M, u: f64, w: f64, h_s: f64) -> bool {
+    w <= 0.0 || model.dissipative_excess_n(u, w) / w >= model.mass_kg(u) / h_s
+}
+
 /// The stiff speed `w_*`, m/s, of the law at displacement `u` for a step of length `h_s`: the
 /// speed at which the secant stiffness `(D(u, w) − F_s(u))/w` equals `M(u)/h_s`. Zero if the law
 /// is nowhere that stiff (an exponent `α ≥ 1` with a modest viscous coefficient).

@@ -38,7 +38,7 @@ use std::convert::Infallible;
 
 use platen_model::{PlatenModel, Specimen};
 
-use crate::creep::{creep_speed_m_s, stiff_speed_m_s};
+use crate::creep::{below_stiff_speed, creep_speed_m_s, stiff_speed_m_s};
 use crate::error::{IntegrateError, Result};
 use crate::event::{
     arrive_at_rest, dip_to_zero, just_past, locate_zero_velocity, mode_at_rest, Direction,
@@ -799,6 +799,9 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         }
         for _ in 0..=MAX_HALVINGS {
             let (y1, stage_min) = self.piece(tau, len, try_grading);
+            if let Some(at) = self.stiff_slip(tau, rest, &y1) {
+                return Ok(at);
+            }
             if !self.plant.is_finite(&y1) {
                 return Err(self.non_finite(tau));
             }
@@ -845,6 +848,30 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         // A piece of 2⁻⁶⁰ of the span still not safe: the event is here.
         let y = self.y;
         Ok(self.event(tau, 0.0, rest, y))
+    }
+
+    /// Where Dopri5 gave up slipping below the stiff speed (a platen started, or
+    /// decelerating, at a few nm/s): there the velocity relaxes within `τ = M/D′ ≪ h` (to rest,
+    /// or to a creep speed below the stiff speed), which the adaptive step had to resolve to
+    /// its tolerance with steps shrinking as the speed fell, until its step budget ran out.
+    /// The point reached is taken as the slip's arrival at rest (the event of a located
+    /// `v = 0`: a stop, a reversal, or creep on where the net force still drives the platen),
+    /// and the failure is withdrawn; the inertia neglected moves the platen by about `τ·|v|`,
+    /// below the creep phase's own bound `h·w_*`. Returns where time landed, in the driver's
+    /// units; `None` (the failure stands) anywhere else. It fires only where the run failed
+    /// before, so no run that succeeded changes.
+    fn stiff_slip(&mut self, tau: f64, rest: f64, y: &Y<L>) -> Option<f64> {
+        let (Some((t_s, _)), Mode::Slip(_)) = (self.gave_up, self.mode) else {
+            return None;
+        };
+        if !below_stiff_speed(self.plant.model(), y[U], y[V].abs(), self.h) {
+            return None;
+        }
+        self.gave_up = None;
+        let x = self.plant.units(t_s - self.plant.time_s(tau));
+        let mut y_event = *y;
+        y_event[V] = 0.0;
+        Some(self.event(tau, x, rest, y_event))
     }
 
     /// The reset at the current mode's event, located `x` past `tau` (`rest` to the span's

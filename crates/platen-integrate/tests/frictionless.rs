@@ -208,3 +208,78 @@ fn a_frictionless_creeping_platen_never_stalls() {
         }
     }
 }
+
+/// `C = 1e6`, `α = 0.2`, no stiffness, started slipping at 1e-9 m/s under a 1e5 N, 1.5 Hz
+/// sine: the law's stiff speed at one sample interval is 1.9 mm/s and the creep speed
+/// `(|F|/C)^(1/α)` at most 1e-5 m/s, so the platen creeps throughout. Dopri5 used to resolve
+/// the slip's relaxation towards the creep speed (τ = M/D′ down to 1e-13 s) and gave up after
+/// its 100 000 steps at t = 4e-4 s (issue 38); it creeps now, as RK4 does.
+///
+/// Against the quasi-static creep integrated independently here (`u̇ = sign(F)·(|F|/C)^5`, the
+/// force linear between samples, Simpson's rule on 64 pieces a sample): the neglected inertia
+/// lags the creep by `τ·w` with `τ = M·w^(1−α)/(α·C)` ≤ 7.2e-5 s at the peak speed 1e-5 m/s,
+/// so by at most 7.2e-10 m; the runs must agree to 2e-9 m (the displacement reaches 1.1e-6 m).
+#[test]
+fn a_platen_slipping_below_the_stiff_speed_creeps_with_both_integrators() {
+    let (c, alpha, f0) = (1e6, 0.2, 1e5);
+    let model = frictionless(0.0, c, alpha);
+    let omega = 2.0 * PI * 1.5;
+    let record = sine_record(f0, omega, 2.0);
+    let start = State {
+        u_m: 0.0,
+        v_m_s: 1e-9,
+    };
+    let mut dp5 = Trajectory::with_capacity(record.len());
+    forward_dopri5(
+        &model,
+        &record,
+        Dopri5Settings::new(1e-10, 1e-12).unwrap(),
+        start,
+        record.len(),
+        &mut dp5,
+    )
+    .unwrap();
+    let mut rk4 = Trajectory::with_capacity(record.len());
+    forward_rk4(
+        &model,
+        &record,
+        Rk4::with_steps_per_sample(1).unwrap(),
+        start,
+        record.len(),
+        &mut rk4,
+    )
+    .unwrap();
+    // The quasi-static creep, from the samples of the force.
+    let force: Vec<f64> = (0..record.len())
+        .map(|j| f0 * (omega * j as f64 / RATE_HZ).sin())
+        .collect();
+    let speed = |f: f64| f.signum() * (f.abs() / c).powf(1.0 / alpha);
+    let mut u_qs = vec![0.0; record.len()];
+    let pieces = 64;
+    for j in 1..record.len() {
+        let at = |x: f64| speed(force[j - 1] + (force[j] - force[j - 1]) * x);
+        let h = 1.0 / pieces as f64;
+        let simpson: f64 = (0..pieces)
+            .map(|p| {
+                let x = p as f64 * h;
+                h / 6.0 * (at(x) + 4.0 * at(x + 0.5 * h) + at(x + h))
+            })
+            .sum();
+        u_qs[j] = u_qs[j - 1] + simpson / RATE_HZ;
+    }
+    let peak = u_qs.iter().fold(0.0_f64, |m, u| m.max(u.abs()));
+    assert!(peak > 1e-6, "{peak}");
+    for (name, out) in [("dopri5", &dp5), ("rk4", &rk4)] {
+        assert_eq!(out.t_s.len(), record.len(), "{name}");
+        let worst = out
+            .u_m
+            .iter()
+            .zip(&u_qs)
+            .map(|(u, q)| (u - q).abs())
+            .fold(0.0, f64::max);
+        eprintln!(
+            "{name}: creep from 1e-9 m/s: max |u − u_qs| = {worst:.3e} m (peak {peak:.3e} m)"
+        );
+        assert!(worst < 2e-9, "{name}: {worst}");
+    }
+}
