@@ -250,3 +250,72 @@ fn the_report_prints_a_rounded_sample_rate() {
     let text = String::from_utf8(o.stdout).unwrap();
     assert!(text.contains("6145 samples at 204.8 Hz,"), "{text}");
 }
+
+/// issue 38: records of different tables fitted jointly passed without a word. Each record's
+/// mass alone (refitted with the other parameters at the joint fit's) is reported, and where
+/// the records that determine it (inertia at least half their force, standard error below
+/// 2.5 %) put it more than 10 % apart, a warning says so. The any-record files' table has
+/// 118 t; the paper's LHPOST, 144 t, under its WN10%g (`scenarios/wn10g-white-noise.json`,
+/// written by `platen simulate`): 119.0 t against 143.7 t here, 18 % of the joint 138.5 t.
+/// The two files of one table give 117.84 and 117.97 t alone (0.1 % apart); the paper's 24
+/// tests at 13.8 MPa (forced to this method), 143.8 to 144.9 t (0.8 %) among the 13 judged
+/// (measured with the release build: the 10 % has a margin of 12 on one table, 1.8 across
+/// two).
+#[test]
+fn records_of_two_tables_fitted_jointly_are_warned_of() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = data();
+    let lhpost = dir.path().join("wn10g.csv");
+    let wn10g = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/wn10g-white-noise.json");
+    let o = platen(&[
+        "simulate",
+        wn10g.to_str().unwrap(),
+        "--out",
+        lhpost.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let columns: Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("columns.json")).unwrap()).unwrap();
+    let manifest = |tests: Vec<Value>| {
+        let path = dir.path().join("m.json");
+        let m = serde_json::json!({"columns": columns, "tests": tests});
+        std::fs::write(&path, m.to_string()).unwrap();
+        path
+    };
+    let file = |f: &str| serde_json::json!({"file": d.join(f), "name": f});
+    let identify = |m: &Path| {
+        json(&platen(&[
+            "identify",
+            "--manifest",
+            m.to_str().unwrap(),
+            "--no-output-error",
+            "--json",
+        ]))
+    };
+    let disagree = |v: &Value| {
+        v["warnings"].as_array().unwrap().iter().any(|w| {
+            w.as_str()
+                .unwrap()
+                .contains("disagree on the platen's mass")
+        })
+    };
+    let one_table = identify(&manifest(vec![file("eq-lab.csv"), file("wn-lab.csv")]));
+    assert!(!disagree(&one_table), "{}", one_table["warnings"]);
+    for r in one_table["records"].as_array().unwrap() {
+        let m = r["mass_alone_kg"].as_f64().unwrap();
+        assert!((m / 118e3 - 1.0).abs() < 0.02, "{r}");
+        assert!(r["mass_alone_std_error_kg"].as_f64().unwrap() > 0.0);
+        assert!(r["mass_alone_inertial_share"].as_f64().unwrap() > 0.5);
+    }
+    let si = serde_json::json!({"t_s": {"name": "t_s"}, "u_m": {"name": "u_m"},
+        "a_m_s2": {"name": "a_m_s2"}, "force_n": {"name": "force_n"}});
+    let other = serde_json::json!({"file": lhpost, "name": "wn10g", "columns": si});
+    let two_tables = identify(&manifest(vec![
+        file("eq-lab.csv"),
+        file("wn-lab.csv"),
+        other,
+    ]));
+    assert!(disagree(&two_tables), "{}", two_tables["warnings"]);
+    let warning = two_tables["warnings"].to_string();
+    assert!(warning.contains("`wn10g` alone 14") && warning.contains("identify them apart"));
+}

@@ -159,6 +159,18 @@ pub struct RecordReport {
     /// The channels' delays against the displacement, given or estimated, and whether each
     /// was corrected ([`crate::anyrecord::ChannelDelay`]).
     pub channel_delays: Vec<crate::anyrecord::ChannelDelay>,
+    /// The effective mass this record alone gives, kg: the mass (and its own offset) refitted
+    /// to this record's samples with the other parameters held at the joint fit's (`None`
+    /// without two used samples of different accelerations). Records of one table agree;
+    /// records of different tables fitted jointly do not
+    /// ([`RecordWarning::RecordsDisagree`]).
+    pub mass_alone_kg: Option<f64>,
+    /// Its standard error, kg (batch means over the record's time: infinite for a record of
+    /// fewer than two blocks).
+    pub mass_alone_std_error_kg: Option<f64>,
+    /// The share of the record's force (RMS about its mean) its inertia makes: below
+    /// one half, friction or stiffness dominate it and its mass alone is not judged.
+    pub mass_alone_inertial_share: Option<f64>,
 }
 
 /// The result of [`crate::identify_records`].
@@ -301,6 +313,17 @@ pub enum RecordWarning {
         /// The output error's.
         output_error: f64,
     },
+    /// The records put the effective mass far apart, each refitted alone with the other
+    /// parameters held at the joint fit's ([`RecordReport::mass_alone_kg`]): records of
+    /// different tables (or of one table with and without a payload) fitted as one.
+    RecordsDisagree {
+        /// The record giving the lightest mass, and that mass, kg.
+        lightest: (String, f64),
+        /// The record giving the heaviest mass, and that mass, kg.
+        heaviest: (String, f64),
+        /// The joint fit's mass, kg.
+        joint_kg: f64,
+    },
 }
 
 impl fmt::Display for RecordWarning {
@@ -398,6 +421,19 @@ impl fmt::Display for RecordWarning {
                 "implausible output-error check: {} = {output_error:.4e} {} against {equation_error:.4e} from the equation error; it does not check the equation error (the record may not excite the platen enough for a forward simulation to pin it)",
                 symbol(*key),
                 key.unit()
+            ),
+            RecordWarning::RecordsDisagree {
+                lightest,
+                heaviest,
+                joint_kg,
+            } => write!(
+                f,
+                "the records disagree on the platen's mass: `{}` alone gives {:.1} t, `{}` alone {:.1} t (the joint fit {:.1} t): records of different tables, or of one table with and without a payload, fitted as one; identify them apart",
+                lightest.0,
+                1e-3 * lightest.1,
+                heaviest.0,
+                1e-3 * heaviest.1,
+                1e-3 * joint_kg
             ),
         }
     }

@@ -232,6 +232,15 @@ pub struct RecordInfoSummary {
     pub speed_range_m_s: Option<[f64; 2]>,
     /// The force offset, N.
     pub offset_n: Option<EstimateSummary>,
+    /// The effective mass this record alone gives, kg, the other parameters held at the
+    /// joint fit's (any-record method; records of one table agree).
+    pub mass_alone_kg: Option<f64>,
+    /// Its standard error, kg (`null` where not estimated: a record of fewer than two
+    /// blocks of 400 samples, or not fitted by the any-record method).
+    pub mass_alone_std_error_kg: Option<f64>,
+    /// The share of the record's force its inertia makes (`null` when not fitted by the
+    /// any-record method): its mass alone is judged from one half.
+    pub mass_alone_inertial_share: Option<f64>,
     /// The storeys' masses whose base shear was removed, kg.
     pub floor_masses_kg: Option<Vec<f64>>,
     /// Largest base shear removed, N.
@@ -263,6 +272,9 @@ impl RecordInfoSummary {
                 .offsets_n
                 .get(index)
                 .map(EstimateSummary::new),
+            mass_alone_kg: r.mass_alone_kg,
+            mass_alone_std_error_kg: r.mass_alone_std_error_kg.filter(|se| se.is_finite()),
+            mass_alone_inertial_share: r.mass_alone_inertial_share,
             floor_masses_kg: r.floors.as_ref().map(|f| f.masses_kg.clone()),
             peak_base_shear_n: r.floors.as_ref().map(|f| f.peak_base_shear_n),
             channel_delay_s: Some(
@@ -289,6 +301,9 @@ impl RecordInfoSummary {
             used_samples: None,
             speed_range_m_s: None,
             offset_n: None,
+            mass_alone_kg: None,
+            mass_alone_std_error_kg: None,
+            mass_alone_inertial_share: None,
             floor_masses_kg: None,
             peak_base_shear_n: None,
             channel_delay_s: Some(
