@@ -503,3 +503,91 @@ fn a_bulk_modulus_or_a_chamber_volume_in_another_unit_is_refused_as_such() {
     let o = platen(&["simulate", fine.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+/// The low side of the same slip: a time column declared in seconds whose values are
+/// milliseconds (a 1024 Hz record reads as 1.024 Hz) is refused before any work, naming the
+/// rate it would have in ms; the same file mapped in ms runs.
+#[test]
+fn a_time_in_milliseconds_read_as_seconds_is_refused_with_the_ms_map() {
+    let dir = tempfile::tempdir().unwrap();
+    // 2 s at 1024 Hz, the time written in ms.
+    let mut text = String::from("Time,F\n");
+    for i in 0..=2048 {
+        let t_ms = i as f64 * 1000.0 / 1024.0;
+        let s = (std::f64::consts::TAU * t_ms / 1000.0).sin();
+        text.push_str(&format!("{t_ms},{}\n", 200e3 * s));
+    }
+    write(dir.path(), "rec.csv", &text);
+    let scenario = |unit: &str| {
+        format!(
+            r#"{{"model": {{"preset": "lhpost-2008"}},
+                 "excitation": {{"force_csv": "rec.csv",
+                                 "columns": {{"t_s": {{"name": "Time", "unit": "{unit}"}},
+                                             "force_n": {{"name": "F"}}}}}}}}"#
+        )
+    };
+    let s = write(dir.path(), "s.json", &scenario("s"));
+    let out = dir.path().join("out.csv");
+    let o = platen(&["simulate", &s, "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    let err = stderr(&o);
+    for part in [
+        "rec.csv",
+        "column t_s: 2049 samples over 2000 s",
+        "a sample rate of 1.0240 Hz",
+        r#""t_s": {"unit": "ms"}"#,
+        "(a rate of 1024.0000 Hz)",
+    ] {
+        assert!(err.contains(part), "{part:?} not in {err}");
+    }
+    assert!(!out.exists() && o.stdout.is_empty());
+    let ms = write(dir.path(), "ms.json", &scenario("ms"));
+    let o = platen(&["simulate", &ms]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+/// An actuator area in cm² written as m² (the LHPOST's 2051 cm² cap side as 2051 m²) is
+/// refused with what it looks like, on the uniaxial and the multi-axis table; 0.2051 runs.
+#[test]
+fn an_area_in_square_centimetres_is_refused_as_such() {
+    let dir = tempfile::tempdir().unwrap();
+    let uniaxial = |area: &str| {
+        format!(
+            r#"{{"model": {{"preset": "lhpost-2008"}},
+                "table_system": {{"preset": "lhpost-2008",
+                                 "actuator": {{"cap_side_area_m2": {area}, "rod_side_area_m2": 0.1291}}}},
+                "excitation": {{"sine_motion": {{"amplitude_m": 0.02, "frequency_hz": 1.0}}}},
+                "duration_s": 0.5}}"#
+        )
+    };
+    let bad = write(dir.path(), "cm2.json", &uniaxial("2051"));
+    let o = platen(&["simulate", &bad]);
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("cap_side_area_m2") && e.contains("2051 looks like cm², which is 0.2051 m²"),
+        "{e}"
+    );
+    let fine = write(dir.path(), "m2.json", &uniaxial("0.2051"));
+    let o = platen(&["simulate", &fine]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // The multi-axis table: the LHPOST6's first actuator in cm².
+    let preset: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string("crates/platen-scenario/presets/lhpost6.json").unwrap(),
+    )
+    .unwrap();
+    let motion = std::fs::canonicalize("scenarios/multi-axis/three-component-motion.csv").unwrap();
+    let mut table = serde_json::json!({"table": preset["table"].clone(),
+        "excitation": {"motion_csv": motion}});
+    let first = &mut table["table"]["actuators"][0];
+    let area = first["cap_side_area_m2"].as_f64().unwrap();
+    first["cap_side_area_m2"] = serde_json::json!(area * 1e4);
+    let file = write(dir.path(), "six.json", &table.to_string());
+    let o = platen(&["simulate", &file]);
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("cap_side_area_m2") && e.contains("looks like cm²"),
+        "{e}"
+    );
+}

@@ -38,6 +38,16 @@ def bad_scenarios(tmp_path):
     yield "missing-column", {**base, "excitation": {"force_csv": "cols.csv"}}, {"cols.csv": "t_s,f\n0,0\n0.1,1\n"}
     yield "too-long", {**base, "duration_s": 100}, {}
     yield "unknown-preset", {**base, "model": {"preset": "lhpost-2099"}}, {}
+    # Unit slips (issue 38): refused with what the value looks like, the CLI's message.
+    loop = {"model": {"preset": "lhpost-2008"}, "duration_s": 0.5,
+            "excitation": {"sine_motion": {"amplitude_m": 0.02, "frequency_hz": 1.0}}}
+    yield "bulk-modulus-in-gpa", {**loop, "table_system": {"preset": "lhpost-2008", "oil_bulk_modulus_pa": 1.5}}, {}
+    yield "supply-in-mpa", {**loop, "table_system": {"preset": "lhpost-2008", "supply_pressure_pa": 20.7}}, {}
+    yield "area-in-cm2", {**loop, "table_system": {"preset": "lhpost-2008", "actuator": {
+        "cap_side_area_m2": 2051, "rod_side_area_m2": 0.1291}}}, {}
+    yield "time-in-ms", {**base, "excitation": {"force_csv": "ms.csv"}}, {
+        "ms.csv": "t_s,force_n\n" + "".join(f"{k * 1000 / 1024!r},{1e4 * (k % 7)}\n" for k in range(2049))
+    }
 
 
 @pytest.mark.parametrize("case", [c[0] for c in bad_scenarios(None)])
@@ -53,6 +63,9 @@ def test_a_bad_scenario_file_raises_scenario_error_with_the_clis_message(case, c
     assert str(raised.value) == expected
     assert code == raised.value.exit_code == 3
     assert isinstance(raised.value, ValueError) and isinstance(raised.value, platen.PlatenError)
+    says = {"bulk-modulus-in-gpa": "looks like GPa", "supply-in-mpa": "looks like MPa",
+            "area-in-cm2": "looks like cm²", "time-in-ms": '"t_s": {"unit": "ms"}'}
+    assert says.get(case, "") in expected
 
 
 def test_a_numerical_failure_raises_simulation_error_with_the_clis_message(cli, tmp_path):

@@ -655,13 +655,27 @@ impl ColumnMap {
 /// (seconds declared as ms give a thousand times the rate).
 pub const MAX_RECORD_RATE_HZ: f64 = 100e3;
 
+/// The slowest sample rate a record is read at, Hz: a shake-table record (a controller's or
+/// a data system's, a PEER accelerogram's 50–200 Hz) is sampled far faster. A time column
+/// of at least [`MIN_RATE_JUDGED_SAMPLES`] samples slower than this is a unit slip
+/// (milliseconds read as seconds give a thousandth of the rate: a 1024 Hz record reads as
+/// 1.024 Hz).
+pub const MIN_RECORD_RATE_HZ: f64 = 5.0;
+
+/// The fewest samples a time column needs for a low rate to be judged a slip: a short file
+/// may be a profile of breakpoints (a force or a command linear between a few samples, a
+/// ramp over 10 s in three rows), not a sampled record.
+pub const MIN_RATE_JUDGED_SAMPLES: usize = 100;
+
 /// Refuses a time column `t_s` (s, increasing) whose mean sample rate is above
-/// [`MAX_RECORD_RATE_HZ`], naming what it reads as and the likely slip: the file's time
-/// unit (`factor_to_s`, 1e-3 for `ms`) applied to values that are already seconds.
+/// [`MAX_RECORD_RATE_HZ`] or, over [`MIN_RATE_JUDGED_SAMPLES`] samples or more, below
+/// [`MIN_RECORD_RATE_HZ`], naming what it reads as and the
+/// likely slip: the file's time unit (`factor_to_s`, 1e-3 for `ms`) applied to values that
+/// are already seconds, or seconds declared for values in milliseconds.
 ///
 /// # Errors
 /// [`IoError::Record`] naming `path`, the samples, span and rate, and the map that reads
-/// the time as seconds.
+/// the time in its unit.
 pub fn check_record_rate(path: &Path, t_s: &[f64], factor_to_s: f64) -> Result<()> {
     let (Some(first), Some(last)) = (t_s.first(), t_s.last()) else {
         return Ok(());
@@ -671,6 +685,29 @@ pub fn check_record_rate(path: &Path, t_s: &[f64], factor_to_s: f64) -> Result<(
         return Ok(());
     }
     let rate = (t_s.len() - 1) as f64 / span;
+    if rate < MIN_RECORD_RATE_HZ && t_s.len() >= MIN_RATE_JUDGED_SAMPLES {
+        let slip = if factor_to_s == 1.0 {
+            format!(
+                "Are its values milliseconds? Then map its unit, \"columns\": {{\"t_s\": \
+                 {{\"unit\": \"ms\"}}}} (a rate of {:.4} Hz)",
+                rate * 1e3
+            )
+        } else {
+            "Map the unit its values are in, e.g. \"columns\": {\"t_s\": {\"unit\": \
+             \"ms\"}}"
+                .to_owned()
+        };
+        return Err(IoError::Record {
+            path: path.to_owned(),
+            message: format!(
+                "column t_s: {} samples over {} s, a sample rate of {:.4} Hz, below any \
+                 shake-table record (at least {MIN_RECORD_RATE_HZ} Hz is read). {slip}",
+                t_s.len(),
+                span,
+                rate
+            ),
+        });
+    }
     if rate <= MAX_RECORD_RATE_HZ {
         return Ok(());
     }

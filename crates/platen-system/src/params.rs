@@ -109,6 +109,8 @@ impl Actuator {
         }
         positive("actuator.cap_side_area_m2", a.cap_area_m2)?;
         positive("actuator.rod_side_area_m2", a.rod_area_m2)?;
+        plausible_area("actuator.cap_side_area_m2", a.cap_area_m2)?;
+        plausible_area("actuator.rod_side_area_m2", a.rod_area_m2)?;
         positive("actuator.chamber_volume_m3", a.cap_volume_m3)?;
         positive("actuator.chamber_volume_m3", a.rod_volume_m3)?;
         plausible_chamber("actuator.chamber_volume_m3", a.cap_volume_m3)?;
@@ -490,6 +492,27 @@ fn plausible_bulk_modulus(path: &'static str, beta: f64) -> Result<()> {
             "an oil bulk modulus in Pa between {} MPa and {} GPa{hint}",
             lo * 1e-6,
             hi * 1e-9
+        ),
+    ))
+}
+
+/// The largest piston area of one actuator, m²: a 1.6 m bore, eight times the LHPOST's
+/// 0.205 m² cap side; an area above this is one in cm² written as m² (the LHPOST's would read
+/// 2051).
+pub const PLAUSIBLE_AREA_M2: f64 = 2.0;
+
+/// Refuses a piston area above [`PLAUSIBLE_AREA_M2`] (cm² written as m²).
+pub(crate) fn plausible_area(path: &'static str, a: f64) -> Result<()> {
+    if a <= PLAUSIBLE_AREA_M2 {
+        return Ok(());
+    }
+    Err(invalid(
+        path,
+        a,
+        format!(
+            "one actuator's piston area in m², at most {PLAUSIBLE_AREA_M2} m² (a 1.6 m bore; \
+             the LHPOST's cap side is 0.2051 m²): {a} looks like cm², which is {} m²",
+            a * 1e-4
         ),
     ))
 }

@@ -74,6 +74,8 @@ impl ActuatorHydraulics {
     fn validate(&self, stroke_m: f64) -> Result<()> {
         positive("cap_side_area_m2", self.cap_area_m2)?;
         non_negative("rod_side_area_m2", self.rod_area_m2)?;
+        crate::params::plausible_area("cap_side_area_m2", self.cap_area_m2)?;
+        crate::params::plausible_area("rod_side_area_m2", self.rod_area_m2)?;
         positive("chamber_volume_m3", self.chamber_volume_m3)?;
         crate::params::plausible_chamber("chamber_volume_m3", self.chamber_volume_m3)?;
         non_negative("leakage_m3_s_per_pa", self.leakage_m3_s_per_pa)?;

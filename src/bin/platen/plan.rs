@@ -53,13 +53,13 @@ pub struct Args {
     #[arg(long, value_name = "RRS.csv")]
     pub rrs: Option<PathBuf>,
     /// Damping ratio of the required response spectrum (a fraction).
-    #[arg(long, value_name = "ZETA", default_value_t = platen_plan::DEFAULT_RRS_DAMPING, value_parser = parse_damping)]
+    #[arg(long, value_name = "ZETA", default_value_t = platen_plan::DEFAULT_RRS_DAMPING, value_parser = |s: &str| parse_checked(s, |z| (0.0..1.0).contains(&z), "a damping ratio in [0, 1) (0.05 for 5 %)"))]
     pub rrs_damping: f64,
     /// Iterate the drive at this fraction of the target (say 0.25), so that the specimen
     /// does not see full-level shaking while the drive converges; the best drive is scaled up
     /// by its inverse and run once at full level, which gives the predicted full-level error
     /// (the drive written is the scaled-up one).
-    #[arg(long, value_name = "LEVEL", value_parser = parse_level)]
+    #[arg(long, value_name = "LEVEL", value_parser = |s: &str| parse_checked(s, |l| l > 0.0 && l <= 1.0, "a fraction of the target in (0, 1] (0.25 for 25 %)"))]
     pub iterate_at: Option<f64>,
     /// Most drive corrections (0: run the target's own command only).
     #[arg(long, value_name = "N", default_value_t = 10, value_parser = clap::value_parser!(u16).range(0..=200))]
@@ -132,24 +132,6 @@ fn parse_checked(s: &str, ok: fn(f64) -> bool, what: &str) -> std::result::Resul
 /// `--gain`: in (0, 2).
 fn parse_gain(s: &str) -> std::result::Result<f64, String> {
     parse_checked(s, |g| g > 0.0 && g < 2.0, "a gain in (0, 2)")
-}
-
-/// `--iterate-at`: a fraction in (0, 1].
-fn parse_level(s: &str) -> std::result::Result<f64, String> {
-    parse_checked(
-        s,
-        |l| l > 0.0 && l <= 1.0,
-        "a fraction of the target in (0, 1] (0.25 for 25 %)",
-    )
-}
-
-/// `--rrs-damping`: a fraction in [0, 1).
-fn parse_damping(s: &str) -> std::result::Result<f64, String> {
-    parse_checked(
-        s,
-        |z| (0.0..1.0).contains(&z),
-        "a damping ratio in [0, 1) (0.05 for 5 %)",
-    )
 }
 
 /// `--target-nrmse`: a fraction >= 0.
