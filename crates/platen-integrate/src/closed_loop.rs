@@ -46,7 +46,7 @@ use platen_system::{
 
 use crate::creep::creep_speed_m_s;
 use crate::error::{IntegrateError, Result};
-use crate::event::{Direction, EventKind, Mode, MAX_EVENTS_PER_STEP};
+use crate::event::{Direction, EventKind, Mode};
 use crate::machine::{Machine, PieceMethod, Plant, DI, SD, U, V, W};
 use crate::output::{SampleSink, SystemSample};
 use crate::run::{EnergyBalance, RunStats, State};
@@ -597,25 +597,7 @@ impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
     /// Integrates the current segment of `span` seconds (no cut inside it), handling every
     /// event.
     fn segment(&mut self, span: f64) -> Result<()> {
-        let m = &mut self.machine;
-        let mut tau = 0.0;
-        let mut events = 0u32;
-        while tau < span {
-            let at = m.advance(0.0, span - tau)?;
-            if let Some((t_s, reason)) = m.take_failure() {
-                return Err(IntegrateError::failed(t_s, Failure::AdaptiveFailed(reason)));
-            }
-            tau += at;
-            m.plant.t += at;
-            if !(m.stiff_cut && at > 0.0) {
-                events += 1;
-            }
-            if events > MAX_EVENTS_PER_STEP {
-                let stalled = Failure::EventLoopStalled { events };
-                return Err(IntegrateError::failed(m.plant.t, stalled));
-            }
-        }
-        Ok(())
+        self.machine.advance_clocked(span, |p| &mut p.t)
     }
 
     /// The command's displacement, velocity and acceleration at `t` (linear between samples,

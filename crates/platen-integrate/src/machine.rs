@@ -764,6 +764,36 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         }
     }
 
+    /// Advances over `span` seconds through every mode and event, for a plant whose positions
+    /// count from its own clock (`clock`: the closed loops, whose controller cuts time into
+    /// segments): each piece moves the clock by its length. The same guards as
+    /// [`Machine::advance_span`]: where Dopri5 gave up, and more than
+    /// [`MAX_EVENTS_PER_STEP`] events (stiff pieces not counted).
+    pub(crate) fn advance_clocked(
+        &mut self,
+        span: f64,
+        clock: fn(&mut P) -> &mut f64,
+    ) -> Result<()> {
+        let mut tau = 0.0;
+        let mut events = 0u32;
+        while tau < span {
+            let at = self.advance(0.0, span - tau)?;
+            if let Some((t_s, reason)) = self.take_failure() {
+                return Err(IntegrateError::failed(t_s, Failure::AdaptiveFailed(reason)));
+            }
+            tau += at;
+            *clock(&mut self.plant) += at;
+            if !(self.stiff_cut && at > 0.0) {
+                events += 1;
+            }
+            if events > MAX_EVENTS_PER_STEP {
+                let stalled = Failure::EventLoopStalled { events };
+                return Err(IntegrateError::failed(*clock(&mut self.plant), stalled));
+            }
+        }
+        Ok(())
+    }
+
     /// Advances in the current mode from position `tau` over at most `rest`, to the end or to
     /// the mode's next event (its reset applied). Returns where the advance stopped, in the
     /// units of the plant's driver ([`Plant::reach`], [`Plant::land`]).

@@ -38,7 +38,6 @@ use platen_system::{
 
 use crate::closed_loop::LoopMethod;
 use crate::error::{IntegrateError, Result};
-use crate::event::MAX_EVENTS_PER_STEP;
 use crate::machine::{Machine, PieceMethod, Y};
 use crate::multi_axis::{PoseMotion, TableRun};
 use crate::stop::Failure;
@@ -657,25 +656,7 @@ impl<'a, const L: usize> TableLoop<'a, L> {
 
     /// Integrates `span` seconds with no cut inside, handling every event.
     fn segment(&mut self, span: f64) -> Result<()> {
-        let m = &mut self.machine;
-        let mut tau = 0.0;
-        let mut events = 0u32;
-        while tau < span {
-            let at = m.advance(0.0, span - tau)?;
-            if let Some((t_s, reason)) = m.take_failure() {
-                return Err(IntegrateError::failed(t_s, Failure::AdaptiveFailed(reason)));
-            }
-            tau += at;
-            m.plant.source.t += at;
-            if !(m.stiff_cut && at > 0.0) {
-                events += 1;
-            }
-            if events > MAX_EVENTS_PER_STEP {
-                let stalled = Failure::EventLoopStalled { events };
-                return Err(IntegrateError::failed(m.plant.source.t, stalled));
-            }
-        }
-        Ok(())
+        self.machine.advance_clocked(span, |p| &mut p.source.t)
     }
 
     /// The row of output sample `j`.
