@@ -77,6 +77,31 @@ fn json_of(o: &std::process::Output) -> Value {
         .unwrap_or_else(|e| panic!("{e}: {}\n{}", String::from_utf8_lossy(&o.stdout), stderr(o)))
 }
 
+/// The drive CSV `drive` (in `d`) replayed through `simulate` on the LHPOST's closed loop as
+/// a `motion_csv`: its `--json` summary and the run's CSV.
+fn replay(d: &Path, drive: &str) -> (Value, PathBuf) {
+    let scenario = write(
+        d,
+        "replay.json",
+        &json!({
+            "model": {"preset": "lhpost-2008"},
+            "table_system": {"preset": "lhpost-2008"},
+            "excitation": {"motion_csv": drive}
+        })
+        .to_string(),
+    );
+    let run = d.join("run.csv");
+    let o = platen(&[
+        "simulate",
+        scenario.to_str().unwrap(),
+        "--out",
+        run.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    (json_of(&o), run)
+}
+
 #[test]
 fn the_drive_replayed_by_simulate_is_the_run_the_plan_reports() {
     let dir = tempfile::tempdir().unwrap();
@@ -140,26 +165,7 @@ fn the_drive_replayed_by_simulate_is_the_run_the_plan_reports() {
     assert_eq!(text.lines().count(), 8 * 1024 + 2);
 
     // Replayed through simulate as a motion_csv: the run the plan reports.
-    let replay = write(
-        d,
-        "replay.json",
-        &json!({
-            "model": {"preset": "lhpost-2008"},
-            "table_system": {"preset": "lhpost-2008"},
-            "excitation": {"motion_csv": "drive.csv"}
-        })
-        .to_string(),
-    );
-    let run = d.join("run.csv");
-    let o = platen(&[
-        "simulate",
-        replay.to_str().unwrap(),
-        "--out",
-        run.to_str().unwrap(),
-        "--json",
-    ]);
-    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let s = json_of(&o);
+    let (s, run) = replay(d, "drive.csv");
     present_null(&s, "specimen");
     present_null(&s["table_system"], "cavitation_at_s");
     assert_eq!(s["limits"], p["drive"]["limits"]);
@@ -754,26 +760,7 @@ fn a_drive_iterated_at_a_low_level_is_scaled_up_and_its_full_level_run_reported(
     );
     assert_eq!(achieved["iteration"], at_level["iteration"]);
     // Its full-level run, replayed through simulate, is the one reported.
-    let replay = write(
-        d,
-        "replay.json",
-        &json!({
-            "model": {"preset": "lhpost-2008"},
-            "table_system": {"preset": "lhpost-2008"},
-            "excitation": {"motion_csv": "low.csv"}
-        })
-        .to_string(),
-    );
-    let run = d.join("run.csv");
-    let o = platen(&[
-        "simulate",
-        replay.to_str().unwrap(),
-        "--out",
-        run.to_str().unwrap(),
-        "--json",
-    ]);
-    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let s = json_of(&o);
+    let (s, run) = replay(d, "low.csv");
     assert_eq!(s["limits"], low["drive"]["limits"]);
     assert_eq!(s["peak_a_m_s2"], achieved["peak_a_m_s2"]);
     let table = platen::io::csv::read_table(&run, &["a_m_s2"], &[]).unwrap();

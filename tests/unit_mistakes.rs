@@ -330,6 +330,17 @@ fn a_supply_pressure_in_mpa_or_far_beyond_any_table_is_refused_as_such() {
     }
 }
 
+/// An LHPOST scenario whose force record `rec.csv` (beside it) has its time in `Time`, in
+/// `unit`, and its force in `F`, N.
+fn force_record_scenario(unit: &str) -> String {
+    format!(
+        r#"{{"model": {{"preset": "lhpost-2008"}},
+             "excitation": {{"force_csv": "rec.csv",
+                             "columns": {{"t_s": {{"name": "Time", "unit": "{unit}"}},
+                                         "force_n": {{"name": "F"}}}}}}}}"#
+    )
+}
+
 /// A time column declared in ms whose values are seconds (the issue 38 case: 5121 samples
 /// over "0.020 s", a 256 kHz record) is refused before any work by every reader that maps
 /// columns: `simulate`'s force record and `plan`'s target, with the rate it would read at,
@@ -346,14 +357,7 @@ fn a_time_in_seconds_declared_as_ms_is_refused_by_simulate_and_plan() {
         text.push_str(&format!("{t},{},{}\n", 200e3 * s, 0.1 * s));
     }
     write(dir.path(), "rec.csv", &text);
-    let scenario = |unit: &str| {
-        format!(
-            r#"{{"model": {{"preset": "lhpost-2008"}},
-                 "excitation": {{"force_csv": "rec.csv",
-                                 "columns": {{"t_s": {{"name": "Time", "unit": "{unit}"}},
-                                             "force_n": {{"name": "F"}}}}}}}}"#
-        )
-    };
+    let scenario = force_record_scenario;
     let ms = write(dir.path(), "ms.json", &scenario("ms"));
     let out = dir.path().join("out.csv");
     let o = platen(&["simulate", &ms, "--out", out.to_str().unwrap()]);
@@ -518,14 +522,7 @@ fn a_time_in_milliseconds_read_as_seconds_is_refused_with_the_ms_map() {
         text.push_str(&format!("{t_ms},{}\n", 200e3 * s));
     }
     write(dir.path(), "rec.csv", &text);
-    let scenario = |unit: &str| {
-        format!(
-            r#"{{"model": {{"preset": "lhpost-2008"}},
-                 "excitation": {{"force_csv": "rec.csv",
-                                 "columns": {{"t_s": {{"name": "Time", "unit": "{unit}"}},
-                                             "force_n": {{"name": "F"}}}}}}}}"#
-        )
-    };
+    let scenario = force_record_scenario;
     let s = write(dir.path(), "s.json", &scenario("s"));
     let out = dir.path().join("out.csv");
     let o = platen(&["simulate", &s, "--out", out.to_str().unwrap()]);

@@ -283,17 +283,19 @@ pub(crate) fn acceptance_warning(what: &str, acceptance: &SpectrumAcceptance) ->
 pub const SCALED_UP_ERROR_WARNED: f64 = 1.5;
 
 /// The warning of a drive iterated at `level` whose full-level run's acceleration NRMSE
-/// `full` exceeds [`SCALED_UP_ERROR_WARNED`] times its low-level one `low`.
-pub(crate) fn scaled_up_warning(level: f64, full: f64, low: f64) -> String {
-    format!(
-        "the drive iterated at {:.0} % predicts {:.2} % acceleration NRMSE at full level, \
+/// `full` exceeds [`SCALED_UP_ERROR_WARNED`] times its low-level one `low` (`None` below).
+pub(crate) fn scaled_up_warning(level: f64, full: f64, low: f64) -> Option<String> {
+    (full > SCALED_UP_ERROR_WARNED * low).then(|| {
+        format!(
+            "the drive iterated at {:.0} % predicts {:.2} % acceleration NRMSE at full level, \
          against {:.2} % at its level: the table does not scale between the two (friction \
          weighs more at a low level, the valves' orifice law is not linear); iterate at a \
          higher level",
-        100.0 * level,
-        100.0 * full,
-        100.0 * low
-    )
+            100.0 * level,
+            100.0 * full,
+            100.0 * low
+        )
+    })
 }
 
 /// The share of an acceleration target's RMS that the baseline treatment may remove before
@@ -412,13 +414,11 @@ fn planned_drive(
                 stop.1
             ));
         }
-        if full_level.acceleration_nrmse > SCALED_UP_ERROR_WARNED * at_level.acceleration_nrmse {
-            warnings.push(scaled_up_warning(
-                level,
-                full_level.acceleration_nrmse,
-                at_level.acceleration_nrmse,
-            ));
-        }
+        warnings.extend(scaled_up_warning(
+            level,
+            full_level.acceleration_nrmse,
+            at_level.acceleration_nrmse,
+        ));
         iteration.drive_u_m = drive;
         iteration.achieved = full;
         Some(IteratedAt {

@@ -813,15 +813,11 @@ pub fn plan_multi_axis(
             &drives,
             &settings.iteration.spectrum,
         )?;
-        if full_level.acceleration_nrmse
-            > crate::plan::SCALED_UP_ERROR_WARNED * at_level.acceleration_nrmse
-        {
-            warnings.push(crate::plan::scaled_up_warning(
-                level,
-                full_level.acceleration_nrmse,
-                at_level.acceleration_nrmse,
-            ));
-        }
+        warnings.extend(crate::plan::scaled_up_warning(
+            level,
+            full_level.acceleration_nrmse,
+            at_level.acceleration_nrmse,
+        ));
         iteration.drive_u_m = drives;
         iteration.achieved = full;
         Some(TableIteratedAt {
