@@ -599,9 +599,10 @@ pub struct TablePlan {
 /// iteration `k`'s run is done.
 ///
 /// # Errors
-/// The scenario's errors (with their JSON paths); [`PlanError::TargetRate`] for a target
-/// faster than the controller; a target whose acceleration is zero on every axis; bad
-/// settings; a run that fails.
+/// The scenario's errors (with their JSON paths); a target whose acceleration is zero on
+/// every axis; an RRS period shorter than two samples of the drive; bad settings (an
+/// `iterate_at` outside (0, 1]); a run that fails. A target faster than the controller is
+/// resampled to its rate, with a notice in the plan's warnings.
 pub fn plan_multi_axis(
     path: &Path,
     file: &ScenarioFile,
