@@ -510,6 +510,10 @@ pub const BLOCK_ROWS: usize = 4096;
 /// there, with this much memory held).
 const BLOCKS_IN_FLIGHT: usize = 4;
 
+/// Blocks written between two [`AtomicFile::sync_ahead`] calls (about 10 MB of text): the
+/// disk syncs while the run goes on, and the commit's sync waits only for the last ones.
+const SYNC_AHEAD_BLOCKS: u64 = 16;
+
 /// Threads that format blocks side by side (their texts are written in the rows' order): two,
 /// so that on a 2-core machine the formatting uses the core the run leaves idle while it waits.
 const FORMATTERS: usize = 2;
@@ -589,6 +593,9 @@ impl Worker {
                     write_text(&mut file, &mut text)?;
                     let _ = written.send(text);
                     due += 1;
+                    if due % SYNC_AHEAD_BLOCKS == 0 {
+                        file.sync_ahead();
+                    }
                 }
             }
             Ok(file)
