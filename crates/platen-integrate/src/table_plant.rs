@@ -57,8 +57,9 @@ pub(crate) const QD: usize = Q + 6;
 const Z: usize = QD + 6;
 /// The state's length without a specimen.
 pub(crate) const BARE: usize = Z;
-/// The most DOFs of a specimen a forward run takes.
-pub const MAX_TABLE_SPECIMEN_DOFS: usize = 12;
+/// The most DOFs of a specimen a forward run takes (the model's own limit, which
+/// [`LinearSpecimen::new`](platen_model::multi_axis::LinearSpecimen::new) enforces).
+pub const MAX_TABLE_SPECIMEN_DOFS: usize = platen_model::multi_axis::MAX_SPECIMEN_DOFS;
 /// The state's length with a specimen (its unused DOFs stay at zero).
 pub(crate) const WITH_SPECIMEN: usize = Z + 2 * MAX_TABLE_SPECIMEN_DOFS;
 

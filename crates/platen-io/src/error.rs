@@ -124,8 +124,9 @@ pub enum IoError {
 
     /// A cell of a selected column is not a number.
     #[error(
-        "`{}`, line {line}, column `{column}`: expected a number, found `{value}`",
-        path.display()
+        "`{}`, line {line}, column `{column}`: expected a number, found `{}`",
+        path.display(),
+        value.escape_debug()
     )]
     NonNumeric {
         /// CSV file.

@@ -55,6 +55,22 @@ pub fn parse_json<T: serde::de::DeserializeOwned>(path: &Path, text: &str) -> Re
         }
         // A syntax error has no field to name: serde_path_to_error's path there is where it
         // was reading (`?` for a key still to come), which means nothing to the reader.
+        // serde_json reads a fixed-length array (`[f64; 3]`) element by element and reports the
+        // elements left over as "trailing characters", a syntax error; in a document that is
+        // valid JSON it is an array too long for its key, named at that key.
+        if inner.is_syntax()
+            && message == "trailing characters"
+            && serde_json::from_str::<serde::de::IgnoredAny>(text).is_ok()
+        {
+            let json_path = e.path().to_string();
+            return IoError::Json {
+                path: path.to_owned(),
+                json_path: format!("{json_path} (line {line} column {column})"),
+                message: "an array with more elements than this key takes (a point or vector \
+                          has three: x, y, z)"
+                    .to_owned(),
+            };
+        }
         if inner.is_syntax() {
             return IoError::JsonSyntax {
                 path: path.to_owned(),

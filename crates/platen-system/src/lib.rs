@@ -83,4 +83,7 @@ pub use table::{
     ActuatorHydraulics, ActuatorRates, ActuatorState, StiffRate, TableHydraulics,
     TableHydraulicsParts,
 };
-pub use table_linear::{ActuatorLinearisation, CrossTalk, FlowGains, TableLinearisation};
+pub use table_linear::{
+    ActuatorLinearisation, CrossTalk, FlowGains, LoopStability, TableLinearisation,
+    MARGINAL_RATE_1_S, PADE_ORDER,
+};

@@ -259,6 +259,8 @@ impl TableSystem {
                 (p.loop_gain(), p.closed_loop().norm())
             },
             0.5 * self.controller.sample_rate_hz,
+            // The platen on its oil column, valve, filters, hold and delay: no unstable pole.
+            0,
         )
     }
 
@@ -324,7 +326,11 @@ impl TableSystem {
 /// gain broken at one point and the closed loop's gain whose peak is reported, from
 /// 0.001 Hz to `f_max` Hz on a logarithmic grid of 20 000 points, each crossing refined by
 /// bisection.
-pub(crate) fn search_margins(loop_at: impl Fn(f64) -> (C64, f64), f_max: f64) -> Margins {
+pub(crate) fn search_margins(
+    loop_at: impl Fn(f64) -> (C64, f64),
+    f_max: f64,
+    open_loop_unstable: usize,
+) -> Margins {
     let loop_gain = |f: f64| loop_at(f).0;
     let (f_min, n) = (0.001_f64, 20_000);
     let at = |i: usize| f_min * (f_max / f_min).powf(i as f64 / n as f64);
@@ -392,7 +398,9 @@ pub(crate) fn search_margins(loop_at: impl Fn(f64) -> (C64, f64), f_max: f64) ->
     let slope = (loop_gain(f_min * 0.01).norm() / loop_gain(f_min * 0.1).norm()).log10();
     let integrators = slope.round().max(0.0);
     let windings = (2.0 * total - std::f64::consts::PI * integrators) / std::f64::consts::TAU;
-    out.stable = windings.round() == 0.0;
+    // Nyquist: the closed loop's unstable poles are the open loop's less the counterclockwise
+    // windings of 1 + L about 0 along the imaginary axis upwards.
+    out.stable = windings.round() == open_loop_unstable as f64;
     out
 }
 

@@ -179,32 +179,59 @@ impl Controller {
     pub(crate) fn validate(&self) -> Result<()> {
         let c = self;
         positive("controller.sample_rate_hz", c.sample_rate_hz)?;
-        for (path, value) in [
+        // Each gain at most what opens the valve fully for an error of a micrometre (a
+        // micrometre per second, per second squared; a pascal): beyond any loop, the unit
+        // slip or typing error that makes the run chatter at full opening forever.
+        for (path, value, max) in [
             (
                 "controller.displacement_gain_per_m",
                 c.displacement_gain_per_m,
+                1e6,
             ),
-            ("controller.integral_gain_per_m_s", c.integral_gain_per_m_s),
+            (
+                "controller.integral_gain_per_m_s",
+                c.integral_gain_per_m_s,
+                1e9,
+            ),
             (
                 "controller.velocity_feedforward_s_per_m",
                 c.velocity_feedforward_s_per_m,
+                1e6,
             ),
             (
                 "controller.acceleration_feedforward_s2_per_m",
                 c.acceleration_feedforward_s2_per_m,
+                1e6,
             ),
             (
                 "controller.velocity_feedback_s_per_m",
                 c.velocity_feedback_s_per_m,
+                1e6,
             ),
             (
                 "controller.acceleration_feedback_s2_per_m",
                 c.acceleration_feedback_s2_per_m,
+                1e6,
             ),
-            ("controller.delta_p_gain_per_pa", c.delta_p_gain_per_pa),
-            ("controller.delta_p_highpass_hz", c.delta_p_highpass_hz),
+            ("controller.delta_p_gain_per_pa", c.delta_p_gain_per_pa, 1.0),
+            (
+                "controller.delta_p_highpass_hz",
+                c.delta_p_highpass_hz,
+                f64::INFINITY,
+            ),
         ] {
             non_negative(path, value)?;
+            if value > max {
+                return Err(invalid(
+                    path,
+                    value,
+                    format!(
+                        "at most {max:e}: a gain that opens the valve fully for an error of \
+                         {:e} of its unit is beyond any loop",
+                        1.0 / max
+                    ),
+                ));
+            }
         }
         if c.delta_p_highpass_hz >= 0.5 * c.sample_rate_hz {
             return Err(invalid(

@@ -91,6 +91,9 @@ use crate::linear::{hold_response, search_margins, spool_response, LawTerms, Mar
 use crate::params::Controller;
 use crate::table::{ActuatorHydraulics, TableHydraulics};
 
+mod poles;
+pub use poles::{LoopStability, MARGINAL_RATE_1_S, PADE_ORDER};
+
 /// Step of the pose's central differences, m or rad (rates, m/s or rad/s).
 const POSE_STEP: f64 = 1e-5;
 /// Step of the actuator forces' and of the wrench's central differences, N or N·m (the
@@ -176,6 +179,9 @@ pub struct TableLinearisation {
     feedback_geometry: DMatrix<f64>,
     /// `K_fb·(I − G_c·G_c⁺)`, actuators × actuators.
     balance: DMatrix<f64>,
+    /// The platen's radius of gyration about x, y and z through its centre of mass, m (the
+    /// weight of a rotation against a translation in a mode's shape).
+    radius_of_gyration_m: [f64; 3],
 }
 
 /// One actuator's response at a frequency: the spool per drive and the force and `Δp` per
@@ -288,7 +294,14 @@ impl TableLinearisation {
         let g_c_pinv = geometry.pseudo_inverse().clone();
         let balance =
             (DMatrix::identity(n, n) - &g_c * &g_c_pinv) * controller.force_balance_gain_per_n();
+        let platen = table.platen();
+        let radius_of_gyration_m = [0, 1, 2].map(|k| {
+            (platen.inertia_kg_m2()[(k, k)] / platen.mass_kg())
+                .sqrt()
+                .max(1e-3)
+        });
         Ok(TableLinearisation {
+            radius_of_gyration_m,
             gains: free.iter().map(|d| *controller.gains(*d)).collect(),
             period_s: controller.period_s(),
             feedback_geometry: &g_c_pinv * &mechanics.strokes,
@@ -364,9 +377,11 @@ impl TableLinearisation {
     /// The margins of DOF `dof`'s loop ([`TableLinearisation::loop_gain`]) by the uniaxial
     /// search ([`TableSystem::margins`](crate::TableSystem::margins)): from 0.001 Hz to the
     /// controller's Nyquist frequency, the peak of the DOF's own closed-loop response. Its
-    /// `stable` counts the encirclements of `−1` by `L_k` as if the loop opened at `d_k` had
-    /// no unstable pole (the other loops closed stable): advisory for a coupled table.
-    /// `None` for a held DOF.
+    /// `stable` is the Nyquist criterion with the unstable poles of the loop opened at `d_k`
+    /// counted (the eigenvalues of [`TableLinearisation::state_matrix`] with that loop open:
+    /// swivel-mounted verticals in compression are an inverted pendulum until the loops
+    /// close), so that it agrees with [`TableLinearisation::stability`]. `None` for a held
+    /// DOF.
     pub fn margins(&self, dof: Dof) -> Option<Margins> {
         let k = self.free.iter().position(|&d| d == dof)?;
         Some(search_margins(
@@ -375,6 +390,7 @@ impl TableLinearisation {
                 (l, h.norm())
             },
             0.5 / self.period_s,
+            self.unstable_with_open(k),
         ))
     }
 

@@ -35,8 +35,9 @@ pub use friction::{
     planar_rate, Contact, ContactLoad, FrictionCapacity, InverseSample, PlanarRate, Stick,
 };
 pub use modes::Mode;
-pub use specimen::LinearSpecimen;
+pub use specimen::{LinearSpecimen, MAX_SPECIMEN_DOFS};
 pub use table::{
     Actuator, ActuatorPose, AxisCapacity, Bearing, BearingLoad, Frame, Kinematics, Mount,
-    MultiAxisTable, Pad, Point, RigidPlaten, Strut, StrutPose, TableParts, Wrench,
+    MultiAxisTable, Pad, Point, RigidPlaten, Strut, StrutPose, TableParts, Wrench, MAX_GEOMETRY_M,
+    RESERVED_NAMES,
 };

@@ -3,7 +3,11 @@
 use nalgebra::{DMatrix, DVector, Matrix6};
 
 use super::modes::Mode;
-use super::table::{MultiAxisTable, Wrench};
+use super::table::{MultiAxisTable, Wrench, MAX_GEOMETRY_M};
+
+/// The most DOFs a general linear specimen may have: the six-DOF runs carry its state in
+/// fixed-size arrays, and a larger one is a finite-element model to condense first.
+pub const MAX_SPECIMEN_DOFS: usize = 12;
 use crate::error::{ModelError, Result};
 use crate::Specimen;
 
@@ -98,16 +102,31 @@ impl LinearSpecimen {
         if n == 0 {
             return Err(invalid("specimen.mass_matrix", "at least one DOF"));
         }
+        if n > MAX_SPECIMEN_DOFS {
+            return Err(invalid(
+                "specimen.mass_matrix",
+                format!(
+                    "at most {MAX_SPECIMEN_DOFS} DOFs (got {n}): the six-DOF runs carry the \
+                     specimen's state in fixed-size arrays; reduce it to its modes that matter \
+                     (a modal or static condensation)"
+                ),
+            ));
+        }
         square("specimen.mass_matrix", &mass, n)?;
         square("specimen.stiffness_matrix", &stiffness, n)?;
         square("specimen.damping_matrix", &damping, n)?;
         if influence.nrows() != n
             || influence.ncols() != 6
-            || !influence.iter().all(|x| x.is_finite())
+            || !influence
+                .iter()
+                .all(|x| x.is_finite() && x.abs() <= MAX_GEOMETRY_M)
         {
             return Err(invalid(
                 "specimen.influence",
-                format!("{n} rows of six finite numbers (x, y, z, roll, pitch, yaw)"),
+                format!(
+                    "{n} rows of six finite numbers (x, y, z, roll, pitch, yaw), each within \
+                     ±{MAX_GEOMETRY_M:e} (the rotations' levers in m)"
+                ),
             ));
         }
         let Some(chol) = mass.clone().cholesky() else {

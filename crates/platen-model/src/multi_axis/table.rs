@@ -35,12 +35,53 @@ fn invalid(path: impl Into<String>, expected: impl Into<String>) -> ModelError {
     }
 }
 
+/// How far from the reference point any point of the table may lie, m: beyond, the statics
+/// and linearisations lose their digits (a scenario refuses far less: a table spans about
+/// 20 m, and `platen_scenario` takes a point beyond 100 m as the unit slip it is).
+pub const MAX_GEOMETRY_M: f64 = 1e6;
+
 fn finite_point(path: &str, p: &Point) -> Result<()> {
-    if p.iter().all(|c| c.is_finite()) {
+    if p.iter().all(|c| c.is_finite() && c.abs() <= MAX_GEOMETRY_M) {
         Ok(())
     } else {
-        Err(invalid(path, "three finite coordinates, m"))
+        Err(invalid(
+            path,
+            format!(
+                "three finite coordinates within {MAX_GEOMETRY_M:e} m of the reference point, m"
+            ),
+        ))
     }
+}
+
+/// Names an actuator or strut may not take: its columns would repeat one of the run's own
+/// (`warping_force_n`, the closed loop's force-balance column).
+pub const RESERVED_NAMES: [&str; 1] = ["warping"];
+
+/// An actuator's or strut's name: not empty, not reserved, and fit for a CSV column name (no
+/// comma, quote or control character, no spaces around it).
+fn check_name(path: String, name: &str) -> Result<()> {
+    if name.trim().is_empty() {
+        return Err(invalid(path, "a non-empty name"));
+    }
+    if name.trim() != name || name.chars().any(|c| c == ',' || c == '"' || c.is_control()) {
+        return Err(invalid(
+            path,
+            format!(
+                "a name fit for a CSV column (no comma, quote, control character or surrounding \
+                 space; got {name:?})"
+            ),
+        ));
+    }
+    if RESERVED_NAMES.contains(&name) {
+        return Err(invalid(
+            path,
+            format!(
+                "a name other than {}: `{name}_force_n` is a column of the run itself",
+                RESERVED_NAMES.map(|r| format!("`{r}`")).join(", ")
+            ),
+        ));
+    }
+    Ok(())
 }
 
 fn positive(path: String, value: f64, unit: &str) -> Result<f64> {
@@ -350,12 +391,16 @@ impl MultiAxisTable {
             parts.oil_bulk_modulus_pa,
             "Pa",
         )?;
+        if parts.held.complement().iter().next().is_none() {
+            return Err(invalid(
+                "held_dofs",
+                "at most five of the six DOFs: with every DOF held the platen cannot move",
+            ));
+        }
         let mut neutral_lengths_m = Vec::with_capacity(parts.actuators.len());
         for (i, a) in parts.actuators.iter().enumerate() {
             let at = |key: &str| format!("actuators[{i}].{key}");
-            if a.name.trim().is_empty() {
-                return Err(invalid(at("name"), "a non-empty name"));
-            }
+            check_name(at("name"), &a.name)?;
             if parts.actuators[..i].iter().any(|b| b.name == a.name) {
                 return Err(invalid(
                     at("name"),
@@ -399,6 +444,7 @@ impl MultiAxisTable {
         let mut strut_neutral_m = Vec::with_capacity(parts.struts.len());
         for (j, s) in parts.struts.iter().enumerate() {
             let at = |key: &str| format!("hold_down_struts[{j}].{key}");
+            check_name(at("name"), &s.name)?;
             if parts.struts[..j].iter().any(|b| b.name == s.name)
                 || parts.actuators.iter().any(|a| a.name == s.name)
             {
