@@ -64,14 +64,16 @@ use crate::target::Target;
 
 /// The scenario JSON `text` (from `path`, for messages) if it is a multi-axis one (it has a
 /// `table`), parsed, its `excitation` optional (a plan's target takes its place, and a
-/// commanded table does not read it); `None` for any other text (not JSON, or no `table`),
-/// which the single-axis planner reads and reports on.
+/// commanded table does not read it); `None` for JSON without a `table`, which the
+/// single-axis planner reads and reports on.
 ///
 /// # Errors
-/// [`PlanError::Io`] for a multi-axis scenario that does not parse (its path and line).
+/// [`PlanError::Io`] for text that is not JSON (its line and column) and for a multi-axis
+/// scenario that does not parse (its path and line).
 pub fn table_scenario_file(path: &Path, text: &str) -> Result<Option<ScenarioFile>> {
     let Ok(mut value) = serde_json::from_str::<serde_json::Value>(text) else {
-        return Ok(None);
+        // Not JSON: its syntax error, at its line and column, as `simulate` reports it.
+        return Ok(Some(platen_io::json::parse_json(path, text)?));
     };
     let Some(object) = value.as_object_mut().filter(|o| o.contains_key("table")) else {
         return Ok(None);

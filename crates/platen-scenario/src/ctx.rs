@@ -80,3 +80,19 @@ pub(crate) fn check_finite(ctx: &Ctx, json_path: &str, value: f64) -> Result<f64
         Err(ctx.invalid(json_path, value, "a finite number"))
     }
 }
+
+/// The value at `json_path` (`a.b[2].c`) of `value`, as compact JSON (for messages).
+pub(crate) fn value_at(value: &serde_json::Value, json_path: &str) -> String {
+    let pointer: String = json_path
+        .split('.')
+        .flat_map(|part| {
+            let mut pieces = part.split('[');
+            let key = pieces.next().unwrap_or_default().to_owned();
+            std::iter::once(key).chain(pieces.map(|p| p.trim_end_matches(']').to_owned()))
+        })
+        .map(|p| format!("/{p}"))
+        .collect();
+    value
+        .pointer(&pointer)
+        .map_or_else(|| "(absent)".to_owned(), ToString::to_string)
+}

@@ -39,6 +39,17 @@ pub enum ScenarioError {
     #[error("the multi-axis run failed; no output was written")]
     TableRun(#[source] IntegrateError),
 
+    /// A multi-axis closed loop whose linearisation is unstable failed in its run (it
+    /// diverged): the verdict says why.
+    #[error("the multi-axis closed loop is unstable (linearised at neutral, {verdict}; `platen model --scenario` shows each DOF's margins): its run failed; no output was written")]
+    TableLoopUnstable {
+        /// The linearised loop's verdict: its growing poles and the DOF that moves most.
+        verdict: String,
+        /// How the run failed.
+        #[source]
+        source: IntegrateError,
+    },
+
     /// A record is shorter than the scenario's `duration_s`.
     #[error("`{}`: record spans {span_s} s{} but the scenario's duration_s is {duration_s} s", path.display(), samples.map_or(String::new(), |n| format!(" ({n} samples)")))]
     RecordTooShort {

@@ -551,7 +551,20 @@ pub(crate) fn motion_run(
                     duration_s: d,
                 });
             }
-            t.partition_point(|&x| x <= end + 1e-9 * d.abs())
+            let samples = t.partition_point(|&x| x <= end + 1e-9 * d.abs());
+            if samples < 2 && t.len() >= 2 {
+                return Err(ctx.invalid(
+                    "duration_s",
+                    d,
+                    format!(
+                        "at least one interval of the record `{}` ({} s): a run needs two \
+                         samples",
+                        path.display(),
+                        t[1] - t[0]
+                    ),
+                ));
+            }
+            samples
         }
     };
     let cut = |c: Vec<f64>| c[..samples].to_vec();

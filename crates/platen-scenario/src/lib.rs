@@ -28,6 +28,7 @@ mod excitation;
 mod execute;
 pub mod file;
 pub mod generate;
+pub mod loop_budget;
 mod model;
 pub mod multi_axis;
 pub mod recorded;

@@ -32,7 +32,7 @@ use platen_system::{
     TableHydraulicsParts,
 };
 
-use crate::ctx::{check_finite, check_positive, Ctx};
+use crate::ctx::{check_finite, check_positive, value_at, Ctx};
 use crate::error::{Result, ScenarioError};
 use crate::excitation::MotionGenerator;
 use crate::excitation::{motion_run, read_mapped, Derived};
@@ -44,6 +44,12 @@ pub use crate::table_file::{
     ActuatorSpec, AxisLimitsSpec, BearingSpec, DofGainsSpec, PadSpec, PlatenSpec,
     RotationLimitSpec, StrutSpec, TableControllerSpec, TableSpec, TranslationLimitSpec,
 };
+
+/// How far from the reference point a table's points (and a specimen's levers, a pose) may
+/// lie in a scenario, m (rad for a rotation): the largest shake tables span about 20 m, so a
+/// value beyond is a unit slip (millimetres written as metres) or a typing error, refused at
+/// its key.
+pub const PLAUSIBLE_GEOMETRY_M: f64 = 100.0;
 
 /// Default oil bulk modulus, Pa.
 pub const DEFAULT_OIL_BULK_MODULUS_PA: f64 = 1.5e9;
@@ -121,6 +127,16 @@ pub struct TableScenario {
     pub limits: crate::table_file::AxisLimitsSpec,
 }
 
+/// Where a scenario's motion comes from as it is built.
+enum Given {
+    /// Its `excitation`.
+    File,
+    /// A closed loop's command in place of its excitation (`platen plan`).
+    Command(PoseMotion),
+    /// A still motion in place of its excitation (`platen model`, which does not run it).
+    Still(PoseMotion),
+}
+
 /// The closed loop around a multi-axis table.
 #[derive(Debug, Clone)]
 pub struct TableLoopSystem {
@@ -156,6 +172,22 @@ impl TableScenario {
         Self::build(path, file, Some(command))
     }
 
+    /// The scenario as `platen model` describes it: its table, specimen, limits and loop,
+    /// with a still motion in place of its excitation, which is not read (a scenario whose
+    /// PEER records are absent is described all the same).
+    ///
+    /// # Errors
+    /// As [`TableScenario::from_file`] for everything but the excitation.
+    pub fn for_description(path: &Path, file: &ScenarioFile) -> Result<Self> {
+        let zero = || vec![0.0; 2];
+        let dofs: [platen_signal::Motion; 6] = std::array::from_fn(|_| {
+            platen_signal::Motion::new(vec![0.0, 1.0], zero(), zero(), zero())
+                .expect("two increasing stamps and finite zeros make a motion")
+        });
+        let still = PoseMotion::new(dofs).map_err(ScenarioError::TableRun)?;
+        Self::build_with(path, file, Given::Still(still))
+    }
+
     /// The same closed loop commanded by `command`.
     ///
     /// # Errors
@@ -184,6 +216,11 @@ impl TableScenario {
     /// [`TableScenario::from_file`], or with `command` as the closed loop's command in
     /// place of the file's excitation.
     fn build(path: &Path, file: &ScenarioFile, command: Option<PoseMotion>) -> Result<Self> {
+        Self::build_with(path, file, command.map_or(Given::File, Given::Command))
+    }
+
+    /// [`TableScenario::build`] with the motion `given`.
+    fn build_with(path: &Path, file: &ScenarioFile, given_motion: Given) -> Result<Self> {
         let ctx = Ctx { path };
         let Some(given) = &file.table else {
             return Err(ctx.invalid("table", "(absent)", "a multi-axis table"));
@@ -224,22 +261,48 @@ impl TableScenario {
             )?),
             None => None,
         };
-        let (run, derived) = match command {
-            None => build_run(&ctx, file, &table, closed)?,
-            Some(_) if !closed => {
+        let (run, derived) = match given_motion {
+            Given::File => build_run(&ctx, file, &table, closed)?,
+            Given::Still(still) => (
+                if closed {
+                    TableRunSpec::Loop {
+                        command: Box::new(still),
+                    }
+                } else {
+                    TableRunSpec::Inverse {
+                        motion: Box::new(still),
+                    }
+                },
+                Derived::new(),
+            ),
+            Given::Command(_) if !closed => {
                 return Err(ctx.invalid(
                     "table.controller",
                     "(absent)",
                     "a DOF controller: only a closed loop follows a command",
                 ))
             }
-            Some(command) => (
+            Given::Command(command) => (
                 TableRunSpec::Loop {
                     command: Box::new(command),
                 },
                 Derived::new(),
             ),
         };
+        if let (Some(sys), TableRunSpec::Loop { command }) = (&system, &run) {
+            crate::loop_budget::check_steps(
+                &ctx,
+                spec,
+                &table,
+                specimen.as_ref(),
+                &crate::loop_budget::LoopCost {
+                    hydraulics: &sys.hydraulics,
+                    period_s: sys.controller.period_s(),
+                    steps_per_period: sys.method.steps_per_period(),
+                },
+                command,
+            )?;
+        }
         let pressure = |key: &str, v: Option<f64>, default: f64| match v {
             Some(p) => check_positive(&ctx, &format!("table.{key}"), p),
             None => Ok(default),
@@ -280,7 +343,16 @@ impl TableScenario {
                 method: sys.method,
             })
             .map(|(run, stats)| (run, Some(stats)))
-            .map_err(ScenarioError::TableRun);
+            .map_err(|source| {
+                // A loop that diverged: say that it is unstable, where, and in which DOF.
+                match self
+                    .linearisation()
+                    .and_then(|lin| loop_verdict_stability(&lin).unstable_words())
+                {
+                    Some(verdict) => ScenarioError::TableLoopUnstable { verdict, source },
+                    None => ScenarioError::TableRun(source),
+                }
+            });
         }
         self.run().map(|run| (run, None))
     }
@@ -378,22 +450,6 @@ impl TableScenario {
     }
 }
 
-/// The value at `json_path` (`a.b[2].c`) of `value`, as compact JSON (for messages).
-fn value_at(value: &serde_json::Value, json_path: &str) -> String {
-    let pointer: String = json_path
-        .split('.')
-        .flat_map(|part| {
-            let mut pieces = part.split('[');
-            let key = pieces.next().unwrap_or_default().to_owned();
-            std::iter::once(key).chain(pieces.map(|p| p.trim_end_matches(']').to_owned()))
-        })
-        .map(|p| format!("/{p}"))
-        .collect();
-    value
-        .pointer(&pointer)
-        .map_or_else(|| "(absent)".to_owned(), ToString::to_string)
-}
-
 /// The error of a model-layer refusal of the table, at its JSON path under `table`.
 fn table_error(ctx: &Ctx, spec: &TableSpec, e: ModelError) -> ScenarioError {
     let json = serde_json::to_value(spec).unwrap_or_default();
@@ -443,8 +499,49 @@ impl TableSpec {
     }
 }
 
+/// Every point of `table` within [`PLAUSIBLE_GEOMETRY_M`] of the reference point.
+fn check_geometry(ctx: &Ctx, spec: &TableSpec) -> Result<()> {
+    let mut points: Vec<(String, [f64; 3])> = Vec::new();
+    if let Some(p) = &spec.platen {
+        points.push(("platen.centre_of_mass_m".into(), p.centre_of_mass_m));
+    }
+    for (i, a) in spec.actuators.iter().enumerate() {
+        points.push((format!("actuators[{i}].base_m"), a.base_m));
+        if let Some(p) = a.platen_m {
+            points.push((format!("actuators[{i}].platen_m"), p));
+        }
+        if let Some(pad) = &a.pad {
+            points.push((format!("actuators[{i}].pad.contact_m"), pad.contact_m));
+        }
+    }
+    for (j, st) in spec.hold_down_struts.iter().enumerate() {
+        points.push((format!("hold_down_struts[{j}].base_m"), st.base_m));
+        points.push((format!("hold_down_struts[{j}].platen_m"), st.platen_m));
+    }
+    for (k, b) in spec.bearings.iter().enumerate() {
+        points.push((format!("bearings[{k}].platen_m"), b.platen_m));
+    }
+    for (path, p) in points {
+        if p.iter()
+            .any(|c| c.is_finite() && c.abs() > PLAUSIBLE_GEOMETRY_M)
+        {
+            return Err(ctx.invalid(
+                &format!("table.{path}"),
+                format!("{p:?}"),
+                format!(
+                    "a point within {PLAUSIBLE_GEOMETRY_M} m of the reference point, m (a table \
+                     spans about 20 m: beyond is a unit slip, millimetres written as metres, or a \
+                     typing error)"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// `table` into a validated table.
 fn build_table(ctx: &Ctx, spec: &TableSpec) -> Result<MultiAxisTable> {
+    check_geometry(ctx, spec)?;
     let platen = spec.platen.as_ref().ok_or_else(|| {
         ctx.invalid(
             "table.platen",
@@ -654,6 +751,26 @@ fn read_pose_motion(ctx: &Ctx, file: &ScenarioFile, path: &Path) -> Result<(Pose
                       roll_rad, pitch_rad, yaw_rad (absent ones are 0)"
                 .into(),
         }));
+    }
+    // A pose beyond any table's reach is a unit slip (mm written as m), refused where it is
+    // read: a run of it would end non-finite, or ride on a stroke limit with nothing said.
+    for (k, name) in POSE_COLUMNS.iter().enumerate() {
+        let Some(column) = cols.get(name) else {
+            continue;
+        };
+        let limit = PLAUSIBLE_GEOMETRY_M;
+        if let Some(i) = column.iter().position(|x| x.abs() > limit) {
+            let unit = if k < 3 { "m" } else { "rad" };
+            return Err(ScenarioError::Io(platen_io::IoError::Record {
+                path: path.to_owned(),
+                message: format!(
+                    "data row {}, column `{name}`: {:e} {unit}, beyond the ±{limit} {unit} any \
+                     table reaches (millimetres or degrees written as {unit}?)",
+                    i + 1,
+                    column[i]
+                ),
+            }));
+        }
     }
     let t = cols.remove("t_s").unwrap_or_default();
     let mut derived = Derived::new();
@@ -1026,6 +1143,7 @@ fn build_system(
     let geometry = DofGeometry::of_table(table).map_err(|e| system_error(ctx, e))?;
     let controller =
         DofController::new(rate, loops, balance, geometry).map_err(|e| system_error(ctx, e))?;
+    crate::loop_budget::check_orifices(ctx, spec, &hydraulics, controller.period_s())?;
     // The fastest mode the integrator steps: the oil columns' (the table's modes with the
     // valves shut, specimen included), resolved to `h·ω ≤ 0.25`. The spools are not
     // stepped: the loop carries them in closed form between drive changes
@@ -1226,6 +1344,19 @@ fn build_specimen(ctx: &Ctx, given: Option<&SpecimenSpec>) -> Result<Option<Line
     let stiffness = matrix("stiffness_matrix", &s.stiffness_matrix, None)?;
     let damping = matrix("damping_matrix", &s.damping_matrix, None)?;
     let influence = matrix("influence", &s.influence, Some(6))?;
+    if let Some((r, c)) = (0..influence.nrows())
+        .flat_map(|r| (0..6).map(move |c| (r, c)))
+        .find(|&(r, c)| influence[(r, c)].abs() > PLAUSIBLE_GEOMETRY_M)
+    {
+        return Err(ctx.invalid(
+            &format!("specimen.influence[{r}][{c}]"),
+            influence[(r, c)],
+            format!(
+                "a share of the platen's motion within ±{PLAUSIBLE_GEOMETRY_M} (a rotation's lever \
+                 in m: no specimen stands {PLAUSIBLE_GEOMETRY_M} m from the reference point)"
+            ),
+        ));
+    }
     LinearSpecimen::new(mass, stiffness, damping, influence)
         .map(Some)
         .map_err(|e| match e {
@@ -1349,6 +1480,11 @@ pub struct TableLoopSummary {
     pub controller_samples: u64,
     /// RK4 steps per controller period (or Dopri5 pieces).
     pub steps_per_period: u32,
+    /// The loop's stability from the eigenvalues of its linearisation at neutral (`null`
+    /// when it cannot be linearised: the actuators cannot hold the platen there).
+    pub stability: Option<LoopStabilityDescription>,
+    /// Per free DOF, its loop's margins, broken at its drive with the others closed.
+    pub loop_margins: std::collections::BTreeMap<&'static str, DofLoopDescription>,
 }
 
 /// One strut's range of pull.
@@ -1618,6 +1754,24 @@ impl TableScenario {
             ));
         }
         let loop_figures = stats.zip(self.system.as_ref()).map(|(st, sys)| {
+            let (stability, loop_margins) = match self.linearisation() {
+                Some(lin) => {
+                    let (s, m) = loop_verdict(&lin);
+                    (Some(s), m)
+                }
+                None => (None, std::collections::BTreeMap::new()),
+            };
+            if let Some(words) = stability.as_ref().and_then(|s| s.unstable_words()) {
+                // The most serious first.
+                warnings.insert(
+                    0,
+                    format!(
+                    "the closed loop is unstable (linearised at neutral, {words}): the run shows what the table would \
+                         do, but check the controller's gains (`platen model --scenario` shows \
+                         each DOF's margins)"
+                    ),
+                );
+            }
             if let Some(at) = st.cavitation_at_s {
                 warnings.push(format!(
                     "cavitation: a chamber reached 0 Pa (absolute) at t = {at:.4} s"
@@ -1637,6 +1791,8 @@ impl TableScenario {
                 hydraulic_energy_j: st.hydraulic_energy_j,
                 controller_samples: st.controller_samples,
                 steps_per_period: sys.method.steps_per_period(),
+                stability,
+                loop_margins,
             }
         });
         let axes_respected = limits.values().all(|l| l.respected);
@@ -1801,6 +1957,29 @@ pub fn summary_text(s: &TableSummary, figures: &[PathBuf]) -> String {
             l.max_warping_force_n / 1e3,
             l.saturated_time_s
         );
+        let verdict = match &l.stability {
+            Some(st) if st.stable => "stable".to_owned(),
+            Some(st) => format!("UNSTABLE, {}", st.unstable_words().unwrap_or_default()),
+            None => "not linearised".to_owned(),
+        };
+        let margins: Vec<String> = Dof::ALL
+            .iter()
+            .filter_map(|d| {
+                let m = l.loop_margins.get(d.name())?;
+                let gm = m
+                    .gain_margin_db
+                    .map_or("-".to_owned(), |g| format!("{g:.1} dB"));
+                let pm = m
+                    .phase_margin_deg
+                    .map_or("-".to_owned(), |p| format!("{p:.0}°"));
+                Some(format!("{} {gm}, {pm}", d.name()))
+            })
+            .collect();
+        let _ = writeln!(
+            t,
+            "  loop stability (linearised at neutral): {verdict}; margins {}",
+            margins.join("; ")
+        );
     }
     for w in &s.warnings {
         let _ = writeln!(t, "  warning: {w}");
@@ -1880,10 +2059,31 @@ pub struct CrossTalkDescription {
     pub largest: Option<f64>,
 }
 
+/// The closed loop's stability from the eigenvalues of its linearisation
+/// (`platen_system::TableLinearisation::stability`: delays by Padé approximants).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LoopStabilityDescription {
+    /// No closed-loop eigenvalue in the right half-plane.
+    pub stable: bool,
+    /// The largest real part of the closed-loop eigenvalues off the imaginary axis (beyond
+    /// 1e-3 1/s either way: the chambers' mean pressures and unclosed integrators sit on
+    /// it), 1/s: negative, the slowest decay of a stable loop; positive, the fastest growth
+    /// of an unstable one.
+    pub largest_real_part_1_s: f64,
+    /// The unstable eigenvalues (upper half-plane of each pair), fastest-growing first:
+    /// `[growth rate 1/s, frequency Hz]`.
+    pub unstable_poles: Vec<[f64; 2]>,
+    /// The DOF that moves the most in the fastest-growing mode (`null` when stable).
+    pub unstable_dof: Option<&'static str>,
+}
+
 /// `platen model` on a table with a controller: the linearised loop about neutral at rest
 /// (mean flow gains, see `platen_system::TableLinearisation`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct TableLoopDescription {
+    /// The whole loop's stability, from its eigenvalues: the verdict (each DOF's margins
+    /// below are measured with the other loops closed).
+    pub stability: LoopStabilityDescription,
     /// Per free DOF, its loop's margins.
     pub dofs: std::collections::BTreeMap<&'static str, DofLoopDescription>,
     /// Per free DOF's command, its largest cross-talk at 1, 2, 5 and 10 Hz.
@@ -1995,36 +2195,23 @@ impl TableScenario {
         )
     }
 
-    /// The closed loop's linearisation: margins per DOF and cross-talk (`None` without one,
-    /// or when it cannot be linearised).
-    fn loop_description(&self) -> Option<TableLoopDescription> {
+    /// The closed loop's linearisation (`None` without one, or when it cannot be linearised).
+    fn linearisation(&self) -> Option<platen_system::TableLinearisation> {
         let sys = self.system.as_ref()?;
-        let lin = platen_system::TableLinearisation::new(
+        platen_system::TableLinearisation::new(
             &self.table,
             &sys.hydraulics,
             &sys.controller,
             self.specimen.as_ref(),
         )
-        .ok()?;
-        let dofs = lin
-            .free()
-            .iter()
-            .filter_map(|&d| {
-                let m = lin.margins(d)?;
-                Some((
-                    d.name(),
-                    DofLoopDescription {
-                        gain_margin_db: m.gain_margin_db,
-                        phase_crossover_hz: m.phase_crossover_hz,
-                        phase_margin_deg: m.phase_margin_deg,
-                        gain_crossover_hz: m.gain_crossover_hz,
-                        stable: m.stable,
-                        peak_gain: m.peak_gain,
-                        peak_gain_hz: m.peak_gain_hz,
-                    },
-                ))
-            })
-            .collect();
+        .ok()
+    }
+
+    /// The closed loop's linearisation: margins per DOF and cross-talk (`None` without one,
+    /// or when it cannot be linearised).
+    fn loop_description(&self) -> Option<TableLoopDescription> {
+        let lin = self.linearisation()?;
+        let (stability, dofs) = loop_verdict(&lin);
         let mut cross_talk: std::collections::BTreeMap<&'static str, Vec<CrossTalkDescription>> =
             std::collections::BTreeMap::new();
         for f in CROSS_TALK_HZ {
@@ -2048,10 +2235,74 @@ impl TableScenario {
             .map(|(a, l)| (a.name.clone(), l.static_force_n))
             .collect();
         Some(TableLoopDescription {
+            stability,
             dofs,
             cross_talk,
             static_forces_n,
         })
+    }
+}
+
+/// The linearised loop's stability (its eigenvalues) alone.
+fn loop_verdict_stability(lin: &platen_system::TableLinearisation) -> LoopStabilityDescription {
+    let st = lin.stability();
+    LoopStabilityDescription {
+        stable: st.stable,
+        largest_real_part_1_s: st.largest_real_part_1_s,
+        unstable_poles: st
+            .unstable_poles
+            .iter()
+            .map(|p| [p.re, p.im / std::f64::consts::TAU])
+            .collect(),
+        unstable_dof: st.unstable_dof.map(Dof::name),
+    }
+}
+
+/// The linearised loop's stability (its eigenvalues) and each free DOF's margins.
+fn loop_verdict(
+    lin: &platen_system::TableLinearisation,
+) -> (
+    LoopStabilityDescription,
+    std::collections::BTreeMap<&'static str, DofLoopDescription>,
+) {
+    let stability = loop_verdict_stability(lin);
+    let dofs = lin
+        .free()
+        .iter()
+        .filter_map(|&d| {
+            let m = lin.margins(d)?;
+            Some((
+                d.name(),
+                DofLoopDescription {
+                    gain_margin_db: m.gain_margin_db,
+                    phase_crossover_hz: m.phase_crossover_hz,
+                    phase_margin_deg: m.phase_margin_deg,
+                    gain_crossover_hz: m.gain_crossover_hz,
+                    stable: m.stable,
+                    peak_gain: m.peak_gain,
+                    peak_gain_hz: m.peak_gain_hz,
+                },
+            ))
+        })
+        .collect();
+    (stability, dofs)
+}
+
+impl LoopStabilityDescription {
+    /// The unstable verdict in words (`None` when stable): its fastest-growing pole and the
+    /// DOF that moves most in it.
+    pub fn unstable_words(&self) -> Option<String> {
+        if self.stable {
+            return None;
+        }
+        let pole = self.unstable_poles.first().map_or(
+            "its eigenvalues could not be computed (values far out of range)".to_owned(),
+            |[re, f]| format!("a pole grows at {re:.3} 1/s at {f:.2} Hz"),
+        );
+        let dof = self
+            .unstable_dof
+            .map_or(String::new(), |d| format!(", mostly in {d}"));
+        Some(format!("{pole}{dof}"))
     }
 }
 
@@ -2090,9 +2341,29 @@ pub fn description_text(d: &TableDescription) -> String {
         let _ = writeln!(t, "    {axis:<6} {}", list.join(", "));
     }
     if let Some(l) = &d.loop_figures {
+        let st = &l.stability;
+        if st.stable {
+            let _ = writeln!(
+                t,
+                "  closed loop (linearised at neutral): stable, no pole in the right half-plane"
+            );
+        } else {
+            let poles: Vec<String> = st
+                .unstable_poles
+                .iter()
+                .map(|[re, f]| format!("{re:.3} 1/s at {f:.2} Hz"))
+                .collect();
+            let _ = writeln!(
+                t,
+                "  closed loop (linearised at neutral): UNSTABLE, growing {}{}",
+                poles.join(", "),
+                st.unstable_dof
+                    .map_or(String::new(), |d| format!(" (mostly {d})"))
+            );
+        }
         let _ = writeln!(
             t,
-            "  closed loop (linearised at neutral, each DOF's loop broken at its drive):"
+            "  each DOF's loop broken at its drive (the others closed):"
         );
         let show =
             |x: Option<f64>, unit: &str| x.map_or("-".to_owned(), |v| format!("{v:.2} {unit}"));

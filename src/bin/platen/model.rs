@@ -236,7 +236,7 @@ fn describe_table(
             path.display()
         );
     }
-    let scenario = platen_scenario::multi_axis::TableScenario::from_file(path, file)?;
+    let scenario = platen_scenario::multi_axis::TableScenario::for_description(path, file)?;
     let written = match (args.plot.as_deref(), &scenario.system) {
         (None, _) => Vec::new(),
         (Some(_), None) => bail!(
