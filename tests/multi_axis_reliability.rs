@@ -233,6 +233,18 @@ fn values_that_would_hang_the_loop_are_refused_at_their_key() {
         dir.path(),
         &valves("natural_frequency_hz", 1e9),
         "table.actuators[0].servo_valve.natural_frequency_hz",
+        &["at most 5000 Hz"],
+    );
+    // A spool within that bound, but the run's steps beyond the budget: 2 000 s of the
+    // LHPOST6 with its spools at 4 kHz.
+    let mut doc = valves("natural_frequency_hz", 4000.0);
+    doc["excitation"] = json!({"sine_motion": {"x": {"amplitude_m": 0.001,
+        "frequency_hz": 1.0, "sample_rate_hz": 200.0}}});
+    doc["duration_s"] = json!(2000.0);
+    refused(
+        dir.path(),
+        &doc,
+        "table.actuators[0].servo_valve.natural_frequency_hz",
         &["spool", "integration steps"],
     );
     let specimen = |k: f64, lever: f64| {

@@ -146,6 +146,12 @@ impl Actuator {
     }
 }
 
+/// The fastest spool a servo-valve may have, Hz ([`ServoValve::natural_frequency_hz`]).
+pub const MAX_SPOOL_HZ: f64 = 5000.0;
+
+/// The largest damping ratio of a spool ([`ServoValve::damping_ratio`]).
+pub const MAX_SPOOL_DAMPING: f64 = 10.0;
+
 impl ServoValve {
     /// `K = m·Q_r/√(Δp_r/2)` of all `m` valves together: the land coefficient, m³/s per √Pa
     /// at full opening.
@@ -166,6 +172,28 @@ impl ServoValve {
         )?;
         positive("servo_valve.natural_frequency_hz", v.natural_frequency_hz)?;
         positive("servo_valve.damping_ratio", v.damping_ratio)?;
+        // A servo-valve's spool answers at tens to hundreds of hertz, damped below critical
+        // or a little above: beyond these bounds a value is a unit slip (rad/s written as Hz,
+        // a percentage as a ratio), and a spool ten kilohertz fast takes the loop a thousand
+        // steps a controller period.
+        if v.natural_frequency_hz > MAX_SPOOL_HZ {
+            return Err(invalid(
+                "servo_valve.natural_frequency_hz",
+                v.natural_frequency_hz,
+                format!(
+                    "at most {MAX_SPOOL_HZ} Hz (servo-valves answer at tens to hundreds of hertz)"
+                ),
+            ));
+        }
+        if v.damping_ratio > MAX_SPOOL_DAMPING {
+            return Err(invalid(
+                "servo_valve.damping_ratio",
+                v.damping_ratio,
+                format!(
+                    "at most {MAX_SPOOL_DAMPING} (a ratio to critical damping, not a percentage)"
+                ),
+            ));
+        }
         non_negative("servo_valve.delay_s", v.delay_s)?;
         if v.delay_s > 1.0 {
             return Err(invalid("servo_valve.delay_s", v.delay_s, "at most 1 s"));
