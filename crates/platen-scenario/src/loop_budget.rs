@@ -89,7 +89,6 @@ pub(crate) fn check_orifices(
     hydraulics: &TableHydraulics,
     period_s: f64,
 ) -> Result<()> {
-    let json = serde_json::to_value(spec).unwrap_or_default();
     for (i, a) in hydraulics.actuators().iter().enumerate() {
         let wide_open = ActuatorState {
             p_a_pa: hydraulics.supply_pressure_pa(),
@@ -118,6 +117,8 @@ pub(crate) fn check_orifices(
             )
         };
         let key = format!("table.actuators[{i}].servo_valve.{key}");
+        // The spec as JSON only for the message: not on every load.
+        let json = serde_json::to_value(spec).unwrap_or_default();
         let value = value_at(&json, &key["table.".len()..]);
         return Err(ctx.invalid(
             &key,

@@ -97,12 +97,12 @@ impl TableLinearisation {
     /// The closed loop's state matrix (see the module docs), with the loop of free DOF
     /// `broken` opened at its drive (`d_k = 0`) when given.
     pub fn state_matrix(&self, broken: Option<usize>) -> DMatrix<f64> {
-        self.assemble(broken).0
+        self.assemble(broken)
     }
 
     /// Stability of the closed loop from its eigenvalues (see [`LoopStability`]).
     pub fn stability(&self) -> LoopStability {
-        let (a, _) = self.assemble(None);
+        let a = self.assemble(None);
         let states = a.nrows();
         let eig = eigenvalues(&a);
         let marginal = |l: &C64| l.re.abs() <= MARGINAL_RATE_1_S;
@@ -180,8 +180,8 @@ impl TableLinearisation {
             .map(|(d, _)| d)
     }
 
-    /// The state matrix and each actuator's slots.
-    fn assemble(&self, broken: Option<usize>) -> (DMatrix<f64>, Vec<ActuatorSlots>) {
+    /// The state matrix.
+    fn assemble(&self, broken: Option<usize>) -> DMatrix<f64> {
         let nf = self.free.len();
         let nz = self.specimen.as_ref().map_or(0, |s| s.mass.nrows());
         let n = self.actuators.len();
@@ -368,7 +368,7 @@ impl TableLinearisation {
                 }
             }
         }
-        (a, slots)
+        a
     }
 }
 
