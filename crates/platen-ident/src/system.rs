@@ -46,6 +46,7 @@ mod judge;
 mod plant;
 mod provenance;
 pub mod skew;
+pub mod transmissibility;
 
 pub use judge::{
     fir_black_box, Baseline, BlackBox, HeldOutMedians, Judgement, Prediction, PredictionSeries,
@@ -58,8 +59,10 @@ pub use plant::{
     NOMINAL_BULK_MODULUS_PA, NOMINAL_RATED_DROP_PA, NOMINAL_RETURN_PRESSURE_PA,
     NOMINAL_SUPPLY_PRESSURE_PA, SLIP_SPEED_M_S, STROKE_FRACTION_OF_ROOM,
 };
+pub use plant::{DECAY_GRID_S_PER_M, EXPONENT_GRID, FRICTION_TERM_T, LOW_SLIP_SPEED_M_S};
 pub use provenance::{Source, ValueProvenance};
-pub use skew::ChannelSkew;
+pub use skew::{ChannelSkew, RecordSkew, PER_RECORD_MAX_SE_SAMPLES};
+pub use transmissibility::{ModeCheck, Transmissibility, TransmissibilityPeak};
 
 /// Corners tried for the `Δp` high-pass when none is given, Hz (0: `Δp` unfiltered).
 pub const HIGHPASS_GRID_HZ: [f64; 12] = [
@@ -502,6 +505,13 @@ pub fn identify_system(
             }
         }
     });
+    let modes: Vec<(f64, f64)> = plant
+        .specimen_modes
+        .iter()
+        .map(|m| (m.frequency_hz, m.damping_ratio))
+        .collect();
+    plant.transmissibility =
+        transmissibility::transmissibility(records_c, &periods, &fitted, &modes);
     if settings.judge {
         result.judgement = judge::judge(records_c, &periods, &fitted, &plant);
     }

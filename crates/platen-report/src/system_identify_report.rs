@@ -316,6 +316,14 @@ fn controller_lines(s: &mut String, id: &SystemIdentification) {
                 ", not corrected"
             }
         );
+        if c.applied && !c.per_record.is_empty() {
+            let each: Vec<String> = c
+                .per_record
+                .iter()
+                .map(|r| format!("{} {:+.3}", r.name, r.applied_samples))
+                .collect();
+            let _ = writeln!(s, "  each record corrected by its own: {}", each.join(", "));
+        }
     }
     for r in &id.records {
         let _ = writeln!(
@@ -348,7 +356,7 @@ fn plant_lines(s: &mut String, p: &IdentifiedPlant) {
     if let Some(m) = &p.mechanics {
         let _ = writeln!(
             s,
-            "platen: mass {} kg, stiffness {} N/m, viscous {} N·s/m, Coulomb {} N (force \
+            "platen: mass {} kg, stiffness {} N/m, viscous {} N·(s/m)^α, Coulomb {} N (force \
              residual {:.3} % over {} samples){}",
             plus_minus(
                 m.effective_mass_kg,
@@ -369,6 +377,20 @@ fn plant_lines(s: &mut String, p: &IdentifiedPlant) {
                 "; rod side {r:.5} of the cap side's area (from both pressures)"
             ))
         );
+        if m.viscous_exponent != 1.0 || m.low_velocity_force_n > 0.0 {
+            let _ = writeln!(
+                s,
+                "platen friction: sgn(v)·[F_μ + a·e^(−b|v|) + C·|v|^α], α {}, a {} N, b {} s/m \
+                 (slips above {} m/s in the fit)",
+                m.viscous_exponent,
+                plus_minus(
+                    m.low_velocity_force_n,
+                    se("model.identified.low_velocity_force_n")
+                ),
+                m.low_velocity_decay_s_per_m,
+                m.slip_speed_m_s
+            );
+        }
     }
     storey_lines(s, p);
     if let Some(h) = &p.hydraulics {
@@ -398,6 +420,46 @@ fn storey_lines(s: &mut String, p: &IdentifiedPlant) {
             m.frequency_hz,
             100.0 * m.damping_ratio
         );
+    }
+    if let Some(t) = &p.transmissibility {
+        let _ = writeln!(
+            s,
+            "the records' own modes (roof over table acceleration, Welch over {} records, \
+             {:.4} Hz bins):",
+            t.records, t.resolution_hz
+        );
+        for (i, pk) in t.peaks.iter().enumerate() {
+            let zeta = if pk.damping_resolved {
+                format!(
+                    "half-power damping {:.2} %",
+                    100.0 * pk.half_power_damping_ratio
+                )
+            } else {
+                format!(
+                    "half-power damping at most {:.2} % (too narrow for the bins to resolve)",
+                    100.0 * pk.half_power_damping_ratio
+                )
+            };
+            let _ = writeln!(
+                s,
+                "  peak {}: {:.4} Hz, {zeta}, coherence {:.3}",
+                i + 1,
+                pk.frequency_hz,
+                pk.coherence
+            );
+        }
+        for c in &t.mode_checks {
+            let _ = writeln!(
+                s,
+                "  identified {:.4} Hz against the peak at {:.4} Hz: {:+.2} %",
+                c.identified_hz,
+                c.transmissibility_hz,
+                100.0 * c.relative_difference
+            );
+        }
+        for w in &t.warnings {
+            let _ = writeln!(s, "warning: {w}");
+        }
     }
 }
 

@@ -49,7 +49,8 @@
 //! * [`Resampler`]: band-limited change of sample rate.
 //! * [`AccelerogramMotion`]: the table motion of a ground-acceleration record as PEER
 //!   integrates it (straight lines between samples, exact integrals), with a [`Baseline`].
-//! * [`Welch`]: power spectral density ([`Psd`], with [`Psd::rms_in_band`]).
+//! * [`Welch`]: power spectral density ([`Psd`], with [`Psd::rms_in_band`]) and cross-spectra
+//!   ([`CrossSpectra`]: transfer functions and coherence).
 //! * [`ResponseSpectrum`]: damped SDOF response spectra (pseudo-acceleration) by the exact
 //!   piecewise-linear step of Nigam & Jennings ([`SdofOscillator`]).
 //!
@@ -118,7 +119,7 @@ pub use motion::{check_len, check_times, derivative, second_derivative, Motion};
 pub use resample::{Interpolation, Resampler};
 pub use response_spectrum::{ResponseSpectrum, SdofOscillator};
 pub use spectral::{trim_to_whole_periods, whole_periods, SpectralLowpass, WholePeriods};
-pub use welch::{Psd, Welch};
+pub use welch::{CrossSpectra, Psd, Welch};
 pub use window::Window;
 
 /// A validated sample rate: finite and > 0, Hz.

@@ -119,6 +119,161 @@ impl Welch {
     }
 }
 
+impl Welch {
+    /// Estimates the one-sided auto- and cross-spectral densities of `x` and `y` (same
+    /// length), segment by segment as [`Welch::estimate`]: `P_xy[k] = c_k·⟨conj(X_k)·Y_k⟩ /
+    /// (f_s·Σw²)`, as `scipy.signal.csd(x, y, fs, nperseg=len)` with its defaults. The
+    /// transfer function from `x` to `y` is `H₁ = P_xy/P_xx` ([`CrossSpectra::transfer`]).
+    ///
+    /// # Errors
+    /// [`SignalError::LengthMismatch`] unless `x` and `y` have the same length,
+    /// [`SignalError::RecordTooShort`] if they are shorter than one segment.
+    pub fn cross(&self, x: &[f64], y: &[f64]) -> Result<CrossSpectra> {
+        if x.len() != y.len() {
+            return Err(SignalError::LengthMismatch {
+                what: "y (the cross-spectrum's output channel)",
+                expected: x.len(),
+                found: y.len(),
+                reference: "x (its input channel)",
+            });
+        }
+        let len = self.segment_len;
+        if x.len() < len {
+            return Err(SignalError::RecordTooShort {
+                what: "record (one Welch segment)",
+                found: x.len(),
+                min: len,
+            });
+        }
+        let step = len - len / 2;
+        let segments = (x.len() - len) / step + 1;
+        let bins = len / 2 + 1;
+        let (mut xx, mut yy) = (vec![0.0; bins], vec![0.0; bins]);
+        let mut xy = vec![Complex::new(0.0, 0.0); bins];
+        let zero = Complex::new(0.0, 0.0);
+        let (mut bx, mut by) = (vec![zero; len], vec![zero; len]);
+        let mut scratch = vec![zero; self.fft.get_inplace_scratch_len()];
+        for s in 0..segments {
+            for (buf, z) in [(&mut bx, x), (&mut by, y)] {
+                let seg = &z[s * step..s * step + len];
+                let mean = seg.iter().sum::<f64>() / len as f64;
+                for ((c, v), w) in buf.iter_mut().zip(seg).zip(&self.window) {
+                    *c = Complex::new((v - mean) * w, 0.0);
+                }
+                self.fft.process_with_scratch(buf, &mut scratch);
+            }
+            for k in 0..bins {
+                xx[k] += bx[k].norm_sqr();
+                yy[k] += by[k].norm_sqr();
+                xy[k] += bx[k].conj() * by[k];
+            }
+        }
+        let base = self.scale / segments as f64;
+        for k in 0..bins {
+            let nyquist = len % 2 == 0 && k == len / 2;
+            let c = base * if k == 0 || nyquist { 1.0 } else { 2.0 };
+            xx[k] *= c;
+            yy[k] *= c;
+            xy[k] *= c;
+        }
+        Ok(CrossSpectra {
+            resolution_hz: self.resolution_hz(),
+            xx,
+            yy,
+            xy: xy.iter().map(|c| (c.re, c.im)).collect(),
+            segments,
+        })
+    }
+}
+
+/// The one-sided auto- and cross-spectral densities of two channels ([`Welch::cross`]),
+/// on the bins `f_k = k·Δf`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CrossSpectra {
+    resolution_hz: f64,
+    xx: Vec<f64>,
+    yy: Vec<f64>,
+    /// `P_xy` as (real, imaginary).
+    xy: Vec<(f64, f64)>,
+    segments: usize,
+}
+
+impl CrossSpectra {
+    /// The segment-weighted mean of estimates on the same bins (the Welch estimate of
+    /// several records taken together: every segment of every record counts alike); `None`
+    /// when `parts` is empty or their bins differ.
+    pub fn pooled(parts: &[CrossSpectra]) -> Option<CrossSpectra> {
+        let first = parts.first()?;
+        let bins = first.xx.len();
+        if parts
+            .iter()
+            .any(|p| p.xx.len() != bins || p.resolution_hz != first.resolution_hz)
+        {
+            return None;
+        }
+        let total: usize = parts.iter().map(|p| p.segments).sum();
+        let mut out = CrossSpectra {
+            resolution_hz: first.resolution_hz,
+            xx: vec![0.0; bins],
+            yy: vec![0.0; bins],
+            xy: vec![(0.0, 0.0); bins],
+            segments: total,
+        };
+        for p in parts {
+            let w = p.segments as f64 / total as f64;
+            for k in 0..bins {
+                out.xx[k] += w * p.xx[k];
+                out.yy[k] += w * p.yy[k];
+                out.xy[k].0 += w * p.xy[k].0;
+                out.xy[k].1 += w * p.xy[k].1;
+            }
+        }
+        Some(out)
+    }
+
+    /// Bin spacing `Δf`, Hz.
+    pub fn resolution_hz(&self) -> f64 {
+        self.resolution_hz
+    }
+
+    /// Frequency of bin `k`, Hz.
+    pub fn frequency_hz(&self, k: usize) -> f64 {
+        k as f64 * self.resolution_hz
+    }
+
+    /// Segments averaged.
+    pub fn segments(&self) -> usize {
+        self.segments
+    }
+
+    /// `|H₁(f_k)| = |P_xy|/P_xx` at each bin (0 where `P_xx` is 0): the gain from `x` to
+    /// `y`, unbiased by noise on `y` that is uncorrelated with `x`.
+    pub fn transfer(&self) -> Vec<f64> {
+        self.xx
+            .iter()
+            .zip(&self.xy)
+            .map(|(&xx, &(re, im))| if xx > 0.0 { re.hypot(im) / xx } else { 0.0 })
+            .collect()
+    }
+
+    /// The magnitude-squared coherence `|P_xy|²/(P_xx·P_yy)` at each bin (0 where either
+    /// auto-spectrum is 0).
+    pub fn coherence(&self) -> Vec<f64> {
+        self.xx
+            .iter()
+            .zip(&self.yy)
+            .zip(&self.xy)
+            .map(|((&xx, &yy), &(re, im))| {
+                if xx > 0.0 && yy > 0.0 {
+                    (re * re + im * im) / (xx * yy)
+                } else {
+                    0.0
+                }
+            })
+            .collect()
+    }
+}
+
 /// A one-sided power spectral density on the bins `f_k = k·Δf`, `k = 0..=segment_len/2`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Psd {

@@ -121,3 +121,77 @@ fn bad_plans_records_and_bands_are_rejected() {
     assert!(psd.rms_in_band(-1.0, 1.0).is_err());
     assert!(psd.rms_in_band(0.0, f64::NAN).is_err());
 }
+
+/// The cross-spectrum against SciPy 1.17, computed independently:
+/// `abs(scipy.signal.csd(x, y, fs=100, nperseg=16)[1]) / scipy.signal.welch(x, …)[1]` and
+/// `scipy.signal.coherence(x, y, …)` for `x[j] = sin(0.3j) + 0.1·(j mod 7)`,
+/// `y[j] = cos(0.2j) + 0.05·(j mod 5)`, 64 samples; 1e-12 relative (a ratio of sums of
+/// products: a few roundings more than the PSD's).
+#[test]
+fn the_transfer_and_coherence_match_scipy() {
+    let j = |k: usize| k as f64;
+    let x: Vec<f64> = (0..64)
+        .map(|k| (0.3 * j(k)).sin() + 0.1 * (k % 7) as f64)
+        .collect();
+    let y: Vec<f64> = (0..64)
+        .map(|k| (0.2 * j(k)).cos() + 0.05 * (k % 5) as f64)
+        .collect();
+    let cs = Welch::new(16, 100.0).unwrap().cross(&x, &y).unwrap();
+    let transfer = [
+        0.027479804205202893,
+        0.05094818076073238,
+        0.04968164666878032,
+        0.04273375318667862,
+        0.09240019493137626,
+        0.05766075212221295,
+        0.2469105883245937,
+        0.07692537888211487,
+        0.05473777628279591,
+    ];
+    let coherence = [
+        0.00297768934418349,
+        0.005191277643079688,
+        0.013114518621563995,
+        0.0063557804625873305,
+        0.02986047925254299,
+        0.2713997121657326,
+        0.12639013549830924,
+        0.035033381519388875,
+        0.13080610770744955,
+    ];
+    assert_eq!(cs.segments(), 7);
+    for (k, (got, want)) in cs.transfer().iter().zip(transfer).enumerate() {
+        assert!(
+            (got - want).abs() < 1e-12 * want,
+            "bin {k}: {got} vs SciPy {want}"
+        );
+    }
+    for (k, (got, want)) in cs.coherence().iter().zip(coherence).enumerate() {
+        assert!(
+            (got - want).abs() < 1e-12 * want,
+            "bin {k}: {got} vs SciPy {want}"
+        );
+    }
+    // Pooling a record with itself changes nothing; channels of unequal length are refused.
+    let pooled = platen_signal::CrossSpectra::pooled(&[cs.clone(), cs.clone()]).unwrap();
+    assert_eq!(pooled.transfer(), cs.transfer());
+    assert_eq!(pooled.segments(), 14);
+    assert!(matches!(
+        Welch::new(16, 100.0).unwrap().cross(&x, &y[..63]),
+        Err(SignalError::LengthMismatch { .. })
+    ));
+}
+
+/// A pure gain: `|H₁| = 2` exactly and coherence 1 at every bin
+/// with power (the closed form), to rounding.
+#[test]
+fn a_pure_gain_is_recovered_exactly() {
+    let mut rng = Rng::new(42);
+    let x: Vec<f64> = (0..4096).map(|_| rng.normal()).collect();
+    let y: Vec<f64> = x.iter().map(|v| 2.0 * v).collect();
+    let cs = Welch::new(256, 100.0).unwrap().cross(&x, &y).unwrap();
+    for (k, (h, c)) in cs.transfer().iter().zip(cs.coherence()).enumerate().skip(1) {
+        assert!((h - 2.0).abs() < 1e-12, "bin {k}: {h}");
+        assert!((c - 1.0).abs() < 1e-12, "bin {k}: {c}");
+    }
+}

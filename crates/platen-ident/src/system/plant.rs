@@ -124,11 +124,20 @@ pub struct IdentifiedMechanics {
     pub effective_mass_kg: f64,
     /// `Kₑ`, N/m.
     pub stiffness_n_per_m: f64,
-    /// Viscous coefficient, N·s/m (exponent 1).
+    /// Viscous coefficient `C`, N·(s/m)^α.
     pub viscous_coefficient: f64,
+    /// Viscous exponent `α` (1 unless the records support another: [`EXPONENT_GRID`]).
+    pub viscous_exponent: f64,
+    /// Stribeck amplitude `a`, N (0 unless the records support the term).
+    pub low_velocity_force_n: f64,
+    /// Stribeck decay `b`, s/m ([`DECAY_GRID_S_PER_M`]; 0 without the term).
+    pub low_velocity_decay_s_per_m: f64,
+    /// Samples slower than this were left out of the fit, m/s ([`SLIP_SPEED_M_S`], or
+    /// [`LOW_SLIP_SPEED_M_S`] for a richer law).
+    pub slip_speed_m_s: f64,
     /// Coulomb force `F_μ`, N.
     pub coulomb_force_n: f64,
-    /// Samples in the fit (`|v| ≥` [`SLIP_SPEED_M_S`]).
+    /// Samples in the fit (`|v| ≥` `slip_speed_m_s`).
     pub samples: usize,
     /// RMS of the force residual, N.
     pub force_rms_residual_n: f64,
@@ -223,6 +232,9 @@ pub struct IdentifiedPlant {
     pub storeys: Vec<IdentifiedStorey>,
     /// The specimen's fixed-base modes, lowest first.
     pub specimen_modes: Vec<Mode>,
+    /// The records' own modal content (roof over table, no model), with the identified modes
+    /// checked against it; `None` without storey accelerations.
+    pub transmissibility: Option<super::Transmissibility>,
     /// Valves and oil column.
     pub hydraulics: Option<IdentifiedHydraulics>,
     /// The absolute scale.
@@ -378,7 +390,11 @@ fn central_velocity(u: &[f64], h: f64) -> Vec<f64> {
 }
 
 /// The force balance's design over the fitted records, the pressures shifted earlier by
-/// `shift_s`. Columns: `[M, C, K, F_μ, m₁ … m_s, (r)]`.
+/// `shift_s`. Columns: `[M, C, K, F_μ, m₁ … m_s, (r), f₁ … f_R]`, the last one constant
+/// force per fitted record: a pressure transducer's offset (a table at rest holds its
+/// friction, so `Δp` cannot be zeroed at rest; ±1 bar on a small actuator is of the order of
+/// its friction) and the accelerometers' (times the masses) differ from record to record.
+#[allow(clippy::too_many_arguments)]
 fn mechanics_design(
     records: &[SystemRecord],
     periods: &[f64],
@@ -387,13 +403,15 @@ fn mechanics_design(
     from: ForceFrom,
     storeys: usize,
     shift_s: f64,
+    law: &Law,
 ) -> Result<Design> {
     let act = &input.base.actuator;
     let n_act = f64::from(act.count);
     let ratio = from == ForceFrom::ChambersRatioFree;
-    let m = 4 + storeys + usize::from(ratio);
+    let m = mechanics_columns(from, storeys, fitted.len(), law);
+    let offsets = 4 + storeys + usize::from(ratio);
     let mut design = Design::new(m);
-    for &k in fitted {
+    for (slot, &k) in fitted.iter().enumerate() {
         let r = &records[k];
         let h = periods[k];
         let lp = mechanics_filter(r, h)?;
@@ -431,9 +449,17 @@ fn mechanics_design(
         let v = central_velocity(&r.u_m, h);
         let sgn: Vec<f64> = v.iter().map(|v| v.signum()).collect();
         let y = filtered(&lp, r, &force)?;
+        // C·|v|^α·sgn(v): exactly v for α = 1 (the linear law's column, bit for bit).
+        let viscous: Vec<f64> = if law.exponent == 1.0 {
+            v.clone()
+        } else {
+            v.iter()
+                .map(|v| v.signum() * v.abs().powf(law.exponent))
+                .collect()
+        };
         let mut cols = vec![
             filtered(&lp, r, a)?,
-            filtered(&lp, r, &v)?,
+            filtered(&lp, r, &viscous)?,
             filtered(&lp, r, &r.u_m)?,
             filtered(&lp, r, &sgn)?,
         ];
@@ -445,21 +471,92 @@ fn mechanics_design(
             // n·A·p_a = M·a + … + r·(n·A·p_b).
             cols.push(filtered(&lp, r, e)?);
         }
+        // The law's extra columns, after the records' constants.
+        let mut tail = Vec::new();
+        if let Some(b) = law.decay_s_per_m {
+            let stribeck: Vec<f64> = v
+                .iter()
+                .map(|v| v.signum() * (-b * v.abs()).exp())
+                .collect();
+            tail.push(filtered(&lp, r, &stribeck)?);
+        }
+        if law.exponent_score {
+            // ∂(|v|^α sgn v)/∂α at α = 1: its coefficient is C·(α − 1) to first order.
+            let score: Vec<f64> = v
+                .iter()
+                .map(|&v| if v == 0.0 { 0.0 } else { v * v.abs().ln() })
+                .collect();
+            tail.push(filtered(&lp, r, &score)?);
+        }
+        // This record's constant, through the same filter (its start is cut with the edge).
+        let constant = filtered(&lp, r, &vec![1.0; r.u_m.len()])?;
         let n = r.u_m.len();
         let edge = ((0.5 / h) as usize).min(n / 4);
         let mut row = vec![0.0; m];
+        let first_tail = offsets + fitted.len();
         for i in edge..n - edge {
-            if v[i].abs() < SLIP_SPEED_M_S {
+            if v[i].abs() < law.slip_speed_m_s {
                 continue;
             }
             for (c, col) in row.iter_mut().zip(&cols) {
                 *c = col[i];
+            }
+            row[offsets + slot] = constant[i];
+            for (j, col) in tail.iter().enumerate() {
+                row[first_tail + j] = col[i];
             }
             design.push(&row, y[i], k, i);
         }
     }
     Ok(design)
 }
+
+/// The force balance's column count: platen, storeys, the free area ratio, one constant per
+/// fitted record (see [`mechanics_design`]).
+fn mechanics_columns(from: ForceFrom, storeys: usize, records: usize, law: &Law) -> usize {
+    4 + storeys
+        + usize::from(from == ForceFrom::ChambersRatioFree)
+        + records
+        + usize::from(law.decay_s_per_m.is_some())
+        + usize::from(law.exponent_score)
+}
+
+/// The friction law a force balance is fitted with: `sgn(v)·[F_μ + a·e^(−b|v|) + C·|v|^α]`,
+/// `F_μ`, `a` and `C` fitted (linear), `b` and `α` given.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Law {
+    /// `α`.
+    pub exponent: f64,
+    /// `b`, s/m, with the Stribeck term; `None` without it.
+    pub decay_s_per_m: Option<f64>,
+    /// Samples slower than this are left out, m/s.
+    pub slip_speed_m_s: f64,
+    /// With the score column `v·ln|v|` of a test of `α = 1` (a law with `α = 1` only).
+    pub exponent_score: bool,
+}
+
+impl Law {
+    /// Coulomb and linear viscous friction, above [`SLIP_SPEED_M_S`].
+    pub const LINEAR: Law = Law {
+        exponent: 1.0,
+        decay_s_per_m: None,
+        slip_speed_m_s: SLIP_SPEED_M_S,
+        exponent_score: false,
+    };
+}
+
+/// Samples slower than this are left out of the fits of a richer friction law, m/s: the
+/// Stribeck term lives at a few mm/s, and above [`SLIP_SPEED_M_S`] there is little of it
+/// left to see (e^(−2) at b = 200 s/m). Four times the velocity noise of a 5 µm displacement
+/// sensor differenced at 204.8 Hz (0.72 mm/s), so a stuck platen's samples stay out.
+pub const LOW_SLIP_SPEED_M_S: f64 = 0.003;
+/// The Stribeck decays `b` tried, s/m (a decay speed 1/b of 40 to 1.25 mm/s).
+pub const DECAY_GRID_S_PER_M: [f64; 6] = [25.0, 50.0, 100.0, 200.0, 400.0, 800.0];
+/// The viscous exponents `α` tried.
+pub const EXPONENT_GRID: [f64; 10] = [0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2];
+/// A richer friction term is kept only when its coefficient is this many (batch-means)
+/// standard errors from 0: the records support it well beyond chance (two-sided p < 0.3 %).
+pub const FRICTION_TERM_T: f64 = 3.0;
 
 /// The constraints of the force balance: `C, K, F_μ ≥ 0`.
 fn mechanics_signs(m: usize) -> Vec<bool> {
@@ -477,14 +574,23 @@ fn fit_mechanics(
     from: ForceFrom,
     storeys: usize,
     skew_report: &mut Vec<ChannelSkew>,
-) -> Result<Option<LinearFit>> {
-    let m = 4 + storeys + usize::from(from == ForceFrom::ChambersRatioFree);
+) -> Result<Option<(LinearFit, Law)>> {
+    let m = mechanics_columns(from, storeys, fitted.len(), &Law::LINEAR);
     let signs = mechanics_signs(m);
     let none = vec![false; m];
     let h0 = periods[fitted[0]];
     let mut grid = Vec::with_capacity(PRESSURE_SHIFT_GRID.len());
     for &s in &PRESSURE_SHIFT_GRID {
-        let d = mechanics_design(records, periods, fitted, input, from, storeys, s * h0)?;
+        let d = mechanics_design(
+            records,
+            periods,
+            fitted,
+            input,
+            from,
+            storeys,
+            s * h0,
+            &Law::LINEAR,
+        )?;
         grid.push(d.fit(&signs, &none).map(|f| f.rss));
     }
     let best = grid
@@ -507,9 +613,18 @@ fn fit_mechanics(
         .iter()
         .position(|&x| x == 0.0)
         .and_then(|i| grid[i]);
-    let final_rss = mechanics_design(records, periods, fitted, input, from, storeys, samples * h0)?
-        .fit(&signs, &none)
-        .map(|f| f.rss);
+    let final_rss = mechanics_design(
+        records,
+        periods,
+        fitted,
+        input,
+        from,
+        storeys,
+        samples * h0,
+        &Law::LINEAR,
+    )?
+    .fit(&signs, &none)
+    .map(|f| f.rss);
     let residual_ratio = match (final_rss, zero) {
         (Some(a), Some(b)) if b > 0.0 => Some(a / b),
         _ => None,
@@ -529,12 +644,79 @@ fn fit_mechanics(
         residual_ratio,
         method: "the shift that fits the platen's force balance best (a grid of half samples, \
                  then a parabola through the best three)",
+        per_record: Vec::new(),
     });
     if applied {
         skew::correct_pressures(records, periods, samples * h0)?;
     }
-    let design = mechanics_design(records, periods, fitted, input, from, storeys, 0.0)?;
-    Ok(design.fit(&signs, &none))
+    friction_law(records, periods, fitted, input, from, storeys)
+}
+
+/// The friction law the corrected records support ([`Law`]): the best of the grids of
+/// [`DECAY_GRID_S_PER_M`] (or none) and [`EXPONENT_GRID`] above [`LOW_SLIP_SPEED_M_S`]; the
+/// Stribeck term kept when its amplitude is positive and [`FRICTION_TERM_T`] standard errors
+/// from 0, an exponent other than 1 when the score of `α = 1` (the coefficient of `v·ln|v|`)
+/// is. Without either, Coulomb and linear viscous friction above [`SLIP_SPEED_M_S`], as
+/// before any richer law was tried. Returns the fit and its law.
+fn friction_law(
+    records: &[SystemRecord],
+    periods: &[f64],
+    fitted: &[usize],
+    input: &PlantInput,
+    from: ForceFrom,
+    storeys: usize,
+) -> Result<Option<(LinearFit, Law)>> {
+    let fit = |law: &Law| -> Result<Option<LinearFit>> {
+        let m = mechanics_columns(from, storeys, fitted.len(), law);
+        let design = mechanics_design(records, periods, fitted, input, from, storeys, 0.0, law)?;
+        Ok(design.fit(&mechanics_signs(m), &vec![false; m]))
+    };
+    let low = |exponent: f64, decay_s_per_m: Option<f64>| Law {
+        exponent,
+        decay_s_per_m,
+        slip_speed_m_s: LOW_SLIP_SPEED_M_S,
+        exponent_score: false,
+    };
+    // The best exponent for each Stribeck decay (or none).
+    let best = |decays: &[Option<f64>], exponents: &[f64]| -> Result<Option<(LinearFit, Law)>> {
+        let mut out: Option<(LinearFit, Law)> = None;
+        for &b in decays {
+            for &alpha in exponents {
+                let law = low(alpha, b);
+                if let Some(f) = fit(&law)? {
+                    if out.as_ref().is_none_or(|(o, _)| f.rss < o.rss) {
+                        out = Some((f, law));
+                    }
+                }
+            }
+        }
+        Ok(out)
+    };
+    let t = |f: &LinearFit, j: usize| f.coef[j] / f.estimates[j].std_error;
+    let last = |f: &LinearFit| f.coef.len() - 1;
+    let decays: Vec<Option<f64>> = DECAY_GRID_S_PER_M.iter().map(|&b| Some(b)).collect();
+    // The Stribeck term: its amplitude at the best decay and exponent.
+    let stribeck = match best(&decays, &EXPONENT_GRID)? {
+        Some((f, law)) if f.coef[last(&f)] > 0.0 && t(&f, last(&f)) > FRICTION_TERM_T => {
+            law.decay_s_per_m
+        }
+        _ => None,
+    };
+    // The exponent: the score of α = 1 with the Stribeck term as found.
+    let score_law = Law {
+        exponent_score: true,
+        ..low(1.0, stribeck)
+    };
+    let exponent_free = fit(&score_law)?.is_some_and(|f| t(&f, last(&f)).abs() > FRICTION_TERM_T);
+    if stribeck.is_none() && !exponent_free {
+        return Ok(fit(&Law::LINEAR)?.map(|f| (f, Law::LINEAR)));
+    }
+    let exponents: &[f64] = if exponent_free {
+        &EXPONENT_GRID
+    } else {
+        &[1.0]
+    };
+    best(&[stribeck], exponents)
 }
 
 /// The second-order filter `1/(s² + 2ζω s + ω²)` of `x` by the trapezoidal rule, started at
@@ -618,13 +800,22 @@ fn fit_storeys(
             // drive is left out, as there.
             let lp = mechanics_filter(r, h).ok()?;
             let (rel, shear) = (lp.apply(&rel).ok()?, lp.apply(&shear).ok()?);
-            // 1/(s+ω₀)²: ζ = 1, run at UPSAMPLE times the rate on the band-limited
-            // interpolation of both sides, then taken at the samples.
+            // Both sides through s²/(s+ω₀)² first: the drift regressor below is the relative
+            // acceleration through 1/(s+ω₀)², whose DC gain 1/ω₀² would carry the
+            // accelerometers' offsets (a few tenths of a mg after zeroing) into the drift as
+            // a constant, which the stiffness cannot fit and is biased by (on the stand-ins of
+            // real records, the first mode came out 11 % low). Then 1/(s+ω₀)²: ζ = 1, both
+            // run at UPSAMPLE times the rate on the band-limited interpolation of both sides,
+            // then taken at the samples.
             let (rel, shear) = (upsampled(&rel)?, upsampled(&shear)?);
             let hu = h / UPSAMPLE as f64;
+            let [_, _, rel] = second_order(&rel, hu, w0, 1.0);
+            let [_, _, shear] = second_order(&shear, hu, w0, 1.0);
             let [d0, d1, _] = second_order(&rel, hu, w0, 1.0);
             let [_, _, s2] = second_order(&shear, hu, w0, 1.0);
-            let skip = (2.0 / (DRIFT_HIGHPASS_HZ * h)) as usize / 10;
+            // The filters' start (a step through the fourth-order chain, e.g. an offset,
+            // decays as (ω₀t)³e^(−ω₀t): below 1e-2 of its peak after 1.5 corner periods).
+            let skip = (1.5 / (DRIFT_HIGHPASS_HZ * h)) as usize;
             let n = r.u_m.len();
             // The last samples' interpolation reaches past the record: left out.
             for i in skip.min(n / 4)..n - UPSAMPLE {
@@ -870,6 +1061,7 @@ pub(crate) fn identify_plant(
         mechanics: None,
         storeys: Vec::new(),
         specimen_modes: Vec::new(),
+        transmissibility: None,
         hydraulics: None,
         geometry: Geometry {
             area_m2: base.actuator.cap_area_m2,
@@ -945,7 +1137,9 @@ fn plant_mechanics(
     not_identified: &mut Vec<(String, String)>,
 ) -> Result<()> {
     let why = |what: &str, reason: &str| (what.to_owned(), reason.to_owned());
-    if let Some(f) = fit_mechanics(records, periods, fitted, input, from, storeys, skew_report)? {
+    if let Some((f, law)) =
+        fit_mechanics(records, periods, fitted, input, from, storeys, skew_report)?
+    {
         let c = &f.coef;
         let se = |j: usize| f.estimates[j].std_error;
         let ratio = (from == ForceFrom::ChambersRatioFree).then(|| c[4 + storeys]);
@@ -956,9 +1150,24 @@ fn plant_mechanics(
                 se(4 + storeys) * base.actuator.cap_area_m2,
             );
         }
+        // The Stribeck amplitude is the last column when the law has it.
+        let stribeck = law
+            .decay_s_per_m
+            .map(|b| (c[c.len() - 1], b, se(c.len() - 1)));
+        if let Some((_, _, e)) = stribeck {
+            if e.is_finite() {
+                plant
+                    .std_errors
+                    .insert("model.identified.low_velocity_force_n".into(), e);
+            }
+        }
         let mech = IdentifiedMechanics {
             effective_mass_kg: c[0],
             viscous_coefficient: c[1],
+            viscous_exponent: law.exponent,
+            low_velocity_force_n: stribeck.map_or(0.0, |s| s.0),
+            low_velocity_decay_s_per_m: stribeck.map_or(0.0, |s| s.1),
+            slip_speed_m_s: law.slip_speed_m_s,
             stiffness_n_per_m: c[2],
             coulomb_force_n: c[3],
             samples: f.rows,
@@ -1105,14 +1314,30 @@ fn finish_plant(plant: &mut IdentifiedPlant, not_identified: &mut Vec<(String, S
             stiffness_n_per_m: m.stiffness_n_per_m.max(0.0),
             coulomb_force_n: m.coulomb_force_n.max(0.0),
             viscous_coefficient: m.viscous_coefficient.max(0.0),
-            viscous_exponent: 1.0,
-            low_velocity_force_n: 0.0,
-            low_velocity_decay_s_per_m: 0.0,
+            viscous_exponent: m.viscous_exponent,
+            low_velocity_force_n: m.low_velocity_force_n,
+            low_velocity_decay_s_per_m: m.low_velocity_decay_s_per_m,
         });
-        not_identified.push(why(
-            "low_velocity_force_n, low_velocity_decay_s_per_m, a viscous exponent other than 1",
-            "the mechanics fit is linear: F_μ·sgn(v) + C·v only (the Stribeck term 0, α = 1)",
-        ));
+        if m.low_velocity_force_n == 0.0 {
+            not_identified.push(why(
+                "low_velocity_force_n, low_velocity_decay_s_per_m",
+                "the records do not support a Stribeck term: its amplitude at the best decay \
+                 is not 3 standard errors above 0 (taken as 0)",
+            ));
+        }
+        if m.viscous_exponent == 1.0 {
+            not_identified.push(why(
+                "a viscous exponent other than 1",
+                "the records do not tell α from 1: the score of α = 1 is within 3 standard \
+                 errors of 0 (taken as 1)",
+            ));
+        } else {
+            not_identified.push(why(
+                "the viscous exponent's standard error",
+                "α is the best of a grid of 0.1 (EXPONENT_GRID), with F_μ, a and C fitted at \
+                 each; the others' standard errors are at that α",
+            ));
+        }
     }
     if !plant.storeys.is_empty() {
         plant.specimen = Specimen::new(

@@ -106,17 +106,39 @@ fn model_provenance(plant: &IdentifiedPlant, out: &mut Vec<ValueProvenance>) {
         ] {
             out.push(entry(&format!("model.identified.{key}"), Identified, None));
         }
-        out.push(entry(
-            "model.identified.viscous_exponent",
-            Assumed,
-            Some("1: the force balance is linear in the friction (F_μ·sgn(v) + C·v)"),
-        ));
-        for key in ["low_velocity_force_n", "low_velocity_decay_s_per_m"] {
+        let law = plant.mechanics.as_ref();
+        if law.is_some_and(|m| m.viscous_exponent != 1.0) {
             out.push(entry(
-                &format!("model.identified.{key}"),
-                Assumed,
-                Some("0: the Stribeck term is not fitted by the loop's force balance"),
+                "model.identified.viscous_exponent",
+                Identified,
+                Some("the best of a grid of 0.1 (the score of α = 1 beyond 3 standard errors)"),
             ));
+        } else {
+            out.push(entry(
+                "model.identified.viscous_exponent",
+                Assumed,
+                Some("1: the records do not tell α from 1 (the score of α = 1 within 3 standard errors)"),
+            ));
+        }
+        if law.is_some_and(|m| m.low_velocity_force_n > 0.0) {
+            out.push(entry(
+                "model.identified.low_velocity_force_n",
+                Identified,
+                None,
+            ));
+            out.push(entry(
+                "model.identified.low_velocity_decay_s_per_m",
+                Identified,
+                Some("the best of a grid (DECAY_GRID_S_PER_M) with the other terms fitted at each"),
+            ));
+        } else {
+            for key in ["low_velocity_force_n", "low_velocity_decay_s_per_m"] {
+                out.push(entry(
+                    &format!("model.identified.{key}"),
+                    Assumed,
+                    Some("0: the records do not support a Stribeck term (its amplitude within 3 standard errors of 0)"),
+                ));
+            }
         }
     }
     for j in 0..plant.storeys.len() {
