@@ -405,3 +405,94 @@ fn the_stability_verdict_agrees_with_the_nonlinear_run() {
         }
     }
 }
+
+/// A pose or rate beyond any table's, in a forward run's `initial` or a `motion_csv` column, is
+/// refused at its key or column (it ran into a non-finite state labelled `u`, `v`).
+#[test]
+fn poses_and_rates_beyond_any_table_are_refused_where_they_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut doc: Value = serde_json::from_str(
+        &std::fs::read_to_string(root().join("scenarios/multi-axis/forward.json")).unwrap(),
+    )
+    .unwrap();
+    let forces = root().join("scenarios/multi-axis/forward-forces.csv");
+    doc["excitation"]["force_csv"] = json!(forces.display().to_string());
+    doc["initial"] = json!({"y_m": 1000.0});
+    refused(dir.path(), &doc, "initial.y_m", &["within ±100 m"]);
+    doc["initial"] = json!({"yaw_rad_s": -1e6});
+    refused(
+        dir.path(),
+        &doc,
+        "initial.yaw_rad_s",
+        &["within ±100 rad/s"],
+    );
+    // A motion whose velocity column is in mm/s: the column and row named.
+    let text = std::fs::read_to_string(motion()).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    let at = header.split(',').position(|c| c == "y_m_s").unwrap();
+    let mut csv = format!("{header}\n");
+    for line in lines {
+        let mut cells: Vec<String> = line.split(',').map(str::to_owned).collect();
+        cells[at] = format!("{}", 1000.0 * cells[at].parse::<f64>().unwrap() + 1.0e3);
+        csv.push_str(&cells.join(","));
+        csv.push('\n');
+    }
+    let path = dir.path().join("mm-per-s.csv");
+    std::fs::write(&path, csv).unwrap();
+    let mut doc = lhpost6();
+    doc["excitation"]["motion_csv"] = json!(path.display().to_string());
+    let out = dir.path().join("out.csv");
+    let (code, _, err) = run(
+        dir.path(),
+        "simulate",
+        &doc,
+        &["--out", out.to_str().unwrap()],
+    );
+    assert_eq!(code, Some(3), "{err}");
+    for w in ["mm-per-s.csv", "column `y_m_s`", "beyond the ±100 m/s"] {
+        assert!(err.contains(w), "expected `{w}` in: {err}");
+    }
+    assert!(!out.exists());
+}
+
+/// z held on a table whose verticals are single-acting: they carry no weight, which such an
+/// actuator cannot hold at rest; said so, not "needs 0 Pa".
+#[test]
+fn z_held_on_single_acting_verticals_is_explained() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut doc = lhpost6();
+    doc["table"]["held_dofs"] = json!(["z"]);
+    refused(
+        dir.path(),
+        &doc,
+        "table.actuators[4].cap_side_area_m2",
+        &["single-acting", "cannot pull", "with z held"],
+    );
+}
+
+/// A strut whose gas runs out under the motion is reported as that, with its key, not as a
+/// non-finite state or a bad number in the output file.
+#[test]
+fn a_strut_out_of_gas_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut doc = lhpost6();
+    // 0.2 mm of travel before the gas is gone (30 cm³ on 0.15 m²).
+    doc["table"]["hold_down_struts"][0]["gas_volume_m3"] = json!(3e-5);
+    let out = dir.path().join("out.csv");
+    let (code, _, err) = run(
+        dir.path(),
+        "simulate",
+        &doc,
+        &["--out", out.to_str().unwrap()],
+    );
+    assert_ne!(code, Some(0), "{err}");
+    for w in [
+        "table.hold_down_struts[0]",
+        "ran out of gas",
+        "gas_volume_m3 / area_m2",
+    ] {
+        assert!(err.contains(w), "expected `{w}` in: {err}");
+    }
+    assert!(!out.exists());
+}

@@ -167,6 +167,15 @@ pub enum IntegrateError {
         /// Displacement, m.
         u_m: f64,
     },
+    /// A six-DOF table's hold-down strut used up its gas: the platen pulled it longer than
+    /// its gas volume over its area allows.
+    #[error("hold-down strut {strut} (table.hold_down_struts[{strut}]) ran out of gas at t = {t_s} s: its pull grew without bound as its gas volume went; the motion lengthens it by more than gas_volume_m3 / area_m2 allows (check those two values, or the command)")]
+    StrutGasSpent {
+        /// Time, s.
+        t_s: f64,
+        /// The strut's index in the table.
+        strut: usize,
+    },
     /// Any other error of `platen_signal` converted with `From` (a [`crate::Motion`]'s
     /// checks convert to the variants above that have the same message).
     #[error(transparent)]

@@ -102,7 +102,9 @@ pub use run::{EnergyBalance, RunStats, State};
 pub use specimen::{forward_rk4_specimen, forward_specimen};
 pub use stepping::{Step, Stepping};
 pub use stop::{AdaptiveFailure, Failure, StopReason};
-pub use table_loop::{forward_table_loop, TableLoopRun, TableLoopStats, MAX_LOOP_ACTUATORS};
+pub use table_loop::{
+    forward_table_loop, TableLoopRun, TableLoopStats, MAX_LOOP_ACTUATORS, SPENT_GAS_FRACTION,
+};
 pub use table_plant::{
     forward_table, table_kinetic_energy_j, table_potential_energy_j, ActuatorForces,
     MAX_TABLE_ACTUATORS, MAX_TABLE_SPECIMEN_DOFS,

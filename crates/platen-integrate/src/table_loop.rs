@@ -47,6 +47,33 @@ use crate::table_plant::{
 };
 use crate::MAX_TABLE_SPECIMEN_DOFS;
 
+/// A strut whose gas volume falls below this fraction of its volume at neutral has used up
+/// its gas: its pressure is then `100^n` times the neutral one (7 600 times for `n` = 1.44),
+/// beyond any strut's rating, and grows without bound as the volume goes.
+pub const SPENT_GAS_FRACTION: f64 = 0.01;
+
+/// A run whose state became non-finite while a strut had less than this fraction of its gas
+/// left (at the last finite state) is reported as that strut's gas spent: a strut at a
+/// quarter of its gas stiffens seven-fold within the step (n = 1.44) and its pull is what the
+/// step could not follow.
+const BLOWN_UP_GAS_FRACTION: f64 = 0.25;
+
+/// The first strut of `table` at pose `q` with less than [`SPENT_GAS_FRACTION`] of its gas
+/// volume left, if any.
+fn spent_strut(table: &MultiAxisTable, q: &Coords) -> Option<usize> {
+    spent_strut_below(table, q, SPENT_GAS_FRACTION)
+}
+
+/// The first strut of `table` at pose `q` with less than `fraction` of its gas volume left.
+fn spent_strut_below(table: &MultiAxisTable, q: &Coords, fraction: f64) -> Option<usize> {
+    table.struts().iter().enumerate().position(|(j, s)| {
+        let p = table.strut_at(j, q).pressure_pa;
+        // V = V₀·(p₀/p)^(1/n); an infinite pressure is a volume gone.
+        let left = (s.pressure_pa / p).powf(1.0 / s.polytropic_exponent);
+        left.is_nan() || left <= fraction
+    })
+}
+
 /// The most actuators a closed-loop table run takes (their hydraulic states live in the
 /// integrator's fixed-size state).
 pub const MAX_LOOP_ACTUATORS: usize = 16;
@@ -656,7 +683,21 @@ impl<'a, const L: usize> TableLoop<'a, L> {
 
     /// Integrates `span` seconds with no cut inside, handling every event.
     fn segment(&mut self, span: f64) -> Result<()> {
-        self.machine.advance_clocked(span, |p| &mut p.source.t)
+        let (q0, _) = pose(&self.machine.y);
+        let t0 = self.t();
+        self.machine
+            .advance_clocked(span, |p| &mut p.source.t)
+            .map_err(|e| match e {
+                // A state that blew up while a strut was running out of gas: the strut's
+                // pull, not the solver, is what went without bound.
+                IntegrateError::NonFiniteState { .. } => {
+                    match spent_strut_below(self.run.table, &q0, BLOWN_UP_GAS_FRACTION) {
+                        Some(strut) => IntegrateError::StrutGasSpent { t_s: t0, strut },
+                        None => e,
+                    }
+                }
+                e => e,
+            })
     }
 
     /// The row of output sample `j`.
@@ -744,10 +785,14 @@ impl<'a, const L: usize> TableLoop<'a, L> {
         Ok(false)
     }
 
-    /// An actuator pushed past its chambers' oil (a chamber's volume gone) ends the run.
+    /// An actuator pushed past its chambers' oil (a chamber's volume gone), or a strut past
+    /// its gas, ends the run.
     fn check_end_stops(&self, t_s: f64) -> Result<()> {
         let (table, hyd) = (self.run.table, self.run.hydraulics);
         let (q, _) = pose(&self.machine.y);
+        if let Some(strut) = spent_strut(table, &q) {
+            return Err(IntegrateError::StrutGasSpent { t_s, strut });
+        }
         for (i, a) in hyd.actuators().iter().enumerate() {
             let s = table.actuator_at(i, &q).stroke_m;
             let (v_a, v_b) = a.chamber_volumes_m3(s);

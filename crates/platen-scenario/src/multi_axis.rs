@@ -51,6 +51,13 @@ pub use crate::table_file::{
 /// its key.
 pub const PLAUSIBLE_GEOMETRY_M: f64 = 100.0;
 
+/// The fastest a scenario's pose may move, m/s (rad/s for a rotation): shake tables reach a
+/// few m/s, so a rate beyond is a unit slip (mm/s written as m/s), refused at its key.
+pub const PLAUSIBLE_RATE_M_S: f64 = 100.0;
+/// The largest acceleration a scenario's pose may have, m/s² (rad/s² for a rotation): about
+/// 100 g, ten times any shake table's; beyond is a unit slip (mm/s² written as m/s²).
+pub const PLAUSIBLE_ACCELERATION_M_S2: f64 = 1000.0;
+
 /// Default oil bulk modulus, Pa.
 pub const DEFAULT_OIL_BULK_MODULUS_PA: f64 = 1.5e9;
 /// Default supply pressure, Pa (3 000 psi).
@@ -754,13 +761,25 @@ fn read_pose_motion(ctx: &Ctx, file: &ScenarioFile, path: &Path) -> Result<(Pose
     }
     // A pose beyond any table's reach is a unit slip (mm written as m), refused where it is
     // read: a run of it would end non-finite, or ride on a stroke limit with nothing said.
-    for (k, name) in POSE_COLUMNS.iter().enumerate() {
+    let bounded = POSE_COLUMNS
+        .iter()
+        .map(|n| (*n, PLAUSIBLE_GEOMETRY_M, ["m", "rad"]))
+        .chain(
+            RATE_COLUMNS
+                .iter()
+                .map(|n| (*n, PLAUSIBLE_RATE_M_S, ["m/s", "rad/s"])),
+        )
+        .chain(
+            ACCELERATION_COLUMNS
+                .iter()
+                .map(|n| (*n, PLAUSIBLE_ACCELERATION_M_S2, ["m/s²", "rad/s²"])),
+        );
+    for (j, (name, limit, units)) in bounded.enumerate() {
         let Some(column) = cols.get(name) else {
             continue;
         };
-        let limit = PLAUSIBLE_GEOMETRY_M;
         if let Some(i) = column.iter().position(|x| x.abs() > limit) {
-            let unit = if k < 3 { "m" } else { "rad" };
+            let unit = units[usize::from(j % 6 >= 3)];
             return Err(ScenarioError::Io(platen_io::IoError::Record {
                 path: path.to_owned(),
                 message: format!(
@@ -1288,6 +1307,24 @@ fn build_initial(
         let at = format!("initial.{key}");
         let v = check_finite(ctx, &at, v)?;
         let dof = Dof::ALL[k % 6];
+        // A pose or rate beyond any table's is a unit slip, refused here rather than run into
+        // a non-finite state with the uniaxial solver's labels.
+        let (limit, unit) = match (k < 6, k % 6 < 3) {
+            (true, true) => (PLAUSIBLE_GEOMETRY_M, "m"),
+            (true, false) => (PLAUSIBLE_GEOMETRY_M, "rad"),
+            (false, true) => (PLAUSIBLE_RATE_M_S, "m/s"),
+            (false, false) => (PLAUSIBLE_RATE_M_S, "rad/s"),
+        };
+        if v.abs() > limit {
+            return Err(ctx.invalid(
+                &at,
+                v,
+                format!(
+                    "a value within ±{limit} {unit}, beyond which no table moves (millimetres \
+                     or degrees written as {unit}?)"
+                ),
+            ));
+        }
         if table.held().contains(dof) && v != 0.0 {
             return Err(ctx.invalid(
                 &at,
