@@ -436,7 +436,7 @@ fn prediction_error_lines(s: &mut String, f: &PredictionErrorFit) {
     let _ = writeln!(
         s,
         "prediction-error fit (the loop run on the fitted records' commands, accelerations \
-         below {} Hz, each channel over its RMS): cost {:.4e} → {:.4e} in {} iterations \
+         and Δp below {} Hz, each channel over its RMS less its offset): cost {:.4e} → {:.4e} in {} iterations \
          ({} steps rejected); {}; {} residuals, correlation time {:.1} samples ({:.0} \
          effective)",
         f.band_hz,

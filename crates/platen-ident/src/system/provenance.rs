@@ -335,7 +335,7 @@ fn refined_provenance(id: &SystemIdentification, out: &mut [ValueProvenance]) {
                 vec![key.to_owned()],
                 format!(
                     "refined by the prediction-error fit (the loop run on the fitted records' \
-                     commands, its accelerations fitted to theirs) from the equation error's \
+                     commands, its accelerations and Δp fitted to theirs) from the equation error's \
                      {:.5e}",
                     p.start
                 ),
