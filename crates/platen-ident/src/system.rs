@@ -43,6 +43,7 @@ use crate::error::{IdentError, Result};
 
 mod fit;
 mod judge;
+mod pem;
 mod plant;
 mod provenance;
 pub mod skew;
@@ -51,6 +52,10 @@ pub mod transmissibility;
 pub use judge::{
     fir_black_box, Baseline, BlackBox, HeldOutMedians, Judgement, Prediction, PredictionSeries,
     BLACK_BOX_LENGTH_S, JUDGE_LOWPASS_HZ, MAX_BLACK_BOX_TAPS,
+};
+pub use pem::{
+    refine_loop, ChannelFit, LoopValues, PemParameter, PredictionErrorFit, RefinedLoop,
+    CHI2_TOLERANCE, FD_STEP, MAX_CORRELATION, MAX_ITERATIONS, MIN_COLUMN_NORM,
 };
 pub use plant::stroke_limit_m;
 pub use plant::{
@@ -231,6 +236,10 @@ pub struct SystemIdentification {
     /// The plant (platen, specimen, valves, oil column), in the base's geometry
     /// ([`SystemSettings::base`]) or, without one, in ratios to a nominal actuator area.
     pub plant: Option<IdentifiedPlant>,
+    /// The loop's values refined by its prediction error on the fitted records
+    /// ([`SystemSettings::prediction_error`]; the plant, the gains and the judgement then
+    /// hold the refined values).
+    pub prediction_error: Option<PredictionErrorFit>,
     /// The identified loop run on each record's command, against a linear black box and
     /// perfect tracking ([`SystemSettings::judge`]).
     pub judgement: Option<Judgement>,
@@ -259,6 +268,11 @@ pub struct SystemSettings {
     /// Whether to run the identified loop on every record's command and judge it
     /// ([`SystemIdentification::judgement`]).
     pub judge: bool,
+    /// Whether to refine the loop's equation-error values by its prediction error on the
+    /// fitted records (the closed loop run on their commands made to reproduce the table's
+    /// and storeys' accelerations: [`PredictionErrorFit`]) before judging it. Default
+    /// `false` here; `platen identify --system` sets it unless `--no-prediction-error`.
+    pub prediction_error: bool,
 }
 
 /// Central differences (one-sided second order at the ends): velocity and acceleration.
@@ -479,6 +493,7 @@ pub fn identify_system(
         gain_estimates,
         channel_skew,
         plant: None,
+        prediction_error: None,
         judgement: None,
         provenance: Vec::new(),
         not_identified,
@@ -505,6 +520,10 @@ pub fn identify_system(
             }
         }
     });
+    if settings.prediction_error {
+        result.prediction_error =
+            pem::refine(records_c, &fitted, &mut plant, &mut result.not_identified);
+    }
     let modes: Vec<(f64, f64)> = plant
         .specimen_modes
         .iter()

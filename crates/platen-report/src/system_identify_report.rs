@@ -9,8 +9,8 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use platen_ident::system::{
-    IdentifiedHydraulics, IdentifiedPlant, Judgement, Prediction, SystemIdentification,
-    SystemRecord, ValueProvenance,
+    IdentifiedHydraulics, IdentifiedPlant, Judgement, Prediction, PredictionErrorFit,
+    SystemIdentification, SystemRecord, ValueProvenance,
 };
 use platen_io::columns::ColumnMap;
 use platen_io::columns::ColumnSpec;
@@ -253,6 +253,9 @@ pub fn identified_system_text(id: &SystemIdentification) -> String {
     if let Some(p) = &id.plant {
         plant_lines(&mut s, p);
     }
+    if let Some(f) = &id.prediction_error {
+        prediction_error_lines(&mut s, f);
+    }
     if let Some(j) = &id.judgement {
         judgement_lines(&mut s, j);
     }
@@ -487,6 +490,46 @@ fn hydraulics_lines(s: &mut String, h: &IdentifiedHydraulics) {
         h.oil_column_frequency_hz,
         h.oil_column_frequency_with_specimen_hz
     );
+}
+
+/// The prediction-error fit: how it ended, each channel's NRMSE before and after, each
+/// parameter from its equation-error start to its refined value.
+fn prediction_error_lines(s: &mut String, f: &PredictionErrorFit) {
+    let _ = writeln!(
+        s,
+        "prediction-error fit (the loop run on the fitted records' commands, accelerations \
+         and Δp below {} Hz, each channel over its RMS less its offset): cost {:.4e} → {:.4e} in {} iterations \
+         ({} steps rejected); {}; {} residuals, correlation time {:.1} samples ({:.0} \
+         effective)",
+        f.band_hz,
+        f.cost_before,
+        f.cost_after,
+        f.iterations,
+        f.rejected_steps,
+        f.stop_reason,
+        f.residuals,
+        f.correlation_time_samples,
+        f.effective_residuals
+    );
+    for c in &f.channels {
+        let _ = writeln!(
+            s,
+            "  {:<40} NRMSE {} → {}",
+            c.channel,
+            pct(c.nrmse_before),
+            pct(c.nrmse_after)
+        );
+    }
+    for p in &f.parameters {
+        let _ = writeln!(
+            s,
+            "  {:<52} {:.5e} → {}{}",
+            p.key,
+            p.start,
+            plus_minus(p.value, p.std_error),
+            if p.refined { "" } else { "  (held)" }
+        );
+    }
 }
 
 /// The identified loop's predictions on each record's command, against the black box and

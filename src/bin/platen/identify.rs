@@ -112,6 +112,11 @@ pub struct IdentifyArgs {
     /// without the rest of the drawings (the plant's absolute scale).
     #[arg(long, value_name = "M2", requires = "system", conflicts_with = "base")]
     area_m2: Option<f64>,
+    /// With --system: keep the equation-error values instead of refining them by the
+    /// loop's prediction error (the closed loop run on the fitted records' commands, its
+    /// table and storey accelerations fitted to theirs by Levenberg–Marquardt).
+    #[arg(long, requires = "system")]
+    no_prediction_error: bool,
     #[command(flatten)]
     size: plot::SizeArgs,
 }
@@ -348,6 +353,7 @@ fn run_system(args: &IdentifyArgs, size: &FigureSize) -> Result<()> {
         base: inputs.base,
         area_m2: args.area_m2,
         judge: true,
+        prediction_error: !args.no_prediction_error,
         ..SystemSettings::default()
     };
     let id = identify_system(&inputs.records, &inputs.fit, &settings)?;

@@ -859,7 +859,7 @@ fn fit_storeys(
 }
 
 /// The fixed-base modes of `storeys` (classical modal damping).
-fn modes(storeys: &[IdentifiedStorey]) -> Vec<Mode> {
+pub(super) fn modes(storeys: &[IdentifiedStorey]) -> Vec<Mode> {
     let n = storeys.len();
     let tri = |f: &dyn Fn(&IdentifiedStorey) -> f64| {
         DMatrix::from_fn(n, n, |i, j| {

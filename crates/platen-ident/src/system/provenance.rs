@@ -57,6 +57,7 @@ pub(crate) fn of(
         loop_provenance(plant, input, &mut out);
     }
     controller_provenance(id, &mut out);
+    refined_provenance(id, &mut out);
     for p in &mut out {
         if p.std_error.is_none() {
             p.std_error = plant.std_errors.get(&p.path).copied();
@@ -315,6 +316,60 @@ fn controller_provenance(id: &SystemIdentification, out: &mut Vec<ValueProvenanc
                     Assumed,
                     Some("0: its channel is not recorded"),
                 ));
+            }
+        }
+    }
+}
+
+/// The values the prediction-error fit refined: identified, with its standard error and a
+/// note of where the fit started.
+fn refined_provenance(id: &SystemIdentification, out: &mut [ValueProvenance]) {
+    let Some(fit) = &id.prediction_error else {
+        return;
+    };
+    for p in fit.parameters.iter().filter(|p| p.refined) {
+        let (paths, note): (Vec<String>, String) = match p.key.as_str() {
+            "table_system.servo_valve.equivalent_lag_s" => (
+                ["delay_s", "natural_frequency_hz"]
+                    .iter()
+                    .map(|k| format!("table_system.servo_valve.{k}"))
+                    .collect(),
+                format!(
+                    "refined by the prediction-error fit with the spool's period: the \
+                     equivalent lag τ + 2ζ/ω_n from {:.4e} s (equation error) to {:.4e} ± {} s",
+                    p.start,
+                    p.value,
+                    p.std_error.map_or("–".into(), |s| format!("{s:.2e}"))
+                ),
+            ),
+            "table_system.actuator.chamber_volume_m3" => (
+                (0..2)
+                    .map(|k| format!("table_system.actuator.chamber_volume_m3[{k}]"))
+                    .collect(),
+                format!(
+                    "identified as V/β (equation error), both chambers then scaled together by \
+                     the prediction-error fit: {:.4e} → {:.4e} m³ at the oil_bulk_modulus_pa \
+                     given or assumed",
+                    p.start, p.value
+                ),
+            ),
+            key => (
+                vec![key.to_owned()],
+                format!(
+                    "refined by the prediction-error fit (the loop run on the fitted records' \
+                     commands, its accelerations and Δp fitted to theirs) from the equation error's \
+                     {:.5e}",
+                    p.start
+                ),
+            ),
+        };
+        for path in paths {
+            if let Some(v) = out.iter_mut().find(|v| v.path == path) {
+                v.source = Source::Identified;
+                v.note = Some(note.clone());
+                if p.key == path {
+                    v.std_error = p.std_error;
+                }
             }
         }
     }
