@@ -16,6 +16,18 @@
 //! over 5 s at both ends; the table then moves up to ±0.18 m at about 1 g), with white
 //! noise on the displacement (0.02 mm), acceleration (0.03 m/s²) and force (20 N). No
 //! velocity channel: the crossover estimate is used, as for lab files.
+//!
+//! **Stand-ins for real records (issue 51).** When `PLATEN_REAL_STANDINS` names a folder of
+//! the 34 stand-ins written by `python3 tools/reference/real_table_records.py DIR` (numpy,
+//! about 10 minutes; 55 minutes of records, 673 000 samples: a small table whose viscous
+//! exponent the records barely fix, unequal lengths, per-record skews, 30–50 Hz content,
+//! long stretches below the speed threshold), the first 1, 2, 4, 8, 16 and 34 of them
+//! (sorted by name, read with the folder's `columns-anyrecord.json`) are timed too, by the
+//! equation error alone and with the output-error check, and after each group the slope of
+//! log time against log records (least squares) is printed: 1 for a cost linear in the
+//! records. Without the variable the group is skipped with a message that says how to make
+//! the folder. The output-error check on 16 and 34 of them takes minutes a run: it is
+//! measured only when `PLATEN_BENCH_34_OE` is set.
 
 // criterion's macros generate undocumented items.
 #![allow(missing_docs)]
@@ -25,8 +37,10 @@ mod common;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use platen::app::records::{read_records, RecordRequest};
 use platen::ident::{identify_records, RecordSettings, TestRecord};
 use platen::integrate::{forward_rk4, ForceRecord, Rk4, State, Trajectory};
+use platen::io::columns::ColumnMap;
 use platen::model::IdentifiedParams;
 use platen::scenario::generate::{white_noise_motion, SplitMix64};
 
@@ -106,8 +120,10 @@ fn scaling(c: &mut Criterion, name: &str, records: &[TestRecord], counts: &[usiz
     }
     group.finish();
     println!("\n{name}: median time per run, per record and per sample");
+    let mut points = Vec::new();
     for (id, count, samples) in rows {
         if let Some(t) = common::median_ns(&id, 10) {
+            points.push(((count as f64).ln(), (t * 1e-9).ln()));
             println!(
                 "  {count:>3} records {samples:>7} samples  {:>9.3} s  {:>7.3} s/record  {:>7.1} ns/sample",
                 t * 1e-9,
@@ -116,7 +132,61 @@ fn scaling(c: &mut Criterion, name: &str, records: &[TestRecord], counts: &[usiz
             );
         }
     }
+    if let Some(slope) = slope(&points) {
+        println!("  slope of log time against log records (least squares): {slope:.3}");
+    }
     println!();
+}
+
+/// The least-squares slope of `y` against `x` (`None` for fewer than two distinct `x`).
+fn slope(points: &[(f64, f64)]) -> Option<f64> {
+    let n = points.len() as f64;
+    let (mx, my) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
+    let sxx: f64 = points.iter().map(|(x, _)| (x - mx).powi(2)).sum();
+    let sxy: f64 = points.iter().map(|(x, y)| (x - mx) * (y - my)).sum();
+    (points.len() >= 2 && sxx > 0.0).then(|| sxy / sxx)
+}
+
+/// The stand-ins for real records in the folder `PLATEN_REAL_STANDINS` names, sorted by
+/// file name, read with its `columns-anyrecord.json`; `None` (and a message) without it.
+fn real_standins() -> Option<Vec<TestRecord>> {
+    let Some(dir) = std::env::var_os("PLATEN_REAL_STANDINS") else {
+        println!(
+            "identify_scaling_real_standins: skipped (PLATEN_REAL_STANDINS is not set). Make the \
+             34 stand-ins with `python3 tools/reference/real_table_records.py DIR` (about 10 \
+             minutes) and set PLATEN_REAL_STANDINS=DIR."
+        );
+        return None;
+    };
+    let dir = std::path::PathBuf::from(dir);
+    let mut files: Vec<std::path::PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("PLATEN_REAL_STANDINS={}: {e}", dir.display()))
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+            name.starts_with('r') && name.ends_with(".csv") && !name.ends_with("-clean.csv")
+        })
+        .collect();
+    files.sort();
+    let columns = ColumnMap::load(&dir.join("columns-anyrecord.json"))
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+    let request = RecordRequest {
+        files,
+        columns,
+        ..RecordRequest::default()
+    };
+    let records = read_records(&request)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .records;
+    println!(
+        "identify_scaling_real_standins: {} records, {} samples, from {}",
+        records.len(),
+        records.iter().map(TestRecord::len).sum::<usize>(),
+        dir.display()
+    );
+    Some(records)
 }
 
 fn bench(c: &mut Criterion) {
@@ -139,6 +209,31 @@ fn bench(c: &mut Criterion) {
         &with_oe,
         true,
     );
+    if let Some(standins) = real_standins() {
+        let counts: Vec<usize> = COUNTS
+            .into_iter()
+            .filter(|&n| n <= standins.len())
+            .collect();
+        scaling(
+            c,
+            "identify_scaling_real_standins_equation_error",
+            &standins,
+            &counts,
+            false,
+        );
+        let with_oe: Vec<usize> = counts
+            .iter()
+            .copied()
+            .filter(|&n| n < 16 || std::env::var_os("PLATEN_BENCH_34_OE").is_some())
+            .collect();
+        scaling(
+            c,
+            "identify_scaling_real_standins_with_output_error",
+            &standins,
+            &with_oe,
+            true,
+        );
+    }
 }
 
 criterion_group!(benches, bench);

@@ -235,7 +235,24 @@ pub(crate) struct LmSettings {
     /// Stop when every parameter changes by less than this fraction of its size (or of 1 for
     /// parameters near zero, scaled by the diagonal of `JᵀJ`).
     pub step_tolerance: f64,
+    /// The statistical stop ([`Stop::Statistical`]): stop when the Gauss–Newton model of the
+    /// cost, over the parameters not held at a bound, predicts a decrease below this many
+    /// units of the residual variance `s² = SSR/(n − p)`. The predicted decrease over `s²`
+    /// is the squared length of the remaining step in standard errors (`δᵀJᵀJδ/s²`), so
+    /// `10⁻⁶` stops when the optimum is within a thousandth of a standard error of every
+    /// parameter and of every combination of them. 0 turns the rule off.
+    pub statistical_tolerance: f64,
 }
+
+/// [`LmSettings::statistical_tolerance`] by default: the remaining step within 10⁻³ of a
+/// standard error (computed as if the residuals were independent; serially correlated
+/// residuals have larger errors, which makes the rule stricter, not looser). Far below what
+/// any reported figure resolves (the estimates are printed with their errors to two or three
+/// digits), and far above rounding: the search's cost is then within `10⁻⁶·s²` of its
+/// minimum, `10⁻⁶/(n − p)` of the cost, where the old rule (a step gaining less than
+/// [`LmSettings::cost_tolerance`] of the cost, `10⁻¹⁴`) let a search crawl along a flat valley
+/// for hundreds of iterations gaining `10⁻¹²` of the cost each.
+pub(crate) const STATISTICAL_TOLERANCE: f64 = 1e-6;
 
 impl Default for LmSettings {
     fn default() -> Self {
@@ -243,8 +260,26 @@ impl Default for LmSettings {
             max_iterations: 200,
             cost_tolerance: 1e-14,
             step_tolerance: 1e-12,
+            statistical_tolerance: STATISTICAL_TOLERANCE,
         }
     }
+}
+
+/// Why a minimisation stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Stop {
+    /// An accepted step changed every parameter, or the cost, by less than the tolerances of
+    /// [`LmSettings`] (or the cost reached zero).
+    Tolerance,
+    /// The Gauss–Newton model predicts a decrease of the cost below
+    /// [`LmSettings::statistical_tolerance`] of the residual variance: what is left to gain is
+    /// statistically nothing (a flat valley's remaining crawl included).
+    Statistical,
+    /// No step along the free parameters lowers the cost (every damping tried), or every
+    /// parameter is held on its bound: a (possibly constrained) minimum.
+    NoDescent,
+    /// The iteration limit ended the run.
+    IterationLimit,
 }
 
 /// Result of a minimisation.
@@ -262,6 +297,11 @@ pub(crate) struct LmResult {
     pub iterations: usize,
     /// Whether a stopping rule (not the iteration limit) ended the run.
     pub converged: bool,
+    /// Which rule ended the run.
+    pub stop: Stop,
+    /// The parameters held on a bound at the optimum: on it, with the cost's gradient
+    /// pushing outward (the active set of [`minimize`]).
+    pub held: Vec<bool>,
 }
 
 fn sum_sq(r: &[f64]) -> f64 {
@@ -273,6 +313,14 @@ fn project(p: &mut [f64], lower: &[f64], upper: &[f64]) {
     for ((x, lo), hi) in p.iter_mut().zip(lower).zip(upper) {
         *x = x.clamp(*lo, *hi);
     }
+}
+
+/// The parameters on a bound whose gradient `g = Jᵀr` pushes outward (a step down the cost
+/// would leave the box): the active set, held where they are for the step.
+fn active_set(p: &[f64], g: &DVector<f64>, lower: &[f64], upper: &[f64]) -> Vec<bool> {
+    (0..p.len())
+        .map(|i| (p[i] <= lower[i] && g[i] > 0.0) || (p[i] >= upper[i] && g[i] < 0.0))
+        .collect()
 }
 
 /// The state of a minimisation between iterations.
@@ -289,46 +337,90 @@ struct Search<'a> {
 
 impl Search<'_> {
     /// One outer iteration at the Jacobian `jac`: raises the damping until a step lowers the
-    /// cost, and takes it. Returns true when a stopping rule says the minimum is reached.
-    fn iterate<P: Problem>(&mut self, problem: &P, jac: &Jacobian, settings: &LmSettings) -> bool {
+    /// cost, and takes it. Returns why it stopped when a stopping rule says the minimum is
+    /// reached.
+    ///
+    /// Bounds by an active set: a parameter on its bound whose gradient pushes outward is
+    /// held, and the step is solved in the others (the damped normal equations restricted to
+    /// them); the trial point is then projected onto the box. Projecting a step solved in
+    /// every parameter instead (the step's held component cut off after the solve) leaves
+    /// the others where the cut-off component would have taken them: along a valley that
+    /// runs into the bound, such a search crawls, gaining a little each iteration, to its
+    /// iteration limit.
+    fn iterate<P: Problem>(
+        &mut self,
+        problem: &P,
+        jac: &Jacobian,
+        settings: &LmSettings,
+    ) -> Option<Stop> {
         let m = self.p.len();
         let jtj = jac.gram();
         let g = jac.tr_mul(&self.r);
-        let diag: Vec<f64> = (0..m)
-            .map(|i| jtj[(i, i)].max(1e-300 + 1e-12 * jtj.diagonal().max()))
+        let held = active_set(&self.p, &g, self.lower, self.upper);
+        let free: Vec<usize> = (0..m).filter(|&i| !held[i]).collect();
+        if free.is_empty() {
+            return Some(Stop::NoDescent);
+        }
+        let k = free.len();
+        let a0 = DMatrix::from_fn(k, k, |x, y| jtj[(free[x], free[y])]);
+        let gf = DVector::from_fn(k, |x, _| g[free[x]]);
+        let max_diag = a0.diagonal().max();
+        let diag: Vec<f64> = (0..k)
+            .map(|x| a0[(x, x)].max(1e-300 + 1e-12 * max_diag))
             .collect();
+        if settings.statistical_tolerance > 0.0 {
+            // The Gauss–Newton decrease gᵀ(JᵀJ)⁻¹g of the cost Σr² over the free parameters,
+            // against the residual variance.
+            let n = jac.rows();
+            let s2 = self.cost / (n as f64 - m as f64).max(1.0);
+            if let Some(chol) = a0.clone().cholesky() {
+                let predicted = gf.dot(&chol.solve(&gf));
+                if predicted.is_finite()
+                    && predicted >= 0.0
+                    && predicted <= settings.statistical_tolerance * s2
+                {
+                    return Some(Stop::Statistical);
+                }
+            }
+        }
         loop {
-            let mut a = jtj.clone();
-            for (i, d) in diag.iter().enumerate() {
-                a[(i, i)] += self.lambda * d;
+            let mut a = a0.clone();
+            for (x, d) in diag.iter().enumerate() {
+                a[(x, x)] += self.lambda * d;
             }
             let Some(chol) = a.cholesky() else {
                 self.lambda *= 10.0;
                 if self.lambda > 1e20 {
-                    return true;
+                    return Some(Stop::NoDescent);
                 }
                 continue;
             };
-            let step = chol.solve(&(-&g));
-            for i in 0..m {
-                self.trial[i] = self.p[i] + step[i];
+            let step = chol.solve(&(-&gf));
+            self.trial.copy_from_slice(&self.p);
+            for (x, &i) in free.iter().enumerate() {
+                self.trial[i] = self.p[i] + step[x];
             }
             project(&mut self.trial, self.lower, self.upper);
             problem.residuals(&self.trial, &mut self.trial_r);
             let trial_cost = sum_sq(&self.trial_r);
             if trial_cost.is_finite() && trial_cost <= self.cost {
-                return self.accept(trial_cost, &diag, settings);
+                let mut full_diag = vec![f64::INFINITY; m];
+                for (x, &i) in free.iter().enumerate() {
+                    full_diag[i] = diag[x];
+                }
+                return self.accept(trial_cost, &full_diag, settings);
             }
             self.lambda *= 10.0;
             if self.lambda > 1e20 {
                 // No descent direction left: a (possibly constrained) minimum.
-                return true;
+                return Some(Stop::NoDescent);
             }
         }
     }
 
-    /// Takes the trial point; true if the step or the gain was below tolerance.
-    fn accept(&mut self, trial_cost: f64, diag: &[f64], settings: &LmSettings) -> bool {
+    /// Takes the trial point; [`Stop::Tolerance`] if the step or the gain was below
+    /// tolerance.
+    fn accept(&mut self, trial_cost: f64, diag: &[f64], settings: &LmSettings) -> Option<Stop> {
         let (p, trial) = (&self.p, &self.trial);
         let small_step = (0..p.len()).all(|i| {
             let scale = p[i].abs().max(1.0 / diag[i].sqrt().max(1e-300));
@@ -339,12 +431,13 @@ impl Search<'_> {
         std::mem::swap(&mut self.r, &mut self.trial_r);
         self.cost = trial_cost;
         self.lambda = (self.lambda * 0.1).max(1e-15);
-        small_step || small_gain || self.cost == 0.0
+        (small_step || small_gain || self.cost == 0.0).then_some(Stop::Tolerance)
     }
 }
 
-/// Minimises `problem` from `start`, keeping `lower ≤ p ≤ upper` by projecting every trial
-/// point onto the box.
+/// Minimises `problem` from `start`, keeping `lower ≤ p ≤ upper`: parameters on a bound
+/// with the gradient pushing outward are held for the step (an active set), and every trial
+/// point is projected onto the box. Stops by the rules of [`LmSettings`] ([`Stop`]).
 pub(crate) fn minimize<P: Problem>(
     problem: &P,
     start: &[f64],
@@ -372,23 +465,26 @@ pub(crate) fn minimize<P: Problem>(
     let mut jac = problem.new_jacobian();
     debug_assert_eq!((jac.rows(), jac.cols()), (n, m));
     let mut iterations = 0;
-    let mut converged = false;
+    let mut stop = Stop::IterationLimit;
     while iterations < settings.max_iterations {
         iterations += 1;
         problem.jacobian(&search.p, &search.r, &mut jac);
-        if search.iterate(problem, &jac, &settings) {
-            converged = true;
+        if let Some(why) = search.iterate(problem, &jac, &settings) {
+            stop = why;
             break;
         }
     }
     problem.jacobian(&search.p, &search.r, &mut jac);
+    let held = active_set(&search.p, &jac.tr_mul(&search.r), lower, upper);
     LmResult {
         params: search.p,
         ssr: search.cost,
         jacobian: jac,
         residuals: search.r,
         iterations,
-        converged,
+        converged: stop != Stop::IterationLimit,
+        stop,
+        held,
     }
 }
 
@@ -597,6 +693,89 @@ mod tests {
                 "{rows} rows"
             );
         }
+    }
+
+    /// Residuals of a valley plus `noise` residuals that do not depend on the parameters
+    /// (a fit's unexplained part: they set the residual variance `s² ≈ 1` and no gradient).
+    struct Valley {
+        /// Weight of the direction along the valley's floor.
+        along: f64,
+        noise: usize,
+    }
+
+    impl Problem for Valley {
+        fn residual_count(&self) -> usize {
+            2 + self.noise
+        }
+        fn parameter_count(&self) -> usize {
+            2
+        }
+        /// Rosenbrock's valley `p1 = p0²`, its floor falling towards `p0 = 1` with weight
+        /// `along`.
+        fn residuals(&self, p: &[f64], r: &mut [f64]) {
+            r[0] = 10.0 * (p[1] - p[0] * p[0]);
+            r[1] = self.along * (1.0 - p[0]);
+            for (k, x) in r[2..].iter_mut().enumerate() {
+                *x = if k % 2 == 0 { 1.0 } else { -1.0 };
+            }
+        }
+        fn jacobian(&self, p: &[f64], _r: &[f64], j: &mut Jacobian) {
+            j.shared.fill(0.0);
+            j.shared[(0, 0)] = -20.0 * p[0];
+            j.shared[(0, 1)] = 10.0;
+            j.shared[(1, 0)] = -self.along;
+        }
+    }
+
+    /// The valley runs into the bound `p0 ≤ 0.5` with the cost still falling beyond it: `p0`
+    /// is held there (the active set) and the search ends in a few iterations at the
+    /// constrained optimum `(0.5, 0.25)`, `p0` reported held. `p1` within 10⁻⁴: a thousandth
+    /// of its standard error (`s ≈ 1`, `∂r/∂p1 = 10`), what the statistical stop leaves.
+    #[test]
+    fn a_parameter_pinned_at_its_bound_is_held_and_the_search_stops_at_once() {
+        let prob = Valley {
+            along: 1.0,
+            noise: 1000,
+        };
+        for start in [[0.2, 0.5], [0.5, 1.0], [0.5, 0.0]] {
+            let fit = minimize(
+                &prob,
+                &start,
+                &[-2.0, -2.0],
+                &[0.5, 2.0],
+                LmSettings::default(),
+            );
+            assert!(fit.converged, "{fit:?}");
+            assert!(fit.iterations <= 5, "{} iterations", fit.iterations);
+            assert_eq!(fit.params[0], 0.5);
+            assert!((fit.params[1] - 0.25).abs() < 1e-4, "{:?}", fit.params);
+            assert_eq!(fit.held, vec![true, false]);
+        }
+    }
+
+    /// Along the valley's floor the cost changes by at most `along²·(1 − p0)² ≈ 4·10⁻⁷`, below
+    /// a millionth of the residual variance (`s² = 10/8`): `p0` is not determined. The
+    /// statistical stop ends the search once it is on the floor (3 iterations), where the old
+    /// rules (a step gaining less than 10⁻¹⁴ of the cost) let it crawl along the floor to its
+    /// iteration limit (200).
+    #[test]
+    fn a_search_along_a_statistically_flat_valley_stops_with_a_verdict() {
+        let prob = Valley {
+            along: 3e-4,
+            noise: 10,
+        };
+        let (lower, upper) = ([-5.0, -5.0], [5.0, 5.0]);
+        let fit = minimize(&prob, &[-1.2, 1.0], &lower, &upper, LmSettings::default());
+        assert_eq!(fit.stop, Stop::Statistical, "{fit:?}");
+        assert!(fit.iterations <= 5, "{} iterations", fit.iterations);
+        // On the floor: the off-valley residual within a thousandth of the noise's scale.
+        assert!((10.0 * (fit.params[1] - fit.params[0].powi(2))).abs() < 1e-3);
+        let old = LmSettings {
+            statistical_tolerance: 0.0,
+            ..LmSettings::default()
+        };
+        let crawl = minimize(&prob, &[-1.2, 1.0], &lower, &upper, old);
+        assert_eq!(crawl.stop, Stop::IterationLimit, "{crawl:?}");
     }
 
     #[test]

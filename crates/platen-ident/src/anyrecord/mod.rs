@@ -108,7 +108,7 @@ pub fn identify_records(
     enough_points(&data, &shape, records, settings)?;
     let mut warnings = Vec::new();
     let (fit, mut hac, low_dropped) = fit_with_low_term(&data, &mut shape, &mut warnings);
-    skew_covariance(&mut hac, &fit, shape, &data, &corrected, settings)?;
+    let skew_refits = skew_covariance(&mut hac, &fit, shape, &data, &corrected, settings)?;
     let clamped = fit.clamped.clone();
     let fixed_reason = |key: IdentifiedKey| -> String {
         match key {
@@ -152,6 +152,17 @@ pub fn identify_records(
         min_speed_m_s: settings.min_speed_m_s,
         iterations: fit.iterations,
         converged: fit.converged,
+        stop: stop_name(fit.stop).to_owned(),
+        not_identified: fit
+            .held
+            .iter()
+            .map(|&i| {
+                let key = IdentifiedKey::ALL[i];
+                (key, held_reason(key, fit.full[i]))
+            })
+            .collect(),
+        skew_refits_newton: skew_refits[0],
+        skew_refits_searched: skew_refits[1],
     };
 
     let (simulated, output_error) = output_error_check(
@@ -298,8 +309,11 @@ fn output_error_check(
 /// vector over the delay. A perturbed fit that frees or clamps other parameters than `fit`
 /// says nothing about `g` along them and is skipped. Each refit prepares the one record whose
 /// channel moved and shares every other record's samples and sums with `data`; it follows
-/// the fit's minimum by Newton's method from the expanded sums (module `refit`), or, where
-/// that does not apply, runs the fit's own search.
+/// the fit's minimum by Newton's method from the expanded sums (module `refit`, a nonlinear
+/// parameter on its bound held there), or, where that does not apply, runs the fit's own
+/// search from the joint fit's `(α, b)` (not from the start grid: the grid's best node moves
+/// along a flat valley with the channel, and a search from it costs tens of passes over
+/// every record). Returns how many refits were made each way, `[Newton, search]`.
 fn skew_covariance(
     hac: &mut Hac,
     fit: &SeparableFit,
@@ -307,22 +321,25 @@ fn skew_covariance(
     data: &Stacked,
     corrected: &skew::Corrected,
     settings: &ValidRecordSettings,
-) -> Result<()> {
+) -> Result<[usize; 2]> {
     let perturbations = skew::perturbations(corrected)?;
-    let refits = if perturbations.is_empty() {
-        None
-    } else {
-        Refits::new(data, fit, shape, refit::Sums::Expanded)
-    };
+    let mut counts = [0; 2];
+    if perturbations.is_empty() {
+        return Ok(counts);
+    }
+    let refits = Refits::new(data, fit, shape, refit::Sums::Expanded);
+    let start: Vec<f64> = shape.nonlinear().iter().map(|&i| fit.full[i]).collect();
     for p in perturbations {
-        let refit = |rec: &TestRecord| -> Result<Refit> {
+        let mut refit = |rec: &TestRecord| -> Result<Refit> {
             let prepared = prepare(std::slice::from_ref(rec), settings)?;
             let block = Block::new(p.record, rec, &prepared[0]);
             let data = data.with_block(p.record, block);
-            if let Some(r) = refits.as_ref().and_then(|x| x.refit(&data, p.record)) {
+            if let Some(r) = refits.refit(&data, p.record) {
+                counts[0] += 1;
                 return Ok(r);
             }
-            let f = Separable::new(&data, shape).fit();
+            counts[1] += 1;
+            let f = Separable::new(&data, shape).fit_from(&start);
             Ok(Refit {
                 full: f.full,
                 free: f.free,
@@ -345,7 +362,27 @@ fn skew_covariance(
             }
         }
     }
-    Ok(())
+    Ok(counts)
+}
+
+/// The name of a search's stop ([`EquationErrorFit::stop`]).
+fn stop_name(stop: crate::lm::Stop) -> &'static str {
+    match stop {
+        crate::lm::Stop::Tolerance => "tolerance",
+        crate::lm::Stop::Statistical => "statistical",
+        crate::lm::Stop::NoDescent => "no descent",
+        crate::lm::Stop::IterationLimit => "iteration limit",
+    }
+}
+
+/// Why a nonlinear parameter on its bound is not identified
+/// ([`EquationErrorFit::not_identified`]).
+fn held_reason(key: IdentifiedKey, value: f64) -> String {
+    format!(
+        "held on its bound ({value}): the records' cost still falls beyond it, so they do not determine {} within the model's range; \
+         the search held it there rather than crawl along the bound",
+        key.name()
+    )
 }
 
 fn free_position(free: &[usize], full: usize) -> usize {
@@ -571,6 +608,7 @@ fn run_output_error(
             max_iterations: settings.output_error_iterations,
             cost_tolerance: 1e-6,
             step_tolerance: 1e-6,
+            ..crate::lm::LmSettings::default()
         },
     );
     let (time, group) = problem.residual_layout();

@@ -79,6 +79,23 @@ pub struct EquationErrorFit {
     pub iterations: usize,
     /// Whether that search met its tolerance.
     pub converged: bool,
+    /// Why that search stopped: `"tolerance"` (a step changed the parameters or the cost by
+    /// less than its tolerances), `"statistical"` (what is left to gain is below a millionth
+    /// of the residual variance: the optimum is within a thousandth of a standard error),
+    /// `"no descent"` (no step lowers the cost: a constrained minimum), or
+    /// `"iteration limit"`.
+    pub stop: String,
+    /// The nonlinear parameters (`α`, `b`) the search held on a bound, with why: the cost
+    /// still falls beyond the bound, so the records do not determine the parameter within
+    /// the model's range. Their values are the bound.
+    pub not_identified: Vec<(IdentifiedKey, String)>,
+    /// Channel-skew refits (module docs of `skew`) made by Newton's method from the joint
+    /// fit's expansions.
+    pub skew_refits_newton: usize,
+    /// Channel-skew refits that Newton's method could not make, made by the search from the
+    /// joint fit's `(α, b)`: each costs passes over every record, so these grow with the
+    /// square of the records.
+    pub skew_refits_searched: usize,
 }
 
 /// The output-error refinement.

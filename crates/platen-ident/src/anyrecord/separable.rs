@@ -751,7 +751,12 @@ impl<'a> Separable<'a> {
 
     /// Runs the fit: grid, then Levenberg–Marquardt on `(α, b)`.
     pub(crate) fn fit(&self) -> SeparableFit {
-        let start = self.grid_start();
+        self.fit_from(&self.grid_start())
+    }
+
+    /// Levenberg–Marquardt on `(α, b)` from `start` (the searched parameters, in
+    /// [`Shape::nonlinear`] order): a refit that starts from the joint fit's optimum.
+    pub(crate) fn fit_from(&self, start: &[f64]) -> SeparableFit {
         let nonlinear = self.shape.nonlinear();
         let lower: Vec<f64> = nonlinear
             .iter()
@@ -773,11 +778,17 @@ impl<'a> Separable<'a> {
                 }
             })
             .collect();
-        let (q, iterations, converged) = if nonlinear.is_empty() {
-            (Vec::new(), 0, true)
+        let (q, iterations, stop, held) = if nonlinear.is_empty() {
+            (Vec::new(), 0, lm::Stop::Tolerance, Vec::new())
         } else {
-            let res = lm::minimize(self, &start, &lower, &upper, LmSettings::default());
-            (res.params, res.iterations, res.converged)
+            let res = lm::minimize(self, start, &lower, &upper, LmSettings::default());
+            let held = nonlinear
+                .iter()
+                .zip(&res.held)
+                .filter(|(_, &h)| h)
+                .map(|(&i, _)| i)
+                .collect();
+            (res.params, res.iterations, res.stop, held)
         };
         let (alpha, b) = alpha_b(&self.shape, &q);
         let ev = self.evaluate(alpha, b);
@@ -817,8 +828,10 @@ impl<'a> Separable<'a> {
             full,
             residual,
             iterations,
-            converged,
+            converged: stop != lm::Stop::IterationLimit,
+            stop,
             at_bound,
+            held,
         }
     }
 
@@ -926,6 +939,11 @@ pub(crate) struct SeparableFit {
     pub iterations: usize,
     /// Whether the search met its tolerance.
     pub converged: bool,
+    /// Why the search stopped.
+    pub stop: lm::Stop,
+    /// Nonlinear parameters the search held on their bound at the end, the cost's gradient
+    /// pushing outward (full-vector indices; a subset of `at_bound`).
+    pub held: Vec<usize>,
     /// Nonlinear parameters that ended on a bound (full-vector indices).
     pub at_bound: Vec<usize>,
 }

@@ -133,6 +133,22 @@ pub struct EquationErrorSummary {
     pub iterations: usize,
     /// Whether that search converged.
     pub converged: bool,
+    /// Why that search stopped ([`EquationErrorFit::stop`]).
+    pub stop: String,
+    /// The nonlinear parameters held on a bound, by key, with why
+    /// ([`EquationErrorFit::not_identified`]).
+    pub not_identified: BTreeMap<&'static str, String>,
+    /// How the channel-skew refits were made.
+    pub skew_refits: SkewRefitsSummary,
+}
+
+/// How the channel-skew refits of the equation error were made.
+#[derive(Debug, Clone, Serialize)]
+pub struct SkewRefitsSummary {
+    /// By Newton's method from the joint fit's expansions.
+    pub newton: usize,
+    /// By the search (passes over every record each).
+    pub searched: usize,
 }
 
 impl EquationErrorSummary {
@@ -146,6 +162,16 @@ impl EquationErrorSummary {
             min_speed_m_s: f.min_speed_m_s,
             iterations: f.iterations,
             converged: f.converged,
+            stop: f.stop.clone(),
+            not_identified: f
+                .not_identified
+                .iter()
+                .map(|(k, why)| (k.name(), why.clone()))
+                .collect(),
+            skew_refits: SkewRefitsSummary {
+                newton: f.skew_refits_newton,
+                searched: f.skew_refits_searched,
+            },
         }
     }
 }
