@@ -55,7 +55,8 @@ fn bash_completes_the_verbs_and_their_options() {
         [
             "--no-low-velocity-term",
             "--no-output-error",
-            "--nonnegative-stiffness"
+            "--nonnegative-stiffness",
+            "--no-prediction-error"
         ]
     );
 }
