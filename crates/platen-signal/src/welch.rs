@@ -80,42 +80,58 @@ impl Welch {
     /// # Errors
     /// [`SignalError::RecordTooShort`] if `x` is shorter than one segment.
     pub fn estimate(&self, x: &[f64]) -> Result<Psd> {
+        let (step, segments) = self.segments_of(x.len())?;
         let len = self.segment_len;
-        if x.len() < len {
-            return Err(SignalError::RecordTooShort {
-                what: "record (one Welch segment)",
-                found: x.len(),
-                min: len,
-            });
-        }
-        let step = len - len / 2;
-        let segments = (x.len() - len) / step + 1;
-        let bins = len / 2 + 1;
-        let mut density = vec![0.0; bins];
+        let mut density = vec![0.0; len / 2 + 1];
         let mut buf = vec![Complex::new(0.0, 0.0); len];
         let mut scratch = vec![Complex::new(0.0, 0.0); self.fft.get_inplace_scratch_len()];
         for s in 0..segments {
-            let seg = &x[s * step..s * step + len];
-            let mean = seg.iter().sum::<f64>() / len as f64;
-            for ((c, v), w) in buf.iter_mut().zip(seg).zip(&self.window) {
-                *c = Complex::new((v - mean) * w, 0.0);
-            }
-            self.fft.process_with_scratch(&mut buf, &mut scratch);
+            self.transform(&x[s * step..s * step + len], &mut buf, &mut scratch);
             for (p, c) in density.iter_mut().zip(&buf) {
                 *p += c.norm_sqr();
             }
         }
-        let base = self.scale / segments as f64;
         for (k, p) in density.iter_mut().enumerate() {
-            let nyquist = len % 2 == 0 && k == len / 2;
-            let one_sided = if k == 0 || nyquist { 1.0 } else { 2.0 };
-            *p *= base * one_sided;
+            *p *= self.bin_scale(k, segments);
         }
         Ok(Psd {
             resolution_hz: self.resolution_hz(),
             density,
             segments,
         })
+    }
+
+    /// The hop between segments and their count for a record of `n` samples (50 % overlap,
+    /// samples after the last whole segment unused).
+    fn segments_of(&self, n: usize) -> Result<(usize, usize)> {
+        let len = self.segment_len;
+        if n < len {
+            return Err(SignalError::RecordTooShort {
+                what: "record (one Welch segment)",
+                found: n,
+                min: len,
+            });
+        }
+        let step = len - len / 2;
+        Ok((step, (n - len) / step + 1))
+    }
+
+    /// The FFT of one segment, its mean removed and windowed, into `buf`.
+    fn transform(&self, seg: &[f64], buf: &mut [Complex<f64>], scratch: &mut [Complex<f64>]) {
+        let mean = seg.iter().sum::<f64>() / seg.len() as f64;
+        for ((c, v), w) in buf.iter_mut().zip(seg).zip(&self.window) {
+            *c = Complex::new((v - mean) * w, 0.0);
+        }
+        self.fft.process_with_scratch(buf, scratch);
+    }
+
+    /// The one-sided density's factor at bin `k` over `segments` segments:
+    /// `c_k/(f_s·Σw²·segments)`, `c_k = 2` but at DC and the Nyquist bin.
+    fn bin_scale(&self, k: usize, segments: usize) -> f64 {
+        let len = self.segment_len;
+        let nyquist = len % 2 == 0 && k == len / 2;
+        let one_sided = if k == 0 || nyquist { 1.0 } else { 2.0 };
+        self.scale / segments as f64 * one_sided
     }
 }
 
@@ -137,41 +153,26 @@ impl Welch {
                 reference: "x (its input channel)",
             });
         }
+        let (step, segments) = self.segments_of(x.len())?;
         let len = self.segment_len;
-        if x.len() < len {
-            return Err(SignalError::RecordTooShort {
-                what: "record (one Welch segment)",
-                found: x.len(),
-                min: len,
-            });
-        }
-        let step = len - len / 2;
-        let segments = (x.len() - len) / step + 1;
         let bins = len / 2 + 1;
         let (mut xx, mut yy) = (vec![0.0; bins], vec![0.0; bins]);
-        let mut xy = vec![Complex::new(0.0, 0.0); bins];
         let zero = Complex::new(0.0, 0.0);
+        let mut xy = vec![zero; bins];
         let (mut bx, mut by) = (vec![zero; len], vec![zero; len]);
         let mut scratch = vec![zero; self.fft.get_inplace_scratch_len()];
         for s in 0..segments {
-            for (buf, z) in [(&mut bx, x), (&mut by, y)] {
-                let seg = &z[s * step..s * step + len];
-                let mean = seg.iter().sum::<f64>() / len as f64;
-                for ((c, v), w) in buf.iter_mut().zip(seg).zip(&self.window) {
-                    *c = Complex::new((v - mean) * w, 0.0);
-                }
-                self.fft.process_with_scratch(buf, &mut scratch);
-            }
+            let at = s * step..s * step + len;
+            self.transform(&x[at.clone()], &mut bx, &mut scratch);
+            self.transform(&y[at], &mut by, &mut scratch);
             for k in 0..bins {
                 xx[k] += bx[k].norm_sqr();
                 yy[k] += by[k].norm_sqr();
                 xy[k] += bx[k].conj() * by[k];
             }
         }
-        let base = self.scale / segments as f64;
         for k in 0..bins {
-            let nyquist = len % 2 == 0 && k == len / 2;
-            let c = base * if k == 0 || nyquist { 1.0 } else { 2.0 };
+            let c = self.bin_scale(k, segments);
             xx[k] *= c;
             yy[k] *= c;
             xy[k] *= c;
