@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 use platen_app::read_system_records;
 use platen_ident::system::{identify_system, SystemIdentification, SystemSettings};
 use platen_io::columns::ColumnMap;
+use platen_signal::metrics::{rms, rms_difference};
 use platen_signal::{advance, ButterworthLowpass, ZeroPhaseFilter};
 
 fn data(name: &str) -> PathBuf {
@@ -122,15 +123,6 @@ fn the_transmissibility_peaks_are_the_numpy_reference_s_and_the_modes_agree_with
     assert!(tr.warnings.is_empty(), "{:?}", tr.warnings);
 }
 
-fn rms(x: impl Iterator<Item = f64>) -> f64 {
-    let (mut s, mut n) = (0.0, 0usize);
-    for v in x {
-        s += v * v;
-        n += 1;
-    }
-    (s / n as f64).sqrt()
-}
-
 /// The held-out table acceleration's NRMSE over its noise floor must not exceed this: 1.21
 /// measured with the equation-error fit (the 1.2 is for a fit by the prediction
 /// error).
@@ -169,9 +161,8 @@ fn the_held_out_prediction_is_near_the_noise_floor_and_beats_the_baselines() {
     let floor = |recorded: &[f64], clean: &[f64], skew: f64| {
         let aligned = advance(recorded, skew).unwrap();
         let (r, c) = (lp.apply(&aligned).unwrap(), lp.apply(clean).unwrap());
-        let n = r.len();
-        let inner = 200..n - 200;
-        rms(inner.clone().map(|i| r[i] - c[i])) / rms(inner.map(|i| r[i]))
+        let inner = 200..r.len() - 200;
+        rms_difference(&r[inner.clone()], &c[inner.clone()]).unwrap() / rms(&r[inner])
     };
     let table_floor = floor(
         rec.a_m_s2.as_ref().unwrap(),

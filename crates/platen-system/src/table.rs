@@ -276,36 +276,28 @@ impl TableHydraulics {
         let inside = |p: f64| p.is_finite() && p > pr && p < ps;
         if inside(p_a) && (a.is_single_acting() || inside(p_b)) {
             Ok((p_a, p_b))
-        } else if a.is_single_acting() && p_a.is_finite() && p_a <= pr {
-            // A single-acting actuator pushes at least the return pressure on its area: it
-            // cannot hold a smaller force (a vertical with none of the platen's weight on it,
-            // as when z is held) at rest.
-            Err(SystemError::OfActuator {
-                index: i,
-                source: Box::new(invalid(
-                    "cap_side_area_m2",
-                    a.cap_area_m2,
-                    format!(
-                        "a single-acting actuator with a static force to hold: it must hold \
-                         {force_n:.6e} N at rest, less than the return pressure on its area \
-                         pushes ({:.6e} N), and it cannot pull (with z held, no weight rests \
-                         on the verticals: hold z on double-acting verticals, or leave z free)",
-                        pr * a.cap_area_m2
-                    ),
-                )),
-            })
         } else {
+            let expected = if a.is_single_acting() && p_a.is_finite() && p_a <= pr {
+                // A single-acting actuator pushes at least the return pressure on its area:
+                // it cannot hold a smaller force (a vertical with none of the platen's weight
+                // on it, as when z is held) at rest.
+                format!(
+                    "a single-acting actuator with a static force to hold: it must hold \
+                     {force_n:.6e} N at rest, less than the return pressure on its area pushes \
+                     ({:.6e} N), and it cannot pull (with z held, no weight rests on the \
+                     verticals: hold z on double-acting verticals, or leave z free)",
+                    pr * a.cap_area_m2
+                )
+            } else {
+                format!(
+                    "an area that holds its static force {force_n:.6e} N at rest with chamber \
+                     pressures between the return and supply pressures (it needs {p_a:.6e} Pa \
+                     in chamber a)"
+                )
+            };
             Err(SystemError::OfActuator {
                 index: i,
-                source: Box::new(invalid(
-                    "cap_side_area_m2",
-                    a.cap_area_m2,
-                    format!(
-                        "an area that holds its static force {force_n:.6e} N at rest with \
-                         chamber pressures between the return and supply pressures (it needs \
-                         {p_a:.6e} Pa in chamber a)"
-                    ),
-                )),
+                source: Box::new(invalid("cap_side_area_m2", a.cap_area_m2, expected)),
             })
         }
     }

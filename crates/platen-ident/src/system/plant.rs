@@ -597,11 +597,10 @@ fn fit_mechanics(
     skew_report: &mut Vec<ChannelSkew>,
 ) -> Result<Option<(LinearFit, Law)>> {
     let m = mechanics_columns(from, storeys, fitted.len(), &Law::LINEAR);
-    let signs = mechanics_signs(m);
-    let none = vec![false; m];
+    let (signs, none) = (mechanics_signs(m), vec![false; m]);
     let h0 = periods[fitted[0]];
-    let mut grid = Vec::with_capacity(PRESSURE_SHIFT_GRID.len());
-    for &s in &PRESSURE_SHIFT_GRID {
+    // The linear law's residual with the pressures shifted earlier by `samples`.
+    let rss_at = |samples: f64| -> Result<Option<f64>> {
         let d = mechanics_design(
             records,
             periods,
@@ -609,11 +608,15 @@ fn fit_mechanics(
             input,
             from,
             storeys,
-            s * h0,
+            samples * h0,
             &Law::LINEAR,
         )?;
-        grid.push(d.fit(&signs, &none).map(|f| f.rss));
-    }
+        Ok(d.fit(&signs, &none).map(|f| f.rss))
+    };
+    let grid = PRESSURE_SHIFT_GRID
+        .iter()
+        .map(|&s| rss_at(s))
+        .collect::<Result<Vec<_>>>()?;
     let best = grid
         .iter()
         .enumerate()
@@ -634,18 +637,7 @@ fn fit_mechanics(
         .iter()
         .position(|&x| x == 0.0)
         .and_then(|i| grid[i]);
-    let final_rss = mechanics_design(
-        records,
-        periods,
-        fitted,
-        input,
-        from,
-        storeys,
-        samples * h0,
-        &Law::LINEAR,
-    )?
-    .fit(&signs, &none)
-    .map(|f| f.rss);
+    let final_rss = rss_at(samples)?;
     let residual_ratio = match (final_rss, zero) {
         (Some(a), Some(b)) if b > 0.0 => Some(a / b),
         _ => None,
@@ -698,26 +690,30 @@ fn friction_law(
         slip_speed_m_s: LOW_SLIP_SPEED_M_S,
         exponent_score: false,
     };
-    // The best exponent for each Stribeck decay (or none).
-    let best = |decays: &[Option<f64>], exponents: &[f64]| -> Result<Option<(LinearFit, Law)>> {
-        let mut out: Option<(LinearFit, Law)> = None;
+    // Every law of a grid, fitted once, in the grid's order (decays outer, exponents inner).
+    let grid = |decays: &[Option<f64>], exponents: &[f64]| -> Result<Vec<(LinearFit, Law)>> {
+        let mut out = Vec::with_capacity(decays.len() * exponents.len());
         for &b in decays {
             for &alpha in exponents {
                 let law = low(alpha, b);
                 if let Some(f) = fit(&law)? {
-                    if out.as_ref().is_none_or(|(o, _)| f.rss < o.rss) {
-                        out = Some((f, law));
-                    }
+                    out.push((f, law));
                 }
             }
         }
         Ok(out)
     };
+    // The fit of least residual among `fits` (the first of equals).
+    let best = |fits: Vec<(LinearFit, Law)>| -> Option<(LinearFit, Law)> {
+        fits.into_iter()
+            .reduce(|a, b| if b.0.rss < a.0.rss { b } else { a })
+    };
     let t = |f: &LinearFit, j: usize| f.coef[j] / f.estimates[j].std_error;
     let last = |f: &LinearFit| f.coef.len() - 1;
     let decays: Vec<Option<f64>> = DECAY_GRID_S_PER_M.iter().map(|&b| Some(b)).collect();
+    let with_stribeck = grid(&decays, &EXPONENT_GRID)?;
     // The Stribeck term: its amplitude at the best decay and exponent.
-    let stribeck = match best(&decays, &EXPONENT_GRID)? {
+    let stribeck = match best(with_stribeck.clone()) {
         Some((f, law)) if f.coef[last(&f)] > 0.0 && t(&f, last(&f)) > FRICTION_TERM_T => {
             law.decay_s_per_m
         }
@@ -732,12 +728,18 @@ fn friction_law(
     if stribeck.is_none() && !exponent_free {
         return Ok(fit(&Law::LINEAR)?.map(|f| (f, Law::LINEAR)));
     }
-    let exponents: &[f64] = if exponent_free {
-        &EXPONENT_GRID
-    } else {
-        &[1.0]
-    };
-    best(&[stribeck], exponents)
+    if stribeck.is_none() {
+        return Ok(best(grid(&[None], &EXPONENT_GRID)?));
+    }
+    // With the Stribeck term: the grid's own fits at its decay (every exponent, or α = 1).
+    Ok(best(
+        with_stribeck
+            .into_iter()
+            .filter(|(_, law)| {
+                law.decay_s_per_m == stribeck && (exponent_free || law.exponent == 1.0)
+            })
+            .collect(),
+    ))
 }
 
 /// The second-order filter `1/(s² + 2ζω s + ω²)` of `x` by the trapezoidal rule, started at
