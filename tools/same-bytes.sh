@@ -153,6 +153,48 @@ run sys_bad_base identify --system $d/wn-a.csv --base scenarios/paper-tests/mani
 run sys_no_drive identify --system $t/no-drive.csv --columns $t/columns.json
 run sys_const identify --system $t/constant-command.csv --columns $t/columns.json --json
 
+# Multi-axis tables (issue 53 puts them on the one stack): every shipped multi-axis and
+# table-system scenario through simulate (CSV, JSON, text), generate excitation and model, a
+# forward run's figures, an LHPOST6 closed loop of generated sines (no records needed) and its
+# three-component plan, and with the records the shipped three-component plan.
+for s in scenarios/multi-axis/*.json scenarios/table-system/northridge-*.json; do
+  if grep -q '"ground_motion"' "$s" && [ -z "${PLATEN_RECORDS_DIR:-}" ]; then
+    continue
+  fi
+  name=$(echo "${s#scenarios/}" | tr '/' '_')
+  run "simulate_${name}_csv" simulate "$s" --out "$out/${name}.csv"
+  run "simulate_${name}_json" simulate "$s" --json
+  run "simulate_${name}_text" simulate "$s"
+  run "generate_excitation_${name}" generate excitation "$s" --out "$out/${name}.excitation.csv"
+  run "model_scenario_${name}_json" model --scenario "$s" --json
+  run "model_scenario_${name}_text" model --scenario "$s"
+done
+run simulate_multi_axis_plot simulate scenarios/multi-axis/forward.json --json --plot "$out/multi-axis-figures"
+run simulate_multi_axis_pressure simulate scenarios/multi-axis/forward.json --pressure-mpa 10
+six="$out/six"
+mkdir -p "$six"
+cat >"$six/lhpost6-sines.json" <<'JSON'
+{"name": "lhpost6 sines", "table": {"preset": "lhpost6"}, "duration_s": 4.0,
+ "excitation": {"sine_motion": {
+   "x": {"amplitude_m": 0.02, "frequency_hz": 1.0, "sample_rate_hz": 256},
+   "y": {"amplitude_m": 0.01, "frequency_hz": 1.5, "sample_rate_hz": 256},
+   "z": {"amplitude_m": 0.002, "frequency_hz": 3.0, "sample_rate_hz": 256}}}}
+JSON
+run simulate_six_csv simulate "$six/lhpost6-sines.json" --out "$six/sines.csv"
+run simulate_six_json simulate "$six/lhpost6-sines.json" --json
+run simulate_six_text simulate "$six/lhpost6-sines.json"
+run model_six_json model --scenario "$six/lhpost6-sines.json" --json
+run generate_six_target generate excitation "$six/lhpost6-sines.json" --out "$six/target.csv"
+run plan_six_json plan "$six/lhpost6-sines.json" --target "$six/target.csv" --out "$six/drive.csv" \
+  --iterations 2 --json
+run plan_six_text plan "$six/lhpost6-sines.json" --target "$six/target.csv" --out "$six/drive2.csv" \
+  --iterations 2 --per-axis-scale --plot "$six/plan-figures"
+if [ -n "${PLATEN_RECORDS_DIR:-}" ]; then
+  run plan_tarzana3_json plan scenarios/multi-axis/lhpost6-northridge-25.json \
+    --target "$out/multi-axis_lhpost6-northridge-25.json.excitation.csv" \
+    --out "$six/tarzana3-drive.csv" --iterations 2 --json
+fi
+
 # The outputs name the folder they were written to; make the listing path-independent.
 grep -rl -- "$out" "$out" | while read -r f; do
   sed -i "s#$out#OUT#g" "$f"
