@@ -386,7 +386,7 @@ impl EndPolynomial {
                 }
             }
         }
-        p.coefficients = solve(&mut g, &mut b, free);
+        p.coefficients = platen_signal::linalg::solve(&mut g, &mut b, free);
         p
     }
 
@@ -480,51 +480,8 @@ impl Scratch {
     }
 }
 
-/// Solves the `size × size` system `g·x = b` (row-major) by Gaussian elimination with
-/// partial pivoting.
-fn solve(g: &mut [f64], b: &mut [f64], size: usize) -> Vec<f64> {
-    for col in 0..size {
-        let pivot = (col..size)
-            .max_by(|&r1, &r2| {
-                g[r1 * size + col]
-                    .abs()
-                    .total_cmp(&g[r2 * size + col].abs())
-            })
-            .unwrap_or(col);
-        if pivot != col {
-            for c in 0..size {
-                g.swap(col * size + c, pivot * size + c);
-            }
-            b.swap(col, pivot);
-        }
-        let d = g[col * size + col];
-        if d == 0.0 {
-            continue;
-        }
-        for r in col + 1..size {
-            let f = g[r * size + col] / d;
-            for c in col..size {
-                g[r * size + c] -= f * g[col * size + c];
-            }
-            b[r] -= f * b[col];
-        }
-    }
-    let mut x = vec![0.0; size];
-    for r in (0..size).rev() {
-        let tail: f64 = (r + 1..size).map(|c| g[r * size + c] * x[c]).sum();
-        let d = g[r * size + r];
-        x[r] = if d == 0.0 { 0.0 } else { (b[r] - tail) / d };
-    }
-    x
-}
-
 /// Root mean square (about zero).
-pub(crate) fn rms(x: &[f64]) -> f64 {
-    if x.is_empty() {
-        return 0.0;
-    }
-    (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt()
-}
+pub(crate) use platen_signal::metrics::rms;
 
 /// Largest magnitude.
 pub(crate) fn peak(x: &[f64]) -> f64 {

@@ -378,9 +378,7 @@ mod tests {
         assert!(sine_force(f64::MAX, 100.0, 0.0, 1024.0, 1.0).is_ok());
     }
 
-    fn rms(x: &[f64]) -> f64 {
-        (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt()
-    }
+    use platen_signal::metrics::rms;
 
     fn peak(x: &[f64]) -> f64 {
         x.iter().fold(0.0f64, |m, v| m.max(v.abs()))

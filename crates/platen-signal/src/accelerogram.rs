@@ -192,7 +192,7 @@ impl Polynomial {
                 }
             }
         }
-        let coefficients = solve(&mut g, &mut b, size);
+        let coefficients = crate::linalg::solve(&mut g, &mut b, size);
         Self {
             coefficients,
             half_span_s,
@@ -256,40 +256,6 @@ fn legendre(s: f64, p: &mut [f64], mut dp: Option<&mut [f64]>) {
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
-/// Solves the symmetric positive definite `size × size` system `g·x = b` (row-major) by
-/// Gaussian elimination with partial pivoting.
-fn solve(g: &mut [f64], b: &mut [f64], size: usize) -> Vec<f64> {
-    for col in 0..size {
-        let pivot = (col..size)
-            .max_by(|&r1, &r2| {
-                g[r1 * size + col]
-                    .abs()
-                    .total_cmp(&g[r2 * size + col].abs())
-            })
-            .unwrap_or(col);
-        if pivot != col {
-            for c in 0..size {
-                g.swap(col * size + c, pivot * size + c);
-            }
-            b.swap(col, pivot);
-        }
-        let d = g[col * size + col];
-        for r in col + 1..size {
-            let f = g[r * size + col] / d;
-            for c in col..size {
-                g[r * size + c] -= f * g[col * size + c];
-            }
-            b[r] -= f * b[col];
-        }
-    }
-    let mut x = vec![0.0; size];
-    for r in (0..size).rev() {
-        let tail: f64 = (r + 1..size).map(|c| g[r * size + c] * x[c]).sum();
-        x[r] = (b[r] - tail) / g[r * size + r];
-    }
-    x
 }
 
 #[cfg(test)]

@@ -94,6 +94,7 @@ mod delay;
 mod error;
 mod extend;
 mod fir;
+pub mod linalg;
 pub mod metrics;
 mod motion;
 mod resample;

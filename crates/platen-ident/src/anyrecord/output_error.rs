@@ -412,7 +412,4 @@ fn by_record<'a>(data: &'a mut [f64], rows: &[usize]) -> Vec<Vec<&'a mut [f64]>>
     out
 }
 
-/// Root mean square.
-fn rms(x: &[f64]) -> f64 {
-    (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt()
-}
+use platen_signal::metrics::rms;

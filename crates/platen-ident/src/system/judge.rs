@@ -232,13 +232,9 @@ impl SampleSink for Collect {
     }
 }
 
+/// [`platen_signal::metrics::rms`] of a computed series.
 fn rms(x: impl Iterator<Item = f64>) -> f64 {
-    let (mut s, mut n) = (0.0, 0usize);
-    for v in x {
-        s += v * v;
-        n += 1;
-    }
-    (s / n.max(1) as f64).sqrt()
+    platen_signal::metrics::rms(&x.collect::<Vec<f64>>())
 }
 
 fn nrmse(recorded: &[f64], predicted: &[f64]) -> f64 {
