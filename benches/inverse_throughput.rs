@@ -23,7 +23,7 @@ const SAMPLE_SIZE: usize = 20;
 
 /// `platen bench`'s S9 motion over `seconds` s.
 fn s9_motion(seconds: usize) -> Motion {
-    platen::bench::s9_motion(seconds * RATE_HZ as usize + 1).unwrap()
+    platen_bench::s9_motion(seconds * RATE_HZ as usize + 1).unwrap()
 }
 
 fn bench(c: &mut Criterion) {

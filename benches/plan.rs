@@ -2,7 +2,7 @@
 //! earthquake-like acceleration target on the `lhpost-2008` closed loop (bare table, `Ĥ`
 //! linearised, 10 corrections: 11 closed-loop runs of 40 s), and the largest scale that fits
 //! (`max_scale`, bisection on the simulated loop), against the plain-loop baseline
-//! (`baseline_rk4` of `platen::bench::baseline`) measured in the same run; the ratio is
+//! (`baseline_rk4` of `platen_bench::baseline`) measured in the same run; the ratio is
 //! per 1024 Hz target sample of one planning task (not per integration step).
 //!
 //! Run: `cargo bench --bench plan -- --warm-up-time 1 --measurement-time 10`.

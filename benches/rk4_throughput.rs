@@ -1,5 +1,5 @@
 //! Step throughput of the forward RK4 with exact stick-slip, against the plain-loop baseline
-//! (`baseline_rk4` of `platen::bench::baseline`) measured in the same run, and the ratio
+//! (`baseline_rk4` of `platen_bench::baseline`) measured in the same run, and the ratio
 //! of the two medians.
 //!
 //! Two records, each at 60 s and 600 s (`BenchmarkId` over the record length), sampled at
@@ -18,7 +18,7 @@
 //!
 //! A third group, `forward_rk4_specimen`, runs the `no_stick` force with a specimen on the
 //! identified model ([`forward_rk4_specimen`]): the 3-storey, 60 t frame of `platen bench`
-//! (`bench_specimen` in `platen::bench`: 20 t floors, 40, 32 and 24 MN/m,
+//! (`bench_specimen` in `platen_bench` (crates/platen-bench): 20 t floors, 40, 32 and 24 MN/m,
 //! dampers 3 ms times each stiffness) and a 2-storey, 55 t frame (the one of
 //! `scenarios/specimen/frame-forward.json`), next to the bare identified run and the baseline
 //! of the same run (the target: a specimen step at most 1.6 × the baseline).
@@ -164,7 +164,7 @@ fn specimen(c: &mut Criterion) {
     let identified = params.build().unwrap();
     let rk4 = Rk4::with_steps_per_sample(1).unwrap();
     // `platen bench`'s frame and the shipped 2-storey frame.
-    let three = platen::bench::bench_specimen().unwrap();
+    let three = platen_bench::bench_specimen().unwrap();
     let two = Specimen::new(vec![
         storey(30e3, 27_083_177.88, 86_208.43),
         storey(25e3, 19_345_127.06, 61_577.45),

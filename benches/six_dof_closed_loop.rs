@@ -29,7 +29,7 @@ const SECONDS: usize = 40;
 
 fn bench(c: &mut Criterion) {
     let model = preset::lhpost_2008_identified(PRESSURE_PA).build().unwrap();
-    let command = platen::bench::s9_motion(SECONDS * RATE_HZ as usize + 1).unwrap();
+    let command = platen_bench::s9_motion(SECONDS * RATE_HZ as usize + 1).unwrap();
     let system = system_preset::lhpost_2008();
     let k = system.default_steps_per_period(144e3, 0.75);
     let uniaxial = LoopRun {
@@ -46,7 +46,7 @@ fn bench(c: &mut Criterion) {
             .unwrap()
             .run
             .steps;
-    let (table, sys, pose) = platen::bench::bench_lhpost6(&command).unwrap();
+    let (table, sys, pose) = platen_bench::bench_lhpost6(&command).unwrap();
     let run = TableLoopRun {
         table: &table,
         hydraulics: &sys.hydraulics,

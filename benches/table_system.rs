@@ -1,7 +1,7 @@
 //! Step throughput of the closed loop (`forward_closed_loop`: controller, servo-valves,
 //! single-ended actuators and accumulator of the `lhpost-2008` table system driving the
 //! identified platen with exact stick-slip), against the plain-loop baseline
-//! (`baseline_rk4` of `platen::bench::baseline`, the platen alone under a recorded force)
+//! (`baseline_rk4` of `platen_bench::baseline`, the platen alone under a recorded force)
 //! measured in the same run, and the ratio of the two medians per integration step.
 //!
 //! The command is the paper's S9 sine motion (0.2 m, 0.6 Hz) over 60 s at 1024 Hz; the loop
@@ -30,7 +30,7 @@ const SECONDS: usize = 60;
 
 /// `platen bench`'s S9 motion over [`SECONDS`] s.
 fn s9_command() -> Motion {
-    platen::bench::s9_motion(SECONDS * RATE_HZ as usize + 1).unwrap()
+    platen_bench::s9_motion(SECONDS * RATE_HZ as usize + 1).unwrap()
 }
 
 fn bench(c: &mut Criterion) {

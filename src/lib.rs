@@ -13,7 +13,6 @@ pub use platen_scenario as scenario;
 pub use platen_signal as signal;
 pub use platen_system as system;
 
-pub mod bench;
 mod error;
 pub mod prelude;
 

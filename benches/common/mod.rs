@@ -10,7 +10,7 @@
 #![allow(dead_code, unused_imports)]
 
 /// The plain-loop measuring stick, the one copy `platen bench` times too.
-pub use platen::bench::baseline;
+pub use platen_bench::baseline;
 
 use std::collections::BTreeMap;
 use std::hint::black_box;
@@ -21,7 +21,7 @@ use criterion::Bencher;
 
 /// Sample rate of every workload, Hz; the RK4 steps once per sample (h = 1/1024 s); and
 /// hold-down pressure of every workload, Pa: `platen bench`'s.
-pub use platen::bench::{PRESSURE_PA, RATE_HZ};
+pub use platen_bench::{PRESSURE_PA, RATE_HZ};
 
 /// A sine force of `amplitude_n` at 0.5 Hz, sampled at 1024 Hz for `seconds`, from `t = 0`.
 ///
@@ -32,7 +32,7 @@ pub use platen::bench::{PRESSURE_PA, RATE_HZ};
 /// * 45 kN, just above the 37.5 kN static threshold: two stick phases per period (≈ 22 % of
 ///   the time stuck), each with a stop and a breakaway to locate.
 pub fn sine_force(amplitude_n: f64, seconds: usize) -> Vec<f64> {
-    platen::bench::sine_force_n(amplitude_n, seconds * RATE_HZ as usize + 1)
+    platen_bench::sine_force_n(amplitude_n, seconds * RATE_HZ as usize + 1)
 }
 
 /// Time per iteration (ns) of every call criterion made of each routine, by benchmark name.

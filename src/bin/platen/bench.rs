@@ -1,10 +1,10 @@
 //! `platen bench`: time the standard workloads on the `lhpost-2008` preset, next to the
 //! plain-loop baseline measured in the same run. The workloads, their inputs, the timing and
-//! the report are [`platen::bench`]'s; this file parses and prints.
+//! the report are [`platen_bench`]'s; this file parses and prints.
 
 use anyhow::Result;
 
-use platen::bench::{self, RATE_HZ};
+use platen_bench::{self as bench, RATE_HZ};
 
 /// The arguments of `platen bench`.
 #[derive(clap::Args)]

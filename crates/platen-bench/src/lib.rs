@@ -44,12 +44,12 @@
 //!
 //! ```
 //! // 0.05 simulated seconds, each workload once (a smoke run, not a measurement).
-//! let m = platen::bench::measure(0.05, 1)?;
+//! let m = platen_bench::measure(0.05, 1)?;
 //! let report = m.report();
 //! assert!(report.rk4_ns_per_step > 0.0);
 //! assert_eq!(report.workloads["rk4"].units_per_run, 51);
 //! print!("{}", m.text());
-//! # Ok::<(), platen::bench::BenchError>(())
+//! # Ok::<(), platen_bench::BenchError>(())
 //! ```
 
 pub mod baseline;
@@ -646,7 +646,7 @@ pub fn bench_lhpost6(motion: &Motion) -> Result<(MultiAxisTable, TableLoopSystem
 /// [`BenchError`] if the compiled-in table is refused (a defect).
 pub fn bench_table() -> Result<MultiAxisTable> {
     let origin = std::path::Path::new("scenarios/multi-axis/forward.json");
-    let text = include_str!("../scenarios/multi-axis/forward.json");
+    let text = include_str!("../../../scenarios/multi-axis/forward.json");
     let file =
         platen_scenario::file::parse(origin, text).map_err(|e| BenchError::Table(e.to_string()))?;
     let spec = file

@@ -12,11 +12,11 @@
 //! exact stick-slip can approach but not beat.
 //!
 //! The criterion benches (`benches/rk4_throughput.rs`, `benches/dopri5_throughput.rs`, through
-//! `benches/common/mod.rs`) and `platen bench` (through [`crate::bench`]) all use this one
+//! `benches/common/mod.rs`) and `platen bench` (through [`crate`]) all use this one
 //! loop, time it in the same run as the real integrators and report their ratio to it;
 //! `benches/c/rk4_baseline.c` is the same loop in C.
 //!
-//! Its test (that it computes the model it claims to) is in [`crate::bench`]'s tests.
+//! Its test (that it computes the model it claims to) is in [`crate`]'s tests.
 //!
 //! Do not use it to simulate anything: with `sign(v)` friction it is off by ~4e-4 m on the
 //! paper's reference record and never sits still (see the crate's stick-slip tests).
