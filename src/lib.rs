@@ -19,13 +19,14 @@ pub mod prelude;
 pub use error::{Error, Result};
 /// Loads and runs a scenario file, keeping every column in memory.
 pub use platen_scenario::simulate;
-/// A finished run in memory: columns by name and the summary ([`simulate`]).
+/// A finished run in memory, of either table: columns by name and the summary ([`simulate`]).
 pub use platen_scenario::RunResult;
 /// The old name of [`RunResult`], which read as [`scenario::Run`] (what a scenario runs).
 #[deprecated(note = "use platen::RunResult: platen::scenario::Run is what a scenario runs")]
 pub type Run = platen_scenario::RunResult;
-/// The validated scenario: [`Scenario::load`] then [`Scenario::run`] into any sink.
-pub use platen_scenario::Scenario;
+/// A validated scenario of any table: [`Scenario::load`] then [`Scenario::run`]; the uniaxial
+/// platen's ([`PlatenScenario`]) streams into any sink.
+pub use platen_scenario::{PlatenScenario, Scenario};
 
 /// The pages under `docs/`, so that `cargo test --doc` compiles and runs their Rust examples
 /// as it does the README's (this crate's documentation).

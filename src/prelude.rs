@@ -27,5 +27,5 @@ pub use platen_integrate::{
     State, Step, Stepping, Trajectory,
 };
 pub use platen_model::{preset, IdentifiedModel, IdentifiedParams, PlatenModel, Specimen, Storey};
-pub use platen_scenario::{simulate, RunResult, Scenario};
+pub use platen_scenario::{simulate, PlatenScenario, RunResult, Scenario};
 pub use platen_system::TableSystem;

@@ -10,7 +10,7 @@ use platen_integrate::{inverse, Trajectory};
 use platen_io::csv::write_csv_atomic;
 use platen_model::PlatenModel;
 use platen_scenario::recorded::{recorded_like, ArtefactSettings, Recorded};
-use platen_scenario::{Model, Run, Scenario};
+use platen_scenario::{Model, PlatenScenario, Run};
 use serde_json::Value;
 
 mod common;
@@ -64,7 +64,7 @@ fn read_columns(path: &Path, names: &[&str]) -> Vec<Vec<f64>> {
 /// Writes recorded-like data of the shipped inverse scenario S9 with `recorded_like`: the
 /// model's force with oil-column ringing, valve tone, quantisation and noise.
 fn s9_recorded(dir: &Path) -> PathBuf {
-    let scenario = Scenario::load(Path::new(&shipped("s9-sine-motion.json"))).unwrap();
+    let scenario = PlatenScenario::load(Path::new(&shipped("s9-sine-motion.json"))).unwrap();
     let (Model::Identified(model), Run::Inverse { motion }) = (&scenario.rig.model, &scenario.run)
     else {
         panic!("S9 is an inverse scenario on the identified model");

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use platen::scenario::{Run, Scenario};
+use platen::scenario::{PlatenScenario, Run};
 
 /// The shipped scenarios at the top of `scenarios/`: those that need a PEER record (a
 /// `ground_motion`) and the others.
@@ -25,7 +25,7 @@ fn shipped_scenarios() -> (Vec<PathBuf>, Vec<PathBuf>) {
 fn every_shipped_scenario_without_a_record_validates_through_the_facade() {
     let (mut forward, mut inverse, mut closed_loop) = (0, 0, 0);
     for path in shipped_scenarios().1 {
-        let s = Scenario::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let s = PlatenScenario::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         match s.run {
             Run::Forward { .. } => forward += 1,
             Run::Inverse { .. } => inverse += 1,
@@ -54,7 +54,7 @@ fn every_shipped_record_scenario_validates_through_the_facade() {
     let records = shipped_scenarios().0;
     assert!(records.len() >= 2, "{records:?}");
     for path in records {
-        let s = Scenario::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let s = PlatenScenario::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         assert!(matches!(s.run, Run::Inverse { .. }), "{}", path.display());
     }
 }

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use platen::integrate::{inverse, Peaks};
-use platen::scenario::{Model, Run, Scenario};
+use platen::scenario::{Model, PlatenScenario, Run};
 
 fn scenarios(folder: &str) -> Vec<PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -19,8 +19,8 @@ fn scenarios(folder: &str) -> Vec<PathBuf> {
     v
 }
 
-fn run(path: &Path) -> (Scenario, Peaks) {
-    let s = Scenario::load(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+fn run(path: &Path) -> (PlatenScenario, Peaks) {
+    let s = PlatenScenario::load(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let mut peaks = Peaks::default();
     match (&s.rig.model, &s.run) {
         (Model::Identified(m), Run::Inverse { motion }) => inverse(m, motion, &mut peaks),

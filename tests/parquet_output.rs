@@ -8,7 +8,7 @@ use std::path::Path;
 use platen::integrate::Trajectory;
 use platen::io::csv::read_table;
 use platen::io::parquet::read_parquet;
-use platen::Scenario;
+use platen::PlatenScenario;
 
 mod common;
 use common::{platen, stderr};
@@ -55,7 +55,7 @@ fn a_forward_run_in_parquet_is_the_trajectory_bit_for_bit() {
     let scenario = shipped("sr9-like-sine-force.json");
     let (names, columns) = parquet_matches_csv(&scenario);
     assert_eq!(names, Trajectory::COLUMN_NAMES);
-    let loaded = Scenario::load(Path::new(&scenario)).unwrap();
+    let loaded = PlatenScenario::load(Path::new(&scenario)).unwrap();
     let mut trajectory = Trajectory::default();
     loaded.run(&mut trajectory).unwrap();
     for ((name, column), expected) in names.iter().zip(&columns).zip(trajectory.columns()) {

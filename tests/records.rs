@@ -125,7 +125,7 @@ fn table_motion_1024(record: &std::path::Path) -> platen_integrate::Motion {
         "excitation": {"ground_motion": {"record": record, "sample_rate_hz": 1024}},
     });
     std::fs::write(&path, json.to_string()).unwrap();
-    match platen_scenario::Scenario::load(&path).unwrap().run {
+    match platen_scenario::PlatenScenario::load(&path).unwrap().run {
         platen_scenario::Run::Inverse { motion } => motion,
         other => panic!("not an inverse run: {other:?}"),
     }

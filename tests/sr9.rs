@@ -8,7 +8,7 @@ use platen::integrate::{inverse, Peaks, Trajectory};
 use platen::io::csv::{read_table, write_csv_atomic};
 use platen::model::PlatenModel;
 use platen::scenario::recorded::{recorded_like, ArtefactSettings, Recorded};
-use platen::scenario::{Model, Run, Scenario};
+use platen::scenario::{Model, PlatenScenario, Run};
 
 fn nrmse(sim: &[f64], rec: &[f64]) -> f64 {
     let n = sim.len().min(rec.len());
@@ -17,7 +17,7 @@ fn nrmse(sim: &[f64], rec: &[f64]) -> f64 {
     (e / r).sqrt()
 }
 
-fn forward(s: &Scenario) -> Trajectory {
+fn forward(s: &PlatenScenario) -> Trajectory {
     assert!(
         matches!(
             &s.run,
@@ -39,7 +39,7 @@ fn forward(s: &Scenario) -> Trajectory {
 #[test]
 fn the_shipped_sr9_check_reproduces_the_recorded_motion_within_3_percent() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/sr9");
-    let s = Scenario::load(&dir.join("sr9-forward.json")).unwrap();
+    let s = PlatenScenario::load(&dir.join("sr9-forward.json")).unwrap();
     let sim = forward(&s);
     let mut rec = read_table(&dir.join("sr9-recorded.csv"), &["t_s", "u_m", "v_m_s"], &[]).unwrap();
     let (u, v) = (
@@ -67,7 +67,7 @@ fn the_sr9_check_holds_for_other_parameters_and_artefacts() {
         format!(r#"{{{model}, "excitation": {{"sine_motion": {{"amplitude_m": 0.38, "frequency_hz": 0.5, "sample_rate_hz": 512}}}}, "duration_s": 20}}"#),
     )
     .unwrap();
-    let s = Scenario::load(&motion).unwrap();
+    let s = PlatenScenario::load(&motion).unwrap();
     let (Model::Identified(m), Run::Inverse { motion: mo }) = (&s.rig.model, &s.run) else {
         panic!()
     };
@@ -92,7 +92,7 @@ fn the_sr9_check_holds_for_other_parameters_and_artefacts() {
         ),
     )
     .unwrap();
-    let sim = forward(&Scenario::load(&fwd).unwrap());
+    let sim = forward(&PlatenScenario::load(&fwd).unwrap());
     let (eu, ev) = (nrmse(&sim.u_m, &rec.u_m), nrmse(&sim.v_m_s, &rec.v_m_s));
     eprintln!(
         "SR9-like, other parameters: NRMSE u = {:.2} %, v = {:.2} %",

@@ -6,7 +6,7 @@ use std::path::Path;
 use platen_integrate::{inverse, Motion, Peaks, Trajectory};
 use platen_model::PlatenModel;
 use platen_scenario::recorded::{recorded_like, ArtefactSettings, Recorded};
-use platen_scenario::{Model, Run, Scenario};
+use platen_scenario::{Model, PlatenScenario, Run};
 
 use crate::error::InputError;
 
@@ -16,7 +16,11 @@ use crate::error::InputError;
 /// # Errors
 /// [`InputError::NotMotion`] for a force-driven scenario, [`InputError::RecordedLike`] if
 /// the data cannot be made.
-pub fn recorded_of(scenario: &Scenario, path: &Path, seed: u64) -> Result<Recorded, InputError> {
+pub fn recorded_of(
+    scenario: &PlatenScenario,
+    path: &Path,
+    seed: u64,
+) -> Result<Recorded, InputError> {
     fn recorded<M: PlatenModel>(
         model: &M,
         motion: &Motion,

@@ -47,7 +47,7 @@ use platen_ident::{TestKind, TestRecord};
 use platen_io::columns::{ColumnMap, ColumnSpec};
 use platen_io::json::parse_json_file;
 use platen_scenario::sampling::uniform_step_s;
-use platen_scenario::Scenario;
+use platen_scenario::PlatenScenario;
 
 use crate::error::InputError;
 use crate::recorded::recorded_of;
@@ -560,7 +560,7 @@ impl RecordSource {
         if !self.floors.is_empty() {
             return Err(InputError::ScenarioFloors { path: path.clone() });
         }
-        let scenario = Scenario::load(path)?;
+        let scenario = PlatenScenario::load(path)?;
         let pressure_pa = scenario.rig.hold_down_pressure_pa;
         if let Some(p) = self.pressure_mpa {
             // The same number written twice (13.8 in both files) may differ in its last bit.
@@ -704,7 +704,7 @@ mod tests {
         assert_eq!(rec.pressure_pa(), Some(13.8e6));
         assert_eq!(rec.kind(), Some(TestKind::Sine));
         // The numbers `platen generate recorded --seed 9` writes.
-        let made = recorded_of(&Scenario::load(&scenario).unwrap(), &scenario, 9).unwrap();
+        let made = recorded_of(&PlatenScenario::load(&scenario).unwrap(), &scenario, 9).unwrap();
         assert_eq!(rec.u_m(), made.u_m.as_slice());
         assert_eq!(rec.force_n(), made.force_n.as_slice());
         assert_eq!(rec.v_m_s(), Some(made.v_m_s.as_slice()));

@@ -24,7 +24,7 @@ use std::path::{Path, PathBuf};
 
 use platen_ident::system::SystemRecord;
 use platen_io::columns::ColumnMap;
-use platen_scenario::Scenario;
+use platen_scenario::PlatenScenario;
 use platen_system::TableSystem;
 
 use crate::error::InputError;
@@ -200,7 +200,7 @@ pub fn read_base_system(
         source,
     };
     let file = platen_scenario::file::parse(path, &scenario.to_string()).map_err(not_system)?;
-    let s = Scenario::from_file(path, file).map_err(not_system)?;
+    let s = PlatenScenario::from_file(path, file).map_err(not_system)?;
     let Some(system) = s.rig.table_system else {
         return Err(InputError::NoTableSystem {
             path: path.to_owned(),

@@ -2,7 +2,7 @@
 
 use platen_integrate::{SpecimenColumns, Trajectory};
 use platen_model::Specimen;
-use platen_scenario::{Run, Scenario};
+use platen_scenario::{PlatenScenario, Run};
 use serde::Serialize;
 
 /// What drives the model, and so what is compared.
@@ -17,7 +17,7 @@ pub enum Direction {
 impl Direction {
     /// The direction of `scenario`'s run. A closed loop is compared on its actuator force,
     /// as an inverse run is: the loop makes the force that the command's motion needs.
-    pub fn of(scenario: &Scenario) -> Self {
+    pub fn of(scenario: &PlatenScenario) -> Self {
         match &scenario.run {
             Run::Forward { .. } => Direction::Forward,
             Run::Inverse { .. } | Run::ClosedLoop { .. } => Direction::Inverse,

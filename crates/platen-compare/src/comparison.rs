@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use platen_integrate::Trajectory;
 use platen_io::columns::ColumnMap;
 use platen_model::{force_terms, PlatenModel};
-use platen_scenario::{Model, Scenario};
+use platen_scenario::{Model, PlatenScenario};
 use platen_signal::metrics::{interpolate_linear, ChannelMetrics, Comparator};
 use platen_signal::{differentiate, CrossoverVelocity, SampleRate, DEFAULT_CROSSOVER_HZ};
 
@@ -121,7 +121,7 @@ impl Comparison {
     /// are read and checked in that order before anything is simulated.
     ///
     /// # Errors
-    /// Every error of [`Scenario::load`], [`ColumnMap::load`], [`Recording::read`] and
+    /// Every error of [`PlatenScenario::load`], [`ColumnMap::load`], [`Recording::read`] and
     /// [`Comparison::new`].
     pub fn from_files(
         scenario_path: &Path,
@@ -129,7 +129,7 @@ impl Comparison {
         columns: Option<&Path>,
         settings: &Settings,
     ) -> Result<Self> {
-        let scenario = Scenario::load(scenario_path)?;
+        let scenario = PlatenScenario::load(scenario_path)?;
         let map = match columns {
             Some(path) => ColumnMap::load(path)?,
             None => ColumnMap::default(),
@@ -150,7 +150,7 @@ impl Comparison {
     /// [`CompareError::SampleRate`], [`CompareError::Settings`] and
     /// [`CompareError::Metrics`] after it.
     pub fn new(
-        scenario: &Scenario,
+        scenario: &PlatenScenario,
         scenario_path: &Path,
         recording: Recording,
         settings: &Settings,
@@ -372,8 +372,8 @@ impl OnRecordedTimes<'_> {
     }
 }
 
-/// Runs the scenario (through [`Scenario::run`]) into a trajectory of at least 2 samples.
-fn simulate(scenario: &Scenario, scenario_path: &Path) -> Result<Trajectory> {
+/// Runs the scenario (through [`PlatenScenario::run`]) into a trajectory of at least 2 samples.
+fn simulate(scenario: &PlatenScenario, scenario_path: &Path) -> Result<Trajectory> {
     let mut sim = Trajectory::default();
     scenario.run(&mut sim)?;
     if sim.len() < 2 {

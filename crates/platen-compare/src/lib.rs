@@ -3,7 +3,7 @@
 //! * **Forward** scenarios (a force drives the model) compare the displacement `u_m` and the
 //!   velocity `v_m_s` with the recorded file's columns; **inverse** scenarios (a motion drives
 //!   the model) compare the actuator force `force_n` ([`Direction::channels`]). The scenario
-//!   runs as it is, through [`Scenario::run`](platen_scenario::Scenario::run): its own
+//!   runs as it is, through [`PlatenScenario::run`](platen_scenario::PlatenScenario::run): its own
 //!   excitation drives it (for a test, the recorded force or motion).
 //! * A scenario with a specimen also compares the record's `base_shear_n`, `storey{i}_u_m` and
 //!   `storey{i}_a_m_s2` where it has them ([`Channel::specimen_channels`]); a column for a

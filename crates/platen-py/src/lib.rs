@@ -4,7 +4,7 @@
 //! This crate only converts: Python arguments to the library's types, the library's results
 //! to NumPy arrays and JSON text, and its errors to one exception,
 //! [`error::Failure`]`(kind, message)`, whose message is the CLI's. Everything is computed
-//! by the library crates ([`platen_scenario::Scenario::run`], [`platen_compare`],
+//! by the library crates ([`platen_scenario::PlatenScenario::run`], [`platen_compare`],
 //! [`platen_ident`], [`platen_scenario::sweep`], [`platen_plan`]), with the GIL released and
 //! panics caught.
 //! The public API, its checks of Python values (dtypes, shapes, dicts) and its docstrings
@@ -24,11 +24,10 @@ use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 
 use platen_compare::{Comparison, Direction, Recording, Settings, Window};
-use platen_integrate::{SpecimenColumns, SystemColumns, Trajectory};
 use platen_io::columns::ColumnMap;
 use platen_model::{IdentifiedKey, PhysicalKey, Preset};
 use platen_scenario::sweep::{csv_text, json_summary, SetAxis, Sweep};
-use platen_scenario::{file, Arrays, ModelKey, RunSummary, Scenario};
+use platen_scenario::{file, Arrays, ModelKey, PlatenScenario, Scenario};
 
 use crate::error::{detached, Fail, Kind};
 
@@ -41,13 +40,13 @@ fn load(
     path: Option<&Path>,
     text: Option<&str>,
     origin: &str,
-) -> Result<(PathBuf, Scenario), Fail> {
+) -> Result<(PathBuf, PlatenScenario), Fail> {
     match (path, text) {
-        (Some(path), _) => Ok((path.to_owned(), Scenario::load(path)?)),
+        (Some(path), _) => Ok((path.to_owned(), PlatenScenario::load(path)?)),
         (None, Some(text)) => {
             let origin = PathBuf::from(origin);
             let parsed = file::parse(&origin, text)?;
-            Ok((origin.clone(), Scenario::from_file(&origin, parsed)?))
+            Ok((origin.clone(), PlatenScenario::from_file(&origin, parsed)?))
         }
         (None, None) => Err(Fail::input("no scenario: give a path or a dict")),
     }
@@ -65,91 +64,23 @@ fn json_text<T: serde::Serialize>(value: &T) -> Result<String, Fail> {
         })
 }
 
-/// Runs `scenario` (named `path` in its summary), keeping every output column.
-fn run_scenario(scenario: &Scenario, path: &Path) -> Result<(Trajectory, String), Fail> {
-    let mut trajectory = Trajectory::with_capacity(scenario.run.samples());
-    let output = scenario.run(&mut trajectory)?;
-    let summary = RunSummary::new(path, scenario, &output, None);
-    Ok((trajectory, json_text(&summary)?))
+/// A run's columns by name, in the CSV's order, and its summary as JSON text.
+type Columns = (Vec<(String, Vec<f64>)>, String);
+
+/// Runs `scenario` (named `path` in its summary), keeping every output column: the
+/// columns by name and the summary's JSON text.
+fn run_scenario(scenario: &Scenario, path: &Path) -> Result<Columns, Fail> {
+    let (columns, summary) = scenario.run_at(path)?.into_columns();
+    Ok((columns, json_text(&summary)?))
 }
 
-/// The trajectory's columns as NumPy arrays that take over its vectors, the specimen's after
-/// the contract's and the table system's last (the CSV's order).
-fn to_python(py: Python<'_>, (mut trajectory, summary): (Trajectory, String)) -> RunParts<'_> {
-    let specimen = trajectory.specimen.take();
-    let system = trajectory.system.take();
-    let mut names = Trajectory::COLUMN_NAMES.to_vec();
-    let mut arrays: Vec<_> = trajectory
-        .into_columns()
-        .into_iter()
-        .map(|c| c.into_pyarray(py))
-        .collect();
-    if let Some(sp) = specimen {
-        let n = sp.storeys();
-        names.push(SpecimenColumns::BASE_SHEAR_NAME);
-        names.extend(&SpecimenColumns::STOREY_U_NAMES[..n]);
-        names.extend(&SpecimenColumns::STOREY_A_NAMES[..n]);
-        arrays.push(sp.base_shear_n.into_pyarray(py));
-        arrays.extend(sp.u_m.into_iter().map(|c| c.into_pyarray(py)));
-        arrays.extend(sp.a_m_s2.into_iter().map(|c| c.into_pyarray(py)));
-    }
-    if let Some(sy) = system {
-        names.extend(SystemColumns::NAMES);
-        let SystemColumns {
-            command_u_m,
-            drive,
-            spool_opening,
-            delta_p_pa,
-            flow_m3_s,
-            supply_pressure_pa,
-            cap_pressure_pa,
-            rod_pressure_pa,
-        } = sy;
-        // In the order of `SystemColumns::NAMES`.
-        arrays.extend(
-            [
-                command_u_m,
-                drive,
-                spool_opening,
-                delta_p_pa,
-                flow_m3_s,
-                supply_pressure_pa,
-                cap_pressure_pa,
-                rod_pressure_pa,
-            ]
-            .into_iter()
-            .map(|c| c.into_pyarray(py)),
-        );
-    }
-    (
-        names.into_iter().map(String::from).collect(),
-        arrays,
-        summary,
-    )
-}
-
-/// A multi-axis scenario's run: its named columns as NumPy arrays and its summary.
-fn table_to_python(
-    py: Python<'_>,
-    (run, summary): (platen_integrate::TableRun, String),
-) -> RunParts<'_> {
-    let (names, arrays) = run
-        .columns
+/// A run's columns as NumPy arrays that take over its vectors, in the CSV's order.
+fn to_python(py: Python<'_>, (columns, summary): Columns) -> RunParts<'_> {
+    let (names, arrays) = columns
         .into_iter()
         .map(|(name, column)| (name, column.into_pyarray(py)))
         .unzip();
     (names, arrays, summary)
-}
-
-/// Runs a parsed scenario file of a multi-axis table (one with a `table`).
-fn run_table(
-    path: &Path,
-    parsed: &file::ScenarioFile,
-) -> Result<(platen_integrate::TableRun, String), Fail> {
-    let scenario = platen_scenario::multi_axis::TableScenario::from_file(path, parsed)?;
-    let (run, stats) = scenario.run_with_stats()?;
-    let summary = json_text(&scenario.summary_with(&run, stats.as_ref(), None))?;
-    Ok((run, summary))
 }
 
 /// Runs a scenario file or a scenario dict's JSON text: `platen.simulate`.
@@ -174,10 +105,6 @@ fn simulate<'py>(
         }
         (None, None) => return Err(Fail::input("no scenario: give a path or a dict").into()),
     };
-    if parsed.table.is_some() {
-        let parts = detached(py, move || run_table(&path, &parsed))?;
-        return Ok(table_to_python(py, parts));
-    }
     let parts = detached(py, move || {
         let scenario = Scenario::from_file(&path, parsed)?;
         run_scenario(&scenario, &path)
@@ -200,8 +127,8 @@ fn run_arrays<'py>(
     let parts = detached(py, move || {
         let origin = PathBuf::from(origin);
         let settings = file::parse(&origin, &text)?;
-        let scenario = Scenario::from_arrays(&origin, settings, arrays)?;
-        run_scenario(&scenario, &origin)
+        let scenario = PlatenScenario::from_arrays(&origin, settings, arrays)?;
+        run_scenario(&Scenario::Platen(scenario), &origin)
     })?;
     Ok(to_python(py, parts))
 }

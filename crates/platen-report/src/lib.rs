@@ -76,6 +76,7 @@ pub mod record_figures;
 pub mod render;
 pub mod run_figures;
 pub mod series;
+pub mod simulate;
 pub mod simulate_report;
 mod svg;
 pub mod sweep_figures;
@@ -84,6 +85,7 @@ pub mod system_figures;
 pub mod system_identify_report;
 pub mod table_figures;
 pub mod table_plan_figures;
+pub mod table_text;
 pub mod text;
 
 pub use error::{ReportError, Result};

@@ -18,7 +18,7 @@
 
 use platen_integrate::{Sample, SampleSink};
 use platen_model::TableLimits;
-use platen_scenario::{Run, Scenario};
+use platen_scenario::{PlatenScenario, Run};
 use platen_system::{Supply, TableSystem};
 
 use crate::figure::{Dash, Figure, Panel, MODEL, RECORDED, RESIDUAL, SIMULATED};
@@ -315,7 +315,7 @@ struct Channel {
 /// The figures of a run: the motion and force over time, the force decomposition, the
 /// hysteresis loops, and those of the specimen and of the closed loop when the run has them.
 /// `scenario` gives the name, the table's limits and the table system.
-pub fn figures(recorder: RunRecorder<'_>, scenario: &Scenario) -> Vec<Figure> {
+pub fn figures(recorder: RunRecorder<'_>, scenario: &PlatenScenario) -> Vec<Figure> {
     let stride = recorder.stride;
     let samples = recorder.samples;
     let closed_loop = match (&scenario.run, &scenario.rig.table_system, &recorder.command) {
@@ -382,7 +382,7 @@ pub fn figures(recorder: RunRecorder<'_>, scenario: &Scenario) -> Vec<Figure> {
 }
 
 /// The specimen's base shear and storey drifts over time (a run with a specimen).
-fn specimen_figure(r: &Recorded, scenario: &Scenario) -> Figure {
+fn specimen_figure(r: &Recorded, scenario: &PlatenScenario) -> Figure {
     let storeys = r.specimen.len() - 1;
     let panels: Vec<Panel> = r
         .specimen
@@ -499,7 +499,7 @@ fn channel_panel(c: &Channel, points: &Points, color: plotters::style::RGBColor)
 }
 
 /// u, v, a and F_A over time.
-fn motion(r: &Recorded, scenario: &Scenario) -> Figure {
+fn motion(r: &Recorded, scenario: &PlatenScenario) -> Figure {
     let l: &TableLimits = &scenario.rig.limits;
     let channels = [
         ("displacement", "u", "m", Some(l.stroke_m)),
@@ -543,7 +543,7 @@ fn motion(r: &Recorded, scenario: &Scenario) -> Figure {
 }
 
 /// F_A and its decomposition F_I + F_E + F_D over time, each on its own scale.
-fn decomposition(r: &Recorded, scenario: &Scenario) -> Figure {
+fn decomposition(r: &Recorded, scenario: &PlatenScenario) -> Figure {
     let actuator = peak_magnitude(&r.channels[3]);
     let terms = [
         ("actuator force", "F_A", 3),
@@ -590,7 +590,7 @@ fn decomposition(r: &Recorded, scenario: &Scenario) -> Figure {
 }
 
 /// F_A against u, v and a.
-fn hysteresis(r: &Recorded, scenario: &Scenario) -> Figure {
+fn hysteresis(r: &Recorded, scenario: &PlatenScenario) -> Figure {
     let panels = [
         ("displacement", "u", "m"),
         ("velocity", "v", "m/s"),
@@ -651,7 +651,7 @@ fn lowest(points: &Points) -> f64 {
 
 /// The figures of a closed-loop run: tracking, tracking errors, valve, pressures, flow,
 /// supply.
-fn loop_figures(r: &Recorded, lo: &LoopRecord, scenario: &Scenario) -> Vec<Figure> {
+fn loop_figures(r: &Recorded, lo: &LoopRecord, scenario: &PlatenScenario) -> Vec<Figure> {
     vec![
         tracking(r, lo, scenario),
         tracking_errors(r, lo, scenario),
@@ -675,7 +675,7 @@ fn unlimited(quantity: &'static str, symbol: &'static str, unit: &'static str) -
 }
 
 /// The displacement and acceleration errors of the closed loop.
-fn tracking_errors(r: &Recorded, lo: &LoopRecord, scenario: &Scenario) -> Figure {
+fn tracking_errors(r: &Recorded, lo: &LoopRecord, scenario: &PlatenScenario) -> Figure {
     let c = &lo.channels;
     Figure {
         name: "tracking-error".into(),
@@ -705,7 +705,7 @@ fn tracking_errors(r: &Recorded, lo: &LoopRecord, scenario: &Scenario) -> Figure
 }
 
 /// The controller's drive and the spool opening, fractions of full opening.
-fn valve(lo: &LoopRecord, scenario: &Scenario) -> Figure {
+fn valve(lo: &LoopRecord, scenario: &PlatenScenario) -> Figure {
     let full = |quantity, symbol| Channel {
         quantity,
         symbol,
@@ -737,7 +737,7 @@ fn valve(lo: &LoopRecord, scenario: &Scenario) -> Figure {
 }
 
 /// The pressure difference across the pistons and the chambers' absolute pressures.
-fn pressures(lo: &LoopRecord, scenario: &Scenario) -> Figure {
+fn pressures(lo: &LoopRecord, scenario: &PlatenScenario) -> Figure {
     let c = &lo.channels;
     let mut dp = channel_panel(
         &unlimited("pressure difference", "Δp", "MPa"),
@@ -778,7 +778,7 @@ fn pressures(lo: &LoopRecord, scenario: &Scenario) -> Figure {
 }
 
 /// The valves' flow against their capacity.
-fn flow(lo: &LoopRecord, scenario: &Scenario) -> Figure {
+fn flow(lo: &LoopRecord, scenario: &PlatenScenario) -> Figure {
     let c = &lo.channels;
     let capacity = lo.system.capacities().valve_flow_m3_s;
     let mut panel = channel_panel(
@@ -812,7 +812,7 @@ fn flow(lo: &LoopRecord, scenario: &Scenario) -> Figure {
 }
 
 /// The command and the achieved displacement and acceleration, whole and zoomed.
-fn tracking(r: &Recorded, lo: &LoopRecord, scenario: &Scenario) -> Figure {
+fn tracking(r: &Recorded, lo: &LoopRecord, scenario: &PlatenScenario) -> Figure {
     let c = &lo.channels;
     let (u, a) = (&r.channels[0], &r.channels[2]);
     let whole = span(u);
@@ -882,7 +882,7 @@ fn tracking(r: &Recorded, lo: &LoopRecord, scenario: &Scenario) -> Figure {
 }
 
 /// The supply pressure over time (MPa), with the set pressure.
-fn supply(points: &Points, system: &TableSystem, scenario: &Scenario) -> Figure {
+fn supply(points: &Points, system: &TableSystem, scenario: &PlatenScenario) -> Figure {
     let set = system.supply_pressure_pa() * 1e-6;
     let t = span(points);
     let kind = match system.supply() {

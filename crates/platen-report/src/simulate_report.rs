@@ -7,28 +7,28 @@ use std::path::{Path, PathBuf};
 
 use platen_integrate::{ForwardIntegrator as _, Peaks, RunStats};
 use platen_model::STANDARD_GRAVITY_M_S2;
-use platen_scenario::{Run, RunOutput, RunSummary, Scenario};
+use platen_scenario::{PlatenScenario, Run, RunOutput, RunSummary};
 
 /// The text summary of `scenario`'s run `output` (summarised as `summary`), its CSV written
 /// to `out` if any, and the figure files `figures` written for it (none: no figure lines).
 ///
 /// ```no_run
 /// use std::path::Path;
-/// use platen_scenario::{RunSummary, Scenario};
+/// use platen_scenario::{PlatenScenario, RunSummary};
 /// # struct Nothing;
 /// # impl platen_integrate::SampleSink for Nothing {
 /// #     fn accept(&mut self, _: &platen_integrate::Sample) {}
 /// # }
 ///
 /// let path = Path::new("scenarios/specimen/frame-forward.json");
-/// let scenario = Scenario::load(path)?;
+/// let scenario = PlatenScenario::load(path)?;
 /// let output = scenario.run(&mut Nothing)?;
 /// let summary = RunSummary::new(path, &scenario, &output, None);
 /// print!("{}", platen_report::simulate_report::text(&scenario, &output, &summary, None, &[]));
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn text(
-    scenario: &Scenario,
+    scenario: &PlatenScenario,
     output: &RunOutput,
     summary: &RunSummary,
     out: Option<&Path>,
@@ -47,7 +47,7 @@ pub fn text(
 }
 
 /// `", overridden: name = value, …"` when the scenario lays values over its preset's.
-fn overridden(s: &Scenario) -> String {
+fn overridden(s: &PlatenScenario) -> String {
     let values = s.rig.overrides.values();
     if values.is_empty() {
         return String::new();
@@ -90,7 +90,7 @@ fn specimen_lines(s: &mut String, peaks: &Peaks) {
 }
 
 /// What ran, its peaks, a forward run's figures and the table's limits.
-fn run_lines(s: &mut String, sc: &Scenario, output: &RunOutput, out: Option<&Path>) {
+fn run_lines(s: &mut String, sc: &PlatenScenario, output: &RunOutput, out: Option<&Path>) {
     let (peaks, stats) = (&output.peaks, output.stats.as_ref());
     let dir = match sc.run {
         Run::ClosedLoop { .. } => "closed loop (command → controller → valves → platen)",
@@ -180,7 +180,7 @@ fn forward_lines(s: &mut String, st: &RunStats, integrator: &str) {
 }
 
 /// The table's limits: within them, or each one exceeded.
-fn limit_lines(s: &mut String, sc: &Scenario, peaks: &Peaks) {
+fn limit_lines(s: &mut String, sc: &PlatenScenario, peaks: &Peaks) {
     let ex = peaks.exceedances(&sc.rig.limits);
     if ex.is_empty() {
         let l = &sc.rig.limits;

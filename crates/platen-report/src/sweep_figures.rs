@@ -7,7 +7,7 @@
 use plotters::style::RGBColor;
 
 use platen_scenario::sweep::{Case, Outcome};
-use platen_scenario::Scenario;
+use platen_scenario::PlatenScenario;
 
 use crate::figure::{Dash, Figure, Panel, Series, MODEL};
 use crate::series::{patterned, series};
@@ -57,7 +57,7 @@ pub(crate) fn limit_text(x: f64) -> String {
 
 /// The figures of a sweep: one per axis with more than one value (none for a single case).
 pub fn figures(
-    scenario: &Scenario,
+    scenario: &PlatenScenario,
     set_names: &[String],
     cases: &[Case],
     outcomes: &[Outcome],
@@ -107,7 +107,7 @@ fn distinct(values: &[f64]) -> usize {
 
 /// The peaks against axis `a`, one line per combination of the other varying axes.
 fn axis_figure(
-    scenario: &Scenario,
+    scenario: &PlatenScenario,
     axes: &[Axis],
     varying: &[usize],
     a: usize,

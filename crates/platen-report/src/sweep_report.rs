@@ -8,12 +8,12 @@ use serde::Serialize;
 
 use platen_model::STANDARD_GRAVITY_M_S2;
 use platen_scenario::sweep::{self, Case, Outcome};
-use platen_scenario::Scenario;
+use platen_scenario::PlatenScenario;
 
 /// How a sweep ran: the grid's cases, its results and where its outputs went.
 pub struct SweepRun<'a> {
     /// The scenario swept.
-    pub scenario: &'a Scenario,
+    pub scenario: &'a PlatenScenario,
     /// The names of the `--set` axes, in the cases' `sets` order.
     pub set_names: &'a [String],
     /// The cases, in grid order.

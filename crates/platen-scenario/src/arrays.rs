@@ -4,7 +4,7 @@
 //!
 //! ```
 //! use std::path::Path;
-//! use platen_scenario::{file, Arrays, Scenario};
+//! use platen_scenario::{file, Arrays, PlatenScenario};
 //! use platen_integrate::Trajectory;
 //!
 //! // The scenario format without an excitation source: the arrays are the excitation.
@@ -15,7 +15,7 @@
 //! let t_s: Vec<f64> = (0..=2048).map(|j| j as f64 / 1024.0).collect();
 //! let force_n: Vec<f64> = t_s.iter().map(|t| 60e3 * (std::f64::consts::PI * t).sin()).collect();
 //! let origin = Path::new("my record");
-//! let scenario = Scenario::from_arrays(origin, settings, Arrays::Force { t_s, force_n })?;
+//! let scenario = PlatenScenario::from_arrays(origin, settings, Arrays::Force { t_s, force_n })?;
 //! let mut out = Trajectory::default();
 //! let output = scenario.run(&mut out)?;
 //! assert_eq!(out.len(), 2049);
@@ -34,7 +34,7 @@ use crate::excitation::{
     Derived, Run,
 };
 use crate::file::ScenarioFile;
-use crate::scenario::Scenario;
+use crate::scenario::PlatenScenario;
 
 /// Records given in memory, in SI units: they take the place of the scenario file's
 /// `excitation.force_csv` or `excitation.motion_csv`.
@@ -61,7 +61,7 @@ pub enum Arrays {
     },
 }
 
-impl Scenario {
+impl PlatenScenario {
     /// Validates `file`, whose excitation names no source, with `arrays` as its excitation.
     /// Everything else of the scenario format applies as in a file: the model, the
     /// integrator and initial state (forward runs), `duration_s`, and a force's
@@ -69,7 +69,7 @@ impl Scenario {
     /// `platen.forward()`); relative paths resolve against its folder.
     ///
     /// # Errors
-    /// Every error of [`Scenario::from_file`] for the settings; for the arrays,
+    /// Every error of [`PlatenScenario::from_file`] for the settings; for the arrays,
     /// [`ScenarioError::RecordRejected`] naming the array and the 0-based index of a bad
     /// value (`force_n[12] = NaN is not finite`, columns of different lengths, times that do
     /// not increase strictly or are not uniformly sampled, too few samples); an excitation
@@ -183,11 +183,12 @@ mod tests {
                 "initial": {{"u_m": 0.01}}, "duration_s": 3}}"#,
             csv.display().to_string()
         );
-        let from_file = Scenario::from_file(&dir.path().join("s.json"), settings(&text)).unwrap();
+        let from_file =
+            PlatenScenario::from_file(&dir.path().join("s.json"), settings(&text)).unwrap();
         let mut in_memory = settings(&text);
         in_memory.excitation.force_csv = None;
         let from_arrays =
-            Scenario::from_arrays(origin(), in_memory, Arrays::Force { t_s: t, force_n: f })
+            PlatenScenario::from_arrays(origin(), in_memory, Arrays::Force { t_s: t, force_n: f })
                 .unwrap();
         let (mut a, mut b) = (Trajectory::default(), Trajectory::default());
         let out_a = from_file.run(&mut a).unwrap();
@@ -212,7 +213,8 @@ mod tests {
                 "duration_s": 1.5}}"#,
             csv.display().to_string()
         );
-        let from_file = Scenario::from_file(&dir.path().join("s.json"), settings(&text)).unwrap();
+        let from_file =
+            PlatenScenario::from_file(&dir.path().join("s.json"), settings(&text)).unwrap();
         let arrays = Arrays::Motion {
             t_s: t,
             u_m: u,
@@ -221,7 +223,7 @@ mod tests {
         };
         let mut in_memory = settings(&text);
         in_memory.excitation.motion_csv = None;
-        let from_arrays = Scenario::from_arrays(origin(), in_memory, arrays).unwrap();
+        let from_arrays = PlatenScenario::from_arrays(origin(), in_memory, arrays).unwrap();
         let (mut a, mut b) = (Trajectory::default(), Trajectory::default());
         from_file.run(&mut a).unwrap();
         from_arrays.run(&mut b).unwrap();
@@ -280,7 +282,7 @@ mod tests {
             ),
         ];
         for (arrays, expected) in cases {
-            let e = Scenario::from_arrays(origin(), bare(), arrays).unwrap_err();
+            let e = PlatenScenario::from_arrays(origin(), bare(), arrays).unwrap_err();
             assert!(matches!(e, ScenarioError::RecordRejected { .. }), "{e:?}");
             assert!(
                 e.to_string().starts_with(expected),
@@ -330,7 +332,7 @@ mod tests {
             ),
         ];
         for (text, arrays, expected) in cases {
-            let e = Scenario::from_arrays(origin(), settings(text), arrays).unwrap_err();
+            let e = PlatenScenario::from_arrays(origin(), settings(text), arrays).unwrap_err();
             assert!(
                 e.to_string().starts_with(expected),
                 "{e}\nexpected: {expected}"

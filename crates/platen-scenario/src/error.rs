@@ -35,6 +35,25 @@ pub enum ScenarioError {
         path: PathBuf,
     },
 
+    /// The model at another hold-down pressure (`platen simulate --pressure-mpa`) is invalid.
+    #[error("`{}`: the model at --pressure-mpa {pressure_mpa}", path.display())]
+    Pressure {
+        /// The scenario file.
+        path: PathBuf,
+        /// The pressure asked for, MPa.
+        pressure_mpa: f64,
+        /// Why the model is invalid there.
+        #[source]
+        source: platen_model::ModelError,
+    },
+
+    /// A hold-down pressure was asked of a multi-axis table, whose struts carry their own.
+    #[error("`{}`: --pressure-mpa sets the uniaxial platen's hold-down pressure; a multi-axis table's struts carry theirs in `table.hold_down_struts[].pressure_pa`", path.display())]
+    PressureOfTable {
+        /// The scenario file.
+        path: PathBuf,
+    },
+
     /// A multi-axis run failed (the actuators lose rank at a pose of the motion).
     #[error("the multi-axis run failed; no output was written")]
     TableRun(#[source] IntegrateError),
@@ -79,7 +98,7 @@ pub enum ScenarioError {
         path: PathBuf,
     },
 
-    /// A closed-loop run was given to a rig without a `table_system` (a [`crate::Scenario`]
+    /// A closed-loop run was given to a rig without a `table_system` (a [`crate::PlatenScenario`]
     /// or [`crate::Rig`] built by hand: a scenario file with a motion and no table system is
     /// an inverse run).
     #[error("a closed-loop run needs a rig with a table_system")]

@@ -233,7 +233,7 @@ impl<'a> Source<'a> {
 }
 
 /// The keys of the sources `ex` names (none for a scenario whose records are given in
-/// memory: [`crate::Scenario::from_arrays`]).
+/// memory: [`crate::PlatenScenario::from_arrays`]).
 pub(crate) fn named_sources(ex: &ExcitationSpec) -> Vec<&'static str> {
     Source::given(ex).into_iter().map(Source::name).collect()
 }

@@ -1,4 +1,4 @@
-//! The executor: [`Scenario::run`] runs a validated scenario into any [`SampleSink`].
+//! The executor: [`PlatenScenario::run`] runs a validated scenario into any [`SampleSink`].
 
 use std::path::Path;
 
@@ -13,7 +13,7 @@ use platen_model::{PlatenModel, Specimen};
 
 use crate::error::{Result, ScenarioError};
 use crate::rig::{LoopSettings, Rig};
-use crate::scenario::{Model, Run, Scenario};
+use crate::scenario::{Model, PlatenScenario, Run};
 use platen_system::TableSystem;
 
 /// What a run leaves besides its samples: the peaks (and span) of every output channel and,
@@ -108,7 +108,7 @@ fn update(p: &mut Peak, value: f64, t_s: f64) {
     }
 }
 
-impl Scenario {
+impl PlatenScenario {
     /// Runs the scenario, delivering every output sample to `sink` in time order: forward
     /// runs at the force record's sample times, inverse runs at the motion's, closed loops
     /// at the command's.

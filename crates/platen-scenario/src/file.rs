@@ -1,5 +1,5 @@
 //! The scenario file as written: serde types with `deny_unknown_fields`, before validation
-//! (see [`crate::scenario`] for the format and [`crate::Scenario`] for the validated type).
+//! (see [`crate::scenario`] for the format and [`crate::PlatenScenario`] for the validated type).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

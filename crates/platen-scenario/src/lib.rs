@@ -1,14 +1,21 @@
-//! Scenario files for `platen`: a rig and a run, validated, and the executor that runs them.
+//! Scenario files for `platen`: validated, and the executor that runs them, for every table.
 //!
-//! * [`scenario`]: the scenario JSON format ([`Scenario::load`] validates a file and loads
-//!   its records before anything is simulated): a [`Rig`] (what the table is: model, limits,
-//!   table system, specimen) and a [`Run`] (what it does: [`Run::Forward`] from a force,
-//!   [`Run::Inverse`] from a motion, [`Run::ClosedLoop`] from a command);
+//! * [`Scenario::load`]: the one entry. It reads a scenario file and validates it as what it
+//!   describes — the uniaxial platen of the paper ([`PlatenScenario`]) or a multi-axis table
+//!   ([`multi_axis::TableScenario`], a file with `table`) — and loads its records before
+//!   anything is simulated; [`Scenario::run`] runs either in memory ([`RunResult`]),
+//!   [`Scenario::excitation`] is what it is driven by, [`ScenarioRig::load`] what it
+//!   describes without its run. Every front end goes through these.
+//! * [`scenario`]: the scenario JSON format: for the platen a [`Rig`] (what the table is:
+//!   model, limits, table system, specimen) and a [`Run`] (what it does: [`Run::Forward`]
+//!   from a force, [`Run::Inverse`] from a motion, [`Run::ClosedLoop`] from a command);
+//!   [`PlatenScenario::run`] streams its samples into any sink (CLI, sweep, bench, Python);
+//! * [`multi_axis`]: the `table` key of a six-DOF table, organised by concern (file format,
+//!   building, excitation, the LHPOST6 preset, running, summary, description);
 //! * [`Rig::load`], [`LoadedRig::load`]: a scenario file's rig without a run (no excitation
 //!   needed), for a planner's own commands;
-//! * [`Scenario::from_arrays`]: the same format with the records given in memory (Python's
-//!   `platen.forward` and `platen.inverse`);
-//! * [`Scenario::run`]: the executor every front end calls (CLI, sweep, bench, Python).
+//! * [`PlatenScenario::from_arrays`]: the same format with the records given in memory
+//!   (Python's `platen.forward` and `platen.inverse`).
 //!
 //! # Conventions
 //!
@@ -23,6 +30,7 @@ pub mod catalog;
 mod ctx;
 pub mod describe;
 mod describe_system;
+mod entry;
 pub mod error;
 mod excitation;
 mod execute;
@@ -44,15 +52,16 @@ pub mod units;
 
 pub use arrays::Arrays;
 pub use describe::describe_model;
+pub use entry::{simulate, Excitation, RunResult, Scenario, ScenarioRig, Summary};
 pub use error::{Result, ScenarioError};
 pub use execute::{CsvSink, LoopOutput, RunOutput, Tracking};
 pub use model::{Model, ModelKey, ModelOverrides};
 /// Column maps are part of the scenario format (`excitation.columns`).
 pub use platen_io::columns;
 pub use rig::{LoadedRig, LoopSettings, Rig};
-pub use scenario::{Run, Scenario};
+pub use scenario::{PlatenScenario, Run};
 pub use summary::{
-    simulate, EnergySummary, ExceedanceSummary, ForwardSummary, LimitCheck, LimitsSummary,
-    RunResult, RunSummary, SolverSummary,
+    EnergySummary, ExceedanceSummary, ForwardSummary, LimitCheck, LimitsSummary, RunSummary,
+    SolverSummary,
 };
 pub use system::TableSystemSpec;

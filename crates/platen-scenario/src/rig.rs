@@ -97,7 +97,7 @@ impl Rig {
     /// ([`LoadedRig::load`]).
     ///
     /// # Errors
-    /// Any [`crate::ScenarioError`] of the rig's keys, as [`crate::Scenario::load`] reports
+    /// Any [`crate::ScenarioError`] of the rig's keys, as [`crate::PlatenScenario::load`] reports
     /// it: unreadable file, malformed JSON or unknown key (with its line and JSON path),
     /// invalid values (with their JSON path and what was expected).
     pub fn load(path: &Path) -> Result<Rig> {
@@ -186,7 +186,7 @@ impl LoadedRig {
     /// and initial state only by [`LoadedRig::loop_settings`].
     ///
     /// # Errors
-    /// Any [`crate::ScenarioError`] of the rig's keys, as [`crate::Scenario::load`] reports
+    /// Any [`crate::ScenarioError`] of the rig's keys, as [`crate::PlatenScenario::load`] reports
     /// it: unreadable file, malformed JSON or unknown key (with its line and JSON path),
     /// invalid values (with their JSON path and what was expected).
     pub fn load(path: &Path) -> Result<LoadedRig> {

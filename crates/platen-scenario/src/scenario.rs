@@ -55,7 +55,7 @@ pub use crate::model::{Model, ModelKey, ModelOverrides};
 /// A validated scenario, ready to run: a rig ([`Rig`]: what the table is) and a run
 /// ([`Run`]: what it does).
 #[derive(Debug, Clone, PartialEq)]
-pub struct Scenario {
+pub struct PlatenScenario {
     /// The scenario's name.
     pub name: String,
     /// The table: model, limits, table system and specimen.
@@ -67,7 +67,7 @@ pub struct Scenario {
     pub derived: Derived,
 }
 
-impl Scenario {
+impl PlatenScenario {
     /// Number of storeys of the specimen (0 without one).
     pub fn storeys(&self) -> usize {
         self.rig.storeys()
@@ -77,8 +77,8 @@ impl Scenario {
     ///
     /// # Errors
     /// As [`Run::scaled`].
-    pub fn scaled(&self, k: f64) -> std::result::Result<Scenario, IntegrateError> {
-        Ok(Scenario {
+    pub fn scaled(&self, k: f64) -> std::result::Result<PlatenScenario, IntegrateError> {
+        Ok(PlatenScenario {
             name: self.name.clone(),
             rig: self.rig.clone(),
             run: self.run.scaled(k)?.into_owned(),
@@ -92,7 +92,10 @@ impl Scenario {
     ///
     /// # Errors
     /// As [`ModelOverrides::build`].
-    pub fn at_pressure(mut self, pressure_pa: f64) -> std::result::Result<Scenario, ModelError> {
+    pub fn at_pressure(
+        mut self,
+        pressure_pa: f64,
+    ) -> std::result::Result<PlatenScenario, ModelError> {
         self.rig = self.rig.at_pressure(pressure_pa)?;
         Ok(self)
     }
@@ -111,13 +114,13 @@ impl Scenario {
     /// Validates a parsed scenario; relative paths are resolved against `path`'s folder.
     ///
     /// # Errors
-    /// As [`Scenario::load`].
+    /// As [`PlatenScenario::load`].
     pub fn from_file(path: &Path, file: ScenarioFile) -> Result<Self> {
         Self::validate(path, &file, build_run)
     }
 
     /// Validates `file`'s rig and settings, with `run` building what it runs (from the
-    /// file's excitation, or from records given in memory: [`Scenario::from_arrays`]). With
+    /// file's excitation, or from records given in memory: [`PlatenScenario::from_arrays`]). With
     /// a table system, a motion is the command of a closed loop ([`Run::ClosedLoop`]).
     pub(crate) fn validate(
         path: &Path,

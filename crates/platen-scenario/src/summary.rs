@@ -6,12 +6,11 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use platen_integrate::{Exceedance, ForwardIntegrator, Peaks, RunStats, Trajectory};
+use platen_integrate::{Exceedance, ForwardIntegrator, Peaks, RunStats};
 use platen_model::{PlatenModel, TableLimits};
 
-use crate::error::Result;
 use crate::rig::Rig;
-use crate::scenario::{Derived, Run, Scenario};
+use crate::scenario::{Derived, PlatenScenario, Run};
 use crate::RunOutput;
 
 /// The summary of one run of a scenario. Serialise it through [`serde_json::to_value`] to
@@ -295,7 +294,12 @@ pub struct LimitsSummary {
 
 impl RunSummary {
     /// The summary of `output`, a run of `scenario` (read from `path`) that wrote `out`.
-    pub fn new(path: &Path, scenario: &Scenario, output: &RunOutput, out: Option<&Path>) -> Self {
+    pub fn new(
+        path: &Path,
+        scenario: &PlatenScenario,
+        output: &RunOutput,
+        out: Option<&Path>,
+    ) -> Self {
         let peaks = &output.peaks;
         let rig = &scenario.rig;
         Self {
@@ -362,7 +366,7 @@ impl RunSummary {
     /// rest), so the platen never moves: most likely a force in the wrong unit (kN read as N).
     /// The run's own output is checked too: a platen that never left stick is reported even
     /// where the force alone does not explain it.
-    fn with_stuck_platen(mut self, scenario: &Scenario) -> Self {
+    fn with_stuck_platen(mut self, scenario: &PlatenScenario) -> Self {
         let Run::Forward {
             record,
             initial,
@@ -432,7 +436,7 @@ impl RunSummary {
 
 impl RunSummary {
     /// The summary with a closed-loop run's figures and warnings laid in.
-    fn with_loop(mut self, scenario: &Scenario, output: &RunOutput) -> Self {
+    fn with_loop(mut self, scenario: &PlatenScenario, output: &RunOutput) -> Self {
         let (Run::ClosedLoop { settings, .. }, Some(system), Some(lo)) =
             (&scenario.run, &scenario.rig.table_system, &output.system)
         else {
@@ -558,58 +562,4 @@ impl LimitsSummary {
             force_n: check(peaks.force_n.value, l.force_n),
         }
     }
-}
-
-/// A finished run held in memory: every output column and the summary
-/// ([`simulate`] returns it).
-#[derive(Debug, Clone, PartialEq)]
-pub struct RunResult {
-    /// The time series: one value per output sample in each of the contract's columns.
-    pub trajectory: Trajectory,
-    /// The summary, as `platen simulate --json` prints it.
-    pub summary: RunSummary,
-}
-
-impl RunResult {
-    /// The names of the output columns, in CSV order (`t_s`, `u_m`, `v_m_s`, `a_m_s2`,
-    /// `force_n`, `inertial_force_n`, `elastic_force_n`, `dissipative_force_n`; a run with a
-    /// specimen adds `base_shear_n`, `storey{i}_u_m`…, `storey{i}_a_m_s2`…).
-    pub fn columns(&self) -> Vec<&'static str> {
-        let mut names = Trajectory::COLUMN_NAMES.to_vec();
-        if let Some(sp) = &self.trajectory.specimen {
-            names.extend(sp.columns().into_iter().map(|(name, _)| name));
-        }
-        if self.trajectory.system.is_some() {
-            names.extend(platen_integrate::SystemColumns::NAMES);
-        }
-        names
-    }
-
-    /// The output column `name` (SI units), or `None` for a name that is not a column
-    /// (the specimen's columns are found in a run with a specimen).
-    pub fn column(&self, name: &str) -> Option<&[f64]> {
-        match Trajectory::COLUMN_NAMES.iter().position(|c| *c == name) {
-            Some(j) => Some(self.trajectory.columns()[j]),
-            None => (self.trajectory.specimen.as_ref())
-                .and_then(|sp| sp.column(name))
-                .or_else(|| self.trajectory.system.as_ref()?.column(name)),
-        }
-    }
-}
-
-/// Loads the scenario at `path`, runs it keeping the whole time series in memory, and
-/// summarises it: `platen simulate` as one library call.
-///
-/// # Errors
-/// Every error of [`Scenario::load`] and [`Scenario::run`].
-pub fn simulate(path: impl AsRef<Path>) -> Result<RunResult> {
-    let path = path.as_ref();
-    let scenario = Scenario::load(path)?;
-    let mut trajectory = Trajectory::default();
-    let output = scenario.run(&mut trajectory)?;
-    let summary = RunSummary::new(path, &scenario, &output, None);
-    Ok(RunResult {
-        trajectory,
-        summary,
-    })
 }

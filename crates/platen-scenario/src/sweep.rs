@@ -23,7 +23,7 @@ use platen_integrate::{
 use platen_io::csv::write_number;
 use platen_model::ModelError;
 
-use crate::scenario::{Model, ModelKey, Run, Scenario};
+use crate::scenario::{Model, ModelKey, PlatenScenario, Run};
 use crate::summary::ExceedanceSummary;
 
 /// One parameter axis: `FORM.KEY` and its values.
@@ -66,7 +66,7 @@ impl Sweep {
     /// # Errors
     /// [`CaseError`] for the first case whose model cannot be built.
     pub fn new(
-        scenario: &Scenario,
+        scenario: &PlatenScenario,
         scales: &[f64],
         pressures_mpa: &[f64],
         sets: &[SetAxis],
@@ -267,7 +267,7 @@ fn failed(e: IntegrateError) -> Outcome {
 }
 
 /// The limits a case's peaks exceed: `"stroke;velocity"`, or `"none"`.
-pub fn exceeded(scenario: &Scenario, peaks: &Peaks) -> String {
+pub fn exceeded(scenario: &PlatenScenario, peaks: &Peaks) -> String {
     let names: Vec<&str> = peaks
         .exceedances(&scenario.rig.limits)
         .iter()
@@ -325,7 +325,7 @@ fn header(set_names: &[String]) -> Vec<String> {
 /// the time-series CSVs; `stick_time_s` and `events` are empty for inverse runs, and every
 /// result column but `status` is empty for a case that failed.
 pub fn csv_text(
-    scenario: &Scenario,
+    scenario: &PlatenScenario,
     set_names: &[String],
     cases: &[Case],
     outs: &[Outcome],
@@ -455,7 +455,7 @@ impl SweepSummary {
     /// `set_names` naming the `--set` axes and `out` the CSV written.
     pub fn new(
         path: &Path,
-        scenario: &Scenario,
+        scenario: &PlatenScenario,
         set_names: &[String],
         cases: &[Case],
         outs: &[Outcome],
@@ -523,7 +523,7 @@ impl SweepSummary {
 /// The `--json` summary of a sweep as a JSON value ([`SweepSummary`]).
 pub fn json_summary(
     path: &Path,
-    scenario: &Scenario,
+    scenario: &PlatenScenario,
     set_names: &[String],
     cases: &[Case],
     outs: &[Outcome],

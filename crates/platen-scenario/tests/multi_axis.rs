@@ -474,7 +474,7 @@ fn the_pose_names_need_a_table() {
     let mut doc: Value = serde_json::from_str(&text).unwrap();
     doc["initial"] = json!({"x_m_s": 0.1});
     let file = parse(&path, &doc.to_string()).unwrap();
-    let err = platen_scenario::Scenario::from_file(&path, file)
+    let err = platen_scenario::PlatenScenario::from_file(&path, file)
         .unwrap_err()
         .to_string();
     assert!(err.contains("initial.x_m_s"), "{err}");
@@ -758,7 +758,7 @@ fn generated_motions_per_axis_command_the_closed_loop() {
             "excitation": {"white_noise_motion": noise(seed)}});
         let text = uni.to_string();
         let file = parse(&path, &text).unwrap();
-        let run = platen_scenario::Scenario::from_file(&path, file)
+        let run = platen_scenario::PlatenScenario::from_file(&path, file)
             .unwrap()
             .run;
         let platen_scenario::Run::Inverse { motion: u } = run else {
@@ -823,7 +823,7 @@ fn bad_generated_motions_per_axis_are_refused_with_their_path() {
         "excitation": {"sine_motion": {"x": sine(0.01, 1.0, 1024.0)}}});
     let text = uni.to_string();
     let file = parse(&path, &text).unwrap();
-    let err = platen_scenario::Scenario::from_file(&path, file)
+    let err = platen_scenario::PlatenScenario::from_file(&path, file)
         .unwrap_err()
         .to_string();
     assert!(

@@ -8,7 +8,7 @@ use std::path::Path;
 use platen_io::csv::read_table;
 use platen_io::peer::read_peer;
 use platen_scenario::scenario::parse;
-use platen_scenario::Scenario;
+use platen_scenario::PlatenScenario;
 use proptest::prelude::*;
 
 const SCENARIO: &str = r#"{
@@ -53,7 +53,7 @@ proptest! {
         std::fs::write(dir.path().join("f.csv"), &csv).unwrap();
         let path = dir.path().join("s.json");
         std::fs::write(&path, &json).unwrap();
-        if let Err(e) = Scenario::load(&path) {
+        if let Err(e) = PlatenScenario::load(&path) {
             // The message names the scenario, or the (possibly mutated) record path it resolved.
             let msg = e.to_string();
             let dir_name = dir.path().display().to_string();

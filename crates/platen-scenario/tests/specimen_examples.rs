@@ -8,7 +8,7 @@
 use std::path::{Path, PathBuf};
 
 use platen_integrate::{Sample, SampleSink, Trajectory};
-use platen_scenario::Scenario;
+use platen_scenario::PlatenScenario;
 
 /// Every sample, specimen part included.
 #[derive(Default)]
@@ -28,7 +28,7 @@ fn shipped(name: &str) -> PathBuf {
 
 #[test]
 fn the_forward_specimen_example_closes_its_energy_balance() {
-    let scenario = Scenario::load(&shipped("frame-forward.json")).unwrap();
+    let scenario = PlatenScenario::load(&shipped("frame-forward.json")).unwrap();
     assert!(scenario.rig.specimen.is_some());
     let mut trajectory = Trajectory::default();
     let output = scenario.run(&mut trajectory).unwrap();
@@ -52,7 +52,7 @@ fn the_forward_specimen_example_closes_its_energy_balance() {
 
 #[test]
 fn the_inverse_specimen_example_adds_the_base_shear() {
-    let scenario = Scenario::load(&shipped("frame-inverse.json")).unwrap();
+    let scenario = PlatenScenario::load(&shipped("frame-inverse.json")).unwrap();
     let mut samples = Samples::default();
     scenario.run(&mut samples).unwrap();
     let peak = |xs: &[f64]| xs.iter().fold(0.0f64, |m, x| m.max(x.abs()));
@@ -85,10 +85,10 @@ fn the_forward_specimen_example_runs_with_dopri5() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("frame-forward-dopri5.json");
     std::fs::write(&path, text).unwrap();
-    let adaptive = Scenario::load(&path).unwrap();
+    let adaptive = PlatenScenario::load(&path).unwrap();
     let mut b = Trajectory::default();
     let stats_b = adaptive.run(&mut b).unwrap().stats.unwrap();
-    let fixed = Scenario::load(&shipped("frame-forward.json")).unwrap();
+    let fixed = PlatenScenario::load(&shipped("frame-forward.json")).unwrap();
     let mut a = Trajectory::default();
     let stats_a = fixed.run(&mut a).unwrap().stats.unwrap();
     let worst = a

@@ -8,7 +8,7 @@ use platen_integrate::{Sample, SampleSink, Trajectory};
 use platen_io::csv::write_csv_atomic;
 use platen_io::IoError;
 use platen_model::ForceTerms;
-use platen_scenario::{CsvSink, Scenario, ScenarioError};
+use platen_scenario::{CsvSink, PlatenScenario, ScenarioError};
 
 fn shipped(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -42,7 +42,7 @@ fn the_streamed_csv_equals_the_one_written_from_memory() {
         "full-model-large-stroke.json",
         "s9-sine-motion.json",
     ] {
-        let scenario = Scenario::load(&shipped(name)).unwrap();
+        let scenario = PlatenScenario::load(&shipped(name)).unwrap();
         let mut trajectory = Trajectory::default();
         let in_memory_output = scenario.run(&mut trajectory).unwrap();
         let in_memory = dir.path().join("memory.csv");

@@ -7,12 +7,12 @@ use std::path::Path;
 use platen_integrate::Peaks;
 use platen_model::IdentifiedKey;
 use platen_scenario::sweep::{Outcome, SetAxis, Sweep};
-use platen_scenario::{ModelKey, Scenario};
+use platen_scenario::{ModelKey, PlatenScenario};
 
-fn scenario() -> Scenario {
+fn scenario() -> PlatenScenario {
     let path =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/sr9-like-sine-force.json");
-    Scenario::load(&path).unwrap()
+    PlatenScenario::load(&path).unwrap()
 }
 
 /// Everything an outcome holds, as text (`{:?}` of an f64 round-trips: equal text is equal

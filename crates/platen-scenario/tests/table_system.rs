@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use serde_json::{json, Value};
 
 use platen_integrate::{LoopMethod, SampleSink, Trajectory};
-use platen_scenario::{CsvSink, LoopSettings, Run, RunSummary, Scenario, ScenarioError};
+use platen_scenario::{CsvSink, LoopSettings, PlatenScenario, Run, RunSummary, ScenarioError};
 use platen_system::{
     preset, Accumulator, Actuator, Controller, ServoValve, Supply, TableSystem, TableSystemParts,
 };
@@ -53,16 +53,16 @@ fn write(dir: &Path, name: &str, scenario: &Value) -> PathBuf {
 }
 
 /// The loop settings of a closed-loop scenario's run.
-fn loop_of(s: &Scenario) -> LoopSettings {
+fn loop_of(s: &PlatenScenario) -> LoopSettings {
     match &s.run {
         Run::ClosedLoop { settings, .. } => *settings,
         other => panic!("not a closed loop: {other:?}"),
     }
 }
 
-fn load(scenario: &Value) -> Result<Scenario, ScenarioError> {
+fn load(scenario: &Value) -> Result<PlatenScenario, ScenarioError> {
     let dir = tempfile::tempdir().unwrap();
-    Scenario::load(&write(dir.path(), "scenario", scenario))
+    PlatenScenario::load(&write(dir.path(), "scenario", scenario))
 }
 
 /// Loads `scenario`, which must be refused naming `json_path` and saying `expected`.
@@ -375,7 +375,7 @@ fn a_force_excitation_with_a_table_system_is_refused() {
         json!({"force_csv": "force.csv"}),
     );
     let s = with(s, "duration_s", Value::Null);
-    let error = Scenario::load(&write(dir.path(), "force", &s)).unwrap_err();
+    let error = PlatenScenario::load(&write(dir.path(), "force", &s)).unwrap_err();
     let message = error.to_string();
     assert!(
         message.contains("excitation.force_csv") && message.contains("a motion excitation"),
@@ -715,7 +715,7 @@ fn an_explicit_double_ended_system_equals_the_one_built_by_hand() {
 
 /// Runs the scenario at `path` into a CSV with the system's columns; the file's bytes.
 fn run_to_csv(path: &Path, out: &Path) -> Vec<u8> {
-    let scenario = Scenario::load(path).unwrap();
+    let scenario = PlatenScenario::load(path).unwrap();
     let mut sink = CsvSink::create_for(out, scenario.storeys(), true).unwrap();
     scenario.run(&mut sink).unwrap();
     sink.finish().unwrap();
@@ -790,7 +790,7 @@ fn an_unstable_loop_runs_and_warns_with_its_margins() {
             json!({"controller": {"displacement_gain_per_m": 1e4}}),
         )),
     );
-    let scenario = Scenario::load(&path).unwrap();
+    let scenario = PlatenScenario::load(&path).unwrap();
     let (_, margins) = scenario.rig.loop_linearisation().unwrap();
     assert!(!margins.stable, "{margins:?}");
     let mut sink = Finite::default();
@@ -830,7 +830,7 @@ fn an_unstable_loop_runs_and_warns_with_its_margins() {
 fn a_stable_loop_has_no_instability_warning_and_reports_its_figures() {
     let dir = tempfile::tempdir().unwrap();
     let path = write(dir.path(), "stable", &scenario_with(lhpost(json!({}))));
-    let scenario = Scenario::load(&path).unwrap();
+    let scenario = PlatenScenario::load(&path).unwrap();
     let mut trajectory = Trajectory::default();
     let output = scenario.run(&mut trajectory).unwrap();
     let summary = RunSummary::new(&path, &scenario, &output, None);

@@ -9,7 +9,7 @@ use platen_app::recorded_of;
 use platen_io::csv::write_csv_atomic;
 use platen_report::sweep_report::GenerateReport;
 use platen_scenario::recorded::Recorded;
-use platen_scenario::{Run, Scenario};
+use platen_scenario::{PlatenScenario, Scenario};
 
 use crate::usage;
 
@@ -48,60 +48,24 @@ pub struct GenerateArgs {
 /// Runs `platen generate`.
 pub fn run(args: &GenerateArgs) -> Result<()> {
     let (scenario_path, out, seed, json_out) = (&args.scenario, &args.out, args.seed, args.json);
-    let file: platen_scenario::file::ScenarioFile =
-        platen_io::json::parse_json_file(scenario_path)?;
-    if file.table.is_some() && matches!(args.what, What::Excitation) {
-        return table_excitation(scenario_path, &file, out, json_out);
-    }
-    let scenario = Scenario::from_file(scenario_path, file)?;
     match args.what {
-        What::Excitation => match &scenario.run {
-            Run::Forward {
-                record, samples, ..
-            } => {
-                let n = *samples;
-                write_csv_atomic(
-                    out,
-                    &["t_s", "force_n"],
-                    &[&record.t_s()[..n], &record.force_n()[..n]],
-                )?;
-                report(json_out, out, n, "force", None)?;
-            }
-            // A closed loop's command is the motion it asks for.
-            Run::Inverse { motion }
-            | Run::ClosedLoop {
-                command: motion, ..
-            } => {
-                write_csv_atomic(
-                    out,
-                    &["t_s", "u_m", "v_m_s", "a_m_s2"],
-                    &[motion.t_s(), motion.u_m(), motion.v_m_s(), motion.a_m_s2()],
-                )?;
-                report(json_out, out, motion.len(), "motion", None)?;
-            }
-        },
+        What::Excitation => {
+            let scenario = Scenario::load(scenario_path)?;
+            let excitation = scenario.excitation();
+            let names: Vec<&str> = excitation.names.iter().map(String::as_str).collect();
+            write_csv_atomic(out, &names, &excitation.columns)?;
+            report(json_out, out, excitation.len(), excitation.kind, None)?;
+        }
         What::Recorded => {
+            // Recorded-like data is the uniaxial platen's (its LVDT, accelerometer and
+            // load-cell channels).
+            let scenario = PlatenScenario::load(scenario_path)?;
             let rec = recorded_of(&scenario, scenario_path, seed)?;
             write_csv_atomic(out, &Recorded::COLUMN_NAMES, &rec.columns())?;
             report(json_out, out, rec.t_s.len(), "recorded", Some(seed))?;
         }
     }
     Ok(())
-}
-
-/// `generate excitation` of a multi-axis scenario: its six-DOF motion or its forces
-/// ([`platen_scenario::multi_axis::TableScenario::excitation_columns`]).
-fn table_excitation(
-    path: &Path,
-    file: &platen_scenario::file::ScenarioFile,
-    out: &Path,
-    json_out: bool,
-) -> Result<()> {
-    let scenario = platen_scenario::multi_axis::TableScenario::from_file(path, file)?;
-    let (names, columns, kind) = scenario.excitation_columns();
-    let names: Vec<&str> = names.iter().map(String::as_str).collect();
-    write_csv_atomic(out, &names, &columns)?;
-    report(json_out, out, columns[0].len(), kind, None)
 }
 
 /// Prints what was written: [`GenerateReport`] as JSON or as its text line.

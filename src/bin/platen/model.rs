@@ -14,7 +14,8 @@ use clap::ValueEnum;
 use platen_model::Preset;
 use platen_report::{model_text, system_figures};
 use platen_scenario::describe::{self, ModelDescription, SystemAnalysis};
-use platen_scenario::{LoadedRig, Model};
+use platen_scenario::multi_axis::TableScenario;
+use platen_scenario::{LoadedRig, Model, ScenarioRig};
 use platen_system::TableSystem;
 
 use crate::plot;
@@ -90,14 +91,11 @@ pub fn run(args: &ModelArgs) -> Result<()> {
              ({names}) or a --scenario with a `table_system`"
         );
     }
-    if let Some(path) = &args.scenario {
-        let file: platen_scenario::file::ScenarioFile = platen_io::json::parse_json_file(path)?;
-        if file.table.is_some() {
-            return describe_table(args, path, &file);
-        }
-    }
     let mut described = match &args.scenario {
-        Some(path) => of_scenario(path)?,
+        Some(path) => match ScenarioRig::load(path)? {
+            ScenarioRig::Platen(loaded) => of_scenario(path, loaded)?,
+            ScenarioRig::Table(table) => return describe_table(args, path, &table),
+        },
         None => of_preset(args)?,
     };
     let system = match &args.system {
@@ -135,8 +133,7 @@ pub fn run(args: &ModelArgs) -> Result<()> {
 }
 
 /// The model, table system and specimen of the scenario at `path`.
-fn of_scenario(path: &Path) -> Result<Described> {
-    let loaded = LoadedRig::load(path)?;
+fn of_scenario(path: &Path, loaded: LoadedRig) -> Result<Described> {
     let rig = loaded.rig;
     let header = model_text::scenario_header(path, &loaded.name, &rig);
     let given = rig
@@ -224,11 +221,7 @@ fn system_preset(name: &str, stroke_m: f64) -> Result<TableSystem> {
 }
 
 /// `platen model --scenario` on a multi-axis scenario: its modes and capacities.
-fn describe_table(
-    args: &ModelArgs,
-    path: &Path,
-    file: &platen_scenario::file::ScenarioFile,
-) -> Result<()> {
+fn describe_table(args: &ModelArgs, path: &Path, scenario: &TableScenario) -> Result<()> {
     if args.system.is_some() {
         bail!(
             "`{}` has a multi-axis `table`: --system describes the uniaxial table system's \
@@ -236,7 +229,6 @@ fn describe_table(
             path.display()
         );
     }
-    let scenario = platen_scenario::multi_axis::TableScenario::for_description(path, file)?;
     let written = match (args.plot.as_deref(), &scenario.system) {
         (None, _) => Vec::new(),
         (Some(_), None) => bail!(
@@ -268,7 +260,7 @@ fn describe_table(
         &description,
         &written,
         || {
-            let mut t = platen_scenario::multi_axis::description_text(&description);
+            let mut t = platen_report::table_text::description_text(&description);
             for f in &written {
                 t += &format!("  wrote {}\n", f.display());
             }

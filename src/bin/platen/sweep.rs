@@ -1,7 +1,7 @@
 //! `platen sweep`: run the Cartesian product of excitation scales, hold-down pressures and
 //! model parameters over one scenario, in parallel on every core, one summary row per case.
 //!
-//! * The scenario is loaded and validated once ([`Scenario::load`]); each case's model is
+//! * The scenario is loaded and validated once ([`PlatenScenario::load`]); each case's model is
 //!   rebuilt from the preset at the case's pressure, with the scenario's own `identified` or
 //!   `full` overrides laid over it (read from the file's JSON) and then the case's `--set`
 //!   values. With no axis given the single case is the scenario itself (checked).
@@ -24,7 +24,7 @@ use platen_io::write_bytes_atomic;
 use platen_model::{IdentifiedKey, PhysicalKey};
 use platen_report::simulate_report::with_outputs;
 use platen_scenario::sweep::{self, Outcome, Sweep};
-use platen_scenario::{ModelKey, Run, Scenario};
+use platen_scenario::{ModelKey, PlatenScenario, Run};
 
 pub use platen_scenario::sweep::SetAxis;
 
@@ -176,8 +176,8 @@ pub fn run(args: &SweepArgs) -> Result<()> {
 
 /// Loads the scenario at `path` and checks that it can be swept with the `--set` axes:
 /// no specimen, no closed loop, axes of its form, and a base case that is its own model.
-fn load(path: &Path, sets: &[SetAxis]) -> Result<Scenario> {
-    let scenario = Scenario::load(path)?;
+fn load(path: &Path, sets: &[SetAxis]) -> Result<PlatenScenario> {
+    let scenario = PlatenScenario::load(path)?;
     if scenario.rig.specimen.is_some() {
         anyhow::bail!(
             "{}: sweeps of a scenario with a specimen are not supported yet (simulate runs it)",
@@ -206,7 +206,7 @@ fn load(path: &Path, sets: &[SetAxis]) -> Result<Scenario> {
 }
 
 /// A form mismatch or an axis given twice is a usage error (exit code 2).
-fn check_axes(path: &Path, scenario: &Scenario, sets: &[SetAxis]) {
+fn check_axes(path: &Path, scenario: &PlatenScenario, sets: &[SetAxis]) {
     let form = scenario.rig.overrides.form();
     for (i, axis) in sets.iter().enumerate() {
         if axis.key.form() != form {

@@ -6,7 +6,7 @@
 use std::f64::consts::PI;
 use std::path::Path;
 
-use platen_scenario::{file, Arrays, LoadedRig, Scenario};
+use platen_scenario::{file, Arrays, LoadedRig, PlatenScenario};
 
 /// Standard gravity, m/s².
 pub const G: f64 = 9.806_65;
@@ -14,9 +14,9 @@ pub const G: f64 = 9.806_65;
 /// A scenario built from `json` (a scenario file without excitation source) with the
 /// displacement command `u_m` at `t_s` as its excitation, exactly as a `motion_csv` holding
 /// `t_s` and `u_m` would give it.
-pub fn scenario_with(json: &str, t_s: Vec<f64>, u_m: Vec<f64>) -> Scenario {
+pub fn scenario_with(json: &str, t_s: Vec<f64>, u_m: Vec<f64>) -> PlatenScenario {
     let settings = file::parse(Path::new("plan-test.json"), json).unwrap();
-    Scenario::from_arrays(
+    PlatenScenario::from_arrays(
         Path::new("plan-test.json"),
         settings,
         Arrays::Motion {

@@ -1,0 +1,480 @@
+//! The summary of a multi-axis run (`platen simulate --json`).
+
+use std::collections::BTreeMap;
+
+use platen_signal::metrics::rms;
+
+use super::*;
+
+/// The peaks of one DOF of a multi-axis run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AxisPeaks {
+    /// Largest |coordinate|, m or rad.
+    pub peak: f64,
+    /// Largest |rate|, m/s or rad/s.
+    pub peak_rate: f64,
+    /// Largest |second derivative|, m/s² or rad/s².
+    pub peak_acceleration: f64,
+}
+
+/// One actuator's peaks against its limits.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ActuatorPeaks {
+    /// Its name.
+    pub name: String,
+    /// Largest |stroke|, m.
+    pub peak_stroke_m: f64,
+    /// Its stroke limit (± from neutral), m.
+    pub stroke_limit_m: f64,
+    /// Largest force (push), N.
+    pub max_force_n: f64,
+    /// Smallest force (most pull), N.
+    pub min_force_n: f64,
+    /// Its push limit at the supply pressure, N.
+    pub push_limit_n: f64,
+    /// Its pull limit at the supply pressure (≤ 0), N.
+    pub pull_limit_n: f64,
+    /// Largest |flow| into chamber `a` (closed loop), m³/s.
+    pub peak_flow_m3_s: Option<f64>,
+    /// Its valves' flow capacity at the supply pressure, `m·Q_r·√((P_s − P_R)/Δp_r)`
+    /// (closed loop), m³/s.
+    pub flow_capacity_m3_s: Option<f64>,
+    /// Time its drive was saturated (`|d| = 1`, counted at the output samples; closed loop),
+    /// s.
+    pub saturated_time_s: Option<f64>,
+    /// Whether stroke and force stayed within the limits.
+    pub respected: bool,
+}
+
+/// How one DOF of a closed loop followed its command (at the output samples).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AxisTracking {
+    /// RMS of command − achieved, m or rad.
+    pub rms_error: f64,
+    /// Largest |command − achieved|, m or rad.
+    pub peak_error: f64,
+    /// RMS of the error over the RMS of the command (`null` for a still command: the
+    /// error is then absolute, `rms_error`, the cross-talk into that DOF).
+    pub displacement_nrmse: Option<f64>,
+    /// RMS of the acceleration error (command's − achieved), m/s² or rad/s².
+    pub rms_acceleration_error: f64,
+    /// Largest |acceleration error|, m/s² or rad/s².
+    pub peak_acceleration_error: f64,
+    /// RMS of the acceleration error over the RMS of the command's acceleration (`null`
+    /// for a still command).
+    pub acceleration_nrmse: Option<f64>,
+}
+
+/// One axis's peaks against its limits (`table.limits`; `null` where none is given).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AxisLimitCheck {
+    /// Its displacement limit (stroke or angle), m or rad.
+    pub displacement_limit: Option<f64>,
+    /// Its rate limit, m/s or rad/s.
+    pub rate_limit: Option<f64>,
+    /// Its acceleration limit, m/s² or rad/s².
+    pub acceleration_limit: Option<f64>,
+    /// Whether the peaks stayed within the limits given.
+    pub respected: bool,
+}
+
+/// The overturning moment the platen exerted on the specimen against the table's limit.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OverturningSummary {
+    /// Largest `√(M_x² + M_y²)` about the reference point, N·m.
+    pub peak_n_m: f64,
+    /// The limit (`table.limits.overturning_moment_n_m`), N·m.
+    pub limit_n_m: Option<f64>,
+    /// Whether it stayed within the limit (true without one).
+    pub respected: bool,
+}
+
+/// A closed loop's own figures.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TableLoopSummary {
+    /// Time with a drive saturated (at the controller's samples), s.
+    pub saturated_time_s: f64,
+    /// First time a chamber reached the cavitation floor (0 Pa absolute), s.
+    pub cavitation_at_s: Option<f64>,
+    /// Lowest supply pressure, Pa.
+    pub min_supply_pressure_pa: f64,
+    /// Largest warping force (the null-space part of the actuator forces), N.
+    pub max_warping_force_n: f64,
+    /// Hydraulic energy delivered into the chambers, J.
+    pub hydraulic_energy_j: f64,
+    /// Controller samples.
+    pub controller_samples: u64,
+    /// RK4 steps per controller period (or Dopri5 pieces).
+    pub steps_per_period: u32,
+    /// The loop's stability from the eigenvalues of its linearisation at neutral (`null`
+    /// when it cannot be linearised: the actuators cannot hold the platen there).
+    pub stability: Option<LoopStabilityDescription>,
+    /// Per free DOF, its loop's margins, broken at its drive with the others closed.
+    pub loop_margins: BTreeMap<&'static str, DofLoopDescription>,
+}
+
+/// One strut's range of pull.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StrutPeaks {
+    /// Its name.
+    pub name: String,
+    /// Smallest pull, N.
+    pub min_force_n: f64,
+    /// Largest pull, N.
+    pub max_force_n: f64,
+}
+
+/// What `platen simulate --json` prints for a multi-axis run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TableSummary {
+    /// The scenario's name.
+    pub name: String,
+    /// `"inverse"` or `"forward"`.
+    pub kind: &'static str,
+    /// Output samples.
+    pub samples: usize,
+    /// Simulated duration, s.
+    pub duration_s: f64,
+    /// The motion's channels platen derived, with how.
+    pub derived: Derived,
+    /// Per DOF (`x` … `yaw`), its peaks.
+    pub axes: BTreeMap<&'static str, AxisPeaks>,
+    /// Per actuator, its peaks against its limits.
+    pub actuators: Vec<ActuatorPeaks>,
+    /// Per strut, its range of pull.
+    pub struts: Vec<StrutPeaks>,
+    /// With a specimen: the largest |value| of each base-force and overturning-moment column.
+    pub specimen: BTreeMap<&'static str, f64>,
+    /// Per DOF, how it followed its command (closed loop; `null` otherwise).
+    pub tracking: Option<BTreeMap<&'static str, AxisTracking>>,
+    /// Per DOF, its peaks against `table.limits` (every DOF; limits `null` where not given).
+    pub limits: BTreeMap<&'static str, AxisLimitCheck>,
+    /// The overturning moment against its limit (with a specimen; `null` otherwise).
+    pub overturning_moment: Option<OverturningSummary>,
+    /// The closed loop's own figures (`null` for an open-loop run).
+    #[serde(rename = "loop")]
+    pub loop_figures: Option<TableLoopSummary>,
+    /// What an engineer should look at: limits exceeded, cavitation, saturation.
+    pub warnings: Vec<String>,
+    /// Whether every actuator and axis stayed within its limits.
+    pub within_limits: bool,
+    /// The CSV written, if any.
+    pub output: Option<String>,
+}
+
+pub(super) fn abs_max(x: &[f64]) -> f64 {
+    x.iter().fold(0.0, |m: f64, v| m.max(v.abs()))
+}
+
+/// The tracking of a command `u_ref`, `a_ref` by the achieved `u`, `a`.
+pub(super) fn tracking(u_ref: &[f64], u: &[f64], a_ref: &[f64], a: &[f64]) -> AxisTracking {
+    let err = |r: &[f64], x: &[f64]| -> Vec<f64> { r.iter().zip(x).map(|(r, x)| r - x).collect() };
+    let (e, ea) = (err(u_ref, u), err(a_ref, a));
+    let ratio = |num: f64, den: f64| (den > 0.0).then(|| num / den);
+    let (rms_e, rms_ea) = (rms(&e), rms(&ea));
+    AxisTracking {
+        rms_error: rms_e,
+        peak_error: abs_max(&e),
+        displacement_nrmse: ratio(rms_e, rms(u_ref)),
+        rms_acceleration_error: rms_ea,
+        peak_acceleration_error: abs_max(&ea),
+        acceleration_nrmse: ratio(rms_ea, rms(a_ref)),
+    }
+}
+
+impl TableScenario {
+    /// The summary of `run` (a run of this scenario); `output` the CSV written.
+    pub fn summary(&self, run: &TableRun, output: Option<&Path>) -> TableSummary {
+        self.summary_with(run, None, output)
+    }
+
+    /// [`TableScenario::summary`] with the closed loop's figures `stats`.
+    pub fn summary_with(
+        &self,
+        run: &TableRun,
+        stats: Option<&TableLoopStats>,
+        output: Option<&Path>,
+    ) -> TableSummary {
+        let col = |name: &str| run.column(name).unwrap_or(&[]);
+        let t = col("t_s");
+        let actuators = self.actuator_peaks(run);
+        // The warnings in their order: the axes' limits, the overturning moment, the
+        // actuators; then the loop's (an unstable loop's first of all).
+        let mut warnings = Vec::new();
+        let limits = self.limit_checks(run, &mut warnings);
+        let overturning_moment = self.overturning(run, &mut warnings);
+        for a in actuators.iter().filter(|a| !a.respected) {
+            warnings.push(format!(
+                "actuator {} beyond its stroke or force limits",
+                a.name
+            ));
+        }
+        let loop_figures = stats.map(|st| self.loop_summary(st, &mut warnings));
+        let axes_respected = limits.values().all(|l| l.respected);
+        let overturning_respected = overturning_moment.as_ref().is_none_or(|o| o.respected);
+        TableSummary {
+            tracking: self.tracking_of(run),
+            limits,
+            overturning_moment,
+            loop_figures: loop_figures.flatten(),
+            warnings,
+            name: self.name.clone(),
+            kind: match self.run {
+                TableRunSpec::Inverse { .. } => "inverse",
+                TableRunSpec::Forward { .. } => "forward",
+                TableRunSpec::Loop { .. } => "closed_loop",
+            },
+            samples: run.len(),
+            duration_s: span_s(t),
+            derived: self.derived.clone(),
+            axes: axis_peaks(run),
+            within_limits: actuators.iter().all(|a| a.respected)
+                && axes_respected
+                && overturning_respected,
+            actuators,
+            struts: self.strut_peaks(run),
+            specimen: specimen_peaks(run),
+            output: output.map(|p| p.display().to_string()),
+        }
+    }
+
+    /// Each actuator's peaks against its limits.
+    fn actuator_peaks(&self, run: &TableRun) -> Vec<ActuatorPeaks> {
+        let col = |name: &str| run.column(name).unwrap_or(&[]);
+        let t = col("t_s");
+        let capacities = self.flow_capacities_m3_s();
+        self.table
+            .actuators()
+            .iter()
+            .zip(self.force_limits_n())
+            .enumerate()
+            .map(|(i, (a, (pull, push)))| {
+                let force = col(&format!("{}_force_n", a.name));
+                let stroke = abs_max(col(&format!("{}_stroke_m", a.name)));
+                let max = force.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                let min = force.iter().copied().fold(f64::INFINITY, f64::min);
+                let capacity = capacities.as_ref().map(|c| c[i]);
+                let flow = run.column(&format!("{}_flow_m3_s", a.name)).map(abs_max);
+                let saturated = run.column(&format!("{}_drive", a.name)).map(|d| {
+                    let n = d.iter().filter(|x| x.abs() >= 1.0).count();
+                    if d.len() > 1 {
+                        span_s(t) * n as f64 / (d.len() - 1) as f64
+                    } else {
+                        0.0
+                    }
+                });
+                ActuatorPeaks {
+                    name: a.name.clone(),
+                    peak_stroke_m: stroke,
+                    stroke_limit_m: a.stroke_m,
+                    max_force_n: max,
+                    min_force_n: min,
+                    push_limit_n: push,
+                    pull_limit_n: pull,
+                    peak_flow_m3_s: flow,
+                    flow_capacity_m3_s: capacity,
+                    saturated_time_s: saturated,
+                    respected: stroke <= a.stroke_m && max <= push && min >= pull,
+                }
+            })
+            .collect()
+    }
+
+    /// Each hold-down strut's force range.
+    fn strut_peaks(&self, run: &TableRun) -> Vec<StrutPeaks> {
+        self.table
+            .struts()
+            .iter()
+            .map(|s| {
+                let f = run.column(&format!("{}_force_n", s.name)).unwrap_or(&[]);
+                StrutPeaks {
+                    name: s.name.clone(),
+                    min_force_n: f.iter().copied().fold(f64::INFINITY, f64::min),
+                    max_force_n: f.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                }
+            })
+            .collect()
+    }
+
+    /// A closed loop's tracking of its command in each free DOF (`None` for the others).
+    fn tracking_of(&self, run: &TableRun) -> Option<BTreeMap<&'static str, AxisTracking>> {
+        let TableRunSpec::Loop { command } = &self.run else {
+            return None;
+        };
+        let col = |name: &str| run.column(name).unwrap_or(&[]);
+        Some(
+            self.table
+                .free()
+                .iter()
+                .map(|d| {
+                    let k = d.index();
+                    let m = command.dof(d);
+                    let n = run.len().min(m.len());
+                    (
+                        d.name(),
+                        tracking(
+                            &m.u_m()[..n],
+                            col(POSE_COLUMNS[k]),
+                            &m.a_m_s2()[..n],
+                            col(ACCELERATION_COLUMNS[k]),
+                        ),
+                    )
+                })
+                .collect(),
+        )
+    }
+
+    /// Each axis's peaks against `table.limits`, a warning for each exceeded.
+    fn limit_checks(
+        &self,
+        run: &TableRun,
+        warnings: &mut Vec<String>,
+    ) -> BTreeMap<&'static str, AxisLimitCheck> {
+        let col = |name: &str| run.column(name).unwrap_or(&[]);
+        Dof::ALL
+            .iter()
+            .zip(self.limits.each())
+            .map(|(d, [u, v, a])| {
+                let k = d.index();
+                let peaks = [
+                    abs_max(col(POSE_COLUMNS[k])),
+                    abs_max(col(RATE_COLUMNS[k])),
+                    abs_max(col(ACCELERATION_COLUMNS[k])),
+                ];
+                let mut respected = true;
+                let checks = [u, v, a].into_iter().zip(peaks);
+                for ((limit, peak), what) in checks.zip(["displacement", "rate", "acceleration"]) {
+                    if let Some(l) = limit.filter(|l| peak > *l) {
+                        respected = false;
+                        warnings.push(format!(
+                            "{} {what} {peak:.4e} beyond its limit {l:.4e} (table.limits)",
+                            d.name()
+                        ));
+                    }
+                }
+                let check = AxisLimitCheck {
+                    displacement_limit: u,
+                    rate_limit: v,
+                    acceleration_limit: a,
+                    respected,
+                };
+                (d.name(), check)
+            })
+            .collect()
+    }
+
+    /// The specimen's peak overturning moment against the table's limit (`None` without a
+    /// specimen), a warning when exceeded.
+    fn overturning(
+        &self,
+        run: &TableRun,
+        warnings: &mut Vec<String>,
+    ) -> Option<OverturningSummary> {
+        let mx = run.column("overturning_moment_x_n_m")?;
+        let my = run.column("overturning_moment_y_n_m")?;
+        let peak = mx
+            .iter()
+            .zip(my)
+            .map(|(a, b)| a.hypot(*b))
+            .fold(0.0, f64::max);
+        let limit = self.limits.overturning_moment_n_m;
+        let respected = limit.is_none_or(|l| peak <= l);
+        if !respected {
+            warnings.push(format!(
+                "overturning moment {peak:.4e} N·m beyond the table's {:.4e} N·m",
+                limit.unwrap_or_default()
+            ));
+        }
+        Some(OverturningSummary {
+            peak_n_m: peak,
+            limit_n_m: limit,
+            respected,
+        })
+    }
+
+    /// The closed loop's figures (`None` without one): its statistics `st`, its linearised
+    /// stability and margins, and their warnings (an unstable loop's first).
+    fn loop_summary(
+        &self,
+        st: &TableLoopStats,
+        warnings: &mut Vec<String>,
+    ) -> Option<TableLoopSummary> {
+        let sys = self.system.as_ref()?;
+        let (stability, loop_margins) = match self.linearisation() {
+            Some(lin) => {
+                let (s, m) = loop_verdict(&lin);
+                (Some(s), m)
+            }
+            None => (None, BTreeMap::new()),
+        };
+        if let Some(words) = stability.as_ref().and_then(|s| s.unstable_words()) {
+            // The most serious first.
+            warnings.insert(
+                0,
+                format!(
+                    "the closed loop is unstable (linearised at neutral, {words}): the run shows \
+                     what the table would do, but check the controller's gains (`platen model \
+                     --scenario` shows each DOF's margins)"
+                ),
+            );
+        }
+        if let Some(at) = st.cavitation_at_s {
+            warnings.push(format!(
+                "cavitation: a chamber reached 0 Pa (absolute) at t = {at:.4} s"
+            ));
+        }
+        if st.saturated_time_s > 0.0 {
+            warnings.push(format!(
+                "drives saturated for {:.3} s: the table could not follow its command",
+                st.saturated_time_s
+            ));
+        }
+        Some(TableLoopSummary {
+            saturated_time_s: st.saturated_time_s,
+            cavitation_at_s: st.cavitation_at_s,
+            min_supply_pressure_pa: st.min_supply_pressure_pa,
+            max_warping_force_n: st.max_warping_force_n,
+            hydraulic_energy_j: st.hydraulic_energy_j,
+            controller_samples: st.controller_samples,
+            steps_per_period: sys.method.steps_per_period(),
+            stability,
+            loop_margins,
+        })
+    }
+}
+
+/// Time from the first to the last of the stamps `t`, s (0 for none).
+fn span_s(t: &[f64]) -> f64 {
+    t.last().zip(t.first()).map_or(0.0, |(b, a)| b - a)
+}
+
+/// Each DOF's peaks.
+fn axis_peaks(run: &TableRun) -> BTreeMap<&'static str, AxisPeaks> {
+    let col = |name: &str| run.column(name).unwrap_or(&[]);
+    Dof::ALL
+        .iter()
+        .map(|d| {
+            let k = d.index();
+            let peaks = AxisPeaks {
+                peak: abs_max(col(POSE_COLUMNS[k])),
+                peak_rate: abs_max(col(RATE_COLUMNS[k])),
+                peak_acceleration: abs_max(col(ACCELERATION_COLUMNS[k])),
+            };
+            (d.name(), peaks)
+        })
+        .collect()
+}
+
+/// The specimen's peak base forces and overturning moments, by column (empty without one).
+fn specimen_peaks(run: &TableRun) -> BTreeMap<&'static str, f64> {
+    [
+        "base_force_x_n",
+        "base_force_y_n",
+        "base_force_z_n",
+        "overturning_moment_x_n_m",
+        "overturning_moment_y_n_m",
+    ]
+    .into_iter()
+    .filter_map(|c| run.column(c).map(|v| (c, abs_max(v))))
+    .collect()
+}
