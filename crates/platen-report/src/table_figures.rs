@@ -159,6 +159,21 @@ fn level(label: String, span: (f64, f64), y: f64) -> crate::figure::Series {
     )
 }
 
+/// A panel of one simulated channel over time, its title naming its peak magnitude.
+fn peak_panel(quantity: &str, symbol: &str, unit: &str, points: Points, span: (f64, f64)) -> Panel {
+    time_panel(
+        format!(
+            "{quantity} {symbol}: peak |{symbol}| {} {unit}",
+            significant(peak_magnitude(&points), 4)
+        ),
+        format!("{symbol} ({unit})"),
+        points,
+        span,
+        SIMULATED,
+        None,
+    )
+}
+
 /// A time-history panel: the points solid, with dashed lines at `limits` = `(low, high)`
 /// (display units, legend `limit_label`), the peak in the title and "EXCEEDS" when the
 /// data pass a limit.
@@ -221,17 +236,7 @@ fn pose(c: &Columns<'_>) -> Figure {
                 ("translation", "mm")
             };
             let symbol = d.name();
-            Some(time_panel(
-                format!(
-                    "{quantity} {symbol}: peak |{symbol}| {} {unit}",
-                    significant(peak_magnitude(&points), 4)
-                ),
-                format!("{symbol} ({unit})"),
-                points,
-                c.span_s,
-                SIMULATED,
-                None,
-            ))
+            Some(peak_panel(quantity, symbol, unit, points, c.span_s))
         })
         .collect();
     Figure {
@@ -369,17 +374,7 @@ fn overturning_moments(c: &Columns<'_>) -> Option<Figure> {
             } else {
                 "kN"
             };
-            Some(time_panel(
-                format!(
-                    "{quantity} {symbol}: peak |{symbol}| {} {unit}",
-                    significant(peak_magnitude(&points), 4)
-                ),
-                format!("{symbol} ({unit})"),
-                points,
-                c.span_s,
-                SIMULATED,
-                None,
-            ))
+            Some(peak_panel(quantity, symbol, unit, points, c.span_s))
         })
         .collect();
     Some(Figure {
