@@ -57,7 +57,9 @@
 #![warn(missing_docs)]
 
 mod bare;
+mod clock;
 mod closed_loop;
+mod control;
 mod creep;
 mod dopri5;
 mod ensemble;
@@ -88,11 +90,12 @@ pub use method::{ForwardIntegrator, Method};
 pub use multi_axis::{inverse_table, PoseMotion, TableRun};
 pub use output::{
     Exceedance, Peak, Peaks, Sample, SampleSink, SpecimenColumns, SpecimenSample, SystemColumns,
-    SystemSample, Trajectory,
+    SystemSample, TableSink, Trajectory,
 };
 // The prescribed motion of inverse and closed-loop runs, and the derivatives its
 // constructors use, are platen-signal's; their errors convert into IntegrateError with `?`.
-pub use closed_loop::{forward_closed_loop, LoopMethod, LoopRun, LoopStats};
+pub use closed_loop::{forward_closed_loop, LoopRun};
+pub use control::{LoopMethod, LoopStats};
 pub use platen_signal::{derivative, second_derivative, Motion};
 pub use record::{
     sampling_grid, uniform_interval_s, ForceRecord, SamplingGrid, UNIFORM_RELATIVE_TOLERANCE,
@@ -103,7 +106,8 @@ pub use specimen::{forward_rk4_specimen, forward_specimen};
 pub use stepping::{Step, Stepping};
 pub use stop::{AdaptiveFailure, Failure, StopReason};
 pub use table_loop::{
-    forward_table_loop, TableLoopRun, TableLoopStats, MAX_LOOP_ACTUATORS, SPENT_GAS_FRACTION,
+    forward_table_loop, forward_table_loop_into, TableLoopRun, TableLoopStats, MAX_LOOP_ACTUATORS,
+    SPENT_GAS_FRACTION,
 };
 pub use table_plant::{
     forward_table, table_kinetic_energy_j, table_potential_energy_j, ActuatorForces,

@@ -21,11 +21,11 @@
 //!
 //! # Where time is kept
 //!
-//! A plant measures time inside its span in its own units (the fraction of a grid step for a
-//! force record, seconds from the start of the advance for the closed loop): the machine
-//! passes lengths and positions in those units and asks the plant ([`Plant::seconds`],
-//! [`Plant::land`], ...) where a located event lands, so that each plant's arithmetic of time
-//! is its own and its runs keep their bits.
+//! A plant's time is its [`Clock`]'s, kept apart from its right-hand side and its events: the
+//! fraction of a grid step for a force record, seconds from the start of the advance for the
+//! closed loop ([`crate::clock`]). The machine passes lengths and positions in the clock's
+//! units and asks the clock ([`Clock::seconds`], [`Clock::land`], ...) where a located event
+//! lands, so that each driver's arithmetic of time is its own and its runs keep their bits.
 //!
 //! # The integrators
 //!
@@ -38,6 +38,7 @@ use std::convert::Infallible;
 
 use platen_model::{PlatenModel, Specimen};
 
+use crate::clock::{Clock, SecondsClock};
 use crate::creep::{below_stiff_speed, creep_speed_m_s, stiff_speed_m_s};
 use crate::error::{IntegrateError, Result};
 use crate::event::{
@@ -66,7 +67,7 @@ pub(crate) type Y<const L: usize> = [f64; L];
 /// [`Plant::rk4_quadrature`]: the start state `y`, the stage states `y2`, `y3`, `y4` and the
 /// inputs in the middle and at the end.
 pub(crate) struct Rk4Stages<'a, const L: usize, I> {
-    /// Where the step starts, in the plant's units.
+    /// Where the step starts, in the clock's units.
     pub(crate) s: f64,
     /// The step over six, s.
     pub(crate) h6: f64,
@@ -99,9 +100,9 @@ pub(crate) enum PieceMethod {
 }
 
 /// A plant: the state of what the platen drives or is driven by, its right-hand side in each
-/// friction mode, the net force that decides stick and breakaway, and where its time lands.
+/// friction mode, the net force that decides stick and breakaway, and its clock.
 ///
-/// Positions `at` are in the plant's own units of time inside the current span; `tau` is where
+/// Positions `at` are in the units of the plant's [`Clock`] inside the current span; `tau` is where
 /// the current advance started and `rest` the length left to the end of the span.
 pub(crate) trait Plant<const L: usize> {
     /// The platen model.
@@ -193,25 +194,12 @@ pub(crate) trait Plant<const L: usize> {
     /// (`atol·unit + rtol·|y|`; infinite for a quadrature that is not controlled).
     fn error_scale(&self, i: usize, y0: f64, y1: f64, rtol: f64, atol: f64) -> f64;
 
-    /// A length in the plant's units, in seconds.
-    fn seconds(&self, len: f64) -> f64;
-    /// A length in seconds, in the plant's units.
-    fn units(&self, seconds: f64) -> f64;
-    /// The time at position `at`, s.
-    fn time_s(&self, at: f64) -> f64;
-    /// The smallest bracket the event root finder is asked for, in the plant's units (the
-    /// bracket is `4ε·max(len, floor)`).
-    fn tolerance_floor(&self) -> f64;
-    /// A creep stop this close to the start of its advance has not moved time.
-    fn min_progress(&self) -> f64;
-    /// Where an event located `x` past `tau` lands (snapped onto the span's end when a
-    /// hair short of it), in the units the plant's driver counts in.
-    fn land(&self, tau: f64, x: f64, rest: f64) -> f64;
-    /// Where a committed piece of length `len` from `tau` ends, in the driver's units.
-    fn reach(&self, tau: f64, len: f64) -> f64;
-    /// Where a breakaway located `x` past `tau` lands, in the driver's units; `held` when
-    /// rounding kept friction holding there (still stuck: time must still move).
-    fn break_at(&self, tau: f64, x: f64, rest: f64, held: bool) -> f64;
+    /// Where the plant's time is kept ([`Clock`]): a force record's grid or seconds.
+    type Clock: Clock;
+    /// The plant's clock.
+    fn clock(&self) -> &Self::Clock;
+    /// The plant's clock, to move (the closed loops' driver moves it between its cuts).
+    fn clock_mut(&mut self) -> &mut Self::Clock;
 }
 
 /// The machine: a plant's state in its friction mode, with the counters of the run.
@@ -289,7 +277,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
     pub(crate) fn note(&mut self, kind: EventKind, at: f64) {
         self.stats.record(kind);
         if let Some(events) = &mut self.events {
-            events.push((self.plant.time_s(at), kind));
+            events.push((self.plant.clock().time_s(at), kind));
         }
     }
 
@@ -404,7 +392,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
     #[inline(always)]
     fn rk4(&mut self, s: f64, len: f64, y: &Y<L>, k1: &Y<L>) -> (Y<L>, f64) {
         let mode = self.mode;
-        let dt = self.plant.seconds(len);
+        let dt = self.plant.clock().seconds(len);
         let (i_mid, i_end) = (self.plant.input(s + 0.5 * len), self.plant.input(s + len));
         let combine = |base: &Y<L>, k: &Y<L>, c: f64| {
             let mut out = *base;
@@ -470,7 +458,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
     /// `k1` there): the end state and the smallest speed along the slip direction at its
     /// stages.
     fn dopri5(&mut self, s: f64, len: f64, y: &Y<L>, k1: &Y<L>, tol: (f64, f64)) -> (Y<L>, f64) {
-        let dt = self.plant.seconds(len);
+        let dt = self.plant.clock().seconds(len);
         let mode = self.mode;
         let w = self.w_stiff;
         let (mut yc, mut kc) = (*y, *k1);
@@ -502,7 +490,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
                     } else {
                         AdaptiveFailure::TooManySteps { steps: MAX_STEPS }
                     };
-                    let t_s = self.plant.time_s(s) + done;
+                    let t_s = self.plant.clock().time_s(s) + done;
                     self.gave_up.get_or_insert((t_s, reason));
                     return (yc, stage_min);
                 }
@@ -559,7 +547,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
                 yi[i] += step * acc;
             }
             ys[stage] = yi;
-            let at = s + self.plant.units(done + DP_C[stage] * step);
+            let at = s + self.plant.clock().units(done + DP_C[stage] * step);
             let input = self.plant.input(at);
             let mut kn = [0.0; L];
             self.plant
@@ -645,7 +633,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
     /// the cubic Hermite interpolant of the speed (slip) or of `F_s ∓ N` (stick) touches zero.
     #[allow(clippy::too_many_arguments)]
     fn dips(&self, len: f64, i0: P::Input, y1: &Y<L>, i1: P::Input, k1: &Y<L>, a1: f64) -> bool {
-        let span = self.plant.seconds(len);
+        let span = self.plant.clock().seconds(len);
         match self.mode {
             Mode::Slip(dir) => {
                 let d = dir.sign();
@@ -671,7 +659,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
             u_m: self.y[U],
             v_m_s: self.y[V],
         };
-        IntegrateError::failed(self.plant.time_s(at), cause)
+        IntegrateError::failed(self.plant.clock().time_s(at), cause)
     }
 
     /// One RK4 step over the rest of a span of length 1, from position `tau`, in slip with
@@ -684,7 +672,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
     #[inline(always)]
     pub(crate) fn slip_fast<const POSITIVE: bool>(&mut self, tau: f64) -> bool {
         let dir = direction::<POSITIVE>();
-        let h = self.plant.seconds(1.0 - tau);
+        let h = self.plant.clock().seconds(1.0 - tau);
         let (i_mid, i_end) = (self.plant.input(0.5 * (1.0 + tau)), self.plant.input(1.0));
         let (y, k1) = (&self.y, &self.k);
         let hh = 0.5 * h;
@@ -759,21 +747,23 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
             }
             if events > MAX_EVENTS_PER_STEP {
                 let stalled = Failure::EventLoopStalled { events };
-                return Err(IntegrateError::failed(self.plant.time_s(tau), stalled));
+                return Err(IntegrateError::failed(
+                    self.plant.clock().time_s(tau),
+                    stalled,
+                ));
             }
         }
     }
 
     /// Advances over `span` seconds through every mode and event, for a plant whose positions
-    /// count from its own clock (`clock`: the closed loops, whose controller cuts time into
+    /// count from its own clock in seconds (the closed loops, whose controller cuts time into
     /// segments): each piece moves the clock by its length. The same guards as
     /// [`Machine::advance_span`]: where Dopri5 gave up, and more than
     /// [`MAX_EVENTS_PER_STEP`] events (stiff pieces not counted).
-    pub(crate) fn advance_clocked(
-        &mut self,
-        span: f64,
-        clock: fn(&mut P) -> &mut f64,
-    ) -> Result<()> {
+    pub(crate) fn advance_clocked(&mut self, span: f64) -> Result<()>
+    where
+        P: Plant<L, Clock = SecondsClock>,
+    {
         let mut tau = 0.0;
         let mut events = 0u32;
         while tau < span {
@@ -782,13 +772,13 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
                 return Err(IntegrateError::failed(t_s, Failure::AdaptiveFailed(reason)));
             }
             tau += at;
-            *clock(&mut self.plant) += at;
+            self.plant.clock_mut().t += at;
             if !(self.stiff_cut && at > 0.0) {
                 events += 1;
             }
             if events > MAX_EVENTS_PER_STEP {
                 let stalled = Failure::EventLoopStalled { events };
-                return Err(IntegrateError::failed(*clock(&mut self.plant), stalled));
+                return Err(IntegrateError::failed(self.plant.clock().t, stalled));
             }
         }
         Ok(())
@@ -796,7 +786,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
 
     /// Advances in the current mode from position `tau` over at most `rest`, to the end or to
     /// the mode's next event (its reset applied). Returns where the advance stopped, in the
-    /// units of the plant's driver ([`Plant::reach`], [`Plant::land`]).
+    /// units of the plant's driver ([`Clock::reach`], [`Clock::land`]).
     pub(crate) fn advance(&mut self, tau: f64, rest: f64) -> Result<f64> {
         let i0 = self.plant.input(tau);
         let slip = matches!(self.mode, Mode::Slip(_));
@@ -806,7 +796,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
             let w_stiff = stiff_speed_m_s(self.plant.model(), self.y[U], self.h);
             if self.plant.creeps_from_rest(dir, tau, &self.y, w_stiff) {
                 self.enter(Mode::Creep(dir), i0);
-                return Ok(self.plant.reach(tau, 0.0));
+                return Ok(self.plant.clock().reach(tau, 0.0));
             }
         }
         let (try_grading, event_grading) = match (slip, from_rest) {
@@ -835,7 +825,8 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
             if !self.plant.is_finite(&y1) {
                 return Err(self.non_finite(tau));
             }
-            self.plant.check(&y1, self.plant.time_s(tau + len))?;
+            self.plant
+                .check(&y1, self.plant.clock().time_s(tau + len))?;
             let i1 = self.plant.input(tau + len);
             let g1 = self.event_g(i1, &y1);
             if g1 > 0.0 && stage_min > 0.0 {
@@ -847,11 +838,11 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
                         return Err(self.non_finite(tau + len));
                     }
                     if self.mode == Mode::Stick {
-                        self.stats.stick_time_s += self.plant.seconds(len);
+                        self.stats.stick_time_s += self.plant.clock().seconds(len);
                     }
-                    let t_s = self.plant.time_s(tau + len);
+                    let t_s = self.plant.clock().time_s(tau + len);
                     self.commit_with(y1, k1, a1, i1, t_s);
-                    return Ok(self.plant.reach(tau, len));
+                    return Ok(self.plant.clock().reach(tau, len));
                 }
             } else if g1 <= 0.0 {
                 let (y2, g2) = if event_grading == try_grading {
@@ -862,7 +853,8 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
                 };
                 if g2 <= 0.0 {
                     let g0 = self.event_g(i0, &self.y);
-                    let tolerance = 4.0 * f64::EPSILON * len.max(self.plant.tolerance_floor());
+                    let tolerance =
+                        4.0 * f64::EPSILON * len.max(self.plant.clock().tolerance_floor());
                     let Ok(found) = locate_zero_velocity(len, g0, (y2, g2), tolerance, |x| {
                         self.stats.root_iterations += 1;
                         let (y, _) = self.piece(tau, x, event_grading);
@@ -898,7 +890,10 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
             return None;
         }
         self.gave_up = None;
-        let x = self.plant.units(t_s - self.plant.time_s(tau));
+        let x = self
+            .plant
+            .clock()
+            .units(t_s - self.plant.clock().time_s(tau));
         let mut y_event = *y;
         y_event[V] = 0.0;
         Some(self.event(tau, x, rest, y_event))
@@ -907,13 +902,13 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
     /// The reset at the current mode's event, located `x` past `tau` (`rest` to the span's
     /// end) with state `y_event` there. Returns where time landed, in the driver's units.
     fn event(&mut self, tau: f64, x: f64, rest: f64, y_event: Y<L>) -> f64 {
-        let mut at = self.plant.land(tau, x, rest);
+        let mut at = self.plant.clock().land(tau, x, rest);
         match self.mode {
             Mode::Slip(from) => {
                 let mut y = y_event;
                 let input = self.plant.input(at);
                 if let Some((mode, kind)) = self.plant.arrive(input, &mut y) {
-                    self.commit(y, input, self.plant.time_s(at));
+                    self.commit(y, input, self.plant.clock().time_s(at));
                     self.enter(mode, input);
                     if let Some(kind) = kind {
                         self.note(kind, at);
@@ -921,7 +916,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
                     return at;
                 }
                 y[V] = 0.0;
-                self.commit(y, input, self.plant.time_s(at));
+                self.commit(y, input, self.plant.clock().time_s(at));
                 let f_eff = self.plant.effective_force(input, &self.y);
                 let (mode, kind) = arrive_at_rest(self.plant.model(), self.y[U], f_eff, from);
                 self.enter(mode, input);
@@ -934,7 +929,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
             Mode::Creep(dir) => {
                 let start = (self.y, self.k);
                 let mut input = self.plant.input(at);
-                self.commit(y_event, input, self.plant.time_s(at));
+                self.commit(y_event, input, self.plant.clock().time_s(at));
                 let sn = dir.sign() * self.plant.net(input, &self.y);
                 let fs = self.plant.model().static_threshold_n(self.y[U]);
                 if sn - fs <= self.exit_level(dir, self.y[U]) - sn {
@@ -943,7 +938,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
                     self.y[V] = 0.0;
                     let f_eff = self.plant.effective_force(input, &self.y);
                     let mut mode = mode_at_rest(self.plant.model(), self.y[U], f_eff);
-                    if mode == Mode::Slip(dir) && x <= self.plant.min_progress() {
+                    if mode == Mode::Slip(dir) && x <= self.plant.clock().min_progress() {
                         // The stop rounded onto the start of the advance, where the net force
                         // at rest is a hair along the motion: creeping on from here would
                         // locate the same stop again without moving time. Step just past it,
@@ -995,22 +990,24 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         } else {
             self.piece(tau, x_b, Grading::Single).0
         };
-        self.stats.stick_time_s += self.plant.seconds(x_b);
-        let input = self.plant.input(self.plant.break_at(tau, x_b, rest, false));
-        self.commit(y, input, self.plant.time_s(tau + x_b));
+        self.stats.stick_time_s += self.plant.clock().seconds(x_b);
+        let input = self
+            .plant
+            .input(self.plant.clock().break_at(tau, x_b, rest, false));
+        self.commit(y, input, self.plant.clock().time_s(tau + x_b));
         let net = self.plant.net(input, &self.y);
         if net.abs() <= fs {
             // Rounding kept friction holding to the end of the span: still stuck.
             self.enter(Mode::Stick, input);
-            return self.plant.break_at(tau, x_b, rest, true);
+            return self.plant.clock().break_at(tau, x_b, rest, true);
         }
-        let at = self.plant.break_at(tau, x_b, rest, false);
+        let at = self.plant.clock().break_at(tau, x_b, rest, false);
         self.note(EventKind::Breakaway, at);
         self.enter(Mode::Slip(Direction::of_sign(net)), input);
         at
     }
 
-    /// A creep stop located `x ≤` [`Plant::min_progress`] past `tau` (from the state and
+    /// A creep stop located `x ≤` [`Clock::min_progress`] past `tau` (from the state and
     /// rates `start`) where the net force at rest still drives the creep on in `dir`: creeps
     /// from `start` to the first of `x + 4ε, x + 8ε, …` ([`just_past`]) where it does not, or
     /// to the span's end, and accepts that state at rest (`v = 0`). Returns where, in the
@@ -1033,12 +1030,12 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         if x_b > x {
             let (y, _) = self.piece(tau, x_b, Grading::Single);
             let at = tau + x_b;
-            self.commit(y, self.plant.input(at), self.plant.time_s(at));
+            self.commit(y, self.plant.input(at), self.plant.clock().time_s(at));
         } else {
             (self.y, self.k, self.a) = stopped;
         }
         self.y[V] = 0.0;
-        self.plant.land(tau, x_b, rest)
+        self.plant.clock().land(tau, x_b, rest)
     }
 }
 

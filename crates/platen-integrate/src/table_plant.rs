@@ -42,12 +42,14 @@ use platen_model::multi_axis::{
 };
 use platen_model::PlatenModel;
 
+use crate::clock::{Clock, GridClock};
 use crate::error::{IntegrateError, Result};
 use crate::event::{Direction, EventKind, Mode};
 use crate::grid::{Grid, GridStep};
 use crate::machine::{Machine, PieceMethod, Plant, DI, U, V, W, Y};
 use crate::method::Method;
 use crate::multi_axis::{platen_acceleration, TableRun, GRAVITY};
+use crate::output::TableSink;
 
 /// Where the pose starts in the state.
 pub(crate) const Q: usize = 5;
@@ -276,46 +278,33 @@ pub(crate) trait Source<const L: usize> {
     fn error_scale(&self, _i: usize, _y0: f64, _y1: f64, _rtol: f64, _atol: f64) -> Option<f64> {
         None
     }
-    /// The grid's step, s.
-    fn step_s(&self) -> f64;
-    /// As [`Plant::seconds`].
-    fn seconds(&self, len: f64) -> f64;
-    /// As [`Plant::units`].
-    fn units(&self, seconds: f64) -> f64;
-    /// As [`Plant::time_s`].
-    fn time_s(&self, at: f64) -> f64;
-    /// As [`Plant::tolerance_floor`].
-    fn tolerance_floor(&self) -> f64;
-    /// As [`Plant::min_progress`].
-    fn min_progress(&self) -> f64;
-    /// As [`Plant::land`].
-    fn land(&self, tau: f64, x: f64, rest: f64) -> f64;
-    /// As [`Plant::reach`].
-    fn reach(&self, tau: f64, len: f64) -> f64;
-    /// As [`Plant::break_at`].
-    fn break_at(&self, tau: f64, x: f64, rest: f64, held: bool) -> f64;
+    /// Where the run's time is kept: the record's grid, or the loop's seconds.
+    type Clock: Clock;
+    /// The run's clock.
+    fn clock(&self) -> &Self::Clock;
+    /// The run's clock, to move.
+    fn clock_mut(&mut self) -> &mut Self::Clock;
 }
 
 /// Recorded actuator forces on their time grid: the source of a forward run.
 pub(crate) struct Recorded<'a> {
     forces: &'a ActuatorForces,
-    /// The time grid (its force is the first actuator's, unused: the input is every
-    /// actuator's, [`Recorded::forces`]).
-    grid: Grid<'a>,
-    /// The grid step being taken.
-    n: GridStep,
+    /// The time grid and the step being taken (the grid's force is the first actuator's,
+    /// unused: the input is every actuator's, [`Recorded::forces`]).
+    clock: GridClock<'a>,
 }
 
-impl<const L: usize> Source<L> for Recorded<'_> {
+impl<'a, const L: usize> Source<L> for Recorded<'a> {
     type Input = At;
     const RATES_ON_COMMIT: bool = false;
     const NEEDS_STROKES: bool = false;
 
     #[inline(always)]
     fn input(&self, at: f64) -> At {
+        let n = self.clock.n;
         At {
-            j: self.n.j,
-            w: (self.n.i + at) * self.grid.inv_k,
+            j: n.j,
+            w: (n.i + at) * self.clock.grid.inv_k,
         }
     }
 
@@ -332,11 +321,13 @@ impl<const L: usize> Source<L> for Recorded<'_> {
         out
     }
 
-    fn step_s(&self) -> f64 {
-        self.grid.h
+    type Clock = GridClock<'a>;
+    fn clock(&self) -> &GridClock<'a> {
+        &self.clock
     }
-
-    crate::grid::grid_clock!();
+    fn clock_mut(&mut self) -> &mut GridClock<'a> {
+        &mut self.clock
+    }
 }
 
 /// The multi-axis platen under its actuator forces: the [`Plant`] of the mode machine.
@@ -580,8 +571,8 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
         let capacity = self.table.friction_capacity(&q, &self.forces_at(at, y));
         self.gauge = gauge;
         self.leaving = along;
-        self.blend_m_s =
-            BLEND_STEPS * self.source.step_s() * capacity.force_n / self.table.platen().mass_kg();
+        self.blend_m_s = BLEND_STEPS * self.source.clock().step_s() * capacity.force_n
+            / self.table.platen().mass_kg();
     }
 }
 
@@ -669,7 +660,7 @@ impl<S: Source<L>, const L: usize> Plant<L> for TablePlant<'_, S, L> {
             .gauge
             .scaled(&planar_rate(&Coords::from_fn(|k, _| dy[QD + k])))
             .norm();
-        if speed > REST_SHARE * accel * self.source.step_s() {
+        if speed > REST_SHARE * accel * self.source.clock().step_s() {
             // Still sliding, on a path that turned: aim the gauge along it again.
             let gauge = self.gauge_along(input, y);
             self.aim(input, y, gauge, w);
@@ -701,7 +692,7 @@ impl<S: Source<L>, const L: usize> Plant<L> for TablePlant<'_, S, L> {
     /// the step.
     fn stiff_rate(&self, y: &Y<L>) -> f64 {
         let bound = self.source.stiff_rate(y, None);
-        if bound * self.source.step_s() <= 1.0 {
+        if bound * self.source.clock().step_s() <= 1.0 {
             return bound;
         }
         let (q, qd) = pose(y);
@@ -720,30 +711,12 @@ impl<S: Source<L>, const L: usize> Plant<L> for TablePlant<'_, S, L> {
         }
     }
 
-    #[inline(always)]
-    fn seconds(&self, len: f64) -> f64 {
-        self.source.seconds(len)
+    type Clock = S::Clock;
+    fn clock(&self) -> &S::Clock {
+        self.source.clock()
     }
-    fn units(&self, seconds: f64) -> f64 {
-        self.source.units(seconds)
-    }
-    fn time_s(&self, at: f64) -> f64 {
-        self.source.time_s(at)
-    }
-    fn tolerance_floor(&self) -> f64 {
-        self.source.tolerance_floor()
-    }
-    fn min_progress(&self) -> f64 {
-        self.source.min_progress()
-    }
-    fn land(&self, tau: f64, x: f64, rest: f64) -> f64 {
-        self.source.land(tau, x, rest)
-    }
-    fn reach(&self, tau: f64, len: f64) -> f64 {
-        self.source.reach(tau, len)
-    }
-    fn break_at(&self, tau: f64, x: f64, rest: f64, held: bool) -> f64 {
-        self.source.break_at(tau, x, rest, held)
+    fn clock_mut(&mut self) -> &mut S::Clock {
+        self.source.clock_mut()
     }
 }
 
@@ -824,27 +797,35 @@ fn run<const L: usize>(
     let h = dt / k as f64;
     let source = Recorded {
         forces,
-        grid: Grid {
+        clock: GridClock::new(Grid {
             force: forces.forces_n.first().map_or(&[][..], Vec::as_slice),
             inv_k: 1.0 / k as f64,
             h,
             t0: forces.t_s[0],
-        },
-        n: GridStep { n: 0, j: 0, i: 0.0 },
+        }),
     };
     let y = start_state::<L>(table, specimen, initial, initial_rates);
     let mut m = start_machine(table, specimen, source, y, h, pieces);
-    let mut out = Output::new(table, specimen, forces.len(), Vec::new());
-    out.push(&m, forces.t_s[0], &recorded_forces(forces, 0), &[]);
+    let mut rows = Rows::new(table, specimen, Vec::new());
+    let mut out = TableRun::default();
+    rows.start(&mut out, forces.len());
+    rows.push(
+        &m,
+        forces.t_s[0],
+        &recorded_forces(forces, 0),
+        &[],
+        &mut out,
+    );
     let mut n = 0u64;
     for j in 0..forces.len() - 1 {
         for i in 0..k {
             step(&mut m, GridStep { n, j, i: i as f64 })?;
             n += 1;
         }
-        out.push(&m, forces.t_s[j + 1], &recorded_forces(forces, j + 1), &[]);
+        let f = recorded_forces(forces, j + 1);
+        rows.push(&m, forces.t_s[j + 1], &f, &[], &mut out);
     }
-    Ok(out.finish())
+    Ok(out)
 }
 
 /// The state at the start of a run of `table` carrying `specimen` from the pose `initial`
@@ -952,7 +933,7 @@ fn step<const L: usize>(
     m: &mut Machine<TablePlant<'_, Recorded<'_>, L>, L>,
     n: GridStep,
 ) -> Result<()> {
-    m.plant.source.n = n;
+    m.plant.source.clock.n = n;
     m.stats.steps += 1;
     let sliding = reaim(m);
     if sliding && m.is_rk4() && m.slip_fast::<true>(0.0) {
@@ -971,19 +952,17 @@ const SPECIMEN_COLUMNS: [&str; 5] = [
     "overturning_moment_y_n_m",
 ];
 
-/// The run's columns, filled a sample at a time.
-pub(crate) struct Output {
+/// The run's columns: their names, and each row filled a sample at a time for a sink.
+pub(crate) struct Rows {
     names: Vec<String>,
-    data: Vec<Vec<f64>>,
     row: Vec<f64>,
 }
 
-impl Output {
+impl Rows {
     /// The columns of a run of `table` carrying `specimen`, with `extra` columns last.
     pub(crate) fn new(
         table: &MultiAxisTable,
         specimen: Option<&LinearSpecimen>,
-        samples: usize,
         extra: Vec<String>,
     ) -> Self {
         let mut names = vec!["t_s".to_string()];
@@ -1013,21 +992,26 @@ impl Output {
             names.push("specimen_damping_j".into());
         }
         names.extend(extra);
-        let data = names.iter().map(|_| Vec::with_capacity(samples)).collect();
-        Output {
+        Rows {
             names,
-            data,
             row: Vec::new(),
         }
     }
 
-    /// A row at time `t_s` with the actuator forces `forces` and the `extra` columns' values.
-    pub(crate) fn push<S: Source<L>, const L: usize>(
+    /// Hands the columns' names to `sink`, before the first of `samples` rows.
+    pub(crate) fn start<K: TableSink>(&self, sink: &mut K, samples: usize) {
+        sink.start(&self.names, samples);
+    }
+
+    /// Delivers to `sink` the row at time `t_s` with the actuator forces `forces` and the
+    /// `extra` columns' values.
+    pub(crate) fn push<S: Source<L>, K: TableSink, const L: usize>(
         &mut self,
         m: &Machine<TablePlant<'_, S, L>, L>,
         t_s: f64,
         forces: &[f64],
         extra: &[f64],
+        sink: &mut K,
     ) {
         let p = &m.plant;
         let (q, qd) = pose(&m.y);
@@ -1061,15 +1045,7 @@ impl Output {
             self.row.push(m.y[crate::machine::SD]);
         }
         self.row.extend_from_slice(extra);
-        for (c, &x) in self.data.iter_mut().zip(&self.row) {
-            c.push(x);
-        }
-    }
-
-    pub(crate) fn finish(self) -> TableRun {
-        TableRun {
-            columns: self.names.into_iter().zip(self.data).collect(),
-        }
+        sink.accept(&self.row);
     }
 }
 
