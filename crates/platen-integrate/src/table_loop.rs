@@ -41,8 +41,9 @@ use crate::machine::{Machine, Plant, Y};
 use crate::multi_axis::{PoseMotion, TableRun};
 use crate::output::TableSink;
 use crate::stop::Failure;
+use crate::table_forward::Rows;
 use crate::table_plant::{
-    pose, reaim, start_machine, start_state, Forces, Rows, Source, Strokes, TablePlant, BARE,
+    pose, reaim, start_machine, start_state, Forces, Source, Strokes, TablePlant, BARE,
     MAX_TABLE_ACTUATORS, QD, WITH_SPECIMEN,
 };
 use crate::MAX_TABLE_SPECIMEN_DOFS;
