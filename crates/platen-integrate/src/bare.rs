@@ -136,13 +136,7 @@ impl<'a, M: PlatenModel> Plant<L> for BarePlant<'a, M> {
         self.clock.force(at)
     }
 
-    type Clock = GridClock<'a>;
-    fn clock(&self) -> &GridClock<'a> {
-        &self.clock
-    }
-    fn clock_mut(&mut self) -> &mut GridClock<'a> {
-        &mut self.clock
-    }
+    crate::clock::clock_field!(GridClock<'a>);
 }
 
 /// A forward run of the bare platen (also one lane of [`crate::ensemble`]): the mode machine

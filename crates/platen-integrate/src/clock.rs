@@ -36,6 +36,21 @@ pub(crate) trait Clock {
     fn break_at(&self, tau: f64, x: f64, rest: f64, held: bool) -> f64;
 }
 
+/// The clock hooks of a plant (or a table's source) whose clock is its field `clock` of type
+/// `$ty`.
+macro_rules! clock_field {
+    ($ty:ty) => {
+        type Clock = $ty;
+        fn clock(&self) -> &$ty {
+            &self.clock
+        }
+        fn clock_mut(&mut self) -> &mut $ty {
+            &mut self.clock
+        }
+    };
+}
+pub(crate) use clock_field;
+
 /// The integer time grid of a force record: positions are fractions of the current grid
 /// step `n`, an event a hair short of the step's end lands on it.
 pub(crate) struct GridClock<'a> {

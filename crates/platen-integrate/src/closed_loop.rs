@@ -401,13 +401,7 @@ impl<M: PlatenModel, const L: usize> Plant<L> for LoopPlant<'_, M, L> {
         atol * unit + rtol * m
     }
 
-    type Clock = SecondsClock;
-    fn clock(&self) -> &SecondsClock {
-        &self.clock
-    }
-    fn clock_mut(&mut self) -> &mut SecondsClock {
-        &mut self.clock
-    }
+    crate::clock::clock_field!(SecondsClock);
 }
 
 /// The uniaxial platen's controller and output around its [`LoopPlant`].

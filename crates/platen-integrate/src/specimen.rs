@@ -503,13 +503,7 @@ impl<'a, M: PlatenModel, const L: usize> Plant<L> for SpecimenPlant<'a, M, L> {
         self.clock.force(at)
     }
 
-    type Clock = GridClock<'a>;
-    fn clock(&self) -> &GridClock<'a> {
-        &self.clock
-    }
-    fn clock_mut(&mut self) -> &mut GridClock<'a> {
-        &mut self.clock
-    }
+    crate::clock::clock_field!(GridClock<'a>);
 }
 
 /// A forward run with a specimen: the mode machine over the force record's grid.

@@ -121,13 +121,7 @@ impl<'a, const L: usize> Source<L> for Recorded<'a> {
         out
     }
 
-    type Clock = GridClock<'a>;
-    fn clock(&self) -> &GridClock<'a> {
-        &self.clock
-    }
-    fn clock_mut(&mut self) -> &mut GridClock<'a> {
-        &mut self.clock
-    }
+    crate::clock::clock_field!(GridClock<'a>);
 }
 
 /// The forward run of `table` under `forces` from the pose `initial` with rates

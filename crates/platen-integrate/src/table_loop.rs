@@ -290,13 +290,7 @@ impl<const L: usize> Source<L> for Hydraulic<'_> {
         Some(atol * unit + rtol * m)
     }
 
-    type Clock = SecondsClock;
-    fn clock(&self) -> &SecondsClock {
-        &self.clock
-    }
-    fn clock_mut(&mut self) -> &mut SecondsClock {
-        &mut self.clock
-    }
+    crate::clock::clock_field!(SecondsClock);
 }
 
 /// One number per actuator (the first `n`), on the stack.
