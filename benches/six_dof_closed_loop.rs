@@ -55,7 +55,7 @@ fn bench(c: &mut Criterion) {
         command: &pose,
         method: sys.method,
     };
-    let six_dof_steps = forward_table_loop(&run).unwrap().1.steps;
+    let six_dof_steps = forward_table_loop(&run).unwrap().1.run.steps;
     let mut group = c.benchmark_group("six_dof_closed_loop");
     group.sample_size(SAMPLE_SIZE);
     group.bench_function("uniaxial_closed_loop", |b| {

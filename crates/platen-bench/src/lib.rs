@@ -605,7 +605,7 @@ fn time_six_dof_closed_loop(inputs: &Inputs) -> Result<Timed> {
     let (s, out) = time(|| forward_table_loop(&run));
     let (run, stats) = integrate("six-DOF closed loop", out)?;
     black_box(&run);
-    Ok((s, stats.steps, None))
+    Ok((s, stats.run.steps, None))
 }
 
 /// The `six_dof_closed_loop` workload's table and loop (the `lhpost6` preset, its default

@@ -19,6 +19,7 @@
 
 use platen_model::PlatenModel;
 
+use crate::clock::{Clock, GridClock};
 use crate::creep::{creep, CreepEnd};
 use crate::error::{IntegrateError, Result};
 use crate::event::{
@@ -38,12 +39,11 @@ type Y = [f64; L];
 /// fractions of the current grid step `n`.
 pub(crate) struct BarePlant<'a, M> {
     model: &'a M,
-    pub(crate) grid: Grid<'a>,
-    /// The grid step being taken.
-    pub(crate) n: GridStep,
+    /// The record's grid and the step being taken.
+    pub(crate) clock: GridClock<'a>,
 }
 
-impl<M: PlatenModel> Plant<L> for BarePlant<'_, M> {
+impl<'a, M: PlatenModel> Plant<L> for BarePlant<'a, M> {
     type Model = M;
     /// The actuator force, N.
     type Input = f64;
@@ -131,7 +131,12 @@ impl<M: PlatenModel> Plant<L> for BarePlant<'_, M> {
         }
     }
 
-    crate::grid::grid_time!();
+    #[inline(always)]
+    fn input(&self, at: f64) -> f64 {
+        self.clock.force(at)
+    }
+
+    crate::clock::clock_field!(GridClock<'a>);
 }
 
 /// A forward run of the bare platen (also one lane of [`crate::ensemble`]): the mode machine
@@ -158,8 +163,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
         let f0 = grid.force[0];
         let plant = BarePlant {
             model,
-            grid,
-            n: GridStep { n: 0, j: 0, i: 0.0 },
+            clock: GridClock::new(grid),
         };
         let mut machine = Machine::new(plant, [y.u, y.v, y.work, y.dissipated], h, method);
         machine.enter(Mode::initial(model, y.u, y.v, f0), f0);
@@ -195,7 +199,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
     fn stick(&mut self, tau: f64) -> f64 {
         let m = &mut self.machine;
         let (p, u) = (&m.plant, m.y[U]);
-        let h = p.grid.h;
+        let h = p.clock.grid.h;
         let (f_start, f_end) = (p.input(tau), p.input(1.0));
         let Some(b) = breakaway(p.model, u, f_start, f_end) else {
             m.stats.stick_time_s += (1.0 - tau) * h;
@@ -218,7 +222,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
     /// Returns where.
     fn creep(&mut self, tau: f64, dir: Direction) -> Result<f64> {
         let m = &mut self.machine;
-        let h = m.plant.grid.h;
+        let h = m.plant.clock.grid.h;
         let span_s = (1.0 - tau) * h;
         let (f_start, f_end) = (m.plant.input(tau), m.plant.input(1.0));
         let y0 = self.kin();
@@ -273,7 +277,7 @@ impl<'a, M: PlatenModel> Stepper<'a, M> {
             u_m: y[U],
             v_m_s: y[V],
         };
-        IntegrateError::failed(self.machine.plant.time_s(at), cause)
+        IntegrateError::failed(self.machine.plant.clock.time_s(at), cause)
     }
 
     /// Slip from fraction `tau`: one RK4 step to the end of the grid step when it is safe
@@ -298,7 +302,7 @@ impl<M: PlatenModel> GridStepper for Stepper<'_, M> {
     /// Advances from grid point `n` to `n + 1`, handling every event inside the step.
     #[inline]
     fn step(&mut self, n: GridStep) -> Result<()> {
-        self.machine.plant.n = n;
+        self.machine.plant.clock.n = n;
         self.machine.stats.steps += 1;
         let mut tau = 0.0;
         let mut events = 0u32;
@@ -317,7 +321,7 @@ impl<M: PlatenModel> GridStepper for Stepper<'_, M> {
             if events > MAX_EVENTS_PER_STEP {
                 let stalled = Failure::EventLoopStalled { events };
                 return Err(IntegrateError::failed(
-                    self.machine.plant.time_s(tau),
+                    self.machine.plant.clock.time_s(tau),
                     stalled,
                 ));
             }
@@ -327,7 +331,7 @@ impl<M: PlatenModel> GridStepper for Stepper<'_, M> {
     /// The output sample at sample `j` of the record (grid point `j·k`, τ = 0).
     fn sample(&self, j: usize, t_s: f64) -> Sample {
         let m = &self.machine;
-        m.sample(j, t_s, m.plant.grid.force[j], 0.0, 0, 0)
+        m.sample(j, t_s, m.plant.clock.grid.force[j], 0.0, 0, 0)
     }
 
     /// Closes the energy balance at the current state, the run having finished at `t_s`.

@@ -2,14 +2,9 @@
 //! actuator chambers of a [`TableSystem`], whose force drives the platen (and a specimen) with
 //! exact stick-slip.
 //!
-//! # Time
-//!
-//! The controller runs at `f_c`; the integration grid divides its period into `k` steps,
-//! `t = t₀ + n·h`, `h = 1/(k·f_c)`, from an integer counter. The drive is held between
-//! controller samples and reaches the valve `τ` later (the valve's pure delay), so the valve
-//! input is piecewise constant: a step is cut where it changes, and where an output sample
-//! (the command record's own time stamps) falls inside it. Between cuts the right-hand side is
-//! smooth but for the friction events, which are located as in the force-driven runs.
+//! The loop around the platen is the one closed-loop driver's ([`crate::control`]): the
+//! controller at `f_c`, the valve's delay, the grid and its cuts. This file is the uniaxial
+//! plant and its controller.
 //!
 //! # Modes
 //!
@@ -44,21 +39,19 @@ use platen_system::{
     ControllerInput, ControllerState, HydraulicConstants, HydraulicState, Supply, TableSystem,
 };
 
+use crate::clock::SecondsClock;
+use crate::control::{Command, ControlLoop, Driver, Emit, LoopMethod, LoopStats};
 use crate::creep::creep_speed_m_s;
 use crate::error::{IntegrateError, Result};
 use crate::event::{Direction, EventKind, Mode};
-use crate::machine::{Machine, PieceMethod, Plant, DI, SD, U, V, W};
+use crate::machine::{Machine, Plant, DI, SD, U, V, W};
 use crate::output::{SampleSink, SystemSample};
 use crate::run::{EnergyBalance, RunStats, State};
 use crate::steppable::{Samples, Steppable};
-use crate::stop::{Failure, StopReason};
+use crate::stop::Failure;
 use crate::Motion;
 
 const NS: usize = Specimen::MAX_STOREYS;
-/// A creep stop located this close (fraction of a step `h`) to where the advance started has
-/// not moved time: if the net force at rest still drives the creep on, it is stepped just
-/// past (`just_past`) instead of creeping on in place.
-const MIN_PROGRESS: f64 = 4.0 * f64::EPSILON;
 const PA: usize = 5;
 const PB: usize = 6;
 const XV: usize = 7;
@@ -74,57 +67,6 @@ const Z: usize = 13;
 /// The state of a loop with `(L − Z)/2` storeys: the stepper is compiled per length so that a
 /// bare platen steps arrays of 12, not of the largest specimen's 36.
 type Y<const L: usize> = [f64; L];
-
-/// The integrator of a closed-loop run.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum LoopMethod {
-    /// Fixed-step RK4 with `steps_per_period` steps per controller period.
-    Rk4 {
-        /// Steps per controller period (`≥ 1`).
-        steps_per_period: u32,
-    },
-    /// Adaptive Dormand–Prince 5(4) inside each piece (pieces as RK4's with
-    /// `steps_per_period` per controller period).
-    Dopri5 {
-        /// Pieces per controller period (`≥ 1`).
-        steps_per_period: u32,
-        /// Relative tolerance.
-        rtol: f64,
-        /// Absolute tolerance, m (scaled to each state's own unit: see the module docs).
-        atol: f64,
-    },
-}
-
-impl LoopMethod {
-    /// The integration steps per controller period.
-    pub fn steps_per_period(&self) -> u32 {
-        match *self {
-            LoopMethod::Rk4 { steps_per_period }
-            | LoopMethod::Dopri5 {
-                steps_per_period, ..
-            } => steps_per_period,
-        }
-    }
-}
-
-/// What a closed-loop run reports besides its samples.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct LoopStats {
-    /// The solver's counters and the platen's energy balance.
-    pub run: RunStats,
-    /// Time with the drive saturated (`|d| = 1`), s.
-    pub saturated_time_s: f64,
-    /// First time a chamber pressure reached the cavitation floor (0 Pa absolute), s.
-    pub cavitation_at_s: Option<f64>,
-    /// Lowest supply pressure, Pa.
-    pub min_supply_pressure_pa: f64,
-    /// Hydraulic energy delivered into the chambers, J.
-    pub hydraulic_energy_j: f64,
-    /// Energy lost to cross-port leakage, J.
-    pub leakage_energy_j: f64,
-    /// Controller samples taken.
-    pub controller_samples: u64,
-}
 
 /// A closed-loop run: the table system, what it carries, its command, its integrator.
 #[derive(Debug, Clone, Copy)]
@@ -162,9 +104,9 @@ pub fn forward_closed_loop<M: PlatenModel, S: SampleSink>(
         ($($n:literal => $len:literal),*) => {
             match run.specimen.map_or(0, Specimen::len) {
                 $($n => {
-                    let mut stepper = Loop::<M, $len>::new(model, run, k, h, samples);
-                    stepper.run(sink)?;
-                    Ok(stepper.finish())
+                    let mut driver = uniaxial_loop::<M, $len>(model, run, k, h, samples);
+                    driver.run(sink)?;
+                    Ok(driver.finish())
                 })*
                 other => unreachable!("a validated specimen has 1 to {NS} storeys, not {other}"),
             }
@@ -177,17 +119,8 @@ pub fn forward_closed_loop<M: PlatenModel, S: SampleSink>(
 /// The checks of a closed-loop run before it starts; its steps per period, step and samples
 /// (at most the command's), or `None` when there is no sample to deliver.
 pub(crate) fn check_loop(run: &LoopRun<'_>, samples: usize) -> Result<Option<(u32, f64, usize)>> {
-    let (system, method) = (run.system, run.method);
-    let k = method.steps_per_period();
-    let period = 1.0 / system.controller().sample_rate_hz;
-    if k == 0 {
-        return Err(IntegrateError::InvalidStep { step_s: 0.0 });
-    }
-    if let LoopMethod::Dopri5 { rtol, atol, .. } = method {
-        if !(rtol > 0.0 && rtol.is_finite() && atol > 0.0 && atol.is_finite()) {
-            return Err(IntegrateError::InvalidStep { step_s: f64::NAN });
-        }
-    }
+    let period = 1.0 / run.system.controller().sample_rate_hz;
+    let k = run.method.checked_steps()?;
     if !(run.initial.u_m.is_finite() && run.initial.v_m_s.is_finite()) {
         return Err(IntegrateError::failed(
             run.command.t_s().first().copied().unwrap_or(0.0),
@@ -216,9 +149,9 @@ pub(crate) fn boxed_loop<'a, M: PlatenModel>(
         ($($n:literal => $len:literal),*) => {
             match run.specimen.map_or(0, Specimen::len) {
                 $($n => {
-                    let mut stepper = Loop::<M, $len>::new(model, run, k, h, samples);
-                    stepper.machine.log_events();
-                    Box::new(Some(stepper))
+                    let mut driver = uniaxial_loop::<M, $len>(model, run, k, h, samples);
+                    driver.machine.log_events();
+                    Box::new(Some(driver))
                 })*
                 other => unreachable!("a validated specimen has 1 to {NS} storeys, not {other}"),
             }
@@ -229,7 +162,7 @@ pub(crate) fn boxed_loop<'a, M: PlatenModel>(
 }
 
 /// A closed loop advanced step by step (`None` once finished).
-impl<M: PlatenModel, const L: usize> Steppable for Option<Loop<'_, M, L>> {
+impl<'a, M: PlatenModel + 'a, const L: usize> Steppable for Option<Driver<Uniaxial<'a, M, L>, L>> {
     fn advance(&mut self, out: &mut Samples) -> Result<bool> {
         let Some(run) = self else {
             return Ok(false);
@@ -257,7 +190,7 @@ impl<M: PlatenModel, const L: usize> Steppable for Option<Loop<'_, M, L>> {
 
 /// The platen (and specimen) driven by the table system's actuators: the [`Plant`] of the mode
 /// machine. Positions are seconds from the start of the current advance.
-struct LoopPlant<'a, M, const L: usize> {
+pub(crate) struct LoopPlant<'a, M, const L: usize> {
     model: &'a M,
     sys: &'a TableSystem,
     /// The right-hand side's constants.
@@ -265,10 +198,8 @@ struct LoopPlant<'a, M, const L: usize> {
     spec: Option<&'a Specimen>,
     /// Storeys.
     n: usize,
-    /// The grid's step, s.
-    h: f64,
-    /// Time at the start of the current advance, s.
-    t: f64,
+    /// Seconds from the start of the current advance.
+    clock: SecondsClock,
     /// The valve's input (the delayed, held drive).
     input: f64,
     /// First time a chamber pressure reached the cavitation floor, s.
@@ -470,163 +401,111 @@ impl<M: PlatenModel, const L: usize> Plant<L> for LoopPlant<'_, M, L> {
         atol * unit + rtol * m
     }
 
-    #[inline(always)]
-    fn seconds(&self, len: f64) -> f64 {
-        len
-    }
-    fn units(&self, seconds: f64) -> f64 {
-        seconds
-    }
-    fn time_s(&self, at: f64) -> f64 {
-        self.t + at
-    }
-    fn tolerance_floor(&self) -> f64 {
-        self.h
-    }
-    fn min_progress(&self) -> f64 {
-        MIN_PROGRESS * self.h
-    }
-    fn land(&self, _tau: f64, x: f64, rest: f64) -> f64 {
-        if rest - x < 1e-12 * self.h {
-            rest
-        } else {
-            x
-        }
-    }
-    fn reach(&self, _tau: f64, len: f64) -> f64 {
-        len
-    }
-    fn break_at(&self, _tau: f64, x: f64, rest: f64, held: bool) -> f64 {
-        if held {
-            x.max(f64::MIN_POSITIVE).min(rest)
-        } else {
-            x
-        }
-    }
+    crate::clock::clock_field!(SecondsClock);
 }
 
-/// A closed-loop run: the mode machine between the controller's samples.
-struct Loop<'a, M, const L: usize> {
-    machine: Machine<LoopPlant<'a, M, L>, L>,
+/// The uniaxial platen's controller and output around its [`LoopPlant`].
+pub(crate) struct Uniaxial<'a, M, const L: usize> {
+    sys: &'a TableSystem,
     command: &'a Motion,
-    h: f64,
-    t0: f64,
     controller: ControllerState,
-    /// Drives on their way through the valve's delay: (time it arrives, value).
-    queue: VecDeque<(f64, f64)>,
-    /// Time with the drive saturated, s.
-    saturated_time_s: f64,
-    /// Controller samples taken.
-    controller_samples: u64,
-    /// Integration steps per controller period.
-    k: u64,
-    /// Output samples to deliver.
-    samples: usize,
-    /// The next grid step.
-    n: u64,
-    /// The next output sample.
-    j: usize,
+    /// The platen model's marker.
+    _model: std::marker::PhantomData<&'a M>,
 }
 
-impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
-    /// The loop of `run`, `k` steps of `h` per controller period, to deliver `samples`.
-    fn new(model: &'a M, run: &LoopRun<'a>, k: u32, h: f64, samples: usize) -> Self {
-        let (sys, spec, command, method) = (run.system, run.specimen, run.command, run.method);
-        let n = spec.map_or(0, Specimen::len);
-        let mut y = [0.0; L];
-        let rest = sys.rest_state();
-        y[U] = run.initial.u_m;
-        y[V] = run.initial.v_m_s;
-        y[PA] = rest.p_a_pa;
-        y[PB] = rest.p_b_pa;
-        y[OIL] = rest.accumulator_oil_m3;
-        y[PS] = rest.supply_pressure_pa;
-        let t0 = command.t_s()[0];
-        let delay = sys.servo_valve().delay_s;
-        let slots = (delay * sys.controller().sample_rate_hz).ceil() as usize + 2;
-        let plant = LoopPlant {
-            model,
-            sys,
-            consts: sys.constants(),
-            spec,
-            n,
-            h,
-            t: t0,
-            input: 0.0,
-            cavitation_at_s: None,
-            min_supply_pressure_pa: sys.supply_pressure_at(rest.accumulator_oil_m3),
-        };
-        let mode = Mode::initial(
-            model,
-            y[U],
-            y[V],
-            plant.net((), &y) + model.elastic_force_n(y[U]),
-        );
-        let specimen_start_j = plant.specimen_energy(&y);
-        let pieces = match method {
-            LoopMethod::Rk4 { .. } => PieceMethod::Rk4,
-            LoopMethod::Dopri5 { rtol, atol, .. } => PieceMethod::Dopri5 { rtol, atol },
-        };
-        let mut machine = Machine::new(plant, y, h, pieces);
-        machine.enter(mode, ());
-        let energy = &mut machine.stats.energy;
-        *energy = EnergyBalance::start(model, y[U], y[V]);
-        energy.specimen_start_j = specimen_start_j;
-        energy.specimen_end_j = specimen_start_j;
-        Loop {
-            machine,
-            command,
-            h,
-            t0,
-            controller: ControllerState::default(),
-            queue: VecDeque::with_capacity(slots),
-            saturated_time_s: 0.0,
-            controller_samples: 0,
-            k: u64::from(k),
-            samples,
-            n: 0,
-            j: 0,
-        }
+/// The closed loop `run` on `model` as the one driver runs it: the platen's state and the
+/// hydraulics' null state, the platen's first mode and energy balance; `k` steps of `h` per
+/// controller period, to deliver `samples`.
+fn uniaxial_loop<'a, M: PlatenModel, const L: usize>(
+    model: &'a M,
+    run: &LoopRun<'a>,
+    k: u32,
+    h: f64,
+    samples: usize,
+) -> Driver<Uniaxial<'a, M, L>, L> {
+    let (sys, spec, command) = (run.system, run.specimen, run.command);
+    let n = spec.map_or(0, Specimen::len);
+    let mut y = [0.0; L];
+    let rest = sys.rest_state();
+    y[U] = run.initial.u_m;
+    y[V] = run.initial.v_m_s;
+    y[PA] = rest.p_a_pa;
+    y[PB] = rest.p_b_pa;
+    y[OIL] = rest.accumulator_oil_m3;
+    y[PS] = rest.supply_pressure_pa;
+    let t0 = command.t_s()[0];
+    let plant = LoopPlant {
+        model,
+        sys,
+        consts: sys.constants(),
+        spec,
+        n,
+        clock: SecondsClock { t: t0, h },
+        input: 0.0,
+        cavitation_at_s: None,
+        min_supply_pressure_pa: sys.supply_pressure_at(rest.accumulator_oil_m3),
+    };
+    let mode = Mode::initial(
+        model,
+        y[U],
+        y[V],
+        plant.net((), &y) + model.elastic_force_n(y[U]),
+    );
+    let specimen_start_j = plant.specimen_energy(&y);
+    let mut machine = Machine::new(plant, y, h, run.method.pieces());
+    machine.enter(mode, ());
+    let energy = &mut machine.stats.energy;
+    *energy = EnergyBalance::start(model, y[U], y[V]);
+    energy.specimen_start_j = specimen_start_j;
+    energy.specimen_end_j = specimen_start_j;
+    let control = Uniaxial {
+        sys,
+        command,
+        controller: ControllerState::default(),
+        _model: std::marker::PhantomData,
+    };
+    let f_c = sys.controller().sample_rate_hz;
+    Driver::new(machine, control, (k, h, f_c), samples)
+}
+
+impl Command for Motion {
+    /// The displacement, velocity and acceleration.
+    type Value = (f64, f64, f64);
+
+    fn t_s(&self) -> &[f64] {
+        Motion::t_s(self)
     }
 
-    /// The current time, s.
-    fn t(&self) -> f64 {
-        self.machine.plant.t
+    fn value(&self, i: usize) -> (f64, f64, f64) {
+        (self.u_m()[i], self.v_m_s()[i], self.a_m_s2()[i])
     }
 
-    /// Integrates the current segment of `span` seconds (no cut inside it), handling every
-    /// event.
-    fn segment(&mut self, span: f64) -> Result<()> {
-        self.machine.advance_clocked(span, |p| &mut p.t)
+    fn lerp(a: &(f64, f64, f64), b: &(f64, f64, f64), w: f64) -> (f64, f64, f64) {
+        (
+            a.0 + w * (b.0 - a.0),
+            a.1 + w * (b.1 - a.1),
+            a.2 + w * (b.2 - a.2),
+        )
+    }
+}
+
+impl<'a, M: PlatenModel + 'a, const L: usize> ControlLoop<L> for Uniaxial<'a, M, L> {
+    type Plant = LoopPlant<'a, M, L>;
+    type Command = Motion;
+    /// The valve's input.
+    type Drive = f64;
+
+    fn command(&self) -> &Motion {
+        self.command
     }
 
-    /// The command's displacement, velocity and acceleration at `t` (linear between samples,
-    /// held past the ends).
-    fn command_at(&self, t: f64) -> (f64, f64, f64) {
-        let ts = self.command.t_s();
-        let (u, v, a) = (
-            self.command.u_m(),
-            self.command.v_m_s(),
-            self.command.a_m_s2(),
-        );
-        let last = ts.len() - 1;
-        if t <= ts[0] {
-            return (u[0], v[0], a[0]);
-        }
-        if t >= ts[last] {
-            return (u[last], v[last], a[last]);
-        }
-        let j = ts.partition_point(|&x| x <= t).clamp(1, last);
-        let (t0, t1) = (ts[j - 1], ts[j]);
-        let w = (t - t0) / (t1 - t0);
-        let lerp = |c: &[f64]| c[j - 1] + w * (c[j] - c[j - 1]);
-        (lerp(u), lerp(v), lerp(a))
+    fn delay_s(&self) -> f64 {
+        self.sys.servo_valve().delay_s
     }
 
-    /// A controller sample at the current time: the new drive enters the valve's delay line.
-    fn tick(&mut self) {
-        let (r, rv, ra) = self.command_at(self.t());
-        let m = &self.machine;
+    /// The three-variable controller on `u`, `v`, the platen's acceleration and `Δp`.
+    fn control(&mut self, m: &Machine<Self::Plant, L>, command: &(f64, f64, f64)) -> f64 {
+        let (r, rv, ra) = *command;
         let input = ControllerInput {
             command_u_m: r,
             command_v_m_s: rv,
@@ -636,35 +515,35 @@ impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
             a_m_s2: m.a,
             delta_p_pa: m.y[PA].max(0.0) - m.y[PB].max(0.0),
         };
-        let sys = m.plant.sys;
-        let d = sys.controller().update(&mut self.controller, &input);
-        self.controller_samples += 1;
-        self.queue
-            .push_back((self.t() + sys.servo_valve().delay_s, d));
+        self.sys.controller().update(&mut self.controller, &input)
     }
 
-    /// Applies every delayed drive that has arrived by the current time (to `slack`).
-    fn apply_arrived(&mut self, slack: f64) -> bool {
-        let mut changed = false;
-        while let Some(&(t, d)) = self.queue.front() {
-            if t <= self.t() + slack {
-                self.machine.plant.input = d;
-                self.queue.pop_front();
-                changed = true;
-            } else {
-                break;
-            }
-        }
-        if changed {
-            let mode = self.machine.mode;
-            self.machine.enter(mode, ());
-        }
-        changed
+    fn saturated(&self) -> bool {
+        self.controller.saturated
     }
 
-    fn emit<S: SampleSink>(&mut self, j: usize, sink: &mut S) {
+    fn arrive(plant: &mut Self::Plant, _t_s: f64, drive: f64) {
+        plant.input = drive;
+    }
+
+    /// The platen's energy balance (and the specimen's), the hydraulics' figures.
+    fn finish(&self, m: &Machine<Self::Plant, L>, stats: &mut LoopStats) {
+        let y = m.y;
+        let run = &mut stats.run;
+        run.energy.close(m.plant.model, y[U], y[V], y[W], y[DI]);
+        run.energy.specimen_end_j = m.plant.specimen_energy(&y);
+        run.energy.specimen_dissipated_j = y[SD];
+        stats.cavitation_at_s = m.plant.cavitation_at_s;
+        stats.min_supply_pressure_pa = m.plant.min_supply_pressure_pa;
+        stats.hydraulic_energy_j = y[EH];
+        stats.leakage_energy_j = y[EL];
+    }
+}
+
+impl<'a, M: PlatenModel + 'a, S: SampleSink, const L: usize> Emit<S, L> for Uniaxial<'a, M, L> {
+    fn emit(&mut self, m: &Machine<Self::Plant, L>, j: usize, sink: &mut S) {
         let t_s = self.command.t_s()[j];
-        let (m, p) = (&self.machine, &self.machine.plant);
+        let p = &m.plant;
         let mut sample = m.sample(j, t_s, p.force(&m.y), p.base_shear(&m.y), p.n, Z);
         let ps = m.y[PS];
         let (p_a, p_b) = (m.y[PA].max(0.0), m.y[PB].max(0.0));
@@ -680,92 +559,5 @@ impl<'a, M: PlatenModel, const L: usize> Loop<'a, M, L> {
             supply_pressure_pa: ps,
         });
         sink.accept(&sample);
-    }
-
-    /// Runs the grid: controller samples every `k` steps, each step cut where the valve's
-    /// input changes or an output sample falls.
-    fn run<S: SampleSink>(&mut self, sink: &mut S) -> Result<()> {
-        while !self.grid_step(sink)? {}
-        Ok(())
-    }
-
-    /// One grid step from `t₀ + n·h`: the controller's sample when one falls there, the
-    /// output samples that fall in it, the cuts inside it. Returns whether the run is over
-    /// (every output sample delivered), having delivered the last ones.
-    fn grid_step<S: SampleSink>(&mut self, sink: &mut S) -> Result<bool> {
-        let ts = self.command.t_s();
-        let samples = self.samples;
-        let t_end = ts[samples - 1];
-        let slack = 1e-9 * self.h;
-        let n = self.n;
-        // At the grid point t₀ + n·h.
-        self.machine.plant.t = self.t0 + n as f64 * self.h;
-        if n % self.k == 0 {
-            self.tick();
-        }
-        self.apply_arrived(slack);
-        while self.j < samples && ts[self.j] <= self.t() + slack {
-            self.emit(self.j, sink);
-            self.j += 1;
-        }
-        if self.j >= samples || self.t() > t_end + slack {
-            self.machine.stats.stop = StopReason::Finished { t_s: t_end };
-            return Ok(true);
-        }
-        let t_next = self.t0 + (n + 1) as f64 * self.h;
-        // Cuts inside (t, t_next): arrivals of delayed drives and output samples.
-        loop {
-            let arrival = self.queue.front().map_or(f64::INFINITY, |&(t, _)| t);
-            let sample = if self.j < samples {
-                ts[self.j]
-            } else {
-                f64::INFINITY
-            };
-            let cut = arrival.min(sample);
-            if cut >= t_next - slack {
-                break;
-            }
-            let span = cut - self.t();
-            if span > 0.0 {
-                self.segment(span)?;
-            }
-            self.machine.plant.t = cut;
-            self.apply_arrived(slack);
-            while self.j < samples && ts[self.j] <= self.t() + slack {
-                self.emit(self.j, sink);
-                self.j += 1;
-            }
-        }
-        let span = t_next - self.t();
-        if span > 0.0 {
-            self.segment(span)?;
-        }
-        if self.controller.saturated {
-            self.saturated_time_s += self.h;
-        }
-        self.n += 1;
-        self.machine.stats.steps += 1;
-        Ok(false)
-    }
-
-    fn finish(self) -> LoopStats {
-        let m = self.machine;
-        let y = m.y;
-        let mut run = m.stats;
-        run.energy.close(m.plant.model, y[U], y[V], y[W], y[DI]);
-        run.energy.specimen_end_j = m.plant.specimen_energy(&y);
-        run.energy.specimen_dissipated_j = y[SD];
-        if m.is_rk4() {
-            run.accepted_steps = run.steps;
-        }
-        LoopStats {
-            run,
-            saturated_time_s: self.saturated_time_s,
-            cavitation_at_s: m.plant.cavitation_at_s,
-            min_supply_pressure_pa: m.plant.min_supply_pressure_pa,
-            hydraulic_energy_j: y[EH],
-            leakage_energy_j: y[EL],
-            controller_samples: self.controller_samples,
-        }
     }
 }

@@ -354,7 +354,7 @@ fn run_group<const N: usize, P: LanePow, S: SampleSink>(
         .iter()
         .map(|c| Stepper::new(c.model, Grid::new(c.record, k), c.initial))
         .collect();
-    let h = lanes[0].machine.plant.grid.h;
+    let h = lanes[0].machine.plant.clock.grid.h;
     let times = cases[0].record.t_s();
     let mut errors: Vec<Option<crate::error::IntegrateError>> = vec![None; m];
     for (lane, sink) in lanes.iter().zip(sinks.iter_mut()) {
@@ -382,7 +382,7 @@ fn run_group<const N: usize, P: LanePow, S: SampleSink>(
                         input.a0[l] = m.a;
                         input.p0[l] = m.k[DI];
                         input.dir[l] = d.sign();
-                        let grid = &m.plant.grid;
+                        let grid = &m.plant.clock.grid;
                         input.f_start[l] = grid.force(g, 0.0);
                         input.f_mid[l] = grid.force(g, 0.5 * (1.0 + 0.0));
                         input.f_end[l] = grid.force(g, 1.0);

@@ -1,6 +1,7 @@
 //! The integer time grid of a force record: grid step `n` is sub-step `i` of the sample
 //! interval that starts at sample `j`, the force linear inside it; the driver that runs a
-//! fixed-grid stepper over it and delivers its samples; the hooks of a plant on the grid.
+//! fixed-grid stepper over it and delivers its samples. A plant on the grid keeps its time
+//! with a [`crate::clock::GridClock`].
 
 use crate::error::Result;
 use crate::output::{Sample, SampleSink};
@@ -54,60 +55,6 @@ impl<'a> Grid<'a> {
         self.t0 + (n.n as f64 + tau) * self.h
     }
 }
-
-/// The input and the time hooks of a [`crate::machine::Plant`] that runs on a force record's
-/// grid (fields `grid: Grid` and `n: GridStep`): positions are fractions of grid step `n`, the
-/// input is the record's force there, an event a hair short of the step's end lands on it.
-macro_rules! grid_time {
-    () => {
-        #[inline(always)]
-        fn input(&self, at: f64) -> f64 {
-            self.grid.force(self.n, at)
-        }
-        crate::grid::grid_clock!();
-    };
-}
-
-/// The time hooks alone of [`grid_time!`], for a plant on the grid whose input is its own
-/// (the multi-axis table's several force records).
-macro_rules! grid_clock {
-    () => {
-        #[inline(always)]
-        fn seconds(&self, len: f64) -> f64 {
-            len * self.grid.h
-        }
-        fn units(&self, seconds: f64) -> f64 {
-            seconds / self.grid.h
-        }
-        fn time_s(&self, at: f64) -> f64 {
-            self.grid.time_s(self.n, at)
-        }
-        fn tolerance_floor(&self) -> f64 {
-            0.0
-        }
-        /// A creep stop located this close (fraction of a step) to where the advance
-        /// started has not moved time (see [`crate::machine::Plant::min_progress`]).
-        fn min_progress(&self) -> f64 {
-            4.0 * f64::EPSILON
-        }
-        fn land(&self, tau: f64, x: f64, _rest: f64) -> f64 {
-            let at = tau + x;
-            if 1.0 - at < 1e-12 {
-                1.0
-            } else {
-                at
-            }
-        }
-        fn reach(&self, tau: f64, len: f64) -> f64 {
-            tau + len
-        }
-        fn break_at(&self, tau: f64, x: f64, _rest: f64, _held: bool) -> f64 {
-            (tau + x).min(1.0)
-        }
-    };
-}
-pub(crate) use grid_clock;
-pub(crate) use grid_time;
 
 /// A fixed-step integrator on the integer time grid: what [`drive`] runs.
 pub(crate) trait GridStepper {

@@ -16,14 +16,21 @@
 //! * [`forward_closed_loop`]: a displacement command → the table system's controller, valves
 //!   and actuators ([`platen_system::TableSystem`]) → the platen (and a specimen), in closed
 //!   loop, with RK4 or Dopri5.
+//! * [`forward_table`] ([`forward_table_into`]): the multi-axis table under recorded actuator
+//!   forces, with the bearings' exact planar stick-slip; [`inverse_table`] its inverse.
+//! * [`forward_table_loop`] ([`forward_table_loop_into`]): a six-DOF command → the DOF
+//!   controller, each actuator's valves and chambers → the multi-axis table, in closed loop.
 //! * [`Stepping`]: a specimen or closed-loop run advanced a [`Step`] at a time (an event with
 //!   its time and kind, a sample, the end), bit for bit the whole-record run.
 //!
-//! The bare platen's RK4, the specimen and the closed loop are *plants* of one mode machine
-//! (the friction modes, their events and resets, RK4 and Dopri5 pieces, written once); a new
-//! plant plugs into it by saying its state, its rates per mode and its net force. The bare
-//! platen rests exactly: nothing else moves while it sticks and the force is linear between
-//! samples, so its breakaway and its creep are its own closed forms.
+//! The bare platen's RK4, the specimen, the uniaxial closed loop and the multi-axis table
+//! are *plants* of one mode machine (the friction modes, their events and resets, RK4 and
+//! Dopri5 pieces, written once); a new plant plugs into it by saying its state, its rates per
+//! mode, its net force and its clock (a force record's grid, or seconds), kept apart from
+//! them. Both tables' closed loops are one driver (the controller's samples, the valves'
+//! delay, the cuts of the grid, [`LoopStats`]) around their plants. The bare platen rests
+//! exactly: nothing else moves while it sticks and the force is linear between samples, so
+//! its breakaway and its creep are its own closed forms.
 //!
 //! Every plant's forward integrators share one event module (the friction modes, the `v = 0` root
 //! finder, the stick decision and the exact breakaway; the [`EventKind`]s it counts in
@@ -51,13 +58,15 @@
 //! linear between samples. Friction at `v = 0` is set-valued and resolved exactly, never
 //! regularised. Time inside a fixed-step run comes from an integer step counter,
 //! `t = t₀ + n·h`, never from accumulated floats. A run never allocates per step; it
-//! allocates only what its [`SampleSink`] stores. Samples before a failure have already been
+//! allocates only what its [`SampleSink`] (a multi-axis run's [`TableSink`]) stores. Samples before a failure have already been
 //! delivered to the sink when the error returns.
 
 #![warn(missing_docs)]
 
 mod bare;
+mod clock;
 mod closed_loop;
+mod control;
 mod creep;
 mod dopri5;
 mod ensemble;
@@ -76,6 +85,7 @@ mod specimen;
 mod steppable;
 mod stepping;
 mod stop;
+mod table_forward;
 mod table_loop;
 mod table_plant;
 
@@ -88,11 +98,12 @@ pub use method::{ForwardIntegrator, Method};
 pub use multi_axis::{inverse_table, PoseMotion, TableRun};
 pub use output::{
     Exceedance, Peak, Peaks, Sample, SampleSink, SpecimenColumns, SpecimenSample, SystemColumns,
-    SystemSample, Trajectory,
+    SystemSample, TableSink, Trajectory,
 };
 // The prescribed motion of inverse and closed-loop runs, and the derivatives its
 // constructors use, are platen-signal's; their errors convert into IntegrateError with `?`.
-pub use closed_loop::{forward_closed_loop, LoopMethod, LoopRun, LoopStats};
+pub use closed_loop::{forward_closed_loop, LoopRun};
+pub use control::{LoopMethod, LoopStats};
 pub use platen_signal::{derivative, second_derivative, Motion};
 pub use record::{
     sampling_grid, uniform_interval_s, ForceRecord, SamplingGrid, UNIFORM_RELATIVE_TOLERANCE,
@@ -102,10 +113,12 @@ pub use run::{EnergyBalance, RunStats, State};
 pub use specimen::{forward_rk4_specimen, forward_specimen};
 pub use stepping::{Step, Stepping};
 pub use stop::{AdaptiveFailure, Failure, StopReason};
+pub use table_forward::{
+    forward_table, forward_table_into, table_kinetic_energy_j, table_potential_energy_j,
+    ActuatorForces,
+};
 pub use table_loop::{
-    forward_table_loop, TableLoopRun, TableLoopStats, MAX_LOOP_ACTUATORS, SPENT_GAS_FRACTION,
+    forward_table_loop, forward_table_loop_into, TableLoopRun, TableLoopStats, MAX_LOOP_ACTUATORS,
+    SPENT_GAS_FRACTION,
 };
-pub use table_plant::{
-    forward_table, table_kinetic_energy_j, table_potential_energy_j, ActuatorForces,
-    MAX_TABLE_ACTUATORS, MAX_TABLE_SPECIMEN_DOFS,
-};
+pub use table_plant::{MAX_TABLE_ACTUATORS, MAX_TABLE_SPECIMEN_DOFS};

@@ -2,6 +2,8 @@
 
 use platen_model::{ForceTerms, Specimen, TableLimits};
 
+use crate::multi_axis::TableRun;
+
 /// The state of the platen and the decomposition of the actuator force at one output time.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sample {
@@ -82,6 +84,44 @@ impl<S: SampleSink + ?Sized> SampleSink for &mut S {
     #[inline]
     fn accept(&mut self, sample: &Sample) {
         (**self).accept(sample);
+    }
+}
+
+/// Receives the rows of a multi-axis run in time order, as [`SampleSink`] the samples of a
+/// uniaxial one.
+pub trait TableSink {
+    /// Called once, before the first row, with the columns' names (each with its unit) and
+    /// the number of rows to come (a hint).
+    fn start(&mut self, names: &[String], samples: usize);
+    /// Called once per output sample with its values in the columns' order.
+    fn accept(&mut self, row: &[f64]);
+}
+
+/// The in-memory collector: the columns of the run, every one as long as the time column.
+impl TableSink for TableRun {
+    fn start(&mut self, names: &[String], samples: usize) {
+        self.columns = names
+            .iter()
+            .map(|n| (n.clone(), Vec::with_capacity(samples)))
+            .collect();
+    }
+
+    fn accept(&mut self, row: &[f64]) {
+        for ((_, c), &x) in self.columns.iter_mut().zip(row) {
+            c.push(x);
+        }
+    }
+}
+
+impl<S: TableSink + ?Sized> TableSink for &mut S {
+    #[inline]
+    fn start(&mut self, names: &[String], samples: usize) {
+        (**self).start(names, samples);
+    }
+
+    #[inline]
+    fn accept(&mut self, row: &[f64]) {
+        (**self).accept(row);
     }
 }
 

@@ -42,6 +42,7 @@ use std::collections::VecDeque;
 
 use platen_model::{PlatenModel, Specimen};
 
+use crate::clock::GridClock;
 use crate::creep::creep_speed_m_s;
 use crate::error::Result;
 use crate::event::{Direction, EventKind, Mode};
@@ -289,9 +290,9 @@ struct SpecimenPlant<'a, M, const L: usize> {
     /// The storeys' constants in fixed-size arrays (the first `N` are live), so that the
     /// storey loops run over compile-time bounds without indexing the specimen's `Vec`.
     storeys: StoreyConstants,
-    grid: Grid<'a>,
-    /// The grid step being taken: positions are fractions `τ ∈ [0, 1]` of it.
-    n: GridStep,
+    /// The record's grid and the step being taken: positions are fractions `τ ∈ [0, 1]` of
+    /// it.
+    clock: GridClock<'a>,
     /// The actuator force's rate in the current grid interval, N/s (the force is linear
     /// between samples).
     f_rate: f64,
@@ -305,7 +306,7 @@ impl<'a, M: PlatenModel, const L: usize> SpecimenPlant<'a, M, L> {
 
     /// The actuator force's rate between samples `j` and `j + 1`, N/s (0 past the record).
     fn force_rate(&self, j: usize) -> f64 {
-        let g = &self.grid;
+        let g = &self.clock.grid;
         match (g.force.get(j), g.force.get(j + 1)) {
             (Some(f0), Some(f1)) => (f1 - f0) * g.inv_k / g.h,
             _ => 0.0,
@@ -398,7 +399,7 @@ impl<'a, M: PlatenModel, const L: usize> SpecimenPlant<'a, M, L> {
     }
 }
 
-impl<M: PlatenModel, const L: usize> Plant<L> for SpecimenPlant<'_, M, L> {
+impl<'a, M: PlatenModel, const L: usize> Plant<L> for SpecimenPlant<'a, M, L> {
     type Model = M;
     /// The actuator force, N.
     type Input = f64;
@@ -497,7 +498,12 @@ impl<M: PlatenModel, const L: usize> Plant<L> for SpecimenPlant<'_, M, L> {
         }
     }
 
-    crate::grid::grid_time!();
+    #[inline(always)]
+    fn input(&self, at: f64) -> f64 {
+        self.clock.force(at)
+    }
+
+    crate::clock::clock_field!(GridClock<'a>);
 }
 
 /// A forward run with a specimen: the mode machine over the force record's grid.
@@ -521,12 +527,11 @@ impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
             model,
             spec,
             storeys: StoreyConstants::of(spec),
-            grid,
-            n: GridStep { n: 0, j: 0, i: 0.0 },
+            clock: GridClock::new(grid),
             f_rate: 0.0,
         };
         plant.f_rate = plant.force_rate(0);
-        let f0 = plant.grid.force[0];
+        let f0 = plant.clock.grid.force[0];
         let mode = Mode::initial(model, y[U], y[V], f0 - plant.base_shear(&y));
         let specimen_start_j = plant.specimen_energy(&y);
         let mut machine = Machine::new(plant, y, h, method);
@@ -555,7 +560,7 @@ impl<M: PlatenModel, const L: usize> GridStepper for Stepper<'_, M, L> {
     #[inline(always)]
     fn step(&mut self, n: GridStep) -> Result<()> {
         let m = &mut self.machine;
-        m.plant.n = n;
+        m.plant.clock.n = n;
         m.stats.steps += 1;
         let rk4 = m.is_rk4();
         let committed = match m.mode {
@@ -573,7 +578,7 @@ impl<M: PlatenModel, const L: usize> GridStepper for Stepper<'_, M, L> {
     fn sample(&self, j: usize, t_s: f64) -> Sample {
         let (m, p) = (&self.machine, &self.machine.plant);
         let n = SpecimenPlant::<M, L>::N;
-        m.sample(j, t_s, p.grid.force[j], p.base_shear(&m.y), n, Z)
+        m.sample(j, t_s, p.clock.grid.force[j], p.base_shear(&m.y), n, Z)
     }
 
     /// Closes the energy balance at the current state, the run having finished at `t_s`.

@@ -28,21 +28,22 @@
 //! in their null state for the forces that hold the platen (and the specimen's weight) at
 //! neutral, resolved as the force balance does: a platen commanded to stay at neutral stays.
 
-use std::collections::VecDeque;
-
 use platen_model::multi_axis::{Coords, Dof, LinearSpecimen, MultiAxisTable};
 use platen_system::{
     ActuatorState, DofCommand, DofController, DofControllerState, DofFeedback, SpoolResponse,
     Supply, TableHydraulics,
 };
 
-use crate::closed_loop::LoopMethod;
+use crate::clock::SecondsClock;
+use crate::control::{Command, ControlLoop, Driver, Emit, LoopMethod, LoopStats};
 use crate::error::{IntegrateError, Result};
-use crate::machine::{Machine, PieceMethod, Y};
+use crate::machine::{Machine, Plant, Y};
 use crate::multi_axis::{PoseMotion, TableRun};
+use crate::output::TableSink;
 use crate::stop::Failure;
+use crate::table_forward::Rows;
 use crate::table_plant::{
-    pose, reaim, start_machine, start_state, Forces, Output, Source, Strokes, TablePlant, BARE,
+    pose, reaim, start_machine, start_state, Forces, Source, Strokes, TablePlant, BARE,
     MAX_TABLE_ACTUATORS, QD, WITH_SPECIMEN,
 };
 use crate::MAX_TABLE_SPECIMEN_DOFS;
@@ -123,27 +124,9 @@ pub struct TableLoopRun<'a> {
     pub method: LoopMethod,
 }
 
-/// What a closed-loop table run reports besides its columns.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct TableLoopStats {
-    /// Time with a drive saturated, s.
-    pub saturated_time_s: f64,
-    /// First time a chamber pressure reached the cavitation floor (0 Pa absolute), s.
-    pub cavitation_at_s: Option<f64>,
-    /// Lowest supply pressure, Pa.
-    pub min_supply_pressure_pa: f64,
-    /// Hydraulic energy delivered into the chambers, J.
-    pub hydraulic_energy_j: f64,
-    /// Energy lost to leakage, J.
-    pub leakage_energy_j: f64,
-    /// The largest warping force (norm of the null-space part of the actuator forces) at
-    /// the controller's samples, N.
-    pub max_warping_force_n: f64,
-    /// Controller samples taken.
-    pub controller_samples: u64,
-    /// Integration grid steps.
-    pub steps: u64,
-}
+/// What a closed-loop table run reports besides its columns: the one closed loop's
+/// statistics ([`LoopStats`]; `run.steps` the integration grid's steps).
+pub type TableLoopStats = LoopStats;
 
 /// The actuators' hydraulics in the state: the source of the closed loop's forces.
 pub(crate) struct Hydraulic<'a> {
@@ -152,10 +135,8 @@ pub(crate) struct Hydraulic<'a> {
     drives: [f64; MAX_LOOP_ACTUATORS],
     /// The spools' exact motion under the held drives (see [`Spools`]).
     spools: Spools,
-    /// Time at the start of the current advance, s.
-    t: f64,
-    /// The grid's step, s.
-    h: f64,
+    /// Seconds from the start of the current advance.
+    clock: SecondsClock,
     cavitation_at_s: Option<f64>,
     min_supply_pressure_pa: f64,
 }
@@ -196,7 +177,7 @@ impl<const L: usize> Source<L> for Hydraulic<'_> {
 
     #[inline(always)]
     fn input(&self, at: f64) -> SpoolPositions {
-        self.spools_at(self.t + at).0
+        self.spools_at(self.clock.t + at).0
     }
 
     fn forces(&self, _input: SpoolPositions, y: &Y<L>) -> Forces {
@@ -309,42 +290,7 @@ impl<const L: usize> Source<L> for Hydraulic<'_> {
         Some(atol * unit + rtol * m)
     }
 
-    fn step_s(&self) -> f64 {
-        self.h
-    }
-    #[inline(always)]
-    fn seconds(&self, len: f64) -> f64 {
-        len
-    }
-    fn units(&self, seconds: f64) -> f64 {
-        seconds
-    }
-    fn time_s(&self, at: f64) -> f64 {
-        self.t + at
-    }
-    fn tolerance_floor(&self) -> f64 {
-        self.h
-    }
-    fn min_progress(&self) -> f64 {
-        4.0 * f64::EPSILON * self.h
-    }
-    fn land(&self, _tau: f64, x: f64, rest: f64) -> f64 {
-        if rest - x < 1e-12 * self.h {
-            rest
-        } else {
-            x
-        }
-    }
-    fn reach(&self, _tau: f64, len: f64) -> f64 {
-        len
-    }
-    fn break_at(&self, _tau: f64, x: f64, rest: f64, held: bool) -> f64 {
-        if held {
-            x.max(f64::MIN_POSITIVE).min(rest)
-        } else {
-            x
-        }
-    }
+    crate::clock::clock_field!(SecondsClock);
 }
 
 /// One number per actuator (the first `n`), on the stack.
@@ -418,13 +364,26 @@ impl Spools {
 const ACTUATOR_COLUMNS: [&str; 4] = ["drive", "spool_opening", "delta_p_pa", "flow_m3_s"];
 
 /// Runs the closed loop `run`: the command drives the DOF controller, whose drives move the
-/// valves, chambers and platen. Delivers a row at each of the command's time stamps: the
-/// columns of [`crate::forward_table`] (with `{name}_force_n` the chambers' force), then
-/// `command_x_m` … `command_yaw_rad`, per actuator `{name}_drive`, `{name}_spool_opening`,
-/// `{name}_delta_p_pa` (`p_a − p_b`; `p_a − P_R` single-acting) and `{name}_flow_m3_s` (into
-/// chamber `a`), then `supply_pressure_pa`, `warping_force_n` (the null-space part of the
-/// actuator forces, the force balance's error, at the last controller sample) and
-/// `hydraulic_energy_j`.
+/// valves, chambers and platen. Returns a row at each of the command's time stamps (the
+/// columns of [`forward_table_loop_into`]) with the run's statistics.
+///
+/// # Errors
+/// As [`forward_table_loop_into`].
+pub fn forward_table_loop(run: &TableLoopRun<'_>) -> Result<(TableRun, TableLoopStats)> {
+    let mut out = TableRun::default();
+    let stats = forward_table_loop_into(run, &mut out)?;
+    Ok((out, stats))
+}
+
+/// Runs the closed loop `run`: the command drives the DOF controller, whose drives move the
+/// valves, chambers and platen. Delivers a row to `sink` at each of the command's time
+/// stamps: the columns of [`crate::forward_table`] (with `{name}_force_n` the chambers'
+/// force), then `command_x_m` … `command_yaw_rad`, per actuator `{name}_drive`,
+/// `{name}_spool_opening`, `{name}_delta_p_pa` (`p_a − p_b`; `p_a − P_R` single-acting) and
+/// `{name}_flow_m3_s` (into chamber `a`), then `supply_pressure_pa`, `warping_force_n` (the
+/// null-space part of the actuator forces, the force balance's error, at the last controller
+/// sample) and `hydraulic_energy_j`. The columns' names reach the sink first
+/// ([`TableSink::start`]), unless the command is empty.
 ///
 /// # Errors
 /// [`IntegrateError::InvalidStep`] for zero steps per period or tolerances that are not
@@ -432,8 +391,31 @@ const ACTUATOR_COLUMNS: [&str; 4] = ["drive", "spool_opening", "delta_p_pa", "fl
 /// have one entry per actuator, or the table more than [`MAX_LOOP_ACTUATORS`]; the static
 /// forces outside what the chambers can exert ([`IntegrateError::InvalidSystem`]);
 /// [`IntegrateError::UnequalValveDelays`]; a numerical failure (non-finite state) or an
-/// actuator at its end stop with its time.
-pub fn forward_table_loop(run: &TableLoopRun<'_>) -> Result<(TableRun, TableLoopStats)> {
+/// actuator at its end stop with its time (the rows before it delivered).
+pub fn forward_table_loop_into<K: TableSink>(
+    run: &TableLoopRun<'_>,
+    sink: &mut K,
+) -> Result<TableLoopStats> {
+    let k = check_table_loop(run)?;
+    if run.command.is_empty() {
+        return Ok(TableLoopStats::default());
+    }
+    match run.specimen {
+        None => run_table_loop::<LOOP_BARE, K>(run, k, sink),
+        Some(s) if s.len() <= MAX_TABLE_SPECIMEN_DOFS => {
+            run_table_loop::<LOOP_WITH_SPECIMEN, K>(run, k, sink)
+        }
+        Some(s) => Err(IntegrateError::LengthMismatch {
+            what: "specimen DOFs of a closed-loop table run (at most MAX_TABLE_SPECIMEN_DOFS)",
+            found: s.len(),
+            expected: MAX_TABLE_SPECIMEN_DOFS,
+        }),
+    }
+}
+
+/// The checks of a closed-loop table run before it starts: one hydraulics and one controller
+/// row per actuator, at most [`MAX_LOOP_ACTUATORS`], one valve delay; its steps per period.
+fn check_table_loop(run: &TableLoopRun<'_>) -> Result<u32> {
     let n = run.table.actuators().len();
     for (what, found) in [
         ("actuator hydraulics", run.hydraulics.actuators().len()),
@@ -466,87 +448,110 @@ pub fn forward_table_loop(run: &TableLoopRun<'_>) -> Result<(TableRun, TableLoop
     if delays.iter().any(|&d| d != delays[0]) {
         return Err(IntegrateError::UnequalValveDelays);
     }
-    let k = run.method.steps_per_period();
-    if k == 0 {
-        return Err(IntegrateError::InvalidStep { step_s: 0.0 });
+    run.method.checked_steps()
+}
+
+/// [`forward_table_loop_into`] with a state of `L` numbers.
+fn run_table_loop<const L: usize, K: TableSink>(
+    run: &TableLoopRun<'_>,
+    k: u32,
+    sink: &mut K,
+) -> Result<TableLoopStats> {
+    let h = run.controller.period_s() / f64::from(k);
+    let machine = table_machine::<L>(run, h)?;
+    let control = TableLoop::new(run);
+    control.rows.start(sink, run.command.len());
+    let f_c = run.controller.sample_rate_hz();
+    let mut driver = Driver::new(machine, control, (k, h, f_c), run.command.len());
+    driver.run(sink)?;
+    Ok(driver.finish())
+}
+
+/// The machine of the closed loop `run` at rest at neutral, the hydraulics in their null
+/// state for the forces that hold the platen (and the specimen's weight) there, on a grid of
+/// step `h`.
+fn table_machine<'a, const L: usize>(
+    run: &TableLoopRun<'a>,
+    h: f64,
+) -> Result<Machine<TablePlant<'a, Hydraulic<'a>, L>, L>> {
+    let (table, hyd) = (run.table, run.hydraulics);
+    // The weight of the specimen on the platen, carried at rest with the platen's.
+    let extra = run.specimen.map_or_else(
+        platen_model::multi_axis::Wrench::zeros,
+        LinearSpecimen::weight_wrench,
+    );
+    let rest = TableHydraulics::static_forces_n(table, &extra)
+        .and_then(|f| hyd.rest_states(&f))
+        .map_err(IntegrateError::InvalidSystem)?;
+    let mut y = start_state::<L>(table, run.specimen, Coords::zeros(), Coords::zeros());
+    for (i, s) in rest.iter().enumerate() {
+        let at = hy::<L>() + 4 * i;
+        y[at] = s.p_a_pa;
+        y[at + 1] = s.p_b_pa;
     }
-    if let LoopMethod::Dopri5 { rtol, atol, .. } = run.method {
-        if !(rtol > 0.0 && rtol.is_finite() && atol > 0.0 && atol.is_finite()) {
-            return Err(IntegrateError::InvalidStep { step_s: f64::NAN });
+    y[oil::<L>()] = hyd.charged_oil_m3();
+    y[ps::<L>()] = hyd.supply_pressure_at(y[oil::<L>()]);
+    let t0 = run.command.t_s()[0];
+    let source = Hydraulic {
+        hyd,
+        drives: [0.0; MAX_LOOP_ACTUATORS],
+        spools: Spools::new(hyd, t0),
+        clock: SecondsClock { t: t0, h },
+        cavitation_at_s: None,
+        min_supply_pressure_pa: y[ps::<L>()],
+    };
+    Ok(start_machine(
+        table,
+        run.specimen,
+        source,
+        y,
+        h,
+        run.method.pieces(),
+    ))
+}
+
+impl Command for PoseMotion {
+    type Value = DofCommand;
+
+    fn t_s(&self) -> &[f64] {
+        PoseMotion::t_s(self)
+    }
+
+    fn value(&self, i: usize) -> DofCommand {
+        let (pose, rates, accelerations) = self.at(i);
+        DofCommand {
+            pose,
+            rates,
+            accelerations,
         }
     }
-    if run.command.is_empty() {
-        return Ok((TableRun::default(), TableLoopStats::default()));
-    }
-    match run.specimen {
-        None => TableLoop::<LOOP_BARE>::new(run, k)?.run(),
-        Some(s) if s.len() <= MAX_TABLE_SPECIMEN_DOFS => {
-            TableLoop::<LOOP_WITH_SPECIMEN>::new(run, k)?.run()
+
+    fn lerp(a: &DofCommand, b: &DofCommand, w: f64) -> DofCommand {
+        DofCommand {
+            pose: a.pose + (b.pose - a.pose) * w,
+            rates: a.rates + (b.rates - a.rates) * w,
+            accelerations: a.accelerations + (b.accelerations - a.accelerations) * w,
         }
-        Some(s) => Err(IntegrateError::LengthMismatch {
-            what: "specimen DOFs of a closed-loop table run (at most MAX_TABLE_SPECIMEN_DOFS)",
-            found: s.len(),
-            expected: MAX_TABLE_SPECIMEN_DOFS,
-        }),
     }
 }
 
-/// A closed-loop table run: the mode machine between the controller's samples.
-struct TableLoop<'a, const L: usize> {
-    machine: Machine<TablePlant<'a, Hydraulic<'a>, L>, L>,
+/// The multi-axis table's DOF controller and output around its [`TablePlant`] driven by the
+/// actuators' hydraulics.
+struct TableLoop<'a> {
     run: TableLoopRun<'a>,
     state: DofControllerState,
-    /// Drives on their way through the valves' delay: (time they arrive, drives).
-    queue: VecDeque<(f64, [f64; MAX_LOOP_ACTUATORS])>,
-    out: Output,
+    /// The columns' names and the row being delivered.
+    rows: Rows,
     /// The loop's own columns of the row being emitted (kept to reuse its allocation).
     extra: Vec<f64>,
-    stats: TableLoopStats,
-    h: f64,
-    t0: f64,
-    /// Integration steps per controller period.
-    k: u64,
-    /// The next grid step.
-    n: u64,
-    /// The next output sample.
-    j: usize,
+    /// The largest warping force at the controller's samples, N.
+    max_warping_force_n: f64,
 }
 
-impl<'a, const L: usize> TableLoop<'a, L> {
-    fn new(run: &TableLoopRun<'a>, k: u32) -> Result<Self> {
-        let (table, hyd) = (run.table, run.hydraulics);
-        let h = run.controller.period_s() / f64::from(k);
-        // The weight of the specimen on the platen, carried at rest with the platen's.
-        let extra = run.specimen.map_or_else(
-            platen_model::multi_axis::Wrench::zeros,
-            LinearSpecimen::weight_wrench,
-        );
-        let rest = TableHydraulics::static_forces_n(table, &extra)
-            .and_then(|f| hyd.rest_states(&f))
-            .map_err(IntegrateError::InvalidSystem)?;
-        let mut y = start_state::<L>(table, run.specimen, Coords::zeros(), Coords::zeros());
-        for (i, s) in rest.iter().enumerate() {
-            let at = hy::<L>() + 4 * i;
-            y[at] = s.p_a_pa;
-            y[at + 1] = s.p_b_pa;
-        }
-        y[oil::<L>()] = hyd.charged_oil_m3();
-        y[ps::<L>()] = hyd.supply_pressure_at(y[oil::<L>()]);
-        let t0 = run.command.t_s()[0];
-        let source = Hydraulic {
-            hyd,
-            drives: [0.0; MAX_LOOP_ACTUATORS],
-            spools: Spools::new(hyd, t0),
-            t: t0,
-            h,
-            cavitation_at_s: None,
-            min_supply_pressure_pa: y[ps::<L>()],
-        };
-        let pieces = match run.method {
-            LoopMethod::Rk4 { .. } => PieceMethod::Rk4,
-            LoopMethod::Dopri5 { rtol, atol, .. } => PieceMethod::Dopri5 { rtol, atol },
-        };
-        let machine = start_machine(table, run.specimen, source, y, h, pieces);
+impl<'a> TableLoop<'a> {
+    /// The controller and the columns of `run`.
+    fn new(run: &TableLoopRun<'a>) -> Self {
+        let table = run.table;
         let mut names: Vec<String> = Dof::ALL
             .iter()
             .map(|d| format!("command_{}_{}", d.name(), d.unit()))
@@ -562,70 +567,21 @@ impl<'a, const L: usize> TableLoop<'a, L> {
             ]
             .map(String::from),
         );
-        let out = Output::new(table, run.specimen, run.command.len(), names);
-        let slots = (hyd.actuators()[0].servo_valve.delay_s * run.controller.sample_rate_hz())
-            .ceil() as usize
-            + 2;
-        Ok(TableLoop {
-            machine,
+        TableLoop {
             run: *run,
             state: run.controller.start(),
-            queue: VecDeque::with_capacity(slots),
-            out,
+            rows: Rows::new(table, run.specimen, names),
             extra: Vec::new(),
-            stats: TableLoopStats {
-                min_supply_pressure_pa: y[ps::<L>()],
-                ..TableLoopStats::default()
-            },
-            h,
-            t0,
-            k: u64::from(k),
-            n: 0,
-            j: 0,
-        })
-    }
-
-    fn t(&self) -> f64 {
-        self.machine.plant.source.t
-    }
-
-    fn set_t(&mut self, t: f64) {
-        self.machine.plant.source.t = t;
-    }
-
-    /// The command at `t` (linear between samples, held past the ends).
-    fn command_at(&self, t: f64) -> DofCommand {
-        let c = self.run.command;
-        let ts = c.t_s();
-        let last = ts.len() - 1;
-        let at = |i: usize| {
-            let (pose, rates, accelerations) = c.at(i);
-            DofCommand {
-                pose,
-                rates,
-                accelerations,
-            }
-        };
-        if t <= ts[0] {
-            return at(0);
-        }
-        if t >= ts[last] {
-            return at(last);
-        }
-        let j = ts.partition_point(|&x| x <= t).clamp(1, last);
-        let w = (t - ts[j - 1]) / (ts[j] - ts[j - 1]);
-        let (a, b) = (at(j - 1), at(j));
-        DofCommand {
-            pose: a.pose + (b.pose - a.pose) * w,
-            rates: a.rates + (b.rates - a.rates) * w,
-            accelerations: a.accelerations + (b.accelerations - a.accelerations) * w,
+            max_warping_force_n: 0.0,
         }
     }
 
     /// What the controller reads now: strokes and their rates, Δp and forces per actuator
     /// (the first `n` of each, on the stack).
-    fn feedback(&self) -> [PerActuator; 4] {
-        let m = &self.machine;
+    fn feedback<const L: usize>(
+        &self,
+        m: &Machine<TablePlant<'a, Hydraulic<'a>, L>, L>,
+    ) -> [PerActuator; 4] {
         let (table, hyd) = (self.run.table, self.run.hydraulics);
         let (q, qd) = pose(&m.y);
         let [mut strokes, mut rates, mut dp, mut forces] = [[0.0; MAX_LOOP_ACTUATORS]; 4];
@@ -638,13 +594,31 @@ impl<'a, const L: usize> TableLoop<'a, L> {
         }
         [strokes, rates, dp, forces]
     }
+}
 
-    /// A controller sample now: the new drives enter the valves' delay line.
-    fn tick(&mut self) {
-        let command = self.command_at(self.t());
-        let [strokes, rates, dp, forces] = self.feedback();
+impl<'a, const L: usize> ControlLoop<L> for TableLoop<'a> {
+    type Plant = TablePlant<'a, Hydraulic<'a>, L>;
+    type Command = PoseMotion;
+    /// One drive per actuator.
+    type Drive = [f64; MAX_LOOP_ACTUATORS];
+
+    fn command(&self) -> &PoseMotion {
+        self.run.command
+    }
+
+    fn delay_s(&self) -> f64 {
+        self.run.hydraulics.actuators()[0].servo_valve.delay_s
+    }
+
+    /// The DOF controller on the strokes, their rates, the platen's accelerations, each
+    /// actuator's `Δp` and force.
+    fn control(
+        &mut self,
+        m: &Machine<Self::Plant, L>,
+        command: &DofCommand,
+    ) -> [f64; MAX_LOOP_ACTUATORS] {
+        let [strokes, rates, dp, forces] = self.feedback(m);
         let n = self.run.table.actuators().len();
-        let m = &self.machine;
         let fb = DofFeedback {
             strokes_m: &strokes[..n],
             stroke_rates_m_s: &rates[..n],
@@ -652,58 +626,85 @@ impl<'a, const L: usize> TableLoop<'a, L> {
             delta_p_pa: &dp[..n],
             forces_n: &forces[..n],
         };
-        self.run.controller.update(&mut self.state, &command, &fb);
-        self.stats.controller_samples += 1;
-        self.stats.max_warping_force_n = self.stats.max_warping_force_n.max(self.state.warping_n);
+        self.run.controller.update(&mut self.state, command, &fb);
+        self.max_warping_force_n = self.max_warping_force_n.max(self.state.warping_n);
         let mut d = [0.0; MAX_LOOP_ACTUATORS];
         d[..self.state.drives.len()].copy_from_slice(&self.state.drives);
-        let delay = self.run.hydraulics.actuators()[0].servo_valve.delay_s;
-        self.queue.push_back((self.t() + delay, d));
+        d
     }
 
-    /// Applies every delayed drive that has arrived by now (to `slack`).
-    fn apply_arrived(&mut self, slack: f64) {
-        let mut changed = false;
-        while let Some(&(t, d)) = self.queue.front() {
-            if t <= self.t() + slack {
-                let now = self.t();
-                self.machine.plant.source.drive(now, d);
-                self.queue.pop_front();
-                changed = true;
-            } else {
-                break;
+    fn saturated(&self) -> bool {
+        self.state.saturated
+    }
+
+    fn arrive(plant: &mut Self::Plant, t_s: f64, drives: [f64; MAX_LOOP_ACTUATORS]) {
+        plant.source.drive(t_s, drives);
+    }
+
+    /// A slide with friction has its gauge aimed along its motion.
+    fn start_step(&self, m: &mut Machine<Self::Plant, L>) {
+        reaim(m);
+    }
+
+    /// A state that blew up while a strut was running out of gas is the strut's gas spent.
+    fn segment(&self, m: &mut Machine<Self::Plant, L>, span: f64) -> Result<()> {
+        let (q0, _) = pose(&m.y);
+        let t0 = m.plant.clock().t;
+        m.advance_clocked(span).map_err(|e| match e {
+            // A state that blew up while a strut was running out of gas: the strut's
+            // pull, not the solver, is what went without bound.
+            IntegrateError::NonFiniteState { .. } => {
+                match spent_strut_below(self.run.table, &q0, BLOWN_UP_GAS_FRACTION) {
+                    Some(strut) => IntegrateError::StrutGasSpent { t_s: t0, strut },
+                    None => e,
+                }
+            }
+            e => e,
+        })
+    }
+
+    /// An actuator pushed past its chambers' oil (a chamber's volume gone), or a strut past
+    /// its gas, ends the run.
+    fn end_step(&self, m: &Machine<Self::Plant, L>, t_s: f64) -> Result<()> {
+        let (table, hyd) = (self.run.table, self.run.hydraulics);
+        let (q, _) = pose(&m.y);
+        if let Some(strut) = spent_strut(table, &q) {
+            return Err(IntegrateError::StrutGasSpent { t_s, strut });
+        }
+        for (i, a) in hyd.actuators().iter().enumerate() {
+            let s = table.actuator_at(i, &q).stroke_m;
+            let (v_a, v_b) = a.chamber_volumes_m3(s);
+            if v_a <= 0.0 || (!a.is_single_acting() && v_b <= 0.0) {
+                return Err(IntegrateError::failed(t_s, Failure::EndStop { u_m: s }));
             }
         }
-        if changed {
-            let mode = self.machine.mode;
-            let spools = Source::<L>::input(&self.machine.plant.source, 0.0);
-            self.machine.enter(mode, spools);
+        if !m.y.iter().all(|x| x.is_finite()) {
+            return Err(IntegrateError::failed(
+                t_s,
+                Failure::NonFiniteState {
+                    u_m: q[0],
+                    v_m_s: m.y[QD],
+                },
+            ));
         }
+        Ok(())
     }
 
-    /// Integrates `span` seconds with no cut inside, handling every event.
-    fn segment(&mut self, span: f64) -> Result<()> {
-        let (q0, _) = pose(&self.machine.y);
-        let t0 = self.t();
-        self.machine
-            .advance_clocked(span, |p| &mut p.source.t)
-            .map_err(|e| match e {
-                // A state that blew up while a strut was running out of gas: the strut's
-                // pull, not the solver, is what went without bound.
-                IntegrateError::NonFiniteState { .. } => {
-                    match spent_strut_below(self.run.table, &q0, BLOWN_UP_GAS_FRACTION) {
-                        Some(strut) => IntegrateError::StrutGasSpent { t_s: t0, strut },
-                        None => e,
-                    }
-                }
-                e => e,
-            })
+    /// The hydraulics' figures and the largest warping force.
+    fn finish(&self, m: &Machine<Self::Plant, L>, stats: &mut LoopStats) {
+        let (y, src) = (&m.y, &m.plant.source);
+        stats.cavitation_at_s = src.cavitation_at_s;
+        stats.min_supply_pressure_pa = src.min_supply_pressure_pa;
+        stats.hydraulic_energy_j = y[eh::<L>()];
+        stats.leakage_energy_j = y[el::<L>()];
+        stats.max_warping_force_n = self.max_warping_force_n;
     }
+}
 
-    /// The row of output sample `j`.
-    fn emit(&mut self, j: usize) {
+impl<'a, K: TableSink, const L: usize> Emit<K, L> for TableLoop<'a> {
+    /// The row of output sample `j`: the table's columns, then the loop's own.
+    fn emit(&mut self, m: &Machine<Self::Plant, L>, j: usize, sink: &mut K) {
         let (table, hyd) = (self.run.table, self.run.hydraulics);
-        let m = &self.machine;
         let y = &m.y;
         let t_s = self.run.command.t_s()[j];
         let n = table.actuators().len();
@@ -726,100 +727,6 @@ impl<'a, const L: usize> TableLoop<'a, L> {
             ]);
         }
         extra.extend([p_s, self.state.warping_n, y[eh::<L>()]]);
-        self.out.push(&self.machine, t_s, &forces[..n], &self.extra);
-    }
-
-    /// Emits every output sample due by now.
-    fn emit_due(&mut self, slack: f64) {
-        let ts = self.run.command.t_s();
-        while self.j < ts.len() && ts[self.j] <= self.t() + slack {
-            self.emit(self.j);
-            self.j += 1;
-        }
-    }
-
-    /// One grid step from `t₀ + n·h` (see [`crate::closed_loop`]): the controller's sample
-    /// when one falls there, the output samples in it, the cuts inside it. Returns whether the
-    /// run is over.
-    fn grid_step(&mut self) -> Result<bool> {
-        let ts = self.run.command.t_s();
-        let t_end = ts[ts.len() - 1];
-        let slack = 1e-9 * self.h;
-        let n = self.n;
-        self.set_t(self.t0 + n as f64 * self.h);
-        if n % self.k == 0 {
-            self.tick();
-        }
-        self.apply_arrived(slack);
-        self.emit_due(slack);
-        if self.j >= ts.len() || self.t() > t_end + slack {
-            return Ok(true);
-        }
-        reaim(&mut self.machine);
-        let t_next = self.t0 + (n + 1) as f64 * self.h;
-        loop {
-            let arrival = self.queue.front().map_or(f64::INFINITY, |&(t, _)| t);
-            let sample = ts.get(self.j).copied().unwrap_or(f64::INFINITY);
-            let cut = arrival.min(sample);
-            if cut >= t_next - slack {
-                break;
-            }
-            let span = cut - self.t();
-            if span > 0.0 {
-                self.segment(span)?;
-            }
-            self.set_t(cut);
-            self.apply_arrived(slack);
-            self.emit_due(slack);
-        }
-        let span = t_next - self.t();
-        if span > 0.0 {
-            self.segment(span)?;
-        }
-        self.check_end_stops(t_next)?;
-        if self.state.saturated {
-            self.stats.saturated_time_s += self.h;
-        }
-        self.n += 1;
-        self.stats.steps += 1;
-        Ok(false)
-    }
-
-    /// An actuator pushed past its chambers' oil (a chamber's volume gone), or a strut past
-    /// its gas, ends the run.
-    fn check_end_stops(&self, t_s: f64) -> Result<()> {
-        let (table, hyd) = (self.run.table, self.run.hydraulics);
-        let (q, _) = pose(&self.machine.y);
-        if let Some(strut) = spent_strut(table, &q) {
-            return Err(IntegrateError::StrutGasSpent { t_s, strut });
-        }
-        for (i, a) in hyd.actuators().iter().enumerate() {
-            let s = table.actuator_at(i, &q).stroke_m;
-            let (v_a, v_b) = a.chamber_volumes_m3(s);
-            if v_a <= 0.0 || (!a.is_single_acting() && v_b <= 0.0) {
-                return Err(IntegrateError::failed(t_s, Failure::EndStop { u_m: s }));
-            }
-        }
-        if !self.machine.y.iter().all(|x| x.is_finite()) {
-            return Err(IntegrateError::failed(
-                t_s,
-                Failure::NonFiniteState {
-                    u_m: q[0],
-                    v_m_s: self.machine.y[QD],
-                },
-            ));
-        }
-        Ok(())
-    }
-
-    fn run(mut self) -> Result<(TableRun, TableLoopStats)> {
-        while !self.grid_step()? {}
-        let y = &self.machine.y;
-        let src = &self.machine.plant.source;
-        self.stats.cavitation_at_s = src.cavitation_at_s;
-        self.stats.min_supply_pressure_pa = src.min_supply_pressure_pa;
-        self.stats.hydraulic_energy_j = y[eh::<L>()];
-        self.stats.leakage_energy_j = y[el::<L>()];
-        Ok((self.out.finish(), self.stats))
+        self.rows.push(m, t_s, &forces[..n], &self.extra, sink);
     }
 }

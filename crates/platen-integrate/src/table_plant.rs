@@ -1,5 +1,6 @@
-//! The multi-axis platen forward from recorded actuator forces: a plant of the one mode
-//! machine ([`crate::machine`]), RK4 or Dopri5.
+//! The multi-axis platen under its actuators' forces, from a record ([`crate::forward_table`])
+//! or from its hydraulics in closed loop ([`crate::forward_table_loop`]): a plant of the one
+//! mode machine ([`crate::machine`]), RK4 or Dopri5.
 //!
 //! The state is the pose `q` and its rates `q̇` (six each) after the machine's five
 //! positions. The right-hand side is Newton–Euler ([`MultiAxisTable::accelerations`]) under
@@ -42,19 +43,17 @@ use platen_model::multi_axis::{
 };
 use platen_model::PlatenModel;
 
-use crate::error::{IntegrateError, Result};
+use crate::clock::Clock;
 use crate::event::{Direction, EventKind, Mode};
-use crate::grid::{Grid, GridStep};
 use crate::machine::{Machine, PieceMethod, Plant, DI, U, V, W, Y};
-use crate::method::Method;
-use crate::multi_axis::{platen_acceleration, TableRun, GRAVITY};
+use crate::multi_axis::{platen_acceleration, GRAVITY};
 
 /// Where the pose starts in the state.
 pub(crate) const Q: usize = 5;
 /// Where its rates start.
 pub(crate) const QD: usize = Q + 6;
 /// Where the specimen's DOFs start (their rates follow them).
-const Z: usize = QD + 6;
+pub(crate) const Z: usize = QD + 6;
 /// The state's length without a specimen.
 pub(crate) const BARE: usize = Z;
 /// The most DOFs of a specimen a forward run takes (the model's own limit, which
@@ -161,74 +160,6 @@ impl Gauge {
     }
 }
 
-/// The actuator forces of a forward run: one record per actuator on one time grid.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ActuatorForces {
-    t_s: Vec<f64>,
-    forces_n: Vec<Vec<f64>>,
-}
-
-impl ActuatorForces {
-    /// The records `forces_n[i]` (actuator `i`, N) at times `t_s` (s, uniform, strictly
-    /// increasing), linear between samples.
-    ///
-    /// # Errors
-    /// [`IntegrateError::LengthMismatch`], [`IntegrateError::NonFiniteInput`] and the checks
-    /// of a force record ([`crate::ForceRecord::new`]) on the time column.
-    pub fn new(t_s: Vec<f64>, forces_n: Vec<Vec<f64>>) -> Result<Self> {
-        // The time grid's checks: those of a force record.
-        let first = forces_n
-            .first()
-            .cloned()
-            .unwrap_or_else(|| vec![0.0; t_s.len()]);
-        crate::ForceRecord::new(t_s.clone(), first)?;
-        for f in &forces_n {
-            if f.len() != t_s.len() {
-                return Err(IntegrateError::LengthMismatch {
-                    what: "an actuator's force",
-                    found: f.len(),
-                    expected: t_s.len(),
-                });
-            }
-            if let Some(index) = f.iter().position(|x| !x.is_finite()) {
-                return Err(IntegrateError::NonFiniteInput {
-                    what: "an actuator's force",
-                    index,
-                    value: f[index],
-                });
-            }
-        }
-        Ok(ActuatorForces { t_s, forces_n })
-    }
-
-    /// The sample times, s.
-    pub fn t_s(&self) -> &[f64] {
-        &self.t_s
-    }
-
-    /// Actuator `i`'s force record, N.
-    pub fn force_n(&self, i: usize) -> &[f64] {
-        &self.forces_n[i]
-    }
-
-    /// Number of samples.
-    pub fn len(&self) -> usize {
-        self.t_s.len()
-    }
-
-    /// Whether it has no sample.
-    pub fn is_empty(&self) -> bool {
-        self.t_s.is_empty()
-    }
-}
-
-/// Where a position lands: sample interval `j`, fraction `w` of it.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct At {
-    j: usize,
-    w: f64,
-}
-
 /// A specimen's restoring forces at an instant (its first `n`), N or N·m.
 type SpecimenForces = [f64; MAX_TABLE_SPECIMEN_DOFS];
 
@@ -276,67 +207,12 @@ pub(crate) trait Source<const L: usize> {
     fn error_scale(&self, _i: usize, _y0: f64, _y1: f64, _rtol: f64, _atol: f64) -> Option<f64> {
         None
     }
-    /// The grid's step, s.
-    fn step_s(&self) -> f64;
-    /// As [`Plant::seconds`].
-    fn seconds(&self, len: f64) -> f64;
-    /// As [`Plant::units`].
-    fn units(&self, seconds: f64) -> f64;
-    /// As [`Plant::time_s`].
-    fn time_s(&self, at: f64) -> f64;
-    /// As [`Plant::tolerance_floor`].
-    fn tolerance_floor(&self) -> f64;
-    /// As [`Plant::min_progress`].
-    fn min_progress(&self) -> f64;
-    /// As [`Plant::land`].
-    fn land(&self, tau: f64, x: f64, rest: f64) -> f64;
-    /// As [`Plant::reach`].
-    fn reach(&self, tau: f64, len: f64) -> f64;
-    /// As [`Plant::break_at`].
-    fn break_at(&self, tau: f64, x: f64, rest: f64, held: bool) -> f64;
-}
-
-/// Recorded actuator forces on their time grid: the source of a forward run.
-pub(crate) struct Recorded<'a> {
-    forces: &'a ActuatorForces,
-    /// The time grid (its force is the first actuator's, unused: the input is every
-    /// actuator's, [`Recorded::forces`]).
-    grid: Grid<'a>,
-    /// The grid step being taken.
-    n: GridStep,
-}
-
-impl<const L: usize> Source<L> for Recorded<'_> {
-    type Input = At;
-    const RATES_ON_COMMIT: bool = false;
-    const NEEDS_STROKES: bool = false;
-
-    #[inline(always)]
-    fn input(&self, at: f64) -> At {
-        At {
-            j: self.n.j,
-            w: (self.n.i + at) * self.grid.inv_k,
-        }
-    }
-
-    fn forces(&self, at: At, _y: &Y<L>) -> Forces {
-        let (j, w) = (at.j, at.w);
-        let mut out = [0.0; MAX_TABLE_ACTUATORS];
-        for (o, f) in out.iter_mut().zip(&self.forces.forces_n) {
-            *o = if w == 0.0 {
-                f[j]
-            } else {
-                f[j] * (1.0 - w) + f[j + 1] * w
-            };
-        }
-        out
-    }
-
-    fn step_s(&self) -> f64 {
-        self.grid.h
-    }
-
-    crate::grid::grid_clock!();
+    /// Where the run's time is kept: the record's grid, or the loop's seconds.
+    type Clock: Clock;
+    /// The run's clock.
+    fn clock(&self) -> &Self::Clock;
+    /// The run's clock, to move.
+    fn clock_mut(&mut self) -> &mut Self::Clock;
 }
 
 /// The multi-axis platen under its actuator forces: the [`Plant`] of the mode machine.
@@ -345,9 +221,9 @@ pub(crate) struct TablePlant<'a, S, const L: usize> {
     /// Where the actuator forces come from.
     pub(crate) source: S,
     /// The specimen on the platen.
-    specimen: Option<&'a LinearSpecimen>,
+    pub(crate) specimen: Option<&'a LinearSpecimen>,
     /// Whether any contact has friction (else the gauge is held at 1: one slip phase).
-    friction: bool,
+    pub(crate) friction: bool,
     /// The slide's gauge.
     gauge: Gauge,
     /// The in-plane motion the slide was last known to go along (at breakaway, at the start
@@ -459,7 +335,7 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
     }
 
     /// The specimen's push on the platen at `y` (zero without one).
-    fn specimen_push(&self, y: &Y<L>) -> Wrench {
+    pub(crate) fn specimen_push(&self, y: &Y<L>) -> Wrench {
         self.push_of(&self.specimen_restoring(y))
     }
 
@@ -580,8 +456,8 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
         let capacity = self.table.friction_capacity(&q, &self.forces_at(at, y));
         self.gauge = gauge;
         self.leaving = along;
-        self.blend_m_s =
-            BLEND_STEPS * self.source.step_s() * capacity.force_n / self.table.platen().mass_kg();
+        self.blend_m_s = BLEND_STEPS * self.source.clock().step_s() * capacity.force_n
+            / self.table.platen().mass_kg();
     }
 }
 
@@ -669,7 +545,7 @@ impl<S: Source<L>, const L: usize> Plant<L> for TablePlant<'_, S, L> {
             .gauge
             .scaled(&planar_rate(&Coords::from_fn(|k, _| dy[QD + k])))
             .norm();
-        if speed > REST_SHARE * accel * self.source.step_s() {
+        if speed > REST_SHARE * accel * self.source.clock().step_s() {
             // Still sliding, on a path that turned: aim the gauge along it again.
             let gauge = self.gauge_along(input, y);
             self.aim(input, y, gauge, w);
@@ -701,7 +577,7 @@ impl<S: Source<L>, const L: usize> Plant<L> for TablePlant<'_, S, L> {
     /// the step.
     fn stiff_rate(&self, y: &Y<L>) -> f64 {
         let bound = self.source.stiff_rate(y, None);
-        if bound * self.source.step_s() <= 1.0 {
+        if bound * self.source.clock().step_s() <= 1.0 {
             return bound;
         }
         let (q, qd) = pose(y);
@@ -720,131 +596,13 @@ impl<S: Source<L>, const L: usize> Plant<L> for TablePlant<'_, S, L> {
         }
     }
 
-    #[inline(always)]
-    fn seconds(&self, len: f64) -> f64 {
-        self.source.seconds(len)
+    type Clock = S::Clock;
+    fn clock(&self) -> &S::Clock {
+        self.source.clock()
     }
-    fn units(&self, seconds: f64) -> f64 {
-        self.source.units(seconds)
+    fn clock_mut(&mut self) -> &mut S::Clock {
+        self.source.clock_mut()
     }
-    fn time_s(&self, at: f64) -> f64 {
-        self.source.time_s(at)
-    }
-    fn tolerance_floor(&self) -> f64 {
-        self.source.tolerance_floor()
-    }
-    fn min_progress(&self) -> f64 {
-        self.source.min_progress()
-    }
-    fn land(&self, tau: f64, x: f64, rest: f64) -> f64 {
-        self.source.land(tau, x, rest)
-    }
-    fn reach(&self, tau: f64, len: f64) -> f64 {
-        self.source.reach(tau, len)
-    }
-    fn break_at(&self, tau: f64, x: f64, rest: f64, held: bool) -> f64 {
-        self.source.break_at(tau, x, rest, held)
-    }
-}
-
-/// The forward run of `table` under `forces` from the pose `initial` with rates
-/// `initial_rates` (held DOFs must be 0 in both), with fixed-step RK4 or adaptive Dopri5
-/// through the one mode machine, the bearings' friction with exact planar stick-slip,
-/// delivering every sample of the record as a row of the run's columns: `t_s`; the pose,
-/// its rates and accelerations; per actuator `{name}_stroke_m`, `{name}_force_n`; per strut
-/// `{name}_force_n`; `actuator_work_j` (the actuators' work on the platen since the start);
-/// with friction `dissipated_j` (the friction's) and `stuck` (1 while the platen rests in
-/// its plane, else 0); with a `specimen` its `base_force_{x,y,z}_n` and
-/// `overturning_moment_{x,y}_n_m` (the force the platen exerts on it, about the reference
-/// point), each of its DOFs `specimen{i}_z` and rate `specimen{i}_zdot` (in the DOF's own
-/// SI unit, m or rad, relative to the platen) and `specimen_damping_j` (its dampers'
-/// dissipation). The specimen starts at rest in its static deflection under its weight and
-/// feels the platen's acceleration less gravity's, as in [`crate::inverse_table`].
-///
-/// # Errors
-/// [`IntegrateError::LengthMismatch`] when `forces` has not one record per actuator (or the
-/// table more than [`MAX_TABLE_ACTUATORS`]); [`IntegrateError::InvalidStep`] for a step
-/// that does not divide the sample interval; [`IntegrateError::NonFiniteState`] and
-/// [`IntegrateError::AdaptiveFailed`] as the other forward runs.
-pub fn forward_table(
-    table: &MultiAxisTable,
-    specimen: Option<&LinearSpecimen>,
-    forces: &ActuatorForces,
-    method: Method,
-    initial: Coords,
-    initial_rates: Coords,
-) -> Result<TableRun> {
-    if forces.forces_n.len() != table.actuators().len() {
-        return Err(IntegrateError::LengthMismatch {
-            what: "actuator force records",
-            found: forces.forces_n.len(),
-            expected: table.actuators().len(),
-        });
-    }
-    if table.actuators().len() > MAX_TABLE_ACTUATORS {
-        return Err(IntegrateError::LengthMismatch {
-            what: "actuators of a forward run (at most MAX_TABLE_ACTUATORS)",
-            found: table.actuators().len(),
-            expected: MAX_TABLE_ACTUATORS,
-        });
-    }
-    let start = (initial, initial_rates);
-    match specimen {
-        None => run::<BARE>(table, None, forces, method, start),
-        Some(s) if s.len() <= MAX_TABLE_SPECIMEN_DOFS => {
-            run::<WITH_SPECIMEN>(table, Some(s), forces, method, start)
-        }
-        Some(s) => Err(IntegrateError::LengthMismatch {
-            what: "specimen DOFs of a forward run (at most MAX_TABLE_SPECIMEN_DOFS)",
-            found: s.len(),
-            expected: MAX_TABLE_SPECIMEN_DOFS,
-        }),
-    }
-}
-
-/// [`forward_table`] with a state of `L` numbers.
-fn run<const L: usize>(
-    table: &MultiAxisTable,
-    specimen: Option<&LinearSpecimen>,
-    forces: &ActuatorForces,
-    method: Method,
-    (initial, initial_rates): (Coords, Coords),
-) -> Result<TableRun> {
-    let dt = forces.t_s[1] - forces.t_s[0];
-    let (k, pieces) = match method {
-        Method::Rk4(rk4) => (u64::from(rk4.steps_per_sample()), PieceMethod::Rk4),
-        Method::Dopri5(s) => (
-            1,
-            PieceMethod::Dopri5 {
-                rtol: s.rtol(),
-                atol: s.atol(),
-            },
-        ),
-    };
-    let h = dt / k as f64;
-    let source = Recorded {
-        forces,
-        grid: Grid {
-            force: forces.forces_n.first().map_or(&[][..], Vec::as_slice),
-            inv_k: 1.0 / k as f64,
-            h,
-            t0: forces.t_s[0],
-        },
-        n: GridStep { n: 0, j: 0, i: 0.0 },
-    };
-    let y = start_state::<L>(table, specimen, initial, initial_rates);
-    let mut m = start_machine(table, specimen, source, y, h, pieces);
-    let mut out = Output::new(table, specimen, forces.len(), Vec::new());
-    out.push(&m, forces.t_s[0], &recorded_forces(forces, 0), &[]);
-    let mut n = 0u64;
-    for j in 0..forces.len() - 1 {
-        for i in 0..k {
-            step(&mut m, GridStep { n, j, i: i as f64 })?;
-            n += 1;
-        }
-        out.push(&m, forces.t_s[j + 1], &recorded_forces(forces, j + 1), &[]);
-    }
-    Ok(out.finish())
 }
 
 /// The state at the start of a run of `table` carrying `specimen` from the pose `initial`
@@ -922,11 +680,6 @@ pub(crate) fn start_machine<'a, S: Source<L>, const L: usize>(
     m
 }
 
-/// The recorded forces at sample `j`.
-fn recorded_forces(forces: &ActuatorForces, j: usize) -> Vec<f64> {
-    forces.forces_n.iter().map(|f| f[j]).collect()
-}
-
 /// At the start of a grid step: a slide with friction has its gauge aimed along its motion.
 /// Returns whether the platen slides (or moves free of friction).
 pub(crate) fn reaim<S: Source<L>, const L: usize>(
@@ -944,167 +697,4 @@ pub(crate) fn reaim<S: Source<L>, const L: usize>(
         m.a = m.k[V];
     }
     sliding
-}
-
-/// One grid step: RK4's single piece when it is safe, else the machine's advance. A slide
-/// with friction has its gauge aimed along its motion first.
-fn step<const L: usize>(
-    m: &mut Machine<TablePlant<'_, Recorded<'_>, L>, L>,
-    n: GridStep,
-) -> Result<()> {
-    m.plant.source.n = n;
-    m.stats.steps += 1;
-    let sliding = reaim(m);
-    if sliding && m.is_rk4() && m.slip_fast::<true>(0.0) {
-        return Ok(());
-    }
-    m.advance_span()
-}
-
-/// The specimen's base force and overturning moments (the force the platen exerts on it,
-/// about the reference point), as the inverse names them.
-const SPECIMEN_COLUMNS: [&str; 5] = [
-    "base_force_x_n",
-    "base_force_y_n",
-    "base_force_z_n",
-    "overturning_moment_x_n_m",
-    "overturning_moment_y_n_m",
-];
-
-/// The run's columns, filled a sample at a time.
-pub(crate) struct Output {
-    names: Vec<String>,
-    data: Vec<Vec<f64>>,
-    row: Vec<f64>,
-}
-
-impl Output {
-    /// The columns of a run of `table` carrying `specimen`, with `extra` columns last.
-    pub(crate) fn new(
-        table: &MultiAxisTable,
-        specimen: Option<&LinearSpecimen>,
-        samples: usize,
-        extra: Vec<String>,
-    ) -> Self {
-        let mut names = vec!["t_s".to_string()];
-        for suffix in ["", "_s", "_s2"] {
-            names.extend(Dof::ALL.map(|d| format!("{}_{}{suffix}", d.name(), d.unit())));
-        }
-        for a in table.actuators() {
-            names.push(format!("{}_stroke_m", a.name));
-            names.push(format!("{}_force_n", a.name));
-        }
-        for s in table.struts() {
-            names.push(format!("{}_force_n", s.name));
-        }
-        if specimen.is_some() {
-            names.extend(SPECIMEN_COLUMNS.map(String::from));
-        }
-        names.push("actuator_work_j".into());
-        if table.has_friction() {
-            names.push("dissipated_j".into());
-            names.push("stuck".into());
-        }
-        if let Some(s) = specimen {
-            for i in 1..=s.len() {
-                names.push(format!("specimen{i}_z"));
-                names.push(format!("specimen{i}_zdot"));
-            }
-            names.push("specimen_damping_j".into());
-        }
-        names.extend(extra);
-        let data = names.iter().map(|_| Vec::with_capacity(samples)).collect();
-        Output {
-            names,
-            data,
-            row: Vec::new(),
-        }
-    }
-
-    /// A row at time `t_s` with the actuator forces `forces` and the `extra` columns' values.
-    pub(crate) fn push<S: Source<L>, const L: usize>(
-        &mut self,
-        m: &Machine<TablePlant<'_, S, L>, L>,
-        t_s: f64,
-        forces: &[f64],
-        extra: &[f64],
-    ) {
-        let p = &m.plant;
-        let (q, qd) = pose(&m.y);
-        self.row.clear();
-        self.row.push(t_s);
-        self.row.extend(q.iter().chain(qd.iter()));
-        self.row.extend((0..6).map(|k| m.k[QD + k]));
-        for (i, f) in forces.iter().enumerate().take(p.table.actuators().len()) {
-            self.row.push(p.table.actuator_at(i, &q).stroke_m);
-            self.row.push(*f);
-        }
-        for s in 0..p.table.struts().len() {
-            self.row.push(p.table.strut_at(s, &q).force_n);
-        }
-        if p.specimen.is_some() {
-            let base = -p.specimen_push(&m.y);
-            self.row
-                .extend([base[0], base[1], base[2], base[3], base[4]]);
-        }
-        self.row.push(m.y[W]);
-        if p.friction {
-            self.row.push(m.y[DI]);
-            self.row.push(f64::from(u8::from(m.mode == Mode::Stick)));
-        }
-        if let Some(s) = p.specimen {
-            let n = s.len();
-            for i in 0..n {
-                self.row.push(m.y[Z + i]);
-                self.row.push(m.y[Z + n + i]);
-            }
-            self.row.push(m.y[crate::machine::SD]);
-        }
-        self.row.extend_from_slice(extra);
-        for (c, &x) in self.data.iter_mut().zip(&self.row) {
-            c.push(x);
-        }
-    }
-
-    pub(crate) fn finish(self) -> TableRun {
-        TableRun {
-            columns: self.names.into_iter().zip(self.data).collect(),
-        }
-    }
-}
-
-/// The platen's kinetic energy at pose `q` with rates `qd`, J (for energy balances).
-pub fn table_kinetic_energy_j(table: &MultiAxisTable, q: &Coords, qd: &Coords) -> f64 {
-    let k = table.kinematics(q, qd);
-    let omega = k.omega_rad_s;
-    let twist = Wrench::new(qd[0], qd[1], qd[2], omega[0], omega[1], omega[2]);
-    0.5 * twist.dot(&(table.spatial_mass_matrix_in(&k) * twist))
-}
-
-/// The potential energy of gravity and of the struts' gas at pose `q`, J, from neutral: the
-/// centre of mass's rise times the weight, and per strut the work done on its gas,
-/// `(p·V − p₀·V₀)/(n − 1)` (`p₀·V₀·ln(V₀/V)` for `n = 1`).
-pub fn table_potential_energy_j(table: &MultiAxisTable, q: &Coords) -> f64 {
-    let p = table.platen();
-    let r = platen_model::multi_axis::rotation(q);
-    let height = q[2] + (r * p.centre_of_mass_m())[2] - p.centre_of_mass_m()[2];
-    let gravity = p.mass_kg() * platen_model::STANDARD_GRAVITY_M_S2 * height;
-    let struts: f64 = table
-        .struts()
-        .iter()
-        .enumerate()
-        .map(|(j, s)| {
-            let pose = table.strut_at(j, q);
-            // The gas volume behind the pressure, V = V₀·(p₀/p)^(1/n).
-            let volume = s.gas_volume_m3
-                * (s.pressure_pa / pose.pressure_pa).powf(1.0 / s.polytropic_exponent);
-            let n = s.polytropic_exponent;
-            if (n - 1.0).abs() < 1e-12 {
-                s.pressure_pa * s.gas_volume_m3 * (s.gas_volume_m3 / volume).ln()
-            } else {
-                (pose.pressure_pa * volume - s.pressure_pa * s.gas_volume_m3) / (n - 1.0)
-            }
-        })
-        .sum();
-    gravity + struts
 }

@@ -12,8 +12,8 @@
 
 use nalgebra::{DMatrix, Matrix3, Unit, Vector3};
 use platen_integrate::{
-    forward_closed_loop, forward_table_loop, LoopMethod, LoopRun, Motion, PoseMotion, State,
-    TableLoopRun, TableRun, Trajectory,
+    forward_closed_loop, forward_table_loop, forward_table_loop_into, LoopMethod, LoopRun, Motion,
+    PoseMotion, State, TableLoopRun, TableRun, TableSink, Trajectory,
 };
 use platen_model::multi_axis::{
     Actuator, Bearing, BearingLoad, Dof, DofSet, LinearSpecimen, Mount, MultiAxisTable, Pad,
@@ -592,6 +592,63 @@ fn the_force_balance_keeps_a_geometry_error_from_warping_the_platen() {
     // error drives the redundant verticals against each other (measured 44 %).
     assert!(with < 0.02 * weight, "{with} N with the balance");
     assert!(without > 3.0 * with, "{without} N without, {with} N with");
+}
+
+/// A sink that keeps only the names and the last row, counting the rows.
+#[derive(Default)]
+struct Last {
+    names: Vec<String>,
+    row: Vec<f64>,
+    rows: usize,
+}
+
+impl TableSink for Last {
+    fn start(&mut self, names: &[String], _samples: usize) {
+        self.names = names.to_vec();
+    }
+    fn accept(&mut self, row: &[f64]) {
+        self.row = row.to_vec();
+        self.rows += 1;
+    }
+}
+
+#[test]
+fn a_streamed_table_loop_delivers_the_rows_of_the_one_kept_in_memory() {
+    let table = six_dof_table(0.005);
+    let hyd = hydraulics_of(&table, Supply::Constant, 1e-12);
+    let controller = controller_of(DofGeometry::of_table(&table).unwrap(), 1024.0, 1e-8);
+    let t = grid(256.0, 0.5);
+    let pose = PoseMotion::new([
+        sine(&t, 0.01, 2.0),
+        still(&t),
+        still(&t),
+        still(&t),
+        still(&t),
+        still(&t),
+    ])
+    .unwrap();
+    let run = TableLoopRun {
+        table: &table,
+        hydraulics: &hyd,
+        controller: &controller,
+        specimen: None,
+        command: &pose,
+        method: LoopMethod::Rk4 {
+            steps_per_period: 4,
+        },
+    };
+    let (kept, stats) = forward_table_loop(&run).unwrap();
+    let mut last = Last::default();
+    let streamed = forward_table_loop_into(&run, &mut last).unwrap();
+    assert_eq!(streamed, stats);
+    assert_eq!(last.rows, t.len());
+    let names: Vec<&String> = kept.columns.iter().map(|(n, _)| n).collect();
+    assert_eq!(last.names.iter().collect::<Vec<_>>(), names);
+    for ((name, values), x) in kept.columns.iter().zip(&last.row) {
+        assert_eq!(values.last().unwrap().to_bits(), x.to_bits(), "{name}");
+    }
+    // The one driver's counters: a controller sample every 4 grid steps.
+    assert_eq!(stats.run.steps, 4 * (stats.controller_samples - 1));
 }
 
 // ---- the step ----------------------------------------------------------------------------

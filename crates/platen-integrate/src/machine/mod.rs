@@ -21,23 +21,24 @@
 //!
 //! # Where time is kept
 //!
-//! A plant measures time inside its span in its own units (the fraction of a grid step for a
-//! force record, seconds from the start of the advance for the closed loop): the machine
-//! passes lengths and positions in those units and asks the plant ([`Plant::seconds`],
-//! [`Plant::land`], ...) where a located event lands, so that each plant's arithmetic of time
-//! is its own and its runs keep their bits.
+//! A plant's time is its [`Clock`]'s, kept apart from its right-hand side and its events: the
+//! fraction of a grid step for a force record, seconds from the start of the advance for the
+//! closed loop ([`crate::clock`]). The machine passes lengths and positions in the clock's
+//! units and asks the clock ([`Clock::seconds`], [`Clock::land`], ...) where a located event
+//! lands, so that each driver's arithmetic of time is its own and its runs keep their bits.
 //!
 //! # The integrators
 //!
 //! A piece is one RK4 step, graded near rest ([`Grading`]), or an adaptive Dormand–Prince
 //! 5(4) that meets `rtol`/`atol` over it, scaled per state ([`Plant::error_scale`]). Dopri5
-//! that cannot meet its tolerance (the step budget [`MAX_STEPS`] spent or the step shrunk
+//! that cannot meet its tolerance (the step budget [`pieces::MAX_STEPS`] spent or the step shrunk
 //! to nothing) stops the run with [`AdaptiveFailure`] ([`Machine::take_failure`]).
 
 use std::convert::Infallible;
 
 use platen_model::{PlatenModel, Specimen};
 
+use crate::clock::{Clock, SecondsClock};
 use crate::creep::{below_stiff_speed, creep_speed_m_s, stiff_speed_m_s};
 use crate::error::{IntegrateError, Result};
 use crate::event::{
@@ -47,6 +48,11 @@ use crate::event::{
 use crate::output::{Sample, SpecimenSample};
 use crate::run::{sample_at, Kin, RunStats};
 use crate::stop::{AdaptiveFailure, Failure};
+
+mod pieces;
+
+pub(crate) use pieces::direction;
+use pieces::Grading;
 
 /// Positions in every plant's state: the platen's displacement, m,
 pub(crate) const U: usize = 0;
@@ -66,7 +72,7 @@ pub(crate) type Y<const L: usize> = [f64; L];
 /// [`Plant::rk4_quadrature`]: the start state `y`, the stage states `y2`, `y3`, `y4` and the
 /// inputs in the middle and at the end.
 pub(crate) struct Rk4Stages<'a, const L: usize, I> {
-    /// Where the step starts, in the plant's units.
+    /// Where the step starts, in the clock's units.
     pub(crate) s: f64,
     /// The step over six, s.
     pub(crate) h6: f64,
@@ -99,9 +105,9 @@ pub(crate) enum PieceMethod {
 }
 
 /// A plant: the state of what the platen drives or is driven by, its right-hand side in each
-/// friction mode, the net force that decides stick and breakaway, and where its time lands.
+/// friction mode, the net force that decides stick and breakaway, and its clock.
 ///
-/// Positions `at` are in the plant's own units of time inside the current span; `tau` is where
+/// Positions `at` are in the units of the plant's [`Clock`] inside the current span; `tau` is where
 /// the current advance started and `rest` the length left to the end of the span.
 pub(crate) trait Plant<const L: usize> {
     /// The platen model.
@@ -193,25 +199,12 @@ pub(crate) trait Plant<const L: usize> {
     /// (`atol·unit + rtol·|y|`; infinite for a quadrature that is not controlled).
     fn error_scale(&self, i: usize, y0: f64, y1: f64, rtol: f64, atol: f64) -> f64;
 
-    /// A length in the plant's units, in seconds.
-    fn seconds(&self, len: f64) -> f64;
-    /// A length in seconds, in the plant's units.
-    fn units(&self, seconds: f64) -> f64;
-    /// The time at position `at`, s.
-    fn time_s(&self, at: f64) -> f64;
-    /// The smallest bracket the event root finder is asked for, in the plant's units (the
-    /// bracket is `4ε·max(len, floor)`).
-    fn tolerance_floor(&self) -> f64;
-    /// A creep stop this close to the start of its advance has not moved time.
-    fn min_progress(&self) -> f64;
-    /// Where an event located `x` past `tau` lands (snapped onto the span's end when a
-    /// hair short of it), in the units the plant's driver counts in.
-    fn land(&self, tau: f64, x: f64, rest: f64) -> f64;
-    /// Where a committed piece of length `len` from `tau` ends, in the driver's units.
-    fn reach(&self, tau: f64, len: f64) -> f64;
-    /// Where a breakaway located `x` past `tau` lands, in the driver's units; `held` when
-    /// rounding kept friction holding there (still stuck: time must still move).
-    fn break_at(&self, tau: f64, x: f64, rest: f64, held: bool) -> f64;
+    /// Where the plant's time is kept ([`Clock`]): a force record's grid or seconds.
+    type Clock: Clock;
+    /// The plant's clock.
+    fn clock(&self) -> &Self::Clock;
+    /// The plant's clock, to move (the closed loops' driver moves it between its cuts).
+    fn clock_mut(&mut self) -> &mut Self::Clock;
 }
 
 /// The machine: a plant's state in its friction mode, with the counters of the run.
@@ -289,7 +282,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
     pub(crate) fn note(&mut self, kind: EventKind, at: f64) {
         self.stats.record(kind);
         if let Some(events) = &mut self.events {
-            events.push((self.plant.time_s(at), kind));
+            events.push((self.plant.clock().time_s(at), kind));
         }
     }
 
@@ -397,225 +390,6 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         (self.y, self.k, self.a) = (y, k, a);
     }
 
-    // ---- one-step maps -------------------------------------------------------------------
-
-    /// One RK4 step of length `len` from position `s` (`y` with rates `k1` there): the end
-    /// state and the smallest stage speed along the slip direction.
-    #[inline(always)]
-    fn rk4(&mut self, s: f64, len: f64, y: &Y<L>, k1: &Y<L>) -> (Y<L>, f64) {
-        let mode = self.mode;
-        let dt = self.plant.seconds(len);
-        let (i_mid, i_end) = (self.plant.input(s + 0.5 * len), self.plant.input(s + len));
-        let combine = |base: &Y<L>, k: &Y<L>, c: f64| {
-            let mut out = *base;
-            for i in 0..L {
-                out[i] += c * k[i];
-            }
-            out
-        };
-        let (mut k2, mut k3, mut k4) = ([0.0; L], [0.0; L], [0.0; L]);
-        let w = self.w_stiff;
-        let y2 = combine(y, k1, 0.5 * dt);
-        self.plant.rates(mode, w, i_mid, &y2, &mut k2);
-        let y3 = combine(y, &k2, 0.5 * dt);
-        self.plant.rates(mode, w, i_mid, &y3, &mut k3);
-        let y4 = combine(y, &k3, dt);
-        self.plant.rates(mode, w, i_end, &y4, &mut k4);
-        self.stats.rhs_evaluations += 3;
-        let h6 = dt / 6.0;
-        let st = Rk4Stages {
-            s,
-            h6,
-            i_mid,
-            i_end,
-            y,
-            y2: &y2,
-            y3: &y3,
-            y4: &y4,
-        };
-        let mut y1 = self.combine_rk4(&st, k1, &k2, &k3, &k4);
-        let stage_min = match mode {
-            Mode::Slip(dir) => {
-                let d = dir.sign();
-                (d * y2[V]).min(d * y3[V]).min(d * y4[V])
-            }
-            _ => f64::INFINITY,
-        };
-        self.plant.settle(mode, w, i_end, &mut y1);
-        (y1, stage_min)
-    }
-
-    /// The end of an RK4 step with stages `st` and rates `k1`…`k4`: the classical
-    /// combination, or the plant's own quadrature of a state ([`Plant::rk4_quadrature`]).
-    #[inline(always)]
-    fn combine_rk4(
-        &self,
-        st: &Rk4Stages<'_, L, P::Input>,
-        k1: &Y<L>,
-        k2: &Y<L>,
-        k3: &Y<L>,
-        k4: &Y<L>,
-    ) -> Y<L> {
-        let mut y1 = *st.y;
-        for i in 0..L {
-            y1[i] = match self.plant.rk4_quadrature(i, st) {
-                Some(yi) => yi,
-                None => y1[i] + st.h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]),
-            };
-        }
-        y1
-    }
-
-    /// Adaptive Dormand–Prince 5(4) over a length `len` from position `s` (`y` with rates
-    /// `k1` there): the end state and the smallest speed along the slip direction at its
-    /// stages.
-    fn dopri5(&mut self, s: f64, len: f64, y: &Y<L>, k1: &Y<L>, tol: (f64, f64)) -> (Y<L>, f64) {
-        let dt = self.plant.seconds(len);
-        let mode = self.mode;
-        let w = self.w_stiff;
-        let (mut yc, mut kc) = (*y, *k1);
-        let mut done = 0.0;
-        let mut stage_min = f64::INFINITY;
-        let mut hs = self.h_dopri.min(dt);
-        let mut guard = 0u32;
-        while done < dt {
-            guard += 1;
-            let last = dt - done <= hs * (1.0 + 1e-12);
-            let step = if last { dt - done } else { hs };
-            let (ks, ys) = self.dopri5_stages(s, done, step, &yc, &kc);
-            let y_new = ys[5];
-            let err = self.dopri5_error(step, &yc, &y_new, &ks, tol);
-            let factor = if err == 0.0 {
-                5.0
-            } else {
-                (0.9 * err.powf(-0.2)).clamp(0.2, 5.0)
-            };
-            // NaN counts as not accurate.
-            let accurate = err <= 1.0;
-            if !accurate {
-                let underflow = step <= 1e-14 * dt.max(1e-9);
-                if underflow || guard > MAX_STEPS {
-                    // Dopri5 gives up: the piece ends where it got to and the run stops there
-                    // with the failure (`Machine::take_failure`).
-                    let reason = if underflow {
-                        AdaptiveFailure::StepSizeUnderflow
-                    } else {
-                        AdaptiveFailure::TooManySteps { steps: MAX_STEPS }
-                    };
-                    let t_s = self.plant.time_s(s) + done;
-                    self.gave_up.get_or_insert((t_s, reason));
-                    return (yc, stage_min);
-                }
-            }
-            if accurate {
-                if let Mode::Slip(dir) = mode {
-                    let d = dir.sign();
-                    for yi in &ys {
-                        stage_min = stage_min.min(d * yi[V]);
-                    }
-                }
-                done += step;
-                yc = y_new;
-                kc = ks[6];
-                self.stats.accepted_steps += 1;
-                if !last {
-                    hs = (step * factor).min(self.h);
-                    self.h_dopri = hs;
-                }
-                if last {
-                    break;
-                }
-            } else {
-                self.stats.rejected_steps += 1;
-                hs = step * factor;
-            }
-        }
-        let input = self.plant.input(s + len);
-        self.plant.settle(mode, w, input, &mut yc);
-        (yc, stage_min)
-    }
-
-    /// The six stages of one Dormand–Prince step of `step` seconds from `yc` (rates `kc`), `done`
-    /// seconds past position `s`: the rates at the stages (the 7th at the new state) and the
-    /// stage states (the 6th is the new state).
-    fn dopri5_stages(
-        &mut self,
-        s: f64,
-        done: f64,
-        step: f64,
-        yc: &Y<L>,
-        kc: &Y<L>,
-    ) -> ([Y<L>; 7], [Y<L>; 6]) {
-        let mut ks = [[0.0; L]; 7];
-        ks[0] = *kc;
-        let mut ys = [*yc; 6];
-        for stage in 0..6 {
-            let mut yi = *yc;
-            for i in 0..L {
-                let mut acc = 0.0;
-                for (j, kj) in ks.iter().enumerate().take(stage + 1) {
-                    acc += DP_A[stage][j] * kj[i];
-                }
-                yi[i] += step * acc;
-            }
-            ys[stage] = yi;
-            let at = s + self.plant.units(done + DP_C[stage] * step);
-            let input = self.plant.input(at);
-            let mut kn = [0.0; L];
-            self.plant
-                .rates(self.mode, self.w_stiff, input, &yi, &mut kn);
-            ks[stage + 1] = kn;
-        }
-        self.stats.rhs_evaluations += 6;
-        (ks, ys)
-    }
-
-    /// The scaled error norm (the largest over the states) of a Dormand–Prince step of
-    /// `step` seconds from `yc` to `y_new` with stage rates `ks`, at tolerances `(rtol, atol)`.
-    fn dopri5_error(
-        &self,
-        step: f64,
-        yc: &Y<L>,
-        y_new: &Y<L>,
-        ks: &[Y<L>; 7],
-        (rtol, atol): (f64, f64),
-    ) -> f64 {
-        let mut err: f64 = 0.0;
-        for i in 0..L {
-            let mut e = 0.0;
-            for (j, kj) in ks.iter().enumerate() {
-                e += DP_E[j] * kj[i];
-            }
-            let sc = self.plant.error_scale(i, yc[i], y_new[i], rtol, atol);
-            err = err.max((step * e / sc).abs());
-        }
-        err
-    }
-
-    /// The current mode's state over a length `x` from position `tau`, as the method maps it
-    /// (RK4 split by `grading`); with the smallest stage speed.
-    fn piece(&mut self, tau: f64, x: f64, grading: Grading) -> (Y<L>, f64) {
-        let (mut y, mut k) = (self.y, self.k);
-        if let PieceMethod::Dopri5 { rtol, atol } = self.method {
-            return self.dopri5(tau, x, &y, &k, (rtol, atol));
-        }
-        let mut stage_min = f64::INFINITY;
-        let mut s = tau;
-        for (i, &p) in grading.pieces().iter().enumerate() {
-            let len = p * x;
-            if i > 0 {
-                let input = self.plant.input(s);
-                self.plant.rates(self.mode, self.w_stiff, input, &y, &mut k);
-                self.stats.rhs_evaluations += 1;
-            }
-            let (y1, m) = self.rk4(s, len, &y, &k);
-            y = y1;
-            stage_min = stage_min.min(m);
-            s += len;
-        }
-        (y, stage_min)
-    }
-
     // ---- events --------------------------------------------------------------------------
 
     /// The current mode's event function at `y` under `input`: positive until the mode ends.
@@ -645,7 +419,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
     /// the cubic Hermite interpolant of the speed (slip) or of `F_s ∓ N` (stick) touches zero.
     #[allow(clippy::too_many_arguments)]
     fn dips(&self, len: f64, i0: P::Input, y1: &Y<L>, i1: P::Input, k1: &Y<L>, a1: f64) -> bool {
-        let span = self.plant.seconds(len);
+        let span = self.plant.clock().seconds(len);
         match self.mode {
             Mode::Slip(dir) => {
                 let d = dir.sign();
@@ -671,71 +445,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
             u_m: self.y[U],
             v_m_s: self.y[V],
         };
-        IntegrateError::failed(self.plant.time_s(at), cause)
-    }
-
-    /// One RK4 step over the rest of a span of length 1, from position `tau`, in slip with
-    /// direction `direction::<POSITIVE>()` (the platen moving, `v ≠ 0`), committed when it is
-    /// safe: from `tau = 0` exactly the first try of [`Machine::advance`] (a single piece of
-    /// length 1), the same operations in the same order, so what it commits is bit for bit
-    /// what [`Machine::advance`] would. Returns whether it committed; if not, nothing has
-    /// changed but the counters of a plant that counts tried steps
-    /// ([`Plant::COUNTS_TRIED_STEPS`]), and the span is taken again by [`Machine::advance`].
-    #[inline(always)]
-    pub(crate) fn slip_fast<const POSITIVE: bool>(&mut self, tau: f64) -> bool {
-        let dir = direction::<POSITIVE>();
-        let h = self.plant.seconds(1.0 - tau);
-        let (i_mid, i_end) = (self.plant.input(0.5 * (1.0 + tau)), self.plant.input(1.0));
-        let (y, k1) = (&self.y, &self.k);
-        let hh = 0.5 * h;
-        let (mut k2, mut k3, mut k4) = ([0.0; L], [0.0; L], [0.0; L]);
-        let mut y2 = *y;
-        for i in 0..L {
-            y2[i] += hh * k1[i];
-        }
-        self.plant.slip_rates::<POSITIVE>(i_mid, &y2, &mut k2);
-        let mut y3 = *y;
-        for i in 0..L {
-            y3[i] += hh * k2[i];
-        }
-        self.plant.slip_rates::<POSITIVE>(i_mid, &y3, &mut k3);
-        let mut y4 = *y;
-        for i in 0..L {
-            y4[i] += h * k3[i];
-        }
-        self.plant.slip_rates::<POSITIVE>(i_end, &y4, &mut k4);
-        let st = Rk4Stages {
-            s: tau,
-            h6: h / 6.0,
-            i_mid,
-            i_end,
-            y,
-            y2: &y2,
-            y3: &y3,
-            y4: &y4,
-        };
-        let y1 = self.combine_rk4(&st, k1, &k2, &k3, &k4);
-        if P::COUNTS_TRIED_STEPS {
-            self.stats.rhs_evaluations += 3;
-        }
-        let stage_min = (dir * y2[V]).min(dir * y3[V]).min(dir * y4[V]);
-        if !(dir * y1[V] > 0.0 && stage_min > 0.0 && self.plant.is_finite(&y1)) {
-            return false;
-        }
-        let mut k_end = [0.0; L];
-        let a1 = self.plant.slip_rates::<POSITIVE>(i_end, &y1, &mut k_end);
-        if P::COUNTS_TRIED_STEPS {
-            self.stats.rhs_evaluations += 1;
-        }
-        let (d0, d1) = (dir * self.a * h, dir * a1 * h);
-        if dip_to_zero(dir * self.y[V], dir * y1[V], d0, d1).is_some() || !a1.is_finite() {
-            return false;
-        }
-        if !P::COUNTS_TRIED_STEPS {
-            self.stats.rhs_evaluations += 4;
-        }
-        (self.y, self.k, self.a) = (y1, k_end, a1);
-        true
+        IntegrateError::failed(self.plant.clock().time_s(at), cause)
     }
 
     /// Advances over a whole span of length 1 (a grid step) through every mode and event:
@@ -759,21 +469,23 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
             }
             if events > MAX_EVENTS_PER_STEP {
                 let stalled = Failure::EventLoopStalled { events };
-                return Err(IntegrateError::failed(self.plant.time_s(tau), stalled));
+                return Err(IntegrateError::failed(
+                    self.plant.clock().time_s(tau),
+                    stalled,
+                ));
             }
         }
     }
 
     /// Advances over `span` seconds through every mode and event, for a plant whose positions
-    /// count from its own clock (`clock`: the closed loops, whose controller cuts time into
+    /// count from its own clock in seconds (the closed loops, whose controller cuts time into
     /// segments): each piece moves the clock by its length. The same guards as
     /// [`Machine::advance_span`]: where Dopri5 gave up, and more than
     /// [`MAX_EVENTS_PER_STEP`] events (stiff pieces not counted).
-    pub(crate) fn advance_clocked(
-        &mut self,
-        span: f64,
-        clock: fn(&mut P) -> &mut f64,
-    ) -> Result<()> {
+    pub(crate) fn advance_clocked(&mut self, span: f64) -> Result<()>
+    where
+        P: Plant<L, Clock = SecondsClock>,
+    {
         let mut tau = 0.0;
         let mut events = 0u32;
         while tau < span {
@@ -782,13 +494,13 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
                 return Err(IntegrateError::failed(t_s, Failure::AdaptiveFailed(reason)));
             }
             tau += at;
-            *clock(&mut self.plant) += at;
+            self.plant.clock_mut().t += at;
             if !(self.stiff_cut && at > 0.0) {
                 events += 1;
             }
             if events > MAX_EVENTS_PER_STEP {
                 let stalled = Failure::EventLoopStalled { events };
-                return Err(IntegrateError::failed(*clock(&mut self.plant), stalled));
+                return Err(IntegrateError::failed(self.plant.clock().t, stalled));
             }
         }
         Ok(())
@@ -796,7 +508,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
 
     /// Advances in the current mode from position `tau` over at most `rest`, to the end or to
     /// the mode's next event (its reset applied). Returns where the advance stopped, in the
-    /// units of the plant's driver ([`Plant::reach`], [`Plant::land`]).
+    /// units of the plant's driver ([`Clock::reach`], [`Clock::land`]).
     pub(crate) fn advance(&mut self, tau: f64, rest: f64) -> Result<f64> {
         let i0 = self.plant.input(tau);
         let slip = matches!(self.mode, Mode::Slip(_));
@@ -806,7 +518,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
             let w_stiff = stiff_speed_m_s(self.plant.model(), self.y[U], self.h);
             if self.plant.creeps_from_rest(dir, tau, &self.y, w_stiff) {
                 self.enter(Mode::Creep(dir), i0);
-                return Ok(self.plant.reach(tau, 0.0));
+                return Ok(self.plant.clock().reach(tau, 0.0));
             }
         }
         let (try_grading, event_grading) = match (slip, from_rest) {
@@ -814,19 +526,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
             (true, false) => (Grading::Single, Grading::End),
             _ => (Grading::Single, Grading::Single),
         };
-        let mut len = rest;
-        self.stiff_cut = false;
-        if self.is_rk4() {
-            // A mode the fixed step does not resolve (an orifice near its laminar drop at
-            // full opening): equal pieces, each within RK4's accuracy of it.
-            let pieces = (rest * self.plant.stiff_rate(&self.y))
-                .ceil()
-                .min(MAX_STIFF_PIECES);
-            if pieces > 1.0 {
-                len = rest / pieces;
-                self.stiff_cut = true;
-            }
-        }
+        let mut len = self.first_length(rest);
         for _ in 0..=MAX_HALVINGS {
             let (y1, stage_min) = self.piece(tau, len, try_grading);
             if let Some(at) = self.stiff_slip(tau, rest, &y1) {
@@ -835,7 +535,8 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
             if !self.plant.is_finite(&y1) {
                 return Err(self.non_finite(tau));
             }
-            self.plant.check(&y1, self.plant.time_s(tau + len))?;
+            self.plant
+                .check(&y1, self.plant.clock().time_s(tau + len))?;
             let i1 = self.plant.input(tau + len);
             let g1 = self.event_g(i1, &y1);
             if g1 > 0.0 && stage_min > 0.0 {
@@ -847,11 +548,11 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
                         return Err(self.non_finite(tau + len));
                     }
                     if self.mode == Mode::Stick {
-                        self.stats.stick_time_s += self.plant.seconds(len);
+                        self.stats.stick_time_s += self.plant.clock().seconds(len);
                     }
-                    let t_s = self.plant.time_s(tau + len);
+                    let t_s = self.plant.clock().time_s(tau + len);
                     self.commit_with(y1, k1, a1, i1, t_s);
-                    return Ok(self.plant.reach(tau, len));
+                    return Ok(self.plant.clock().reach(tau, len));
                 }
             } else if g1 <= 0.0 {
                 let (y2, g2) = if event_grading == try_grading {
@@ -861,15 +562,8 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
                     (y2, self.event_g(i1, &y2))
                 };
                 if g2 <= 0.0 {
-                    let g0 = self.event_g(i0, &self.y);
-                    let tolerance = 4.0 * f64::EPSILON * len.max(self.plant.tolerance_floor());
-                    let Ok(found) = locate_zero_velocity(len, g0, (y2, g2), tolerance, |x| {
-                        self.stats.root_iterations += 1;
-                        let (y, _) = self.piece(tau, x, event_grading);
-                        let g = self.event_g(self.plant.input(tau + x), &y);
-                        Ok::<_, Infallible>((y, g))
-                    });
-                    let (x, y_event) = found.unwrap_or((0.0, self.y));
+                    let x = self.locate(tau, len, i0, (y2, g2), event_grading);
+                    let (x, y_event) = x.unwrap_or((0.0, self.y));
                     return Ok(self.event(tau, x, rest, y_event));
                 }
             }
@@ -878,6 +572,47 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         // A piece of 2⁻⁶⁰ of the span still not safe: the event is here.
         let y = self.y;
         Ok(self.event(tau, 0.0, rest, y))
+    }
+
+    /// The first piece's length over the rest `rest` of a span: all of it, or for RK4 an
+    /// equal share of it where a mode the fixed step does not resolve (an orifice near its
+    /// laminar drop at full opening) asks for pieces each within RK4's accuracy of it
+    /// ([`Machine::stiff_cut`] then set).
+    fn first_length(&mut self, rest: f64) -> f64 {
+        let mut len = rest;
+        self.stiff_cut = false;
+        if self.is_rk4() {
+            let pieces = (rest * self.plant.stiff_rate(&self.y))
+                .ceil()
+                .min(MAX_STIFF_PIECES);
+            if pieces > 1.0 {
+                len = rest / pieces;
+                self.stiff_cut = true;
+            }
+        }
+        len
+    }
+
+    /// The current mode's event inside a piece of length `len` from `tau` (input `i0` there),
+    /// found at its end (`y2`, event function `g2 ≤ 0`): located by Illinois root finding on
+    /// the map of `grading`'s pieces, with its position and state there.
+    fn locate(
+        &mut self,
+        tau: f64,
+        len: f64,
+        i0: P::Input,
+        (y2, g2): (Y<L>, f64),
+        grading: Grading,
+    ) -> Option<(f64, Y<L>)> {
+        let g0 = self.event_g(i0, &self.y);
+        let tolerance = 4.0 * f64::EPSILON * len.max(self.plant.clock().tolerance_floor());
+        let Ok(found) = locate_zero_velocity(len, g0, (y2, g2), tolerance, |x| {
+            self.stats.root_iterations += 1;
+            let (y, _) = self.piece(tau, x, grading);
+            let g = self.event_g(self.plant.input(tau + x), &y);
+            Ok::<_, Infallible>((y, g))
+        });
+        found
     }
 
     /// Where Dopri5 gave up slipping below the stiff speed (a platen started, or
@@ -898,7 +633,10 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
             return None;
         }
         self.gave_up = None;
-        let x = self.plant.units(t_s - self.plant.time_s(tau));
+        let x = self
+            .plant
+            .clock()
+            .units(t_s - self.plant.clock().time_s(tau));
         let mut y_event = *y;
         y_event[V] = 0.0;
         Some(self.event(tau, x, rest, y_event))
@@ -907,13 +645,13 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
     /// The reset at the current mode's event, located `x` past `tau` (`rest` to the span's
     /// end) with state `y_event` there. Returns where time landed, in the driver's units.
     fn event(&mut self, tau: f64, x: f64, rest: f64, y_event: Y<L>) -> f64 {
-        let mut at = self.plant.land(tau, x, rest);
+        let mut at = self.plant.clock().land(tau, x, rest);
         match self.mode {
             Mode::Slip(from) => {
                 let mut y = y_event;
                 let input = self.plant.input(at);
                 if let Some((mode, kind)) = self.plant.arrive(input, &mut y) {
-                    self.commit(y, input, self.plant.time_s(at));
+                    self.commit(y, input, self.plant.clock().time_s(at));
                     self.enter(mode, input);
                     if let Some(kind) = kind {
                         self.note(kind, at);
@@ -921,7 +659,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
                     return at;
                 }
                 y[V] = 0.0;
-                self.commit(y, input, self.plant.time_s(at));
+                self.commit(y, input, self.plant.clock().time_s(at));
                 let f_eff = self.plant.effective_force(input, &self.y);
                 let (mode, kind) = arrive_at_rest(self.plant.model(), self.y[U], f_eff, from);
                 self.enter(mode, input);
@@ -934,7 +672,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
             Mode::Creep(dir) => {
                 let start = (self.y, self.k);
                 let mut input = self.plant.input(at);
-                self.commit(y_event, input, self.plant.time_s(at));
+                self.commit(y_event, input, self.plant.clock().time_s(at));
                 let sn = dir.sign() * self.plant.net(input, &self.y);
                 let fs = self.plant.model().static_threshold_n(self.y[U]);
                 if sn - fs <= self.exit_level(dir, self.y[U]) - sn {
@@ -943,7 +681,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
                     self.y[V] = 0.0;
                     let f_eff = self.plant.effective_force(input, &self.y);
                     let mut mode = mode_at_rest(self.plant.model(), self.y[U], f_eff);
-                    if mode == Mode::Slip(dir) && x <= self.plant.min_progress() {
+                    if mode == Mode::Slip(dir) && x <= self.plant.clock().min_progress() {
                         // The stop rounded onto the start of the advance, where the net force
                         // at rest is a hair along the motion: creeping on from here would
                         // locate the same stop again without moving time. Step just past it,
@@ -995,22 +733,24 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         } else {
             self.piece(tau, x_b, Grading::Single).0
         };
-        self.stats.stick_time_s += self.plant.seconds(x_b);
-        let input = self.plant.input(self.plant.break_at(tau, x_b, rest, false));
-        self.commit(y, input, self.plant.time_s(tau + x_b));
+        self.stats.stick_time_s += self.plant.clock().seconds(x_b);
+        let input = self
+            .plant
+            .input(self.plant.clock().break_at(tau, x_b, rest, false));
+        self.commit(y, input, self.plant.clock().time_s(tau + x_b));
         let net = self.plant.net(input, &self.y);
         if net.abs() <= fs {
             // Rounding kept friction holding to the end of the span: still stuck.
             self.enter(Mode::Stick, input);
-            return self.plant.break_at(tau, x_b, rest, true);
+            return self.plant.clock().break_at(tau, x_b, rest, true);
         }
-        let at = self.plant.break_at(tau, x_b, rest, false);
+        let at = self.plant.clock().break_at(tau, x_b, rest, false);
         self.note(EventKind::Breakaway, at);
         self.enter(Mode::Slip(Direction::of_sign(net)), input);
         at
     }
 
-    /// A creep stop located `x ≤` [`Plant::min_progress`] past `tau` (from the state and
+    /// A creep stop located `x ≤` [`Clock::min_progress`] past `tau` (from the state and
     /// rates `start`) where the net force at rest still drives the creep on in `dir`: creeps
     /// from `start` to the first of `x + 4ε, x + 8ε, …` ([`just_past`]) where it does not, or
     /// to the span's end, and accepts that state at rest (`v = 0`). Returns where, in the
@@ -1033,142 +773,19 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         if x_b > x {
             let (y, _) = self.piece(tau, x_b, Grading::Single);
             let at = tau + x_b;
-            self.commit(y, self.plant.input(at), self.plant.time_s(at));
+            self.commit(y, self.plant.input(at), self.plant.clock().time_s(at));
         } else {
             (self.y, self.k, self.a) = stopped;
         }
         self.y[V] = 0.0;
-        self.plant.land(tau, x_b, rest)
+        self.plant.clock().land(tau, x_b, rest)
     }
 }
-
-/// The Dormand–Prince 5(4) tableau: nodes.
-const DP_C: [f64; 6] = [0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0];
-/// The Dormand–Prince 5(4) tableau: stage coefficients (the last row is the 5th-order
-/// solution, so the 7th stage is the rate at the new state: first same as last).
-const DP_A: [[f64; 6]; 6] = [
-    [0.2, 0.0, 0.0, 0.0, 0.0, 0.0],
-    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
-    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
-    [
-        19372.0 / 6561.0,
-        -25360.0 / 2187.0,
-        64448.0 / 6561.0,
-        -212.0 / 729.0,
-        0.0,
-        0.0,
-    ],
-    [
-        9017.0 / 3168.0,
-        -355.0 / 33.0,
-        46732.0 / 5247.0,
-        49.0 / 176.0,
-        -5103.0 / 18656.0,
-        0.0,
-    ],
-    [
-        35.0 / 384.0,
-        0.0,
-        500.0 / 1113.0,
-        125.0 / 192.0,
-        -2187.0 / 6784.0,
-        11.0 / 84.0,
-    ],
-];
-/// The Dormand–Prince 5(4) tableau: the error estimate's weights (5th − 4th order).
-const DP_E: [f64; 7] = [
-    71.0 / 57600.0,
-    0.0,
-    -71.0 / 16695.0,
-    71.0 / 1920.0,
-    -17253.0 / 339200.0,
-    22.0 / 525.0,
-    -1.0 / 40.0,
-];
-
-/// Most Dopri5 steps in one piece before it gives up ([`AdaptiveFailure::TooManySteps`]).
-pub(crate) const MAX_STEPS: u32 = 100_000;
 
 /// The most pieces one RK4 advance is cut into for a stiff mode ([`Plant::stiff_rate`]): a
 /// rate that diverges (a chamber emptying at the end stop, `β/V` with `V → 0`) must not stall
 /// time. 2¹⁶ pieces of a 1024 Hz controller's period resolve rates up to 6.7e7 1/s.
 pub(crate) const MAX_STIFF_PIECES: f64 = 65_536.0;
-
-/// The friction direction of slip as a number: `+1.0` for `POSITIVE`, `−1.0` otherwise.
-///
-/// The slip path is monomorphised over the direction so that, once the model's
-/// `slip_rates` is inlined, `direction·v` and `direction·D` fold to `v`/`−v` and `D`/`−D`
-/// (exact for ±1, so the results are bit for bit those of a run-time direction) and two
-/// multiplications leave the dependency chain of every stage.
-#[inline(always)]
-pub(crate) const fn direction<const POSITIVE: bool>() -> f64 {
-    if POSITIVE {
-        1.0
-    } else {
-        -1.0
-    }
-}
-
-/// How a slip interval is split into RK4 sub-steps.
-///
-/// Near `v = 0` the `|v|^α` law (α < 1) makes the right-hand side singular like `√(t − t*)`,
-/// which cuts a single RK4 step's accuracy to `O(h^1.5)` (about 1e-7 m/s per event at
-/// h = 1/1024 s on the paper's model). Geometric sub-steps that halve towards the singular
-/// end make the step that holds it `2⁵` times shorter, which removes that error to the
-/// 1e-10 m level, at the cost of a few extra stages per event only.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum Grading {
-    /// One plain RK4 step.
-    Single,
-    /// Singular at the start (leaving rest).
-    Start,
-    /// Singular at the end (arriving at rest).
-    End,
-    /// Singular at both ends.
-    Both,
-}
-
-const GRADED_START: [f64; 6] = [
-    1.0 / 32.0,
-    1.0 / 32.0,
-    1.0 / 16.0,
-    1.0 / 8.0,
-    1.0 / 4.0,
-    1.0 / 2.0,
-];
-const GRADED_END: [f64; 6] = [
-    1.0 / 2.0,
-    1.0 / 4.0,
-    1.0 / 8.0,
-    1.0 / 16.0,
-    1.0 / 32.0,
-    1.0 / 32.0,
-];
-const GRADED_BOTH: [f64; 12] = [
-    1.0 / 64.0,
-    1.0 / 64.0,
-    1.0 / 32.0,
-    1.0 / 16.0,
-    1.0 / 8.0,
-    1.0 / 4.0,
-    1.0 / 4.0,
-    1.0 / 8.0,
-    1.0 / 16.0,
-    1.0 / 32.0,
-    1.0 / 64.0,
-    1.0 / 64.0,
-];
-
-impl Grading {
-    pub(crate) fn pieces(self) -> &'static [f64] {
-        match self {
-            Grading::Single => &[1.0],
-            Grading::Start => &GRADED_START,
-            Grading::End => &GRADED_END,
-            Grading::Both => &GRADED_BOTH,
-        }
-    }
-}
 
 /// Halvings of a careful piece before its start is taken as a state at rest (2⁻⁶⁰ of a step:
 /// the speed there is below what a piece that short can resolve).
