@@ -314,7 +314,10 @@ fn three_component_drives_iterated_at_half_level_are_scaled_up_and_run_at_full_l
     let achieved = &s["drive"]["achieved"];
     // Doubled exactly in the JSON; serde_json's default float parser (no `float_roundtrip`)
     // may read a printed number one unit in the last place off, so compare to 1e-15.
-    let (full, twice_low) = (x(achieved, "peak_drive_u_m"), 2.0 * x(low, "peak_drive_u_m"));
+    let (full, twice_low) = (
+        x(achieved, "peak_drive_u_m"),
+        2.0 * x(low, "peak_drive_u_m"),
+    );
     assert!(
         (full - twice_low).abs() <= 1e-15 * twice_low,
         "{full} against {twice_low}"
