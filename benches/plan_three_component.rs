@@ -86,15 +86,16 @@ fn bench(c: &mut Criterion) {
     ];
     for (name, file) in &tables {
         let plan = plan_multi_axis(&path, file, &targets, &settings, &mut |_| {}).unwrap();
-        let records = &plan.iteration.records;
-        let best = plan.iteration.best_record();
+        let it = plan.iteration().expect("the target fits: iterated");
+        let records = &it.records;
+        let best = it.best_record();
         println!(
             "{name}: {} iterations, overall acceleration NRMSE {:.2} % → {:.2} % (iteration {}), \
              feasible {}",
             records.len() - 1,
             100.0 * records[0].acceleration_nrmse,
             100.0 * best.acceleration_nrmse,
-            plan.iteration.best,
+            it.best,
             plan.feasibility.feasible
         );
     }
@@ -111,8 +112,8 @@ fn bench(c: &mut Criterion) {
             timed(b, &id, || {
                 plan_multi_axis(&path, file, black_box(&targets), &settings, &mut |_| {})
                     .unwrap()
-                    .iteration
-                    .best
+                    .iteration()
+                    .map(|it| it.best)
             })
         });
     }

@@ -57,7 +57,8 @@
 //!   noise.
 //! * [`iterate()`](fn@iterate), [`iterate_with`] ([`mod@iterate`]): offline drive iteration
 //!   `D_{k+1} = D_k + g·Ĥ⁻¹(T − R_k)` with a regularised inverse in a band, and its stop
-//!   criteria.
+//!   criteria; written once for any number of coupled axes ([`iterate_axes`],
+//!   [`iterate_mimo`], [`DriveCorrection`]), one axis being the case `p = 1`.
 //! * [`plan()`](fn@plan), [`plan_observed`], [`plan_table`]: all of it, with the summary
 //!   `platen plan --json` prints ([`PlanSummary`]).
 //!
@@ -71,7 +72,9 @@
 
 #![warn(missing_docs)]
 
+mod acceptance;
 pub mod baseline;
+mod correction;
 mod error;
 pub mod feasibility;
 pub mod frf;
@@ -80,6 +83,7 @@ pub mod mimo;
 mod plan;
 pub mod rrs;
 pub mod six_dof;
+mod steps;
 mod table;
 mod target;
 
@@ -90,22 +94,21 @@ pub use feasibility::{
 };
 pub use frf::{FrequencyResponse, FrfSource, NoiseSettings};
 pub use iterate::{
-    iterate, iterate_observed, iterate_with, spectrum_acceptance, Iteration, IterationRecord,
-    IterationSettings, Response, SpectrumAcceptance, SpectrumMiss, Stop, ACCEPTANCE_BAND,
+    iterate, iterate_axes, iterate_observed, iterate_with, spectrum_acceptance, Correction,
+    DriveCorrection, Iteration, IterationRecord, IterationSettings, Response, SpectrumAcceptance,
+    SpectrumMiss, Stop, TransferMatrix, ACCEPTANCE_BAND,
 };
-pub use mimo::{
-    iterate_mimo, AxisRecord, AxisTarget, MimoCorrection, MimoIteration, MimoRecord, MimoResponse,
-    TransferMatrix,
-};
+pub use mimo::{iterate_mimo, AxisRecord, AxisTarget, MimoIteration, MimoRecord};
 pub use plan::{
-    load_rig, plan, plan_observed, plan_table, write_drive, DriveSummary, FrfSummary, IteratedAt,
-    Plan, PlanSettings, PlanSummary, PlannedDrive, TargetSummary,
+    load_rig, plan, plan_observed, plan_table, write_drive, DriveSummary, FrfSummary, Plan,
+    PlanSettings, PlanSummary, PlannedDrive, TargetSummary,
 };
 pub use rrs::{RequiredSpectrum, DEFAULT_RRS_DAMPING};
 pub use six_dof::{
-    plan_multi_axis, pose_command, AxisTargets, TableAchieved, TableFeasibility, TableLimitUse,
-    TablePlan, TablePlanSettings, TablePlant,
+    plan_multi_axis, pose_command, AxisTargets, TableAchieved, TableFeasibility, TableIteratedAt,
+    TableLimitUse, TablePlan, TablePlanSettings, TablePlannedDrive, TablePlant,
 };
+pub use steps::{IteratedAt, SCALED_UP_ERROR_WARNED};
 pub use table::{Achieved, Table};
 pub use target::{
     enveloped_sines_m_s2, synthetic_three_component_m_s2, Target, TargetKind, MIN_TARGET_SAMPLES,

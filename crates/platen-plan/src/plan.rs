@@ -9,16 +9,18 @@ use platen_io::csv::write_csv_atomic;
 use platen_scenario::{LimitsSummary, LoadedRig};
 
 use crate::baseline::{peak, rms, BaselineSettings, TargetMotion};
-use crate::error::{check_setting, PlanError, Result};
+use crate::error::{PlanError, Result};
 use crate::feasibility::{
     failing, feasibility, limit_uses, limits_summary, Feasibility, LimitUse, MaxScale,
     MaxScaleSettings,
 };
 use crate::iterate::{
-    iterate_observed, record_of, spectrum_acceptance, IterationRecord, IterationSettings, Response,
-    SpectrumAcceptance, Stop, ACCEPTANCE_BAND,
+    iterate_observed, record_of, IterationRecord, IterationSettings, SpectrumAcceptance, Stop,
 };
 use crate::rrs::RequiredSpectrum;
+use crate::steps::{
+    acceptance, iteration_level, on_controller_rate, scaled_up, IteratedAt, Resampled,
+};
 use crate::table::{Achieved, Table};
 use crate::target::Target;
 use crate::Iteration;
@@ -33,7 +35,7 @@ pub struct PlanSettings {
     /// The search of the largest scale (`None`: not searched).
     pub max_scale: Option<MaxScaleSettings>,
     /// The required response spectrum the drive's run is accepted against (`None`: the
-    /// target's own spectrum, [`ACCEPTANCE_BAND`] either way).
+    /// target's own spectrum, [`crate::ACCEPTANCE_BAND`] either way).
     pub rrs: Option<RequiredSpectrum>,
     /// The level the drive is iterated at, a fraction of the target in `(0, 1]` (`None` or 1:
     /// at full level). Below 1 the drive is iterated on the target scaled by it, as labs
@@ -94,19 +96,6 @@ pub struct PlannedDrive {
     pub spectrum_acceptance: SpectrumAcceptance,
     /// Where the drive was iterated at a low level and scaled up (`None`: at full level).
     pub iterated_at: Option<IteratedAt>,
-}
-
-/// A drive iterated at a low level and scaled up ([`PlanSettings::iterate_at`]). The
-/// iteration's `drive_u_m` and `achieved` are then the scaled-up drive and its full-level run;
-/// its records are the low-level runs' (their NRMSEs are relative, so they compare).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct IteratedAt {
-    /// The level, a fraction of the target.
-    pub level: f64,
-    /// The best iteration's record at that level.
-    pub at_level: IterationRecord,
-    /// The scaled-up drive's run at full level: the predicted full-level error.
-    pub full_level: IterationRecord,
 }
 
 impl Plan {
@@ -191,26 +180,11 @@ pub fn plan_table(
     settings: &PlanSettings,
     on_run: &mut dyn FnMut(usize),
 ) -> Result<Plan> {
-    if let Some(level) = settings.iterate_at {
-        check_setting(
-            "iterate_at",
-            level,
-            level > 0.0 && level <= 1.0,
-            "a fraction of the target in (0, 1]",
-        )?;
-    }
+    iteration_level(settings.iterate_at)?;
     // A target faster than the controller is put on its rate (anti-aliased), with a notice.
-    let controller_hz = table.controller_rate_hz();
     let mut notices = Vec::new();
-    let resampled;
-    let on_controller = if target.sample_rate_hz() > controller_hz * (1.0 + 1e-9) {
-        resampled = target.resampled_to(controller_hz)?;
-        notices.push(resample_notice(target.sample_rate_hz(), controller_hz));
-        &resampled
-    } else {
-        target
-    };
-    let motion = target_motion(table, on_controller, settings)?;
+    let on_controller = on_controller_rate(target, table.controller_rate_hz(), &mut notices)?;
+    let motion = target_motion(table, &on_controller, settings)?;
     if let Some(rrs) = &settings.rrs {
         rrs.check_rate(1.0 / motion.interval_s())?;
     }
@@ -241,60 +215,6 @@ pub fn plan_table(
         feasibility,
         drive,
         warnings,
-    })
-}
-
-/// The notice of a target sampled at `from_hz`, faster than the controller's `to_hz`, put
-/// on the controller's rate ([`Target::resampled_to`]).
-pub(crate) fn resample_notice(from_hz: f64, to_hz: f64) -> String {
-    format!(
-        "the target's {from_hz:.6} Hz is faster than the controller's {to_hz} Hz: it was \
-         resampled to {to_hz} Hz, low-passed at {:.1} Hz (its content below {:.1} Hz kept \
-         within 0.5 %, above {:.1} Hz removed)",
-        0.4 * to_hz,
-        0.3 * to_hz,
-        0.5 * to_hz
-    )
-}
-
-/// The warning of a spectrum acceptance check that fails (`None` when within), `what` naming
-/// the spectrum ("the drive's achieved response spectrum", with its axis on a multi-axis
-/// table).
-pub(crate) fn acceptance_warning(what: &str, acceptance: &SpectrumAcceptance) -> Option<String> {
-    let miss = &acceptance.outside;
-    let (first, last) = (miss.first()?, miss.last()?);
-    Some(format!(
-        "{what} ({:.0} % damped) is outside {:+.0}/{:+.0} % of {} at {} of {} periods, from \
-         {:.3} to {:.3} s",
-        100.0 * acceptance.damping_ratio,
-        100.0 * acceptance.band.0,
-        100.0 * acceptance.band.1,
-        acceptance.required_name(),
-        miss.len(),
-        acceptance.count,
-        first.period_s,
-        last.period_s
-    ))
-}
-
-/// How many times the low-level error a drive iterated at a low level and scaled up may
-/// reach at full level before the plan warns: beyond it the table does not scale between the
-/// levels, and the low-level iteration did not converge on the full-level drive.
-pub const SCALED_UP_ERROR_WARNED: f64 = 1.5;
-
-/// The warning of a drive iterated at `level` whose full-level run's acceleration NRMSE
-/// `full` exceeds [`SCALED_UP_ERROR_WARNED`] times its low-level one `low` (`None` below).
-pub(crate) fn scaled_up_warning(level: f64, full: f64, low: f64) -> Option<String> {
-    (full > SCALED_UP_ERROR_WARNED * low).then(|| {
-        format!(
-            "the drive iterated at {:.0} % predicts {:.2} % acceleration NRMSE at full level, \
-         against {:.2} % at its level: the table does not scale between the two (friction \
-         weighs more at a low level, the valves' orifice law is not linear); iterate at a \
-         higher level",
-            100.0 * level,
-            100.0 * full,
-            100.0 * low
-        )
     })
 }
 
@@ -401,31 +321,19 @@ fn planned_drive(
     let mut iteration;
     let iterated_at = if level < 1.0 {
         iteration = iterate_observed(table, &motion.scaled(level), settings, on_run)?;
-        let at_level = *iteration.best_record();
-        let drive: Vec<f64> = iteration.drive_u_m.iter().map(|d| d / level).collect();
-        let full = table.run_or_end_stop(&motion.t_s, &drive, "the full-level drive")?;
-        let full_level = record_of(iteration.best, &full, &drive, motion, &settings.spectrum)?;
-        if let Some(stop) = full.end_stop() {
-            warnings.push(format!(
-                "the drive iterated at {:.0} % and scaled up drives the platen to the end of \
-                 its actuators at {:.3} s (u = {:.3} m): its full-level figures end there",
-                100.0 * level,
-                stop.0,
-                stop.1
-            ));
-        }
-        warnings.extend(scaled_up_warning(
+        let best = iteration.best;
+        Some(scaled_up(
             level,
-            full_level.acceleration_nrmse,
-            at_level.acceleration_nrmse,
-        ));
-        iteration.drive_u_m = drive;
-        iteration.achieved = full;
-        Some(IteratedAt {
-            level,
-            at_level,
-            full_level,
-        })
+            &mut iteration,
+            |d, level| d.iter().map(|d| d / level).collect(),
+            |drive| {
+                let full = table.run_or_end_stop(&motion.t_s, drive, "the full-level drive")?;
+                let record = record_of(best, &full, drive, motion, &settings.spectrum)?;
+                Ok((full, record))
+            },
+            |r| r.acceleration_nrmse,
+            warnings,
+        )?)
     } else {
         iteration = iterate_observed(table, motion, settings, on_run)?;
         None
@@ -449,22 +357,14 @@ fn planned_drive(
              run"
         ));
     }
-    let fs = 1.0 / motion.interval_s();
-    let achieved_a = iteration.achieved.a_m_s2();
-    let spectrum_acceptance = match &plan_settings.rrs {
-        Some(rrs) => rrs.acceptance(fs, achieved_a, ACCEPTANCE_BAND)?,
-        None => spectrum_acceptance(
-            &settings.spectrum,
-            fs,
-            &motion.a_m_s2,
-            achieved_a,
-            ACCEPTANCE_BAND,
-        )?,
-    };
-    warnings.extend(acceptance_warning(
+    let spectrum_acceptance = acceptance(
+        plan_settings.rrs.as_ref(),
+        &settings.spectrum,
+        1.0 / motion.interval_s(),
+        (&motion.a_m_s2, &iteration.achieved.a_m_s2),
         "the drive's achieved response spectrum",
-        &spectrum_acceptance,
-    ));
+        warnings,
+    )?;
     Ok(PlannedDrive {
         limits: limits_summary(table, &iteration.achieved),
         frf: FrfSummary::new(settings, &iteration),
@@ -678,5 +578,14 @@ impl Plan {
             }),
             warnings: self.warnings.clone(),
         }
+    }
+}
+
+impl Resampled for Target {
+    fn sample_rate_hz(&self) -> f64 {
+        Target::sample_rate_hz(self)
+    }
+    fn resampled_to(&self, rate_hz: f64) -> Result<Self> {
+        Target::resampled_to(self, rate_hz)
     }
 }

@@ -51,10 +51,10 @@ struct Linear {
 }
 
 impl Response for Linear {
-    fn u_m(&self) -> &[f64] {
+    fn u_m(&self, _axis: usize) -> &[f64] {
         &self.u
     }
-    fn a_m_s2(&self) -> &[f64] {
+    fn a_m_s2(&self, _axis: usize) -> &[f64] {
         &self.a
     }
 }

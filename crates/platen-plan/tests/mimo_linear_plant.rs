@@ -9,9 +9,7 @@ use std::f64::consts::TAU;
 use rustfft::num_complex::Complex64 as C64;
 use rustfft::FftPlanner;
 
-use platen_plan::{
-    iterate_mimo, AxisTarget, IterationSettings, MimoResponse, Stop, TransferMatrix,
-};
+use platen_plan::{iterate_mimo, AxisTarget, IterationSettings, Response, Stop, TransferMatrix};
 
 /// `ωₙ²/(s² + 2ζωₙs + ωₙ²)·e^{−sτ}`.
 fn loop_h(f_hz: f64, fn_hz: f64, zeta: f64, delay_s: f64) -> C64 {
@@ -64,7 +62,7 @@ struct Linear {
     a: Vec<Vec<f64>>,
 }
 
-impl MimoResponse for Linear {
+impl Response for Linear {
     fn u_m(&self, i: usize) -> &[f64] {
         &self.u[i]
     }

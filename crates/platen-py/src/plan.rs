@@ -196,8 +196,12 @@ pub fn plan_table<'py>(
         }
         settings.iterate_at = iterate_at;
         let p = platen_plan::plan_multi_axis(&path, &file, &targets, &settings, &mut |_| {})?;
-        let (_, mut columns) = p.drive_columns();
-        let t = columns.remove(0);
+        let (_, mut columns) = p.drive_columns().unwrap_or_default();
+        let t = if columns.is_empty() {
+            Vec::new()
+        } else {
+            columns.remove(0)
+        };
         Ok((t, columns, json_text(&p.summary(&settings, None))?))
     })?;
     Ok((

@@ -1,11 +1,13 @@
-//! The text summary of a test plan (`platen plan`): the target, feasibility and the limits'
-//! margins, the largest scale that fits, the drive iterations and the drive.
+//! The text summaries of a test plan (`platen plan`): the target, feasibility and the limits'
+//! margins, the largest scale that fits, the drive iterations and the drive; of a uniaxial
+//! plan ([`text`]) and of a multi-axis one ([`table_text`]).
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use platen_model::STANDARD_GRAVITY_M_S2;
-use platen_plan::PlanSummary;
+use platen_plan::six_dof::{TablePlanSummary, AXES};
+use platen_plan::{PlanSummary, TableLimitUse};
 
 use crate::text::{engineering_unit, rounded, significant};
 
@@ -190,6 +192,157 @@ fn iteration_lines(o: &mut String, s: &PlanSummary) {
     }
     if let Some(d) = &s.drive {
         let _ = writeln!(o, "  {}", d.spectrum_acceptance.line("response spectrum"));
+    }
+}
+
+/// The text summary of the multi-axis plan `s` (`platen plan` without `--json` on a
+/// scenario with a `table`).
+pub fn table_text(s: &TablePlanSummary) -> String {
+    let mut t = String::new();
+    table_target_lines(&mut t, s);
+    table_feasibility_lines(&mut t, s);
+    table_iteration_lines(&mut t, s);
+    t
+}
+
+/// The target, per axis.
+fn table_target_lines(t: &mut String, s: &TablePlanSummary) {
+    let _ = writeln!(
+        t,
+        "{}: three-component plan of `{}` ({} samples at {} Hz, drive at {} Hz, {:.3} s)",
+        s.name,
+        s.target.file,
+        s.target.samples,
+        s.target.sample_rate_hz,
+        s.target.drive_sample_rate_hz,
+        s.target.duration_s
+    );
+    for axis in AXES {
+        match s.target.axes.get(axis) {
+            Some(a) => {
+                let _ = writeln!(
+                    t,
+                    "  {axis}: {} target, peak {:.4} m/s², command peak {:.4} m",
+                    a.kind, a.peak_a_m_s2, a.peak_u_m
+                );
+            }
+            None => {
+                let _ = writeln!(t, "  {axis}: held at zero");
+            }
+        }
+    }
+}
+
+/// The feasibility: what binds first, what fails, the closest limits, the largest scales.
+fn table_feasibility_lines(t: &mut String, s: &TablePlanSummary) {
+    let _ = writeln!(t, "feasible: {}", if s.feasible { "yes" } else { "no" });
+    if let Some(b) = &s.binds_first {
+        let _ = writeln!(
+            t,
+            "  binds first: {} at {:.3} s (peak {:.4e} against {:.4e}, {:.3} times at {:.3} s)",
+            b.limit,
+            b.first_exceeded_s.unwrap_or(b.t_s),
+            b.peak,
+            b.allowed,
+            b.ratio,
+            b.t_s
+        );
+    }
+    for u in &s.limiting {
+        let _ = writeln!(
+            t,
+            "  exceeded: {:<28} {:.3} times its limit ({:.4e} against {:.4e}) at {:.3} s",
+            u.limit, u.ratio, u.peak, u.allowed, u.t_s
+        );
+    }
+    let mut closest: Vec<&TableLimitUse> = s.margins.iter().collect();
+    closest.sort_by(|a, b| b.ratio.total_cmp(&a.ratio));
+    let _ = writeln!(t, "  closest limits:");
+    for u in closest.iter().take(5) {
+        let _ = writeln!(
+            t,
+            "    {:<28} {:>6.1} % ({:.4e} against {:.4e}) at {:.3} s",
+            u.limit,
+            100.0 * u.ratio,
+            u.peak,
+            u.allowed,
+            u.t_s
+        );
+    }
+    if let Some(m) = s.max_scale {
+        let _ = writeln!(t, "largest common scale that fits: {m:.4}");
+    }
+    for (axis, m) in &s.per_axis_max_scale {
+        let _ = writeln!(t, "  largest scale of {axis} alone: {m:.4}");
+    }
+}
+
+/// The drive iteration, per iteration and axis, its stop, and the drives (or why there are
+/// none).
+fn table_iteration_lines(t: &mut String, s: &TablePlanSummary) {
+    let (Some(frf), Some(drive), Some(best)) = (&s.frf, &s.drive, s.best_iteration) else {
+        let _ = writeln!(
+            t,
+            "drive iteration: not run (the target's own commands reach the end of an \
+             actuator's stroke); no drives written"
+        );
+        return;
+    };
+    let _ = writeln!(
+        t,
+        "drive iteration (matrix Ĥ, linearised; band {}–{} Hz, gain {}, largest condition number {:.1}):",
+        frf.band_hz[0], frf.band_hz[1], frf.gain, frf.max_condition
+    );
+    let _ = writeln!(
+        t,
+        "  iter  overall   x nrmse   y nrmse   z nrmse   (held axes: rms error, m/s²)"
+    );
+    for r in &s.iterations {
+        let cell = |axis: &str| {
+            let a = &r.axes[axis];
+            a.acceleration_nrmse.map_or_else(
+                || format!("({:.3})", a.rms_acceleration_error_m_s2),
+                |e| format!("{:.2} %", 100.0 * e),
+            )
+        };
+        let _ = writeln!(
+            t,
+            "  {:>4}  {:>6.2} %  {:>8}  {:>8}  {:>8}",
+            r.iteration,
+            100.0 * r.acceleration_nrmse,
+            cell("x"),
+            cell("y"),
+            cell("z")
+        );
+    }
+    let _ = writeln!(
+        t,
+        "  stop: {}{}; best iteration {}",
+        s.stop,
+        s.stall_reason
+            .as_ref()
+            .map_or(String::new(), |r| format!(" ({r})")),
+        best
+    );
+    if let (Some(level), Some(low)) = (s.iterate_at, &drive.at_iteration_level) {
+        let _ = writeln!(
+            t,
+            "  iterated at {:.0} % of the target ({:.2} % overall acceleration NRMSE there), \
+             scaled up by {:.4}: predicted full-level error {:.2} % overall acceleration NRMSE",
+            100.0 * level,
+            100.0 * low.acceleration_nrmse,
+            1.0 / level,
+            100.0 * drive.achieved.acceleration_nrmse
+        );
+    }
+    for (axis, a) in &drive.spectrum_acceptance {
+        let _ = writeln!(t, "  {}", a.line(&format!("{axis} response spectrum")));
+    }
+    if let Some(out) = &drive.out {
+        let _ = writeln!(
+            t,
+            "wrote {out} (t_s, x_m … yaw_rad: replay it with a motion_csv)"
+        );
     }
 }
 

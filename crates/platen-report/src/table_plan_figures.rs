@@ -7,9 +7,9 @@
 //! The target is drawn solid blue ([`RECORDED`]: the reference), iteration 0 dotted purple
 //! ([`RESIDUAL`]), the drives' iteration dashed orange ([`SIMULATED`]).
 
-use platen_plan::mimo::MimoResponse;
 use platen_plan::six_dof::{TableLimitUse, AXES};
-use platen_plan::TablePlan;
+use platen_plan::Response;
+use platen_plan::{TablePlan, TablePlannedDrive};
 use platen_signal::ResponseSpectrum;
 use plotters::style::RGBColor;
 
@@ -28,13 +28,18 @@ const AXIS_COLOURS: [RGBColor; 3] = [SIMULATED, RECORDED, RESIDUAL];
 
 /// The figures of `p`: `table-plan-acceleration`, `table-plan-spectra`,
 /// `table-plan-convergence` and `table-plan-margins`.
+/// A plan whose target's own commands reach the end of an actuator has no drives: its
+/// figure is `table-plan-margins` alone.
 pub fn figures(p: &TablePlan) -> Vec<Figure> {
-    let mut out = vec![acceleration(p)];
-    if let Some(f) = spectra(p) {
+    let Some(d) = &p.drive else {
+        return vec![margins(p, None)];
+    };
+    let mut out = vec![acceleration(p, d)];
+    if let Some(f) = spectra(p, d) {
         out.push(f);
     }
-    out.push(convergence(p));
-    out.push(margins(p));
+    out.push(convergence(p, d));
+    out.push(margins(p, Some(d)));
     out
 }
 
@@ -51,8 +56,8 @@ fn subject(p: &TablePlan) -> String {
     crate::plan_figures::subject(&p.target_origin, &p.scenario_name)
 }
 
-fn acceleration(p: &TablePlan) -> Figure {
-    let it = &p.iteration;
+fn acceleration(p: &TablePlan, d: &TablePlannedDrive) -> Figure {
+    let it = &d.iteration;
     let panels = AXES
         .iter()
         .enumerate()
@@ -112,7 +117,7 @@ fn acceleration(p: &TablePlan) -> Figure {
     }
 }
 
-fn spectra(p: &TablePlan) -> Option<Figure> {
+fn spectra(p: &TablePlan, d: &TablePlannedDrive) -> Option<Figure> {
     let dt = p.t_s.get(1).zip(p.t_s.first()).map(|(b, a)| b - a)?;
     let (lo, hi) = SPECTRUM_PERIODS_S;
     let periods = ResponseSpectrum::log_periods_s(lo, hi, SPECTRUM_COUNT).ok()?;
@@ -124,7 +129,7 @@ fn spectra(p: &TablePlan) -> Option<Figure> {
             .zip(rs.pseudo_acceleration_m_s2(a))
             .collect()
     };
-    let it = &p.iteration;
+    let it = &d.iteration;
     let panels = AXES
         .iter()
         .enumerate()
@@ -176,8 +181,8 @@ fn spectra(p: &TablePlan) -> Option<Figure> {
     })
 }
 
-fn convergence(p: &TablePlan) -> Figure {
-    let it = &p.iteration;
+fn convergence(p: &TablePlan, d: &TablePlannedDrive) -> Figure {
+    let it = &d.iteration;
     let last = it.records.len().saturating_sub(1).max(1) as f64;
     // In percent on a logarithmic axis (`y_log`), labelled in percent.
     let log = |x: f64| 100.0 * x;
@@ -269,18 +274,21 @@ fn bars(uses: &[&TableLimitUse], dx: f64) -> Points {
         .collect()
 }
 
-fn margins(p: &TablePlan) -> Figure {
+fn margins(p: &TablePlan, d: Option<&TablePlannedDrive>) -> Figure {
     let mut closest: Vec<&TableLimitUse> = p.feasibility.uses.iter().collect();
     closest.sort_by(|a, b| b.ratio.total_cmp(&a.ratio));
     closest.truncate(MARGIN_BARS);
     let drive: Vec<&TableLimitUse> = closest
         .iter()
-        .filter_map(|u| p.drive_uses.iter().find(|v| v.limit == u.limit))
+        .filter_map(|u| d?.uses.iter().find(|v| v.limit == u.limit))
         .collect();
     let mut zero = segments(bars(&closest, -0.12), RESIDUAL);
     zero.label = "iteration 0".into();
     let mut after = segments(bars(&drive, 0.12), SIMULATED);
-    after.label = format!("drives (iteration {})", p.iteration.best);
+    after.label = match d {
+        Some(d) => format!("drives (iteration {})", d.iteration.best),
+        None => "drives (not iterated)".into(),
+    };
     let n = closest.len().max(1) as f64;
     let mut series = vec![
         zero,

@@ -265,7 +265,6 @@ fn iteration_progress(args: &Args) -> Progress {
 /// `platen plan` on a multi-axis scenario (one with a `table` and its `controller`): the
 /// three-component plan ([`platen_plan::six_dof`]).
 fn run_table(args: &Args, file: &platen_scenario::file::ScenarioFile) -> Result<()> {
-    use platen_plan::six_dof::summary_text;
     use platen_plan::{plan_multi_axis, AxisTargets, TablePlanSettings};
     if matches!(args.frf, Frf::Measured) {
         anyhow::bail!(
@@ -303,8 +302,10 @@ fn run_table(args: &Args, file: &platen_scenario::file::ScenarioFile) -> Result<
     let p = plan_multi_axis(&args.scenario, file, &targets, &settings, on_run);
     progress.finish();
     let p = p.map_err(cli_error)?;
-    p.write_drive_rows(writer).map_err(cli_error)?;
-    let summary = p.summary(&settings, Some(&args.out));
+    // No drives (the target's own commands reach the end of an actuator): nothing is
+    // written; the temporary file goes with the writer.
+    let written = p.write_drive_rows(writer).map_err(cli_error)?;
+    let summary = p.summary(&settings, written.then_some(args.out.as_path()));
     let figures = platen_report::write_outputs(
         args.plot.as_deref(),
         None,
@@ -316,7 +317,7 @@ fn run_table(args: &Args, file: &platen_scenario::file::ScenarioFile) -> Result<
         eprintln!("warning: {warning}");
     }
     crate::plot::print(args.json, args.plot.is_some(), &summary, &figures, || {
-        let mut t = summary_text(&summary);
+        let mut t = platen_report::plan_report::table_text(&summary);
         for f in &figures {
             t += &format!("wrote {}\n", f.display());
         }
