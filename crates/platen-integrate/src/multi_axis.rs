@@ -14,6 +14,7 @@ use platen_signal::Motion;
 
 use crate::error::{IntegrateError, Result};
 use crate::inverse::INVERSE_SPECIMEN_SUBSTEPS;
+use crate::output::TableSink;
 
 /// A prescribed six-DOF motion: one [`Motion`] per DOF (pose coordinate, its rate and second
 /// derivative) on one time grid.
@@ -288,6 +289,22 @@ impl SpecimenState {
             let z_new = z + (zd + (&zd2 + &zd3) * 2.0 + &zd4) * (h / 6.0);
             let zd_new = zd + (&k1 + (&k2 + &k3) * 2.0 + &k4) * (h / 6.0);
             (self.z, self.zd) = (z_new, zd_new);
+        }
+    }
+}
+
+/// The in-memory collector: the columns of the run, every one as long as the time column.
+impl TableSink for TableRun {
+    fn start(&mut self, names: &[String], samples: usize) {
+        self.columns = names
+            .iter()
+            .map(|n| (n.clone(), Vec::with_capacity(samples)))
+            .collect();
+    }
+
+    fn accept(&mut self, row: &[f64]) {
+        for ((_, c), &x) in self.columns.iter_mut().zip(row) {
+            c.push(x);
         }
     }
 }

@@ -2,8 +2,6 @@
 
 use platen_model::{ForceTerms, Specimen, TableLimits};
 
-use crate::multi_axis::TableRun;
-
 /// The state of the platen and the decomposition of the actuator force at one output time.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sample {
@@ -95,22 +93,6 @@ pub trait TableSink {
     fn start(&mut self, names: &[String], samples: usize);
     /// Called once per output sample with its values in the columns' order.
     fn accept(&mut self, row: &[f64]);
-}
-
-/// The in-memory collector: the columns of the run, every one as long as the time column.
-impl TableSink for TableRun {
-    fn start(&mut self, names: &[String], samples: usize) {
-        self.columns = names
-            .iter()
-            .map(|n| (n.clone(), Vec::with_capacity(samples)))
-            .collect();
-    }
-
-    fn accept(&mut self, row: &[f64]) {
-        for ((_, c), &x) in self.columns.iter_mut().zip(row) {
-            c.push(x);
-        }
-    }
 }
 
 impl<S: TableSink + ?Sized> TableSink for &mut S {

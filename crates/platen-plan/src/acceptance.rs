@@ -7,7 +7,7 @@ use serde::Serialize;
 use platen_signal::ResponseSpectrum;
 
 use crate::error::Result;
-use crate::iterate::SpectrumSettings;
+use crate::settings::SpectrumSettings;
 
 /// The response spectrum of the error report and the target's own spectrum.
 pub(crate) struct SpectrumCheck {

@@ -15,7 +15,7 @@ use rustfft::num_complex::Complex64 as C64;
 use rustfft::{Fft, FftPlanner};
 
 use crate::error::{check_setting, PlanError, Result};
-use crate::iterate::{default_band_hz, IterationSettings};
+use crate::settings::{default_band_hz, IterationSettings};
 
 /// The transfer matrix `Ĥ(f)` of `p` axes: `h[i][j]` is axis `i`'s response to axis `j`'s
 /// command (`1 × 1` for one axis).

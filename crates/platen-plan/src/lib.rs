@@ -82,6 +82,7 @@ pub mod iterate;
 pub mod mimo;
 mod plan;
 pub mod rrs;
+mod settings;
 pub mod six_dof;
 mod steps;
 mod table;

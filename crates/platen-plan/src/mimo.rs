@@ -50,41 +50,7 @@ use crate::iterate::{
     iterate_axes, nrmse, signed_peak, Iteration, IterationSettings, Response, SpectrumSettings,
 };
 
-/// One axis of a multi-axis target: its name and its target motion at the common samples.
-#[derive(Debug, Clone, PartialEq)]
-pub struct AxisTarget {
-    /// The axis: `x`, `y` or `z`.
-    pub name: &'static str,
-    /// Target displacement (the drive of iteration 0), m.
-    pub u_m: Vec<f64>,
-    /// Target acceleration, m/s² (all zero on an axis held still).
-    pub a_m_s2: Vec<f64>,
-}
-
-impl AxisTarget {
-    /// An axis held still: zero displacement and acceleration over `samples`.
-    pub fn still(name: &'static str, samples: usize) -> Self {
-        Self {
-            name,
-            u_m: vec![0.0; samples],
-            a_m_s2: vec![0.0; samples],
-        }
-    }
-
-    /// The same axis at `level` times its size.
-    pub fn scaled(&self, level: f64) -> Self {
-        Self {
-            name: self.name,
-            u_m: self.u_m.iter().map(|u| u * level).collect(),
-            a_m_s2: self.a_m_s2.iter().map(|a| a * level).collect(),
-        }
-    }
-
-    /// Whether the axis is held still (its target acceleration is zero throughout).
-    pub fn is_still(&self) -> bool {
-        self.a_m_s2.iter().all(|&a| a == 0.0)
-    }
-}
+pub use crate::settings::AxisTarget;
 
 /// One axis's figures in one iteration.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
