@@ -224,7 +224,7 @@ pub fn plan_multi_axis(
         FirstRun::Ran(first) => {
             let first_a_m_s2 = (0..3).map(|i| first.a_m_s2(i).to_vec()).collect();
             let before = feasibility_warnings(&first, &feasibility, notices);
-            let drive = planning.drives(first, level, before, &motions, on_run, &mut warnings)?;
+            let drive = planning.drives(*first, level, before, &motions, on_run, &mut warnings)?;
             (first_a_m_s2, Some(drive))
         }
         FirstRun::BeyondReach { t_s } => {
@@ -365,8 +365,8 @@ fn failed_at_s(e: &PlanError) -> Option<f64> {
 
 /// How the run of the target's own commands went.
 enum FirstRun {
-    /// It ran to the end.
-    Ran(TableAchieved),
+    /// It ran to the end (boxed: a whole run beside a time).
+    Ran(Box<TableAchieved>),
     /// It failed at `t_s` after the commands asked an actuator for more stroke than it has.
     BeyondReach {
         /// When it failed, s.
@@ -418,7 +418,10 @@ impl Planning<'_> {
     /// A run that fails before the commands ask an actuator for more stroke than it has.
     fn feasibility(&self) -> Result<(TableFeasibility, FirstRun)> {
         let (uses, first) = match self.plant.run(&self.scaled_commands([1.0; 3])) {
-            Ok(first) => (limit_uses(self.scenario, &first.run), FirstRun::Ran(first)),
+            Ok(first) => (
+                limit_uses(self.scenario, &first.run),
+                FirstRun::Ran(Box::new(first)),
+            ),
             Err(e) => {
                 let Some(t_s) = failed_at_s(&e) else {
                     return Err(e);
