@@ -155,6 +155,20 @@ pub struct SystemColumns {
 }
 
 impl SystemColumns {
+    /// The columns, moved out in the order of [`SystemColumns::NAMES`].
+    pub fn into_columns(self) -> [Vec<f64>; 8] {
+        [
+            self.command_u_m,
+            self.drive,
+            self.spool_opening,
+            self.delta_p_pa,
+            self.flow_m3_s,
+            self.supply_pressure_pa,
+            self.cap_pressure_pa,
+            self.rod_pressure_pa,
+        ]
+    }
+
     /// The column names, in CSV order.
     pub const NAMES: [&'static str; 8] = [
         "command_u_m",

@@ -339,28 +339,7 @@ impl RunResult {
                     columns.extend(named(&SpecimenColumns::STOREY_A_NAMES[..n], sp.a_m_s2));
                 }
                 if let Some(sy) = system {
-                    let SystemColumns {
-                        command_u_m,
-                        drive,
-                        spool_opening,
-                        delta_p_pa,
-                        flow_m3_s,
-                        supply_pressure_pa,
-                        cap_pressure_pa,
-                        rod_pressure_pa,
-                    } = sy;
-                    // In the order of `SystemColumns::NAMES`.
-                    let system = vec![
-                        command_u_m,
-                        drive,
-                        spool_opening,
-                        delta_p_pa,
-                        flow_m3_s,
-                        supply_pressure_pa,
-                        cap_pressure_pa,
-                        rod_pressure_pa,
-                    ];
-                    columns.extend(named(&SystemColumns::NAMES, system));
+                    columns.extend(named(&SystemColumns::NAMES, sy.into_columns().into()));
                 }
                 (columns, Summary::Platen(summary))
             }

@@ -91,15 +91,28 @@ fn simulate_runs_a_multi_axis_file_as_its_table_does() {
 }
 
 /// The columns taken out of a run (what Python receives) are the ones `column` reads, in
-/// `columns` order: a uniaxial run with a specimen, whose storeys' columns follow the
+/// `columns` order: a uniaxial run with a specimen and a closed loop, whose columns follow the
 /// contract's.
 #[test]
 fn taken_columns_are_the_columns_read_in_place() {
-    let path = root().join("scenarios/specimen/frame-forward.json");
-    let run = Scenario::load(&path).unwrap().run_at(&path).unwrap();
+    for (file, extra) in [
+        ("scenarios/specimen/frame-forward.json", "storey1_u_m"),
+        (
+            "scenarios/table-system/wn10g-closed-loop.json",
+            "rod_pressure_pa",
+        ),
+    ] {
+        taken_columns_match(&root().join(file), extra);
+    }
+}
+
+/// [`taken_columns_are_the_columns_read_in_place`] on the scenario at `path`, whose run has
+/// the column `extra` beside the contract's.
+fn taken_columns_match(path: &Path, extra: &str) {
+    let run = Scenario::load(path).unwrap().run_at(path).unwrap();
     assert!(matches!(run, RunResult::Platen { .. }));
     let names: Vec<String> = run.columns().iter().map(|n| n.to_string()).collect();
-    assert!(names.iter().any(|n| n == "storey1_u_m"), "{names:?}");
+    assert!(names.iter().any(|n| n == extra), "{names:?}");
     let expected: Vec<Vec<f64>> = names
         .iter()
         .map(|n| run.column(n).unwrap().to_vec())
