@@ -331,7 +331,7 @@ impl<M: PlatenModel> GridStepper for Stepper<'_, M> {
     /// The output sample at sample `j` of the record (grid point `j·k`, τ = 0).
     fn sample(&self, j: usize, t_s: f64) -> Sample {
         let m = &self.machine;
-        m.sample(j, t_s, m.plant.clock.grid.force[j], 0.0, 0, 0)
+        m.sample(j, t_s, m.plant.clock.grid.force[j], 0.0, None, 0)
     }
 
     /// Closes the energy balance at the current state, the run having finished at `t_s`.

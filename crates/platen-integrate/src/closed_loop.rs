@@ -228,7 +228,7 @@ impl<M: PlatenModel, const L: usize> LoopPlant<'_, M, L> {
     #[inline(always)]
     fn base_shear(&self, y: &Y<L>) -> f64 {
         match self.spec {
-            Some(spec) => spec.base_shear_n(y[Z], y[Z + self.n]),
+            Some(spec) => spec.base_shear_n(&y[Z..Z + self.n], &y[Z + self.n..Z + 2 * self.n]),
             None => 0.0,
         }
     }
@@ -339,8 +339,8 @@ impl<M: PlatenModel, const L: usize> Plant<L> for LoopPlant<'_, M, L> {
         let df = f64::from(act.count) * (act.cap_area_m2 * k[PA] - act.rod_area_m2 * k[PB]);
         match self.spec {
             Some(spec) => {
-                let st = spec.storeys()[0];
-                df + st.stiffness_n_per_m * k[Z] + st.damping_n_s_per_m * k[Z + self.n]
+                let n = self.n;
+                spec.less_base_shear_rate(df, &k[Z..Z + n], &k[Z + n..Z + 2 * n])
             }
             None => df,
         }
@@ -544,7 +544,7 @@ impl<'a, M: PlatenModel + 'a, S: SampleSink, const L: usize> Emit<S, L> for Unia
     fn emit(&mut self, m: &Machine<Self::Plant, L>, j: usize, sink: &mut S) {
         let t_s = self.command.t_s()[j];
         let p = &m.plant;
-        let mut sample = m.sample(j, t_s, p.force(&m.y), p.base_shear(&m.y), p.n, Z);
+        let mut sample = m.sample(j, t_s, p.force(&m.y), p.base_shear(&m.y), p.spec, Z);
         let ps = m.y[PS];
         let (p_a, p_b) = (m.y[PA].max(0.0), m.y[PB].max(0.0));
         let (q_a, _) = p.sys.valve_flows_with(&p.consts, m.y[XV], p_a, p_b, ps);

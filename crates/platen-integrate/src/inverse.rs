@@ -120,7 +120,7 @@ pub fn inverse_specimen<M: PlatenModel, S: SampleSink>(
                 }
             }
         }
-        let base_shear_n = specimen.base_shear_n(z[0], zd[0]);
+        let base_shear_n = specimen.base_shear_n(&z[..ns], &zd[..ns]);
         let at_rest = band.is_some_and(|b| v[i].abs() <= b);
         let mut terms = if at_rest {
             static_reaction(model, u[i], a[i], base_shear_n)
@@ -137,12 +137,10 @@ pub fn inverse_specimen<M: PlatenModel, S: SampleSink>(
             a_m_s2: [0.0; NS],
             drift_m: [0.0; NS],
         };
-        let mut below = 0.0;
         for j in 0..ns {
             spec.u_m[j] = z[j];
-            spec.a_m_s2[j] = a[i] + zdd[j];
-            spec.drift_m[j] = z[j] - below;
-            below = z[j];
+            spec.a_m_s2[j] = specimen.absolute_acceleration_m_s2(j, a[i], zdd[j]);
+            spec.drift_m[j] = specimen.drift_m(j, &z[..ns]);
         }
         sink.accept(&prescribed_sample(motion, i, terms, at_rest, Some(spec)));
     }

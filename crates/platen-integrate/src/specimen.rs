@@ -230,6 +230,8 @@ struct StoreyConstants {
     m: [f64; NS],
     k: [f64; NS],
     c: [f64; NS],
+    /// Each DOF's share `ιᵢ` of the platen's acceleration (1 for storeys).
+    iota: [f64; NS],
 }
 
 impl StoreyConstants {
@@ -238,9 +240,13 @@ impl StoreyConstants {
             m: [0.0; NS],
             k: [0.0; NS],
             c: [0.0; NS],
+            iota: [0.0; NS],
         };
         for (i, s) in spec.storeys().iter().enumerate() {
             (st.m[i], st.k[i], st.c[i]) = (s.mass_kg, s.stiffness_n_per_m, s.damping_n_s_per_m);
+        }
+        for (i, iota) in st.iota[..spec.len()].iter_mut().enumerate() {
+            *iota = spec.influence(i);
         }
         st
     }
@@ -315,7 +321,8 @@ impl<'a, M: PlatenModel, const L: usize> SpecimenPlant<'a, M, L> {
 
     #[inline(always)]
     fn base_shear(&self, y: &Y<L>) -> f64 {
-        self.spec.base_shear_n(y[Z], y[Self::ZD])
+        self.spec
+            .base_shear_n(&y[Z..Z + Self::N], &y[Self::ZD..Self::ZD + Self::N])
     }
 
     fn specimen_energy(&self, y: &Y<L>) -> f64 {
@@ -330,18 +337,31 @@ impl<'a, M: PlatenModel, const L: usize> SpecimenPlant<'a, M, L> {
     /// `(shearᵢ₊₁ − shearᵢ)/mᵢ − a` is `qᵢ − a` here, and whose bottom storey's shear
     /// `k₁(z₁ − 0) + c₁(ż₁ − 0)` is `−B` bit for bit), so the results are identical; the
     /// unit test `storey_part_is_the_model_s` checks it.
+    ///
+    /// A general linear specimen takes [`Specimen::storey_accelerations`] at `a = 0`.
     #[inline(always)]
     fn storey_part(&self, y: &Y<L>) -> StoreyPart {
-        storey_part(&self.storeys, y)
+        if self.spec.is_shear_building() {
+            return storey_part(&self.storeys, y);
+        }
+        let (n, zd) = (Self::N, Self::ZD);
+        let (z, zd) = (&y[Z..Z + n], &y[zd..zd + n]);
+        let mut part = StoreyPart {
+            q: [0.0; NS],
+            power: 0.0,
+            shear0: -self.spec.base_shear_n(z, zd),
+        };
+        part.power = self.spec.storey_accelerations(0.0, z, zd, &mut part.q[..n]);
+        part
     }
 
     /// Writes the storeys' rates into `dy` from their linear part under platen acceleration
-    /// `a`.
+    /// `a` (`z̈ᵢ = qᵢ − ιᵢ·a`).
     #[inline(always)]
-    fn storey_rates(part: &StoreyPart, a: f64, y: &Y<L>, dy: &mut Y<L>) {
+    fn storey_rates(&self, part: &StoreyPart, a: f64, y: &Y<L>, dy: &mut Y<L>) {
         for i in 0..Self::N {
             dy[Z + i] = y[Self::ZD + i];
-            dy[Self::ZD + i] = part.q[i] - a;
+            dy[Self::ZD + i] = part.q[i] - self.storeys.iota[i] * a;
         }
         dy[SD] = part.power;
     }
@@ -381,9 +401,9 @@ impl<'a, M: PlatenModel, const L: usize> SpecimenPlant<'a, M, L> {
         let mut zdd0 = [0.0; NS];
         self.spec
             .storey_accelerations(0.0, &y[Z..Z + n], &y[zd..zd + n], &mut zdd0[..n]);
-        let st = self.spec.storeys()[0];
-        let b_rate0 = -(st.stiffness_n_per_m * y[zd] + st.damping_n_s_per_m * zdd0[0]);
-        let w_rate = (s * (self.f_rate - b_rate0) - e_u * s * w) / (e_w + st.damping_n_s_per_m);
+        let b_rate0 = self.spec.base_shear_rate_n_s(&y[zd..zd + n], &zdd0[..n]);
+        let c_base = self.spec.base_damping_n_s_per_m();
+        let w_rate = (s * (self.f_rate - b_rate0) - e_u * s * w) / (e_w + c_base);
         if w_rate.is_finite() {
             s * w_rate
         } else {
@@ -441,7 +461,7 @@ impl<'a, M: PlatenModel, const L: usize> Plant<L> for SpecimenPlant<'a, M, L> {
                 }
             }
         };
-        Self::storey_rates(&part, a, y, dy);
+        self.storey_rates(&part, a, y, dy);
         a
     }
 
@@ -458,7 +478,7 @@ impl<'a, M: PlatenModel, const L: usize> Plant<L> for SpecimenPlant<'a, M, L> {
         dy[V] = r.a_m_s2;
         dy[W] = f * y[V];
         dy[DI] = r.dissipated_power_w;
-        Self::storey_rates(&part, r.a_m_s2, y, dy);
+        self.storey_rates(&part, r.a_m_s2, y, dy);
         r.a_m_s2
     }
 
@@ -475,8 +495,9 @@ impl<'a, M: PlatenModel, const L: usize> Plant<L> for SpecimenPlant<'a, M, L> {
 
     /// `Ṅ = Ḟ_A − Ḃ = Ḟ_A + k₁ż₁ + c₁z̈₁` (`u` fixed).
     fn net_rate(&self, k: &Y<L>) -> f64 {
-        let st = self.spec.storeys()[0];
-        self.f_rate + st.stiffness_n_per_m * k[Z] + st.damping_n_s_per_m * k[Self::ZD]
+        let (n, zd) = (Self::N, Self::ZD);
+        self.spec
+            .less_base_shear_rate(self.f_rate, &k[Z..Z + n], &k[zd..zd + n])
     }
 
     /// In creep the velocity is slaved to the net force at the end of each piece.
@@ -577,8 +598,14 @@ impl<M: PlatenModel, const L: usize> GridStepper for Stepper<'_, M, L> {
     /// The output sample at sample `j` of the record (grid point `j·k`).
     fn sample(&self, j: usize, t_s: f64) -> Sample {
         let (m, p) = (&self.machine, &self.machine.plant);
-        let n = SpecimenPlant::<M, L>::N;
-        m.sample(j, t_s, p.clock.grid.force[j], p.base_shear(&m.y), n, Z)
+        m.sample(
+            j,
+            t_s,
+            p.clock.grid.force[j],
+            p.base_shear(&m.y),
+            Some(p.spec),
+            Z,
+        )
     }
 
     /// Closes the energy balance at the current state, the run having finished at `t_s`.
@@ -643,7 +670,7 @@ mod tests {
             for (i, (zdd, q)) in zdd.iter().zip(part.q).enumerate() {
                 assert_eq!(zdd.to_bits(), (q - a).to_bits(), "case {case} storey {i}");
             }
-            let bs = spec.base_shear_n(y[Z], y[Z + 3]);
+            let bs = spec.base_shear_n(&y[Z..Z + 3], &y[Z + 3..Z + 6]);
             assert_eq!(bs.to_bits(), (-part.shear0).to_bits(), "case {case}");
         }
     }

@@ -1,5 +1,7 @@
 //! A specimen on the platen: a linear shear building fixed on it (the contract's
-//! `specimen.storeys`, bottom storey first).
+//! `specimen.storeys`, bottom storey first), or a general linear specimen (its mass, stiffness
+//! and damping matrices and its influence along the platen's axis), of which the shear
+//! building is the special case.
 //!
 //! # Equations
 //!
@@ -21,6 +23,22 @@
 //!
 //! The specimen's energy is `E = ½Σmᵢ(v + żᵢ)² + ½Σkᵢdᵢ²`, and `Ė = B·v − Σcᵢḋᵢ²`: the power
 //! the platen feeds in minus what the storey dampers dissipate.
+//!
+//! A **general linear specimen** ([`Specimen::general`]) has DOFs `z` relative to the platen,
+//! symmetric matrices `M` (positive definite), `K`, `C` (positive semi-definite) and the
+//! influence `ι` (each DOF's rigid-body share of the platen's motion along its axis: the `x`
+//! column of the six-DOF influence matrix; the platen moves along `x` only, so the other
+//! columns do not matter here). Then
+//!
+//! ```text
+//!     M·(z̈ + ι·a) + C·ż + K·z = 0
+//!     B = ιᵀ·M·(z̈ + ι·a) = −ιᵀ·(K·z + C·ż)
+//!     E = ½(v·ι + ż)ᵀ·M·(v·ι + ż) + ½zᵀ·K·z,   Ė = B·v − żᵀ·C·ż
+//! ```
+//!
+//! and the storeys are the case `ι = 1`, `M` diagonal, `K` and `C` tridiagonal. A general
+//! specimen's "drift" of DOF `i` (its column `storey{i}_…` of the output) is its displacement
+//! relative to the platen: its DOFs need not be storeys stacked on one another.
 
 use crate::error::{non_negative, positive, ModelError, Result};
 
@@ -35,10 +53,56 @@ pub struct Storey {
     pub damping_n_s_per_m: f64,
 }
 
-/// A validated shear building on the platen, bottom storey first (see the module docs).
+/// A validated specimen on the platen: a shear building (bottom storey first) or a general
+/// linear specimen (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Specimen {
+    /// The storeys, bottom first; empty for a general specimen.
     storeys: Vec<Storey>,
+    /// A general specimen's matrices; `None` for a shear building.
+    matrices: Option<Box<Matrices>>,
+}
+
+/// A general linear specimen along the platen's axis: its matrices row-major (`n × n`) and
+/// what the rates and the base shear take from them.
+#[derive(Debug, Clone, PartialEq)]
+struct Matrices {
+    n: usize,
+    mass: Vec<f64>,
+    mass_inverse: Vec<f64>,
+    stiffness: Vec<f64>,
+    damping: Vec<f64>,
+    /// `ι`, each DOF's share of the platen's motion.
+    influence: Vec<f64>,
+    /// `K·ι`: the base shear is `−(K·ι)·z − (C·ι)·ż` (`K`, `C` symmetric).
+    base_stiffness: Vec<f64>,
+    /// `C·ι`.
+    base_damping: Vec<f64>,
+    /// `ιᵀ·C·ι`: how the base shear's rate feels the platen's acceleration.
+    base_damping_n_s_per_m: f64,
+    /// `ιᵀ·M·ι`: the rigid-body mass the platen carries, kg.
+    rigid_mass_kg: f64,
+}
+
+/// `Σⱼ a[i·n + j]·x[j]`, `j` rising.
+#[inline(always)]
+fn row_dot(a: &[f64], n: usize, i: usize, x: &[f64]) -> f64 {
+    let row = &a[i * n..(i + 1) * n];
+    let mut sum = 0.0;
+    for (aij, xj) in row.iter().zip(x) {
+        sum += aij * xj;
+    }
+    sum
+}
+
+/// `Σᵢ a[i]·b[i]`, `i` rising.
+#[inline(always)]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut sum = 0.0;
+    for (ai, bi) in a.iter().zip(b) {
+        sum += ai * bi;
+    }
+    sum
 }
 
 impl Specimen {
@@ -71,7 +135,86 @@ impl Specimen {
             positive("stiffness_n_per_m", s.stiffness_n_per_m).map_err(wrap)?;
             non_negative("damping_n_s_per_m", s.damping_n_s_per_m).map_err(wrap)?;
         }
-        Ok(Self { storeys })
+        Ok(Self {
+            storeys,
+            matrices: None,
+        })
+    }
+
+    /// The general linear specimen `linear` on the uniaxial platen: its matrices, and the `x`
+    /// column of its influence (the platen moves along `x` only; the other columns do not
+    /// matter here).
+    ///
+    /// # Errors
+    /// [`ModelError::InvalidTable`] at `specimen.influence` when the `x` column is all zero:
+    /// such a specimen would not feel the platen's motion at all, which is a mistake in the
+    /// file rather than a test.
+    pub fn general(linear: &crate::multi_axis::LinearSpecimen) -> Result<Self> {
+        let n = linear.len();
+        let influence: Vec<f64> = linear.influence().column(0).iter().copied().collect();
+        if influence.iter().all(|&x| x == 0.0) {
+            return Err(ModelError::InvalidTable {
+                path: "specimen.influence".into(),
+                expected: "a non-zero share of x for some DOF (the first of each row's six \
+                           numbers): on the uniaxial platen only x moves, and a specimen that \
+                           does not feel it is not on the table"
+                    .into(),
+            });
+        }
+        let row_major = |m: &nalgebra::DMatrix<f64>| -> Vec<f64> {
+            (0..n)
+                .flat_map(|i| (0..n).map(move |j| (i, j)))
+                .map(|(i, j)| m[(i, j)])
+                .collect()
+        };
+        let (mass, stiffness, damping) = (
+            row_major(linear.mass()),
+            row_major(linear.stiffness()),
+            row_major(linear.damping()),
+        );
+        let inverse = linear
+            .mass()
+            .clone()
+            .cholesky()
+            .expect("a validated linear specimen has a positive definite mass")
+            .inverse();
+        let base_stiffness: Vec<f64> = (0..n)
+            .map(|i| row_dot(&stiffness, n, i, &influence))
+            .collect();
+        let base_damping: Vec<f64> = (0..n)
+            .map(|i| row_dot(&damping, n, i, &influence))
+            .collect();
+        let mass_influence: Vec<f64> = (0..n).map(|i| row_dot(&mass, n, i, &influence)).collect();
+        Ok(Self {
+            storeys: Vec::new(),
+            matrices: Some(Box::new(Matrices {
+                n,
+                mass_inverse: row_major(&inverse),
+                base_damping_n_s_per_m: dot(&influence, &base_damping),
+                rigid_mass_kg: dot(&influence, &mass_influence),
+                mass,
+                stiffness,
+                damping,
+                influence,
+                base_stiffness,
+                base_damping,
+            })),
+        })
+    }
+
+    /// Whether it is a shear building (its [`storeys`](Self::storeys) given), not a general
+    /// linear specimen.
+    pub fn is_shear_building(&self) -> bool {
+        self.matrices.is_none()
+    }
+
+    /// Its influence `ιᵢ` along the platen's axis: 1 for every storey.
+    #[inline(always)]
+    pub fn influence(&self, i: usize) -> f64 {
+        match &self.matrices {
+            None => 1.0,
+            Some(g) => g.influence[i],
+        }
     }
 
     /// A specimen from the modal data a user usually has: the storey masses (bottom first),
@@ -138,28 +281,38 @@ impl Specimen {
         )
     }
 
-    /// The storeys, bottom first.
+    /// The storeys, bottom first (empty for a general linear specimen).
     pub fn storeys(&self) -> &[Storey] {
         &self.storeys
     }
 
-    /// Number of storeys.
+    /// Number of storeys (of DOFs, for a general linear specimen).
     pub fn len(&self) -> usize {
-        self.storeys.len()
+        match &self.matrices {
+            None => self.storeys.len(),
+            Some(g) => g.n,
+        }
     }
 
     /// Always `false`: a specimen has at least one storey (for clippy's `len` convention).
     pub fn is_empty(&self) -> bool {
-        self.storeys.is_empty()
+        self.len() == 0
     }
 
-    /// Total mass `Σmᵢ`, kg.
+    /// Total mass `Σmᵢ`, kg: the mass the platen carries (a general specimen's rigid-body
+    /// mass along the axis, `ιᵀ·M·ι`).
     pub fn total_mass_kg(&self) -> f64 {
-        self.storeys.iter().map(|s| s.mass_kg).sum()
+        match &self.matrices {
+            None => self.storeys.iter().map(|s| s.mass_kg).sum(),
+            Some(g) => g.rigid_mass_kg,
+        }
     }
 
-    /// The mass matrix (diagonal), row-major `n×n`, kg.
+    /// The mass matrix (diagonal for storeys), row-major `n×n`, kg.
     pub fn mass_matrix(&self) -> Vec<f64> {
+        if let Some(g) = &self.matrices {
+            return g.mass.clone();
+        }
         let n = self.len();
         let mut m = vec![0.0; n * n];
         for (i, s) in self.storeys.iter().enumerate() {
@@ -168,14 +321,20 @@ impl Specimen {
         m
     }
 
-    /// The fixed-base stiffness matrix (tridiagonal), row-major `n×n`, N/m.
+    /// The fixed-base stiffness matrix (tridiagonal for storeys), row-major `n×n`, N/m.
     pub fn stiffness_matrix(&self) -> Vec<f64> {
-        self.tridiagonal(|s| s.stiffness_n_per_m)
+        match &self.matrices {
+            None => self.tridiagonal(|s| s.stiffness_n_per_m),
+            Some(g) => g.stiffness.clone(),
+        }
     }
 
-    /// The fixed-base damping matrix (tridiagonal), row-major `n×n`, N·s/m.
+    /// The fixed-base damping matrix (tridiagonal for storeys), row-major `n×n`, N·s/m.
     pub fn damping_matrix(&self) -> Vec<f64> {
-        self.tridiagonal(|s| s.damping_n_s_per_m)
+        match &self.matrices {
+            None => self.tridiagonal(|s| s.damping_n_s_per_m),
+            Some(g) => g.damping.clone(),
+        }
     }
 
     fn tridiagonal(&self, value: impl Fn(&Storey) -> f64) -> Vec<f64> {
@@ -194,8 +353,21 @@ impl Specimen {
     }
 
     /// The lowest eigenvalue `ω₁²` of `K·φ = ω²·M·φ` (fixed base), rad²/s², by inverse
-    /// iteration with the tridiagonal solve (the matrix is symmetric positive definite).
+    /// iteration with the tridiagonal solve (the matrix is symmetric positive definite); for a
+    /// general specimen, the lowest eigenvalue of `L⁻¹·K·L⁻ᵀ` (`M = L·Lᵀ`).
     pub fn first_eigenvalue(&self) -> f64 {
+        if let Some(g) = &self.matrices {
+            let n = g.n;
+            let l = nalgebra::DMatrix::from_row_slice(n, n, &g.mass)
+                .cholesky()
+                .expect("a validated linear specimen has a positive definite mass")
+                .l();
+            let l_inv = l.try_inverse().expect("a Cholesky factor is invertible");
+            let k = nalgebra::DMatrix::from_row_slice(n, n, &g.stiffness);
+            let a = &l_inv * k * l_inv.transpose();
+            let a = (&a + a.transpose()) * 0.5;
+            return a.symmetric_eigenvalues().min();
+        }
         let n = self.len();
         let k = self.stiffness_matrix();
         let mut x: Vec<f64> = (0..n).map(|i| (i + 1) as f64).collect();
@@ -222,19 +394,82 @@ impl Specimen {
         lambda
     }
 
-    /// The base shear `B = −(k₁z₁ + c₁ż₁)`, N, from the bottom storey's relative displacement
-    /// and velocity: the force the platen exerts on the specimen (module docs).
+    /// The base shear `B = −(k₁z₁ + c₁ż₁)`, N (general: `−ιᵀ·(K·z + C·ż)`), from the relative
+    /// displacements `z` and velocities `zd`: the force the platen exerts on the specimen
+    /// (module docs).
     #[inline(always)]
-    pub fn base_shear_n(&self, z1_m: f64, z1_m_s: f64) -> f64 {
-        let s = &self.storeys[0];
-        -(s.stiffness_n_per_m * z1_m + s.damping_n_s_per_m * z1_m_s)
+    pub fn base_shear_n(&self, z: &[f64], zd: &[f64]) -> f64 {
+        match &self.matrices {
+            None => {
+                let s = &self.storeys[0];
+                -(s.stiffness_n_per_m * z[0] + s.damping_n_s_per_m * zd[0])
+            }
+            Some(g) => -(dot(&g.base_stiffness, &z[..g.n]) + dot(&g.base_damping, &zd[..g.n])),
+        }
+    }
+
+    /// The base shear's rate `Ḃ = −(k₁ż₁ + c₁z̈₁)`, N/s (general: `−ιᵀ·(K·ż + C·z̈)`), from the
+    /// relative velocities `zd` and accelerations `zdd`.
+    #[inline(always)]
+    pub fn base_shear_rate_n_s(&self, zd: &[f64], zdd: &[f64]) -> f64 {
+        self.base_shear_n(zd, zdd)
+    }
+
+    /// `Ḟ − Ḃ`, N/s: the force rate `force_rate_n_s` less the base shear's rate, as
+    /// `Ḟ + k₁ż₁ + c₁z̈₁` for storeys (general: `Ḟ + ιᵀ·(K·ż + C·z̈)`), from the relative
+    /// velocities `zd` and accelerations `zdd`. The net force's rate at rest.
+    #[inline(always)]
+    pub fn less_base_shear_rate(&self, force_rate_n_s: f64, zd: &[f64], zdd: &[f64]) -> f64 {
+        match &self.matrices {
+            None => {
+                let s = &self.storeys[0];
+                force_rate_n_s + s.stiffness_n_per_m * zd[0] + s.damping_n_s_per_m * zdd[0]
+            }
+            Some(_) => force_rate_n_s - self.base_shear_rate_n_s(zd, zdd),
+        }
+    }
+
+    /// How the base shear's rate feels the platen's acceleration `a` (`∂Ḃ/∂a`, N·s/m): the
+    /// bottom storey's `c₁` (general: `ιᵀ·C·ι`), since `z̈ = z̈⁰ − ι·a`.
+    #[inline(always)]
+    pub fn base_damping_n_s_per_m(&self) -> f64 {
+        match &self.matrices {
+            None => self.storeys[0].damping_n_s_per_m,
+            Some(g) => g.base_damping_n_s_per_m,
+        }
+    }
+
+    /// The absolute acceleration of storey (DOF) `i`, m/s², under platen acceleration `a`
+    /// from its relative acceleration `zdd_i`: `a + z̈ᵢ` (general: `ιᵢ·a + z̈ᵢ`).
+    #[inline(always)]
+    pub fn absolute_acceleration_m_s2(&self, i: usize, a_m_s2: f64, zdd_i: f64) -> f64 {
+        match &self.matrices {
+            None => a_m_s2 + zdd_i,
+            Some(g) => g.influence[i] * a_m_s2 + zdd_i,
+        }
+    }
+
+    /// The drift of storey `i`, m: `zᵢ − zᵢ₋₁` (`z₀ = 0`); a general specimen's DOF `i`
+    /// relative to the platen, `zᵢ`.
+    #[inline(always)]
+    pub fn drift_m(&self, i: usize, z: &[f64]) -> f64 {
+        match (&self.matrices, i) {
+            (None, 0) => z[0] - 0.0,
+            (None, _) => z[i] - z[i - 1],
+            (Some(_), _) => z[i],
+        }
     }
 
     /// The relative storey accelerations `z̈ᵢ` under platen acceleration `a`, written into
     /// `out[..n]`, from the relative displacements `z[..n]` and velocities `zd[..n]`; returns
     /// the power `Σcᵢḋᵢ² ≥ 0` dissipated by the storey dampers, W.
+    ///
+    /// A general specimen: `z̈ = −M⁻¹·(K·z + C·ż) − ι·a`, and the power `żᵀ·C·ż`.
     #[inline(always)]
     pub fn storey_accelerations(&self, a_m_s2: f64, z: &[f64], zd: &[f64], out: &mut [f64]) -> f64 {
+        if let Some(g) = &self.matrices {
+            return g.accelerations(a_m_s2, z, zd, out);
+        }
         let n = self.len();
         let (storeys, z, zd, out) = (&self.storeys[..n], &z[..n], &zd[..n], &mut out[..n]);
         let mut power = 0.0;
@@ -255,8 +490,12 @@ impl Specimen {
         power
     }
 
-    /// The specimen's energy `½Σmᵢ(v + żᵢ)² + ½Σkᵢdᵢ²`, J, at platen velocity `v`.
+    /// The specimen's energy `½Σmᵢ(v + żᵢ)² + ½Σkᵢdᵢ²`, J, at platen velocity `v` (general:
+    /// `½(v·ι + ż)ᵀ·M·(v·ι + ż) + ½zᵀ·K·z`).
     pub fn energy_j(&self, v_m_s: f64, z: &[f64], zd: &[f64]) -> f64 {
+        if let Some(g) = &self.matrices {
+            return g.energy_j(v_m_s, z, zd);
+        }
         let mut e = 0.0;
         let mut z_prev = 0.0;
         for (i, s) in self.storeys.iter().enumerate() {
@@ -264,6 +503,40 @@ impl Specimen {
             let d = z[i] - z_prev;
             e += 0.5 * s.mass_kg * w * w + 0.5 * s.stiffness_n_per_m * d * d;
             z_prev = z[i];
+        }
+        e
+    }
+}
+
+impl Matrices {
+    /// [`Specimen::storey_accelerations`] of a general specimen: `z̈ = −M⁻¹·r − ι·a` with
+    /// `r = K·z + C·ż`, and the power `żᵀ·C·ż`. No allocation (the DOFs are at most
+    /// [`Specimen::MAX_STOREYS`]).
+    #[inline(always)]
+    fn accelerations(&self, a_m_s2: f64, z: &[f64], zd: &[f64], out: &mut [f64]) -> f64 {
+        let n = self.n;
+        let (z, zd) = (&z[..n], &zd[..n]);
+        let mut r = [0.0; Specimen::MAX_STOREYS];
+        let mut power = 0.0;
+        for (i, ri) in r[..n].iter_mut().enumerate() {
+            let cz = row_dot(&self.damping, n, i, zd);
+            *ri = row_dot(&self.stiffness, n, i, z) + cz;
+            power += zd[i] * cz;
+        }
+        for (i, o) in out[..n].iter_mut().enumerate() {
+            *o = -row_dot(&self.mass_inverse, n, i, &r[..n]) - self.influence[i] * a_m_s2;
+        }
+        power
+    }
+
+    /// [`Specimen::energy_j`] of a general specimen.
+    fn energy_j(&self, v_m_s: f64, z: &[f64], zd: &[f64]) -> f64 {
+        let n = self.n;
+        let w: Vec<f64> = (0..n).map(|i| v_m_s * self.influence[i] + zd[i]).collect();
+        let mut e = 0.0;
+        for i in 0..n {
+            e += 0.5 * w[i] * row_dot(&self.mass, n, i, &w)
+                + 0.5 * z[i] * row_dot(&self.stiffness, n, i, &z[..n]);
         }
         e
     }
@@ -361,7 +634,7 @@ mod tests {
             assert!((lhs - rhs).abs() <= 1e-9 * rhs.abs(), "{i}: {lhs} vs {rhs}");
         }
         let inertia: f64 = (0..2).map(|i| m[i * 2 + i] * (out[i] + a)).sum();
-        let b = s.base_shear_n(z[0], zd[0]);
+        let b = s.base_shear_n(&z, &zd);
         assert!((inertia - b).abs() <= 1e-9 * b.abs(), "{inertia} vs {b}");
         let expected = 40e3 * 0.3f64.powi(2) + 25e3 * 0.5f64.powi(2);
         assert!((power - expected).abs() <= 1e-9 * expected);

@@ -43,6 +43,7 @@ pub mod recorded;
 mod rig;
 pub mod sampling;
 pub mod scenario;
+mod specimen;
 mod summary;
 pub mod sweep;
 pub mod system;

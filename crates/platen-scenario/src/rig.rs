@@ -23,7 +23,7 @@ use serde::Deserialize;
 
 use platen_integrate::{LoopMethod, State};
 use platen_io::json::{parse_json, parse_json_file};
-use platen_model::{ModelError, Preset, Specimen, Storey, TableLimits};
+use platen_model::{ModelError, Preset, Specimen, TableLimits};
 use platen_system::TableSystem;
 
 use crate::ctx::{check_finite, check_positive, Ctx};
@@ -357,7 +357,7 @@ impl RigStart {
 
     /// The rig: the specimen and the table system of `keys` added.
     pub(crate) fn finish(self, ctx: &Ctx, keys: &RigKeys) -> Result<Rig> {
-        let specimen = build_specimen(ctx, keys.specimen)?;
+        let specimen = crate::specimen::platen_specimen(ctx, keys.specimen)?;
         let table_system = keys
             .table_system
             .map(|spec| build_table_system(ctx, spec, self.limits.stroke_m))
@@ -372,44 +372,6 @@ impl RigStart {
             specimen,
         })
     }
-}
-
-/// The validated `specimen`, with JSON paths in its errors.
-pub(crate) fn build_specimen(ctx: &Ctx, given: Option<&SpecimenSpec>) -> Result<Option<Specimen>> {
-    let Some(given) = given else {
-        return Ok(None);
-    };
-    if given.is_general() {
-        return Err(ctx.invalid(
-            "specimen.mass_matrix",
-            "(a general linear specimen)",
-            "storeys: a general linear specimen (matrices) runs on a multi-axis `table` for now",
-        ));
-    }
-    let storeys = given
-        .storeys
-        .iter()
-        .map(|s| Storey {
-            mass_kg: s.mass_kg,
-            stiffness_n_per_m: s.stiffness_n_per_m,
-            damping_n_s_per_m: s.damping_n_s_per_m,
-        })
-        .collect();
-    Specimen::new(storeys).map(Some).map_err(|e| match e {
-        ModelError::InvalidStorey { index, source } => match *source {
-            ModelError::InvalidParameter {
-                name,
-                value,
-                expected,
-            } => ctx.invalid(
-                &format!("specimen.storeys[{index}].{name}"),
-                value,
-                expected,
-            ),
-            other => ctx.invalid(&format!("specimen.storeys[{index}]"), "", other.to_string()),
-        },
-        other => ctx.invalid("specimen.storeys", given.storeys.len(), other.to_string()),
-    })
 }
 
 /// The preset's table limits with the scenario's `limits` laid over them.

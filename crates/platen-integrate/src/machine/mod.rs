@@ -287,7 +287,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
     }
 
     /// The output sample at the current state: index `j` at `t_s`, actuator force `f`, and
-    /// the specimen's `storeys` (displacements from position `z` of the state, velocities
+    /// the specimen `spec`'s storeys (displacements from position `z` of the state, velocities
     /// after them) with base shear `bs`. The platen's own terms see `F_A − B`, so the
     /// remainder `F_D` excludes the base shear.
     pub(crate) fn sample(
@@ -296,7 +296,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         t_s: f64,
         f: f64,
         bs: f64,
-        storeys: usize,
+        spec: Option<&Specimen>,
         z: usize,
     ) -> Sample {
         let y = &self.y;
@@ -310,7 +310,8 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         let stuck = self.mode == Mode::Stick;
         let mut sample = sample_at(model, j, t_s, f - bs, kin, self.a, stuck);
         sample.terms.actuator_n = f;
-        if storeys > 0 {
+        if let Some(specimen) = spec {
+            let storeys = specimen.len();
             let mut spec = SpecimenSample {
                 base_shear_n: bs,
                 storeys,
@@ -318,12 +319,11 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
                 a_m_s2: [0.0; Specimen::MAX_STOREYS],
                 drift_m: [0.0; Specimen::MAX_STOREYS],
             };
-            let mut below = 0.0;
             for i in 0..storeys {
                 spec.u_m[i] = y[z + i];
-                spec.a_m_s2[i] = self.a + self.k[z + storeys + i];
-                spec.drift_m[i] = y[z + i] - below;
-                below = y[z + i];
+                spec.a_m_s2[i] =
+                    specimen.absolute_acceleration_m_s2(i, self.a, self.k[z + storeys + i]);
+                spec.drift_m[i] = specimen.drift_m(i, &y[z..z + storeys]);
             }
             sample.specimen = Some(spec);
         }

@@ -15,7 +15,7 @@
 
 use std::path::{Path, PathBuf};
 
-use nalgebra::{DMatrix, Matrix3, Unit, Vector3};
+use nalgebra::{Matrix3, Unit, Vector3};
 use serde::Serialize;
 
 use platen_integrate::{
@@ -36,7 +36,7 @@ use crate::ctx::{check_finite, check_positive, value_at, Ctx};
 use crate::error::{Result, ScenarioError};
 use crate::excitation::MotionGenerator;
 use crate::excitation::{motion_run, read_mapped, Derived};
-use crate::file::{GroundMotionSpec, ScenarioFile, SpecimenSpec};
+use crate::file::{GroundMotionSpec, ScenarioFile};
 use crate::scenario::Run;
 use crate::system::{complete_servo_valve_under, controller_gains, loop_method_at, supply_under};
 use crate::system_file::Overlay;

@@ -153,7 +153,7 @@ impl TableScenario {
         let closed = spec.controller.is_some();
         refuse_uniaxial_keys(&ctx, file, closed)?;
         let table = build_table(&ctx, spec)?;
-        let specimen = build_specimen(&ctx, file.specimen.as_ref())?;
+        let specimen = crate::specimen::table_specimen(&ctx, file.specimen.as_ref())?;
         let limits = build_limits(&ctx, spec)?;
         let system = match &spec.controller {
             Some(c) => Some(build_system(
