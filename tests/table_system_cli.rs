@@ -279,6 +279,26 @@ fn the_tracking_summary_gives_the_relative_errors_the_readme_quotes() {
     }
     let a = ts["tracking_acceleration_nrmse"].as_f64().unwrap();
     assert!((0.525..0.535).contains(&a), "the quoted 53 %: {a}");
+    // The keys a multi-axis table gives each DOF carry the same figures for the one DOF x;
+    // the flat keys are their aliases.
+    let x = &ts["tracking"]["x"];
+    for (key, alias) in [
+        ("displacement_nrmse", "tracking_displacement_nrmse"),
+        ("acceleration_nrmse", "tracking_acceleration_nrmse"),
+        ("rms_error", "tracking_displacement_rms_m"),
+        ("rms_acceleration_error", "tracking_acceleration_rms_m_s2"),
+    ] {
+        assert_eq!(x[key], ts[alias], "tracking.x.{key} against {alias}");
+    }
+    for (key, alias) in [
+        ("peak_error", "tracking_displacement_peak_m"),
+        ("peak_acceleration_error", "tracking_acceleration_peak_m_s2"),
+    ] {
+        let (got, signed) = (x[key].as_f64().unwrap(), ts[alias].as_f64().unwrap());
+        assert_eq!(got, signed.abs(), "tracking.x.{key}: the magnitude of {alias}");
+    }
+    assert_eq!(ts["saturated_time_s"], ts["valve_saturated_time_s"]);
+    assert_eq!(ts["steps_per_period"], ts["steps_per_controller_period"]);
     let text = platen(&["simulate", s]);
     let out = String::from_utf8_lossy(&text.stdout);
     assert!(out.contains("acceleration error 53.4 % NRMSE"), "{out}");

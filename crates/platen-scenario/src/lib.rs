@@ -62,7 +62,7 @@ pub use platen_io::columns;
 pub use rig::{LoadedRig, LoopSettings, Rig};
 pub use scenario::{PlatenScenario, Run};
 pub use summary::{
-    EnergySummary, ExceedanceSummary, ForwardSummary, LimitCheck, LimitsSummary, RunSummary,
-    SolverSummary,
+    AxisTracking, EnergySummary, ExceedanceSummary, ForwardSummary, LimitCheck, LimitsSummary,
+    RunSummary, SolverSummary,
 };
 pub use system::TableSystemSpec;

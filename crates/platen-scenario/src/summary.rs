@@ -76,8 +76,20 @@ pub struct RunSummary {
 }
 
 /// A closed-loop run's figures.
+///
+/// `tracking`, `saturated_time_s` and `steps_per_period` carry the keys a multi-axis table's
+/// summary has (`loop` there); the flat `tracking_*`, `valve_saturated_time_s` and
+/// `steps_per_controller_period` are the same figures under the names this summary had first,
+/// kept for the scripts that read them.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SystemSummary {
+    /// How the one DOF followed its command, as a multi-axis table reports each of its DOFs
+    /// (`x`; the peaks there are magnitudes).
+    pub tracking: std::collections::BTreeMap<&'static str, AxisTracking>,
+    /// Time with the drive saturated, s (`valve_saturated_time_s`).
+    pub saturated_time_s: f64,
+    /// Integration steps per controller period (`steps_per_controller_period`).
+    pub steps_per_period: u32,
     /// RMS of the displacement error `u − u_ref`, m.
     pub tracking_displacement_rms_m: f64,
     /// Signed peak of the displacement error, m.
@@ -115,6 +127,26 @@ pub struct SystemSummary {
     pub steps_per_controller_period: u32,
     /// The linearised loop's stability and margins.
     pub loop_margins: MarginsSummary,
+}
+
+/// How one DOF of a closed loop followed its command (at the output samples): the same keys
+/// on every table, under `tracking.<dof>` (the uniaxial table's one DOF is `x`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AxisTracking {
+    /// RMS of command − achieved, m or rad.
+    pub rms_error: f64,
+    /// Largest |command − achieved|, m or rad.
+    pub peak_error: f64,
+    /// RMS of the error over the RMS of the command (`null` for a still command: the
+    /// error is then absolute, `rms_error`, the cross-talk into that DOF).
+    pub displacement_nrmse: Option<f64>,
+    /// RMS of the acceleration error (command's − achieved), m/s² or rad/s².
+    pub rms_acceleration_error: f64,
+    /// Largest |acceleration error|, m/s² or rad/s².
+    pub peak_acceleration_error: f64,
+    /// RMS of the acceleration error over the RMS of the command's acceleration (`null`
+    /// for a still command).
+    pub acceleration_nrmse: Option<f64>,
 }
 
 /// The linearised loop's margins ([`platen_system::Margins`]).
@@ -470,7 +502,18 @@ impl RunSummary {
                 st.saturated_time_s
             ));
         }
+        let x = AxisTracking {
+            rms_error: tr.displacement_rms_m(),
+            peak_error: tr.displacement_peak.value.abs(),
+            displacement_nrmse: tr.displacement_nrmse(),
+            rms_acceleration_error: tr.acceleration_rms_m_s2(),
+            peak_acceleration_error: tr.acceleration_peak.value.abs(),
+            acceleration_nrmse: tr.acceleration_nrmse(),
+        };
         self.table_system = Some(SystemSummary {
+            tracking: std::iter::once(("x", x)).collect(),
+            saturated_time_s: st.saturated_time_s,
+            steps_per_period: settings.method.steps_per_period(),
             tracking_displacement_rms_m: tr.displacement_rms_m(),
             tracking_displacement_peak_m: tr.displacement_peak.value,
             tracking_displacement_peak_t_s: tr.displacement_peak.t_s,

@@ -5,6 +5,7 @@ use std::collections::BTreeMap;
 use platen_signal::metrics::rms;
 
 use super::*;
+pub use crate::summary::AxisTracking;
 
 /// The peaks of one DOF of a multi-axis run.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -44,25 +45,6 @@ pub struct ActuatorPeaks {
     pub saturated_time_s: Option<f64>,
     /// Whether stroke and force stayed within the limits.
     pub respected: bool,
-}
-
-/// How one DOF of a closed loop followed its command (at the output samples).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct AxisTracking {
-    /// RMS of command − achieved, m or rad.
-    pub rms_error: f64,
-    /// Largest |command − achieved|, m or rad.
-    pub peak_error: f64,
-    /// RMS of the error over the RMS of the command (`null` for a still command: the
-    /// error is then absolute, `rms_error`, the cross-talk into that DOF).
-    pub displacement_nrmse: Option<f64>,
-    /// RMS of the acceleration error (command's − achieved), m/s² or rad/s².
-    pub rms_acceleration_error: f64,
-    /// Largest |acceleration error|, m/s² or rad/s².
-    pub peak_acceleration_error: f64,
-    /// RMS of the acceleration error over the RMS of the command's acceleration (`null`
-    /// for a still command).
-    pub acceleration_nrmse: Option<f64>,
 }
 
 /// One axis's peaks against its limits (`table.limits`; `null` where none is given).
