@@ -494,3 +494,68 @@ fn a_strut_out_of_gas_is_named() {
         ],
     );
 }
+
+/// The shipped open-loop forward scenario (actuator forces, pads with friction, the tower)
+/// copied into `dir` with its force record, laid over by `edit`.
+fn forward_in(dir: &Path, scale_forces: f64) -> Value {
+    let csv =
+        std::fs::read_to_string(root().join("scenarios/multi-axis/forward-forces.csv")).unwrap();
+    let mut lines = csv.lines();
+    let mut out = format!("{}\n", lines.next().unwrap());
+    for line in lines {
+        let mut cells = line.split(',');
+        let t = cells.next().unwrap();
+        out.push_str(t);
+        for c in cells {
+            let f: f64 = c.parse().unwrap();
+            out.push_str(&format!(",{:e}", f * scale_forces));
+        }
+        out.push('\n');
+    }
+    std::fs::write(dir.join("forward-forces.csv"), out).unwrap();
+    let text = std::fs::read_to_string(root().join("scenarios/multi-axis/forward.json")).unwrap();
+    serde_json::from_str(&text).unwrap()
+}
+
+/// A forward run on a strut with almost no gas (0.3 cm³: a gas spring of about 1.5e12 N/m
+/// on the platen, faster than the step can follow) stops with the table's six coordinates
+/// and the key to look at, exit 4 and nothing written; it used to run on and fail writing a
+/// non-finite force into the output file ("`out.csv`, line 116, column `a1_force_n`").
+#[test]
+fn a_strut_with_almost_no_gas_stops_a_forward_run_naming_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut doc = forward_in(dir.path(), 1.0);
+    doc["table"]["hold_down_struts"][0]["gas_volume_m3"] = json!(3e-7);
+    fails(
+        dir.path(),
+        &doc,
+        Some(4),
+        &[
+            "the table's state became non-finite",
+            "roll = ",
+            "gas_volume_m3",
+        ],
+    );
+}
+
+/// A forward run whose state blows up (forces of 1e290 N) says so with the table's six
+/// coordinates and the keys to look at, not the uniaxial platen's `u` and `v`; exit 4 (a
+/// numerical failure), nothing written.
+#[test]
+fn a_table_state_that_blows_up_is_reported_with_six_dof_labels() {
+    let dir = tempfile::tempdir().unwrap();
+    let doc = forward_in(dir.path(), 1e284);
+    fails(
+        dir.path(),
+        &doc,
+        Some(4),
+        &[
+            "the table's state became non-finite",
+            "x = ",
+            "yaw = ",
+            "rated_flow_m3_s",
+        ],
+    );
+    let (_, _, err) = run(dir.path(), "simulate", &doc, &[]);
+    assert!(!err.contains("(u = "), "{err}");
+}

@@ -295,7 +295,11 @@ fn the_tracking_summary_gives_the_relative_errors_the_readme_quotes() {
         ("peak_acceleration_error", "tracking_acceleration_peak_m_s2"),
     ] {
         let (got, signed) = (x[key].as_f64().unwrap(), ts[alias].as_f64().unwrap());
-        assert_eq!(got, signed.abs(), "tracking.x.{key}: the magnitude of {alias}");
+        assert_eq!(
+            got,
+            signed.abs(),
+            "tracking.x.{key}: the magnitude of {alias}"
+        );
     }
     assert_eq!(ts["saturated_time_s"], ts["valve_saturated_time_s"]);
     assert_eq!(ts["steps_per_period"], ts["steps_per_controller_period"]);

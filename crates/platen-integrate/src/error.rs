@@ -167,6 +167,17 @@ pub enum IntegrateError {
         /// Displacement, m.
         u_m: f64,
     },
+    /// A multi-axis table's state became NaN or infinite.
+    #[error(
+        "numerical failure at t = {t_s} s: the table's state became non-finite, from the pose x = {} m, y = {} m, z = {} m, roll = {} rad, pitch = {} rad, yaw = {} rad; something makes its motion unbounded or faster than the step can follow: look at the servo-valves (rated_flow_m3_s, natural_frequency_hz, rated_pressure_drop_pa), the oil columns, the hold-down struts' gas_volume_m3 (a small gas volume is a stiff spring), the controller's gains, a stiff specimen and the initial state",
+        .pose[0], .pose[1], .pose[2], .pose[3], .pose[4], .pose[5]
+    )]
+    TableNonFiniteState {
+        /// Time of the failure, s.
+        t_s: f64,
+        /// The pose the failing step started from: x, y, z (m), roll, pitch, yaw (rad).
+        pose: [f64; 6],
+    },
     /// A six-DOF table's hold-down strut used up its gas: the platen pulled it longer than
     /// its gas volume over its area allows.
     #[error("hold-down strut {strut} (table.hold_down_struts[{strut}]) ran out of gas at t = {t_s} s: its pull grew without bound as its gas volume went; the motion lengthens it by more than gas_volume_m3 / area_m2 allows (check those two values, or the command)")]
@@ -202,6 +213,9 @@ impl IntegrateError {
             }
             Failure::AdaptiveFailed(reason) => IntegrateError::AdaptiveFailed { t_s, reason },
             Failure::EndStop { u_m } => IntegrateError::EndStop { t_s, u_m },
+            Failure::TableNonFiniteState { pose } => {
+                IntegrateError::TableNonFiniteState { t_s, pose }
+            }
         }
     }
 
@@ -220,6 +234,9 @@ impl IntegrateError {
                 (t_s, Failure::AdaptiveFailed(reason))
             }
             IntegrateError::EndStop { t_s, u_m } => (t_s, Failure::EndStop { u_m }),
+            IntegrateError::TableNonFiniteState { t_s, pose } => {
+                (t_s, Failure::TableNonFiniteState { pose })
+            }
             _ => return None,
         };
         Some(StopReason::Failed { t_s, cause })

@@ -43,6 +43,11 @@ pub enum Failure {
         /// Velocity, m/s.
         v_m_s: f64,
     },
+    /// A multi-axis table's state became NaN or infinite.
+    TableNonFiniteState {
+        /// The pose the failing step started from: x, y, z (m), roll, pitch, yaw (rad).
+        pose: [f64; 6],
+    },
     /// The stick-slip event loop stopped advancing inside one step.
     EventLoopStalled {
         /// Events handled inside the step.

@@ -14,8 +14,8 @@ use crate::method::Method;
 use crate::multi_axis::TableRun;
 use crate::output::TableSink;
 use crate::table_plant::{
-    pose, reaim, start_machine, start_state, Forces, Source, TablePlant, BARE, MAX_TABLE_ACTUATORS,
-    MAX_TABLE_SPECIMEN_DOFS, QD, WITH_SPECIMEN, Z,
+    pose, reaim, start_machine, start_state, table_step_error, Forces, Source, TablePlant, BARE,
+    MAX_TABLE_ACTUATORS, MAX_TABLE_SPECIMEN_DOFS, QD, WITH_SPECIMEN, Z,
 };
 
 /// The actuator forces of a forward run: one record per actuator on one time grid.
@@ -257,11 +257,13 @@ fn step<const L: usize>(
 ) -> Result<()> {
     m.plant.source.clock.n = n;
     m.stats.steps += 1;
+    let (q0, _) = pose(&m.y);
     let sliding = reaim(m);
     if sliding && m.is_rk4() && m.slip_fast::<true>(0.0) {
         return Ok(());
     }
     m.advance_span()
+        .map_err(|e| table_step_error(e, m.plant.table, &q0))
 }
 
 /// The specimen's base force and overturning moments (the force the platen exerts on it,

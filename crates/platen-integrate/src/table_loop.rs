@@ -42,38 +42,13 @@ use crate::multi_axis::{PoseMotion, TableRun};
 use crate::output::TableSink;
 use crate::stop::Failure;
 use crate::table_forward::Rows;
+pub use crate::table_plant::SPENT_GAS_FRACTION;
 use crate::table_plant::{
     pose, reaim, start_machine, start_state, Forces, Source, Strokes, TablePlant, BARE,
     MAX_TABLE_ACTUATORS, QD, WITH_SPECIMEN,
 };
+use crate::table_plant::{spent_strut, table_step_error};
 use crate::MAX_TABLE_SPECIMEN_DOFS;
-
-/// A strut whose gas volume falls below this fraction of its volume at neutral has used up
-/// its gas: its pressure is then `100^n` times the neutral one (7 600 times for `n` = 1.44),
-/// beyond any strut's rating, and grows without bound as the volume goes.
-pub const SPENT_GAS_FRACTION: f64 = 0.01;
-
-/// A run whose state became non-finite while a strut had less than this fraction of its gas
-/// left (at the last finite state) is reported as that strut's gas spent: a strut at a
-/// quarter of its gas stiffens seven-fold within the step (n = 1.44) and its pull is what the
-/// step could not follow.
-const BLOWN_UP_GAS_FRACTION: f64 = 0.25;
-
-/// The first strut of `table` at pose `q` with less than [`SPENT_GAS_FRACTION`] of its gas
-/// volume left, if any.
-fn spent_strut(table: &MultiAxisTable, q: &Coords) -> Option<usize> {
-    spent_strut_below(table, q, SPENT_GAS_FRACTION)
-}
-
-/// The first strut of `table` at pose `q` with less than `fraction` of its gas volume left.
-fn spent_strut_below(table: &MultiAxisTable, q: &Coords, fraction: f64) -> Option<usize> {
-    table.struts().iter().enumerate().position(|(j, s)| {
-        let p = table.strut_at(j, q).pressure_pa;
-        // V = V₀·(p₀/p)^(1/n); an infinite pressure is a volume gone.
-        let left = (s.pressure_pa / p).powf(1.0 / s.polytropic_exponent);
-        left.is_nan() || left <= fraction
-    })
-}
 
 /// The most actuators a closed-loop table run takes (their hydraulic states live in the
 /// integrator's fixed-size state).
@@ -651,14 +626,16 @@ impl<'a, const L: usize> ControlLoop<L> for TableLoop<'a> {
         let (q0, _) = pose(&m.y);
         let t0 = m.plant.clock().t;
         m.advance_clocked(span).map_err(|e| match e {
-            // A state that blew up while a strut was running out of gas: the strut's
-            // pull, not the solver, is what went without bound.
-            IntegrateError::NonFiniteState { .. } => {
-                match spent_strut_below(self.run.table, &q0, BLOWN_UP_GAS_FRACTION) {
-                    Some(strut) => IntegrateError::StrutGasSpent { t_s: t0, strut },
-                    None => e,
-                }
-            }
+            // Reported at the segment's start, where the state was last finite.
+            IntegrateError::NonFiniteState { u_m, v_m_s, .. } => table_step_error(
+                IntegrateError::NonFiniteState {
+                    t_s: t0,
+                    u_m,
+                    v_m_s,
+                },
+                self.run.table,
+                &q0,
+            ),
             e => e,
         })
     }
@@ -681,9 +658,8 @@ impl<'a, const L: usize> ControlLoop<L> for TableLoop<'a> {
         if !m.y.iter().all(|x| x.is_finite()) {
             return Err(IntegrateError::failed(
                 t_s,
-                Failure::NonFiniteState {
-                    u_m: q[0],
-                    v_m_s: m.y[QD],
+                Failure::TableNonFiniteState {
+                    pose: std::array::from_fn(|k| q[k]),
                 },
             ));
         }

@@ -44,9 +44,11 @@ use platen_model::multi_axis::{
 use platen_model::PlatenModel;
 
 use crate::clock::Clock;
+use crate::error::IntegrateError;
 use crate::event::{Direction, EventKind, Mode};
 use crate::machine::{Machine, PieceMethod, Plant, DI, U, V, W, Y};
 use crate::multi_axis::{platen_acceleration, GRAVITY};
+use crate::stop::Failure;
 
 /// Where the pose starts in the state.
 pub(crate) const Q: usize = 5;
@@ -458,6 +460,58 @@ impl<S: Source<L>, const L: usize> TablePlant<'_, S, L> {
         self.leaving = along;
         self.blend_m_s = BLEND_STEPS * self.source.clock().step_s() * capacity.force_n
             / self.table.platen().mass_kg();
+    }
+}
+
+/// A strut whose gas volume falls below this fraction of its volume at neutral has used up
+/// its gas: its pressure is then `100^n` times the neutral one (7 600 times for `n` = 1.44),
+/// beyond any strut's rating, and grows without bound as the volume goes.
+pub const SPENT_GAS_FRACTION: f64 = 0.01;
+
+/// A run whose state became non-finite while a strut had less than this fraction of its gas
+/// left (at the last finite state) is reported as that strut's gas spent: a strut at a
+/// quarter of its gas stiffens seven-fold within the step (n = 1.44) and its pull is what the
+/// step could not follow.
+pub(crate) const BLOWN_UP_GAS_FRACTION: f64 = 0.25;
+
+/// The first strut of `table` at pose `q` with less than [`SPENT_GAS_FRACTION`] of its gas
+/// volume left, if any.
+pub(crate) fn spent_strut(table: &MultiAxisTable, q: &Coords) -> Option<usize> {
+    spent_strut_below(table, q, SPENT_GAS_FRACTION)
+}
+
+/// The first strut of `table` at pose `q` with less than `fraction` of its gas volume left.
+fn spent_strut_below(table: &MultiAxisTable, q: &Coords, fraction: f64) -> Option<usize> {
+    table.struts().iter().enumerate().position(|(j, s)| {
+        let p = table.strut_at(j, q).pressure_pa;
+        // V = V₀·(p₀/p)^(1/n); an infinite pressure is a volume gone.
+        let left = (s.pressure_pa / p).powf(1.0 / s.polytropic_exponent);
+        left.is_nan() || left <= fraction
+    })
+}
+
+/// The error of a table run whose step from pose `q0` failed with `e`: a state that blew up
+/// while a strut was running out of gas is the strut's gas spent (its pull, not the solver,
+/// went without bound); any other non-finite state is reported with the table's six
+/// coordinates (the pose the step started from), not the uniaxial platen's `u` and `v`.
+pub(crate) fn table_step_error(
+    e: IntegrateError,
+    table: &MultiAxisTable,
+    q0: &Coords,
+) -> IntegrateError {
+    match e {
+        IntegrateError::NonFiniteState { t_s, .. } => {
+            match spent_strut_below(table, q0, BLOWN_UP_GAS_FRACTION) {
+                Some(strut) => IntegrateError::StrutGasSpent { t_s, strut },
+                None => IntegrateError::failed(
+                    t_s,
+                    Failure::TableNonFiniteState {
+                        pose: std::array::from_fn(|k| q0[k]),
+                    },
+                ),
+            }
+        }
+        e => e,
     }
 }
 

@@ -307,7 +307,11 @@ fn exit_code(e: &anyhow::Error) -> u8 {
             _ => cause.downcast_ref::<ScenarioError>(),
         };
         match scenario {
-            Some(ScenarioError::Run(ie)) => return integrate_exit_code(ie),
+            Some(
+                ScenarioError::Run(ie)
+                | ScenarioError::TableRun(ie)
+                | ScenarioError::TableLoopUnstable { source: ie, .. },
+            ) => return integrate_exit_code(ie),
             Some(ScenarioError::Io(io)) => return io_exit_code(io),
             Some(_) => return 3,
             None => {}
@@ -338,7 +342,9 @@ fn io_exit_code(e: &IoError) -> u8 {
 /// 4 for a numerical failure, 3 for an input the integrator cannot use.
 fn integrate_exit_code(e: &IntegrateError) -> u8 {
     match e {
-        IntegrateError::NonFiniteState { .. } | IntegrateError::EventLoopStalled { .. } => 4,
+        IntegrateError::NonFiniteState { .. }
+        | IntegrateError::TableNonFiniteState { .. }
+        | IntegrateError::EventLoopStalled { .. } => 4,
         _ => 3,
     }
 }
