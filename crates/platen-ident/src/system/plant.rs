@@ -230,7 +230,8 @@ impl PlantInput {
 /// skew in `records` (reported in `skew_report`); `not_identified` gets what cannot be seen.
 ///
 /// # Errors
-/// [`IdentError::Signal`] when a filter cannot be made for a record's rate.
+/// [`IdentError::Signal`](crate::IdentError::Signal) when a filter cannot be made for a
+/// record's rate.
 pub(crate) fn identify_plant(
     records: &mut [SystemRecord],
     periods: &[f64],

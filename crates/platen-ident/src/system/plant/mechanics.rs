@@ -29,14 +29,16 @@ pub struct IdentifiedMechanics {
     pub stiffness_n_per_m: f64,
     /// Viscous coefficient `C`, N·(s/m)^α.
     pub viscous_coefficient: f64,
-    /// Viscous exponent `α` (1 unless the records support another: [`EXPONENT_GRID`]).
+    /// Viscous exponent `α` (1 unless the records support another:
+    /// [`EXPONENT_GRID`](crate::system::EXPONENT_GRID)).
     pub viscous_exponent: f64,
     /// Stribeck amplitude `a`, N (0 unless the records support the term).
     pub low_velocity_force_n: f64,
-    /// Stribeck decay `b`, s/m ([`DECAY_GRID_S_PER_M`]; 0 without the term).
+    /// Stribeck decay `b`, s/m ([`DECAY_GRID_S_PER_M`](crate::system::DECAY_GRID_S_PER_M);
+    /// 0 without the term).
     pub low_velocity_decay_s_per_m: f64,
     /// Samples slower than this were left out of the fit, m/s ([`SLIP_SPEED_M_S`], or
-    /// [`LOW_SLIP_SPEED_M_S`] for a richer law).
+    /// [`LOW_SLIP_SPEED_M_S`](crate::system::LOW_SLIP_SPEED_M_S) for a richer law).
     pub slip_speed_m_s: f64,
     /// Coulomb force `F_μ`, N.
     pub coulomb_force_n: f64,
