@@ -110,18 +110,16 @@ pub(crate) fn fit_dissipative(
         w.rec_corr.clear();
         w.update_peak();
     }
-    let ref_points = |work: &[Work]| {
-        let mut pts = LawPoints::default();
-        for w in work.iter().filter(|w| w.group == reference_group) {
-            pts.extend(&w.weighted_points());
-        }
-        pts
-    };
     let mut outcome = None;
     let mut warnings = Vec::new();
     for _ in 0..SMEARING_ITERATIONS {
         warnings.clear();
-        outcome = fit_law(&ref_points(work), settings, corr, &mut warnings);
+        outcome = fit_law(
+            &group_points(work, reference_group),
+            settings,
+            corr,
+            &mut warnings,
+        );
         let Some((_, fit)) = &outcome else { break };
         for w in work.iter_mut().filter(|w| w.group == reference_group) {
             w.correct_smearing(&fit.law);
@@ -130,54 +128,73 @@ pub(crate) fn fit_dissipative(
     let mut group_coulomb: Vec<Option<Estimate>> = vec![None; groups];
     if let Some((_, fit)) = &outcome {
         for (g, slot) in group_coulomb.iter_mut().enumerate() {
-            let mut law_g = fit.law;
-            for round in 0..SMEARING_ITERATIONS {
-                if g != reference_group || round == 0 {
-                    let mut pts = LawPoints::default();
-                    for w in work.iter().filter(|w| w.group == g) {
-                        pts.extend(&w.weighted_points());
-                    }
-                    let mut base = law_values(&law_g);
-                    base[law::COULOMB] = 0.0;
-                    let Some(f) = law::fit(&pts, [true, false, false, false, false], base, corr)
-                    else {
-                        break;
-                    };
-                    // One standard error everywhere: the reference pressure's `F_μ` is the
-                    // joint fit's (the top-level value and its standard error); another
-                    // pressure's carries the uncertainty of the law held from that fit too.
-                    *slot = Some(if g == reference_group {
-                        Estimate::new(
-                            fit.law.coulomb_force_n,
-                            fit.std_errors[law::COULOMB],
-                            fit.dof,
-                        )
-                    } else {
-                        let se = law::coulomb_std_error_with_held(
-                            &pts,
-                            &f.law,
-                            f.std_errors[law::COULOMB],
-                            &fit.covariance,
-                        );
-                        Estimate::new(f.law.coulomb_force_n, se, f.dof.min(fit.dof))
-                    });
-                    law_g.coulomb_force_n = f.law.coulomb_force_n;
-                }
-                if g == reference_group {
-                    break;
-                }
-                for w in work.iter_mut().filter(|w| w.group == g) {
-                    w.correct_smearing(&law_g);
-                }
-            }
+            *slot = group_coulomb_force(work, (g, reference_group), fit, corr);
         }
     }
     Dissipative {
         outcome,
         group_coulomb,
-        ref_points: ref_points(work),
+        ref_points: group_points(work, reference_group),
         warnings,
     }
+}
+
+/// The Eq. 20 points of pressure group `group`'s tests.
+fn group_points(work: &[Work], group: usize) -> LawPoints {
+    let mut pts = LawPoints::default();
+    for w in work.iter().filter(|w| w.group == group) {
+        pts.extend(&w.weighted_points());
+    }
+    pts
+}
+
+/// `F_μ` of pressure group `g` with the rest of the reference group's law `fit` held,
+/// alternating with the correction of the smearing by it (the reference group's own is the
+/// joint fit's); `None` when it cannot be fitted.
+fn group_coulomb_force(
+    work: &mut [Work],
+    (g, reference_group): (usize, usize),
+    fit: &LawFit,
+    corr: f64,
+) -> Option<Estimate> {
+    let mut slot = None;
+    let mut law_g = fit.law;
+    for round in 0..SMEARING_ITERATIONS {
+        if g != reference_group || round == 0 {
+            let pts = group_points(work, g);
+            let mut base = law_values(&law_g);
+            base[law::COULOMB] = 0.0;
+            let Some(f) = law::fit(&pts, [true, false, false, false, false], base, corr) else {
+                break;
+            };
+            // One standard error everywhere: the reference pressure's `F_μ` is the
+            // joint fit's (the top-level value and its standard error); another
+            // pressure's carries the uncertainty of the law held from that fit too.
+            slot = Some(if g == reference_group {
+                Estimate::new(
+                    fit.law.coulomb_force_n,
+                    fit.std_errors[law::COULOMB],
+                    fit.dof,
+                )
+            } else {
+                let se = law::coulomb_std_error_with_held(
+                    &pts,
+                    &f.law,
+                    f.std_errors[law::COULOMB],
+                    &fit.covariance,
+                );
+                Estimate::new(f.law.coulomb_force_n, se, f.dof.min(fit.dof))
+            });
+            law_g.coulomb_force_n = f.law.coulomb_force_n;
+        }
+        if g == reference_group {
+            break;
+        }
+        for w in work.iter_mut().filter(|w| w.group == g) {
+            w.correct_smearing(&law_g);
+        }
+    }
+    slot
 }
 
 /// Fits the law at the reference pressure; decides which parameters the data determine.

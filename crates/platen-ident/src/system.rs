@@ -441,25 +441,8 @@ pub fn identify_system(
     // (by the force balance, inside the plant's fit).
     let mut channel_skew = Vec::new();
     let mut corrected = skew::correct_accelerations(records, &periods, &fitted, &mut channel_skew)?;
-    let all = |f: fn(&SystemRecord) -> bool| fitted.iter().all(|&i| f(&records[i]));
     let mut not_identified = Vec::new();
-    let cols = Columns {
-        acceleration: all(|r| r.a_m_s2.is_some()),
-        delta_p: all(|r| r.delta_p_pa.is_some()),
-    };
-    let why = |what: &str, reason: &str| (what.to_owned(), reason.to_owned());
-    if !cols.acceleration {
-        not_identified.push(why(
-            "acceleration_feedback_s2_per_m",
-            "no a_m_s2 recorded: taken as 0",
-        ));
-    }
-    if !cols.delta_p {
-        not_identified.push(why(
-            "delta_p_gain_per_pa, delta_p_highpass_hz",
-            "no delta_p_pa recorded: taken as 0",
-        ));
-    }
+    let cols = recorded_columns(records, &fitted, &mut not_identified);
     let plant_input = plant::PlantInput::new(settings, &corrected[0]);
     let mut plant = plant::identify_plant(
         &mut corrected,
@@ -488,7 +471,7 @@ pub fn identify_system(
     let mut result = SystemIdentification {
         gains: Some(gains),
         fitted_records: fitted.iter().map(|&i| records[i].name.clone()).collect(),
-        records: Vec::new(),
+        records: held_out(records_c, &periods, &fitted, cols, corner, c),
         saturated_samples: sat,
         gain_estimates,
         channel_skew,
@@ -498,28 +481,7 @@ pub fn identify_system(
         provenance: Vec::new(),
         not_identified,
     };
-    result.records = held_out(records_c, &periods, &fitted, cols, corner, c);
-    // The identified gains on the identified system: still a table system only if they are
-    // gains a controller takes (checked again at the same stroke).
-    // If they are not, say so: the result then carries no table system (and no scenario).
-    plant.system = plant.system.and_then(|sys| {
-        let stroke_m = stroke_limit_m(&sys);
-        let mut parts = sys.into_parts();
-        set_controller(&mut parts.controller, &gains);
-        match platen_system::TableSystem::new(parts, stroke_m) {
-            Ok(system) => Some(system),
-            Err(e) => {
-                result.not_identified.push((
-                    "table_system".to_owned(),
-                    format!(
-                        "the identified gains are not gains a controller takes ({e}): no \
-                         identified table system or scenario is given"
-                    ),
-                ));
-                None
-            }
-        }
-    });
+    plant.system = with_gains(plant.system, &gains, &mut result.not_identified);
     if settings.prediction_error {
         result.prediction_error =
             pem::refine(records_c, &fitted, &mut plant, &mut result.not_identified);
@@ -537,6 +499,61 @@ pub fn identify_system(
     result.provenance = provenance::of(&result, &plant, &plant_input);
     result.plant = Some(plant);
     Ok(result)
+}
+
+/// The controller's columns every fitted record has (the acceleration, `Δp`); the gains a
+/// missing one leaves at 0 into `not_identified`.
+fn recorded_columns(
+    records: &[SystemRecord],
+    fitted: &[usize],
+    not_identified: &mut Vec<(String, String)>,
+) -> Columns {
+    let all = |f: fn(&SystemRecord) -> bool| fitted.iter().all(|&i| f(&records[i]));
+    let cols = Columns {
+        acceleration: all(|r| r.a_m_s2.is_some()),
+        delta_p: all(|r| r.delta_p_pa.is_some()),
+    };
+    let why = |what: &str, reason: &str| (what.to_owned(), reason.to_owned());
+    if !cols.acceleration {
+        not_identified.push(why(
+            "acceleration_feedback_s2_per_m",
+            "no a_m_s2 recorded: taken as 0",
+        ));
+    }
+    if !cols.delta_p {
+        not_identified.push(why(
+            "delta_p_gain_per_pa, delta_p_highpass_hz",
+            "no delta_p_pa recorded: taken as 0",
+        ));
+    }
+    cols
+}
+
+/// The identified `system` with the identified `gains`: still a table system only if they
+/// are gains a controller takes (checked again at the same stroke). If they are not, said in
+/// `not_identified`: the result then carries no table system (and no scenario).
+fn with_gains(
+    system: Option<platen_system::TableSystem>,
+    gains: &IdentifiedGains,
+    not_identified: &mut Vec<(String, String)>,
+) -> Option<platen_system::TableSystem> {
+    let sys = system?;
+    let stroke_m = stroke_limit_m(&sys);
+    let mut parts = sys.into_parts();
+    set_controller(&mut parts.controller, gains);
+    match platen_system::TableSystem::new(parts, stroke_m) {
+        Ok(system) => Some(system),
+        Err(e) => {
+            not_identified.push((
+                "table_system".to_owned(),
+                format!(
+                    "the identified gains are not gains a controller takes ({e}): no \
+                     identified table system or scenario is given"
+                ),
+            ));
+            None
+        }
+    }
 }
 
 /// The checks of [`identify_system`] before any fit: the records' periods and which are

@@ -162,6 +162,7 @@ pub(crate) struct Moments {
 }
 
 impl Moments {
+    /// The moments of `block` about `(alpha, b)` (the low-velocity term's sums with `low`).
     fn of(block: &Block, alpha: f64, b: f64, low: bool) -> Self {
         let mut m = Moments {
             c: [[0.0; POWERS]; 5],
@@ -177,10 +178,6 @@ impl Moments {
             ee_bound: [[0.0; 2]; 2],
             ce_bound: [[0.0; ORDER + 3]; 3],
         };
-        let mut pl = [0.0; POWERS];
-        let mut pw = [0.0; POWERS];
-        let mut al_pow = [0.0; POWERS];
-        let mut aw_pow = [0.0; POWERS];
         for i in 0..block.len() {
             let (ln, w) = (block.ln_w[i], block.w[i]);
             m.max_ln = m.max_ln.max(ln.abs());
@@ -188,69 +185,66 @@ impl Moments {
             let s = block.s[i];
             let c = s * (alpha * ln).exp();
             let h = [block.a[i], block.u[i], s, 1.0, block.f[i]];
-            pl[0] = 1.0;
-            pw[0] = 1.0;
-            al_pow[0] = 1.0;
-            aw_pow[0] = 1.0;
-            for k in 1..POWERS {
-                pl[k] = pl[k - 1] * ln;
-                pw[k] = pw[k - 1] * w;
-                al_pow[k] = al_pow[k - 1] * ln.abs();
-                aw_pow[k] = aw_pow[k - 1] * w;
-            }
-            for (sums, &h) in m.c.iter_mut().zip(&h) {
-                let ch = c * h;
-                for (x, &p) in sums.iter_mut().zip(&pl) {
-                    *x += ch * p;
-                }
-            }
-            for (x, &p) in m.cc.iter_mut().zip(&pl) {
-                *x += c * c * p;
-            }
-            let (al, aw) = (ln.abs(), w);
-            let (lk, wk) = (al_pow[POWERS - 1], aw_pow[POWERS - 1]);
-            let add = |b: &mut [[f64; 2]; 2], g: f64, x: f64, xk: f64| {
-                b[0][0] += g;
-                b[0][1] += g * xk;
-                b[1][0] += g * x;
-                b[1][1] += g * x * xk;
-            };
-            for (b, &h) in m.c_bound.iter_mut().zip(&h) {
-                add(b, (c * h).abs(), al, lk);
-            }
-            add(&mut m.cc_bound, c * c, al, lk);
+            let p = Powers::of(ln, w);
+            m.add_c(c, &h, &p);
             if low {
                 let e = s * (-b * w).exp();
-                for (sums, &h) in m.e.iter_mut().zip(&h) {
-                    let eh = e * h;
-                    for (x, &p) in sums.iter_mut().zip(&pw) {
-                        *x += eh * p;
-                    }
-                }
-                for (x, &p) in m.ee.iter_mut().zip(&pw) {
-                    *x += e * e * p;
-                }
-                for (b, &h) in m.e_bound.iter_mut().zip(&h) {
-                    add(b, (e * h).abs(), aw, wk);
-                }
-                add(&mut m.ee_bound, e * e, aw, wk);
-                let g = (c * e).abs();
-                for (b, x) in m.ce_bound.iter_mut().zip([1.0, al, aw]) {
-                    b[0] += g * x;
-                    for i in 0..=ORDER + 1 {
-                        b[1 + i] += g * x * al_pow[i] * aw_pow[ORDER + 1 - i];
-                    }
-                }
-                let ce = c * e;
-                for (j, (row, &lj)) in m.ce.iter_mut().zip(&pl).enumerate() {
-                    let cej = ce * lj;
-                    for (x, &wl) in row.iter_mut().zip(&pw).take(POWERS - j) {
-                        *x += cej * wl;
-                    }
-                }
+                m.add_e(e, c, &h, &p);
             }
         }
         m
+    }
+
+    /// One sample's `ĉ` terms (`c = ĉ`, `h` its `a, u, s, 1, F`): `Σ h·ĉ·Lᵐ`, `Σ ĉ²·Lᵐ` and
+    /// their bounds.
+    fn add_c(&mut self, c: f64, h: &[f64; 5], p: &Powers) {
+        for (sums, &h) in self.c.iter_mut().zip(h) {
+            let ch = c * h;
+            for (x, &p) in sums.iter_mut().zip(&p.l) {
+                *x += ch * p;
+            }
+        }
+        for (x, &p) in self.cc.iter_mut().zip(&p.l) {
+            *x += c * c * p;
+        }
+        let (al, lk) = (p.abs_ln, p.abs_l[POWERS - 1]);
+        for (b, &h) in self.c_bound.iter_mut().zip(h) {
+            add_bound(b, (c * h).abs(), al, lk);
+        }
+        add_bound(&mut self.cc_bound, c * c, al, lk);
+    }
+
+    /// One sample's `ê` terms (`e = ê`, with its `ĉ` = `c`): `Σ h·ê·Wᵐ`, `Σ ê²·Wᵐ`,
+    /// `Σ ĉ·ê·Lʲ·Wˡ` and their bounds.
+    fn add_e(&mut self, e: f64, c: f64, h: &[f64; 5], p: &Powers) {
+        for (sums, &h) in self.e.iter_mut().zip(h) {
+            let eh = e * h;
+            for (x, &p) in sums.iter_mut().zip(&p.w) {
+                *x += eh * p;
+            }
+        }
+        for (x, &p) in self.ee.iter_mut().zip(&p.w) {
+            *x += e * e * p;
+        }
+        let (al, aw, wk) = (p.abs_ln, p.abs_w, p.abs_w_pow[POWERS - 1]);
+        for (b, &h) in self.e_bound.iter_mut().zip(h) {
+            add_bound(b, (e * h).abs(), aw, wk);
+        }
+        add_bound(&mut self.ee_bound, e * e, aw, wk);
+        let g = (c * e).abs();
+        for (b, x) in self.ce_bound.iter_mut().zip([1.0, al, aw]) {
+            b[0] += g * x;
+            for i in 0..=ORDER + 1 {
+                b[1 + i] += g * x * p.abs_l[i] * p.abs_w_pow[ORDER + 1 - i];
+            }
+        }
+        let ce = c * e;
+        for (j, (row, &lj)) in self.ce.iter_mut().zip(&p.l).enumerate() {
+            let cej = ce * lj;
+            for (x, &wl) in row.iter_mut().zip(&p.w).take(POWERS - j) {
+                *x += cej * wl;
+            }
+        }
     }
 
     /// Whether every expansion's truncation error at `(δα, δb)` is below [`TRUNCATION`].
@@ -356,6 +350,51 @@ impl Moments {
     }
 }
 
+/// One sample's powers `0 ..= ORDER + 1` of `L = ln|v|`, `W = |v|`, `|L|` and `W` (again,
+/// for the bounds).
+struct Powers {
+    l: [f64; POWERS],
+    w: [f64; POWERS],
+    abs_l: [f64; POWERS],
+    abs_w_pow: [f64; POWERS],
+    /// `|L|` and `W`.
+    abs_ln: f64,
+    abs_w: f64,
+}
+
+impl Powers {
+    fn of(ln: f64, w: f64) -> Self {
+        let mut p = Powers {
+            l: [0.0; POWERS],
+            w: [0.0; POWERS],
+            abs_l: [0.0; POWERS],
+            abs_w_pow: [0.0; POWERS],
+            abs_ln: ln.abs(),
+            abs_w: w,
+        };
+        p.l[0] = 1.0;
+        p.w[0] = 1.0;
+        p.abs_l[0] = 1.0;
+        p.abs_w_pow[0] = 1.0;
+        for k in 1..POWERS {
+            p.l[k] = p.l[k - 1] * ln;
+            p.w[k] = p.w[k - 1] * w;
+            p.abs_l[k] = p.abs_l[k - 1] * ln.abs();
+            p.abs_w_pow[k] = p.abs_w_pow[k - 1] * w;
+        }
+        p
+    }
+}
+
+/// A term of weight `g` at `x` (`xk = |x|^(K+1)`) into a sum's bounds: `Σ|g|·|x|^shift` and
+/// `Σ|g|·|x|^(shift + K + 1)` for the shifts 0 and 1.
+fn add_bound(b: &mut [[f64; 2]; 2], g: f64, x: f64, xk: f64) {
+    b[0][0] += g;
+    b[0][1] += g * xk;
+    b[1][0] += g * x;
+    b[1][1] += g * x * xk;
+}
+
 /// How a refit's sums are formed: from the moments (the refits), or from the samples
 /// (a reference for the tests).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -396,13 +435,6 @@ impl Refits {
     /// as the bound stays active ([`Refits::refit`] checks that it does).
     pub(crate) fn new(data: &Stacked, fit: &SeparableFit, shape: Shape, sums: Sums) -> Self {
         let (alpha, b) = (fit.full[EXPONENT], fit.full[LOW_DECAY]);
-        let bounds = |i: usize| {
-            if i == EXPONENT {
-                ALPHA_BOUNDS
-            } else {
-                DECAY_BOUNDS
-            }
-        };
         let mut searched = Vec::new();
         let mut held = Vec::new();
         for i in shape.nonlinear() {
@@ -439,15 +471,6 @@ impl Refits {
     /// the bound, as the search's would be). At the end every held parameter's bound must be
     /// active: the cost's gradient still pushing outward.
     pub(crate) fn refit(&self, data: &Stacked, record: usize) -> Option<Refit> {
-        let bounds = |i: usize| {
-            if i == EXPONENT {
-                ALPHA_BOUNDS
-            } else {
-                DECAY_BOUNDS
-            }
-        };
-        let scale = |q: f64| q.abs().max(PARAMETER_FLOOR);
-        let slot = |i: usize| usize::from(i != EXPONENT);
         let mut searched = self.searched.clone();
         let mut held = self.held.clone();
         let mut ab = [self.alpha, if self.shape.low { self.b } else { 0.0 }];
@@ -457,43 +480,12 @@ impl Refits {
             if converged {
                 break;
             }
-            let m = searched.len();
-            let mut h = DMatrix::zeros(m, m);
-            for (l, &il) in searched.iter().enumerate() {
-                let step = HESSIAN_STEP * scale(ab[slot(il)]);
-                let (mut abp, mut abm) = (ab, ab);
-                abp[slot(il)] += step;
-                abm[slot(il)] -= step;
-                let (gp, gm) = (
-                    self.point(data, record, abp, &searched, &held)?.gradient,
-                    self.point(data, record, abm, &searched, &held)?.gradient,
-                );
-                for k in 0..m {
-                    h[(k, l)] = (gp[k] - gm[k]) / (2.0 * step);
-                }
-            }
-            let h = (&h + h.transpose()) * 0.5;
+            let h = self.hessian(data, record, ab, &searched, &held)?;
             let step = h
                 .cholesky()?
                 .solve(&(-DVector::from_column_slice(&point.gradient)));
             // A full step across a bound: to the bound, the parameter held there from now on.
-            let crossing = searched
-                .iter()
-                .zip(&step)
-                .enumerate()
-                .filter_map(|(k, (&i, &d))| {
-                    let [lo, hi] = bounds(i);
-                    let x = ab[slot(i)];
-                    if x + d >= hi {
-                        Some((k, (hi - x) / d, hi, -1.0))
-                    } else if x + d <= lo {
-                        Some((k, (lo - x) / d, lo, 1.0))
-                    } else {
-                        None
-                    }
-                })
-                .min_by(|a, b| a.1.total_cmp(&b.1));
-            if let Some((k, fraction, bound, sign)) = crossing {
+            if let Some((k, fraction, bound, sign)) = first_crossing(&searched, &step, ab) {
                 let mut next = ab;
                 for (&i, &d) in searched.iter().zip(&step) {
                     next[slot(i)] += fraction * d;
@@ -506,28 +498,8 @@ impl Refits {
                 converged = searched.is_empty();
                 continue;
             }
-            // The Newton step, halved while it leaves the expansions' accuracy.
-            let mut fraction = 1.0;
-            loop {
-                let mut next = ab;
-                for (&i, &d) in searched.iter().zip(&step) {
-                    next[slot(i)] += fraction * d;
-                }
-                if let Some(p) = self.point(data, record, next, &searched, &held) {
-                    converged = fraction == 1.0
-                        && searched
-                            .iter()
-                            .zip(&step)
-                            .all(|(&i, d)| d.abs() <= STEP_TOLERANCE * scale(ab[slot(i)]));
-                    ab = next;
-                    point = p;
-                    break;
-                }
-                fraction *= 0.5;
-                if fraction < MIN_STEP_FRACTION {
-                    return None;
-                }
-            }
+            (ab, point, converged) =
+                self.newton_step(data, record, ab, &step, (&searched, &held))?;
         }
         // A held parameter's bound must stay active: the cost still falls beyond it.
         if !converged
@@ -538,6 +510,72 @@ impl Refits {
         {
             return None;
         }
+        Some(self.refit_at(ab, &point))
+    }
+
+    /// The Hessian of the cost along the `searched` parameters at `ab`: the central
+    /// difference of its gradient, symmetrised.
+    fn hessian(
+        &self,
+        data: &Stacked,
+        record: usize,
+        ab: [f64; 2],
+        searched: &[usize],
+        held: &[(usize, f64)],
+    ) -> Option<DMatrix<f64>> {
+        let m = searched.len();
+        let mut h = DMatrix::zeros(m, m);
+        for (l, &il) in searched.iter().enumerate() {
+            let step = HESSIAN_STEP * scale(ab[slot(il)]);
+            let (mut abp, mut abm) = (ab, ab);
+            abp[slot(il)] += step;
+            abm[slot(il)] -= step;
+            let (gp, gm) = (
+                self.point(data, record, abp, searched, held)?.gradient,
+                self.point(data, record, abm, searched, held)?.gradient,
+            );
+            for k in 0..m {
+                h[(k, l)] = (gp[k] - gm[k]) / (2.0 * step);
+            }
+        }
+        Some((&h + h.transpose()) * 0.5)
+    }
+
+    /// The Newton `step` from `ab` along the `searched` parameters, halved while it leaves
+    /// the expansions' accuracy (`None` below [`MIN_STEP_FRACTION`]): the new `(α, b)`, its
+    /// point, and whether the step was full and within [`STEP_TOLERANCE`] (converged).
+    fn newton_step(
+        &self,
+        data: &Stacked,
+        record: usize,
+        ab: [f64; 2],
+        step: &DVector<f64>,
+        (searched, held): (&[usize], &[(usize, f64)]),
+    ) -> Option<([f64; 2], Point, bool)> {
+        let mut fraction = 1.0;
+        loop {
+            let mut next = ab;
+            for (&i, &d) in searched.iter().zip(step) {
+                next[slot(i)] += fraction * d;
+            }
+            if let Some(p) = self.point(data, record, next, searched, held) {
+                let converged = fraction == 1.0
+                    && searched
+                        .iter()
+                        .zip(step)
+                        .all(|(&i, d)| d.abs() <= STEP_TOLERANCE * scale(ab[slot(i)]));
+                return Some((next, p, converged));
+            }
+            fraction *= 0.5;
+            if fraction < MIN_STEP_FRACTION {
+                return None;
+            }
+        }
+    }
+
+    /// The refit at the converged `(α, b)` = `ab` and its `point`: the full vector and the
+    /// fitted parameters (a linear one the solve clamps is not fitted).
+    fn refit_at(&self, ab: [f64; 2], point: &Point) -> Refit {
         let mut full = vec![0.0; self.shape.full_len()];
         full[EXPONENT] = ab[0];
         full[LOW_DECAY] = ab[1];
@@ -556,7 +594,7 @@ impl Refits {
                     .is_none_or(|c| !point.clamped[c])
             })
             .collect();
-        Some(Refit { full, free })
+        Refit { full, free }
     }
 
     /// The linear solve at `(α, b) = ab` and the cost's gradient along the `searched`
@@ -636,6 +674,51 @@ impl Refits {
             held_gradient,
         })
     }
+}
+
+/// The bounds of nonlinear parameter `i` (full-vector index): `α`'s or `b`'s.
+fn bounds(i: usize) -> [f64; 2] {
+    if i == EXPONENT {
+        ALPHA_BOUNDS
+    } else {
+        DECAY_BOUNDS
+    }
+}
+
+/// Where nonlinear parameter `i` is in an `(α, b)` pair.
+fn slot(i: usize) -> usize {
+    usize::from(i != EXPONENT)
+}
+
+/// The scale of a parameter's value `q`, for the tolerance and the difference step.
+fn scale(q: f64) -> f64 {
+    q.abs().max(PARAMETER_FLOOR)
+}
+
+/// The first bound the full Newton `step` from `ab` crosses, if any: the searched
+/// parameter's position in `searched`, the fraction of the step to the bound, the bound and
+/// the sign the gradient must keep there (`+1` at a lower bound, `−1` at an upper one).
+fn first_crossing(
+    searched: &[usize],
+    step: &DVector<f64>,
+    ab: [f64; 2],
+) -> Option<(usize, f64, f64, f64)> {
+    searched
+        .iter()
+        .zip(step)
+        .enumerate()
+        .filter_map(|(k, (&i, &d))| {
+            let [lo, hi] = bounds(i);
+            let x = ab[slot(i)];
+            if x + d >= hi {
+                Some((k, (hi - x) / d, hi, -1.0))
+            } else if x + d <= lo {
+                Some((k, (lo - x) / d, lo, 1.0))
+            } else {
+                None
+            }
+        })
+        .min_by(|a, b| a.1.total_cmp(&b.1))
 }
 
 /// The linear solve and the cost's gradient at one `(α, b)`.

@@ -380,13 +380,7 @@ impl fmt::Display for RecordWarning {
                 below_m_s,
                 fraction,
                 min_speed_m_s,
-            } => write!(
-                f,
-                "only {:.1} % of the fitted samples are below {:.1} mm/s, where the low-velocity term acts (none below {:.1} mm/s): a and b rest on few samples",
-                100.0 * fraction,
-                1e3 * below_m_s,
-                1e3 * min_speed_m_s
-            ),
+            } => few_low_speed_samples(f, *below_m_s, *fraction, *min_speed_m_s),
             RecordWarning::NotIdentifiable { fit, key } => write!(
                 f,
                 "{} is not identifiable from this record ({}: singular)",
@@ -400,13 +394,7 @@ impl fmt::Display for RecordWarning {
                 key,
                 equation_error,
                 output_error,
-            } => write!(
-                f,
-                "{}: equation error {equation_error:.6e} and output error {output_error:.6e} disagree ({:.1} %)",
-                key.name(),
-                100.0 * (equation_error - output_error).abs()
-                    / equation_error.abs().max(f64::MIN_POSITIVE)
-            ),
+            } => fits_disagree(f, *key, *equation_error, *output_error),
             RecordWarning::DeclaredPeriodicButNot { test, reason } => write!(
                 f,
                 "test `{test}` was declared periodic but is not ({reason}): identified by the any-record method"
@@ -423,37 +411,98 @@ impl fmt::Display for RecordWarning {
             RecordWarning::FrictionAbovePeakForce {
                 static_friction_n,
                 peak_force_n,
-            } => write!(
-                f,
-                "implausible: the static friction F_μ + a = {:.1} kN exceeds the largest force in the records ({:.1} kN), so the platen could never have moved: is the force in the wrong unit or the wrong channel?",
-                static_friction_n / 1e3,
-                peak_force_n / 1e3
-            ),
+            } => friction_above_peak_force(f, *static_friction_n, *peak_force_n),
             RecordWarning::OutputErrorImplausible {
                 key,
                 equation_error,
                 output_error,
-            } => write!(
-                f,
-                "implausible output-error check: {} = {output_error:.4e} {} against {equation_error:.4e} from the equation error; it does not check the equation error (the record may not excite the platen enough for a forward simulation to pin it)",
-                symbol(*key),
-                key.unit()
-            ),
+            } => output_error_implausible(f, *key, *equation_error, *output_error),
             RecordWarning::RecordsDisagree {
                 lightest,
                 heaviest,
                 joint_kg,
-            } => write!(
-                f,
-                "the records disagree on the platen's mass: `{}` alone gives {:.1} t, `{}` alone {:.1} t (the joint fit {:.1} t): records of different tables, or of one table with and without a payload, fitted as one; identify them apart",
-                lightest.0,
-                1e-3 * lightest.1,
-                heaviest.0,
-                1e-3 * heaviest.1,
-                1e-3 * joint_kg
-            ),
+            } => records_disagree(f, lightest, heaviest, *joint_kg),
         }
     }
+}
+
+/// [`RecordWarning::FewLowSpeedSamples`]'s message.
+fn few_low_speed_samples(
+    f: &mut fmt::Formatter<'_>,
+    below_m_s: f64,
+    fraction: f64,
+    min_speed_m_s: f64,
+) -> fmt::Result {
+    write!(
+        f,
+        "only {:.1} % of the fitted samples are below {:.1} mm/s, where the low-velocity term acts (none below {:.1} mm/s): a and b rest on few samples",
+        100.0 * fraction,
+        1e3 * below_m_s,
+        1e3 * min_speed_m_s
+    )
+}
+
+/// [`RecordWarning::FitsDisagree`]'s message.
+fn fits_disagree(
+    f: &mut fmt::Formatter<'_>,
+    key: IdentifiedKey,
+    equation_error: f64,
+    output_error: f64,
+) -> fmt::Result {
+    write!(
+        f,
+        "{}: equation error {equation_error:.6e} and output error {output_error:.6e} disagree ({:.1} %)",
+        key.name(),
+        100.0 * (equation_error - output_error).abs()
+            / equation_error.abs().max(f64::MIN_POSITIVE)
+    )
+}
+
+/// [`RecordWarning::FrictionAbovePeakForce`]'s message.
+fn friction_above_peak_force(
+    f: &mut fmt::Formatter<'_>,
+    static_friction_n: f64,
+    peak_force_n: f64,
+) -> fmt::Result {
+    write!(
+        f,
+        "implausible: the static friction F_μ + a = {:.1} kN exceeds the largest force in the records ({:.1} kN), so the platen could never have moved: is the force in the wrong unit or the wrong channel?",
+        static_friction_n / 1e3,
+        peak_force_n / 1e3
+    )
+}
+
+/// [`RecordWarning::OutputErrorImplausible`]'s message.
+fn output_error_implausible(
+    f: &mut fmt::Formatter<'_>,
+    key: IdentifiedKey,
+    equation_error: f64,
+    output_error: f64,
+) -> fmt::Result {
+    write!(
+        f,
+        "implausible output-error check: {} = {output_error:.4e} {} against {equation_error:.4e} from the equation error; it does not check the equation error (the record may not excite the platen enough for a forward simulation to pin it)",
+        symbol(key),
+        key.unit()
+    )
+}
+
+/// [`RecordWarning::RecordsDisagree`]'s message.
+fn records_disagree(
+    f: &mut fmt::Formatter<'_>,
+    lightest: &(String, f64),
+    heaviest: &(String, f64),
+    joint_kg: f64,
+) -> fmt::Result {
+    write!(
+        f,
+        "the records disagree on the platen's mass: `{}` alone gives {:.1} t, `{}` alone {:.1} t (the joint fit {:.1} t): records of different tables, or of one table with and without a payload, fitted as one; identify them apart",
+        lightest.0,
+        1e-3 * lightest.1,
+        heaviest.0,
+        1e-3 * heaviest.1,
+        1e-3 * joint_kg
+    )
 }
 
 /// [`RecordWarning::NotSeparable`]'s message.

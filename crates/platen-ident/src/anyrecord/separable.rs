@@ -31,6 +31,7 @@ use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use crate::lm::{self, Dot8, Jacobian, LmSettings, Problem};
 
 use super::data::{FixedSums, GridSums, NodeSums, Stacked};
+use super::settings::ValidRecordSettings;
 
 /// Index of each parameter in the full vector `[Mₑ, Kₑ, F_μ, Cₑ, α, a, b, c_1…c_R]`.
 pub(crate) const MASS: usize = 0;
@@ -75,6 +76,16 @@ pub(crate) struct Shape {
 }
 
 impl Shape {
+    /// What `settings` fit on `records` records.
+    pub(crate) fn of(settings: &ValidRecordSettings, records: usize) -> Self {
+        Shape {
+            alpha: settings.viscous_exponent,
+            low: settings.low_velocity_term,
+            records,
+            nonneg_stiffness: settings.nonnegative_stiffness,
+        }
+    }
+
     /// Full-vector indices of the linear parameters, in the order of the design's columns.
     pub(crate) fn linear(&self) -> Vec<usize> {
         let mut v = vec![MASS, STIFFNESS, COULOMB, VISCOUS];
@@ -501,6 +512,62 @@ struct Evaluation {
     e: Vec<f64>,
 }
 
+/// The sums of [`Separable::lane_sums`]: the model columns `[a, u, s, c, e]` against each
+/// other (`mm`, lower triangle), against each record's constant (`mo`) and against the force
+/// (`xm`), each record's force sum (`xo`) and sample count, in lanes; the samples beyond the
+/// lanes (`tail`: record, columns, force); every sample's `c` and `e`.
+struct LaneSums {
+    mm: Vec<Dot8>,
+    mo: Vec<Dot8>,
+    xm: Vec<Dot8>,
+    xo: Vec<Dot8>,
+    counts: Vec<f64>,
+    tail: Vec<(usize, [f64; 5], f64)>,
+    c: Vec<f64>,
+    e: Vec<f64>,
+}
+
+impl LaneSums {
+    /// `XᵀX` and `Xᵀy` of the `k` model columns and `records` constants, symmetric.
+    fn normal_equations(&self, k: usize, records: usize) -> (DMatrix<f64>, DVector<f64>) {
+        let mut g = DMatrix::zeros(k + records, k + records);
+        let mut xty = DVector::zeros(k + records);
+        for p in 0..k {
+            for q in 0..=p {
+                g[(p, q)] = self.mm[p * k + q].finish();
+            }
+            xty[p] = self.xm[p].finish();
+        }
+        for r in 0..records {
+            for p in 0..k {
+                g[(p, k + r)] = self.mo[r * k + p].finish();
+            }
+            g[(k + r, k + r)] = self.counts[r];
+            xty[k + r] = self.xo[r].finish();
+        }
+        for &(r, x, f) in &self.tail {
+            for p in 0..k {
+                for q in 0..=p {
+                    g[(p, q)] += x[p] * x[q];
+                }
+                g[(p, k + r)] += x[p];
+                xty[p] += x[p] * f;
+            }
+            xty[k + r] += f;
+        }
+        for p in 0..k + records {
+            for q in p + 1..k + records {
+                if q < k {
+                    g[(p, q)] = g[(q, p)];
+                } else {
+                    g[(q, p)] = g[(p, q)];
+                }
+            }
+        }
+        (g, xty)
+    }
+}
+
 /// The equation-error problem: the stacked samples and which parameters are fitted.
 pub(crate) struct Separable<'a> {
     data: &'a Stacked,
@@ -561,80 +628,8 @@ impl<'a> Separable<'a> {
         }
         let k = self.model_columns();
         let records = self.data.blocks.len();
-        let n = self.data.len();
-        let lanes = Dot8::lane_rows(n);
-        let mut mm = vec![Dot8::default(); k * k];
-        let mut mo = vec![Dot8::default(); records * k];
-        let mut xm = vec![Dot8::default(); k];
-        let mut xo = vec![Dot8::default(); records];
-        let mut counts = vec![0.0; records];
-        let (mut c_all, mut e_all) = (Vec::with_capacity(n), Vec::with_capacity(n));
-        let mut tail = Vec::new();
-        let mut i = 0;
-        for block in &self.data.blocks {
-            let r = block.record;
-            counts[r] = block.len() as f64;
-            for j in 0..block.len() {
-                let s = block.s[j];
-                let c = s * (alpha * block.ln_w[j]).exp();
-                let e = if self.shape.low {
-                    s * (-b * block.w[j]).exp()
-                } else {
-                    0.0
-                };
-                c_all.push(c);
-                e_all.push(e);
-                let x = [block.a[j], block.u[j], s, c, e];
-                let f = block.f[j];
-                if i < lanes {
-                    for p in 0..k {
-                        for q in 0..=p {
-                            mm[p * k + q].add(i, x[p] * x[q]);
-                        }
-                        mo[r * k + p].add(i, x[p]);
-                        xm[p].add(i, x[p] * f);
-                    }
-                    xo[r].add(i, f);
-                } else {
-                    tail.push((r, x, f));
-                }
-                i += 1;
-            }
-        }
-        let mut g = DMatrix::zeros(k + records, k + records);
-        let mut xty = DVector::zeros(k + records);
-        for p in 0..k {
-            for q in 0..=p {
-                g[(p, q)] = mm[p * k + q].finish();
-            }
-            xty[p] = xm[p].finish();
-        }
-        for r in 0..records {
-            for p in 0..k {
-                g[(p, k + r)] = mo[r * k + p].finish();
-            }
-            g[(k + r, k + r)] = counts[r];
-            xty[k + r] = xo[r].finish();
-        }
-        for (r, x, f) in tail {
-            for p in 0..k {
-                for q in 0..=p {
-                    g[(p, q)] += x[p] * x[q];
-                }
-                g[(p, k + r)] += x[p];
-                xty[p] += x[p] * f;
-            }
-            xty[k + r] += f;
-        }
-        for p in 0..k + records {
-            for q in p + 1..k + records {
-                if q < k {
-                    g[(p, q)] = g[(q, p)];
-                } else {
-                    g[(q, p)] = g[(p, q)];
-                }
-            }
-        }
+        let sums = self.lane_sums(alpha, b);
+        let (mut g, xty) = sums.normal_equations(k, records);
         // Corrected least squares: the sensors' noise is not motion.
         g[(0, 0)] -= self.data.noise_sums[0];
         g[(1, 1)] -= self.data.noise_sums[1];
@@ -644,11 +639,62 @@ impl<'a> Separable<'a> {
             alpha,
             b,
             solve: solve_dense(&g, &xty, self.yy, &nonneg),
-            c: c_all,
-            e: e_all,
+            c: sums.c,
+            e: sums.e,
         });
         *self.last.borrow_mut() = Some(Rc::clone(&ev));
         ev
+    }
+
+    /// The sums of the normal equations at `(α, b)` over every sample (the first
+    /// [`Dot8::lane_rows`] in lanes, the rest apart), with each sample's `c` and `e`.
+    fn lane_sums(&self, alpha: f64, b: f64) -> LaneSums {
+        let k = self.model_columns();
+        let records = self.data.blocks.len();
+        let n = self.data.len();
+        let lanes = Dot8::lane_rows(n);
+        let mut sums = LaneSums {
+            mm: vec![Dot8::default(); k * k],
+            mo: vec![Dot8::default(); records * k],
+            xm: vec![Dot8::default(); k],
+            xo: vec![Dot8::default(); records],
+            counts: vec![0.0; records],
+            tail: Vec::new(),
+            c: Vec::with_capacity(n),
+            e: Vec::with_capacity(n),
+        };
+        let mut i = 0;
+        for block in &self.data.blocks {
+            let r = block.record;
+            sums.counts[r] = block.len() as f64;
+            for j in 0..block.len() {
+                let s = block.s[j];
+                let c = s * (alpha * block.ln_w[j]).exp();
+                let e = if self.shape.low {
+                    s * (-b * block.w[j]).exp()
+                } else {
+                    0.0
+                };
+                sums.c.push(c);
+                sums.e.push(e);
+                let x = [block.a[j], block.u[j], s, c, e];
+                let f = block.f[j];
+                if i < lanes {
+                    for p in 0..k {
+                        for q in 0..=p {
+                            sums.mm[p * k + q].add(i, x[p] * x[q]);
+                        }
+                        sums.mo[r * k + p].add(i, x[p]);
+                        sums.xm[p].add(i, x[p] * f);
+                    }
+                    sums.xo[r].add(i, f);
+                } else {
+                    sums.tail.push((r, x, f));
+                }
+                i += 1;
+            }
+        }
+        sums
     }
 
     /// `X·z` at every sample for `z` in [`Shape::linear`] order (the design's columns in

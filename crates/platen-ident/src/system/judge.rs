@@ -379,22 +379,7 @@ fn predict(
     let Ok(command) = Motion::from_displacement(r.t_s.clone(), r.command_u_m.clone()) else {
         return Ok(None);
     };
-    let run = LoopRun {
-        system: ctx.system,
-        specimen: ctx.plant.specimen.as_ref(),
-        command: &command,
-        method: LoopMethod::Rk4 {
-            steps_per_period: ctx.steps_per_period,
-        },
-        initial: State {
-            u_m: r.command_u_m[0],
-            v_m_s: 0.0,
-        },
-    };
-    let mut sink = Collect::default();
-    if let Err(e) = forward_closed_loop(ctx.model, &run, r.t_s.len(), &mut sink) {
-        return Err((r.name.clone(), e.to_string()));
-    }
+    let sink = run_loop(ctx, r, &command)?;
     let n = a_rec.len();
     let a_ref = super::central(&r.command_u_m, hi).1;
     let (Some(rec_b), Some(pred_b), Some(cmd_b)) = (band(a_rec), band(&sink.a), band(&a_ref))
@@ -402,22 +387,14 @@ fn predict(
         return Ok(None);
     };
     let box_b = ctx.boxes[0].as_ref().and_then(|b| band(&b.predict(&a_ref)));
-    let mut storeys = Vec::new();
-    let mut storey_model = Vec::new();
-    let mut storey_box = Vec::new();
-    for (k, st) in r.storey_a_m_s2.iter().enumerate() {
-        let (Some(rec_s), Some(pred_s)) = (band(st), sink.storeys.get(k).and_then(|p| band(p)))
-        else {
-            return Ok(None);
-        };
-        storey_model.push(nrmse(&rec_s, &pred_s));
-        if let Some(b) = ctx.boxes.get(k + 1).and_then(Option::as_ref) {
-            if let Some(bs) = band(&b.predict(&a_ref)) {
-                storey_box.push(nrmse(&rec_s, &bs));
-            }
-        }
-        storeys.push((rec_s, pred_s));
-    }
+    let Some(StoreyFits {
+        storeys,
+        model: storey_model,
+        black_box: storey_box,
+    }) = storey_fits(ctx, r, &sink, &band, &a_ref)
+    else {
+        return Ok(None);
+    };
     let noise = rms((1..n - 1).map(|j| a_rec[j + 1] - 2.0 * a_rec[j] + a_rec[j - 1])) / 6f64.sqrt();
     Ok(Some(Prediction {
         name: r.name.clone(),
@@ -454,6 +431,74 @@ fn predict(
             storeys,
         },
     }))
+}
+
+/// The identified loop run on record `r`'s `command` from rest at its first sample; `Err`
+/// with the record's name and why when the run fails.
+fn run_loop(
+    ctx: &Judge<'_>,
+    r: &SystemRecord,
+    command: &Motion,
+) -> Result<Collect, (String, String)> {
+    let run = LoopRun {
+        system: ctx.system,
+        specimen: ctx.plant.specimen.as_ref(),
+        command,
+        method: LoopMethod::Rk4 {
+            steps_per_period: ctx.steps_per_period,
+        },
+        initial: State {
+            u_m: r.command_u_m[0],
+            v_m_s: 0.0,
+        },
+    };
+    let mut sink = Collect::default();
+    if let Err(e) = forward_closed_loop(ctx.model, &run, r.t_s.len(), &mut sink) {
+        return Err((r.name.clone(), e.to_string()));
+    }
+    Ok(sink)
+}
+
+/// The storeys' accelerations of a record, recorded and predicted, in the band.
+struct StoreyFits {
+    /// Each storey's `(recorded, predicted)`.
+    storeys: Vec<(Vec<f64>, Vec<f64>)>,
+    /// Each storey's NRMSE by the identified loop.
+    model: Vec<f64>,
+    /// Each storey's by the black box, where it has one.
+    black_box: Vec<f64>,
+}
+
+/// [`StoreyFits`] of record `r` against the loop's run `sink` and the black boxes on the
+/// command's acceleration `a_ref`, through `band`; `None` when a storey cannot be filtered.
+fn storey_fits(
+    ctx: &Judge<'_>,
+    r: &SystemRecord,
+    sink: &Collect,
+    band: &dyn Fn(&[f64]) -> Option<Vec<f64>>,
+    a_ref: &[f64],
+) -> Option<StoreyFits> {
+    let mut storeys = Vec::new();
+    let mut storey_model = Vec::new();
+    let mut storey_box = Vec::new();
+    for (k, st) in r.storey_a_m_s2.iter().enumerate() {
+        let (Some(rec_s), Some(pred_s)) = (band(st), sink.storeys.get(k).and_then(|p| band(p)))
+        else {
+            return None;
+        };
+        storey_model.push(nrmse(&rec_s, &pred_s));
+        if let Some(b) = ctx.boxes.get(k + 1).and_then(Option::as_ref) {
+            if let Some(bs) = band(&b.predict(a_ref)) {
+                storey_box.push(nrmse(&rec_s, &bs));
+            }
+        }
+        storeys.push((rec_s, pred_s));
+    }
+    Some(StoreyFits {
+        storeys,
+        model: storey_model,
+        black_box: storey_box,
+    })
 }
 
 /// The medians over the records held out of the fit, if any.

@@ -119,27 +119,11 @@ pub(crate) fn correct_accelerations(
     let own: Vec<Option<(f64, f64)>> = records
         .iter()
         .zip(periods)
-        .map(|(r, &h)| {
-            let a = r.a_m_s2.as_ref()?;
-            let e = DelayEstimator::new(1.0 / h)
-                .and_then(|d| d.acceleration_against_displacement(a, &r.u_m))
-                .ok()?;
-            (e.std_error_s > 0.0 && e.std_error_s.is_finite()).then_some((e.delay_s, e.std_error_s))
-        })
+        .map(|(r, &h)| own_acceleration_delay(r, h))
         .collect();
-    let (mut wsum, mut dsum) = (0.0, 0.0);
-    for &i in fitted {
-        if let Some((d, se)) = own[i] {
-            let w = 1.0 / (se * se);
-            wsum += w;
-            dsum += w * d;
-        }
-    }
-    if wsum <= 0.0 {
+    let Some((delay_s, se)) = pooled(&own, fitted) else {
         return Ok(out);
-    }
-    let delay_s = dsum / wsum;
-    let se = 1.0 / wsum.sqrt();
+    };
     let h = periods[fitted[0]];
     let samples = delay_s / h;
     let applied = delay_s.abs() > SIGNIFICANT * se && samples.abs() > MIN_APPLIED_SAMPLES;
@@ -177,18 +161,51 @@ pub(crate) fn correct_accelerations(
     });
     if applied {
         for ((r, (c, &hp)), &d) in records.iter().zip(out.iter_mut().zip(periods)).zip(&delays) {
-            let k = d / hp;
-            if let Some(a) = &r.a_m_s2 {
-                c.a_m_s2 = Some(shift(r, a, k)?);
-            }
-            c.storey_a_m_s2 = r
-                .storey_a_m_s2
-                .iter()
-                .map(|s| shift(r, s, k))
-                .collect::<Result<_>>()?;
+            shift_accelerations(r, c, d / hp)?;
         }
     }
     Ok(out)
+}
+
+/// Record `r`'s own delay of the table's acceleration against its displacement and the
+/// standard error, s (period `h`); `None` without an acceleration or a usable estimate.
+fn own_acceleration_delay(r: &SystemRecord, h: f64) -> Option<(f64, f64)> {
+    let a = r.a_m_s2.as_ref()?;
+    let e = DelayEstimator::new(1.0 / h)
+        .and_then(|d| d.acceleration_against_displacement(a, &r.u_m))
+        .ok()?;
+    (e.std_error_s > 0.0 && e.std_error_s.is_finite()).then_some((e.delay_s, e.std_error_s))
+}
+
+/// The inverse-variance mean of the `fitted` records' `own` delays and its standard error,
+/// s; `None` when none has one.
+fn pooled(own: &[Option<(f64, f64)>], fitted: &[usize]) -> Option<(f64, f64)> {
+    let (mut wsum, mut dsum) = (0.0, 0.0);
+    for &i in fitted {
+        if let Some((d, se)) = own[i] {
+            let w = 1.0 / (se * se);
+            wsum += w;
+            dsum += w * d;
+        }
+    }
+    if wsum <= 0.0 {
+        return None;
+    }
+    Some((dsum / wsum, 1.0 / wsum.sqrt()))
+}
+
+/// The accelerations of `r` (the table's and the storeys') shifted earlier by `samples`,
+/// into its corrected copy `c`.
+fn shift_accelerations(r: &SystemRecord, c: &mut SystemRecord, samples: f64) -> Result<()> {
+    if let Some(a) = &r.a_m_s2 {
+        c.a_m_s2 = Some(shift(r, a, samples)?);
+    }
+    c.storey_a_m_s2 = r
+        .storey_a_m_s2
+        .iter()
+        .map(|s| shift(r, s, samples))
+        .collect::<Result<_>>()?;
+    Ok(())
 }
 
 /// Corrects the pressure channels of every record by `samples` (at the first fitted

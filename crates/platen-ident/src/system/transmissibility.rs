@@ -150,6 +150,26 @@ pub(crate) fn transmissibility(
         .iter()
         .map(|&k| peak(&gain, k, df, coherence[k]))
         .collect();
+    let (mode_checks, warnings) = check_modes(modes, &peaks, df);
+    Some(Transmissibility {
+        resolution_hz: df,
+        segment_samples: len,
+        segments: pooled.segments(),
+        records: with.len(),
+        peaks,
+        mode_checks,
+        warnings,
+    })
+}
+
+/// The identified `modes` (frequency, damping ratio; lowest first) each against the nearest
+/// of the transmissibility's `peaks` (bins of `df` Hz), and a warning for each farther than
+/// [`MODE_TOLERANCE`].
+fn check_modes(
+    modes: &[(f64, f64)],
+    peaks: &[TransmissibilityPeak],
+    df: f64,
+) -> (Vec<ModeCheck>, Vec<String>) {
     let mut mode_checks = Vec::new();
     let mut warnings = Vec::new();
     for &(f, zeta) in modes {
@@ -178,15 +198,7 @@ pub(crate) fn transmissibility(
             ));
         }
     }
-    Some(Transmissibility {
-        resolution_hz: df,
-        segment_samples: len,
-        segments: pooled.segments(),
-        records: with.len(),
-        peaks,
-        mode_checks,
-        warnings,
-    })
+    (mode_checks, warnings)
 }
 
 /// The `count` tallest distinct resonances of `gain` between bins `lo` and `hi`, lowest first:
