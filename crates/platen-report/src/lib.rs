@@ -24,7 +24,8 @@
 //!   and the HTML page, every file atomically ([`write_outputs`]).
 //! * [`identify_report`] writes `platen identify`'s text report and HTML page.
 //! * [`simulate_report`], [`plan_report`] and [`sweep_report`] write the text summaries of
-//!   `platen simulate`, `plan`, `sweep` and `generate` (and `generate`'s JSON report).
+//!   `platen simulate`, `plan`, `sweep` and `generate` (and `generate`'s JSON report);
+//!   [`bench_report`] `platen bench`'s table.
 //! * [`html`] builds self-contained pages; [`text`] the numbers, metric rows and terminal
 //!   summary.
 //!
@@ -65,6 +66,7 @@
 //! * Legends sit in a strip above each panel's axes: they never hide data or stretch an axis.
 
 mod axes;
+pub mod bench_report;
 pub mod compare_figures;
 mod error;
 pub mod figure;
