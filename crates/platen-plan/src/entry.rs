@@ -3,9 +3,9 @@
 //! wants them, the plan ([`plan()`](fn@plan)) and what it gives ([`Planned`], its summary
 //! [`PlannedSummary`], its drive written with [`Planned::write_drive_rows`]).
 //!
-//! Whatever the table, a plan takes the same steps, written once in [`crate::steps`] and
-//! [`crate::feasibility`]: the level the drive is iterated at is checked, the target is put on
-//! the controller's rate, its motion is made (the baseline treatment of each axis), its own
+//! Whatever the table, a plan takes the same steps, each written once (the crate's `steps`
+//! module and [`crate::feasibility`]): the level the drive is iterated at is checked, the
+//! target is put on the controller's rate, its motion is made (the baseline treatment of each axis), its own
 //! command is run for the feasibility and the largest scale is searched on the simulated loop,
 //! the drive is iterated ([`crate::iterate_axes`]: one axis on the uniaxial table, x, y and z
 //! on a multi-axis one), scaled up when iterated at a low level, and its run is held against
@@ -23,7 +23,7 @@ use platen_scenario::file::ScenarioFile;
 use platen_scenario::LoadedRig;
 
 use crate::error::{PlanError, Result};
-use crate::plan::{load_rig, plan_platen, Plan, PlanSettings, PlanSummary, DRIVE_COLUMNS};
+use crate::plan::{load_rig, plan_platen, Plan, PlanSettings, PlanSummary, UNIAXIAL_DRIVE_COLUMNS};
 use crate::rrs::RequiredSpectrum;
 use crate::six_dof::{self, plan_multi_axis, AxisTargets, TablePlan, TablePlanSummary};
 use crate::table::Table;
@@ -92,11 +92,12 @@ impl PlanScenario {
         matches!(self, Self::Table { .. })
     }
 
-    /// The columns of its drive CSV: `t_s`, `u_m` on the uniaxial table ([`DRIVE_COLUMNS`]),
-    /// the six-DOF `motion_csv`'s on a multi-axis one ([`six_dof::DRIVE_COLUMNS`]).
+    /// The columns of its drive CSV: `t_s`, `u_m` on the uniaxial table
+    /// ([`crate::UNIAXIAL_DRIVE_COLUMNS`]), the six-DOF `motion_csv`'s on a multi-axis one
+    /// ([`six_dof::DRIVE_COLUMNS`]).
     pub fn drive_columns(&self) -> &'static [&'static str] {
         match self {
-            Self::Platen { .. } => &DRIVE_COLUMNS,
+            Self::Platen { .. } => &UNIAXIAL_DRIVE_COLUMNS,
             Self::Table { .. } => &six_dof::DRIVE_COLUMNS,
         }
     }
@@ -216,7 +217,8 @@ impl PlannedSummary {
 /// let target = PlanTarget::Platen(Target::acceleration(Path::new("sine"), t, a)?);
 /// let p = plan(&scenario, &target, &PlanSettings::default(), &mut |_| {})?;
 /// let platen = p.platen().expect("a uniaxial scenario's plan");
-/// assert!(platen.feasibility.feasible && platen.iteration().unwrap().best_record().acceleration_nrmse < 0.1);
+/// let best = platen.iteration().unwrap().best_record();
+/// assert!(platen.feasibility.feasible && best.acceleration_nrmse < 0.1);
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 ///

@@ -16,7 +16,8 @@
 //!
 //! // Uniaxial (a `table_system`) or multi-axis (a `table`): the same path. Its excitation is
 //! // ignored.
-//! let scenario = PlanScenario::load(Path::new("scenarios/table-system/northridge-closed-loop.json"))?;
+//! let path = Path::new("scenarios/table-system/northridge-closed-loop.json");
+//! let scenario = PlanScenario::load(path)?;
 //! // t_s and a_m_s2 (or u_m); on a multi-axis table x_m_s2, y_m_s2, z_m_s2.
 //! let target = PlanTarget::read_csv(&scenario, Path::new("target.csv"), &ColumnMap::default())?;
 //! let settings = PlanSettings::with_max_scale();
@@ -44,7 +45,8 @@
 //! let target = Target::acceleration(Path::new("sine"), t, a)?;
 //! let p = plan_platen(&table, &rig.name, Path::new("lhpost.json"), &target,
 //!                     &PlanSettings::default(), &mut |_| {})?;
-//! assert!(p.feasibility.feasible && p.iteration().unwrap().best_record().acceleration_nrmse < 0.1);
+//! let best = p.iteration().unwrap().best_record();
+//! assert!(p.feasibility.feasible && best.acceleration_nrmse < 0.1);
 //! if let Some(it) = p.iteration() {
 //!     for r in &it.records {
 //!         println!("{}: acceleration NRMSE {:.3}", r.iteration, r.acceleration_nrmse);
@@ -117,7 +119,7 @@ pub use iterate::{
 pub use mimo::{iterate_mimo, AxisRecord, AxisTarget, MimoIteration, MimoRecord};
 pub use plan::{
     load_rig, plan_platen, write_drive, DriveSummary, FrfSummary, Plan, PlanSettings, PlanSummary,
-    PlannedDrive, TargetSummary,
+    PlannedDrive, TargetSummary, UNIAXIAL_DRIVE_COLUMNS,
 };
 pub use rrs::{RequiredSpectrum, DEFAULT_RRS_DAMPING};
 pub use six_dof::{

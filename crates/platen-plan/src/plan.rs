@@ -148,9 +148,9 @@ impl Plan {
         self.drive.as_ref().map(|d| &d.iteration)
     }
 
-    /// Writes the drive's rows to `writer` (created with [`DRIVE_COLUMNS`]) and finishes
-    /// it; returns whether there was a drive to write (without, the writer is dropped and its
-    /// temporary file with it).
+    /// Writes the drive's rows to `writer` (created with [`crate::UNIAXIAL_DRIVE_COLUMNS`])
+    /// and finishes it; returns whether there was a drive to write (without, the writer is
+    /// dropped and its temporary file with it).
     ///
     /// # Errors
     /// [`PlanError::Io`] if it cannot be written.
@@ -168,7 +168,7 @@ impl Plan {
 
 /// The uniaxial drive CSV's columns: the displacement command at the controller's rate, a
 /// `motion_csv` that `simulate` replays.
-pub const DRIVE_COLUMNS: [&str; 2] = ["t_s", "u_m"];
+pub const UNIAXIAL_DRIVE_COLUMNS: [&str; 2] = ["t_s", "u_m"];
 
 /// Loads a scenario file's rig for planning ([`LoadedRig::load`]): its model, table system,
 /// specimen and limits, and its loop's integrator and initial state. The `excitation` may be
@@ -405,7 +405,11 @@ fn planned_drive(
 /// # Errors
 /// [`PlanError::Io`].
 pub fn write_drive(path: &Path, t_s: &[f64], u_m: &[f64]) -> Result<()> {
-    Ok(write_csv_atomic(path, &DRIVE_COLUMNS, &[t_s, u_m])?)
+    Ok(write_csv_atomic(
+        path,
+        &UNIAXIAL_DRIVE_COLUMNS,
+        &[t_s, u_m],
+    )?)
 }
 
 /// Where `Ĥ` came from, as the summary reports it.

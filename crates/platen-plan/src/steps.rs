@@ -1,8 +1,8 @@
 //! The steps every plan takes, whatever the table (uniaxial [`crate::plan_platen`],
 //! multi-axis [`crate::plan_multi_axis`], both behind [`crate::plan()`](fn@crate::plan)),
-//! written once: the level the drive is iterated at,
-//! the target put on the controller's rate, the drive iterated at a low level and scaled up,
-//! the response-spectrum acceptance and the warnings they give.
+//! written once: the level the drive is iterated at, the target put on the controller's rate,
+//! the drive iterated at a low level and scaled up, the response-spectrum acceptance and the
+//! warnings they give, and the iteration's outcome as the summaries report it.
 
 use std::borrow::Cow;
 
@@ -15,9 +15,9 @@ use crate::iterate::{
 };
 use crate::rrs::RequiredSpectrum;
 
-/// A drive iterated at a low level and scaled up ([`crate::PlanSettings::iterate_at`]). The iteration's drives and `achieved` are then
-/// the scaled-up drives and their full-level run; its records are the low-level runs' (their
-/// NRMSEs are relative, so they compare). `Rec` is an iteration's record: one axis's
+/// A drive iterated at a low level and scaled up ([`crate::PlanSettings::iterate_at`]). The
+/// iteration's drives and `achieved` are then the scaled-up drives and their full-level run;
+/// its records are the low-level runs' (their NRMSEs are relative, so they compare). `Rec` is an iteration's record: one axis's
 /// ([`IterationRecord`]) or several axes' ([`crate::MimoRecord`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct IteratedAt<Rec = IterationRecord> {

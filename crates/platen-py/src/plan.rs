@@ -152,34 +152,8 @@ pub fn plan_table<'py>(
         .map(|(n, k, v)| Ok((n.clone(), k.clone(), vector(v)?)))
         .collect::<PyResult<_>>()?;
     let (t, columns, summary) = detached(py, move || {
-        let (path, text) = match (path, text) {
-            (Some(path), _) => {
-                let text = std::fs::read_to_string(&path).map_err(|e| {
-                    Fail::input(format!("`{}`: cannot be read: {e}", path.display()))
-                })?;
-                (path, text)
-            }
-            (None, Some(text)) => (PathBuf::from(&origin), text),
-            (None, None) => return Err(Fail::input("no scenario: give a path or a dict")),
-        };
-        let file = platen_plan::six_dof::table_scenario_file(&path, &text)?
-            .ok_or_else(|| Fail::input("per-axis targets need a scenario with a `table`"))?;
-        let scenario = PlanScenario::table(&path, file);
-        let origin = Path::new("target");
-        let mut given: [Option<Target>; 3] = [None, None, None];
-        for (name, kind, values) in axes {
-            let k = platen_plan::six_dof::AXES
-                .iter()
-                .position(|a| *a == name)
-                .ok_or_else(|| {
-                    Fail::input(format!("target axis `{name}`: expected one of x, y, z"))
-                })?;
-            given[k] = Some(match kind.as_str() {
-                "acceleration" => Target::acceleration(origin, t_s.clone(), values)?,
-                _ => Target::displacement(origin, t_s.clone(), values)?,
-            });
-        }
-        let targets = platen_plan::AxisTargets::new(origin, given)?;
+        let scenario = table_scenario(path, text, &origin)?;
+        let targets = axis_targets(&t_s, axes)?;
         let mut settings = PlanSettings::new(
             iterations,
             gain,
@@ -214,4 +188,45 @@ pub fn plan_table<'py>(
         columns.into_iter().map(|c| c.into_pyarray(py)).collect(),
         summary,
     ))
+}
+
+/// The multi-axis scenario of the file at `path`, or of the JSON `text` named `origin`.
+fn table_scenario(
+    path: Option<PathBuf>,
+    text: Option<String>,
+    origin: &str,
+) -> Result<PlanScenario, Fail> {
+    let (path, text) = match (path, text) {
+        (Some(path), _) => {
+            let text = std::fs::read_to_string(&path)
+                .map_err(|e| Fail::input(format!("`{}`: cannot be read: {e}", path.display())))?;
+            (path, text)
+        }
+        (None, Some(text)) => (PathBuf::from(origin), text),
+        (None, None) => return Err(Fail::input("no scenario: give a path or a dict")),
+    };
+    let file = platen_plan::six_dof::table_scenario_file(&path, &text)?
+        .ok_or_else(|| Fail::input("per-axis targets need a scenario with a `table`"))?;
+    Ok(PlanScenario::table(&path, file))
+}
+
+/// The three-component target of `axes` (per axis `(name, kind, values)`, `kind`
+/// `acceleration` or `displacement`) at `t_s`.
+fn axis_targets(
+    t_s: &[f64],
+    axes: Vec<(String, String, Vec<f64>)>,
+) -> Result<platen_plan::AxisTargets, Fail> {
+    let origin = Path::new("target");
+    let mut given: [Option<Target>; 3] = [None, None, None];
+    for (name, kind, values) in axes {
+        let k = platen_plan::six_dof::AXES
+            .iter()
+            .position(|a| *a == name)
+            .ok_or_else(|| Fail::input(format!("target axis `{name}`: expected one of x, y, z")))?;
+        given[k] = Some(match kind.as_str() {
+            "acceleration" => Target::acceleration(origin, t_s.to_vec(), values)?,
+            _ => Target::displacement(origin, t_s.to_vec(), values)?,
+        });
+    }
+    Ok(platen_plan::AxisTargets::new(origin, given)?)
 }
