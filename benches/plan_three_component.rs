@@ -30,8 +30,8 @@ use platen::integrate::State;
 use platen::model::preset;
 use platen::plan::six_dof::table_scenario_file;
 use platen::plan::{
-    plan_multi_axis, synthetic_three_component_m_s2, AxisTargets, IterationSettings,
-    TablePlanSettings, Target,
+    plan_multi_axis, synthetic_three_component_m_s2, AxisTargets, IterationSettings, PlanSettings,
+    Target,
 };
 use platen::scenario::file::ScenarioFile;
 
@@ -71,14 +71,14 @@ fn bench(c: &mut Criterion) {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("scenarios/multi-axis/lhpost6-northridge-25.json");
     let targets = targets(Path::new("three-component-quake"));
-    let settings = TablePlanSettings {
+    let settings = PlanSettings {
         iteration: IterationSettings {
             max_iterations: 10,
             target_nrmse: 0.0,
             stall_iterations: 100,
             ..Default::default()
         },
-        ..TablePlanSettings::default()
+        ..PlanSettings::default()
     };
     let tables = [
         ("lhpost6_bare", scenario(&path, true)),

@@ -1,5 +1,6 @@
 //! What a measurement gives: each workload's time against the baseline's, its ratio and its
-//! final state, as JSON (`platen bench --json`) or text.
+//! final state, as JSON (`platen bench --json`); `platen_report::bench_report` writes it as
+//! text.
 
 use super::*;
 
@@ -179,48 +180,5 @@ impl Measurement {
                 .map(|w| (w.key, w.report(simulated_s)))
                 .collect(),
         }
-    }
-
-    /// The text table (`platen bench`), one line per workload in the order they ran.
-    pub fn text(&self) -> String {
-        let (simulated_s, base) = (self.simulated_s, self.base_ns());
-        let mut s = String::new();
-        let _ = writeln!(
-            s,
-            "platen bench: lhpost-2008 at {} MPa, {simulated_s} s records at {RATE_HZ} Hz from rest, \
-             median of {} runs",
-            PRESSURE_PA / 1e6,
-            self.repeats
-        );
-        let _ = writeln!(
-            s,
-            "  forward workloads: a {} kN, {FORCE_FREQUENCY_HZ} Hz sine force, a table test within the \
-             LHPOST's limits (±0.35 m, 1.09 m/s, 0.38 g), one reversal per second",
-            FORCE_AMPLITUDE_N / 1e3
-        );
-        let _ = writeln!(
-            s,
-            "  {:<54} {:>14} {:>10} {:>10} {:>12} {:>6}",
-            "workload", "unit", "ns/unit", "units/s", "sim s/wall s", "ratio"
-        );
-        for w in &self.workloads {
-            let ratio = if w.unit == "step" {
-                format!("{:.3}", w.ns_per_unit() / base)
-            } else {
-                "-".to_owned()
-            };
-            let _ = writeln!(
-                s,
-                "  {:<54} {:>14} {:>10.1} {:>10.3e} {:>12.0} {:>6}",
-                w.title,
-                w.unit,
-                w.ns_per_unit(),
-                w.units as f64 / w.median_s(),
-                simulated_s / w.median_s(),
-                ratio
-            );
-        }
-        s.push_str("  ratio: ns/step over the baseline's, measured in the same run\n");
-        s
     }
 }

@@ -3,43 +3,56 @@
 //! answer comes from running a rig's closed loop ([`platen_scenario::Rig`]: its model,
 //! `table_system` and specimen) with displacement commands.
 //!
-//! A 2 Hz, 2 m/s² sine planned on the LHPOST (the `lhpost-2008` platen and table system):
-//!
-//! ```
-//! use std::path::Path;
-//! use platen_plan::{plan, PlanSettings, Target};
-//!
-//! let json = r#"{"model": {"preset": "lhpost-2008"}, "table_system": {"preset": "lhpost-2008"}}"#;
-//! let rig = platen_scenario::LoadedRig::parse(Path::new("lhpost.json"), json)?;
-//! let t: Vec<f64> = (0..4097).map(|j| j as f64 / 1024.0).collect(); // 4 s at 1024 Hz
-//! let a = t.iter().map(|t| 2.0 * (std::f64::consts::TAU * 2.0 * t).sin()).collect();
-//! let target = Target::acceleration(Path::new("sine"), t, a)?;
-//! let p = plan(&rig, Path::new("lhpost.json"), &target, &PlanSettings::default())?;
-//! assert!(p.feasibility.feasible && p.iteration().unwrap().best_record().acceleration_nrmse < 0.1);
-//! # Ok::<(), Box<dyn std::error::Error>>(())
-//! ```
-//!
-//! From a scenario file and a target CSV, as `platen plan` does, writing the drive:
+//! One entry for every table ([`plan()`](fn@plan)): a scenario read for planning
+//! ([`PlanScenario`], uniaxial or multi-axis), its target ([`PlanTarget`]), the settings
+//! ([`PlanSettings`]), the plan ([`Planned`]) and its summary ([`PlannedSummary`]). From a
+//! scenario file and a target CSV, as `platen plan` does, writing the drive:
 //!
 //! ```no_run
 //! use std::path::Path;
-//! use platen_plan::{load_rig, plan, write_drive, PlanSettings, Target};
+//! use platen_io::columns::ColumnMap;
+//! use platen_io::csv::CsvWriter;
+//! use platen_plan::{plan, PlanScenario, PlanSettings, PlanTarget};
 //!
-//! let scenario_path = Path::new("scenarios/table-system/northridge-closed-loop.json");
-//! let rig = load_rig(scenario_path)?; // its excitation is ignored
-//! let target = Target::read_csv(Path::new("target.csv"))?; // t_s and a_m_s2 (or u_m)
-//! let p = plan(&rig, scenario_path, &target, &PlanSettings::with_max_scale())?;
-//! println!("feasible: {}, max scale {:?}", p.feasibility.feasible,
-//!          p.feasibility.max_scale.as_ref().map(|m| m.scale));
+//! // Uniaxial (a `table_system`) or multi-axis (a `table`): the same path. Its excitation is
+//! // ignored.
+//! let path = Path::new("scenarios/table-system/northridge-closed-loop.json");
+//! let scenario = PlanScenario::load(path)?;
+//! // t_s and a_m_s2 (or u_m); on a multi-axis table x_m_s2, y_m_s2, z_m_s2.
+//! let target = PlanTarget::read_csv(&scenario, Path::new("target.csv"), &ColumnMap::default())?;
+//! let settings = PlanSettings::with_max_scale();
+//! let p = plan(&scenario, &target, &settings, &mut |_| {})?;
+//! let writer = CsvWriter::create(Path::new("drive.csv"), scenario.drive_columns())?;
+//! let written = p.write_drive_rows(writer)?;
+//! let summary = p.summary(&settings, written.then_some(Path::new("drive.csv")));
+//! println!("{}", serde_json::to_string_pretty(&summary).unwrap());
+//! # Ok::<(), platen_plan::PlanError>(())
+//! ```
+//!
+//! A 2 Hz, 2 m/s² sine planned on a uniaxial table built in memory (the `lhpost-2008`
+//! platen and table system) with the uniaxial planner [`plan_platen`], which
+//! [`plan()`](fn@plan) calls for such a scenario:
+//!
+//! ```
+//! use std::path::Path;
+//! use platen_plan::{plan_platen, PlanSettings, Table, Target};
+//!
+//! let json = r#"{"model": {"preset": "lhpost-2008"}, "table_system": {"preset": "lhpost-2008"}}"#;
+//! let rig = platen_scenario::LoadedRig::parse(Path::new("lhpost.json"), json)?;
+//! let table = Table::of_loaded(&rig, Path::new("lhpost.json"))?;
+//! let t: Vec<f64> = (0..4097).map(|j| j as f64 / 1024.0).collect(); // 4 s at 1024 Hz
+//! let a = t.iter().map(|t| 2.0 * (std::f64::consts::TAU * 2.0 * t).sin()).collect();
+//! let target = Target::acceleration(Path::new("sine"), t, a)?;
+//! let p = plan_platen(&table, &rig.name, Path::new("lhpost.json"), &target,
+//!                     &PlanSettings::default(), &mut |_| {})?;
+//! let best = p.iteration().unwrap().best_record();
+//! assert!(p.feasibility.feasible && best.acceleration_nrmse < 0.1);
 //! if let Some(it) = p.iteration() {
 //!     for r in &it.records {
 //!         println!("{}: acceleration NRMSE {:.3}", r.iteration, r.acceleration_nrmse);
 //!     }
 //! }
-//! if let Some((t_s, u_m)) = p.drive() {
-//!     write_drive(Path::new("drive.csv"), t_s, u_m)?;
-//! }
-//! # Ok::<(), platen_plan::PlanError>(())
+//! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
 //! # What is here
@@ -59,8 +72,10 @@
 //!   `D_{k+1} = D_k + g·Ĥ⁻¹(T − R_k)` with a regularised inverse in a band, and its stop
 //!   criteria; written once for any number of coupled axes ([`iterate_axes`],
 //!   [`iterate_mimo`], [`DriveCorrection`]), one axis being the case `p = 1`.
-//! * [`plan()`](fn@plan), [`plan_observed`], [`plan_table`]: all of it, with the summary
-//!   `platen plan --json` prints ([`PlanSummary`]).
+//! * [`plan()`](fn@plan) ([`mod@entry`]): all of it, for every table, with the summary
+//!   `platen plan --json` prints ([`PlannedSummary`]); the uniaxial table's plan
+//!   [`plan_platen`] ([`Plan`]), the multi-axis table's [`plan_multi_axis`] ([`six_dof`],
+//!   [`TablePlan`]), the steps they share written once.
 //!
 //! # Conventions
 //!
@@ -75,6 +90,7 @@
 mod acceptance;
 pub mod baseline;
 mod correction;
+pub mod entry;
 mod error;
 pub mod feasibility;
 pub mod frf;
@@ -89,6 +105,7 @@ mod table;
 mod target;
 
 pub use baseline::{command_motion, BaselineSettings, EndCorrection, TargetMotion};
+pub use entry::{plan, PlanScenario, PlanTarget, Planned, PlannedSummary};
 pub use error::{PlanError, Result};
 pub use feasibility::{
     max_scale, search_max_scale, Feasibility, LimitUse, MaxScale, MaxScaleSettings,
@@ -101,13 +118,13 @@ pub use iterate::{
 };
 pub use mimo::{iterate_mimo, AxisRecord, AxisTarget, MimoIteration, MimoRecord};
 pub use plan::{
-    load_rig, plan, plan_observed, plan_table, write_drive, DriveSummary, FrfSummary, Plan,
-    PlanSettings, PlanSummary, PlannedDrive, TargetSummary,
+    load_rig, plan_platen, write_drive, DriveSummary, FrfSummary, Plan, PlanSettings, PlanSummary,
+    PlannedDrive, TargetSummary, UNIAXIAL_DRIVE_COLUMNS,
 };
 pub use rrs::{RequiredSpectrum, DEFAULT_RRS_DAMPING};
 pub use six_dof::{
     plan_multi_axis, pose_command, AxisTargets, TableAchieved, TableFeasibility, TableIteratedAt,
-    TableLimitUse, TablePlan, TablePlanSettings, TablePlannedDrive, TablePlant,
+    TableLimitUse, TablePlan, TablePlannedDrive, TablePlant,
 };
 pub use steps::{IteratedAt, SCALED_UP_ERROR_WARNED};
 pub use table::{Achieved, Table};

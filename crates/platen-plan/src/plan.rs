@@ -1,11 +1,13 @@
-//! A whole plan: the target's motion, its feasibility and largest scale, the drive
-//! iteration, and the summary `platen plan --json` prints ([`plan`], [`PlanSummary`]).
+//! The plan of the uniaxial table (a platen and its `table_system`, [`plan_platen`]): the
+//! target's motion, its feasibility and largest scale, the drive iteration, and the summary
+//! `platen plan --json` prints ([`PlanSummary`]); and the settings of every plan
+//! ([`PlanSettings`]). [`crate::plan()`](fn@crate::plan) is the one entry that calls it.
 
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use platen_io::csv::write_csv_atomic;
+use platen_io::csv::{write_csv_atomic, CsvWriter};
 use platen_scenario::{LimitsSummary, LoadedRig};
 
 use crate::baseline::{peak, rms, BaselineSettings, TargetMotion};
@@ -19,24 +21,33 @@ use crate::iterate::{
 };
 use crate::rrs::RequiredSpectrum;
 use crate::steps::{
-    acceptance, iteration_level, on_controller_rate, scaled_up, IteratedAt, Resampled,
+    acceptance, iteration_level, on_controller_rate, scaled_up, IteratedAt, IterationOutcome,
+    Resampled,
 };
 use crate::table::{Achieved, Table};
 use crate::target::Target;
 use crate::Iteration;
 
-/// Everything a plan can be told.
+/// Everything a plan can be told, whatever the table.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct PlanSettings {
-    /// How an acceleration target becomes a displacement command.
+    /// How an acceleration target (each axis's, on a multi-axis table) becomes a
+    /// displacement command.
     pub baseline: BaselineSettings,
-    /// The drive iteration.
+    /// The drive iteration (on a multi-axis table its `frf` is ignored: the table's
+    /// linearised transfer matrix is used).
     pub iteration: IterationSettings,
-    /// The search of the largest scale (`None`: not searched).
+    /// The search of the largest (common) scale (`None`: not searched).
     pub max_scale: Option<MaxScaleSettings>,
-    /// The required response spectrum the drive's run is accepted against (`None`: the
-    /// target's own spectrum, [`crate::ACCEPTANCE_BAND`] either way).
+    /// A multi-axis table: the largest scale of each axis too, the others as given (the
+    /// uniaxial table has one axis: its scale is the common one).
+    pub per_axis_max_scale: bool,
+    /// The uniaxial table: the required response spectrum the drive's run is accepted
+    /// against (`None`: the target's own spectrum, [`crate::ACCEPTANCE_BAND`] either way).
     pub rrs: Option<RequiredSpectrum>,
+    /// A multi-axis table: per axis (x, y, z), the required response spectrum its achieved
+    /// acceleration is accepted against (`None`: its target's own spectrum).
+    pub axis_rrs: [Option<RequiredSpectrum>; 3],
     /// The level the drive is iterated at, a fraction of the target in `(0, 1]` (`None` or 1:
     /// at full level). Below 1 the drive is iterated on the target scaled by it, as labs
     /// iterate so that the specimen does not see full-level shaking while the drive
@@ -46,6 +57,32 @@ pub struct PlanSettings {
 }
 
 impl PlanSettings {
+    /// The settings of `platen plan`'s options (and `platen.plan`'s arguments): at most
+    /// `iterations` corrections at `gain`, stopping at `target_nrmse`, in `band_hz` (default
+    /// band when `None`); the largest common scale searched when `max_scale` or
+    /// `per_axis_scale`, each axis's too with `per_axis_scale`; the rest default.
+    pub fn new(
+        iterations: usize,
+        gain: f64,
+        target_nrmse: f64,
+        band_hz: Option<(f64, f64)>,
+        max_scale: bool,
+        per_axis_scale: bool,
+    ) -> Self {
+        Self {
+            iteration: IterationSettings {
+                max_iterations: iterations,
+                gain,
+                target_nrmse,
+                band_hz,
+                ..Default::default()
+            },
+            max_scale: (max_scale || per_axis_scale).then(MaxScaleSettings::default),
+            per_axis_max_scale: per_axis_scale,
+            ..Default::default()
+        }
+    }
+
     /// The defaults with the largest scale searched.
     pub fn with_max_scale() -> Self {
         Self {
@@ -110,7 +147,28 @@ impl Plan {
     pub fn iteration(&self) -> Option<&Iteration<Achieved>> {
         self.drive.as_ref().map(|d| &d.iteration)
     }
+
+    /// Writes the drive's rows to `writer` (created with [`crate::UNIAXIAL_DRIVE_COLUMNS`])
+    /// and finishes it; returns whether there was a drive to write (without, the writer is
+    /// dropped and its temporary file with it).
+    ///
+    /// # Errors
+    /// [`PlanError::Io`] if it cannot be written.
+    pub fn write_drive_rows(&self, mut writer: CsvWriter) -> Result<bool> {
+        let Some((t_s, u_m)) = self.drive() else {
+            return Ok(false);
+        };
+        for (t, u) in t_s.iter().zip(u_m) {
+            writer.write_row(&[*t, *u])?;
+        }
+        writer.finish()?;
+        Ok(true)
+    }
 }
+
+/// The uniaxial drive CSV's columns: the displacement command at the controller's rate, a
+/// `motion_csv` that `simulate` replays.
+pub const UNIAXIAL_DRIVE_COLUMNS: [&str; 2] = ["t_s", "u_m"];
 
 /// Loads a scenario file's rig for planning ([`LoadedRig::load`]): its model, table system,
 /// specimen and limits, and its loop's integrator and initial state. The `excitation` may be
@@ -126,53 +184,20 @@ pub fn load_rig(path: &Path) -> Result<LoadedRig> {
     Ok(loaded)
 }
 
-/// Plans `target` on the rig `loaded` (read from `scenario_path`, for messages): the
-/// target's motion, its feasibility and largest scale, then the drive iteration.
+/// Plans `target` on the uniaxial `table` (a scenario's rig, [`Table::of_loaded`], or one
+/// built by hand: any [`Rig`](platen_scenario::Rig) with a table system and its
+/// [`LoopSettings`](platen_scenario::LoopSettings), [`Table::new`]): the target's motion, its
+/// feasibility and largest scale, then the drive iteration; `name` and `scenario_path` name
+/// it in the summary, and `on_run(k)` is called when the closed-loop run of drive iteration
+/// `k` is done (0: the target's own command; at most `settings.iteration.max_iterations`),
+/// a hook for progress reports ([`iterate_observed`]). [`crate::plan()`](fn@crate::plan)
+/// calls it for a scenario without `table`.
 ///
 /// # Errors
-/// [`PlanError::NoTableSystem`]; bad settings; a closed-loop run that fails. A target sampled
-/// faster than the controller is resampled to its rate ([`Target::resampled_to`]), with a
-/// notice in the plan's warnings.
-pub fn plan(
-    loaded: &LoadedRig,
-    scenario_path: &Path,
-    target: &Target,
-    settings: &PlanSettings,
-) -> Result<Plan> {
-    plan_observed(loaded, scenario_path, target, settings, &mut |_| {})
-}
-
-/// [`plan`], calling `on_run(k)` when the closed-loop run of drive iteration `k` is done (0:
-/// the target's own command; at most `settings.iteration.max_iterations`): a hook for
-/// progress reports ([`iterate_observed`]).
-///
-/// # Errors
-/// As [`plan`].
-pub fn plan_observed(
-    loaded: &LoadedRig,
-    scenario_path: &Path,
-    target: &Target,
-    settings: &PlanSettings,
-    on_run: &mut dyn FnMut(usize),
-) -> Result<Plan> {
-    let table = Table::of_loaded(loaded, scenario_path)?;
-    plan_table(
-        &table,
-        &loaded.name,
-        scenario_path,
-        target,
-        settings,
-        on_run,
-    )
-}
-
-/// [`plan_observed`] on a table built by hand (any [`Rig`](platen_scenario::Rig) with a
-/// table system and its [`LoopSettings`](platen_scenario::LoopSettings): [`Table::new`]);
-/// `name` and `scenario_path` name it in the summary.
-///
-/// # Errors
-/// As [`plan`].
-pub fn plan_table(
+/// Bad settings; a closed-loop run that fails. A target sampled faster than the controller
+/// is resampled to its rate ([`Target::resampled_to`]), with a notice in the plan's
+/// warnings.
+pub fn plan_platen(
     table: &Table,
     name: &str,
     scenario_path: &Path,
@@ -254,7 +279,7 @@ fn target_warnings(motion: &TargetMotion) -> Vec<String> {
 }
 
 /// The motion asked of `table` for `target` (already at most the controller's rate: a faster
-/// one is resampled by [`plan_table`] first), not zero.
+/// one is resampled by [`plan_platen`] first), not zero.
 fn target_motion(table: &Table, target: &Target, settings: &PlanSettings) -> Result<TargetMotion> {
     let controller_hz = table.controller_rate_hz();
     if target.kind() == crate::target::TargetKind::Displacement {
@@ -316,7 +341,7 @@ fn planned_drive(
     warnings: &mut Vec<String>,
 ) -> Result<PlannedDrive> {
     let settings = &plan_settings.iteration;
-    // Checked by `plan_table` before any run.
+    // Checked by `plan_platen` before any run.
     let level = plan_settings.iterate_at.unwrap_or(1.0);
     let mut iteration;
     let iterated_at = if level < 1.0 {
@@ -380,7 +405,11 @@ fn planned_drive(
 /// # Errors
 /// [`PlanError::Io`].
 pub fn write_drive(path: &Path, t_s: &[f64], u_m: &[f64]) -> Result<()> {
-    Ok(write_csv_atomic(path, &["t_s", "u_m"], &[t_s, u_m])?)
+    Ok(write_csv_atomic(
+        path,
+        &UNIAXIAL_DRIVE_COLUMNS,
+        &[t_s, u_m],
+    )?)
 }
 
 /// Where `Ĥ` came from, as the summary reports it.
@@ -523,7 +552,14 @@ impl Plan {
     pub fn summary(&self, out: Option<&Path>) -> PlanSummary {
         let f = &self.feasibility;
         let m = &self.motion;
-        let it = self.iteration();
+        let iterated_at = self.drive.as_ref().and_then(|d| d.iterated_at.as_ref());
+        let IterationOutcome {
+            iterate_at,
+            iterations,
+            best_iteration,
+            stop,
+            stall_reason,
+        } = IterationOutcome::of(self.iteration(), iterated_at);
         PlanSummary {
             scenario: self.scenario_path.display().to_string(),
             name: self.scenario_name.clone(),
@@ -546,18 +582,12 @@ impl Plan {
             limiting: f.limiting.clone(),
             margins: f.uses.clone(),
             max_scale: f.max_scale.as_ref().map(|s| s.scale),
-            iterate_at: self
-                .drive
-                .as_ref()
-                .and_then(|d| d.iterated_at.map(|i| i.level)),
+            iterate_at,
             max_scale_search: f.max_scale.clone(),
-            iterations: it.map_or_else(Vec::new, |it| it.records.clone()),
-            best_iteration: it.map(|it| it.best),
-            stop: it.map_or("not_run", |it| it.stop.name()),
-            stall_reason: match it.map(|it| &it.stop) {
-                Some(Stop::Stalled { reason }) => Some(reason.clone()),
-                _ => None,
-            },
+            iterations,
+            best_iteration,
+            stop,
+            stall_reason,
             frf: self.drive.as_ref().map(|d| d.frf.clone()),
             drive: self.drive.as_ref().map(|d| {
                 let it = &d.iteration;

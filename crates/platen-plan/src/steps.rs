@@ -1,7 +1,8 @@
-//! The steps every plan takes, whatever the table (uniaxial [`crate::plan()`](fn@crate::plan),
-//! multi-axis [`crate::plan_multi_axis`]), written once: the level the drive is iterated at,
-//! the target put on the controller's rate, the drive iterated at a low level and scaled up,
-//! the response-spectrum acceptance and the warnings they give.
+//! The steps every plan takes, whatever the table (uniaxial [`crate::plan_platen`],
+//! multi-axis [`crate::plan_multi_axis`], both behind [`crate::plan()`](fn@crate::plan)),
+//! written once: the level the drive is iterated at, the target put on the controller's rate,
+//! the drive iterated at a low level and scaled up, the response-spectrum acceptance and the
+//! warnings they give, and the iteration's outcome as the summaries report it.
 
 use std::borrow::Cow;
 
@@ -10,14 +11,13 @@ use serde::Serialize;
 use crate::error::{check_setting, Result};
 use crate::iterate::{
     spectrum_acceptance, Iteration, IterationRecord, Response, SpectrumAcceptance,
-    SpectrumSettings, ACCEPTANCE_BAND,
+    SpectrumSettings, Stop, ACCEPTANCE_BAND,
 };
 use crate::rrs::RequiredSpectrum;
 
-/// A drive iterated at a low level and scaled up ([`crate::PlanSettings::iterate_at`],
-/// [`crate::TablePlanSettings::iterate_at`]). The iteration's drives and `achieved` are then
-/// the scaled-up drives and their full-level run; its records are the low-level runs' (their
-/// NRMSEs are relative, so they compare). `Rec` is an iteration's record: one axis's
+/// A drive iterated at a low level and scaled up ([`crate::PlanSettings::iterate_at`]). The
+/// iteration's drives and `achieved` are then the scaled-up drives and their full-level run;
+/// its records are the low-level runs' (their NRMSEs are relative, so they compare). `Rec` is an iteration's record: one axis's
 /// ([`IterationRecord`]) or several axes' ([`crate::MimoRecord`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct IteratedAt<Rec = IterationRecord> {
@@ -144,6 +144,42 @@ fn scaled_up_warning(level: f64, full: f64, low: f64) -> Option<String> {
             100.0 * low
         )
     })
+}
+
+/// The drive iteration as a plan's summary reports it, whatever the table: the level it was
+/// iterated at, every iteration's record, the best one, how it stopped and why it stalled.
+pub(crate) struct IterationOutcome<Rec> {
+    /// The level the drive was iterated at, a fraction of the target (`None`: full level).
+    pub iterate_at: Option<f64>,
+    /// Every iteration's record, from 0 (the target's own command); empty when not iterated.
+    pub iterations: Vec<Rec>,
+    /// The iteration whose drive is written (`None` when not iterated).
+    pub best_iteration: Option<usize>,
+    /// `converged`, `max_iterations`, `stalled`, or `not_run` (not iterated: the target's own
+    /// command reaches the end of the actuators).
+    pub stop: &'static str,
+    /// Why the iteration stalled (`None` otherwise).
+    pub stall_reason: Option<String>,
+}
+
+impl<Rec: Clone> IterationOutcome<Rec> {
+    /// The outcome of the drive iteration `it` (`None`: not iterated), scaled up from the
+    /// level of `iterated_at` where it was iterated at a low level.
+    pub(crate) fn of<R, D>(
+        it: Option<&Iteration<R, Rec, D>>,
+        iterated_at: Option<&IteratedAt<Rec>>,
+    ) -> Self {
+        Self {
+            iterate_at: iterated_at.map(|i| i.level),
+            iterations: it.map_or_else(Vec::new, |it| it.records.clone()),
+            best_iteration: it.map(|it| it.best),
+            stop: it.map_or("not_run", |it| it.stop.name()),
+            stall_reason: match it.map(|it| &it.stop) {
+                Some(Stop::Stalled { reason }) => Some(reason.clone()),
+                _ => None,
+            },
+        }
+    }
 }
 
 /// The acceptance of the achieved acceleration `achieved_a` (at `sample_rate_hz`) against

@@ -8,9 +8,21 @@ use std::path::Path;
 
 use platen_io::IoError;
 use platen_plan::{
-    load_rig, plan, write_drive, IterationSettings, PlanError, PlanSettings, Target,
-    MIN_TARGET_SAMPLES,
+    load_rig, write_drive, IterationSettings, PlanError, PlanSettings, Target, MIN_TARGET_SAMPLES,
 };
+
+/// The one plan ([`platen_plan::plan`]) of the uniaxial scenario `rig` (read from `path`).
+fn plan(
+    rig: &platen_scenario::LoadedRig,
+    path: &Path,
+    target: &Target,
+    settings: &PlanSettings,
+) -> platen_plan::Result<platen_plan::Plan> {
+    let scenario = platen_plan::PlanScenario::platen(path, rig.clone());
+    let target = platen_plan::PlanTarget::Platen(target.clone());
+    let p = platen_plan::plan(&scenario, &target, settings, &mut |_| {})?;
+    Ok(p.into_platen().expect("a uniaxial scenario's plan"))
+}
 
 /// Writes `text` to `name` in `dir` and reads it as a target.
 fn read(dir: &Path, name: &str, text: &str) -> Result<Target, PlanError> {

@@ -10,9 +10,22 @@ use std::path::Path;
 use platen_integrate::Trajectory;
 use platen_plan::feasibility::{feasibility, limit_uses};
 use platen_plan::{
-    max_scale, plan, BaselineSettings, MaxScaleSettings, PlanSettings, Table, Target, TargetMotion,
+    max_scale, BaselineSettings, MaxScaleSettings, PlanSettings, Table, Target, TargetMotion,
 };
 use platen_scenario::RunSummary;
+
+/// The one plan ([`platen_plan::plan`]) of the uniaxial scenario `rig` (read from `path`).
+fn plan(
+    rig: &platen_scenario::LoadedRig,
+    path: &Path,
+    target: &Target,
+    settings: &PlanSettings,
+) -> platen_plan::Result<platen_plan::Plan> {
+    let scenario = platen_plan::PlanScenario::platen(path, rig.clone());
+    let target = platen_plan::PlanTarget::Platen(target.clone());
+    let p = platen_plan::plan(&scenario, &target, settings, &mut |_| {})?;
+    Ok(p.into_platen().expect("a uniaxial scenario's plan"))
+}
 
 const RATE_HZ: f64 = 1024.0;
 

@@ -8,7 +8,20 @@ use std::path::Path;
 
 use platen_integrate::Trajectory;
 use platen_plan::iterate::nrmse;
-use platen_plan::{plan, PlanSettings, Stop, Target, TargetKind};
+use platen_plan::{PlanSettings, Stop, Target, TargetKind};
+
+/// The one plan ([`platen_plan::plan`]) of the uniaxial scenario `rig` (read from `path`).
+fn plan(
+    rig: &platen_scenario::LoadedRig,
+    path: &Path,
+    target: &Target,
+    settings: &PlanSettings,
+) -> platen_plan::Result<platen_plan::Plan> {
+    let scenario = platen_plan::PlanScenario::platen(path, rig.clone());
+    let target = platen_plan::PlanTarget::Platen(target.clone());
+    let p = platen_plan::plan(&scenario, &target, settings, &mut |_| {})?;
+    Ok(p.into_platen().expect("a uniaxial scenario's plan"))
+}
 
 fn synthetic_target(seed: u64, duration_s: f64) -> Target {
     let (t, a) = common::accelerogram(seed, duration_s, 1024.0, 0.5);

@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 use platen_model::multi_axis::Dof;
 use platen_plan::six_dof::limit_uses;
 use platen_plan::{
-    plan_multi_axis, AxisTargets, MaxScaleSettings, TablePlanSettings, TablePlant, Target,
+    plan_multi_axis, AxisTargets, MaxScaleSettings, PlanSettings, TablePlant, Target,
 };
 use platen_scenario::file::parse;
 use platen_scenario::multi_axis::{TableRunSpec, TableScenario};
@@ -62,12 +62,12 @@ fn northridge_three_components_on_the_lhpost6_with_a_tower() {
     };
     // The 120 t tower at 50 %: not feasible, an actuator lifted off, cavitation warned of.
     let (path, _, file, _, targets) = load("lhpost6-northridge.json");
-    let few = TablePlanSettings {
+    let few = PlanSettings {
         iteration: platen_plan::IterationSettings {
             max_iterations: 1,
             ..Default::default()
         },
-        ..TablePlanSettings::default()
+        ..PlanSettings::default()
     };
     let full = plan_multi_axis(&path, &file, &targets, &few, &mut |_| {}).unwrap();
     for u in &full.feasibility.limiting {
@@ -89,9 +89,9 @@ fn northridge_three_components_on_the_lhpost6_with_a_tower() {
     );
     // The 40 t tower at 50 %: feasible; iterated, replayed, scaled.
     let (path, text, file, t, targets) = load("lhpost6-light-tower-northridge.json");
-    let settings = TablePlanSettings {
+    let settings = PlanSettings {
         max_scale: Some(MaxScaleSettings::default()),
-        ..TablePlanSettings::default()
+        ..PlanSettings::default()
     };
     let plan = plan_multi_axis(&path, &file, &targets, &settings, &mut |_| {}).unwrap();
     assert!(plan.feasibility.feasible, "{:?}", plan.feasibility.limiting);
@@ -200,13 +200,13 @@ fn a_synthetic_target_that_ends_at_rest_iterates_to_the_end() {
     let axes = platen_plan::synthetic_three_component_m_s2(&t)
         .map(|a| Some(Target::acceleration(Path::new("quake"), t.clone(), a).unwrap()));
     let targets = AxisTargets::new(Path::new("quake"), axes).unwrap();
-    let settings = TablePlanSettings {
+    let settings = PlanSettings {
         iteration: platen_plan::IterationSettings {
             max_iterations: 6,
             target_nrmse: 0.0,
             ..Default::default()
         },
-        ..TablePlanSettings::default()
+        ..PlanSettings::default()
     };
     let plan = plan_multi_axis(&path, &file, &targets, &settings, &mut |_| {}).unwrap();
     let records = &plan.iteration().unwrap().records;

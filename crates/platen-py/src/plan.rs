@@ -7,7 +7,7 @@ use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 
 use platen_plan::{
-    FrfSource, MaxScaleSettings, NoiseSettings, PlanError, PlanSettings, RequiredSpectrum, Target,
+    FrfSource, NoiseSettings, PlanError, PlanScenario, PlanSettings, PlanTarget, Planned, Target,
 };
 use platen_scenario::LoadedRig;
 
@@ -70,16 +70,13 @@ pub fn plan<'py>(
                 )))
             }
         };
-        let (path, rig) = match (path, text) {
-            (Some(path), _) => {
-                let rig = platen_plan::load_rig(&path)?;
-                (path, rig)
-            }
+        let scenario = match (path, text) {
+            (Some(path), _) => PlanScenario::platen(&path, platen_plan::load_rig(&path)?),
             (None, Some(text)) => {
                 // As `load_rig` reads a file: the excitation, if any, is ignored.
                 let origin = PathBuf::from(&origin);
                 let rig = LoadedRig::parse(&origin, &text).map_err(PlanError::from)?;
-                (origin, rig)
+                PlanScenario::platen(&origin, rig)
             }
             (None, None) => return Err(Fail::input("no scenario: give a path or a dict")),
         };
@@ -93,23 +90,22 @@ pub fn plan<'py>(
                 ))
             }
         };
-        let settings = PlanSettings {
-            iteration: platen_plan::IterationSettings {
-                max_iterations: iterations,
-                gain,
-                target_nrmse,
-                band_hz,
-                frf,
-                ..Default::default()
-            },
-            max_scale: max_scale.then(MaxScaleSettings::default),
-            rrs: rrs
-                .map(|f| RequiredSpectrum::read_csv(&f, rrs_damping))
-                .transpose()?,
-            iterate_at,
-            ..Default::default()
+        let mut settings =
+            PlanSettings::new(iterations, gain, target_nrmse, band_hz, max_scale, false);
+        settings.iteration.frf = frf;
+        if let Some(f) = rrs {
+            settings.read_rrs(&scenario, &f, rrs_damping)?;
+        }
+        settings.iterate_at = iterate_at;
+        let p = platen_plan::plan(
+            &scenario,
+            &PlanTarget::Platen(target),
+            &settings,
+            &mut |_| {},
+        )?;
+        let Planned::Platen(p) = &p else {
+            unreachable!("a uniaxial scenario's plan")
         };
-        let p = platen_plan::plan(&rig, &path, &target, &settings)?;
         let drive = p.drive().map(|(t, u)| (t.to_vec(), u.to_vec()));
         Ok((drive, json_text(&p.summary(None))?))
     })?;
@@ -156,34 +152,9 @@ pub fn plan_table<'py>(
         .map(|(n, k, v)| Ok((n.clone(), k.clone(), vector(v)?)))
         .collect::<PyResult<_>>()?;
     let (t, columns, summary) = detached(py, move || {
-        let (path, text) = match (path, text) {
-            (Some(path), _) => {
-                let text = std::fs::read_to_string(&path).map_err(|e| {
-                    Fail::input(format!("`{}`: cannot be read: {e}", path.display()))
-                })?;
-                (path, text)
-            }
-            (None, Some(text)) => (PathBuf::from(&origin), text),
-            (None, None) => return Err(Fail::input("no scenario: give a path or a dict")),
-        };
-        let file = platen_plan::six_dof::table_scenario_file(&path, &text)?
-            .ok_or_else(|| Fail::input("per-axis targets need a scenario with a `table`"))?;
-        let origin = Path::new("target");
-        let mut given: [Option<Target>; 3] = [None, None, None];
-        for (name, kind, values) in axes {
-            let k = platen_plan::six_dof::AXES
-                .iter()
-                .position(|a| *a == name)
-                .ok_or_else(|| {
-                    Fail::input(format!("target axis `{name}`: expected one of x, y, z"))
-                })?;
-            given[k] = Some(match kind.as_str() {
-                "acceleration" => Target::acceleration(origin, t_s.clone(), values)?,
-                _ => Target::displacement(origin, t_s.clone(), values)?,
-            });
-        }
-        let targets = platen_plan::AxisTargets::new(origin, given)?;
-        let mut settings = platen_plan::TablePlanSettings::new(
+        let scenario = table_scenario(path, text, &origin)?;
+        let targets = axis_targets(&t_s, axes)?;
+        let mut settings = PlanSettings::new(
             iterations,
             gain,
             target_nrmse,
@@ -192,10 +163,18 @@ pub fn plan_table<'py>(
             per_axis_scale,
         );
         if let Some(f) = rrs {
-            settings.rrs = RequiredSpectrum::read_csv_axes(&f, rrs_damping)?;
+            settings.read_rrs(&scenario, &f, rrs_damping)?;
         }
         settings.iterate_at = iterate_at;
-        let p = platen_plan::plan_multi_axis(&path, &file, &targets, &settings, &mut |_| {})?;
+        let p = platen_plan::plan(
+            &scenario,
+            &PlanTarget::Table(targets),
+            &settings,
+            &mut |_| {},
+        )?;
+        let Planned::Table(p) = &p else {
+            unreachable!("a multi-axis scenario's plan")
+        };
         let (_, mut columns) = p.drive_columns().unwrap_or_default();
         let t = if columns.is_empty() {
             Vec::new()
@@ -209,4 +188,45 @@ pub fn plan_table<'py>(
         columns.into_iter().map(|c| c.into_pyarray(py)).collect(),
         summary,
     ))
+}
+
+/// The multi-axis scenario of the file at `path`, or of the JSON `text` named `origin`.
+fn table_scenario(
+    path: Option<PathBuf>,
+    text: Option<String>,
+    origin: &str,
+) -> Result<PlanScenario, Fail> {
+    let (path, text) = match (path, text) {
+        (Some(path), _) => {
+            let text = std::fs::read_to_string(&path)
+                .map_err(|e| Fail::input(format!("`{}`: cannot be read: {e}", path.display())))?;
+            (path, text)
+        }
+        (None, Some(text)) => (PathBuf::from(origin), text),
+        (None, None) => return Err(Fail::input("no scenario: give a path or a dict")),
+    };
+    let file = platen_plan::six_dof::table_scenario_file(&path, &text)?
+        .ok_or_else(|| Fail::input("per-axis targets need a scenario with a `table`"))?;
+    Ok(PlanScenario::table(&path, file))
+}
+
+/// The three-component target of `axes` (per axis `(name, kind, values)`, `kind`
+/// `acceleration` or `displacement`) at `t_s`.
+fn axis_targets(
+    t_s: &[f64],
+    axes: Vec<(String, String, Vec<f64>)>,
+) -> Result<platen_plan::AxisTargets, Fail> {
+    let origin = Path::new("target");
+    let mut given: [Option<Target>; 3] = [None, None, None];
+    for (name, kind, values) in axes {
+        let k = platen_plan::six_dof::AXES
+            .iter()
+            .position(|a| *a == name)
+            .ok_or_else(|| Fail::input(format!("target axis `{name}`: expected one of x, y, z")))?;
+        given[k] = Some(match kind.as_str() {
+            "acceleration" => Target::acceleration(origin, t_s.to_vec(), values)?,
+            _ => Target::displacement(origin, t_s.to_vec(), values)?,
+        });
+    }
+    Ok(platen_plan::AxisTargets::new(origin, given)?)
 }

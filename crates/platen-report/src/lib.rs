@@ -17,12 +17,15 @@
 //!   actuators' strokes and forces against their limits, and the specimen's overturning
 //!   moments and base forces.
 //! * [`plan_figures`] draws a test plan (`platen plan --plot`, `--report`): target against
-//!   achieved acceleration, response spectra, convergence and the limits' margins.
+//!   achieved acceleration, response spectra, convergence and the limits' margins;
+//!   [`table_plan_figures`] a multi-axis table's, per axis; [`planned`] any plan's text,
+//!   figures and page, whatever the table.
 //! * [`render`] writes them: SVG, PNG copies rendered by resvg with the embedded Noto Sans,
 //!   and the HTML page, every file atomically ([`write_outputs`]).
 //! * [`identify_report`] writes `platen identify`'s text report and HTML page.
 //! * [`simulate_report`], [`plan_report`] and [`sweep_report`] write the text summaries of
-//!   `platen simulate`, `plan`, `sweep` and `generate` (and `generate`'s JSON report).
+//!   `platen simulate`, `plan`, `sweep` and `generate` (and `generate`'s JSON report);
+//!   [`bench_report`] `platen bench`'s table.
 //! * [`html`] builds self-contained pages; [`text`] the numbers, metric rows and terminal
 //!   summary.
 //!
@@ -63,6 +66,7 @@
 //! * Legends sit in a strip above each panel's axes: they never hide data or stretch an axis.
 
 mod axes;
+pub mod bench_report;
 pub mod compare_figures;
 mod error;
 pub mod figure;
@@ -72,6 +76,7 @@ pub mod identify_report;
 pub mod model_text;
 pub mod plan_figures;
 pub mod plan_report;
+pub mod planned;
 pub mod record_figures;
 pub mod render;
 pub mod run_figures;

@@ -67,9 +67,42 @@ fn history(t: &[f64], y: &[f64], range: Option<(f64, f64)>) -> Points {
     envelope(&t[..n], &y[..n], range.unwrap_or((t[0], t[n - 1])), BUCKETS)
 }
 
+/// `plan-acceleration`: the target against the achieved acceleration of iteration 0 and of
+/// the drive, each over the whole record, then the interval around the target's largest |a|
+/// close up.
 fn acceleration(p: &Plan) -> Figure {
     let m = &p.motion;
     let zoom = crate::run_figures::zoom_window(&m.t_s, &m.a_m_s2);
+    let drive = best(p);
+    let mut panels = whole_accelerations(p, zoom, drive);
+    if let Some(range) = zoom {
+        panels.push(close_up(p, range, drive));
+    }
+    let rows = panels.len() as u32;
+    Figure {
+        name: "plan-acceleration".into(),
+        title: format!(
+            "{}: target and achieved table acceleration",
+            subject(&p.target_origin, &p.scenario_name)
+        ),
+        caption: "The target acceleration against the simulated table's, for the target's own \
+                  command (iteration 0) and for the drive; the shaded interval close up below."
+            .into(),
+        panels,
+        columns: 1,
+        rows: Vec::new(),
+        size: (1200, 120 + 330 * rows),
+    }
+}
+
+/// The target against iteration 0's achieved acceleration over the whole record, then against
+/// the drive's (iteration `k`, achieved `a`) when there is one, `zoom` shaded.
+fn whole_accelerations(
+    p: &Plan,
+    zoom: Option<(f64, f64)>,
+    drive: Option<(usize, &[f64])>,
+) -> Vec<Panel> {
+    let m = &p.motion;
     let target = history(&m.t_s, &m.a_m_s2, None);
     let zero = history(&m.t_s, &p.feasibility.achieved.a_m_s2, None);
     let mut whole = Panel::new(
@@ -83,7 +116,6 @@ fn acceleration(p: &Plan) -> Figure {
     );
     whole.shade_x = zoom;
     let mut panels = vec![whole];
-    let drive = best(p);
     if let Some((k, a)) = drive {
         let mut whole = Panel::new(
             format!("Target and achieved, iteration {k} (the drive)"),
@@ -103,56 +135,45 @@ fn acceleration(p: &Plan) -> Figure {
         whole.shade_x = zoom;
         panels.push(whole);
     }
-    // The shaded interval close up (around the target's largest |a|), every trace at its
-    // own samples' resolution.
-    if let Some(range) = zoom {
-        let close = |y: &[f64]| history(&m.t_s, y, Some(range));
-        let mut series = vec![
-            patterned("target", close(&m.a_m_s2), RECORDED, 2, Dash::Solid),
-            patterned(
-                "iteration 0",
-                close(&p.feasibility.achieved.a_m_s2),
-                RESIDUAL,
-                1,
-                Dash::Dotted,
-            ),
-        ];
-        if let Some((k, a)) = drive {
-            series.push(patterned(
-                format!("iteration {k}"),
-                close(a),
-                SIMULATED,
-                2,
-                Dash::Dashed,
-            ));
-        }
-        let mut zoomed = Panel::new(
-            format!(
-                "Close up: {:.2}–{:.2} s, around the target's largest |a|",
-                range.0, range.1
-            ),
-            "t (s)",
-            "a (m/s²)",
-            series,
-        );
-        zoomed.x_range = Some(range);
-        panels.push(zoomed);
-    }
-    let rows = panels.len() as u32;
-    Figure {
-        name: "plan-acceleration".into(),
-        title: format!(
-            "{}: target and achieved table acceleration",
-            subject(&p.target_origin, &p.scenario_name)
+    panels
+}
+
+/// The shaded interval `range` close up (around the target's largest |a|), every trace at its
+/// own samples' resolution: the target, iteration 0 and the drive's (iteration `k`, achieved
+/// `a`) when there is one.
+fn close_up(p: &Plan, range: (f64, f64), drive: Option<(usize, &[f64])>) -> Panel {
+    let m = &p.motion;
+    let close = |y: &[f64]| history(&m.t_s, y, Some(range));
+    let mut series = vec![
+        patterned("target", close(&m.a_m_s2), RECORDED, 2, Dash::Solid),
+        patterned(
+            "iteration 0",
+            close(&p.feasibility.achieved.a_m_s2),
+            RESIDUAL,
+            1,
+            Dash::Dotted,
         ),
-        caption: "The target acceleration against the simulated table's, for the target's own \
-                  command (iteration 0) and for the drive; the shaded interval close up below."
-            .into(),
-        panels,
-        columns: 1,
-        rows: Vec::new(),
-        size: (1200, 120 + 330 * rows),
+    ];
+    if let Some((k, a)) = drive {
+        series.push(patterned(
+            format!("iteration {k}"),
+            close(a),
+            SIMULATED,
+            2,
+            Dash::Dashed,
+        ));
     }
+    let mut zoomed = Panel::new(
+        format!(
+            "Close up: {:.2}–{:.2} s, around the target's largest |a|",
+            range.0, range.1
+        ),
+        "t (s)",
+        "a (m/s²)",
+        series,
+    );
+    zoomed.x_range = Some(range);
+    zoomed
 }
 
 fn spectra(p: &Plan) -> Option<Figure> {

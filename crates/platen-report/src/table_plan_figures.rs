@@ -13,7 +13,7 @@ use platen_plan::{TablePlan, TablePlannedDrive};
 use platen_signal::ResponseSpectrum;
 use plotters::style::RGBColor;
 
-use crate::figure::{Dash, Figure, Panel, MODEL, RECORDED, RESIDUAL, SIMULATED};
+use crate::figure::{Dash, Figure, Panel, Series, MODEL, RECORDED, RESIDUAL, SIMULATED};
 use crate::plan_figures::{SPECTRUM_DAMPING, SPECTRUM_PERIODS_S};
 use crate::series::{envelope, patterned, points, segments, Points};
 
@@ -181,9 +181,55 @@ fn spectra(p: &TablePlan, d: &TablePlannedDrive) -> Option<Figure> {
     })
 }
 
+/// `table-plan-convergence`: the acceleration NRMSE per axis and overall per iteration, and
+/// the cross-talk of the axes held at zero.
 fn convergence(p: &TablePlan, d: &TablePlannedDrive) -> Figure {
     let it = &d.iteration;
     let last = it.records.len().saturating_sub(1).max(1) as f64;
+    let (nrmse, cross) = convergence_series(p, d);
+    let mut panel = Panel::new(
+        format!(
+            "Acceleration NRMSE per axis (best: {}, stop: {})",
+            it.best,
+            it.stop.name()
+        ),
+        "iteration",
+        "NRMSE (%, logarithmic)",
+        nrmse,
+    );
+    panel.x_range = Some((-0.2, last + 0.2));
+    panel.y_log = true;
+    let mut panels = vec![panel];
+    if !cross.is_empty() {
+        let mut c = Panel::new(
+            "Cross-talk: RMS acceleration of the axes held at zero",
+            "iteration",
+            "RMS a (m/s²)",
+            cross,
+        );
+        c.x_range = Some((-0.2, last + 0.2));
+        panels.push(c);
+    }
+    Figure {
+        name: "table-plan-convergence".into(),
+        title: format!("{}: drive iteration", subject(p)),
+        caption: "The acceleration NRMSE per axis and overall (all axes' errors over all axes' \
+                  targets) per iteration, in percent on a logarithmic axis; the RMS \
+                  acceleration of the \
+                  axes held at zero (their cross-talk)."
+            .into(),
+        panels,
+        columns: 1,
+        rows: Vec::new(),
+        size: (1000, 800),
+    }
+}
+
+/// The series of the convergence figure: the acceleration NRMSE overall and of each axis
+/// given, in percent (for a logarithmic axis), and the RMS acceleration of each axis held at
+/// zero (its cross-talk), per iteration.
+fn convergence_series(p: &TablePlan, d: &TablePlannedDrive) -> (Vec<Series>, Vec<Series>) {
+    let it = &d.iteration;
     // In percent on a logarithmic axis (`y_log`), labelled in percent.
     let log = |x: f64| 100.0 * x;
     let mut nrmse = Vec::new();
@@ -225,42 +271,7 @@ fn convergence(p: &TablePlan, d: &TablePlannedDrive) -> Figure {
             nrmse.push(points("", pts, colour, 4));
         }
     }
-    let mut panel = Panel::new(
-        format!(
-            "Acceleration NRMSE per axis (best: {}, stop: {})",
-            it.best,
-            it.stop.name()
-        ),
-        "iteration",
-        "NRMSE (%, logarithmic)",
-        nrmse,
-    );
-    panel.x_range = Some((-0.2, last + 0.2));
-    panel.y_log = true;
-    let mut panels = vec![panel];
-    if !cross.is_empty() {
-        let mut c = Panel::new(
-            "Cross-talk: RMS acceleration of the axes held at zero",
-            "iteration",
-            "RMS a (m/s²)",
-            cross,
-        );
-        c.x_range = Some((-0.2, last + 0.2));
-        panels.push(c);
-    }
-    Figure {
-        name: "table-plan-convergence".into(),
-        title: format!("{}: drive iteration", subject(p)),
-        caption: "The acceleration NRMSE per axis and overall (all axes' errors over all axes' \
-                  targets) per iteration, in percent on a logarithmic axis; the RMS \
-                  acceleration of the \
-                  axes held at zero (their cross-talk)."
-            .into(),
-        panels,
-        columns: 1,
-        rows: Vec::new(),
-        size: (1000, 800),
-    }
+    (nrmse, cross)
 }
 
 /// Bars of peak/allowed in percent, one per limit at x = 1, 2, … (offset by `dx`).

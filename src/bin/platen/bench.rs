@@ -1,6 +1,7 @@
 //! `platen bench`: time the standard workloads on the `lhpost-2008` preset, next to the
 //! plain-loop baseline measured in the same run. The workloads, their inputs, the timing and
-//! the report are [`platen_bench`]'s; this file parses and prints.
+//! the report are [`platen_bench`]'s, its text [`platen_report::bench_report`]'s; this file
+//! parses and prints.
 
 use anyhow::Result;
 
@@ -27,7 +28,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&m.report())?);
     } else {
-        out!("{}", m.text());
+        out!("{}", platen_report::bench_report::text(&m));
     }
     Ok(())
 }

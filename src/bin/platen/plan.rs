@@ -14,10 +14,9 @@ use clap::ValueEnum;
 use platen_io::columns::ColumnMap;
 use platen_io::csv::CsvWriter;
 use platen_plan::{
-    load_rig, plan_observed, FrfSource, MaxScaleSettings, NoiseSettings, PlanError, PlanSettings,
-    RequiredSpectrum, Target,
+    FrfSource, MaxScaleSettings, NoiseSettings, PlanError, PlanScenario, PlanSettings, PlanTarget,
 };
-use platen_report::plan_figures;
+use platen_report::planned;
 use platen_report::simulate_report::with_outputs;
 
 use crate::progress::Progress;
@@ -165,8 +164,68 @@ fn cli_error(e: PlanError) -> anyhow::Error {
     }
 }
 
+/// `platen plan`: the scenario read for planning, whatever its table, its target and
+/// required spectra as that table takes them, the one plan ([`platen_plan::plan`]), its drive
+/// written, its figures, report, warnings and summary.
 pub fn run(args: &Args) -> Result<()> {
-    let mut settings = PlanSettings {
+    let mut settings = settings(args);
+    let columns = match &args.columns {
+        Some(map) => ColumnMap::load(map)?,
+        None => ColumnMap::default(),
+    };
+    let scenario = PlanScenario::load(&args.scenario).map_err(cli_error)?;
+    if scenario.is_multi_axis() {
+        refuse_for_multi_axis(args)?;
+    }
+    // The drive's temporary file first: an unwritable destination fails before any run.
+    let writer = CsvWriter::create(&args.out, scenario.drive_columns())?;
+    let target = PlanTarget::read_csv(&scenario, &args.target, &columns).map_err(cli_error)?;
+    if let Some(rrs) = &args.rrs {
+        settings
+            .read_rrs(&scenario, rrs, args.rrs_damping)
+            .map_err(cli_error)?;
+    }
+    let progress = iteration_progress(args);
+    let on_run = &mut |k: usize| progress.set_position(k as u64 + 1);
+    let p = platen_plan::plan(&scenario, &target, &settings, on_run);
+    progress.finish();
+    let p = p.map_err(cli_error)?;
+    // No drive (the target's own command reaches the end of the actuators): nothing is
+    // written; the temporary file goes with the writer.
+    let written = p.write_drive_rows(writer).map_err(cli_error)?;
+    let summary = p.summary(&settings, written.then_some(args.out.as_path()));
+    let value = serde_json::to_value(&summary)?;
+    let figures = platen_report::write_outputs(
+        args.plot.as_deref(),
+        args.report.as_deref(),
+        &args.size.size(),
+        || planned::figures(&p),
+        |figures, rendered| planned::page(&p, value.clone(), figures, rendered),
+    )?;
+    for warning in summary.warnings() {
+        eprintln!("warning: {warning}");
+    }
+    if args.json {
+        let figures = args.plot.as_ref().map(|_| figures.as_slice());
+        let value = with_outputs(value, figures, args.report.as_deref());
+        outln!("{}", serde_json::to_string_pretty(&value)?);
+        return Ok(());
+    }
+    out!(
+        "{}",
+        planned::text(
+            &summary,
+            &figures,
+            args.plot.as_deref(),
+            args.report.as_deref()
+        )
+    );
+    Ok(())
+}
+
+/// The plan's settings of the options (its required spectra read apart).
+fn settings(args: &Args) -> PlanSettings {
+    PlanSettings {
         iteration: platen_plan::IterationSettings {
             max_iterations: usize::from(args.iterations),
             gain: args.gain,
@@ -180,92 +239,22 @@ pub fn run(args: &Args) -> Result<()> {
             ..Default::default()
         },
         max_scale: (!args.no_max_scale).then(MaxScaleSettings::default),
+        per_axis_max_scale: args.per_axis_scale,
         iterate_at: args.iterate_at,
         ..Default::default()
-    };
-    let columns = match &args.columns {
-        Some(map) => ColumnMap::load(map)?,
-        None => ColumnMap::default(),
-    };
-    if let Some(file) =
-        platen_plan::six_dof::read_table_scenario(&args.scenario).map_err(cli_error)?
-    {
-        if let Some(map) = &args.columns {
-            anyhow::bail!(
-                "--columns {}: a three-component target is read under platen's own names \
-                 (t_s, x_m_s2, y_m_s2, z_m_s2 or x_m, y_m, z_m, SI units); --columns maps a \
-                 uniaxial target's",
-                map.display()
-            );
-        }
-        return run_table(args, &file);
     }
-    // The drive's temporary file first: an unwritable destination fails before any run.
-    let mut writer = CsvWriter::create(&args.out, &["t_s", "u_m"])?;
-    let rig = load_rig(&args.scenario).map_err(cli_error)?;
-    let target = Target::read_csv_mapped(&args.target, &columns).map_err(cli_error)?;
-    if let Some(rrs) = &args.rrs {
-        settings.rrs = Some(RequiredSpectrum::read_csv(rrs, args.rrs_damping).map_err(cli_error)?);
-    }
-    let progress = iteration_progress(args);
-    let on_run = &mut |k: usize| progress.set_position(k as u64 + 1);
-    let p = plan_observed(&rig, &args.scenario, &target, &settings, on_run);
-    progress.finish();
-    let p = p.map_err(cli_error)?;
-    let written = match p.drive() {
-        Some((t_s, u_m)) => {
-            for (t, u) in t_s.iter().zip(u_m) {
-                writer.write_row(&[*t, *u])?;
-            }
-            writer.finish()?;
-            Some(args.out.as_path())
-        }
-        // No drive (the target's command reaches the end of the actuators): nothing is
-        // written; the temporary file goes with the writer.
-        None => None,
-    };
-    let summary = p.summary(written);
-    let value = serde_json::to_value(&summary)?;
-    let figures = platen_report::write_outputs(
-        args.plot.as_deref(),
-        args.report.as_deref(),
-        &args.size.size(),
-        || plan_figures::figures(&p),
-        |figures, rendered| plan_figures::page(&p, value.clone(), figures, rendered),
-    )?;
-    for warning in &summary.warnings {
-        eprintln!("warning: {warning}");
-    }
-    if args.json {
-        let figures = args.plot.as_ref().map(|_| figures.as_slice());
-        let value = with_outputs(value, figures, args.report.as_deref());
-        outln!("{}", serde_json::to_string_pretty(&value)?);
-        return Ok(());
-    }
-    out!(
-        "{}",
-        platen_report::plan_report::text(
-            &summary,
-            &figures,
-            args.plot.as_deref(),
-            args.report.as_deref()
-        )
-    );
-    Ok(())
 }
 
-/// A bar of the drive iterations (on a terminal, after a second).
-fn iteration_progress(args: &Args) -> Progress {
-    Progress::new(
-        u64::from(args.iterations) + 1,
-        "{bar:30} {pos}/{len} runs of the drive iteration, {elapsed_precise} elapsed",
-    )
-}
-
-/// `platen plan` on a multi-axis scenario (one with a `table` and its `controller`): the
-/// three-component plan ([`platen_plan::six_dof`]).
-fn run_table(args: &Args, file: &platen_scenario::file::ScenarioFile) -> Result<()> {
-    use platen_plan::{plan_multi_axis, AxisTargets, TablePlanSettings};
+/// The options a multi-axis table's plan does not take (yet).
+fn refuse_for_multi_axis(args: &Args) -> Result<()> {
+    if let Some(map) = &args.columns {
+        anyhow::bail!(
+            "--columns {}: a three-component target is read under platen's own names \
+             (t_s, x_m_s2, y_m_s2, z_m_s2 or x_m, y_m, z_m, SI units); --columns maps a \
+             uniaxial target's",
+            map.display()
+        );
+    }
     if matches!(args.frf, Frf::Measured) {
         anyhow::bail!(
             "--frf measured: a multi-axis table's drives are iterated through its linearised \
@@ -282,45 +271,13 @@ fn run_table(args: &Args, file: &platen_scenario::file::ScenarioFile) -> Result<
     if args.per_axis_scale && args.no_max_scale {
         anyhow::bail!("--per-axis-scale searches scales: it cannot go with --no-max-scale");
     }
-    let mut settings = TablePlanSettings::new(
-        usize::from(args.iterations),
-        args.gain,
-        args.target_nrmse,
-        args.band_hz,
-        !args.no_max_scale,
-        args.per_axis_scale,
-    );
-    // The drive's temporary file first: an unwritable destination fails before any run.
-    let writer = CsvWriter::create(&args.out, &platen_plan::six_dof::DRIVE_COLUMNS)?;
-    let targets = AxisTargets::read_csv(&args.target).map_err(cli_error)?;
-    if let Some(rrs) = &args.rrs {
-        settings.rrs = RequiredSpectrum::read_csv_axes(rrs, args.rrs_damping).map_err(cli_error)?;
-    }
-    settings.iterate_at = args.iterate_at;
-    let progress = iteration_progress(args);
-    let on_run = &mut |k: usize| progress.set_position(k as u64 + 1);
-    let p = plan_multi_axis(&args.scenario, file, &targets, &settings, on_run);
-    progress.finish();
-    let p = p.map_err(cli_error)?;
-    // No drives (the target's own commands reach the end of an actuator): nothing is
-    // written; the temporary file goes with the writer.
-    let written = p.write_drive_rows(writer).map_err(cli_error)?;
-    let summary = p.summary(&settings, written.then_some(args.out.as_path()));
-    let figures = platen_report::write_outputs(
-        args.plot.as_deref(),
-        None,
-        &args.size.size(),
-        || platen_report::table_plan_figures::figures(&p),
-        |_, _| String::new(),
-    )?;
-    for warning in &summary.warnings {
-        eprintln!("warning: {warning}");
-    }
-    crate::plot::print(args.json, args.plot.is_some(), &summary, &figures, || {
-        let mut t = platen_report::plan_report::table_text(&summary);
-        for f in &figures {
-            t += &format!("wrote {}\n", f.display());
-        }
-        t
-    })
+    Ok(())
+}
+
+/// A bar of the drive iterations (on a terminal, after a second).
+fn iteration_progress(args: &Args) -> Progress {
+    Progress::new(
+        u64::from(args.iterations) + 1,
+        "{bar:30} {pos}/{len} runs of the drive iteration, {elapsed_precise} elapsed",
+    )
 }

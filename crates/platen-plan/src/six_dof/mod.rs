@@ -60,10 +60,10 @@ use platen_system::TableLinearisation;
 
 use crate::baseline::{BaselineSettings, TargetMotion};
 use crate::error::{PlanError, Result};
-use crate::feasibility::{search_max_scale, MaxScale, MaxScaleSettings};
-use crate::iterate::{IterationSettings, Response, SpectrumAcceptance, TransferMatrix};
+use crate::feasibility::{search_max_scale, MaxScale};
+use crate::iterate::{Response, SpectrumAcceptance, TransferMatrix};
 use crate::mimo::{iterate_mimo, record_of_run, AxisTarget, MimoIteration, MimoRecord};
-use crate::rrs::RequiredSpectrum;
+use crate::plan::PlanSettings;
 use crate::steps::{acceptance, iteration_level, on_controller_rate, scaled_up, IteratedAt};
 
 pub use limits::{limit_uses, TableFeasibility, TableLimitUse, UPLIFT_RESIDUAL};
@@ -75,55 +75,7 @@ pub use targets::{read_table_scenario, table_scenario_file, AxisTargets, AXES, D
 
 use limits::{failing, use_of};
 
-/// What a multi-axis plan does.
-#[derive(Debug, Clone, Default)]
-pub struct TablePlanSettings {
-    /// The baseline treatment of each axis's target.
-    pub baseline: BaselineSettings,
-    /// The drive iteration (its `frf` is ignored: the table's linearised matrix is used).
-    pub iteration: IterationSettings,
-    /// The largest common scale (absent: not searched).
-    pub max_scale: Option<MaxScaleSettings>,
-    /// The largest scale of each axis too, the others as given.
-    pub per_axis_max_scale: bool,
-    /// Per axis (x, y, z), the required response spectrum its achieved acceleration is
-    /// accepted against (`None`: its target's own spectrum).
-    pub rrs: [Option<RequiredSpectrum>; 3],
-    /// The level the drives are iterated at, a fraction of the target in `(0, 1]` (`None` or
-    /// 1: full level), then scaled up and run once at full level, as the single-axis plan's
-    /// ([`crate::PlanSettings::iterate_at`]).
-    pub iterate_at: Option<f64>,
-}
-
-impl TablePlanSettings {
-    /// The settings of `platen plan`'s options (and `platen.plan`'s arguments): at most
-    /// `iterations` corrections at `gain`, stopping at `target_nrmse`, in `band_hz` (default
-    /// band when `None`); the largest common scale searched when `max_scale` or
-    /// `per_axis_scale`, each axis's too with `per_axis_scale`; the rest default.
-    pub fn new(
-        iterations: usize,
-        gain: f64,
-        target_nrmse: f64,
-        band_hz: Option<(f64, f64)>,
-        max_scale: bool,
-        per_axis_scale: bool,
-    ) -> Self {
-        Self {
-            iteration: IterationSettings {
-                max_iterations: iterations,
-                gain,
-                target_nrmse,
-                band_hz,
-                ..Default::default()
-            },
-            max_scale: (max_scale || per_axis_scale).then(MaxScaleSettings::default),
-            per_axis_max_scale: per_axis_scale,
-            ..Default::default()
-        }
-    }
-}
-
-/// Drives iterated at a low level and scaled up ([`TablePlanSettings::iterate_at`]).
+/// Drives iterated at a low level and scaled up ([`PlanSettings::iterate_at`]).
 pub type TableIteratedAt = IteratedAt<MimoRecord>;
 
 /// The plan of a three-component test.
@@ -174,7 +126,8 @@ pub struct TablePlannedDrive {
 }
 
 /// Plans `targets` on the closed loop of the multi-axis scenario `file` (at `path`; its
-/// excitation is ignored): feasibility, the largest scale that fits (when asked), the drives
+/// excitation is ignored; [`crate::plan()`](fn@crate::plan) calls it for a scenario with a
+/// `table`): feasibility, the largest scale that fits (when asked), the drives
 /// iterated (see the [module documentation](self)); `on_run(k)` is called when drive
 /// iteration `k`'s run is done. A target whose own commands drive an actuator to the end of
 /// its stroke is an answer (infeasible, not iterated), not an error.
@@ -188,7 +141,7 @@ pub fn plan_multi_axis(
     path: &Path,
     file: &ScenarioFile,
     targets: &AxisTargets,
-    settings: &TablePlanSettings,
+    settings: &PlanSettings,
     on_run: &mut dyn FnMut(usize),
 ) -> Result<TablePlan> {
     let level = iteration_level(settings.iterate_at)?;
@@ -383,7 +336,7 @@ struct Planning<'a> {
     plant: TablePlant<'a>,
     targets: Vec<AxisTarget>,
     interval_s: f64,
-    settings: &'a TablePlanSettings,
+    settings: &'a PlanSettings,
 }
 
 impl Planning<'_> {
@@ -396,7 +349,7 @@ impl Planning<'_> {
                     .into(),
             });
         }
-        for rrs in self.settings.rrs.iter().flatten() {
+        for rrs in self.settings.axis_rrs.iter().flatten() {
             rrs.check_rate(1.0 / self.interval_s)?;
         }
         Ok(())
@@ -654,7 +607,7 @@ impl Planning<'_> {
                 continue;
             };
             let a = acceptance(
-                self.settings.rrs[k].as_ref(),
+                self.settings.axis_rrs[k].as_ref(),
                 &self.settings.iteration.spectrum,
                 1.0 / self.interval_s,
                 (&motion.a_m_s2, iteration.achieved.a_m_s2(k)),

@@ -8,11 +8,13 @@ use serde::Serialize;
 
 use crate::baseline::peak;
 use crate::feasibility::MaxScale;
-use crate::iterate::{SpectrumAcceptance, Stop};
+use crate::iterate::SpectrumAcceptance;
 use crate::mimo::MimoRecord;
 
 use super::limits::{failing, TableLimitUse};
-use super::{TablePlan, TablePlanSettings, TablePlannedDrive, AXES};
+use super::{TablePlan, TablePlannedDrive, AXES};
+use crate::plan::PlanSettings;
+use crate::steps::IterationOutcome;
 
 /// One axis of the target, as the summary reports it.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -131,9 +133,17 @@ pub struct TablePlanSummary {
 
 impl TablePlan {
     /// The summary, with `out` the drive CSV written (if any) and `settings` the plan's.
-    pub fn summary(&self, settings: &TablePlanSettings, out: Option<&Path>) -> TablePlanSummary {
+    pub fn summary(&self, settings: &PlanSettings, out: Option<&Path>) -> TablePlanSummary {
         let f = &self.feasibility;
         let it = self.iteration();
+        let iterated_at = self.drive.as_ref().and_then(|d| d.iterated_at.as_ref());
+        let IterationOutcome {
+            iterate_at,
+            iterations,
+            best_iteration,
+            stop,
+            stall_reason,
+        } = IterationOutcome::of(it, iterated_at);
         TablePlanSummary {
             scenario: self.scenario_path.display().to_string(),
             name: self.scenario_name.clone(),
@@ -149,17 +159,11 @@ impl TablePlan {
                 .iter()
                 .map(|(k, m)| (*k, m.scale))
                 .collect(),
-            iterate_at: self
-                .drive
-                .as_ref()
-                .and_then(|d| d.iterated_at.as_ref().map(|i| i.level)),
-            iterations: it.map_or_else(Vec::new, |it| it.records.clone()),
-            best_iteration: it.map(|it| it.best),
-            stop: it.map_or("not_run", |it| it.stop.name()),
-            stall_reason: match it.map(|it| &it.stop) {
-                Some(Stop::Stalled { reason }) => Some(reason.clone()),
-                _ => None,
-            },
+            iterate_at,
+            iterations,
+            best_iteration,
+            stop,
+            stall_reason,
             frf: it.map(|it| MatrixFrfSummary {
                 source: "linearised",
                 band_hz: [it.band_hz.0, it.band_hz.1],
