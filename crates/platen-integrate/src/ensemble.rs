@@ -30,7 +30,7 @@
 use platen_model::{Exponent, IdentifiedModel, SlipRates};
 
 use crate::bare::Stepper;
-use crate::error::Result;
+use crate::error::{IntegrateError, Result};
 use crate::event::Mode;
 use crate::grid::{Grid, GridStep, GridStepper};
 use crate::machine::{DI, V};
@@ -356,7 +356,7 @@ fn run_group<const N: usize, P: LanePow, S: SampleSink>(
         .collect();
     let h = lanes[0].machine.plant.clock.grid.h;
     let times = cases[0].record.t_s();
-    let mut errors: Vec<Option<crate::error::IntegrateError>> = vec![None; m];
+    let mut errors: Vec<Option<IntegrateError>> = vec![None; m];
     for (lane, sink) in lanes.iter().zip(sinks.iter_mut()) {
         sink.accept(&lane.sample(0, times[0]));
     }
@@ -365,54 +365,13 @@ fn run_group<const N: usize, P: LanePow, S: SampleSink>(
     for j in 0..samples - 1 {
         for i in 0..k {
             let g = GridStep { n, j, i: i as f64 };
-            let mut fast = [false; N];
-            for (l, lane) in lanes.iter().enumerate() {
-                if errors[l].is_some() {
-                    continue;
-                }
-                let m = &lane.machine;
-                if let Mode::Slip(d) = m.mode {
-                    if m.y[V] != 0.0 {
-                        let y = lane.kin();
-                        fast[l] = true;
-                        input.u[l] = y.u;
-                        input.v[l] = y.v;
-                        input.work[l] = y.work;
-                        input.dissipated[l] = y.dissipated;
-                        input.a0[l] = m.a;
-                        input.p0[l] = m.k[DI];
-                        input.dir[l] = d.sign();
-                        let grid = &m.plant.clock.grid;
-                        input.f_start[l] = grid.force(g, 0.0);
-                        input.f_mid[l] = grid.force(g, 0.5 * (1.0 + 0.0));
-                        input.f_end[l] = grid.force(g, 1.0);
-                    }
-                }
-            }
+            let fast = gather_slipping(&lanes, &errors, g, &mut input);
             let out = if fast.iter().any(|&f| f) {
                 Some(lane_step::<N, P>(&params, h, &input))
             } else {
                 None
             };
-            for (l, lane) in lanes.iter_mut().enumerate() {
-                if errors[l].is_some() {
-                    continue;
-                }
-                match &out {
-                    Some(out) if fast[l] && out.accept[l] => {
-                        let stats = &mut lane.machine.stats;
-                        stats.steps += 1;
-                        stats.rhs_evaluations += 4;
-                        let r = out.rates[l];
-                        lane.commit_slip(out.y[l], r.a_m_s2, r.dissipated_power_w, input.f_end[l]);
-                    }
-                    _ => {
-                        if let Err(e) = lane.step(g) {
-                            errors[l] = Some(e);
-                        }
-                    }
-                }
-            }
+            advance_lanes(&mut lanes, &mut errors, g, out.as_ref(), &fast, &input);
             n += 1;
         }
         for (l, (lane, sink)) in lanes.iter().zip(sinks.iter_mut()).enumerate() {
@@ -429,4 +388,74 @@ fn run_group<const N: usize, P: LanePow, S: SampleSink>(
             None => Ok(lane.finish(times[samples - 1])),
         })
         .collect()
+}
+
+/// The lanes that slide (in a slip with a non-zero velocity, and not failed) at grid step
+/// `g`: their states and forces written into `input`, and a flag per lane (`true` for those
+/// the fast path steps).
+#[inline(always)]
+fn gather_slipping<const N: usize>(
+    lanes: &[Stepper<'_, IdentifiedModel>],
+    errors: &[Option<IntegrateError>],
+    g: GridStep,
+    input: &mut LaneIn<N>,
+) -> [bool; N] {
+    let mut fast = [false; N];
+    for (l, lane) in lanes.iter().enumerate() {
+        if errors[l].is_some() {
+            continue;
+        }
+        let m = &lane.machine;
+        if let Mode::Slip(d) = m.mode {
+            if m.y[V] != 0.0 {
+                let y = lane.kin();
+                fast[l] = true;
+                input.u[l] = y.u;
+                input.v[l] = y.v;
+                input.work[l] = y.work;
+                input.dissipated[l] = y.dissipated;
+                input.a0[l] = m.a;
+                input.p0[l] = m.k[DI];
+                input.dir[l] = d.sign();
+                let grid = &m.plant.clock.grid;
+                input.f_start[l] = grid.force(g, 0.0);
+                input.f_mid[l] = grid.force(g, 0.5 * (1.0 + 0.0));
+                input.f_end[l] = grid.force(g, 1.0);
+            }
+        }
+    }
+    fast
+}
+
+/// Every lane not failed through grid step `g`: the fast path's step `out` committed where
+/// it ran (`fast`) and accepts it, the lane's own step otherwise (a failure kept in
+/// `errors`).
+#[inline(always)]
+fn advance_lanes<const N: usize>(
+    lanes: &mut [Stepper<'_, IdentifiedModel>],
+    errors: &mut [Option<IntegrateError>],
+    g: GridStep,
+    out: Option<&LaneOut<N>>,
+    fast: &[bool; N],
+    input: &LaneIn<N>,
+) {
+    for (l, lane) in lanes.iter_mut().enumerate() {
+        if errors[l].is_some() {
+            continue;
+        }
+        match out {
+            Some(out) if fast[l] && out.accept[l] => {
+                let stats = &mut lane.machine.stats;
+                stats.steps += 1;
+                stats.rhs_evaluations += 4;
+                let r = out.rates[l];
+                lane.commit_slip(out.y[l], r.a_m_s2, r.dissipated_power_w, input.f_end[l]);
+            }
+            _ => {
+                if let Err(e) = lane.step(g) {
+                    errors[l] = Some(e);
+                }
+            }
+        }
+    }
 }

@@ -9,7 +9,9 @@
 //! overturning moment); `constraint` is what the held DOFs take.
 
 use nalgebra::DVector;
-use platen_model::multi_axis::{Coords, Dof, LinearSpecimen, MultiAxisTable, Wrench};
+use platen_model::multi_axis::{
+    Coords, Dof, InverseSample, LinearSpecimen, MultiAxisTable, Wrench,
+};
 use platen_signal::Motion;
 
 use crate::error::{IntegrateError, Result};
@@ -169,33 +171,7 @@ pub fn inverse_table(
     motion: &PoseMotion,
 ) -> Result<TableRun> {
     let n = motion.len();
-    let mut names = vec!["t_s".to_string()];
-    names.extend(pose_names(""));
-    names.extend(pose_names("_s"));
-    names.extend(pose_names("_s2"));
-    for a in table.actuators() {
-        names.push(format!("{}_stroke_m", a.name));
-        names.push(format!("{}_force_n", a.name));
-    }
-    for s in table.struts() {
-        names.push(format!("{}_force_n", s.name));
-    }
-    if specimen.is_some() {
-        names.extend(
-            [
-                "base_force_x_n",
-                "base_force_y_n",
-                "base_force_z_n",
-                "overturning_moment_x_n_m",
-                "overturning_moment_y_n_m",
-            ]
-            .map(String::from),
-        );
-    }
-    for term in ["inertial", "elastic", "dissipative", "weight", "constraint"] {
-        names.extend(wrench_names(term));
-    }
-    let mut out = Columns::new(names, n);
+    let mut out = Columns::new(inverse_names(table, specimen.is_some()), n);
     let mut spec = specimen.map(|s| SpecimenState {
         z: s.equilibrium_under(&-GRAVITY)
             .unwrap_or_else(|| DVector::zeros(s.len())),
@@ -222,29 +198,73 @@ pub fn inverse_table(
         row.clear();
         row.push(t[i]);
         row.extend(q.iter().chain(qd.iter()).chain(qdd.iter()));
-        for (k, f) in sample.actuator_forces_n.iter().enumerate() {
-            row.push(table.actuator_at(k, &q).stroke_m);
-            row.push(*f);
-        }
-        for j in 0..table.struts().len() {
-            row.push(table.strut_at(j, &q).force_n);
-        }
-        if specimen.is_some() {
-            let base = -on_platen;
-            row.extend([base[0], base[1], base[2], base[3], base[4]]);
-        }
-        for w in [
-            sample.inertial,
-            -sample.struts,
-            -sample.friction,
-            -sample.gravity,
-            sample.constraint,
-        ] {
-            row.extend(w.iter());
-        }
+        let base = specimen.is_some().then(|| -on_platen);
+        push_inverse_forces(&mut row, table, &q, &sample, base.as_ref());
         out.push(&row);
     }
     Ok(out.finish())
+}
+
+/// The columns of [`inverse_table`]'s run (see there), `with_specimen` or not.
+fn inverse_names(table: &MultiAxisTable, with_specimen: bool) -> Vec<String> {
+    let mut names = vec!["t_s".to_string()];
+    names.extend(pose_names(""));
+    names.extend(pose_names("_s"));
+    names.extend(pose_names("_s2"));
+    for a in table.actuators() {
+        names.push(format!("{}_stroke_m", a.name));
+        names.push(format!("{}_force_n", a.name));
+    }
+    for s in table.struts() {
+        names.push(format!("{}_force_n", s.name));
+    }
+    if with_specimen {
+        names.extend(
+            [
+                "base_force_x_n",
+                "base_force_y_n",
+                "base_force_z_n",
+                "overturning_moment_x_n_m",
+                "overturning_moment_y_n_m",
+            ]
+            .map(String::from),
+        );
+    }
+    for term in ["inertial", "elastic", "dissipative", "weight", "constraint"] {
+        names.extend(wrench_names(term));
+    }
+    names
+}
+
+/// Appends to `row` the columns after the motion at pose `q`: per actuator its stroke and
+/// its force from `sample`, per strut its force, the specimen's `base` wrench (force and
+/// overturning moments) when there is one, then the terms of the decomposition.
+fn push_inverse_forces(
+    row: &mut Vec<f64>,
+    table: &MultiAxisTable,
+    q: &Coords,
+    sample: &InverseSample,
+    base: Option<&Wrench>,
+) {
+    for (k, f) in sample.actuator_forces_n.iter().enumerate() {
+        row.push(table.actuator_at(k, q).stroke_m);
+        row.push(*f);
+    }
+    for j in 0..table.struts().len() {
+        row.push(table.strut_at(j, q).force_n);
+    }
+    if let Some(base) = base {
+        row.extend([base[0], base[1], base[2], base[3], base[4]]);
+    }
+    for w in [
+        sample.inertial,
+        -sample.struts,
+        -sample.friction,
+        -sample.gravity,
+        sample.constraint,
+    ] {
+        row.extend(w.iter());
+    }
 }
 
 /// Gravity as a spatial acceleration, m/s².

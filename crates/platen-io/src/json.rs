@@ -32,87 +32,112 @@ pub fn parse_json_file<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T>
 /// [`IoError::Json`].
 pub fn parse_json<T: serde::de::DeserializeOwned>(path: &Path, text: &str) -> Result<T> {
     let de = &mut serde_json::Deserializer::from_str(text);
-    serde_path_to_error::deserialize(de).map_err(|e| {
-        let inner = e.inner();
-        let (line, column) = (inner.line(), inner.column());
-        if inner.is_eof() {
-            return IoError::Json {
-                path: path.to_owned(),
-                json_path: format!("line {line}"),
-                message: if text.trim().is_empty() {
-                    "the file is empty: expected a JSON object".to_owned()
-                } else {
-                    "the file ends before the JSON is complete (a bracket, brace or quote is \
-                     not closed)"
-                        .to_owned()
-                },
-            };
-        }
-        // serde_json appends " at line L column C"; the location is already in json_path.
-        let mut message = inner.to_string();
-        if let Some(pos) = message.rfind(" at line ") {
-            message.truncate(pos);
-        }
-        // A syntax error has no field to name: serde_path_to_error's path there is where it
-        // was reading (`?` for a key still to come), which means nothing to the reader.
-        // serde_json reads a fixed-length array (`[f64; 3]`) element by element and reports the
-        // elements left over as "trailing characters", a syntax error; in a document that is
-        // valid JSON it is an array too long for its key, named at that key.
-        if inner.is_syntax()
-            && message == "trailing characters"
-            && serde_json::from_str::<serde::de::IgnoredAny>(text).is_ok()
-        {
-            let json_path = e.path().to_string();
-            return IoError::Json {
-                path: path.to_owned(),
-                json_path: format!("{json_path} (line {line} column {column})"),
-                message: "an array with more elements than this key takes (a point or vector \
-                          has three: x, y, z)"
-                    .to_owned(),
-            };
-        }
-        if inner.is_syntax() {
-            return IoError::JsonSyntax {
-                path: path.to_owned(),
-                line: line as u64,
-                column: column as u64,
-                message,
-            };
-        }
-        if let Some(rest) = message.strip_suffix(", expected f64") {
-            message = format!("{rest}, expected a number");
-        }
-        let segments: Vec<String> = e
-            .path()
-            .iter()
-            .map(|s| match s {
-                serde_path_to_error::Segment::Seq { index } => format!("[{index}]"),
-                serde_path_to_error::Segment::Map { key } => key.clone(),
-                serde_path_to_error::Segment::Enum { variant } => variant.clone(),
-                serde_path_to_error::Segment::Unknown => "?".to_owned(),
-            })
-            .collect();
-        let mut json_path = e.path().to_string();
-        if inner.is_data() && !segments.iter().any(|s| s == "?") {
-            if let Some(field) = innermost_field(text, &segments, &message) {
-                json_path = if json_path == "." || json_path.is_empty() {
-                    field
-                } else {
-                    format!("{json_path}.{field}")
-                };
-            }
-        }
-        let json_path = if json_path == "." || json_path.is_empty() {
-            format!("line {line} column {column}")
-        } else {
-            format!("{json_path} (line {line} column {column})")
-        };
-        IoError::Json {
+    serde_path_to_error::deserialize(de).map_err(|e| json_error(path, text, &e))
+}
+
+/// The error `e` of reading `text` (from `path`), as [`parse_json`] reports it.
+fn json_error(
+    path: &Path,
+    text: &str,
+    e: &serde_path_to_error::Error<serde_json::Error>,
+) -> IoError {
+    let inner = e.inner();
+    let (line, column) = (inner.line(), inner.column());
+    if inner.is_eof() {
+        return early_end(path, text, line);
+    }
+    // serde_json appends " at line L column C"; the location is already in json_path.
+    let mut message = inner.to_string();
+    if let Some(pos) = message.rfind(" at line ") {
+        message.truncate(pos);
+    }
+    // A syntax error has no field to name: serde_path_to_error's path there is where it
+    // was reading (`?` for a key still to come), which means nothing to the reader.
+    // serde_json reads a fixed-length array (`[f64; 3]`) element by element and reports the
+    // elements left over as "trailing characters", a syntax error; in a document that is
+    // valid JSON it is an array too long for its key, named at that key.
+    if inner.is_syntax()
+        && message == "trailing characters"
+        && serde_json::from_str::<serde::de::IgnoredAny>(text).is_ok()
+    {
+        let json_path = e.path().to_string();
+        return IoError::Json {
             path: path.to_owned(),
-            json_path,
+            json_path: format!("{json_path} (line {line} column {column})"),
+            message: "an array with more elements than this key takes (a point or vector \
+                      has three: x, y, z)"
+                .to_owned(),
+        };
+    }
+    if inner.is_syntax() {
+        return IoError::JsonSyntax {
+            path: path.to_owned(),
+            line: line as u64,
+            column: column as u64,
             message,
+        };
+    }
+    if let Some(rest) = message.strip_suffix(", expected f64") {
+        message = format!("{rest}, expected a number");
+    }
+    let json_path = data_path(e, text, &message);
+    let json_path = if json_path == "." || json_path.is_empty() {
+        format!("line {line} column {column}")
+    } else {
+        format!("{json_path} (line {line} column {column})")
+    };
+    IoError::Json {
+        path: path.to_owned(),
+        json_path,
+        message,
+    }
+}
+
+/// The error of `text` (from `path`) ending on `line` before its JSON is complete: empty,
+/// or cut off.
+fn early_end(path: &Path, text: &str, line: usize) -> IoError {
+    IoError::Json {
+        path: path.to_owned(),
+        json_path: format!("line {line}"),
+        message: if text.trim().is_empty() {
+            "the file is empty: expected a JSON object".to_owned()
+        } else {
+            "the file ends before the JSON is complete (a bracket, brace or quote is \
+             not closed)"
+                .to_owned()
+        },
+    }
+}
+
+/// The JSON path of error `e` (its `message` rewritten): serde's, with the innermost field
+/// below it holding the quoted value ([`innermost_field`]) for a data error where serde lost
+/// it; `.` or empty for the document itself.
+fn data_path(
+    e: &serde_path_to_error::Error<serde_json::Error>,
+    text: &str,
+    message: &str,
+) -> String {
+    let segments: Vec<String> = e
+        .path()
+        .iter()
+        .map(|s| match s {
+            serde_path_to_error::Segment::Seq { index } => format!("[{index}]"),
+            serde_path_to_error::Segment::Map { key } => key.clone(),
+            serde_path_to_error::Segment::Enum { variant } => variant.clone(),
+            serde_path_to_error::Segment::Unknown => "?".to_owned(),
+        })
+        .collect();
+    let mut json_path = e.path().to_string();
+    if e.inner().is_data() && !segments.iter().any(|s| s == "?") {
+        if let Some(field) = innermost_field(text, &segments, message) {
+            json_path = if json_path == "." || json_path.is_empty() {
+                field
+            } else {
+                format!("{json_path}.{field}")
+            };
         }
-    })
+    }
+    json_path
 }
 
 /// The relative path of the one field below `segments` whose value is the one `message`

@@ -274,6 +274,30 @@ fn legend_rows(panel: &Panel, width: f64) -> Vec<Vec<(&Series, i32)>> {
 /// A panel: its caption and (with `legend`) its legend strip above the axes, then the axes
 /// and the series.
 fn draw_panel(panel: &Panel, area: &Area<'_>, y_area: u32, legend: bool) -> Result<()> {
+    let body = draw_panel_head(panel, area, y_area, legend)?;
+    let (x_log, y_log) = (panel.x_log, panel.y_log);
+    let logged;
+    let panel = if x_log || y_log {
+        logged = log_panel(panel);
+        &logged
+    } else {
+        panel
+    };
+    let layout = Layout::new(panel, &body, y_area);
+    if !panel.x_categories.is_empty() {
+        return draw_category_chart(panel, &body, y_area, &layout, y_log);
+    }
+    draw_chart(panel, &body, y_area, &layout, (x_log, y_log))
+}
+
+/// A panel's head: its caption and (with `legend`) its legend strip, drawn at the top of
+/// `area`; the rest of `area`, for the axes.
+fn draw_panel_head<'a>(
+    panel: &Panel,
+    area: &Area<'a>,
+    y_area: u32,
+    legend: bool,
+) -> Result<Area<'a>> {
     let (w, _) = area.dim_in_pixel();
     let (_, _, margin_left, margin_right) = MARGINS;
     let left = (y_area + margin_left) as i32;
@@ -305,63 +329,77 @@ fn draw_panel(panel: &Panel, area: &Area<'_>, y_area: u32, legend: bool) -> Resu
         .map_err(draw_error)?;
     }
     draw_legend(&head, &legend, left, caption_px as i32)?;
-    let (x_log, y_log) = (panel.x_log, panel.y_log);
-    let logged;
-    let panel = if x_log || y_log {
-        logged = log_panel(panel);
-        &logged
-    } else {
-        panel
+    Ok(body)
+}
+
+/// A linear axis over `r`.
+fn linear(r: (f64, f64)) -> RangedCoordf64 {
+    (r.0..r.1).into()
+}
+
+/// A panel with named categories along x (`panel.x_categories`, at 1, 2, …), its y axis
+/// logarithmic with `y_log`.
+fn draw_category_chart(
+    panel: &Panel,
+    body: &Area<'_>,
+    y_area: u32,
+    layout: &Layout,
+    y_log: bool,
+) -> Result<()> {
+    let (x, y) = (layout.x, layout.y);
+    let y_dec = layout.decimals.1;
+    let y_fmt = move |v: &f64| format_tick(*v, y_dec);
+    let log_fmt = |v: &f64| log_tick_label(*v);
+    let names = &panel.x_categories;
+    let name = |v: &f64| {
+        let i = v.round();
+        match (i >= 1.0 && (v - i).abs() < 1e-9).then(|| names.get(i as usize - 1)) {
+            Some(Some(n)) => n.clone(),
+            _ => String::new(),
+        }
     };
-    let layout = Layout::new(panel, &body, y_area);
+    let x_axis = CategoryAxis {
+        range: linear(x),
+        count: names.len(),
+    };
+    let y_fmt_ref: &dyn Fn(&f64) -> String = if y_log { &log_fmt } else { &y_fmt };
+    if y_log {
+        let (y_axis, minor) = LogAxis::over(y, layout.labels.1);
+        let axes = Axes::new(x_axis, y_axis, &name, y_fmt_ref).minor_y(minor);
+        draw_axes_and_data(panel, body, y_area, layout, axes)
+    } else {
+        let axes = Axes::new(x_axis, linear(y), &name, y_fmt_ref);
+        draw_axes_and_data(panel, body, y_area, layout, axes)
+    }
+}
+
+/// A panel with numbers along both axes, each linear or logarithmic as `(x_log, y_log)`.
+fn draw_chart(
+    panel: &Panel,
+    body: &Area<'_>,
+    y_area: u32,
+    layout: &Layout,
+    (x_log, y_log): (bool, bool),
+) -> Result<()> {
     let (x, y) = (layout.x, layout.y);
     let (x_dec, y_dec) = layout.decimals;
-    let linear = |r: (f64, f64)| -> RangedCoordf64 { (r.0..r.1).into() };
     let x_fmt = move |v: &f64| format_tick(*v, x_dec);
     let y_fmt = move |v: &f64| format_tick(*v, y_dec);
     let log_fmt = |v: &f64| log_tick_label(*v);
-    if !panel.x_categories.is_empty() {
-        let names = &panel.x_categories;
-        let name = |v: &f64| {
-            let i = v.round();
-            match (i >= 1.0 && (v - i).abs() < 1e-9).then(|| names.get(i as usize - 1)) {
-                Some(Some(n)) => n.clone(),
-                _ => String::new(),
-            }
-        };
-        let x_axis = CategoryAxis {
-            range: linear(x),
-            count: names.len(),
-        };
-        let y_fmt_ref: &dyn Fn(&f64) -> String = if y_log { &log_fmt } else { &y_fmt };
-        return if y_log {
-            let (y_axis, minor) = LogAxis::over(y, layout.labels.1);
-            let axes = Axes::new(x_axis, y_axis, &name, y_fmt_ref).minor_y(minor);
-            let mut chart = draw_axes(panel, &body, y_area, &layout, axes)?;
-            draw_data(&mut chart, panel, &layout)
-        } else {
-            let axes = Axes::new(x_axis, linear(y), &name, y_fmt_ref);
-            let mut chart = draw_axes(panel, &body, y_area, &layout, axes)?;
-            draw_data(&mut chart, panel, &layout)
-        };
-    }
     match (x_log, y_log) {
         (false, false) => {
             let axes = Axes::new(linear(x), linear(y), &x_fmt, &y_fmt);
-            let mut chart = draw_axes(panel, &body, y_area, &layout, axes)?;
-            draw_data(&mut chart, panel, &layout)
+            draw_axes_and_data(panel, body, y_area, layout, axes)
         }
         (true, false) => {
             let (x_axis, minor) = LogAxis::over(x, layout.labels.0);
             let axes = Axes::new(x_axis, linear(y), &log_fmt, &y_fmt).minor_x(minor);
-            let mut chart = draw_axes(panel, &body, y_area, &layout, axes)?;
-            draw_data(&mut chart, panel, &layout)
+            draw_axes_and_data(panel, body, y_area, layout, axes)
         }
         (false, true) => {
             let (y_axis, minor) = LogAxis::over(y, layout.labels.1);
             let axes = Axes::new(linear(x), y_axis, &x_fmt, &log_fmt).minor_y(minor);
-            let mut chart = draw_axes(panel, &body, y_area, &layout, axes)?;
-            draw_data(&mut chart, panel, &layout)
+            draw_axes_and_data(panel, body, y_area, layout, axes)
         }
         (true, true) => {
             let (x_axis, minor_x) = LogAxis::over(x, layout.labels.0);
@@ -369,10 +407,25 @@ fn draw_panel(panel: &Panel, area: &Area<'_>, y_area: u32, legend: bool) -> Resu
             let axes = Axes::new(x_axis, y_axis, &log_fmt, &log_fmt)
                 .minor_x(minor_x)
                 .minor_y(minor_y);
-            let mut chart = draw_axes(panel, &body, y_area, &layout, axes)?;
-            draw_data(&mut chart, panel, &layout)
+            draw_axes_and_data(panel, body, y_area, layout, axes)
         }
     }
+}
+
+/// A panel's axes ([`draw_axes`]), then its series ([`draw_data`]).
+fn draw_axes_and_data<X, Y>(
+    panel: &Panel,
+    body: &Area<'_>,
+    y_area: u32,
+    layout: &Layout,
+    axes: Axes<'_, X, Y>,
+) -> Result<()>
+where
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let mut chart = draw_axes(panel, body, y_area, layout, axes)?;
+    draw_data(&mut chart, panel, layout)
 }
 
 /// A panel's two axes with their tick labels' formats and their minor grid lines (the

@@ -491,25 +491,56 @@ pub fn table_loop_figures(
         F_MAX_HZ.min(0.5 * sample_rate_hz).max(2.0 * F_MIN_HZ),
     );
     let f = frequencies(range);
-    let matrices: Vec<[[num_complex::Complex64; 6]; 6]> =
-        f.iter().map(|&fi| lin.transfer_matrix(fi)).collect();
+    let matrices: Vec<TransferMatrix> = f.iter().map(|&fi| lin.transfer_matrix(fi)).collect();
     let free = lin.free();
-    let style = |d: platen_model::multi_axis::Dof| DOF_COLOURS[d.index()];
+    let diagonal = diagonal_figure(name, free, &f, &matrices, range, sample_rate_hz);
+    let cross = cross_talk_series(free, &f, &matrices);
+    let mut out = vec![diagonal];
+    if !cross.is_empty() {
+        out.push(cross_talk_figure(name, range, cross));
+    }
+    out
+}
+
+/// The closed loop's response at one frequency, pose DOF × command DOF.
+type TransferMatrix = [[num_complex::Complex64; 6]; 6];
+
+/// A free DOF's colour in the table-loop figures.
+fn dof_style(d: platen_model::multi_axis::Dof) -> RGBColor {
+    DOF_COLOURS[d.index()]
+}
+
+/// `table-loop-diagonal`: each free DOF's own response at frequencies `f` (the transfer
+/// `matrices`), magnitude and phase over `range`.
+fn diagonal_figure(
+    name: &str,
+    free: &[platen_model::multi_axis::Dof],
+    f: &[f64],
+    matrices: &[TransferMatrix],
+    range: (f64, f64),
+    sample_rate_hz: f64,
+) -> Figure {
     let (mut magnitude, mut phase) = (Vec::new(), Vec::new());
     for &d in free {
         let k = d.index();
-        let b = Bode::from_responses(&f, matrices.iter().map(|m| m[k][k]));
+        let b = Bode::from_responses(f, matrices.iter().map(|m| m[k][k]));
         magnitude.push(patterned(
             d.name(),
             b.magnitude_db.clone(),
-            style(d),
+            dof_style(d),
             2,
             Dash::Solid,
         ));
-        phase.push(patterned(d.name(), b.phase_deg, style(d), 2, Dash::Solid));
+        phase.push(patterned(
+            d.name(),
+            b.phase_deg,
+            dof_style(d),
+            2,
+            Dash::Solid,
+        ));
     }
     magnitude.push(reference("0 dB (pose = command)", 0.0, range));
-    let diagonal = Figure {
+    Figure {
         name: "table-loop-diagonal".into(),
         title: format!("{name}: closed loop per DOF, command → pose (linearised)"),
         caption: format!(
@@ -533,64 +564,85 @@ pub fn table_loop_figures(
         columns: 1,
         rows: Vec::new(),
         size: (1200, 900),
-    };
+    }
+}
+
+/// For each free DOF's command, the other DOF whose response peaks highest over the
+/// frequencies (the first of equal peaks), with that peak; `None` with one free DOF.
+fn largest_cross_talk(
+    free: &[platen_model::multi_axis::Dof],
+    matrices: &[TransferMatrix],
+    c: platen_model::multi_axis::Dof,
+) -> Option<(platen_model::multi_axis::Dof, f64)> {
+    let j = c.index();
+    free.iter()
+        .filter(|&&o| o != c)
+        .map(|&o| {
+            let peak = matrices
+                .iter()
+                .map(|m| m[o.index()][j].norm())
+                .fold(0.0, f64::max);
+            (o, peak)
+        })
+        .fold(
+            None,
+            |best: Option<(platen_model::multi_axis::Dof, f64)>, x| match best {
+                Some(b) if b.1 >= x.1 => best,
+                _ => Some(x),
+            },
+        )
+}
+
+/// Per free DOF's command, the magnitude (dB) over frequencies `f` of its largest
+/// cross-talk ([`largest_cross_talk`]).
+fn cross_talk_series(
+    free: &[platen_model::multi_axis::Dof],
+    f: &[f64],
+    matrices: &[TransferMatrix],
+) -> Vec<Series> {
     let mut cross = Vec::new();
     for &c in free {
         let j = c.index();
-        let best = free
-            .iter()
-            .filter(|&&o| o != c)
-            .map(|&o| {
-                let peak = matrices
-                    .iter()
-                    .map(|m| m[o.index()][j].norm())
-                    .fold(0.0, f64::max);
-                (o, peak)
-            })
-            .fold(
-                None,
-                |best: Option<(platen_model::multi_axis::Dof, f64)>, x| match best {
-                    Some(b) if b.1 >= x.1 => best,
-                    _ => Some(x),
-                },
-            );
-        let Some((o, _)) = best else { continue };
+        let Some((o, _)) = largest_cross_talk(free, matrices, c) else {
+            continue;
+        };
         let points: Points = f
             .iter()
-            .zip(&matrices)
+            .zip(matrices)
             .map(|(&fi, m)| (fi, 20.0 * m[o.index()][j].norm().log10()))
             .filter(|p| p.1.is_finite())
             .collect();
         cross.push(patterned(
             format!("{} → {}", c.name(), o.name()),
             points,
-            style(c),
+            dof_style(c),
             2,
             Dash::Solid,
         ));
     }
-    let mut out = vec![diagonal];
-    if !cross.is_empty() {
-        out.push(Figure {
-            name: "table-loop-cross-talk".into(),
-            title: format!("{name}: cross-talk, the largest other DOF per command (linearised)"),
-            caption: "For each DOF's command, the magnitude (dB) of the other DOF's response \
-                      that peaks highest over the range (units as numbers: m/m, rad/rad, m/rad, \
-                      rad/m). A coupling through the specimen's overturning moment shows as \
-                      x → pitch or y → roll."
-                .into(),
-            panels: vec![bode_panel(
-                "largest cross-talk per commanded DOF".into(),
-                "|H| (dB)",
-                range,
-                cross,
-            )],
-            columns: 1,
-            rows: Vec::new(),
-            size: (1200, 600),
-        });
+    cross
+}
+
+/// `table-loop-cross-talk`: the `cross` series over `range`.
+fn cross_talk_figure(name: &str, range: (f64, f64), cross: Vec<Series>) -> Figure {
+    Figure {
+        name: "table-loop-cross-talk".into(),
+        title: format!("{name}: cross-talk, the largest other DOF per command (linearised)"),
+        caption: "For each DOF's command, the magnitude (dB) of the other DOF's response \
+                  that peaks highest over the range (units as numbers: m/m, rad/rad, m/rad, \
+                  rad/m). A coupling through the specimen's overturning moment shows as \
+                  x → pitch or y → roll."
+            .into(),
+        panels: vec![bode_panel(
+            "largest cross-talk per commanded DOF".into(),
+            "|H| (dB)",
+            range,
+            cross,
+        )],
+        columns: 1,
+        rows: Vec::new(),
+        size: (1200, 600),
     }
-    out
 }
 
 #[cfg(test)]

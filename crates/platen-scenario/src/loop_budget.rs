@@ -143,9 +143,44 @@ fn fastest_source(
     hydraulics: &TableHydraulics,
     period_s: f64,
 ) -> Source {
-    use std::f64::consts::TAU;
-    let hz = |w: f64| w / TAU;
     let mut sources = Vec::new();
+    push_spool_sources(&mut sources, json, table, hydraulics, period_s);
+    let oil = push_oil_column_sources(&mut sources, json, table, hydraulics, period_s);
+    if let Some(s) = specimen {
+        push_specimen_sources(&mut sources, table, s, oil, period_s);
+    }
+    // The first of the fastest (the lowest-numbered actuator of equal ones).
+    sources
+        .into_iter()
+        .reduce(|best, s| {
+            if s.steps_per_period > best.steps_per_period {
+                s
+            } else {
+                best
+            }
+        })
+        .unwrap_or(Source {
+            steps_per_period: 0.0,
+            key: "table.controller.sample_rate_hz".into(),
+            value: String::new(),
+            what: "the loop".into(),
+        })
+}
+
+/// Hz of an angular frequency `w`, rad/s.
+fn hz(w: f64) -> f64 {
+    w / std::f64::consts::TAU
+}
+
+/// Each actuator's spool, at its valve's natural frequency.
+fn push_spool_sources(
+    sources: &mut Vec<Source>,
+    json: &serde_json::Value,
+    table: &MultiAxisTable,
+    hydraulics: &TableHydraulics,
+    period_s: f64,
+) {
+    use std::f64::consts::TAU;
     for (i, a) in hydraulics.actuators().iter().enumerate() {
         let f = a.servo_valve.natural_frequency_hz;
         let key = format!("table.actuators[{i}].servo_valve.natural_frequency_hz");
@@ -159,7 +194,17 @@ fn fastest_source(
             ),
         });
     }
-    // The oil columns: each actuator's shut-valve stiffness on the platen's mass.
+}
+
+/// The oil columns: each actuator's shut-valve stiffness on the platen's mass (each one
+/// faster than those before it); the fastest's angular frequency, rad/s (0 without one).
+fn push_oil_column_sources(
+    sources: &mut Vec<Source>,
+    json: &serde_json::Value,
+    table: &MultiAxisTable,
+    hydraulics: &TableHydraulics,
+    period_s: f64,
+) -> f64 {
     let mass = table.platen().mass_kg();
     let mut oil = 0.0_f64;
     for i in 0..hydraulics.actuators().len() {
@@ -179,51 +224,47 @@ fn fastest_source(
             });
         }
     }
-    if let Some(s) = specimen {
-        let own = stiffest_mode_rad_s(s);
+    oil
+}
+
+/// The specimen's stiffest mode on its own base, and its fastest mode on the platen when
+/// that is far above both its own and the fastest oil column's (`oil`, rad/s): its levers
+/// then couple it to the platen's rotations.
+fn push_specimen_sources(
+    sources: &mut Vec<Source>,
+    table: &MultiAxisTable,
+    s: &LinearSpecimen,
+    oil: f64,
+    period_s: f64,
+) {
+    use std::f64::consts::TAU;
+    let own = stiffest_mode_rad_s(s);
+    sources.push(Source {
+        steps_per_period: period_s * own / 0.25,
+        key: "specimen.stiffness_matrix".into(),
+        value: "(as given)".into(),
+        what: format!(
+            "the specimen's stiffest mode on its own base, {:.4e} Hz",
+            hz(own)
+        ),
+    });
+    let coupled = table
+        .modes_with(s)
+        .iter()
+        .map(|m| TAU * m.frequency_hz)
+        .fold(0.0, f64::max);
+    if coupled > 1.1 * own.max(oil) {
         sources.push(Source {
-            steps_per_period: period_s * own / 0.25,
-            key: "specimen.stiffness_matrix".into(),
+            steps_per_period: period_s * coupled / 0.25,
+            key: "specimen.influence".into(),
             value: "(as given)".into(),
             what: format!(
-                "the specimen's stiffest mode on its own base, {:.4e} Hz",
-                hz(own)
+                "a mode of the specimen on the platen at {:.4e} Hz, far above its own and \
+                 the oil columns': its levers couple it to the platen's rotations",
+                hz(coupled)
             ),
         });
-        let coupled = table
-            .modes_with(s)
-            .iter()
-            .map(|m| TAU * m.frequency_hz)
-            .fold(0.0, f64::max);
-        if coupled > 1.1 * own.max(oil) {
-            sources.push(Source {
-                steps_per_period: period_s * coupled / 0.25,
-                key: "specimen.influence".into(),
-                value: "(as given)".into(),
-                what: format!(
-                    "a mode of the specimen on the platen at {:.4e} Hz, far above its own and \
-                     the oil columns': its levers couple it to the platen's rotations",
-                    hz(coupled)
-                ),
-            });
-        }
     }
-    // The first of the fastest (the lowest-numbered actuator of equal ones).
-    sources
-        .into_iter()
-        .reduce(|best, s| {
-            if s.steps_per_period > best.steps_per_period {
-                s
-            } else {
-                best
-            }
-        })
-        .unwrap_or(Source {
-            steps_per_period: 0.0,
-            key: "table.controller.sample_rate_hz".into(),
-            value: String::new(),
-            what: "the loop".into(),
-        })
 }
 
 /// The specimen's fastest natural frequency on a fixed base, rad/s: `√λ_max` of `M⁻¹K` (by

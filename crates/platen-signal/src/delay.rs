@@ -187,14 +187,44 @@ impl DelayEstimator {
         let x = &reference[start..end];
         let y = &channel[(start as isize + lag) as usize..(end as isize + lag) as usize];
         let fs = self.rate.hz();
-        let target = (SEGMENT_S * fs).max(64.0) as usize;
-        let mut len = target.next_power_of_two();
-        if len > 2 * target {
-            len /= 2;
-        }
-        while len > 64 && x.len() < 4 * len {
-            len /= 2;
-        }
+        let len = segment_length(x.len(), fs);
+        let spectra = CrossSpectra::welch(x, y, len);
+        spectra.phase_fit(fs)
+    }
+}
+
+/// The Welch segments' length for `samples` samples at `fs` Hz: the power of two nearest
+/// [`SEGMENT_S`] (at least 64 samples), halved until at least four fit.
+fn segment_length(samples: usize, fs: f64) -> usize {
+    let target = (SEGMENT_S * fs).max(64.0) as usize;
+    let mut len = target.next_power_of_two();
+    if len > 2 * target {
+        len /= 2;
+    }
+    while len > 64 && samples < 4 * len {
+        len /= 2;
+    }
+    len
+}
+
+/// The auto- and cross-spectra of two records summed over half-overlapping Hann segments.
+struct CrossSpectra {
+    /// The segments' length, samples.
+    len: usize,
+    /// How many segments were summed.
+    segments: usize,
+    /// `Σ|X|²` per bin.
+    sxx: Vec<f64>,
+    /// `Σ|Y|²` per bin.
+    syy: Vec<f64>,
+    /// `Σ X̄·Y` per bin.
+    sxy: Vec<Complex<f64>>,
+}
+
+impl CrossSpectra {
+    /// The spectra of `x` and `y` (of equal length, at least `len`) over segments of `len`
+    /// samples stepped by `len / 2`, each de-meaned and windowed.
+    fn welch(x: &[f64], y: &[f64], len: usize) -> Self {
         let step = len / 2;
         let segments = (x.len() - len) / step + 1;
         let window = Window::Hann.periodic(len);
@@ -222,6 +252,30 @@ impl DelayEstimator {
                 sxy[k] += bx[k].conj() * by[k];
             }
         }
+        CrossSpectra {
+            len,
+            segments,
+            sxx,
+            syy,
+            sxy,
+        }
+    }
+
+    /// The delay `τ` of the weighted least-squares line `phase = −2πf·τ` through the even
+    /// bins from 2 up to [`MAX_RELATIVE_FREQUENCY`] of `fs` with a coherence of at least
+    /// [`MIN_COHERENCE`], each weighted by the inverse of its phase's variance.
+    ///
+    /// # Errors
+    /// [`SignalError::Incoherent`] with fewer than [`MIN_BINS`] such bins.
+    fn phase_fit(&self, fs: f64) -> Result<DelayEstimate> {
+        let CrossSpectra {
+            len,
+            segments,
+            ref sxx,
+            ref syy,
+            ref sxy,
+        } = *self;
+        let bins = len / 2 + 1;
         let df = fs / len as f64;
         let (mut swff, mut swfp) = (0.0, 0.0);
         let mut used = Vec::new();

@@ -84,7 +84,7 @@ use nalgebra::DMatrix;
 use num_complex::Complex64 as C64;
 use platen_model::multi_axis::{Coords, Dof, LinearSpecimen, MultiAxisTable, Wrench};
 
-use crate::dof_control::DofController;
+use crate::dof_control::{DofController, DofGeometry};
 use crate::error::{invalid, Result, SystemError};
 use crate::hydraulics::{root, HydraulicConstants};
 use crate::linear::{hold_response, search_margins, spool_response, LawTerms, Margins};
@@ -243,50 +243,14 @@ impl TableLinearisation {
         let n = table.actuators().len();
         let free: Vec<Dof> = table.free().iter().collect();
         let geometry = controller.geometry();
-        for (what, found) in [
-            (
-                "actuators of the hydraulics and the table",
-                hydraulics.actuators().len(),
-            ),
-            (
-                "actuators of the controller's geometry and the table",
-                geometry.actuators(),
-            ),
-        ] {
-            if found != n {
-                return Err(SystemError::Mismatch {
-                    what,
-                    found: found.to_string(),
-                    expected: n.to_string(),
-                });
-            }
-        }
-        if geometry.free() != free.as_slice() {
-            let names = |d: &[Dof]| d.iter().map(|d| d.name()).collect::<Vec<_>>().join(" ");
-            return Err(SystemError::Mismatch {
-                what: "free DOFs of the controller and the table",
-                found: names(geometry.free()),
-                expected: names(&free),
-            });
-        }
+        check_shapes(hydraulics, geometry, n, &free)?;
         let mut gravity = Wrench::zeros();
         gravity[2] = -platen_model::STANDARD_GRAVITY_M_S2;
         // A specimen at rest pushes on the platen with its weight.
         let push = specimen.map_or_else(Wrench::zeros, |s| s.rigid_mass() * gravity);
         let f0 = TableHydraulics::static_forces_n(table, &push)?;
         let mechanics = Mechanics::of(table, &free, &f0, &push)?;
-        let specimen = specimen.map(|s| {
-            let influence = DMatrix::from_fn(s.len(), free.len(), |a, c| {
-                s.influence()[(a, free[c].index())]
-            });
-            SpecimenPart {
-                mass: s.mass().clone(),
-                stiffness: s.stiffness().clone(),
-                damping: s.damping().clone(),
-                mass_influence: s.mass() * influence,
-                push: &mechanics.per_wrench * s.influence().transpose(),
-            }
-        });
+        let specimen = specimen.map(|s| SpecimenPart::of(s, &free, &mechanics));
         let actuators = (0..n)
             .map(|i| actuator_linearisation(hydraulics, i, f0[i], gains))
             .collect::<Result<Vec<_>>>()?;
@@ -294,14 +258,8 @@ impl TableLinearisation {
         let g_c_pinv = geometry.pseudo_inverse().clone();
         let balance =
             (DMatrix::identity(n, n) - &g_c * &g_c_pinv) * controller.force_balance_gain_per_n();
-        let platen = table.platen();
-        let radius_of_gyration_m = [0, 1, 2].map(|k| {
-            (platen.inertia_kg_m2()[(k, k)] / platen.mass_kg())
-                .sqrt()
-                .max(1e-3)
-        });
         Ok(TableLinearisation {
-            radius_of_gyration_m,
+            radius_of_gyration_m: radius_of_gyration_m(table),
             gains: free.iter().map(|d| *controller.gains(*d)).collect(),
             period_s: controller.period_s(),
             feedback_geometry: &g_c_pinv * &mechanics.strokes,
@@ -593,6 +551,71 @@ struct AtFrequency {
     feedback: DMatrix<C64>,
     /// `C_k = K_p + K_i/s + K_vf·s + K_af·s²` per free DOF: its drive per command.
     command: Vec<C64>,
+}
+
+/// Checks that the hydraulics and the controller's geometry have one entry per actuator of
+/// the table (`n`), and the geometry the table's `free` DOFs.
+fn check_shapes(
+    hydraulics: &TableHydraulics,
+    geometry: &DofGeometry,
+    n: usize,
+    free: &[Dof],
+) -> Result<()> {
+    for (what, found) in [
+        (
+            "actuators of the hydraulics and the table",
+            hydraulics.actuators().len(),
+        ),
+        (
+            "actuators of the controller's geometry and the table",
+            geometry.actuators(),
+        ),
+    ] {
+        if found != n {
+            return Err(SystemError::Mismatch {
+                what,
+                found: found.to_string(),
+                expected: n.to_string(),
+            });
+        }
+    }
+    if geometry.free() != free {
+        let names = |d: &[Dof]| d.iter().map(|d| d.name()).collect::<Vec<_>>().join(" ");
+        return Err(SystemError::Mismatch {
+            what: "free DOFs of the controller and the table",
+            found: names(geometry.free()),
+            expected: names(free),
+        });
+    }
+    Ok(())
+}
+
+/// The platen's radius of gyration about x, y and z through its centre of mass, m (at least
+/// 1 mm).
+fn radius_of_gyration_m(table: &MultiAxisTable) -> [f64; 3] {
+    let platen = table.platen();
+    [0, 1, 2].map(|k| {
+        (platen.inertia_kg_m2()[(k, k)] / platen.mass_kg())
+            .sqrt()
+            .max(1e-3)
+    })
+}
+
+impl SpecimenPart {
+    /// Specimen `s`'s matrices, its influence taken over the `free` DOFs and its push on the
+    /// platen through `mechanics`.
+    fn of(s: &LinearSpecimen, free: &[Dof], mechanics: &Mechanics) -> Self {
+        let influence = DMatrix::from_fn(s.len(), free.len(), |a, c| {
+            s.influence()[(a, free[c].index())]
+        });
+        SpecimenPart {
+            mass: s.mass().clone(),
+            stiffness: s.stiffness().clone(),
+            damping: s.damping().clone(),
+            mass_influence: s.mass() * influence,
+            push: &mechanics.per_wrench * s.influence().transpose(),
+        }
+    }
 }
 
 /// The mechanics linearised at neutral (see the module docs).

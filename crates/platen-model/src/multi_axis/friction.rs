@@ -208,91 +208,64 @@ impl MultiAxisTable {
             .collect();
         let n = active.len();
         if n == 0 {
-            // Nothing holds (every contact lifted off): the platen flies along its in-plane
-            // acceleration.
-            let a = self
-                .accelerations(q, qd, applied)
-                .unwrap_or_else(Coords::zeros);
-            let w = planar_rate(&a);
-            let size = w.norm();
-            return if size > 0.0 { w / size } else { w };
+            return self.flight_direction(q, qd, applied);
         }
         let arm = capacity.centre_m - translation(q);
-        let basis = [
-            point_wrench(&arm, &Vector3::x()),
-            point_wrench(&arm, &Vector3::y()),
-            Wrench::new(0.0, 0.0, 0.0, 0.0, 0.0, 1.0),
-        ];
-        // G: the friction centre's in-plane accelerations per unit of each friction
-        // component, from the dynamics (the other DOFs free as they are).
-        let Some(base) = self.accelerations(q, qd, applied) else {
+        let Some(g) = self.friction_mobility(q, qd, applied, &active, &arm) else {
             return PlanarRate::zeros();
         };
-        let centre = |a: &Coords| Vector3::new(a[0] - a[5] * arm[1], a[1] + a[5] * arm[0], a[5]);
-        let mut g = DMatrix::zeros(n, n);
-        for (c, &k) in active.iter().enumerate() {
-            let Some(a) = self.accelerations(q, qd, &(applied + basis[k])) else {
-                return PlanarRate::zeros();
-            };
-            let response = centre(&(a - base));
-            for (r, &j) in active.iter().enumerate() {
-                g[(r, c)] = response[j];
-            }
-        }
-        let g = (&g + g.transpose()) * 0.5;
-        // In β = S⁻¹·b the surface is the unit ball: minimise βᵀHβ − 2βᵀc, H = S·G·S,
-        // c = S·G·λ, over |β| ≤ 1 (the trust-region problem: β = (H + νI)⁻¹·c with ν ≥ 0
-        // the root of |β(ν)| = 1, by bisection; |β| falls as ν grows).
         let sv = DVector::from_fn(n, |r, _| limits[active[r]]);
         let lambda = DVector::from_fn(n, |r, _| stick.holding[active[r]]);
-        let h = DMatrix::from_fn(n, n, |r, c| sv[r] * g[(r, c)] * sv[c]);
-        let cvec = sv.component_mul(&(&g * &lambda));
-        let eig = h.symmetric_eigen();
-        let proj = eig.eigenvectors.transpose() * &cvec;
-        let beta_at = |nu: f64| {
-            let y = DVector::from_fn(n, |i, _| proj[i] / (eig.eigenvalues[i] + nu));
-            &eig.eigenvectors * y
+        let Some(beta) = nearest_on_limit_surface(&g, &sv, &lambda) else {
+            return PlanarRate::zeros();
         };
-        let (mut lo, mut hi) = (0.0, cvec.norm().max(f64::MIN_POSITIVE));
-        if beta_at(lo).norm() <= 1.0 {
-            // Held after all (the surface holds it): leave along the normal at λ.
-            hi = 0.0;
-        }
-        for _ in 0..200 {
-            if hi - lo <= 1e-15 * hi {
-                break;
-            }
-            let mid = 0.5 * (lo + hi);
-            if beta_at(mid).norm() > 1.0 {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        let beta = if hi == 0.0 {
-            let l = DVector::from_fn(n, |r, _| lambda[r] / sv[r]);
-            let norm = l.norm();
-            if norm == 0.0 {
-                return PlanarRate::zeros();
-            }
-            l / norm
-        } else {
-            beta_at(hi)
-        };
-        // The motion along the normal at b = S·β, against it: the centre's velocity and the
-        // yaw rate ∝ −S⁻¹·β, then the reference point's.
-        let mut u = Vector3::zeros();
-        for (r, &k) in active.iter().enumerate() {
-            u[k] = -beta[r] / sv[r];
-        }
-        let w = PlanarRate::new(u[0] + u[2] * arm[1], u[1] - u[2] * arm[0], u[2]);
-        let rho = capacity.moment_n_m / capacity.force_n;
-        let size = Vector3::new(u[0], u[1], u[2] * rho).norm();
+        leaving_motion(&active, &beta, &sv, &arm, capacity)
+    }
+
+    /// Where nothing holds (every contact lifted off): the direction of the platen's in-plane
+    /// acceleration, along which it flies (zero when it has none).
+    fn flight_direction(&self, q: &Coords, qd: &Coords, applied: &Wrench) -> PlanarRate {
+        let a = self
+            .accelerations(q, qd, applied)
+            .unwrap_or_else(Coords::zeros);
+        let w = planar_rate(&a);
+        let size = w.norm();
         if size > 0.0 {
             w / size
         } else {
             w
         }
+    }
+
+    /// `G`: the friction centre's in-plane accelerations per unit of each `active` friction
+    /// component (x and y forces at the centre, `arm` from the reference point, and the yaw
+    /// moment), from the dynamics with the other DOFs free as they are; symmetrised. `None`
+    /// where the dynamics are singular.
+    fn friction_mobility(
+        &self,
+        q: &Coords,
+        qd: &Coords,
+        applied: &Wrench,
+        active: &[usize],
+        arm: &Vector3<f64>,
+    ) -> Option<DMatrix<f64>> {
+        let n = active.len();
+        let basis = [
+            point_wrench(arm, &Vector3::x()),
+            point_wrench(arm, &Vector3::y()),
+            Wrench::new(0.0, 0.0, 0.0, 0.0, 0.0, 1.0),
+        ];
+        let base = self.accelerations(q, qd, applied)?;
+        let centre = |a: &Coords| Vector3::new(a[0] - a[5] * arm[1], a[1] + a[5] * arm[0], a[5]);
+        let mut g = DMatrix::zeros(n, n);
+        for (c, &k) in active.iter().enumerate() {
+            let a = self.accelerations(q, qd, &(applied + basis[k]))?;
+            let response = centre(&(a - base));
+            for (r, &j) in active.iter().enumerate() {
+                g[(r, c)] = response[j];
+            }
+        }
+        Some((&g + g.transpose()) * 0.5)
     }
 
     /// The platen at rest in its plane (x, y and yaw, where free, held by the bearings'
@@ -384,6 +357,78 @@ impl MultiAxisTable {
 /// and pitch rates times the contact's depth) is left out, so that a platen whose in-plane
 /// coordinates are still does not slide.
 pub type PlanarRate = Vector3<f64>;
+
+/// The point `b = S·β` of the limit surface (limits `sv` on the diagonal of `S`) nearest to
+/// the holding friction `lambda` in the metric `g`, as `β`. In `β = S⁻¹·b` the surface is the
+/// unit ball: minimise `βᵀHβ − 2βᵀc`, `H = S·G·S`, `c = S·G·λ`, over `|β| ≤ 1` (the
+/// trust-region problem: `β = (H + νI)⁻¹·c` with `ν ≥ 0` the root of `|β(ν)| = 1`, by
+/// bisection; `|β|` falls as `ν` grows). When the surface holds `λ` after all, the direction
+/// of `S⁻¹·λ` (the normal at `λ`); `None` when that is zero.
+fn nearest_on_limit_surface(
+    g: &DMatrix<f64>,
+    sv: &DVector<f64>,
+    lambda: &DVector<f64>,
+) -> Option<DVector<f64>> {
+    let n = sv.len();
+    let h = DMatrix::from_fn(n, n, |r, c| sv[r] * g[(r, c)] * sv[c]);
+    let cvec = sv.component_mul(&(g * lambda));
+    let eig = h.symmetric_eigen();
+    let proj = eig.eigenvectors.transpose() * &cvec;
+    let beta_at = |nu: f64| {
+        let y = DVector::from_fn(n, |i, _| proj[i] / (eig.eigenvalues[i] + nu));
+        &eig.eigenvectors * y
+    };
+    let (mut lo, mut hi) = (0.0, cvec.norm().max(f64::MIN_POSITIVE));
+    if beta_at(lo).norm() <= 1.0 {
+        // Held after all (the surface holds it): leave along the normal at λ.
+        hi = 0.0;
+    }
+    for _ in 0..200 {
+        if hi - lo <= 1e-15 * hi {
+            break;
+        }
+        let mid = 0.5 * (lo + hi);
+        if beta_at(mid).norm() > 1.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    if hi == 0.0 {
+        let l = DVector::from_fn(n, |r, _| lambda[r] / sv[r]);
+        let norm = l.norm();
+        if norm == 0.0 {
+            return None;
+        }
+        Some(l / norm)
+    } else {
+        Some(beta_at(hi))
+    }
+}
+
+/// The motion along the normal at `b = S·β`, against it: the friction centre's velocity and
+/// the yaw rate `∝ −S⁻¹·β` (over the `active` DOFs), then the reference point's, `arm` away,
+/// at unit speed in the limit surface's metric.
+fn leaving_motion(
+    active: &[usize],
+    beta: &DVector<f64>,
+    sv: &DVector<f64>,
+    arm: &Vector3<f64>,
+    capacity: &FrictionCapacity,
+) -> PlanarRate {
+    let mut u = Vector3::zeros();
+    for (r, &k) in active.iter().enumerate() {
+        u[k] = -beta[r] / sv[r];
+    }
+    let w = PlanarRate::new(u[0] + u[2] * arm[1], u[1] - u[2] * arm[0], u[2]);
+    let rho = capacity.moment_n_m / capacity.force_n;
+    let size = Vector3::new(u[0], u[1], u[2] * rho).norm();
+    if size > 0.0 {
+        w / size
+    } else {
+        w
+    }
+}
 
 /// The in-plane motion of the rates `qd`.
 pub fn planar_rate(qd: &Coords) -> PlanarRate {

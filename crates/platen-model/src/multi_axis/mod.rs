@@ -21,12 +21,14 @@
 //!   or along its axis (pad); a strut's pull `p·A` is positive and draws the platen towards
 //!   its base.
 
+mod capacity;
 mod dof;
 mod friction;
 mod modes;
 mod specimen;
 mod table;
 
+pub use capacity::AxisCapacity;
 pub use dof::{
     angular_rate_bias, angular_rate_map, angular_velocity, rotation, translation, Coords, Dof,
     DofSet,
@@ -37,7 +39,6 @@ pub use friction::{
 pub use modes::Mode;
 pub use specimen::{LinearSpecimen, MAX_SPECIMEN_DOFS};
 pub use table::{
-    Actuator, ActuatorPose, AxisCapacity, Bearing, BearingLoad, Frame, Kinematics, Mount,
-    MultiAxisTable, Pad, Point, RigidPlaten, Strut, StrutPose, TableParts, Wrench, MAX_GEOMETRY_M,
-    RESERVED_NAMES,
+    Actuator, ActuatorPose, Bearing, BearingLoad, Frame, Kinematics, Mount, MultiAxisTable, Pad,
+    Point, RigidPlaten, Strut, StrutPose, TableParts, Wrench, MAX_GEOMETRY_M, RESERVED_NAMES,
 };

@@ -369,6 +369,109 @@ pub(crate) fn point_wrench(arm: &Vector3<f64>, force: &Vector3<f64>) -> Wrench {
     Wrench::new(force[0], force[1], force[2], m[0], m[1], m[2])
 }
 
+/// Checks actuator `i` of `parts` (its name unique, its areas, volume and stroke, its
+/// mount); its length at neutral, m (0 for a pad).
+fn check_actuator(parts: &TableParts, i: usize) -> Result<f64> {
+    let a = &parts.actuators[i];
+    let at = |key: &str| format!("actuators[{i}].{key}");
+    check_name(at("name"), &a.name)?;
+    if parts.actuators[..i].iter().any(|b| b.name == a.name) {
+        return Err(invalid(
+            at("name"),
+            format!("a name used once (`{}` repeats)", a.name),
+        ));
+    }
+    finite_point(&at("base_m"), &a.base_m)?;
+    positive(at("cap_side_area_m2"), a.cap_side_area_m2, "m²")?;
+    non_negative(at("rod_side_area_m2"), a.rod_side_area_m2, "m²")?;
+    positive(at("chamber_volume_m3"), a.chamber_volume_m3, "m³")?;
+    positive(at("stroke_m"), a.stroke_m, "m")?;
+    match &a.mount {
+        Mount::Swivel { platen_m } => {
+            finite_point(&at("platen_m"), platen_m)?;
+            let length = (platen_m - a.base_m).norm();
+            if length <= 1e-6 {
+                return Err(invalid(
+                    at("platen_m"),
+                    "a platen point apart from the base point (the actuator has zero length)",
+                ));
+            }
+            Ok(length)
+        }
+        Mount::Pad(pad) => {
+            finite_point(&at("pad.contact_m"), &pad.contact_m)?;
+            if !pad.axis.iter().all(|c| c.is_finite()) || pad.axis[2].abs() < 1e-3 {
+                return Err(invalid(
+                    at("pad.axis"),
+                    "a direction that crosses the platen's underside (not horizontal)",
+                ));
+            }
+            non_negative(
+                at("pad.friction_coefficient"),
+                pad.friction_coefficient,
+                "1",
+            )?;
+            Ok(0.0)
+        }
+    }
+}
+
+/// Checks hold-down strut `j` of `parts` (its name unique among struts and actuators, its
+/// points, area, pressure, gas and exponent); its length at neutral, m.
+fn check_strut(parts: &TableParts, j: usize) -> Result<f64> {
+    let s = &parts.struts[j];
+    let at = |key: &str| format!("hold_down_struts[{j}].{key}");
+    check_name(at("name"), &s.name)?;
+    if parts.struts[..j].iter().any(|b| b.name == s.name)
+        || parts.actuators.iter().any(|a| a.name == s.name)
+    {
+        return Err(invalid(
+            at("name"),
+            format!("a name used once (`{}` repeats)", s.name),
+        ));
+    }
+    finite_point(&at("base_m"), &s.base_m)?;
+    finite_point(&at("platen_m"), &s.platen_m)?;
+    positive(at("area_m2"), s.area_m2, "m²")?;
+    non_negative(at("pressure_pa"), s.pressure_pa, "Pa")?;
+    positive(at("gas_volume_m3"), s.gas_volume_m3, "m³")?;
+    if !(s.polytropic_exponent.is_finite() && (1.0..=2.0).contains(&s.polytropic_exponent)) {
+        return Err(invalid(at("polytropic_exponent"), "a number in [1, 2]"));
+    }
+    let length = (s.platen_m - s.base_m).norm();
+    if length <= 1e-6 {
+        return Err(invalid(
+            at("platen_m"),
+            "a platen point apart from the base point",
+        ));
+    }
+    Ok(length)
+}
+
+/// Checks bearing `k` of `parts`: its point, its friction and its load (a constant force or
+/// a swivel-mounted actuator's).
+fn check_bearing(parts: &TableParts, k: usize) -> Result<()> {
+    let b = &parts.bearings[k];
+    let at = |key: &str| format!("bearings[{k}].{key}");
+    finite_point(&at("platen_m"), &b.platen_m)?;
+    non_negative(at("friction_coefficient"), b.friction_coefficient, "1")?;
+    match b.load {
+        BearingLoad::Constant(n) => {
+            non_negative(at("normal_force_n"), n, "N")?;
+        }
+        BearingLoad::Actuator(i) => match parts.actuators.get(i).map(|a| &a.mount) {
+            Some(Mount::Swivel { .. }) => {}
+            _ => {
+                return Err(invalid(
+                    at("actuator"),
+                    "the name of a swivel-mounted actuator (a pad carries its own friction)",
+                ))
+            }
+        },
+    }
+    Ok(())
+}
+
 /// Where a pad's axis meets the underside of the platen whose z axis is `normal` and whose
 /// reference point is at `t`, and how far along the axis from its neutral contact, m.
 pub(crate) fn pad_point(pad: &Pad, t: &Vector3<f64>, normal: &Vector3<f64>) -> (Point, f64) {
@@ -397,96 +500,14 @@ impl MultiAxisTable {
                 "at most five of the six DOFs: with every DOF held the platen cannot move",
             ));
         }
-        let mut neutral_lengths_m = Vec::with_capacity(parts.actuators.len());
-        for (i, a) in parts.actuators.iter().enumerate() {
-            let at = |key: &str| format!("actuators[{i}].{key}");
-            check_name(at("name"), &a.name)?;
-            if parts.actuators[..i].iter().any(|b| b.name == a.name) {
-                return Err(invalid(
-                    at("name"),
-                    format!("a name used once (`{}` repeats)", a.name),
-                ));
-            }
-            finite_point(&at("base_m"), &a.base_m)?;
-            positive(at("cap_side_area_m2"), a.cap_side_area_m2, "m²")?;
-            non_negative(at("rod_side_area_m2"), a.rod_side_area_m2, "m²")?;
-            positive(at("chamber_volume_m3"), a.chamber_volume_m3, "m³")?;
-            positive(at("stroke_m"), a.stroke_m, "m")?;
-            match &a.mount {
-                Mount::Swivel { platen_m } => {
-                    finite_point(&at("platen_m"), platen_m)?;
-                    let length = (platen_m - a.base_m).norm();
-                    if length <= 1e-6 {
-                        return Err(invalid(
-                            at("platen_m"),
-                            "a platen point apart from the base point (the actuator has zero length)",
-                        ));
-                    }
-                    neutral_lengths_m.push(length);
-                }
-                Mount::Pad(pad) => {
-                    finite_point(&at("pad.contact_m"), &pad.contact_m)?;
-                    if !pad.axis.iter().all(|c| c.is_finite()) || pad.axis[2].abs() < 1e-3 {
-                        return Err(invalid(
-                            at("pad.axis"),
-                            "a direction that crosses the platen's underside (not horizontal)",
-                        ));
-                    }
-                    non_negative(
-                        at("pad.friction_coefficient"),
-                        pad.friction_coefficient,
-                        "1",
-                    )?;
-                    neutral_lengths_m.push(0.0);
-                }
-            }
-        }
-        let mut strut_neutral_m = Vec::with_capacity(parts.struts.len());
-        for (j, s) in parts.struts.iter().enumerate() {
-            let at = |key: &str| format!("hold_down_struts[{j}].{key}");
-            check_name(at("name"), &s.name)?;
-            if parts.struts[..j].iter().any(|b| b.name == s.name)
-                || parts.actuators.iter().any(|a| a.name == s.name)
-            {
-                return Err(invalid(
-                    at("name"),
-                    format!("a name used once (`{}` repeats)", s.name),
-                ));
-            }
-            finite_point(&at("base_m"), &s.base_m)?;
-            finite_point(&at("platen_m"), &s.platen_m)?;
-            positive(at("area_m2"), s.area_m2, "m²")?;
-            non_negative(at("pressure_pa"), s.pressure_pa, "Pa")?;
-            positive(at("gas_volume_m3"), s.gas_volume_m3, "m³")?;
-            if !(s.polytropic_exponent.is_finite() && (1.0..=2.0).contains(&s.polytropic_exponent))
-            {
-                return Err(invalid(at("polytropic_exponent"), "a number in [1, 2]"));
-            }
-            let length = (s.platen_m - s.base_m).norm();
-            if length <= 1e-6 {
-                return Err(invalid(
-                    at("platen_m"),
-                    "a platen point apart from the base point",
-                ));
-            }
-            strut_neutral_m.push(length);
-        }
-        for (k, b) in parts.bearings.iter().enumerate() {
-            let at = |key: &str| format!("bearings[{k}].{key}");
-            finite_point(&at("platen_m"), &b.platen_m)?;
-            non_negative(at("friction_coefficient"), b.friction_coefficient, "1")?;
-            match b.load {
-                BearingLoad::Constant(n) => {
-                    non_negative(at("normal_force_n"), n, "N")?;
-                }
-                BearingLoad::Actuator(i) => match parts.actuators.get(i).map(|a| &a.mount) {
-                    Some(Mount::Swivel { .. }) => {}
-                    _ => return Err(invalid(
-                        at("actuator"),
-                        "the name of a swivel-mounted actuator (a pad carries its own friction)",
-                    )),
-                },
-            }
+        let neutral_lengths_m = (0..parts.actuators.len())
+            .map(|i| check_actuator(&parts, i))
+            .collect::<Result<Vec<_>>>()?;
+        let strut_neutral_m = (0..parts.struts.len())
+            .map(|j| check_strut(&parts, j))
+            .collect::<Result<Vec<_>>>()?;
+        for k in 0..parts.bearings.len() {
+            check_bearing(&parts, k)?;
         }
         let table = MultiAxisTable {
             parts,
@@ -862,122 +883,5 @@ impl MultiAxisTable {
             return None;
         }
         svd.solve(&b, 0.0).ok().map(|f| f.iter().copied().collect())
-    }
-}
-
-/// What the table can do along one DOF (bare table, at neutral).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AxisCapacity {
-    /// The DOF.
-    pub dof: Dof,
-    /// The largest excursion either way before an actuator reaches its stroke (exact
-    /// kinematics, the other DOFs at zero), m or rad.
-    pub stroke: f64,
-    /// The largest force (N) or moment (N·m) the actuators add either way along it, over the
-    /// forces that hold the platen still at neutral (its weight and the struts' pull), with
-    /// the force balance's distribution and the other DOFs' wrench at zero, before one
-    /// reaches its force limit.
-    pub force: f64,
-    /// The largest acceleration along it (the other DOFs' at zero) from rest at neutral, m/s²
-    /// or rad/s², gravity aside.
-    pub acceleration: f64,
-}
-
-impl Actuator {
-    /// Its force limits `(pull ≤ 0, push ≥ 0)` at supply `ps` and return `pr` pressures, N:
-    /// push `A_cap·p_s − A_rod·p_r`, pull `−(A_rod·p_s − A_cap·p_r)` (none for a
-    /// single-acting actuator, whose rod side is 0).
-    pub fn force_limits_n(&self, supply_pa: f64, return_pa: f64) -> (f64, f64) {
-        let push = self.cap_side_area_m2 * supply_pa - self.rod_side_area_m2 * return_pa;
-        let pull = (self.rod_side_area_m2 * supply_pa - self.cap_side_area_m2 * return_pa).max(0.0);
-        (-pull, push.max(0.0))
-    }
-}
-
-impl MultiAxisTable {
-    /// The capacities of every free DOF at supply and return pressures `supply_pa`,
-    /// `return_pa` (see [`AxisCapacity`]); a held DOF has none.
-    pub fn capacities(&self, supply_pa: f64, return_pa: f64) -> Vec<AxisCapacity> {
-        let neutral = Coords::zeros();
-        let limits: Vec<(f64, f64)> = self
-            .actuators()
-            .iter()
-            .map(|a| a.force_limits_n(supply_pa, return_pa))
-            .collect();
-        // The forces that hold the platen still at neutral (its weight and the struts' pull
-        // carried), about which the capacities are taken.
-        let hold = -(self.gravity_wrench(&neutral) + self.struts_wrench(&neutral));
-        let still = self
-            .resolve_forces(&neutral, &self.generalised_force(&neutral, &hold), None)
-            .unwrap_or_else(|| vec![0.0; limits.len()]);
-        // The largest k with every force of still + k·f within its limits, either sign of k.
-        let scale = |f: &[f64]| {
-            let reach = |sign: f64| {
-                f.iter()
-                    .zip(&still)
-                    .zip(&limits)
-                    .map(|((&fi, &f0), &(pull, push))| {
-                        let x = sign * fi;
-                        if x > 0.0 {
-                            ((push - f0) / x).max(0.0)
-                        } else if x < 0.0 {
-                            ((pull - f0) / x).max(0.0)
-                        } else {
-                            f64::INFINITY
-                        }
-                    })
-                    .fold(f64::INFINITY, f64::min)
-            };
-            reach(1.0).min(reach(-1.0))
-        };
-        let m6 = self.spatial_mass_matrix(&neutral);
-        self.free()
-            .iter()
-            .map(|dof| {
-                let mut unit = Coords::zeros();
-                unit[dof.index()] = 1.0;
-                let force = self
-                    .resolve_forces(&neutral, &unit, None)
-                    .map_or(0.0, |f| scale(&f));
-                let per_acc = self.generalised_force(&neutral, &(m6 * unit));
-                let acceleration = self
-                    .resolve_forces(&neutral, &per_acc, None)
-                    .map_or(0.0, |f| scale(&f));
-                AxisCapacity {
-                    dof,
-                    stroke: self.stroke_along(dof),
-                    force,
-                    acceleration,
-                }
-            })
-            .collect()
-    }
-
-    /// The largest excursion along `dof` both ways with every actuator within its stroke,
-    /// by bisection on the exact kinematics to 1e-9 of the first bracket.
-    fn stroke_along(&self, dof: Dof) -> f64 {
-        let fits = |x: f64| {
-            let mut q = Coords::zeros();
-            q[dof.index()] = x;
-            (0..self.actuators().len())
-                .all(|i| self.actuator_at(i, &q).stroke_m.abs() <= self.actuators()[i].stroke_m)
-        };
-        let one_way = |sign: f64| {
-            let mut hi = 1e-3;
-            while fits(sign * hi) && hi < 1e3 {
-                hi *= 2.0;
-            }
-            let mut lo = 0.0;
-            for _ in 0..60 {
-                let mid = 0.5 * (lo + hi);
-                if fits(sign * mid) {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            lo
-        };
-        one_way(1.0).min(one_way(-1.0))
     }
 }

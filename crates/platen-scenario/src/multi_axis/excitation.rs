@@ -80,6 +80,36 @@ pub(super) fn read_pose_motion(
         .copied()
         .collect();
     let mut cols = read_mapped(ctx, path, ex, &["t_s"], &optional)?;
+    check_pose_columns(path, &cols)?;
+    let t = cols.remove("t_s").unwrap_or_default();
+    let mut derived = Derived::new();
+    let mut dofs = Vec::with_capacity(6);
+    for k in 0..6 {
+        let u = cols.remove(POSE_COLUMNS[k]);
+        let given = u.is_some();
+        let u = u.unwrap_or_else(|| vec![0.0; t.len()]);
+        let v = cols.remove(RATE_COLUMNS[k]);
+        let a = cols.remove(ACCELERATION_COLUMNS[k]);
+        let (run, how) = motion_run(ctx, file, path, t.clone(), u, v, a)?;
+        let Run::Inverse { motion } = run else {
+            unreachable!("a motion record makes an inverse run")
+        };
+        if given {
+            note_derived(k, how, &mut derived);
+        }
+        dofs.push(motion);
+    }
+    let dofs: [platen_signal::Motion; 6] = dofs.try_into().expect("six DOFs");
+    let motion = PoseMotion::new(dofs).map_err(|cause| crate::excitation::rejected(path, cause))?;
+    Ok((motion, derived))
+}
+
+/// Refuses a six-DOF motion record's columns `cols` (read from `path`) without a pose
+/// column, or with a value beyond any table's reach.
+fn check_pose_columns(
+    path: &Path,
+    cols: &std::collections::BTreeMap<&'static str, Vec<f64>>,
+) -> Result<()> {
     if !POSE_COLUMNS.iter().any(|c| cols.contains_key(c)) {
         return Err(ScenarioError::Io(platen_io::IoError::Record {
             path: path.to_owned(),
@@ -120,38 +150,24 @@ pub(super) fn read_pose_motion(
             }));
         }
     }
-    let t = cols.remove("t_s").unwrap_or_default();
-    let mut derived = Derived::new();
-    let mut dofs = Vec::with_capacity(6);
-    for k in 0..6 {
-        let u = cols.remove(POSE_COLUMNS[k]);
-        let given = u.is_some();
-        let u = u.unwrap_or_else(|| vec![0.0; t.len()]);
-        let v = cols.remove(RATE_COLUMNS[k]);
-        let a = cols.remove(ACCELERATION_COLUMNS[k]);
-        let (run, how) = motion_run(ctx, file, path, t.clone(), u, v, a)?;
-        let Run::Inverse { motion } = run else {
-            unreachable!("a motion record makes an inverse run")
+    Ok(())
+}
+
+/// Files how DOF `k`'s rate and acceleration were derived (`how`, in the uniaxial columns'
+/// names) in `derived`, under the DOF's own columns' names.
+fn note_derived(k: usize, how: Derived, derived: &mut Derived) {
+    for (name, note) in how {
+        let ours = if name == "v_m_s" {
+            RATE_COLUMNS[k]
+        } else {
+            ACCELERATION_COLUMNS[k]
         };
-        if given {
-            for (name, note) in how {
-                let ours = if name == "v_m_s" {
-                    RATE_COLUMNS[k]
-                } else {
-                    ACCELERATION_COLUMNS[k]
-                };
-                let note = note
-                    .replace("v_m_s", RATE_COLUMNS[k])
-                    .replace("a_m_s2", ACCELERATION_COLUMNS[k])
-                    .replace("u_m", POSE_COLUMNS[k]);
-                derived.insert(ours, note);
-            }
-        }
-        dofs.push(motion);
+        let note = note
+            .replace("v_m_s", RATE_COLUMNS[k])
+            .replace("a_m_s2", ACCELERATION_COLUMNS[k])
+            .replace("u_m", POSE_COLUMNS[k]);
+        derived.insert(ours, note);
     }
-    let dofs: [platen_signal::Motion; 6] = dofs.try_into().expect("six DOFs");
-    let motion = PoseMotion::new(dofs).map_err(|cause| crate::excitation::rejected(path, cause))?;
-    Ok((motion, derived))
 }
 
 /// `excitation.ground_motion` per axis: each record integrated as the uniaxial

@@ -30,7 +30,7 @@ use nalgebra::DMatrix;
 use num_complex::Complex64 as C64;
 use platen_model::multi_axis::Dof;
 
-use super::TableLinearisation;
+use super::{ActuatorLinearisation, TableLinearisation};
 
 /// Order of the Padé approximants of the delays: `[6/6]` is within 1e-6 in phase of
 /// `e^{−sθ}` for `ωθ < 2`, well past the valves' bandwidth at the delays of servo-valves.
@@ -180,13 +180,35 @@ impl TableLinearisation {
             .map(|(d, _)| d)
     }
 
-    /// The state matrix.
+    /// The state matrix: the states' layout, the algebraic outputs over the state (forces,
+    /// `Δp`, the accelerations, the drives), then the rates row block by row block.
     fn assemble(&self, broken: Option<usize>) -> DMatrix<f64> {
+        let layout = self.layout();
+        let (force, delta_p) = self.chamber_outputs(&layout);
+        let mut qdd = self.platen_accelerations(&layout, &force);
+        let zdd = self.specimen_accelerations(&layout, &mut qdd);
+        // The DOF drives d (free × state), then the actuator drives D = G_c·d − balance·f.
+        let dp_hat = &self.g_c_pinv * &delta_p;
+        let d = self.dof_drives(&layout, &qdd, &dp_hat, broken);
+        let drives = &self.g_c * &d - &self.balance * &force;
+        // The rates.
+        let mut a = DMatrix::zeros(layout.size, layout.size);
+        layout.kinematic_rows(&mut a, &qdd, &zdd);
+        let pade = pade(PADE_ORDER);
+        for (i, (act, s)) in self.actuators.iter().zip(&layout.slots).enumerate() {
+            self.chamber_rows(&mut a, &layout, i, act, s);
+            self.valve_rows(&mut a, i, act, s, &drives, &pade);
+        }
+        self.controller_rows(&mut a, &layout, &dp_hat);
+        a
+    }
+
+    /// Where every state sits: the free DOFs and the specimen, each actuator's chambers,
+    /// spool and delay line, then the controllers' integrators and high-passes.
+    fn layout(&self) -> StateLayout {
         let nf = self.free.len();
         let nz = self.specimen.as_ref().map_or(0, |s| s.mass.nrows());
         let n = self.actuators.len();
-        let (pade_a, pade_c, pade_d) = pade(PADE_ORDER);
-        // Layout.
         let (iq, iqd, iz, izd) = (0, nf, 2 * nf, 2 * nf + nz);
         let mut next = 2 * nf + 2 * nz;
         let mut slots = Vec::with_capacity(n);
@@ -216,11 +238,26 @@ impl TableLinearisation {
                 next += 1;
             }
         }
-        let size = next;
-        // Algebraic outputs as rows over the state: forces f, Δp, q̈, the drives D.
-        let mut force = DMatrix::zeros(n, size);
-        let mut delta_p = DMatrix::zeros(n, size);
-        for (i, (a, s)) in self.actuators.iter().zip(&slots).enumerate() {
+        StateLayout {
+            nf,
+            nz,
+            iq,
+            iqd,
+            iz,
+            izd,
+            slots,
+            integrator,
+            highpass,
+            size: next,
+        }
+    }
+
+    /// The actuators' forces `f` and pressure differences `Δp` as rows over the state.
+    fn chamber_outputs(&self, layout: &StateLayout) -> (DMatrix<f64>, DMatrix<f64>) {
+        let n = self.actuators.len();
+        let mut force = DMatrix::zeros(n, layout.size);
+        let mut delta_p = DMatrix::zeros(n, layout.size);
+        for (i, (a, s)) in self.actuators.iter().zip(&layout.slots).enumerate() {
             force[(i, s.p_a)] = a.hydraulics.cap_area_m2;
             delta_p[(i, s.p_a)] = 1.0;
             if let Some(b) = s.p_b {
@@ -228,15 +265,30 @@ impl TableLinearisation {
                 delta_p[(i, b)] = -1.0;
             }
         }
-        // q̈ = A_q·q + A_v·q̇ + B·f + P·Γᵀ·(C·ż + K·z).
-        let mut qdd = &self.b * &force;
+        (force, delta_p)
+    }
+
+    /// The platen's accelerations without the specimen's push, rows over the state:
+    /// `q̈ = A_q·q + A_v·q̇ + B·f`.
+    fn platen_accelerations(&self, layout: &StateLayout, force: &DMatrix<f64>) -> DMatrix<f64> {
+        let StateLayout { nf, iq, iqd, .. } = *layout;
+        let mut qdd = &self.b * force;
         for r in 0..nf {
             for c in 0..nf {
                 qdd[(r, iq + c)] += self.a_q[(r, c)];
                 qdd[(r, iqd + c)] += self.a_v[(r, c)];
             }
         }
-        let mut zdd = DMatrix::zeros(nz, size);
+        qdd
+    }
+
+    /// Adds the specimen's push `P·Γᵀ·(C·ż + K·z)` to the platen's accelerations `qdd`, and
+    /// returns the specimen's, `z̈ = −Γ_f·q̈ − M⁻¹·(C·ż + K·z)` (no rows without a specimen).
+    fn specimen_accelerations(&self, layout: &StateLayout, qdd: &mut DMatrix<f64>) -> DMatrix<f64> {
+        let StateLayout {
+            nf, nz, iz, izd, ..
+        } = *layout;
+        let mut zdd = DMatrix::zeros(nz, layout.size);
         if let Some(sp) = &self.specimen {
             let on_platen_k = &sp.push * &sp.stiffness;
             let on_platen_c = &sp.push * &sp.damping;
@@ -246,14 +298,13 @@ impl TableLinearisation {
                     qdd[(r, izd + j)] += on_platen_c[(r, j)];
                 }
             }
-            // z̈ = −Γ_f·q̈ − M⁻¹·(C·ż + K·z).
             let m_inv = sp
                 .mass
                 .clone()
                 .try_inverse()
                 .unwrap_or_else(|| DMatrix::zeros(nz, nz));
             let influence = &m_inv * &sp.mass_influence;
-            zdd = -(&influence * &qdd);
+            zdd = -(&influence * &*qdd);
             let (mk, mc) = (&m_inv * &sp.stiffness, &m_inv * &sp.damping);
             for r in 0..nz {
                 for j in 0..nz {
@@ -262,8 +313,21 @@ impl TableLinearisation {
                 }
             }
         }
-        // The DOF drives d (free × state), then the actuator drives D = G_c·d − balance·f.
-        let dp_hat = &self.g_c_pinv * &delta_p;
+        zdd
+    }
+
+    /// The DOF drives `d_k = −K_p·q̂_k + K_i·ξ_k − K_vb·q̂̇_k − K_ab·q̈_k − K_Δp·h_k`, free ×
+    /// state, with the loop `broken` left at zero.
+    fn dof_drives(
+        &self,
+        layout: &StateLayout,
+        qdd: &DMatrix<f64>,
+        dp_hat: &DMatrix<f64>,
+        broken: Option<usize>,
+    ) -> DMatrix<f64> {
+        let StateLayout {
+            nf, iq, iqd, size, ..
+        } = *layout;
         let mut d = DMatrix::zeros(nf, size);
         for (k, g) in self.gains.iter().enumerate() {
             if Some(k) == broken {
@@ -278,17 +342,148 @@ impl TableLinearisation {
                 d[(k, c)] -= g.acceleration_feedback_s2_per_m * qdd[(k, c)];
                 d[(k, c)] -= g.delta_p_gain_per_pa * dp_hat[(k, c)];
             }
-            if let Some(j) = integrator[k] {
+            if let Some(j) = layout.integrator[k] {
                 d[(k, j)] += g.integral_gain_per_m_s;
             }
-            if let Some(j) = highpass[k] {
+            if let Some(j) = layout.highpass[k] {
                 let w = std::f64::consts::TAU * g.delta_p_highpass_hz;
                 d[(k, j)] += g.delta_p_gain_per_pa * w;
             }
         }
-        let drives = &self.g_c * &d - &self.balance * &force;
-        // The rates.
-        let mut a = DMatrix::zeros(size, size);
+        d
+    }
+
+    /// Actuator `i`'s chamber rows: `c·Ṗ_a = −C_L·(P_a − P_b) + K_qa·x − A_a·(G·q̇)` and its
+    /// mirror for `P_b` (single-acting: `c·Ṗ_a = −C_L·P_a + K_qa·x − A_a·(G·q̇)`).
+    fn chamber_rows(
+        &self,
+        a: &mut DMatrix<f64>,
+        layout: &StateLayout,
+        i: usize,
+        act: &ActuatorLinearisation,
+        s: &ActuatorSlots,
+    ) {
+        let StateLayout { nf, iqd, .. } = *layout;
+        let stroke_rate = &self.g; // actuators × free: S = G·q, Ṡ = G·q̇.
+        let h = &act.hydraulics;
+        let comp = act.compliance_m3_per_pa;
+        let leak = h.leakage_m3_s_per_pa;
+        match s.p_b {
+            None => {
+                a[(s.p_a, s.p_a)] = -leak / comp;
+                a[(s.p_a, s.spool)] = act.flow_gain_a_m3_s / comp;
+                for c in 0..nf {
+                    a[(s.p_a, iqd + c)] = -h.cap_area_m2 * stroke_rate[(i, c)] / comp;
+                }
+            }
+            Some(b) => {
+                a[(s.p_a, s.p_a)] = -leak / comp;
+                a[(s.p_a, b)] = leak / comp;
+                a[(b, s.p_a)] = leak / comp;
+                a[(b, b)] = -leak / comp;
+                a[(s.p_a, s.spool)] = act.flow_gain_a_m3_s / comp;
+                a[(b, s.spool)] = -act.flow_gain_b_m3_s / comp;
+                for c in 0..nf {
+                    a[(s.p_a, iqd + c)] = -h.cap_area_m2 * stroke_rate[(i, c)] / comp;
+                    a[(b, iqd + c)] = h.rod_area_m2 * stroke_rate[(i, c)] / comp;
+                }
+            }
+        }
+    }
+
+    /// Actuator `i`'s delay line `w' = (A·w + e_m·D)/θ`, `D_θ = c·w + d·D`, and spool rows
+    /// `ẍ = ω²·(D_θ − x) − 2ζω·ẋ`, from its drive's row in `drives` and the Padé approximant
+    /// `(A, c, d)`.
+    fn valve_rows(
+        &self,
+        a: &mut DMatrix<f64>,
+        i: usize,
+        act: &ActuatorLinearisation,
+        s: &ActuatorSlots,
+        drives: &DMatrix<f64>,
+        (pade_a, pade_c, pade_d): &(DMatrix<f64>, Vec<f64>, f64),
+    ) {
+        let size = a.ncols();
+        let valve = &act.hydraulics.servo_valve;
+        let wv = std::f64::consts::TAU * valve.natural_frequency_hz;
+        let theta = valve.delay_s + 0.5 * self.period_s;
+        for r in 0..PADE_ORDER {
+            for c in 0..PADE_ORDER {
+                a[(s.delay + r, s.delay + c)] = pade_a[(r, c)] / theta;
+            }
+        }
+        for c in 0..size {
+            a[(s.delay + PADE_ORDER - 1, c)] += drives[(i, c)] / theta;
+        }
+        a[(s.spool, s.spool + 1)] = 1.0;
+        let row = s.spool + 1;
+        a[(row, s.spool)] -= wv * wv;
+        a[(row, s.spool + 1)] -= 2.0 * valve.damping_ratio * wv;
+        for k in 0..PADE_ORDER {
+            a[(row, s.delay + k)] += wv * wv * pade_c[k];
+        }
+        for c in 0..size {
+            a[(row, c)] += wv * wv * pade_d * drives[(i, c)];
+        }
+    }
+
+    /// The controllers' own states' rows: `ξ̇_k = −q̂_k` and the high-pass
+    /// `η̇ = −ω_hp·η + Δp̂`.
+    fn controller_rows(&self, a: &mut DMatrix<f64>, layout: &StateLayout, dp_hat: &DMatrix<f64>) {
+        let StateLayout { nf, iq, size, .. } = *layout;
+        let q_hat = &self.feedback_geometry; // free × free
+        for k in 0..nf {
+            if let Some(j) = layout.integrator[k] {
+                for c in 0..nf {
+                    a[(j, iq + c)] = -q_hat[(k, c)];
+                }
+            }
+            if let Some(j) = layout.highpass[k] {
+                let w = std::f64::consts::TAU * self.gains[k].delta_p_highpass_hz;
+                a[(j, j)] -= w;
+                for c in 0..size {
+                    a[(j, c)] += dp_hat[(k, c)];
+                }
+            }
+        }
+    }
+}
+
+/// Where every state sits in the state vector (see the module docs).
+struct StateLayout {
+    /// How many free DOFs.
+    nf: usize,
+    /// How many specimen DOFs.
+    nz: usize,
+    /// The first of `q`, `q̇`, `z` and `ż`.
+    iq: usize,
+    iqd: usize,
+    iz: usize,
+    izd: usize,
+    /// Per actuator its states.
+    slots: Vec<ActuatorSlots>,
+    /// Per free DOF its integrator's state, if any.
+    integrator: Vec<Option<usize>>,
+    /// Per free DOF its `Δp` high-pass's state, if any.
+    highpass: Vec<Option<usize>>,
+    /// How many states.
+    size: usize,
+}
+
+impl StateLayout {
+    /// The rows of the mechanics: `q̇` and `ż` as rates of `q` and `z`, the accelerations
+    /// `qdd` and `zdd` as rates of `q̇` and `ż`.
+    fn kinematic_rows(&self, a: &mut DMatrix<f64>, qdd: &DMatrix<f64>, zdd: &DMatrix<f64>) {
+        let StateLayout {
+            nf,
+            nz,
+            iq,
+            iqd,
+            iz,
+            izd,
+            size,
+            ..
+        } = *self;
         for r in 0..nf {
             a[(iq + r, iqd + r)] = 1.0;
             for c in 0..size {
@@ -301,74 +496,6 @@ impl TableLinearisation {
                 a[(izd + r, c)] = zdd[(r, c)];
             }
         }
-        let stroke_rate = &self.g; // actuators × free: S = G·q, Ṡ = G·q̇.
-        for (i, (act, s)) in self.actuators.iter().zip(&slots).enumerate() {
-            let h = &act.hydraulics;
-            let comp = act.compliance_m3_per_pa;
-            let leak = h.leakage_m3_s_per_pa;
-            let valve = &h.servo_valve;
-            let wv = std::f64::consts::TAU * valve.natural_frequency_hz;
-            // Chambers.
-            match s.p_b {
-                None => {
-                    a[(s.p_a, s.p_a)] = -leak / comp;
-                    a[(s.p_a, s.spool)] = act.flow_gain_a_m3_s / comp;
-                    for c in 0..nf {
-                        a[(s.p_a, iqd + c)] = -h.cap_area_m2 * stroke_rate[(i, c)] / comp;
-                    }
-                }
-                Some(b) => {
-                    a[(s.p_a, s.p_a)] = -leak / comp;
-                    a[(s.p_a, b)] = leak / comp;
-                    a[(b, s.p_a)] = leak / comp;
-                    a[(b, b)] = -leak / comp;
-                    a[(s.p_a, s.spool)] = act.flow_gain_a_m3_s / comp;
-                    a[(b, s.spool)] = -act.flow_gain_b_m3_s / comp;
-                    for c in 0..nf {
-                        a[(s.p_a, iqd + c)] = -h.cap_area_m2 * stroke_rate[(i, c)] / comp;
-                        a[(b, iqd + c)] = h.rod_area_m2 * stroke_rate[(i, c)] / comp;
-                    }
-                }
-            }
-            // The delay line: w' = (A·w + e_m·D)/θ, D_θ = c·w + d·D.
-            let theta = valve.delay_s + 0.5 * self.period_s;
-            for r in 0..PADE_ORDER {
-                for c in 0..PADE_ORDER {
-                    a[(s.delay + r, s.delay + c)] = pade_a[(r, c)] / theta;
-                }
-            }
-            for c in 0..size {
-                a[(s.delay + PADE_ORDER - 1, c)] += drives[(i, c)] / theta;
-            }
-            // The spool: ẍ = ω²·(D_θ − x) − 2ζω·ẋ.
-            a[(s.spool, s.spool + 1)] = 1.0;
-            let row = s.spool + 1;
-            a[(row, s.spool)] -= wv * wv;
-            a[(row, s.spool + 1)] -= 2.0 * valve.damping_ratio * wv;
-            for k in 0..PADE_ORDER {
-                a[(row, s.delay + k)] += wv * wv * pade_c[k];
-            }
-            for c in 0..size {
-                a[(row, c)] += wv * wv * pade_d * drives[(i, c)];
-            }
-        }
-        // The controller's own states.
-        let q_hat = &self.feedback_geometry; // free × free
-        for k in 0..nf {
-            if let Some(j) = integrator[k] {
-                for c in 0..nf {
-                    a[(j, iq + c)] = -q_hat[(k, c)];
-                }
-            }
-            if let Some(j) = highpass[k] {
-                let w = std::f64::consts::TAU * self.gains[k].delta_p_highpass_hz;
-                a[(j, j)] -= w;
-                for c in 0..size {
-                    a[(j, c)] += dp_hat[(k, c)];
-                }
-            }
-        }
-        a
     }
 }
 
