@@ -11,7 +11,12 @@ use platen_model::{ModelError, Specimen, Storey};
 use crate::ctx::Ctx;
 use crate::error::Result;
 use crate::file::SpecimenSpec;
-use crate::multi_axis::PLAUSIBLE_GEOMETRY_M;
+
+/// How far from the reference point a table's points (and a specimen's levers, a pose) may
+/// lie in a scenario, m (rad for a rotation): the largest shake tables span about 20 m, so a
+/// value beyond is a unit slip (millimetres written as metres) or a typing error, refused at
+/// its key.
+pub const PLAUSIBLE_GEOMETRY_M: f64 = 100.0;
 
 /// `specimen` of a uniaxial scenario: storeys, or the four matrices on the platen's axis.
 pub(crate) fn platen_specimen(ctx: &Ctx, given: Option<&SpecimenSpec>) -> Result<Option<Specimen>> {

@@ -70,19 +70,22 @@ use platen_system::{Actuator, Controller, ServoValve, Supply, TableSystem, Table
 use super::skew::ChannelSkew;
 use super::{SystemRecord, SystemSettings};
 use crate::error::Result;
+use design::force_from;
 use hydraulics::plant_hydraulics;
-use mechanics::{force_from, plant_mechanics};
+use mechanics::plant_mechanics;
 
+mod design;
 mod filters;
 mod friction;
 mod hydraulics;
 mod mechanics;
 mod storeys;
 
+pub use design::SLIP_SPEED_M_S;
 pub use filters::MECHANICS_LOWPASS_FRACTION;
 pub use friction::{DECAY_GRID_S_PER_M, EXPONENT_GRID, FRICTION_TERM_T, LOW_SLIP_SPEED_M_S};
 pub use hydraulics::{IdentifiedHydraulics, CONTINUITY_LOWPASS_HZ};
-pub use mechanics::{IdentifiedMechanics, SLIP_SPEED_M_S};
+pub use mechanics::IdentifiedMechanics;
 pub(super) use storeys::modes;
 pub use storeys::{IdentifiedStorey, Mode, DRIFT_HIGHPASS_HZ};
 

@@ -59,11 +59,7 @@ pub use preset::*;
 pub use scenario::*;
 pub use summary::*;
 
-/// How far from the reference point a table's points (and a specimen's levers, a pose) may
-/// lie in a scenario, m (rad for a rotation): the largest shake tables span about 20 m, so a
-/// value beyond is a unit slip (millimetres written as metres) or a typing error, refused at
-/// its key.
-pub const PLAUSIBLE_GEOMETRY_M: f64 = 100.0;
+pub use crate::specimen::PLAUSIBLE_GEOMETRY_M;
 
 /// The fastest a scenario's pose may move, m/s (rad/s for a rotation): shake tables reach a
 /// few m/s, so a rate beyond is a unit slip (mm/s written as m/s), refused at its key.

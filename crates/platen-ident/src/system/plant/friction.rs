@@ -2,40 +2,14 @@
 //! where the records support it, a Stribeck term and a viscous exponent other than 1, each
 //! found on a grid and kept only beyond [`FRICTION_TERM_T`] standard errors.
 
-use super::mechanics::{
-    mechanics_columns, mechanics_design, mechanics_signs, ForceFrom, SLIP_SPEED_M_S,
-};
+use super::design::{mechanics_columns, mechanics_design, mechanics_signs, ForceFrom, Law};
 use super::PlantInput;
 use crate::error::Result;
 use crate::system::fit::LinearFit;
 use crate::system::SystemRecord;
 
-/// The friction law a force balance is fitted with: `sgn(v)·[F_μ + a·e^(−b|v|) + C·|v|^α]`,
-/// `F_μ`, `a` and `C` fitted (linear), `b` and `α` given.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Law {
-    /// `α`.
-    pub exponent: f64,
-    /// `b`, s/m, with the Stribeck term; `None` without it.
-    pub decay_s_per_m: Option<f64>,
-    /// Samples slower than this are left out, m/s.
-    pub slip_speed_m_s: f64,
-    /// With the score column `v·ln|v|` of a test of `α = 1` (a law with `α = 1` only).
-    pub exponent_score: bool,
-}
-
-impl Law {
-    /// Coulomb and linear viscous friction, above [`SLIP_SPEED_M_S`].
-    pub const LINEAR: Law = Law {
-        exponent: 1.0,
-        decay_s_per_m: None,
-        slip_speed_m_s: SLIP_SPEED_M_S,
-        exponent_score: false,
-    };
-}
-
 /// Samples slower than this are left out of the fits of a richer friction law, m/s: the
-/// Stribeck term lives at a few mm/s, and above [`SLIP_SPEED_M_S`] there is little of it
+/// Stribeck term lives at a few mm/s, and above [`SLIP_SPEED_M_S`](super::design::SLIP_SPEED_M_S) there is little of it
 /// left to see (e^(−2) at b = 200 s/m). Four times the velocity noise of a 5 µm displacement
 /// sensor differenced at 204.8 Hz (0.72 mm/s), so a stuck platen's samples stay out.
 pub const LOW_SLIP_SPEED_M_S: f64 = 0.003;
@@ -51,7 +25,7 @@ pub const FRICTION_TERM_T: f64 = 3.0;
 /// [`DECAY_GRID_S_PER_M`] (or none) and [`EXPONENT_GRID`] above [`LOW_SLIP_SPEED_M_S`]; the
 /// Stribeck term kept when its amplitude is positive and [`FRICTION_TERM_T`] standard errors
 /// from 0, an exponent other than 1 when the score of `α = 1` (the coefficient of `v·ln|v|`)
-/// is. Without either, Coulomb and linear viscous friction above [`SLIP_SPEED_M_S`], as
+/// is. Without either, Coulomb and linear viscous friction above [`SLIP_SPEED_M_S`](super::design::SLIP_SPEED_M_S), as
 /// before any richer law was tried. Returns the fit and its law.
 pub(super) fn friction_law(
     records: &[SystemRecord],

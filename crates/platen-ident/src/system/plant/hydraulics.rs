@@ -6,8 +6,8 @@ use std::collections::BTreeMap;
 
 use platen_system::{TableSystem, TableSystemParts};
 
+use super::design::ForceFrom;
 use super::filters::second_order;
-use super::mechanics::ForceFrom;
 use super::{actuator_stroke_limit_m, IdentifiedPlant};
 use crate::system::fit::{Design, LinearFit};
 use crate::system::SystemRecord;
