@@ -9,6 +9,7 @@ use serde::Serialize;
 use platen_system::{Linearisation, Margins, Mechanics, Passband, TableSystem, SECANT_SPEED_M_S};
 
 use crate::scenario::Model;
+use crate::summary::LoopMargins;
 use crate::system_file::TableSystemSpec;
 
 /// The small-signal coefficients of the loop about mid-stroke (`linearisation`; see
@@ -51,38 +52,8 @@ impl From<&Linearisation> for LinearisationDescription {
     }
 }
 
-/// The loop's margins and closed-loop peak (`loop_margins`; see [`Margins`]).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct LoopMarginsDescription {
-    /// Frequency of the gain crossover of the phase margin, Hz.
-    pub gain_crossover_hz: Option<f64>,
-    /// Gain margin, dB.
-    pub gain_margin_db: Option<f64>,
-    /// Largest closed-loop gain command → displacement.
-    pub peak_gain: f64,
-    /// Where it is, Hz.
-    pub peak_gain_hz: f64,
-    /// Frequency of the phase crossover of the gain margin, Hz.
-    pub phase_crossover_hz: Option<f64>,
-    /// Phase margin, degrees.
-    pub phase_margin_deg: Option<f64>,
-    /// Whether the closed loop is stable (Nyquist).
-    pub stable: bool,
-}
-
-impl From<&Margins> for LoopMarginsDescription {
-    fn from(m: &Margins) -> Self {
-        Self {
-            gain_crossover_hz: m.gain_crossover_hz,
-            gain_margin_db: m.gain_margin_db,
-            peak_gain: m.peak_gain,
-            peak_gain_hz: m.peak_gain_hz,
-            phase_crossover_hz: m.phase_crossover_hz,
-            phase_margin_deg: m.phase_margin_deg,
-            stable: m.stable,
-        }
-    }
-}
+/// [`LoopMargins`]' former name in `platen model`'s description.
+pub type LoopMarginsDescription = LoopMargins;
 
 /// The `table_system` object of `platen model --json` (SI; fields in alphabetical order).
 /// The loop described is the one the table drives: with the specimen as a rigid payload
@@ -104,7 +75,7 @@ pub struct SystemDescription {
     /// The linearisation about mid-stroke.
     pub linearisation: LinearisationDescription,
     /// The loop's margins and peak.
-    pub loop_margins: LoopMarginsDescription,
+    pub loop_margins: LoopMargins,
     /// The model's moving mass at mid-stroke (bare table), kg.
     pub model_mass_kg: f64,
     /// Null pressure of chamber `a`, Pa.
@@ -231,7 +202,7 @@ impl SystemAnalysis {
             force_capacity_pull_n: caps.pull_force_n,
             force_capacity_push_n: caps.push_force_n,
             linearisation: LinearisationDescription::from(self.driven()),
-            loop_margins: LoopMarginsDescription::from(&self.margins),
+            loop_margins: LoopMargins::from(&self.margins),
             model_mass_kg: self.model_mass_kg,
             null_pressure_a_pa: p_a0,
             null_pressure_b_pa: p_b0,

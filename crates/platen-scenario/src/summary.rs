@@ -126,7 +126,7 @@ pub struct SystemSummary {
     /// Integration steps per controller period.
     pub steps_per_controller_period: u32,
     /// The linearised loop's stability and margins.
-    pub loop_margins: MarginsSummary,
+    pub loop_margins: LoopMargins,
 }
 
 /// How one DOF of a closed loop followed its command (at the output samples): the same keys
@@ -149,35 +149,40 @@ pub struct AxisTracking {
     pub acceleration_nrmse: Option<f64>,
 }
 
-/// The linearised loop's margins ([`platen_system::Margins`]).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct MarginsSummary {
-    /// Whether the closed loop is stable (Nyquist).
-    pub stable: bool,
-    /// Gain margin, dB (`null`: no phase crossover).
+/// A loop's margins, broken at its drive, and its closed-loop peak
+/// ([`platen_system::Margins`]): the uniaxial loop's `loop_margins` (in `platen simulate`'s
+/// summary and `platen model`'s description) and each DOF's of a multi-axis table's (the
+/// other DOFs' loops closed).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LoopMargins {
+    /// Frequency of the gain crossover of the phase margin, Hz.
+    pub gain_crossover_hz: Option<f64>,
+    /// Gain margin, dB (`null`: no phase crossover below the controller's Nyquist
+    /// frequency).
     pub gain_margin_db: Option<f64>,
-    /// Its frequency, Hz.
+    /// The closed loop's largest gain command → displacement (or pose) up to the
+    /// controller's Nyquist frequency.
+    pub peak_gain: f64,
+    /// Where that peak is, Hz.
+    pub peak_gain_hz: f64,
+    /// Frequency of the phase crossover of the gain margin, Hz.
     pub phase_crossover_hz: Option<f64>,
     /// Phase margin, degrees (`null`: no gain crossover).
     pub phase_margin_deg: Option<f64>,
-    /// Its frequency, Hz.
-    pub gain_crossover_hz: Option<f64>,
-    /// The closed loop's largest gain command → displacement.
-    pub peak_gain: f64,
-    /// Its frequency, Hz.
-    pub peak_gain_hz: f64,
+    /// Whether the closed loop is stable (Nyquist).
+    pub stable: bool,
 }
 
-impl From<&platen_system::Margins> for MarginsSummary {
+impl From<&platen_system::Margins> for LoopMargins {
     fn from(m: &platen_system::Margins) -> Self {
         Self {
-            stable: m.stable,
-            gain_margin_db: m.gain_margin_db,
-            phase_crossover_hz: m.phase_crossover_hz,
-            phase_margin_deg: m.phase_margin_deg,
             gain_crossover_hz: m.gain_crossover_hz,
+            gain_margin_db: m.gain_margin_db,
             peak_gain: m.peak_gain,
             peak_gain_hz: m.peak_gain_hz,
+            phase_crossover_hz: m.phase_crossover_hz,
+            phase_margin_deg: m.phase_margin_deg,
+            stable: m.stable,
         }
     }
 }
@@ -531,7 +536,7 @@ impl RunSummary {
             hydraulic_energy_j: st.hydraulic_energy_j,
             controller_samples: st.controller_samples,
             steps_per_controller_period: settings.method.steps_per_period(),
-            loop_margins: MarginsSummary::from(&margins),
+            loop_margins: LoopMargins::from(&margins),
         });
         self
     }

@@ -1,6 +1,7 @@
 //! The description of a multi-axis scenario (`platen model --scenario --json`).
 
 use super::*;
+use crate::summary::LoopMargins;
 
 /// One mode of `platen model --json` on a multi-axis scenario.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -35,25 +36,9 @@ pub struct TableDescription {
     pub loop_figures: Option<TableLoopDescription>,
 }
 
-/// One DOF's loop, broken at its drive with the others closed.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct DofLoopDescription {
-    /// Gain margin, dB (`null`: no phase crossover below the controller's Nyquist
-    /// frequency).
-    pub gain_margin_db: Option<f64>,
-    /// Its phase crossover, Hz.
-    pub phase_crossover_hz: Option<f64>,
-    /// Phase margin, degrees.
-    pub phase_margin_deg: Option<f64>,
-    /// Its gain crossover, Hz.
-    pub gain_crossover_hz: Option<f64>,
-    /// Whether this loop is stable by the Nyquist criterion (the others closed).
-    pub stable: bool,
-    /// Largest |pose/command| of the DOF up to the Nyquist frequency, and where.
-    pub peak_gain: f64,
-    /// Where that peak is, Hz.
-    pub peak_gain_hz: f64,
-}
+/// One DOF's loop, broken at its drive with the others closed: its [`LoopMargins`] (the
+/// former name).
+pub type DofLoopDescription = LoopMargins;
 
 /// The largest cross-talk of one DOF's command at a frequency.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -94,7 +79,7 @@ pub struct TableLoopDescription {
     /// below are measured with the other loops closed).
     pub stability: LoopStabilityDescription,
     /// Per free DOF, its loop's margins.
-    pub dofs: std::collections::BTreeMap<&'static str, DofLoopDescription>,
+    pub dofs: std::collections::BTreeMap<&'static str, LoopMargins>,
     /// Per free DOF's command, its largest cross-talk at 1, 2, 5 and 10 Hz.
     pub cross_talk: std::collections::BTreeMap<&'static str, Vec<CrossTalkDescription>>,
     /// Per actuator its force at rest (the static hold), N.
@@ -274,7 +259,7 @@ pub(super) fn loop_verdict(
     lin: &platen_system::TableLinearisation,
 ) -> (
     LoopStabilityDescription,
-    std::collections::BTreeMap<&'static str, DofLoopDescription>,
+    std::collections::BTreeMap<&'static str, LoopMargins>,
 ) {
     let stability = loop_verdict_stability(lin);
     let dofs = lin
@@ -282,18 +267,7 @@ pub(super) fn loop_verdict(
         .iter()
         .filter_map(|&d| {
             let m = lin.margins(d)?;
-            Some((
-                d.name(),
-                DofLoopDescription {
-                    gain_margin_db: m.gain_margin_db,
-                    phase_crossover_hz: m.phase_crossover_hz,
-                    phase_margin_deg: m.phase_margin_deg,
-                    gain_crossover_hz: m.gain_crossover_hz,
-                    stable: m.stable,
-                    peak_gain: m.peak_gain,
-                    peak_gain_hz: m.peak_gain_hz,
-                },
-            ))
+            Some((d.name(), LoopMargins::from(&m)))
         })
         .collect();
     (stability, dofs)

@@ -6,6 +6,7 @@ use platen_signal::metrics::rms;
 
 use super::*;
 pub use crate::summary::AxisTracking;
+use crate::summary::LoopMargins;
 
 /// The peaks of one DOF of a multi-axis run.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -92,7 +93,7 @@ pub struct TableLoopSummary {
     /// when it cannot be linearised: the actuators cannot hold the platen there).
     pub stability: Option<LoopStabilityDescription>,
     /// Per free DOF, its loop's margins, broken at its drive with the others closed.
-    pub loop_margins: BTreeMap<&'static str, DofLoopDescription>,
+    pub loop_margins: BTreeMap<&'static str, LoopMargins>,
 }
 
 /// One strut's range of pull.
