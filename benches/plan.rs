@@ -20,7 +20,7 @@ use platen::integrate::State;
 use platen::model::preset;
 use platen::plan::{
     enveloped_sines_m_s2, iterate, max_scale, BaselineSettings, FrfSource, IterationSettings,
-    MaxScaleSettings, Table, Target, TargetMotion,
+    MaxScaleSettings, PlatenLoop, Target, TargetMotion,
 };
 use platen::scenario::LoadedRig;
 
@@ -62,7 +62,7 @@ fn bench(c: &mut Criterion) {
     let base_steps = (force.len() - 1) as u64;
     let path = PathBuf::from("lhpost-closed-loop.json");
     let loaded = rig(&path);
-    let table = Table::of_loaded(&loaded, &path).unwrap();
+    let table = PlatenLoop::of_loaded(&loaded, &path).unwrap();
     let n = SECONDS * RATE_HZ as usize + 1;
     let t_s: Vec<f64> = (0..n).map(|j| j as f64 / RATE_HZ).collect();
     let a_m_s2: Vec<f64> = t_s.iter().map(|&t| quake(t)).collect();

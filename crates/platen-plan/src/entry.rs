@@ -24,9 +24,9 @@ use platen_scenario::LoadedRig;
 
 use crate::error::{PlanError, Result};
 use crate::plan::{load_rig, plan_platen, Plan, PlanSettings, PlanSummary, UNIAXIAL_DRIVE_COLUMNS};
+use crate::platen_loop::PlatenLoop;
 use crate::rrs::RequiredSpectrum;
 use crate::six_dof::{self, plan_multi_axis, AxisTargets, TablePlan, TablePlanSummary};
-use crate::table::Table;
 use crate::target::Target;
 
 /// A scenario read for planning, whatever its table: its rig (model or table, specimen,
@@ -236,7 +236,7 @@ pub fn plan(
 ) -> Result<Planned> {
     match (scenario, target) {
         (PlanScenario::Platen { path, rig }, PlanTarget::Platen(target)) => {
-            let table = Table::of_loaded(rig, path)?;
+            let table = PlatenLoop::of_loaded(rig, path)?;
             let p = plan_platen(&table, &rig.name, path, target, settings, on_run)?;
             Ok(Planned::Platen(Box::new(p)))
         }

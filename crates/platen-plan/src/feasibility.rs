@@ -48,7 +48,7 @@ use serde::Serialize;
 
 use crate::baseline::TargetMotion;
 use crate::error::{check_setting, Result};
-use crate::table::{Achieved, Table};
+use crate::platen_loop::{Achieved, PlatenLoop};
 
 /// One limit against a run's peak.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -75,7 +75,7 @@ impl LimitUse {
 
 /// Every limit of `table` against its run `achieved` (see the [module
 /// documentation](self)), in a fixed order.
-pub fn limit_uses(table: &Table, achieved: &Achieved) -> Vec<LimitUse> {
+pub fn limit_uses(table: &PlatenLoop, achieved: &Achieved) -> Vec<LimitUse> {
     let p = &achieved.output.peaks;
     let l = &table.rig().limits;
     let plain = |limit, peak: Peak, allowed: f64| LimitUse {
@@ -109,7 +109,7 @@ pub fn limit_uses(table: &Table, achieved: &Achieved) -> Vec<LimitUse> {
 }
 
 /// The rig's four table limits against a run of `table`, as `simulate` reports them.
-pub fn limits_summary(table: &Table, achieved: &Achieved) -> LimitsSummary {
+pub fn limits_summary(table: &PlatenLoop, achieved: &Achieved) -> LimitsSummary {
     let p = &achieved.output.peaks;
     let l = &table.rig().limits;
     let check = |peak: f64, limit: f64| LimitCheck {
@@ -196,7 +196,7 @@ pub struct Feasibility {
 /// # Errors
 /// [`crate::PlanError::Run`] if the unscaled run fails; a bad [`MaxScaleSettings`].
 pub fn feasibility(
-    table: &Table<'_>,
+    table: &PlatenLoop<'_>,
     motion: &TargetMotion,
     search: Option<&MaxScaleSettings>,
 ) -> Result<Feasibility> {
@@ -224,7 +224,7 @@ pub fn feasibility(
 /// [`crate::PlanError::Setting`] for a tolerance outside `(0, 0.5]` or bounds that are not
 /// `0 < min_scale < 1 < max_scale`; [`crate::PlanError::Run`] if the unscaled run fails.
 pub fn max_scale(
-    table: &Table<'_>,
+    table: &PlatenLoop<'_>,
     motion: &TargetMotion,
     settings: &MaxScaleSettings,
 ) -> Result<MaxScale> {
@@ -236,7 +236,7 @@ pub fn max_scale(
 }
 
 fn max_scale_from(
-    table: &Table<'_>,
+    table: &PlatenLoop<'_>,
     motion: &TargetMotion,
     settings: &MaxScaleSettings,
     unscaled: &[LimitUse],

@@ -28,7 +28,7 @@ use rustfft::FftPlanner;
 use platen_signal::Window;
 
 use crate::error::{check_setting, PlanError, Result};
-use crate::table::Table;
+use crate::platen_loop::PlatenLoop;
 
 /// Where `Ĥ` comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -104,7 +104,7 @@ struct Measured {
 
 impl FrequencyResponse {
     /// The linearised response of `table`'s loop about mid-stroke.
-    pub fn linearised(table: &Table<'_>) -> Self {
+    pub fn linearised(table: &PlatenLoop<'_>) -> Self {
         let (linearisation, _) = table
             .rig()
             .loop_linearisation()
@@ -123,7 +123,7 @@ impl FrequencyResponse {
     /// [`PlanError::Setting`] for a duration, segment or band the measurement cannot use;
     /// [`PlanError::Run`] if the run fails.
     pub fn measured(
-        table: &Table<'_>,
+        table: &PlatenLoop<'_>,
         sample_rate_hz: f64,
         settings: &NoiseSettings,
         default_band_hz: (f64, f64),

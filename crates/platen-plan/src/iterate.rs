@@ -82,10 +82,10 @@ use crate::correction::checked;
 pub use crate::correction::{Correction, DriveCorrection, TransferMatrix};
 use crate::error::{PlanError, Result};
 use crate::frf::{FrequencyResponse, FrfSource};
+use crate::platen_loop::{Achieved, PlatenLoop};
 pub use crate::settings::{
     default_band_hz, AxisTarget, IterationSettings, SpectrumSettings, DEFAULT_GAIN,
 };
-use crate::table::{Achieved, Table};
 
 /// One iteration's figures.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -238,7 +238,7 @@ impl<R, Rec, D> Iteration<R, Rec, D> {
 /// # Errors
 /// Bad settings; [`PlanError::Run`] if a closed-loop run fails.
 pub fn iterate(
-    table: &Table<'_>,
+    table: &PlatenLoop<'_>,
     motion: &TargetMotion,
     settings: &IterationSettings,
 ) -> Result<Iteration<Achieved>> {
@@ -251,7 +251,7 @@ pub fn iterate(
 /// # Errors
 /// As [`iterate`].
 pub fn iterate_observed(
-    table: &Table<'_>,
+    table: &PlatenLoop<'_>,
     motion: &TargetMotion,
     settings: &IterationSettings,
     on_run: &mut dyn FnMut(usize),

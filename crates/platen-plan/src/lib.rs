@@ -35,11 +35,11 @@
 //!
 //! ```
 //! use std::path::Path;
-//! use platen_plan::{plan_platen, PlanSettings, Table, Target};
+//! use platen_plan::{plan_platen, PlanSettings, PlatenLoop, Target};
 //!
 //! let json = r#"{"model": {"preset": "lhpost-2008"}, "table_system": {"preset": "lhpost-2008"}}"#;
 //! let rig = platen_scenario::LoadedRig::parse(Path::new("lhpost.json"), json)?;
-//! let table = Table::of_loaded(&rig, Path::new("lhpost.json"))?;
+//! let table = PlatenLoop::of_loaded(&rig, Path::new("lhpost.json"))?;
 //! let t: Vec<f64> = (0..4097).map(|j| j as f64 / 1024.0).collect(); // 4 s at 1024 Hz
 //! let a = t.iter().map(|t| 2.0 * (std::f64::consts::TAU * 2.0 * t).sin()).collect();
 //! let target = Target::acceleration(Path::new("sine"), t, a)?;
@@ -61,7 +61,7 @@
 //! * [`TargetMotion`] ([`baseline`]): the displacement command of a target, integrated from
 //!   an acceleration with a baseline treatment that starts and ends at rest and keeps the
 //!   displacement as small as a polynomial correction can.
-//! * [`Table`]: a rig's closed loop driven by any command ([`Achieved`]).
+//! * [`PlatenLoop`]: a rig's closed loop driven by any command ([`Achieved`]).
 //! * [`feasibility()`](feasibility::feasibility), [`max_scale`] ([`feasibility`]): peaks and
 //!   margins of stroke, velocity, acceleration, actuator force, valve flow and supply
 //!   pressure; the limits that fail; the largest scale that fits, by bisection on the
@@ -97,11 +97,11 @@ pub mod frf;
 pub mod iterate;
 pub mod mimo;
 mod plan;
+mod platen_loop;
 pub mod rrs;
 mod settings;
 pub mod six_dof;
 mod steps;
-mod table;
 mod target;
 
 pub use baseline::{command_motion, BaselineSettings, EndCorrection, TargetMotion};
@@ -121,13 +121,18 @@ pub use plan::{
     load_rig, plan_platen, write_drive, DriveSummary, FrfSummary, Plan, PlanSettings, PlanSummary,
     PlannedDrive, TargetSummary, UNIAXIAL_DRIVE_COLUMNS,
 };
+pub use platen_loop::{Achieved, PlatenLoop};
 pub use rrs::{RequiredSpectrum, DEFAULT_RRS_DAMPING};
 pub use six_dof::{
     plan_multi_axis, pose_command, AxisTargets, TableAchieved, TableFeasibility, TableIteratedAt,
     TableLimitUse, TablePlan, TablePlannedDrive, TablePlant,
 };
 pub use steps::{IteratedAt, SCALED_UP_ERROR_WARNED};
-pub use table::{Achieved, Table};
+
+/// The name [`PlatenLoop`] had before the words were settled (`docs/library.md`: "table"
+/// names a multi-axis table, "platen" the uniaxial one).
+#[deprecated(note = "renamed PlatenLoop: the uniaxial platen's closed loop")]
+pub type Table<'a> = PlatenLoop<'a>;
 pub use target::{
     enveloped_sines_m_s2, synthetic_three_component_m_s2, Target, TargetKind, MIN_TARGET_SAMPLES,
 };

@@ -19,12 +19,12 @@ use crate::feasibility::{
 use crate::iterate::{
     iterate_observed, record_of, IterationRecord, IterationSettings, SpectrumAcceptance, Stop,
 };
+use crate::platen_loop::{Achieved, PlatenLoop};
 use crate::rrs::RequiredSpectrum;
 use crate::steps::{
     acceptance, iteration_level, on_controller_rate, scaled_up, IteratedAt, IterationOutcome,
     Resampled,
 };
-use crate::table::{Achieved, Table};
 use crate::target::Target;
 use crate::Iteration;
 
@@ -180,13 +180,13 @@ pub const UNIAXIAL_DRIVE_COLUMNS: [&str; 2] = ["t_s", "u_m"];
 /// [`PlanError::NoTableSystem`].
 pub fn load_rig(path: &Path) -> Result<LoadedRig> {
     let loaded = LoadedRig::load(path)?;
-    Table::of_loaded(&loaded, path)?;
+    PlatenLoop::of_loaded(&loaded, path)?;
     Ok(loaded)
 }
 
-/// Plans `target` on the uniaxial `table` (a scenario's rig, [`Table::of_loaded`], or one
+/// Plans `target` on the uniaxial `table` (a scenario's rig, [`PlatenLoop::of_loaded`], or one
 /// built by hand: any [`Rig`](platen_scenario::Rig) with a table system and its
-/// [`LoopSettings`](platen_scenario::LoopSettings), [`Table::new`]): the target's motion, its
+/// [`LoopSettings`](platen_scenario::LoopSettings), [`PlatenLoop::new`]): the target's motion, its
 /// feasibility and largest scale, then the drive iteration; `name` and `scenario_path` name
 /// it in the summary, and `on_run(k)` is called when the closed-loop run of drive iteration
 /// `k` is done (0: the target's own command; at most `settings.iteration.max_iterations`),
@@ -198,7 +198,7 @@ pub fn load_rig(path: &Path) -> Result<LoadedRig> {
 /// is resampled to its rate ([`Target::resampled_to`]), with a notice in the plan's
 /// warnings.
 pub fn plan_platen(
-    table: &Table,
+    table: &PlatenLoop,
     name: &str,
     scenario_path: &Path,
     target: &Target,
@@ -280,7 +280,11 @@ fn target_warnings(motion: &TargetMotion) -> Vec<String> {
 
 /// The motion asked of `table` for `target` (already at most the controller's rate: a faster
 /// one is resampled by [`plan_platen`] first), not zero.
-fn target_motion(table: &Table, target: &Target, settings: &PlanSettings) -> Result<TargetMotion> {
+fn target_motion(
+    table: &PlatenLoop,
+    target: &Target,
+    settings: &PlanSettings,
+) -> Result<TargetMotion> {
     let controller_hz = table.controller_rate_hz();
     if target.kind() == crate::target::TargetKind::Displacement {
         // Beyond ten strokes no table reading exists (mm read as m): refused with the hint
@@ -333,7 +337,7 @@ fn feasibility_warning(feasibility: &Feasibility) -> Option<String> {
 /// The drive iteration on `table` and its best drive's limits, with what it warns of pushed
 /// on `warnings`.
 fn planned_drive(
-    table: &Table,
+    table: &PlatenLoop,
     motion: &TargetMotion,
     feasibility: &Feasibility,
     plan_settings: &PlanSettings,

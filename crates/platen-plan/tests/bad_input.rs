@@ -245,7 +245,7 @@ fn scenarios_for_planning_need_a_table_system_and_no_excitation() {
         m.contains("table_system.oil_bulk_modulus_pa") && m.contains("line 3"),
         "{m}"
     );
-    // Plan's own Table refuses a scenario without a loop too.
+    // Plan's own PlatenLoop refuses a scenario without a loop too.
     let open_loop = common::scenario(r#"{"model": {"preset": "lhpost-2008"}, "excitation": {}}"#);
     let t: Vec<f64> = (0..64).map(|j| j as f64 / 1024.0).collect();
     let target = Target::acceleration(Path::new("t"), t, vec![0.1; 64]).unwrap();

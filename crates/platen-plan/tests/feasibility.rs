@@ -10,7 +10,7 @@ use std::path::Path;
 use platen_integrate::Trajectory;
 use platen_plan::feasibility::{feasibility, limit_uses};
 use platen_plan::{
-    max_scale, BaselineSettings, MaxScaleSettings, PlanSettings, Table, Target, TargetMotion,
+    max_scale, BaselineSettings, MaxScaleSettings, PlanSettings, PlatenLoop, Target, TargetMotion,
 };
 use platen_scenario::RunSummary;
 
@@ -52,7 +52,7 @@ fn motion(target: &Target) -> TargetMotion {
 }
 
 /// The largest scale on a grid of `step` from `from` to `to` that fits, by running every one.
-fn scan(table: &Table<'_>, m: &TargetMotion, from: f64, to: f64, step: f64) -> f64 {
+fn scan(table: &PlatenLoop<'_>, m: &TargetMotion, from: f64, to: f64, step: f64) -> f64 {
     let mut best = 0.0;
     let mut s = from;
     let mut last_fit = true;
@@ -82,7 +82,7 @@ fn a_target_beyond_the_stroke_is_infeasible_on_the_stroke_and_its_max_scale_is_t
         r#"{"model": {"preset": "lhpost-2008"}, "excitation": {},
             "table_system": {"preset": "lhpost-2008", "accumulator": null}}"#,
     );
-    let table = Table::of_loaded(&scenario, Path::new("lhpost")).unwrap();
+    let table = PlatenLoop::of_loaded(&scenario, Path::new("lhpost")).unwrap();
     let m = motion(&sine_target(0.9, 0.25, 12.0));
     let f = feasibility(&table, &m, Some(&MaxScaleSettings::default())).unwrap();
     assert!(!f.feasible);
@@ -116,7 +116,7 @@ fn a_target_beyond_the_stroke_is_infeasible_on_the_stroke_and_its_max_scale_is_t
 #[test]
 fn a_target_beyond_the_velocity_limit_is_infeasible_on_the_velocity() {
     let scenario = common::lhpost("");
-    let table = Table::of_loaded(&scenario, Path::new("lhpost")).unwrap();
+    let table = PlatenLoop::of_loaded(&scenario, Path::new("lhpost")).unwrap();
     let m = motion(&sine_target(0.6, 0.6, 8.0));
     let f = feasibility(&table, &m, Some(&MaxScaleSettings::default())).unwrap();
     assert!(!f.feasible);
@@ -146,7 +146,7 @@ fn a_long_period_acceleration_target_cannot_be_brought_inside_the_stroke() {
     // Auto keeps the least correction.
     assert_eq!(m.end_degree, Some(3));
     let scenario = common::lhpost("");
-    let table = Table::of_loaded(&scenario, Path::new("lhpost")).unwrap();
+    let table = PlatenLoop::of_loaded(&scenario, Path::new("lhpost")).unwrap();
     let f = feasibility(&table, &m, None).unwrap();
     assert!(!f.feasible);
     assert_eq!(f.limiting[0].limit, "stroke_m");
@@ -177,7 +177,7 @@ fn a_long_period_acceleration_target_cannot_be_brought_inside_the_stroke() {
 fn a_small_target_fits_with_room_and_its_limits_are_simulates() {
     let json = common::lhpost_json("");
     let scenario = common::scenario(&json);
-    let table = Table::of_loaded(&scenario, Path::new("lhpost")).unwrap();
+    let table = PlatenLoop::of_loaded(&scenario, Path::new("lhpost")).unwrap();
     let (t, a) = common::accelerogram(2, 10.0, RATE_HZ, 0.3);
     let target = Target::acceleration(Path::new("eq"), t, a).unwrap();
     let m = TargetMotion::new(&target, &BaselineSettings::default(), 0.75, RATE_HZ).unwrap();
@@ -214,7 +214,7 @@ fn a_small_target_fits_with_room_and_its_limits_are_simulates() {
 #[test]
 fn a_tiny_target_fits_at_the_upper_bound() {
     let scenario = common::lhpost("");
-    let table = Table::of_loaded(&scenario, Path::new("lhpost")).unwrap();
+    let table = PlatenLoop::of_loaded(&scenario, Path::new("lhpost")).unwrap();
     let m = motion(&sine_target(1e-4, 1.0, 6.0));
     let settings = MaxScaleSettings {
         max_scale: 20.0,

@@ -1,5 +1,5 @@
 //! The simulated table: a rig's closed loop (model, `table_system`, specimen) driven by any
-//! displacement command ([`Table::run`]).
+//! displacement command ([`PlatenLoop::run`]).
 
 use std::path::{Path, PathBuf};
 
@@ -12,7 +12,7 @@ use crate::error::{PlanError, Result};
 
 /// A rig's closed loop, ready to run any command: what the planner simulates.
 #[derive(Debug, Clone, Copy)]
-pub struct Table<'a> {
+pub struct PlatenLoop<'a> {
     rig: &'a Rig,
     system: &'a TableSystem,
     settings: LoopSettings,
@@ -23,7 +23,7 @@ pub struct Table<'a> {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Achieved {
     /// Where the run stopped at the end of the actuators, if it did
-    /// ([`Table::run_or_end_stop`]): the samples and peaks then hold the run up to there, and
+    /// ([`PlatenLoop::run_or_end_stop`]): the samples and peaks then hold the run up to there, and
     /// `output` has no statistics.
     pub end_stop: Option<Peak>,
     /// Achieved displacement, m.
@@ -98,7 +98,7 @@ impl SampleSink for Recorder {
     }
 }
 
-impl<'a> Table<'a> {
+impl<'a> PlatenLoop<'a> {
     /// The table of `rig`, which must have a `table_system`, its loop integrated as
     /// `settings` say; `path` names the rig's scenario file in the error.
     ///
@@ -173,7 +173,7 @@ impl<'a> Table<'a> {
         }
     }
 
-    /// [`Table::run`], but a run that reaches the end of the actuators (a chamber's oil
+    /// [`PlatenLoop::run`], but a run that reaches the end of the actuators (a chamber's oil
     /// volume gone) is an answer, not an error: [`Achieved::end_stop`] says where, and the
     /// rest holds the run up to there.
     ///
