@@ -170,6 +170,11 @@ for s in scenarios/multi-axis/*.json scenarios/table-system/northridge-*.json; d
   run "model_scenario_${name}_text" model --scenario "$s"
 done
 run simulate_multi_axis_plot simulate scenarios/multi-axis/forward.json --json --plot "$out/multi-axis-figures"
+# A run longer than the figures' 2 200 envelope points (bucketed), to Parquet and to CSV.
+run simulate_tower_inverse_plot simulate scenarios/multi-axis/tower-inverse.json --json \
+  --out "$out/tower-inverse.parquet" --plot "$out/tower-inverse-figures"
+run simulate_tower_inverse_plot_text simulate scenarios/multi-axis/tower-inverse.json \
+  --out "$out/tower-inverse-2.csv" --plot "$out/tower-inverse-figures-2"
 run simulate_multi_axis_pressure simulate scenarios/multi-axis/forward.json --pressure-mpa 10
 six="$out/six"
 mkdir -p "$six"
@@ -183,6 +188,8 @@ JSON
 run simulate_six_csv simulate "$six/lhpost6-sines.json" --out "$six/sines.csv"
 run simulate_six_json simulate "$six/lhpost6-sines.json" --json
 run simulate_six_text simulate "$six/lhpost6-sines.json"
+run simulate_six_plot simulate "$six/lhpost6-sines.json" --json --out "$six/sines.parquet" \
+  --plot "$six/sines-figures"
 run model_six_json model --scenario "$six/lhpost6-sines.json" --json
 run generate_six_target generate excitation "$six/lhpost6-sines.json" --out "$six/target.csv"
 run plan_six_json plan "$six/lhpost6-sines.json" --target "$six/target.csv" --out "$six/drive.csv" \

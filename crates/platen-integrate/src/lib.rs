@@ -95,7 +95,9 @@ pub use error::{IntegrateError, Result};
 pub use event::EventKind;
 pub use inverse::{inverse, inverse_specimen, INVERSE_SPECIMEN_SUBSTEPS};
 pub use method::{ForwardIntegrator, Method};
-pub use multi_axis::{inverse_table, PoseMotion, TableRun};
+pub use multi_axis::{
+    inverse_table, inverse_table_columns, inverse_table_into, PoseMotion, TableRun,
+};
 pub use output::{
     Exceedance, Peak, Peaks, Sample, SampleSink, SpecimenColumns, SpecimenSample, SystemColumns,
     SystemSample, TableSink, Trajectory,
@@ -114,11 +116,11 @@ pub use specimen::{forward_rk4_specimen, forward_specimen};
 pub use stepping::{Step, Stepping};
 pub use stop::{AdaptiveFailure, Failure, StopReason};
 pub use table_forward::{
-    forward_table, forward_table_into, table_kinetic_energy_j, table_potential_energy_j,
-    ActuatorForces,
+    forward_table, forward_table_into, table_columns, table_kinetic_energy_j,
+    table_potential_energy_j, ActuatorForces,
 };
 pub use table_loop::{
-    forward_table_loop, forward_table_loop_into, TableLoopRun, TableLoopStats, MAX_LOOP_ACTUATORS,
-    SPENT_GAS_FRACTION,
+    forward_table_loop, forward_table_loop_into, table_loop_columns, TableLoopRun, TableLoopStats,
+    MAX_LOOP_ACTUATORS, SPENT_GAS_FRACTION,
 };
 pub use table_plant::{MAX_TABLE_ACTUATORS, MAX_TABLE_SPECIMEN_DOFS};

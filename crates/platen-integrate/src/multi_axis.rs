@@ -122,31 +122,6 @@ fn wrench_names(term: &str) -> [String; 6] {
         .expect("six names")
 }
 
-/// A column builder: names first, then one row at a time.
-struct Columns {
-    names: Vec<String>,
-    data: Vec<Vec<f64>>,
-}
-
-impl Columns {
-    fn new(names: Vec<String>, rows: usize) -> Self {
-        let data = names.iter().map(|_| Vec::with_capacity(rows)).collect();
-        Columns { names, data }
-    }
-
-    fn push(&mut self, row: &[f64]) {
-        for (c, &x) in self.data.iter_mut().zip(row) {
-            c.push(x);
-        }
-    }
-
-    fn finish(self) -> TableRun {
-        TableRun {
-            columns: self.names.into_iter().zip(self.data).collect(),
-        }
-    }
-}
-
 /// The inverse of the multi-axis platen: at every sample of `motion`, the actuator forces
 /// ([`MultiAxisTable::inverse`]) with every term, the actuators' strokes, the struts' pulls
 /// and, with a `specimen`, its base force and overturning moments. The specimen is driven by
@@ -170,8 +145,24 @@ pub fn inverse_table(
     specimen: Option<&LinearSpecimen>,
     motion: &PoseMotion,
 ) -> Result<TableRun> {
+    let mut out = TableRun::default();
+    inverse_table_into(table, specimen, motion, &mut out)?;
+    Ok(out)
+}
+
+/// [`inverse_table`], delivering its rows to `sink` (the columns' names first,
+/// [`inverse_table_columns`]) as they are computed.
+///
+/// # Errors
+/// As [`inverse_table`] (the rows before the failing sample delivered).
+pub fn inverse_table_into<K: TableSink>(
+    table: &MultiAxisTable,
+    specimen: Option<&LinearSpecimen>,
+    motion: &PoseMotion,
+    sink: &mut K,
+) -> Result<()> {
     let n = motion.len();
-    let mut out = Columns::new(inverse_names(table, specimen.is_some()), n);
+    sink.start(&inverse_table_columns(table, specimen.is_some()), n);
     let mut spec = specimen.map(|s| SpecimenState {
         z: s.equilibrium_under(&-GRAVITY)
             .unwrap_or_else(|| DVector::zeros(s.len())),
@@ -200,13 +191,15 @@ pub fn inverse_table(
         row.extend(q.iter().chain(qd.iter()).chain(qdd.iter()));
         let base = specimen.is_some().then(|| -on_platen);
         push_inverse_forces(&mut row, table, &q, &sample, base.as_ref());
-        out.push(&row);
+        sink.accept(&row);
     }
-    Ok(out.finish())
+    Ok(())
 }
 
-/// The columns of [`inverse_table`]'s run (see there), `with_specimen` or not.
-fn inverse_names(table: &MultiAxisTable, with_specimen: bool) -> Vec<String> {
+/// The columns of [`inverse_table`]'s run (see there), `with_specimen` or not: what
+/// [`TableSink::start`] receives, known before the run so that its output can be created
+/// first.
+pub fn inverse_table_columns(table: &MultiAxisTable, with_specimen: bool) -> Vec<String> {
     let mut names = vec!["t_s".to_string()];
     names.extend(pose_names(""));
     names.extend(pose_names("_s"));

@@ -107,6 +107,38 @@ impl<S: TableSink + ?Sized> TableSink for &mut S {
     }
 }
 
+/// Both sinks receive every row, the first first.
+impl<A: TableSink, B: TableSink> TableSink for (A, B) {
+    #[inline]
+    fn start(&mut self, names: &[String], samples: usize) {
+        self.0.start(names, samples);
+        self.1.start(names, samples);
+    }
+
+    #[inline]
+    fn accept(&mut self, row: &[f64]) {
+        self.0.accept(row);
+        self.1.accept(row);
+    }
+}
+
+/// An absent sink receives nothing.
+impl<S: TableSink> TableSink for Option<S> {
+    #[inline]
+    fn start(&mut self, names: &[String], samples: usize) {
+        if let Some(s) = self {
+            s.start(names, samples);
+        }
+    }
+
+    #[inline]
+    fn accept(&mut self, row: &[f64]) {
+        if let Some(s) = self {
+            s.accept(row);
+        }
+    }
+}
+
 /// A run kept in memory as the contract's columns.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Trajectory {

@@ -276,6 +276,40 @@ const SPECIMEN_COLUMNS: [&str; 5] = [
     "overturning_moment_y_n_m",
 ];
 
+/// The columns of a forward run ([`forward_table_into`]) of `table` carrying `specimen`, in
+/// their order (the closed loop's follow them, [`crate::table_loop_columns`]): what
+/// [`TableSink::start`] receives, known before the run so that its output can be created
+/// first.
+pub fn table_columns(table: &MultiAxisTable, specimen: Option<&LinearSpecimen>) -> Vec<String> {
+    let mut names = vec!["t_s".to_string()];
+    for suffix in ["", "_s", "_s2"] {
+        names.extend(Dof::ALL.map(|d| format!("{}_{}{suffix}", d.name(), d.unit())));
+    }
+    for a in table.actuators() {
+        names.push(format!("{}_stroke_m", a.name));
+        names.push(format!("{}_force_n", a.name));
+    }
+    for s in table.struts() {
+        names.push(format!("{}_force_n", s.name));
+    }
+    if specimen.is_some() {
+        names.extend(SPECIMEN_COLUMNS.map(String::from));
+    }
+    names.push("actuator_work_j".into());
+    if table.has_friction() {
+        names.push("dissipated_j".into());
+        names.push("stuck".into());
+    }
+    if let Some(s) = specimen {
+        for i in 1..=s.len() {
+            names.push(format!("specimen{i}_z"));
+            names.push(format!("specimen{i}_zdot"));
+        }
+        names.push("specimen_damping_j".into());
+    }
+    names
+}
+
 /// The run's columns: their names, and each row filled a sample at a time for a sink.
 pub(crate) struct Rows {
     names: Vec<String>,
@@ -283,38 +317,14 @@ pub(crate) struct Rows {
 }
 
 impl Rows {
-    /// The columns of a run of `table` carrying `specimen`, with `extra` columns last.
+    /// The columns of a run of `table` carrying `specimen` ([`table_columns`]), with `extra`
+    /// columns last.
     pub(crate) fn new(
         table: &MultiAxisTable,
         specimen: Option<&LinearSpecimen>,
         extra: Vec<String>,
     ) -> Self {
-        let mut names = vec!["t_s".to_string()];
-        for suffix in ["", "_s", "_s2"] {
-            names.extend(Dof::ALL.map(|d| format!("{}_{}{suffix}", d.name(), d.unit())));
-        }
-        for a in table.actuators() {
-            names.push(format!("{}_stroke_m", a.name));
-            names.push(format!("{}_force_n", a.name));
-        }
-        for s in table.struts() {
-            names.push(format!("{}_force_n", s.name));
-        }
-        if specimen.is_some() {
-            names.extend(SPECIMEN_COLUMNS.map(String::from));
-        }
-        names.push("actuator_work_j".into());
-        if table.has_friction() {
-            names.push("dissipated_j".into());
-            names.push("stuck".into());
-        }
-        if let Some(s) = specimen {
-            for i in 1..=s.len() {
-                names.push(format!("specimen{i}_z"));
-                names.push(format!("specimen{i}_zdot"));
-            }
-            names.push("specimen_damping_j".into());
-        }
+        let mut names = table_columns(table, specimen);
         names.extend(extra);
         Rows {
             names,

@@ -510,6 +510,38 @@ impl Command for PoseMotion {
     }
 }
 
+/// The columns of a closed-loop run ([`forward_table_loop_into`]) of `table` carrying
+/// `specimen`, in their order: what [`TableSink::start`] receives, known before the run so
+/// that its output can be created first.
+pub fn table_loop_columns(
+    table: &MultiAxisTable,
+    specimen: Option<&LinearSpecimen>,
+) -> Vec<String> {
+    let mut names = crate::table_columns(table, specimen);
+    names.extend(loop_columns(table));
+    names
+}
+
+/// The closed loop's own columns, after those of [`crate::table_columns`].
+fn loop_columns(table: &MultiAxisTable) -> Vec<String> {
+    let mut names: Vec<String> = Dof::ALL
+        .iter()
+        .map(|d| format!("command_{}_{}", d.name(), d.unit()))
+        .collect();
+    for a in table.actuators() {
+        names.extend(ACTUATOR_COLUMNS.iter().map(|c| format!("{}_{c}", a.name)));
+    }
+    names.extend(
+        [
+            "supply_pressure_pa",
+            "warping_force_n",
+            "hydraulic_energy_j",
+        ]
+        .map(String::from),
+    );
+    names
+}
+
 /// The multi-axis table's DOF controller and output around its [`TablePlant`] driven by the
 /// actuators' hydraulics.
 struct TableLoop<'a> {
@@ -526,26 +558,10 @@ struct TableLoop<'a> {
 impl<'a> TableLoop<'a> {
     /// The controller and the columns of `run`.
     fn new(run: &TableLoopRun<'a>) -> Self {
-        let table = run.table;
-        let mut names: Vec<String> = Dof::ALL
-            .iter()
-            .map(|d| format!("command_{}_{}", d.name(), d.unit()))
-            .collect();
-        for a in table.actuators() {
-            names.extend(ACTUATOR_COLUMNS.iter().map(|c| format!("{}_{c}", a.name)));
-        }
-        names.extend(
-            [
-                "supply_pressure_pa",
-                "warping_force_n",
-                "hydraulic_energy_j",
-            ]
-            .map(String::from),
-        );
         TableLoop {
             run: *run,
             state: run.controller.start(),
-            rows: Rows::new(table, run.specimen, names),
+            rows: Rows::new(run.table, run.specimen, loop_columns(run.table)),
             extra: Vec::new(),
             max_warping_force_n: 0.0,
         }

@@ -34,7 +34,7 @@ const LIMIT_SHOWN_FROM: f64 = 0.6;
 
 /// The envelope of one channel, built one sample at a time.
 #[derive(Debug, Clone)]
-struct Envelope {
+pub(crate) struct Envelope {
     /// Every sample is kept (a record of at most `2·BUCKETS` samples).
     all: bool,
     t0_s: f64,
@@ -47,7 +47,8 @@ struct Envelope {
 }
 
 impl Envelope {
-    fn new(span_s: (f64, f64), samples: usize) -> Self {
+    /// An envelope over `span_s` of a channel of `samples` samples.
+    pub(crate) fn new(span_s: (f64, f64), samples: usize) -> Self {
         Self {
             all: samples <= 2 * BUCKETS,
             t0_s: span_s.0,
@@ -59,7 +60,8 @@ impl Envelope {
         }
     }
 
-    fn push(&mut self, index: usize, t: f64, y: f64) {
+    /// Sample `index`, `(t, y)`.
+    pub(crate) fn push(&mut self, index: usize, t: f64, y: f64) {
         if self.all {
             self.points.push((t, y));
             return;
@@ -96,7 +98,8 @@ impl Envelope {
         }
     }
 
-    fn finish(mut self) -> Points {
+    /// The envelope's points.
+    pub(crate) fn finish(mut self) -> Points {
         self.flush();
         self.points
     }

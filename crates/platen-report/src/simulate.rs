@@ -3,21 +3,24 @@
 //! the figures) and reports it (its [`Summary`], as JSON or text). The front ends call this
 //! and do not tell the tables apart.
 //!
-//! A uniaxial run streams: its samples go to the output file as they are produced (to a
-//! temporary file renamed over the target when the run is complete, removed if it fails) and
-//! the figures' points are gathered in memory that does not grow with the run. A multi-axis
-//! run is held in memory and written when complete, atomically as well.
+//! Every run streams, whatever its table: its samples go to the output file as they are
+//! produced (to a temporary file, created before the run, renamed over the target when the
+//! run is complete, removed if it fails), and the figures' points and the summary's figures
+//! are gathered as it goes, in memory that does not grow with the run (a uniaxial run's
+//! [`RunRecorder`] and `Tracking`, a multi-axis run's [`TableRecorder`] and [`TablePeaks`]).
 
 use std::path::{Path, PathBuf};
 
-use platen_integrate::SampleSink;
+use platen_integrate::{SampleSink, TableSink};
 use platen_io::IoError;
+use platen_scenario::multi_axis::{TablePeaks, TableScenario};
 use platen_scenario::{CsvSink, PlatenScenario, Run, RunSummary, Scenario, ScenarioError, Summary};
 
 use crate::error::ReportError;
 use crate::render::FigureSize;
 use crate::run_figures::{self, RunRecorder};
 use crate::simulate_report::with_outputs;
+use crate::table_figures::{self, TableRecorder};
 
 /// Where [`simulate`] writes a run.
 #[derive(Debug, Clone, Copy)]
@@ -76,14 +79,14 @@ impl Simulated {
     }
 }
 
-/// Runs `scenario` (read from `path`) into `outputs`, delivering a uniaxial run's samples to
-/// `tick` too (a progress bar), and reports it.
+/// Runs `scenario` (read from `path`) into `outputs`, delivering its samples (a uniaxial
+/// run's) or rows (a multi-axis run's) to `tick` too (a progress bar), and reports it.
 ///
 /// # Errors
 /// [`SimulateError`]: an output that cannot be created (before the run), the run's failure,
 /// a value that cannot be written, a figure that cannot be drawn. Nothing is left half
 /// written.
-pub fn simulate<T: SampleSink>(
+pub fn simulate<T: SampleSink + TableSink>(
     scenario: &Scenario,
     path: &Path,
     outputs: &Outputs<'_>,
@@ -91,7 +94,7 @@ pub fn simulate<T: SampleSink>(
 ) -> Result<Simulated, SimulateError> {
     match scenario {
         Scenario::Platen(s) => simulate_platen(s, path, outputs, tick),
-        Scenario::Table(s) => simulate_table(s, outputs),
+        Scenario::Table(s) => simulate_table(s, outputs, tick),
     }
 }
 
@@ -144,30 +147,37 @@ fn simulate_platen<T: SampleSink>(
     })
 }
 
-/// [`simulate`] on a multi-axis table: in memory, written when complete.
-fn simulate_table(
-    scenario: &platen_scenario::multi_axis::TableScenario,
+/// [`simulate`] on a multi-axis table: streamed.
+fn simulate_table<T: TableSink>(
+    scenario: &TableScenario,
     outputs: &Outputs<'_>,
+    tick: T,
 ) -> Result<Simulated, SimulateError> {
     let Outputs { out, plot, size } = *outputs;
-    let (run, stats) = scenario.run_with_stats()?;
-    if let Some(out) = out {
-        let header: Vec<&str> = run.columns.iter().map(|(n, _)| n.as_str()).collect();
-        let columns: Vec<&[f64]> = run.columns.iter().map(|(_, c)| c.as_slice()).collect();
-        platen_io::parquet::write_columns_atomic(out, &header, &columns)?;
+    // Create the temporary output first, so that an unwritable path fails before the run.
+    let mut stream = out
+        .map(|p| CsvSink::create_named(p, &scenario.columns()))
+        .transpose()?;
+    let mut recorder = plot.map(|_| TableRecorder::new(scenario.output_t_s()));
+    let mut peaks = TablePeaks::new(scenario);
+    let mut tick = tick;
+    let sinks = (&mut tick, (stream.as_mut(), recorder.as_mut()));
+    let stats = scenario.run_into(&mut (&mut peaks, sinks))?;
+    if let Some(stream) = stream {
+        stream.finish()?;
     }
-    let figures = match plot {
-        Some(dir) => crate::table_figures::write_table_figures(
-            &run,
+    let figures = match (plot, recorder) {
+        (Some(dir), Some(recorder)) => table_figures::write_recorded_figures(
+            recorder,
             &scenario.table,
             Some(&scenario.force_limits_n()),
             scenario.flow_capacities_m3_s().as_deref(),
             dir,
             size,
         )?,
-        None => Vec::new(),
+        _ => Vec::new(),
     };
-    let summary = scenario.summary_with(&run, stats.as_ref(), out);
+    let summary = scenario.summary_of(&peaks, stats.as_ref(), out);
     let text = crate::table_text::summary_text(&summary, &figures);
     Ok(Simulated {
         summary: Summary::Table(Box::new(summary)),

@@ -12,10 +12,14 @@
 //!
 //! Panels are in the table's order of the actuators, each titled with the actuator's name,
 //! its mount (swivel or pad) and its peak. Every channel is drawn as the smallest and largest
-//! sample of each of [`BUCKETS`] equal time intervals ([`envelope`]), so a 40 s run at
+//! sample of each of [`BUCKETS`] equal time intervals ([`envelope`](crate::series::envelope)), so a 40 s run at
 //! 1024 Hz draws about 2200 points per panel. A column the run lacks is left out (its panel
 //! is not drawn, nor a figure without any); a run without `t_s` or without samples has no
 //! figures.
+//!
+//! A [`TableRecorder`] is a [`TableSink`] that keeps, while the run goes, only these
+//! envelopes, so that `platen simulate --plot` draws a run it streams to its file without
+//! holding it; [`figures`] draws a run held in memory through the same recorder.
 //!
 //! Output is a pure function of the run and the table: the same input gives the same bytes.
 
@@ -23,14 +27,14 @@ use std::path::{Path, PathBuf};
 
 use plotters::style::RGBColor;
 
-use platen_integrate::TableRun;
+use platen_integrate::{TableRun, TableSink};
 use platen_model::multi_axis::{Dof, Mount, MultiAxisTable};
 
 use crate::error::Result;
 use crate::figure::{Dash, Figure, Panel, MODEL, SIMULATED};
 use crate::render::{render_all, write_figures, FigureSize};
-use crate::run_figures::BUCKETS;
-use crate::series::{envelope, line, patterned, Points};
+use crate::run_figures::{Envelope, BUCKETS};
+use crate::series::{line, patterned, Points};
 use crate::sweep_figures::limit_text;
 use crate::text::significant;
 
@@ -54,10 +58,23 @@ pub fn figures(
     force_limits_n: Option<&[(f64, f64)]>,
     flow_capacity_m3_s: Option<&[f64]>,
 ) -> Vec<Figure> {
-    let Some(t) = run.column("t_s").filter(|t| !t.is_empty()) else {
+    let Some(recorder) = TableRecorder::of_run(run) else {
         return Vec::new();
     };
-    let c = Columns::new(run, t);
+    recorded_figures(recorder, table, force_limits_n, flow_capacity_m3_s)
+}
+
+/// [`figures`] of a run whose envelopes `recorder` kept as it went.
+pub fn recorded_figures(
+    recorder: TableRecorder,
+    table: &MultiAxisTable,
+    force_limits_n: Option<&[(f64, f64)]>,
+    flow_capacity_m3_s: Option<&[f64]>,
+) -> Vec<Figure> {
+    if recorder.rows == 0 {
+        return Vec::new();
+    }
+    let c = recorder.finish();
     let mut out = vec![
         pose(&c),
         actuator_strokes(&c, table),
@@ -88,7 +105,28 @@ pub fn write_table_figures(
     dir: &Path,
     size: FigureSize,
 ) -> Result<Vec<PathBuf>> {
-    let mut figures = figures(run, table, force_limits_n, flow_capacity_m3_s);
+    let figures = figures(run, table, force_limits_n, flow_capacity_m3_s);
+    write_all(figures, dir, size)
+}
+
+/// [`write_table_figures`] of a run whose envelopes `recorder` kept as it went.
+///
+/// # Errors
+/// As [`write_table_figures`].
+pub fn write_recorded_figures(
+    recorder: TableRecorder,
+    table: &MultiAxisTable,
+    force_limits_n: Option<&[(f64, f64)]>,
+    flow_capacity_m3_s: Option<&[f64]>,
+    dir: &Path,
+    size: FigureSize,
+) -> Result<Vec<PathBuf>> {
+    let figures = recorded_figures(recorder, table, force_limits_n, flow_capacity_m3_s);
+    write_all(figures, dir, size)
+}
+
+/// Writes `figures` to `dir` at `size` (see [`write_table_figures`]).
+fn write_all(mut figures: Vec<Figure>, dir: &Path, size: FigureSize) -> Result<Vec<PathBuf>> {
     for f in &mut figures {
         f.size = size.of(f.size);
     }
@@ -98,39 +136,116 @@ pub fn write_table_figures(
     Ok(written)
 }
 
-/// A run's time column and the envelopes of its other columns.
-struct Columns<'a> {
-    run: &'a TableRun,
-    t_s: &'a [f64],
+/// The envelopes of a multi-axis run's columns, kept as the run goes (a [`TableSink`]):
+/// per column the smallest and largest sample of each of [`BUCKETS`] equal time intervals of
+/// the run's span, the points [`envelope`](crate::series::envelope) picks from the whole column. Its memory does not
+/// grow with the run.
+#[derive(Debug, Clone)]
+pub struct TableRecorder {
     /// First and last time stamps (a unit interval around a single sample).
     span_s: (f64, f64),
+    /// The run's rows, as announced.
+    samples: usize,
+    names: Vec<String>,
+    envelopes: Vec<Envelope>,
+    /// Rows received.
+    rows: usize,
 }
 
-impl<'a> Columns<'a> {
-    fn new(run: &'a TableRun, t_s: &'a [f64]) -> Self {
-        let (t0, t1) = (t_s[0], t_s[t_s.len() - 1]);
-        let span_s = if t1 > t0 {
-            (t0, t1)
-        } else {
-            (t0 - 0.5, t0 + 0.5)
+impl TableRecorder {
+    /// A recorder for a run whose rows are at the time stamps `t_s` (known before it:
+    /// `TableScenario::output_t_s`).
+    pub fn new(t_s: &[f64]) -> Self {
+        let span_s = match (t_s.first(), t_s.last()) {
+            (Some(&t0), Some(&t1)) if t1 > t0 => (t0, t1),
+            (Some(&t0), _) => (t0 - 0.5, t0 + 0.5),
+            _ => (0.0, 1.0),
         };
-        Self { run, t_s, span_s }
+        Self {
+            span_s,
+            samples: t_s.len(),
+            names: Vec::new(),
+            envelopes: Vec::new(),
+            rows: 0,
+        }
     }
 
-    /// The envelope of column `name` times `scale` (`None` if the run lacks it); a column
-    /// shorter than the time column is drawn over its own samples.
+    /// The envelopes of `run` (`None` without a time column or samples); a column shorter
+    /// than the time column over its own samples.
+    fn of_run(run: &TableRun) -> Option<Self> {
+        let t = run.column("t_s").filter(|t| !t.is_empty())?;
+        let mut recorder = Self::new(t);
+        recorder.rows = t.len();
+        for (name, y) in &run.columns {
+            let mut e = Envelope::new(recorder.span_s, y.len().min(t.len()));
+            for (i, (&t, &y)) in t.iter().zip(y).enumerate() {
+                e.push(i, t, y);
+            }
+            recorder.names.push(name.clone());
+            recorder.envelopes.push(e);
+        }
+        Some(recorder)
+    }
+
+    /// The columns' envelopes.
+    fn finish(self) -> Columns {
+        Columns {
+            samples: self.rows,
+            span_s: self.span_s,
+            points: self
+                .names
+                .into_iter()
+                .zip(self.envelopes.into_iter().map(Envelope::finish))
+                .collect(),
+        }
+    }
+}
+
+impl TableSink for TableRecorder {
+    fn start(&mut self, names: &[String], _samples: usize) {
+        self.names = names.to_vec();
+        self.envelopes = names
+            .iter()
+            .map(|_| Envelope::new(self.span_s, self.samples))
+            .collect();
+    }
+
+    fn accept(&mut self, row: &[f64]) {
+        let (i, t) = (self.rows, row.first().copied().unwrap_or_default());
+        for (e, &y) in self.envelopes.iter_mut().zip(row) {
+            e.push(i, t, y);
+        }
+        self.rows += 1;
+    }
+}
+
+/// A run's envelopes by column.
+struct Columns {
+    /// Each column's name and envelope.
+    points: Vec<(String, Points)>,
+    /// First and last time stamps (a unit interval around a single sample).
+    span_s: (f64, f64),
+    samples: usize,
+}
+
+impl Columns {
+    /// The envelope of column `name` times `scale` (`None` if the run lacks it).
     fn envelope(&self, name: &str, scale: f64) -> Option<Points> {
-        let y = self.run.column(name)?;
-        let n = y.len().min(self.t_s.len());
-        let mut points = envelope(&self.t_s[..n], &y[..n], self.span_s, BUCKETS);
+        let (_, points) = self.points.iter().find(|(n, _)| n == name)?;
+        let mut points = points.clone();
         for p in &mut points {
             p.1 *= scale;
         }
         Some(points)
     }
 
+    /// Whether the run has column `name`.
+    fn has(&self, name: &str) -> bool {
+        self.points.iter().any(|(n, _)| n == name)
+    }
+
     fn samples(&self) -> usize {
-        self.t_s.len()
+        self.samples
     }
 }
 
@@ -210,7 +325,7 @@ fn mount_name(mount: &Mount) -> &'static str {
 }
 
 /// The "over the run" clause of the captions.
-fn sampling(c: &Columns<'_>) -> String {
+fn sampling(c: &Columns) -> String {
     format!(
         "{} samples; the smallest and largest sample of each of {BUCKETS} equal time intervals",
         c.samples()
@@ -223,7 +338,7 @@ fn height(panels: usize, columns: usize, per_row: u32) -> u32 {
 }
 
 /// The six pose coordinates over time: x, y, z in mm (left), roll, pitch, yaw in mrad (right).
-fn pose(c: &Columns<'_>) -> Figure {
+fn pose(c: &Columns) -> Figure {
     // Row by row: x | roll, y | pitch, z | yaw.
     let order = [Dof::X, Dof::Roll, Dof::Y, Dof::Pitch, Dof::Z, Dof::Yaw];
     let panels: Vec<Panel> = order
@@ -255,7 +370,7 @@ fn pose(c: &Columns<'_>) -> Figure {
 }
 
 /// Every actuator's stroke over time (mm), with its ±`stroke_m` dashed.
-fn actuator_strokes(c: &Columns<'_>, table: &MultiAxisTable) -> Figure {
+fn actuator_strokes(c: &Columns, table: &MultiAxisTable) -> Figure {
     let panels: Vec<Panel> = table
         .actuators()
         .iter()
@@ -297,7 +412,7 @@ fn actuator_strokes(c: &Columns<'_>, table: &MultiAxisTable) -> Figure {
 
 /// Every actuator's force over time (kN), with its pull and push limits dashed when given.
 fn actuator_forces(
-    c: &Columns<'_>,
+    c: &Columns,
     table: &MultiAxisTable,
     force_limits_n: Option<&[(f64, f64)]>,
 ) -> Figure {
@@ -358,11 +473,8 @@ fn actuator_forces(
 
 /// The specimen's overturning moments (kN·m) and base forces (kN) over time, when the run
 /// has the overturning moments' columns.
-fn overturning_moments(c: &Columns<'_>) -> Option<Figure> {
-    if !SPECIMEN_COLUMNS[..2]
-        .iter()
-        .any(|(name, ..)| c.run.column(name).is_some())
-    {
+fn overturning_moments(c: &Columns) -> Option<Figure> {
+    if !SPECIMEN_COLUMNS[..2].iter().any(|(name, ..)| c.has(name)) {
         return None;
     }
     let panels: Vec<Panel> = SPECIMEN_COLUMNS
@@ -395,7 +507,7 @@ fn overturning_moments(c: &Columns<'_>) -> Option<Figure> {
 
 /// A closed loop's tracking: per DOF the command (dashed) and the achieved pose (solid), mm
 /// or mrad; the DOFs commanded still show the cross-talk. `None` without command columns.
-fn tracking(c: &Columns<'_>) -> Option<Figure> {
+fn tracking(c: &Columns) -> Option<Figure> {
     let order = [Dof::X, Dof::Roll, Dof::Y, Dof::Pitch, Dof::Z, Dof::Yaw];
     let panels: Vec<Panel> = order
         .iter()
@@ -453,7 +565,7 @@ fn tracking(c: &Columns<'_>) -> Option<Figure> {
 
 /// A closed loop's valve flows: each actuator's flow into its chamber a (l/s) with its
 /// valves' capacity at the supply pressure dashed. `None` without flow columns.
-fn flows(c: &Columns<'_>, table: &MultiAxisTable, capacity: Option<&[f64]>) -> Option<Figure> {
+fn flows(c: &Columns, table: &MultiAxisTable, capacity: Option<&[f64]>) -> Option<Figure> {
     let panels: Vec<Panel> = table
         .actuators()
         .iter()
@@ -504,7 +616,7 @@ fn flows(c: &Columns<'_>, table: &MultiAxisTable, capacity: Option<&[f64]>) -> O
 }
 
 /// A closed loop's supply pressure (MPa). `None` without the column.
-fn supply_pressure(c: &Columns<'_>) -> Option<Figure> {
+fn supply_pressure(c: &Columns) -> Option<Figure> {
     let points = c.envelope("supply_pressure_pa", 1e-6)?;
     let (lo, hi) = extremes(&points);
     Some(Figure {

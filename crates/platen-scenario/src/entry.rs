@@ -153,7 +153,7 @@ impl Scenario {
     pub fn samples(&self) -> usize {
         match self {
             Scenario::Platen(s) => s.run.samples(),
-            Scenario::Table(_) => self.excitation().len(),
+            Scenario::Table(s) => s.output_t_s().len(),
         }
     }
 

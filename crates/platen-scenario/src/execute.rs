@@ -5,7 +5,7 @@ use std::path::Path;
 use platen_integrate::{
     forward_closed_loop, forward_specimen, inverse, inverse_specimen, ForwardIntegrator,
     IntegrateError, LoopRun, LoopStats, Motion, Peak, Peaks, RunStats, Sample, SampleSink,
-    SystemColumns, Trajectory,
+    SystemColumns, TableSink, Trajectory,
 };
 use platen_io::series::SeriesWriter;
 use platen_io::IoError;
@@ -294,10 +294,14 @@ fn run_model<M: PlatenModel, S: SampleSink>(
 /// CSV file as the run produces them, atomically ([`SeriesWriter`]): a one-hour 1024 Hz run
 /// holds no trajectory in memory, and a failed run leaves no partial file. A destination
 /// ending in `.parquet` gets the same columns as a Parquet file (`float64`, one row per
-/// sample) instead.
+/// sample) instead. Created with [`CsvSink::create_named`], it is the [`TableSink`] of a
+/// multi-axis run, streamed the same way.
 #[derive(Debug)]
 pub struct CsvSink {
     writer: SeriesWriter,
+    /// The destination and its header's width.
+    path: std::path::PathBuf,
+    columns: usize,
     error: Option<IoError>,
     /// The row being written (allocated once).
     row: Vec<f64>,
@@ -341,8 +345,19 @@ impl CsvSink {
         if system {
             names.extend(SystemColumns::NAMES.iter().map(|&n| n.to_owned()));
         }
+        Self::create_named(path, &names)
+    }
+
+    /// [`CsvSink::create`] for a multi-axis run whose columns are `names`
+    /// (`TableScenario::columns`): the rows a [`TableSink`] receives are written as they are.
+    ///
+    /// # Errors
+    /// As [`CsvSink::create`].
+    pub fn create_named(path: &Path, names: &[String]) -> Result<Self> {
         Ok(Self {
-            writer: SeriesWriter::create(path, &names)?,
+            writer: SeriesWriter::create(path, names)?,
+            path: path.to_owned(),
+            columns: names.len(),
             error: None,
             row: Vec::with_capacity(names.len()),
         })
@@ -358,6 +373,31 @@ impl CsvSink {
             return Err(error.into());
         }
         Ok(self.writer.finish()?)
+    }
+}
+
+/// The rows of a multi-axis run, under the header the sink was created with.
+impl TableSink for CsvSink {
+    fn start(&mut self, names: &[String], _samples: usize) {
+        // The header was written at creation, from the scenario's columns: the run's are the
+        // same (a mismatch would be a bug, reported as such; it leaves no file).
+        if names.len() != self.columns && self.error.is_none() {
+            self.error = Some(IoError::HeaderMismatch {
+                path: self.path.clone(),
+                names: self.columns,
+                columns: names.len(),
+            });
+        }
+    }
+
+    #[inline]
+    fn accept(&mut self, row: &[f64]) {
+        if self.error.is_some() {
+            return;
+        }
+        if let Err(error) = self.writer.write_row(row) {
+            self.error = Some(error);
+        }
     }
 }
 

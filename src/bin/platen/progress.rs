@@ -7,7 +7,7 @@ use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use platen_integrate::{Sample, SampleSink};
+use platen_integrate::{Sample, SampleSink, TableSink};
 
 /// How long the work runs before its bar appears.
 const SHOW_AFTER: Duration = Duration::from_secs(1);
@@ -69,12 +69,29 @@ pub struct Ticker<'a> {
     pub samples: u64,
 }
 
-impl SampleSink for Ticker<'_> {
+impl Ticker<'_> {
     #[inline]
-    fn accept(&mut self, _: &Sample) {
+    fn tick(&mut self) {
         self.samples += 1;
         if self.samples % 4096 == 0 {
             self.progress.set_position(self.samples);
         }
+    }
+}
+
+impl SampleSink for Ticker<'_> {
+    #[inline]
+    fn accept(&mut self, _: &Sample) {
+        self.tick();
+    }
+}
+
+/// A multi-axis run's rows tick the bar as a uniaxial run's samples do.
+impl TableSink for Ticker<'_> {
+    fn start(&mut self, _: &[String], _: usize) {}
+
+    #[inline]
+    fn accept(&mut self, _: &[f64]) {
+        self.tick();
     }
 }

@@ -19,8 +19,9 @@ use nalgebra::{Matrix3, Unit, Vector3};
 use serde::Serialize;
 
 use platen_integrate::{
-    forward_table, forward_table_loop, inverse_table, ActuatorForces, ForceRecord, LoopMethod,
-    Method, PoseMotion, TableLoopRun, TableLoopStats, TableRun,
+    forward_table_into, forward_table_loop_into, inverse_table_columns, inverse_table_into,
+    table_columns, table_loop_columns, ActuatorForces, ForceRecord, IntegrateError, LoopMethod,
+    Method, PoseMotion, TableLoopRun, TableLoopStats, TableRun, TableSink,
 };
 use platen_model::multi_axis::{
     Actuator, Bearing, BearingLoad, Coords, Dof, DofSet, LinearSpecimen, Mount, MultiAxisTable,
@@ -48,6 +49,7 @@ pub use crate::table_file::{
 mod build;
 mod describe;
 mod excitation;
+mod peaks;
 mod preset;
 mod scenario;
 mod summary;
@@ -55,6 +57,7 @@ mod summary;
 use build::*;
 pub use describe::*;
 use excitation::*;
+pub use peaks::*;
 pub use preset::*;
 pub use scenario::*;
 pub use summary::*;

@@ -206,61 +206,105 @@ impl TableScenario {
         })
     }
 
-    /// Runs it, with the closed loop's own figures when it is one.
-    ///
-    /// # Errors
-    /// As [`TableScenario::run`].
-    pub fn run_with_stats(&self) -> Result<(TableRun, Option<TableLoopStats>)> {
-        if let (TableRunSpec::Loop { command }, Some(sys)) = (&self.run, &self.system) {
-            return forward_table_loop(&TableLoopRun {
-                table: &self.table,
-                hydraulics: &sys.hydraulics,
-                controller: &sys.controller,
-                specimen: self.specimen.as_ref(),
-                command,
-                method: sys.method,
-            })
-            .map(|(run, stats)| (run, Some(stats)))
-            .map_err(|source| {
-                // A loop that diverged: say that it is unstable, where, and in which DOF.
-                match self
-                    .linearisation()
-                    .and_then(|lin| loop_verdict_stability(&lin).unstable_words())
-                {
-                    Some(verdict) => ScenarioError::TableLoopUnstable { verdict, source },
-                    None => ScenarioError::TableRun(source),
-                }
-            });
+    /// The columns of its run in their order (its output file's header), known before the
+    /// run: the forward run's, the closed loop's or the inverse's (see
+    /// [`platen_integrate::table_columns`], [`platen_integrate::table_loop_columns`],
+    /// [`platen_integrate::inverse_table_columns`]).
+    pub fn columns(&self) -> Vec<String> {
+        let specimen = self.specimen.as_ref();
+        match &self.run {
+            TableRunSpec::Inverse { .. } => inverse_table_columns(&self.table, specimen.is_some()),
+            TableRunSpec::Loop { .. } => table_loop_columns(&self.table, specimen),
+            TableRunSpec::Forward { .. } => table_columns(&self.table, specimen),
         }
-        self.run().map(|run| (run, None))
     }
 
-    /// Runs it.
+    /// The time stamps of its run's rows, s: one row at each sample of its motion, command
+    /// or forces.
+    pub fn output_t_s(&self) -> &[f64] {
+        match &self.run {
+            TableRunSpec::Inverse { motion } | TableRunSpec::Loop { command: motion } => {
+                motion.t_s()
+            }
+            TableRunSpec::Forward { forces, .. } => forces.t_s(),
+        }
+    }
+
+    /// Runs it, delivering its rows to `sink` as they are computed (the columns' names first,
+    /// [`TableScenario::columns`]); returns the closed loop's own figures when it is one.
     ///
     /// # Errors
-    /// [`ScenarioError::TableRun`] when the actuators lose rank at a pose of the motion
-    /// (inverse) or the integration fails (forward: a non-finite state, Dopri5 unable to meet
-    /// its tolerance).
-    pub fn run(&self) -> Result<TableRun> {
+    /// As [`TableScenario::run`] (the rows before a failure delivered); a closed loop that
+    /// diverged is [`ScenarioError::TableLoopUnstable`] when its linearisation is unstable.
+    pub fn run_into<K: TableSink>(&self, sink: &mut K) -> Result<Option<TableLoopStats>> {
+        let specimen = self.specimen.as_ref();
         let run = match &self.run {
             TableRunSpec::Inverse { motion } => {
-                inverse_table(&self.table, self.specimen.as_ref(), motion)
+                inverse_table_into(&self.table, specimen, motion, sink)
             }
             TableRunSpec::Forward {
                 forces,
                 method,
                 initial,
-            } => forward_table(
-                &self.table,
-                self.specimen.as_ref(),
-                forces,
-                *method,
-                initial.0,
-                initial.1,
-            ),
-            TableRunSpec::Loop { .. } => return self.run_with_stats().map(|(run, _)| run),
+            } => forward_table_into(&self.table, specimen, forces, *method, *initial, sink),
+            TableRunSpec::Loop { command } => return self.run_loop_into(command, sink).map(Some),
         };
-        run.map_err(ScenarioError::TableRun)
+        run.map(|()| None).map_err(ScenarioError::TableRun)
+    }
+
+    /// [`TableScenario::run_into`] of its closed loop driven by `command`.
+    fn run_loop_into<K: TableSink>(
+        &self,
+        command: &PoseMotion,
+        sink: &mut K,
+    ) -> Result<TableLoopStats> {
+        let Some(sys) = &self.system else {
+            // Every scenario read from a file has its loop; one assembled by hand may not.
+            return Err(ScenarioError::TableRun(IntegrateError::LengthMismatch {
+                what: "closed-loop systems (a `Loop` run needs the scenario's `system`)",
+                found: 0,
+                expected: 1,
+            }));
+        };
+        let run = TableLoopRun {
+            table: &self.table,
+            hydraulics: &sys.hydraulics,
+            controller: &sys.controller,
+            specimen: self.specimen.as_ref(),
+            command,
+            method: sys.method,
+        };
+        forward_table_loop_into(&run, sink).map_err(|source| {
+            // A loop that diverged: say that it is unstable, where, and in which DOF.
+            match self
+                .linearisation()
+                .and_then(|lin| loop_verdict_stability(&lin).unstable_words())
+            {
+                Some(verdict) => ScenarioError::TableLoopUnstable { verdict, source },
+                None => ScenarioError::TableRun(source),
+            }
+        })
+    }
+
+    /// Runs it in memory, with the closed loop's own figures when it is one.
+    ///
+    /// # Errors
+    /// As [`TableScenario::run_into`].
+    pub fn run_with_stats(&self) -> Result<(TableRun, Option<TableLoopStats>)> {
+        let mut run = TableRun::default();
+        let stats = self.run_into(&mut run)?;
+        Ok((run, stats))
+    }
+
+    /// Runs it in memory.
+    ///
+    /// # Errors
+    /// [`ScenarioError::TableRun`] when the actuators lose rank at a pose of the motion
+    /// (inverse) or the integration fails (forward: a non-finite state, Dopri5 unable to meet
+    /// its tolerance); [`ScenarioError::TableLoopUnstable`] for a closed loop that diverged
+    /// with an unstable linearisation.
+    pub fn run(&self) -> Result<TableRun> {
+        self.run_with_stats().map(|(run, _)| run)
     }
 
     /// What `platen generate excitation` writes for this scenario: its six-DOF motion (the

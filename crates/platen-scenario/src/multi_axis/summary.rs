@@ -2,8 +2,6 @@
 
 use std::collections::BTreeMap;
 
-use platen_signal::metrics::rms;
-
 use super::*;
 pub use crate::summary::AxisTracking;
 use crate::summary::LoopMargins;
@@ -145,26 +143,6 @@ pub struct TableSummary {
     pub output: Option<String>,
 }
 
-pub(super) fn abs_max(x: &[f64]) -> f64 {
-    x.iter().fold(0.0, |m: f64, v| m.max(v.abs()))
-}
-
-/// The tracking of a command `u_ref`, `a_ref` by the achieved `u`, `a`.
-pub(super) fn tracking(u_ref: &[f64], u: &[f64], a_ref: &[f64], a: &[f64]) -> AxisTracking {
-    let err = |r: &[f64], x: &[f64]| -> Vec<f64> { r.iter().zip(x).map(|(r, x)| r - x).collect() };
-    let (e, ea) = (err(u_ref, u), err(a_ref, a));
-    let ratio = |num: f64, den: f64| (den > 0.0).then(|| num / den);
-    let (rms_e, rms_ea) = (rms(&e), rms(&ea));
-    AxisTracking {
-        rms_error: rms_e,
-        peak_error: abs_max(&e),
-        displacement_nrmse: ratio(rms_e, rms(u_ref)),
-        rms_acceleration_error: rms_ea,
-        peak_acceleration_error: abs_max(&ea),
-        acceleration_nrmse: ratio(rms_ea, rms(a_ref)),
-    }
-}
-
 impl TableScenario {
     /// The summary of `run` (a run of this scenario); `output` the CSV written.
     pub fn summary(&self, run: &TableRun, output: Option<&Path>) -> TableSummary {
@@ -178,8 +156,18 @@ impl TableScenario {
         stats: Option<&TableLoopStats>,
         output: Option<&Path>,
     ) -> TableSummary {
-        let col = |name: &str| run.column(name).unwrap_or(&[]);
-        let t = col("t_s");
+        self.summary_of(&TablePeaks::of_run(self, run), stats, output)
+    }
+
+    /// The summary of a run of this scenario from its `peaks`, gathered as it went (see
+    /// [`TablePeaks`]), with the closed loop's figures `stats`; `output` the file written.
+    pub fn summary_of(
+        &self,
+        peaks: &TablePeaks<'_>,
+        stats: Option<&TableLoopStats>,
+        output: Option<&Path>,
+    ) -> TableSummary {
+        let run = peaks;
         let actuators = self.actuator_peaks(run);
         // The warnings in their order: the axes' limits, the overturning moment, the
         // actuators; then the loop's (an unstable loop's first of all).
@@ -196,7 +184,7 @@ impl TableScenario {
         let axes_respected = limits.values().all(|l| l.respected);
         let overturning_respected = overturning_moment.as_ref().is_none_or(|o| o.respected);
         TableSummary {
-            tracking: self.tracking_of(run),
+            tracking: run.tracking(),
             limits,
             overturning_moment,
             loop_figures: loop_figures.flatten(),
@@ -207,8 +195,8 @@ impl TableScenario {
                 TableRunSpec::Forward { .. } => "forward",
                 TableRunSpec::Loop { .. } => "closed_loop",
             },
-            samples: run.len(),
-            duration_s: span_s(t),
+            samples: run.samples(),
+            duration_s: run.span_s(),
             derived: self.derived.clone(),
             axes: axis_peaks(run),
             within_limits: actuators.iter().all(|a| a.respected)
@@ -222,9 +210,7 @@ impl TableScenario {
     }
 
     /// Each actuator's peaks against its limits.
-    fn actuator_peaks(&self, run: &TableRun) -> Vec<ActuatorPeaks> {
-        let col = |name: &str| run.column(name).unwrap_or(&[]);
-        let t = col("t_s");
+    fn actuator_peaks(&self, run: &TablePeaks<'_>) -> Vec<ActuatorPeaks> {
         let capacities = self.flow_capacities_m3_s();
         self.table
             .actuators()
@@ -232,20 +218,12 @@ impl TableScenario {
             .zip(self.force_limits_n())
             .enumerate()
             .map(|(i, (a, (pull, push)))| {
-                let force = col(&format!("{}_force_n", a.name));
-                let stroke = abs_max(col(&format!("{}_stroke_m", a.name)));
-                let max = force.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-                let min = force.iter().copied().fold(f64::INFINITY, f64::min);
+                let force = format!("{}_force_n", a.name);
+                let stroke = run.abs_max(&format!("{}_stroke_m", a.name));
+                let (max, min) = (run.max(&force), run.min(&force));
                 let capacity = capacities.as_ref().map(|c| c[i]);
-                let flow = run.column(&format!("{}_flow_m3_s", a.name)).map(abs_max);
-                let saturated = run.column(&format!("{}_drive", a.name)).map(|d| {
-                    let n = d.iter().filter(|x| x.abs() >= 1.0).count();
-                    if d.len() > 1 {
-                        span_s(t) * n as f64 / (d.len() - 1) as f64
-                    } else {
-                        0.0
-                    }
-                });
+                let flow = run.abs_max_of(&format!("{}_flow_m3_s", a.name));
+                let saturated = run.saturated_time_s(&format!("{}_drive", a.name));
                 ActuatorPeaks {
                     name: a.name.clone(),
                     peak_stroke_m: stroke,
@@ -264,65 +242,36 @@ impl TableScenario {
     }
 
     /// Each hold-down strut's force range.
-    fn strut_peaks(&self, run: &TableRun) -> Vec<StrutPeaks> {
+    fn strut_peaks(&self, run: &TablePeaks<'_>) -> Vec<StrutPeaks> {
         self.table
             .struts()
             .iter()
             .map(|s| {
-                let f = run.column(&format!("{}_force_n", s.name)).unwrap_or(&[]);
+                let f = format!("{}_force_n", s.name);
                 StrutPeaks {
                     name: s.name.clone(),
-                    min_force_n: f.iter().copied().fold(f64::INFINITY, f64::min),
-                    max_force_n: f.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                    min_force_n: run.min(&f),
+                    max_force_n: run.max(&f),
                 }
             })
             .collect()
     }
 
-    /// A closed loop's tracking of its command in each free DOF (`None` for the others).
-    fn tracking_of(&self, run: &TableRun) -> Option<BTreeMap<&'static str, AxisTracking>> {
-        let TableRunSpec::Loop { command } = &self.run else {
-            return None;
-        };
-        let col = |name: &str| run.column(name).unwrap_or(&[]);
-        Some(
-            self.table
-                .free()
-                .iter()
-                .map(|d| {
-                    let k = d.index();
-                    let m = command.dof(d);
-                    let n = run.len().min(m.len());
-                    (
-                        d.name(),
-                        tracking(
-                            &m.u_m()[..n],
-                            col(POSE_COLUMNS[k]),
-                            &m.a_m_s2()[..n],
-                            col(ACCELERATION_COLUMNS[k]),
-                        ),
-                    )
-                })
-                .collect(),
-        )
-    }
-
     /// Each axis's peaks against `table.limits`, a warning for each exceeded.
     fn limit_checks(
         &self,
-        run: &TableRun,
+        run: &TablePeaks<'_>,
         warnings: &mut Vec<String>,
     ) -> BTreeMap<&'static str, AxisLimitCheck> {
-        let col = |name: &str| run.column(name).unwrap_or(&[]);
         Dof::ALL
             .iter()
             .zip(self.limits.each())
             .map(|(d, [u, v, a])| {
                 let k = d.index();
                 let peaks = [
-                    abs_max(col(POSE_COLUMNS[k])),
-                    abs_max(col(RATE_COLUMNS[k])),
-                    abs_max(col(ACCELERATION_COLUMNS[k])),
+                    run.abs_max(POSE_COLUMNS[k]),
+                    run.abs_max(RATE_COLUMNS[k]),
+                    run.abs_max(ACCELERATION_COLUMNS[k]),
                 ];
                 let mut respected = true;
                 let checks = [u, v, a].into_iter().zip(peaks);
@@ -350,16 +299,10 @@ impl TableScenario {
     /// specimen), a warning when exceeded.
     fn overturning(
         &self,
-        run: &TableRun,
+        run: &TablePeaks<'_>,
         warnings: &mut Vec<String>,
     ) -> Option<OverturningSummary> {
-        let mx = run.column("overturning_moment_x_n_m")?;
-        let my = run.column("overturning_moment_y_n_m")?;
-        let peak = mx
-            .iter()
-            .zip(my)
-            .map(|(a, b)| a.hypot(*b))
-            .fold(0.0, f64::max);
+        let peak = run.peak_overturning_n_m()?;
         let limit = self.limits.overturning_moment_n_m;
         let respected = limit.is_none_or(|l| peak <= l);
         if !respected {
@@ -426,22 +369,16 @@ impl TableScenario {
     }
 }
 
-/// Time from the first to the last of the stamps `t`, s (0 for none).
-fn span_s(t: &[f64]) -> f64 {
-    t.last().zip(t.first()).map_or(0.0, |(b, a)| b - a)
-}
-
 /// Each DOF's peaks.
-fn axis_peaks(run: &TableRun) -> BTreeMap<&'static str, AxisPeaks> {
-    let col = |name: &str| run.column(name).unwrap_or(&[]);
+fn axis_peaks(run: &TablePeaks<'_>) -> BTreeMap<&'static str, AxisPeaks> {
     Dof::ALL
         .iter()
         .map(|d| {
             let k = d.index();
             let peaks = AxisPeaks {
-                peak: abs_max(col(POSE_COLUMNS[k])),
-                peak_rate: abs_max(col(RATE_COLUMNS[k])),
-                peak_acceleration: abs_max(col(ACCELERATION_COLUMNS[k])),
+                peak: run.abs_max(POSE_COLUMNS[k]),
+                peak_rate: run.abs_max(RATE_COLUMNS[k]),
+                peak_acceleration: run.abs_max(ACCELERATION_COLUMNS[k]),
             };
             (d.name(), peaks)
         })
@@ -449,7 +386,7 @@ fn axis_peaks(run: &TableRun) -> BTreeMap<&'static str, AxisPeaks> {
 }
 
 /// The specimen's peak base forces and overturning moments, by column (empty without one).
-fn specimen_peaks(run: &TableRun) -> BTreeMap<&'static str, f64> {
+fn specimen_peaks(run: &TablePeaks<'_>) -> BTreeMap<&'static str, f64> {
     [
         "base_force_x_n",
         "base_force_y_n",
@@ -458,6 +395,6 @@ fn specimen_peaks(run: &TableRun) -> BTreeMap<&'static str, f64> {
         "overturning_moment_y_n_m",
     ]
     .into_iter()
-    .filter_map(|c| run.column(c).map(|v| (c, abs_max(v))))
+    .filter_map(|c| run.abs_max_of(c).map(|v| (c, v)))
     .collect()
 }
