@@ -544,7 +544,8 @@ impl<'a, M: PlatenModel + 'a, S: SampleSink, const L: usize> Emit<S, L> for Unia
     fn emit(&mut self, m: &Machine<Self::Plant, L>, j: usize, sink: &mut S) {
         let t_s = self.command.t_s()[j];
         let p = &m.plant;
-        let mut sample = m.sample(j, t_s, p.force(&m.y), p.base_shear(&m.y), p.spec, Z);
+        let spec = p.spec.map(|s| (s, !s.is_shear_building()));
+        let mut sample = m.sample(j, t_s, p.force(&m.y), p.base_shear(&m.y), spec, Z);
         let ps = m.y[PS];
         let (p_a, p_b) = (m.y[PA].max(0.0), m.y[PB].max(0.0));
         let (q_a, _) = p.sys.valve_flows_with(&p.consts, m.y[XV], p_a, p_b, ps);

@@ -129,10 +129,17 @@ macro_rules! with_stepper {
     (@len $model:expr, $specimen:expr, $grid:expr, $initial:expr, $pieces:expr, $stepper:ident, $body:expr;
         $($n:literal => $len:literal),*) => {
         match $specimen.len() {
+            // The storeys' arithmetic or a general specimen's, chosen at compile time.
+            $($n if $specimen.is_shear_building() => {
+                #[allow(unused_mut)]
+                let mut $stepper =
+                    Stepper::<_, $len, false>::new($model, $specimen, $grid, $initial, $pieces);
+                $body
+            })*
             $($n => {
                 #[allow(unused_mut)]
                 let mut $stepper =
-                    Stepper::<_, $len>::new($model, $specimen, $grid, $initial, $pieces);
+                    Stepper::<_, $len, true>::new($model, $specimen, $grid, $initial, $pieces);
                 $body
             })*
             other => unreachable!("a validated specimen has 1 to {NS} storeys, not {other}"),
@@ -186,8 +193,8 @@ pub(crate) fn boxed_specimen<'a, M: PlatenModel>(
 }
 
 /// A specimen run advanced a sample interval at a time.
-struct Steps<'a, M, const L: usize> {
-    stepper: Stepper<'a, M, L>,
+struct Steps<'a, M, const L: usize, const G: bool> {
+    stepper: Stepper<'a, M, L, G>,
     times: &'a [f64],
     /// Steps per sample interval.
     k: u64,
@@ -195,7 +202,7 @@ struct Steps<'a, M, const L: usize> {
     j: Option<usize>,
 }
 
-impl<M: PlatenModel, const L: usize> Steppable for Steps<'_, M, L> {
+impl<M: PlatenModel, const L: usize, const G: bool> Steppable for Steps<'_, M, L, G> {
     fn advance(&mut self, out: &mut Samples) -> Result<bool> {
         let last = self.times.len() - 1;
         let j = match self.j {
@@ -290,7 +297,11 @@ fn storey_part<const L: usize>(st: &StoreyConstants, y: &Y<L>) -> StoreyPart {
 }
 
 /// The platen with a specimen on it, under a force record: the [`Plant`] of the mode machine.
-struct SpecimenPlant<'a, M, const L: usize> {
+///
+/// `G`: a general linear specimen (its matrices), whose arithmetic is the specimen's; storeys
+/// otherwise, whose arithmetic is written out here for the hot loops. A compile-time choice:
+/// a test of it at every evaluation of the rates cost the storeys' run 18 % of its speed.
+struct SpecimenPlant<'a, M, const L: usize, const G: bool> {
     model: &'a M,
     spec: &'a Specimen,
     /// The storeys' constants in fixed-size arrays (the first `N` are live), so that the
@@ -304,7 +315,7 @@ struct SpecimenPlant<'a, M, const L: usize> {
     f_rate: f64,
 }
 
-impl<'a, M: PlatenModel, const L: usize> SpecimenPlant<'a, M, L> {
+impl<'a, M: PlatenModel, const L: usize, const G: bool> SpecimenPlant<'a, M, L, G> {
     /// The number of storeys.
     const N: usize = (L - Z) / 2;
     /// Where the storey velocities start.
@@ -321,8 +332,14 @@ impl<'a, M: PlatenModel, const L: usize> SpecimenPlant<'a, M, L> {
 
     #[inline(always)]
     fn base_shear(&self, y: &Y<L>) -> f64 {
-        self.spec
-            .base_shear_n(&y[Z..Z + Self::N], &y[Self::ZD..Self::ZD + Self::N])
+        let st = &self.storeys;
+        if G {
+            self.spec
+                .base_shear_n(&y[Z..Z + Self::N], &y[Self::ZD..Self::ZD + Self::N])
+        } else {
+            // `Specimen::base_shear_n` of storeys, from the constants at hand.
+            -(st.k[0] * y[Z] + st.c[0] * y[Self::ZD])
+        }
     }
 
     fn specimen_energy(&self, y: &Y<L>) -> f64 {
@@ -341,7 +358,7 @@ impl<'a, M: PlatenModel, const L: usize> SpecimenPlant<'a, M, L> {
     /// A general linear specimen takes [`Specimen::storey_accelerations`] at `a = 0`.
     #[inline(always)]
     fn storey_part(&self, y: &Y<L>) -> StoreyPart {
-        if self.spec.is_shear_building() {
+        if !G {
             return storey_part(&self.storeys, y);
         }
         let (n, zd) = (Self::N, Self::ZD);
@@ -359,9 +376,14 @@ impl<'a, M: PlatenModel, const L: usize> SpecimenPlant<'a, M, L> {
     /// `a` (`z̈ᵢ = qᵢ − ιᵢ·a`).
     #[inline(always)]
     fn storey_rates(&self, part: &StoreyPart, a: f64, y: &Y<L>, dy: &mut Y<L>) {
+        let st = &self.storeys;
         for i in 0..Self::N {
             dy[Z + i] = y[Self::ZD + i];
-            dy[Self::ZD + i] = part.q[i] - self.storeys.iota[i] * a;
+            dy[Self::ZD + i] = if G {
+                part.q[i] - st.iota[i] * a
+            } else {
+                part.q[i] - a
+            };
         }
         dy[SD] = part.power;
     }
@@ -419,7 +441,7 @@ impl<'a, M: PlatenModel, const L: usize> SpecimenPlant<'a, M, L> {
     }
 }
 
-impl<'a, M: PlatenModel, const L: usize> Plant<L> for SpecimenPlant<'a, M, L> {
+impl<'a, M: PlatenModel, const L: usize, const G: bool> Plant<L> for SpecimenPlant<'a, M, L, G> {
     type Model = M;
     /// The actuator force, N.
     type Input = f64;
@@ -495,9 +517,13 @@ impl<'a, M: PlatenModel, const L: usize> Plant<L> for SpecimenPlant<'a, M, L> {
 
     /// `Ṅ = Ḟ_A − Ḃ = Ḟ_A + k₁ż₁ + c₁z̈₁` (`u` fixed).
     fn net_rate(&self, k: &Y<L>) -> f64 {
-        let (n, zd) = (Self::N, Self::ZD);
-        self.spec
-            .less_base_shear_rate(self.f_rate, &k[Z..Z + n], &k[zd..zd + n])
+        let (n, zd, st) = (Self::N, Self::ZD, &self.storeys);
+        if G {
+            self.spec
+                .less_base_shear_rate(self.f_rate, &k[Z..Z + n], &k[zd..zd + n])
+        } else {
+            self.f_rate + st.k[0] * k[Z] + st.c[0] * k[zd]
+        }
     }
 
     /// In creep the velocity is slaved to the net force at the end of each piece.
@@ -528,11 +554,11 @@ impl<'a, M: PlatenModel, const L: usize> Plant<L> for SpecimenPlant<'a, M, L> {
 }
 
 /// A forward run with a specimen: the mode machine over the force record's grid.
-struct Stepper<'a, M, const L: usize> {
-    machine: Machine<SpecimenPlant<'a, M, L>, L>,
+struct Stepper<'a, M, const L: usize, const G: bool> {
+    machine: Machine<SpecimenPlant<'a, M, L, G>, L>,
 }
 
-impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
+impl<'a, M: PlatenModel, const L: usize, const G: bool> Stepper<'a, M, L, G> {
     fn new(
         model: &'a M,
         spec: &'a Specimen,
@@ -572,7 +598,7 @@ impl<'a, M: PlatenModel, const L: usize> Stepper<'a, M, L> {
     }
 }
 
-impl<M: PlatenModel, const L: usize> GridStepper for Stepper<'_, M, L> {
+impl<M: PlatenModel, const L: usize, const G: bool> GridStepper for Stepper<'_, M, L, G> {
     /// Advances from grid point `n` to `n + 1`, handling every event inside the step.
     ///
     /// A step of RK4 in slip away from rest first tries [`Machine::slip_fast`] (compiled per
@@ -596,6 +622,7 @@ impl<M: PlatenModel, const L: usize> GridStepper for Stepper<'_, M, L> {
     }
 
     /// The output sample at sample `j` of the record (grid point `j·k`).
+    #[inline(always)]
     fn sample(&self, j: usize, t_s: f64) -> Sample {
         let (m, p) = (&self.machine, &self.machine.plant);
         m.sample(
@@ -603,7 +630,7 @@ impl<M: PlatenModel, const L: usize> GridStepper for Stepper<'_, M, L> {
             t_s,
             p.clock.grid.force[j],
             p.base_shear(&m.y),
-            Some(p.spec),
+            Some((p.spec, G)),
             Z,
         )
     }

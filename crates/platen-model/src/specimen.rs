@@ -529,13 +529,18 @@ impl Matrices {
         power
     }
 
-    /// [`Specimen::energy_j`] of a general specimen.
+    /// [`Specimen::energy_j`] of a general specimen (no allocation: it is called at every
+    /// output sample of an energy-checked run).
     fn energy_j(&self, v_m_s: f64, z: &[f64], zd: &[f64]) -> f64 {
         let n = self.n;
-        let w: Vec<f64> = (0..n).map(|i| v_m_s * self.influence[i] + zd[i]).collect();
+        let mut w = [0.0; Specimen::MAX_STOREYS];
+        for (i, wi) in w[..n].iter_mut().enumerate() {
+            *wi = v_m_s * self.influence[i] + zd[i];
+        }
+        let w = &w[..n];
         let mut e = 0.0;
         for i in 0..n {
-            e += 0.5 * w[i] * row_dot(&self.mass, n, i, &w)
+            e += 0.5 * w[i] * row_dot(&self.mass, n, i, w)
                 + 0.5 * z[i] * row_dot(&self.stiffness, n, i, &z[..n]);
         }
         e

@@ -288,15 +288,17 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
 
     /// The output sample at the current state: index `j` at `t_s`, actuator force `f`, and
     /// the specimen `spec`'s storeys (displacements from position `z` of the state, velocities
-    /// after them) with base shear `bs`. The platen's own terms see `F_A − B`, so the
-    /// remainder `F_D` excludes the base shear.
+    /// after them) with base shear `bs`; `spec`'s flag says that it is a general specimen
+    /// (its matrices), not storeys. The platen's own terms see `F_A − B`, so the remainder
+    /// `F_D` excludes the base shear.
+    #[inline(always)]
     pub(crate) fn sample(
         &self,
         j: usize,
         t_s: f64,
         f: f64,
         bs: f64,
-        spec: Option<&Specimen>,
+        spec: Option<(&Specimen, bool)>,
         z: usize,
     ) -> Sample {
         let y = &self.y;
@@ -310,7 +312,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         let stuck = self.mode == Mode::Stick;
         let mut sample = sample_at(model, j, t_s, f - bs, kin, self.a, stuck);
         sample.terms.actuator_n = f;
-        if let Some(specimen) = spec {
+        if let Some((specimen, general)) = spec {
             let storeys = specimen.len();
             let mut spec = SpecimenSample {
                 base_shear_n: bs,
@@ -319,11 +321,24 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
                 a_m_s2: [0.0; Specimen::MAX_STOREYS],
                 drift_m: [0.0; Specimen::MAX_STOREYS],
             };
-            for i in 0..storeys {
-                spec.u_m[i] = y[z + i];
-                spec.a_m_s2[i] =
-                    specimen.absolute_acceleration_m_s2(i, self.a, self.k[z + storeys + i]);
-                spec.drift_m[i] = specimen.drift_m(i, &y[z..z + storeys]);
+            if !general {
+                // `Specimen::absolute_acceleration_m_s2` and `drift_m` of storeys, written
+                // out: this runs at every output sample.
+                let mut below = 0.0;
+                for i in 0..storeys {
+                    spec.u_m[i] = y[z + i];
+                    spec.a_m_s2[i] = self.a + self.k[z + storeys + i];
+                    spec.drift_m[i] = y[z + i] - below;
+                    below = y[z + i];
+                }
+            } else {
+                let zs = &y[z..z + storeys];
+                for i in 0..storeys {
+                    spec.u_m[i] = y[z + i];
+                    spec.a_m_s2[i] =
+                        specimen.absolute_acceleration_m_s2(i, self.a, self.k[z + storeys + i]);
+                    spec.drift_m[i] = specimen.drift_m(i, zs);
+                }
             }
             sample.specimen = Some(spec);
         }
