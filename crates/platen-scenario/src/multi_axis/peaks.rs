@@ -137,11 +137,6 @@ impl<'a> TablePeaks<'a> {
         }
     }
 
-    /// Whether the run has column `name`.
-    pub fn has(&self, name: &str) -> bool {
-        self.index(name).is_some()
-    }
-
     /// The largest |value| of column `name` (0 for a column the run lacks or without rows).
     pub fn abs_max(&self, name: &str) -> f64 {
         self.column(name).map_or(0.0, |c| c.abs_max)

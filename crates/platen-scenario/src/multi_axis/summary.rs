@@ -167,13 +167,12 @@ impl TableScenario {
         stats: Option<&TableLoopStats>,
         output: Option<&Path>,
     ) -> TableSummary {
-        let run = peaks;
-        let actuators = self.actuator_peaks(run);
+        let actuators = self.actuator_peaks(peaks);
         // The warnings in their order: the axes' limits, the overturning moment, the
         // actuators; then the loop's (an unstable loop's first of all).
         let mut warnings = Vec::new();
-        let limits = self.limit_checks(run, &mut warnings);
-        let overturning_moment = self.overturning(run, &mut warnings);
+        let limits = self.limit_checks(peaks, &mut warnings);
+        let overturning_moment = self.overturning(peaks, &mut warnings);
         for a in actuators.iter().filter(|a| !a.respected) {
             warnings.push(format!(
                 "actuator {} beyond its stroke or force limits",
@@ -184,7 +183,7 @@ impl TableScenario {
         let axes_respected = limits.values().all(|l| l.respected);
         let overturning_respected = overturning_moment.as_ref().is_none_or(|o| o.respected);
         TableSummary {
-            tracking: run.tracking(),
+            tracking: peaks.tracking(),
             limits,
             overturning_moment,
             loop_figures: loop_figures.flatten(),
@@ -195,22 +194,22 @@ impl TableScenario {
                 TableRunSpec::Forward { .. } => "forward",
                 TableRunSpec::Loop { .. } => "closed_loop",
             },
-            samples: run.samples(),
-            duration_s: run.span_s(),
+            samples: peaks.samples(),
+            duration_s: peaks.span_s(),
             derived: self.derived.clone(),
-            axes: axis_peaks(run),
+            axes: axis_peaks(peaks),
             within_limits: actuators.iter().all(|a| a.respected)
                 && axes_respected
                 && overturning_respected,
             actuators,
-            struts: self.strut_peaks(run),
-            specimen: specimen_peaks(run),
+            struts: self.strut_peaks(peaks),
+            specimen: specimen_peaks(peaks),
             output: output.map(|p| p.display().to_string()),
         }
     }
 
     /// Each actuator's peaks against its limits.
-    fn actuator_peaks(&self, run: &TablePeaks<'_>) -> Vec<ActuatorPeaks> {
+    fn actuator_peaks(&self, peaks: &TablePeaks<'_>) -> Vec<ActuatorPeaks> {
         let capacities = self.flow_capacities_m3_s();
         self.table
             .actuators()
@@ -219,11 +218,11 @@ impl TableScenario {
             .enumerate()
             .map(|(i, (a, (pull, push)))| {
                 let force = format!("{}_force_n", a.name);
-                let stroke = run.abs_max(&format!("{}_stroke_m", a.name));
-                let (max, min) = (run.max(&force), run.min(&force));
+                let stroke = peaks.abs_max(&format!("{}_stroke_m", a.name));
+                let (max, min) = (peaks.max(&force), peaks.min(&force));
                 let capacity = capacities.as_ref().map(|c| c[i]);
-                let flow = run.abs_max_of(&format!("{}_flow_m3_s", a.name));
-                let saturated = run.saturated_time_s(&format!("{}_drive", a.name));
+                let flow = peaks.abs_max_of(&format!("{}_flow_m3_s", a.name));
+                let saturated = peaks.saturated_time_s(&format!("{}_drive", a.name));
                 ActuatorPeaks {
                     name: a.name.clone(),
                     peak_stroke_m: stroke,
@@ -242,7 +241,7 @@ impl TableScenario {
     }
 
     /// Each hold-down strut's force range.
-    fn strut_peaks(&self, run: &TablePeaks<'_>) -> Vec<StrutPeaks> {
+    fn strut_peaks(&self, peaks: &TablePeaks<'_>) -> Vec<StrutPeaks> {
         self.table
             .struts()
             .iter()
@@ -250,8 +249,8 @@ impl TableScenario {
                 let f = format!("{}_force_n", s.name);
                 StrutPeaks {
                     name: s.name.clone(),
-                    min_force_n: run.min(&f),
-                    max_force_n: run.max(&f),
+                    min_force_n: peaks.min(&f),
+                    max_force_n: peaks.max(&f),
                 }
             })
             .collect()
@@ -260,7 +259,7 @@ impl TableScenario {
     /// Each axis's peaks against `table.limits`, a warning for each exceeded.
     fn limit_checks(
         &self,
-        run: &TablePeaks<'_>,
+        peaks: &TablePeaks<'_>,
         warnings: &mut Vec<String>,
     ) -> BTreeMap<&'static str, AxisLimitCheck> {
         Dof::ALL
@@ -269,9 +268,9 @@ impl TableScenario {
             .map(|(d, [u, v, a])| {
                 let k = d.index();
                 let peaks = [
-                    run.abs_max(POSE_COLUMNS[k]),
-                    run.abs_max(RATE_COLUMNS[k]),
-                    run.abs_max(ACCELERATION_COLUMNS[k]),
+                    peaks.abs_max(POSE_COLUMNS[k]),
+                    peaks.abs_max(RATE_COLUMNS[k]),
+                    peaks.abs_max(ACCELERATION_COLUMNS[k]),
                 ];
                 let mut respected = true;
                 let checks = [u, v, a].into_iter().zip(peaks);
@@ -299,10 +298,10 @@ impl TableScenario {
     /// specimen), a warning when exceeded.
     fn overturning(
         &self,
-        run: &TablePeaks<'_>,
+        peaks: &TablePeaks<'_>,
         warnings: &mut Vec<String>,
     ) -> Option<OverturningSummary> {
-        let peak = run.peak_overturning_n_m()?;
+        let peak = peaks.peak_overturning_n_m()?;
         let limit = self.limits.overturning_moment_n_m;
         let respected = limit.is_none_or(|l| peak <= l);
         if !respected {
@@ -370,15 +369,15 @@ impl TableScenario {
 }
 
 /// Each DOF's peaks.
-fn axis_peaks(run: &TablePeaks<'_>) -> BTreeMap<&'static str, AxisPeaks> {
+fn axis_peaks(peaks: &TablePeaks<'_>) -> BTreeMap<&'static str, AxisPeaks> {
     Dof::ALL
         .iter()
         .map(|d| {
             let k = d.index();
             let peaks = AxisPeaks {
-                peak: run.abs_max(POSE_COLUMNS[k]),
-                peak_rate: run.abs_max(RATE_COLUMNS[k]),
-                peak_acceleration: run.abs_max(ACCELERATION_COLUMNS[k]),
+                peak: peaks.abs_max(POSE_COLUMNS[k]),
+                peak_rate: peaks.abs_max(RATE_COLUMNS[k]),
+                peak_acceleration: peaks.abs_max(ACCELERATION_COLUMNS[k]),
             };
             (d.name(), peaks)
         })
@@ -386,7 +385,7 @@ fn axis_peaks(run: &TablePeaks<'_>) -> BTreeMap<&'static str, AxisPeaks> {
 }
 
 /// The specimen's peak base forces and overturning moments, by column (empty without one).
-fn specimen_peaks(run: &TablePeaks<'_>) -> BTreeMap<&'static str, f64> {
+fn specimen_peaks(peaks: &TablePeaks<'_>) -> BTreeMap<&'static str, f64> {
     [
         "base_force_x_n",
         "base_force_y_n",
@@ -395,6 +394,6 @@ fn specimen_peaks(run: &TablePeaks<'_>) -> BTreeMap<&'static str, f64> {
         "overturning_moment_y_n_m",
     ]
     .into_iter()
-    .filter_map(|c| run.abs_max_of(c).map(|v| (c, v)))
+    .filter_map(|c| peaks.abs_max_of(c).map(|v| (c, v)))
     .collect()
 }
