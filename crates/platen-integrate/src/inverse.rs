@@ -2,6 +2,7 @@
 
 use platen_model::{force_terms, ForceTerms, PlatenModel, Specimen};
 
+use crate::hysteretic::{HystereticBuilding, StoreyEvent};
 use crate::output::{Sample, SampleSink, SpecimenSample};
 use crate::Motion;
 
@@ -76,6 +77,9 @@ pub fn inverse_specimen<M: PlatenModel, S: SampleSink>(
     motion: &Motion,
     sink: &mut S,
 ) {
+    if specimen.is_hysteretic() {
+        return inverse_hysteretic(model, specimen, motion, sink);
+    }
     const NS: usize = Specimen::MAX_STOREYS;
     let (t, u, v, a) = (motion.t_s(), motion.u_m(), motion.v_m_s(), motion.a_m_s2());
     let band = motion.rest_velocity_m_s();
@@ -130,13 +134,7 @@ pub fn inverse_specimen<M: PlatenModel, S: SampleSink>(
         terms.actuator_n += base_shear_n;
         let mut zdd = [0.0; NS];
         rates(a[i], &z, &zd, &mut zdd);
-        let mut spec = SpecimenSample {
-            base_shear_n,
-            storeys: ns,
-            u_m: [0.0; NS],
-            a_m_s2: [0.0; NS],
-            drift_m: [0.0; NS],
-        };
+        let mut spec = SpecimenSample::new(ns, base_shear_n);
         for j in 0..ns {
             spec.u_m[j] = z[j];
             spec.a_m_s2[j] = specimen.absolute_acceleration_m_s2(j, a[i], zdd[j]);
@@ -144,6 +142,84 @@ pub fn inverse_specimen<M: PlatenModel, S: SampleSink>(
         }
         sink.accept(&prescribed_sample(motion, i, terms, at_rest, Some(spec)));
     }
+}
+
+/// [`inverse_specimen`] for a specimen whose storeys yield: the storeys are stepped by
+/// [`HystereticBuilding`] (the same RK4 sub-steps, with every yield and unloading event of a
+/// bilinear storey located inside them), and the samples carry each storey's restoring force,
+/// hysteretic force and hysteretic energy.
+fn inverse_hysteretic<M: PlatenModel, S: SampleSink>(
+    model: &M,
+    specimen: &Specimen,
+    motion: &Motion,
+    sink: &mut S,
+) {
+    inverse_building(model, HystereticBuilding::new(specimen), motion, sink);
+}
+
+/// [`inverse_specimen`] with the specimen's storey events: every yield and unloading of a
+/// bilinear storey, in time order, at the instant located inside the sub-step (a linear or
+/// Bouc–Wen specimen has none).
+pub fn inverse_specimen_events<M: PlatenModel, S: SampleSink>(
+    model: &M,
+    specimen: &Specimen,
+    motion: &Motion,
+    sink: &mut S,
+) -> Vec<StoreyEvent> {
+    if !specimen.is_hysteretic() {
+        inverse_specimen(model, specimen, motion, sink);
+        return Vec::new();
+    }
+    let mut building = HystereticBuilding::new(specimen);
+    building.log_events();
+    inverse_building(model, building, motion, sink).take_events()
+}
+
+/// The hysteretic inverse run of `building`, which it returns at the end.
+fn inverse_building<M: PlatenModel, S: SampleSink>(
+    model: &M,
+    mut building: HystereticBuilding,
+    motion: &Motion,
+    sink: &mut S,
+) -> HystereticBuilding {
+    let (t, u, v, a) = (motion.t_s(), motion.u_m(), motion.v_m_s(), motion.a_m_s2());
+    let band = motion.rest_velocity_m_s();
+    let ns = building.len();
+    for i in 0..motion.len() {
+        if i > 0 {
+            let (a0, a1) = (a[i - 1], a[i]);
+            let steps = INVERSE_SPECIMEN_SUBSTEPS;
+            let h = (t[i] - t[i - 1]) / f64::from(steps);
+            let acc = |s: f64| a0 + (a1 - a0) * s / f64::from(steps);
+            for k in 0..steps {
+                building.step(t[i - 1], h, f64::from(k), &acc);
+            }
+        }
+        let y = building.y;
+        let base_shear_n = building.base_shear_n(&y);
+        let at_rest = band.is_some_and(|b| v[i].abs() <= b);
+        let mut terms = if at_rest {
+            static_reaction(model, u[i], a[i], base_shear_n)
+        } else {
+            force_terms(model, u[i], v[i], a[i])
+        };
+        terms.actuator_n += base_shear_n;
+        let zdd = building.relative_accelerations(a[i], &y);
+        let mut spec = SpecimenSample::new(ns, base_shear_n);
+        spec.hysteretic = true;
+        let mut below = 0.0;
+        for (j, zdd) in zdd[..ns].iter().enumerate() {
+            spec.u_m[j] = y.z[j];
+            spec.a_m_s2[j] = a[i] + zdd;
+            spec.drift_m[j] = y.z[j] - below;
+            below = y.z[j];
+            spec.force_n[j] = building.force_n(j, &y);
+            spec.hysteretic_force_n[j] = building.hysteretic_force_n(j, &y);
+            spec.hysteretic_j[j] = y.e[j];
+        }
+        sink.accept(&prescribed_sample(motion, i, terms, at_rest, Some(spec)));
+    }
+    building
 }
 
 /// The output sample of an inverse run at sample `i` of the prescribed `motion`: its force

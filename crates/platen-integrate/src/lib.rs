@@ -73,6 +73,7 @@ mod ensemble;
 mod error;
 mod event;
 mod grid;
+mod hysteretic;
 mod inverse;
 mod machine;
 mod method;
@@ -93,7 +94,8 @@ pub use dopri5::{forward_dopri5, Dopri5Settings};
 pub use ensemble::{forward_rk4_ensemble, forward_rk4_lanes, EnsembleCase, ENSEMBLE_LANES};
 pub use error::{IntegrateError, Result};
 pub use event::EventKind;
-pub use inverse::{inverse, inverse_specimen, INVERSE_SPECIMEN_SUBSTEPS};
+pub use hysteretic::StoreyEvent;
+pub use inverse::{inverse, inverse_specimen, inverse_specimen_events, INVERSE_SPECIMEN_SUBSTEPS};
 pub use method::{ForwardIntegrator, Method};
 pub use multi_axis::{
     inverse_table, inverse_table_columns, inverse_table_into, PoseMotion, TableRun,

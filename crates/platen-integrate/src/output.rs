@@ -62,6 +62,34 @@ pub struct SpecimenSample {
     pub a_m_s2: [f64; Specimen::MAX_STOREYS],
     /// Storey drifts `zᵢ − zᵢ₋₁`, m, bottom first.
     pub drift_m: [f64; Specimen::MAX_STOREYS],
+    /// Whether the specimen yields (some storey carries a hysteresis): only then are
+    /// `force_n`, `hysteretic_force_n` and `hysteretic_j` filled.
+    pub hysteretic: bool,
+    /// Storey restoring forces (the dashpot excluded), N, bottom first.
+    pub force_n: [f64; Specimen::MAX_STOREYS],
+    /// Storey hysteretic forces `q` (the restoring force less `a·k·δ`), N, bottom first.
+    pub hysteretic_force_n: [f64; Specimen::MAX_STOREYS],
+    /// Energy dissipated in hysteresis per storey since the start, J, bottom first.
+    pub hysteretic_j: [f64; Specimen::MAX_STOREYS],
+}
+
+impl SpecimenSample {
+    /// A sample of `storeys` storeys with base shear `base_shear_n` and every storey channel
+    /// zero, to be filled in.
+    pub fn new(storeys: usize, base_shear_n: f64) -> Self {
+        const Z: [f64; Specimen::MAX_STOREYS] = [0.0; Specimen::MAX_STOREYS];
+        Self {
+            base_shear_n,
+            storeys,
+            u_m: Z,
+            a_m_s2: Z,
+            drift_m: Z,
+            hysteretic: false,
+            force_n: Z,
+            hysteretic_force_n: Z,
+            hysteretic_j: Z,
+        }
+    }
 }
 
 /// Receives the samples of a run in time order.

@@ -39,6 +39,7 @@
 
 mod error;
 mod full;
+pub mod hysteresis;
 mod identified;
 mod keys;
 mod law;
@@ -50,6 +51,7 @@ mod specimen;
 
 pub use error::{ModelError, Result};
 pub use full::{DerivedQuantities, FullModel, PhysicalParams};
+pub use hysteresis::{Branch, Hysteresis, HysteresisLaw, HystereticStorey};
 pub use identified::{IdentifiedModel, IdentifiedParams};
 pub use keys::{IdentifiedKey, IDENTIFIED_KEY_NAMES};
 pub use law::DissipativeLaw;

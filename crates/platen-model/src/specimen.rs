@@ -41,6 +41,7 @@
 //! relative to the platen: its DOFs need not be storeys stacked on one another.
 
 use crate::error::{non_negative, positive, ModelError, Result};
+use crate::hysteresis::{Hysteresis, HystereticStorey};
 
 /// One storey of a shear building: its floor mass, storey stiffness and storey damping.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -61,6 +62,9 @@ pub struct Specimen {
     storeys: Vec<Storey>,
     /// A general specimen's matrices; `None` for a shear building.
     matrices: Option<Box<Matrices>>,
+    /// Each storey's hysteresis (`None`: linear), one per storey; empty when every storey is
+    /// linear.
+    hysteresis: Vec<Option<Hysteresis>>,
 }
 
 /// A general linear specimen along the platen's axis: its matrices row-major (`n × n`) and
@@ -138,6 +142,7 @@ impl Specimen {
         Ok(Self {
             storeys,
             matrices: None,
+            hysteresis: Vec::new(),
         })
     }
 
@@ -199,7 +204,55 @@ impl Specimen {
                 base_stiffness,
                 base_damping,
             })),
+            hysteresis: Vec::new(),
         })
+    }
+
+    /// The shear building with `hysteresis` laid over its storeys (one entry per storey, bottom
+    /// first; `None` keeps a storey linear): the storeys that yield
+    /// ([`crate::hysteresis`]). The storey's stiffness is the elastic one.
+    ///
+    /// # Errors
+    /// [`ModelError::InvalidParameter`] for a general linear specimen (its DOFs are not
+    /// storeys with a drift to yield on) or a count that is not one per storey.
+    pub fn with_hysteresis(mut self, hysteresis: Vec<Option<Hysteresis>>) -> Result<Self> {
+        if self.matrices.is_some() {
+            return Err(ModelError::InvalidParameter {
+                name: "hysteresis",
+                value: hysteresis.len() as f64,
+                expected: "storeys of a shear building: a general linear specimen's DOFs have \
+                           no storey drift to yield on",
+            });
+        }
+        if hysteresis.len() != self.storeys.len() {
+            return Err(ModelError::InvalidParameter {
+                name: "hysteresis",
+                value: hysteresis.len() as f64,
+                expected: "one entry per storey",
+            });
+        }
+        self.hysteresis = if hysteresis.iter().any(Option::is_some) {
+            hysteresis
+        } else {
+            Vec::new()
+        };
+        Ok(self)
+    }
+
+    /// Whether some storey yields (carries a [`Hysteresis`]).
+    pub fn is_hysteretic(&self) -> bool {
+        !self.hysteresis.is_empty()
+    }
+
+    /// Storey `i`'s hysteresis, if it has one.
+    pub fn hysteresis(&self, i: usize) -> Option<&Hysteresis> {
+        self.hysteresis.get(i).and_then(Option::as_ref)
+    }
+
+    /// Storey `i`'s hysteretic constants, if it yields.
+    pub fn hysteretic_storey(&self, i: usize) -> Option<HystereticStorey> {
+        self.hysteresis(i)
+            .map(|h| HystereticStorey::new(self.storeys[i].stiffness_n_per_m, h))
     }
 
     /// Whether it is a shear building (its [`storeys`](Self::storeys) given), not a general

@@ -314,13 +314,7 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         sample.terms.actuator_n = f;
         if let Some((specimen, general)) = spec {
             let storeys = specimen.len();
-            let mut spec = SpecimenSample {
-                base_shear_n: bs,
-                storeys,
-                u_m: [0.0; Specimen::MAX_STOREYS],
-                a_m_s2: [0.0; Specimen::MAX_STOREYS],
-                drift_m: [0.0; Specimen::MAX_STOREYS],
-            };
+            let mut spec = SpecimenSample::new(storeys, bs);
             if !general {
                 // `Specimen::absolute_acceleration_m_s2` and `drift_m` of storeys, written
                 // out: this runs at every output sample.
