@@ -94,10 +94,22 @@ fn check_shipped_scenario_run(path: &Path, dir: &Path) {
     // A specimen adds base_shear_n, storey{i}_u_m, storey{i}_a_m_s2 (contract); a closed loop
     // (a table_system) then adds the loop's columns (contract, then the chamber pressures).
     let mut extra: Vec<String> = Vec::new();
-    if let Some(n) = summary["specimen"]["storeys"].as_u64() {
+    if let Some(storeys) = summary["specimen"]["storeys"].as_array() {
+        let n = storeys.len();
         extra.push("base_shear_n".to_string());
         extra.extend((1..=n).map(|i| format!("storey{i}_u_m")));
         extra.extend((1..=n).map(|i| format!("storey{i}_a_m_s2")));
+        // A specimen that yields (some storey with a ductility) adds its storeys' hysteresis.
+        if storeys.iter().any(|s| !s["ductility"].is_null()) {
+            for suffix in [
+                "_drift_m",
+                "_force_n",
+                "_hysteretic_force_n",
+                "_hysteretic_j",
+            ] {
+                extra.extend((1..=n).map(|i| format!("storey{i}{suffix}")));
+            }
+        }
     }
     if !summary["table_system"].is_null() {
         extra.extend(

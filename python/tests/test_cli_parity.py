@@ -19,6 +19,7 @@ SHIPPED = [
     "sr9/sr9-forward.json",
     "specimen/frame-forward.json",
     "specimen/frame-inverse.json",
+    "specimen/frame-yielding-inverse.json",
 ]
 
 
@@ -256,3 +257,31 @@ def test_forward_and_inverse_with_a_specimen_give_the_scenarios_run():
     # The inverse's force is Eq. 23 plus the base shear of the specimen it drives.
     parts = inv["inertial_force_n"] + inv["elastic_force_n"] + inv["dissipative_force_n"]
     assert np.allclose(inv["force_n"], parts + inv["base_shear_n"], rtol=0, atol=1e-6)
+
+
+def test_a_yielding_specimen_from_python_gives_its_hysteresis():
+    """``specimen=`` with a storey's ``hysteresis`` (issue 52): the forward and inverse runs
+    give each storey's drift, restoring force, hysteretic force and energy, and the summary
+    its ductility."""
+    storeys = [
+        {"mass_kg": 12e3, "stiffness_n_per_m": 6e6, "damping_n_s_per_m": 2e4,
+         "hysteresis": {"bilinear": {"yield_force_n": 6e3, "post_yield_stiffness_ratio": 0.05}}},
+        {"mass_kg": 8e3, "stiffness_n_per_m": 4e6, "damping_n_s_per_m": 1.2e4,
+         "hysteresis": {"bouc_wen": {"yield_force_n": 4e3, "exponent": 3}}},
+    ]
+    t = np.arange(0, 4 * 1024 + 1) / 1024
+    force = 2e6 * np.sin(2 * np.pi * 1.5 * t)
+    run = platen.forward(t, force, specimen=storeys)
+    for name in ("storey1_drift_m", "storey2_force_n", "storey1_hysteretic_force_n",
+                 "storey2_hysteretic_j"):
+        assert name in run.columns, name
+    assert run["storey1_hysteretic_j"][-1] > 0 and run["storey2_hysteretic_j"][-1] > 0
+    # Elastic-plastic with 5 % hardening: the restoring force stays within its envelope.
+    k, fy = 6e6, 6e3
+    dy = fy / k
+    envelope = fy + 0.05 * k * np.maximum(np.abs(run["storey1_drift_m"]) - dy, 0.0)
+    assert np.all(np.abs(run["storey1_force_n"]) <= envelope * (1 + 1e-9))
+    summary = run.summary["specimen"]["storeys"]
+    assert summary[0]["ductility"] > 1 and summary[1]["ductility"] > 1
+    assert summary[0]["ductility"] == pytest.approx(
+        np.max(np.abs(run["storey1_drift_m"])) / dy, rel=1e-12)

@@ -20,13 +20,25 @@
 //! force is integrated with the rest of the state; its law has a kink where the drift rate
 //! crosses zero (its `sgn(δ̇·q)`), located the same way so that RK4 keeps its order there.
 
+use std::convert::Infallible;
+
 use platen_model::{Branch, HystereticStorey, Specimen};
+
+use crate::event::locate_zero_velocity;
 
 const NS: usize = Specimen::MAX_STOREYS;
 
 /// The most events a single sub-step may hold before the rest of it is taken without looking
 /// further: far more than a drift can turn or yield in a tenth of a millisecond.
 const MAX_EVENTS_PER_STEP: usize = 64;
+
+/// The most pieces a sub-step is cut into for a stiff Bouc–Wen storey.
+const MAX_STIFF_PIECES: f64 = 4096.0;
+
+/// The share of `q_y` beyond which a Bouc–Wen storey's excursion is counted as a yield (the law
+/// has no yield point; at 90 % the tangent stiffness has fallen to a small share of the
+/// elastic one for the exponents in use).
+pub(crate) const BOUC_WEN_YIELD_SHARE: f64 = 0.9;
 
 /// A shear building with hysteretic storeys: its constants and its state.
 #[derive(Debug, Clone)]
@@ -43,8 +55,11 @@ pub(crate) struct HystereticBuilding {
     pub(crate) branch: [Branch; NS],
     /// The energy dissipated by the storey dampers, J.
     pub(crate) damper_j: f64,
-    /// Yield events met, per storey (the number of excursions into the plastic range).
+    /// Yield excursions, per storey: a bilinear storey's yield events; a Bouc–Wen storey's
+    /// passages of `|q|` beyond [`BOUC_WEN_YIELD_SHARE`] of `q_y`, once per direction of drift.
     pub(crate) yield_events: [usize; NS],
+    /// Whether a Bouc–Wen storey's excursion in its current direction has been counted.
+    counted: [bool; NS],
     /// The events met since they were last drained, if they are being logged.
     log: Option<Vec<StoreyEvent>>,
 }
@@ -102,6 +117,7 @@ impl HystereticBuilding {
             branch: [Branch::Elastic; NS],
             damper_j: 0.0,
             yield_events: [0; NS],
+            counted: [false; NS],
             log: None,
         };
         for (i, s) in specimen.storeys().iter().enumerate() {
@@ -250,8 +266,51 @@ impl HystereticBuilding {
     /// Takes one sub-step of length `h` from the sub-step fraction `s0` (counted from `t0_s`),
     /// the base acceleration `acc(s)`, with every yield and unloading event inside it located
     /// and the branch changed there.
+    ///
+    /// A Bouc–Wen storey whose own rate the sub-step does not resolve (a fast drift over a
+    /// small yield drift: `|∂q̇/∂q| ≤ n·|δ̇|/δ_y·|q/q_y|ⁿ⁻¹`) has the sub-step cut into equal
+    /// pieces each within it (`h·rate ≤ 1`, as the forward run's stiff pieces).
     pub(crate) fn step(&mut self, t0_s: f64, h: f64, s0: f64, acc: &impl Fn(f64) -> f64) {
-        let (mut s, mut left) = (s0, 1.0);
+        let pieces = (h * self.stiff_rate()).ceil().clamp(1.0, MAX_STIFF_PIECES);
+        if pieces == 1.0 {
+            self.step_events(t0_s, h, s0, 1.0, acc);
+        } else {
+            for p in 0..pieces as u32 {
+                let s = s0 + f64::from(p) / pieces;
+                self.step_events(t0_s, h, s, 1.0 / pieces, acc);
+            }
+        }
+        for i in 0..self.n {
+            if let Some(hy) = &self.hyst[i] {
+                // Loading (the drift moving the way of q) past the share of the yield level.
+                let loading = matches!(self.branch[i], Branch::Moving(d) if d * self.y.h[i] > 0.0);
+                if !hy.is_bilinear()
+                    && loading
+                    && !self.counted[i]
+                    && self.y.h[i].abs() >= BOUC_WEN_YIELD_SHARE * hy.qy
+                {
+                    self.counted[i] = true;
+                    self.yield_events[i] += 1;
+                }
+            }
+        }
+    }
+
+    /// The stiffest Bouc–Wen storey's own rate at the current state, 1/s (0 without one).
+    fn stiff_rate(&self) -> f64 {
+        let mut rate: f64 = 0.0;
+        for i in 0..self.n {
+            if let Some(h) = &self.hyst[i] {
+                rate = rate.max(h.own_rate_1_s(self.drift(i, &self.y.zd), self.y.h[i]));
+            }
+        }
+        rate
+    }
+
+    /// [`HystereticBuilding::step`] over `len` sub-steps from `s0`, but for the counting of
+    /// Bouc–Wen excursions.
+    fn step_events(&mut self, t0_s: f64, h: f64, s0: f64, len: f64, acc: &impl Fn(f64) -> f64) {
+        let (mut s, mut left) = (s0, len);
         // Storeys found on their boundary at a piece's start whose event did not change their
         // branch (a graze): not looked at again in this sub-step.
         let mut grazed = [false; NS];
@@ -280,7 +339,9 @@ impl HystereticBuilding {
             let (branch, plastic) = hyst.after_event(d, dd, self.y.h[i], before);
             if branch == before {
                 grazed[i] = true;
-            } else if hyst.is_bilinear() {
+            } else if !hyst.is_bilinear() {
+                self.counted[i] = false;
+            } else {
                 let yielded = branch != Branch::Elastic;
                 self.yield_events[i] += usize::from(yielded);
                 if let Some(log) = &mut self.log {
@@ -303,40 +364,21 @@ impl HystereticBuilding {
     }
 
     /// Where storey `i`'s margin first reaches zero along the RK4 map from the current state,
-    /// as a length in `(0, left]` (in sub-steps): Illinois root finding, bracketed until the
-    /// bracket is a few ulps wide, the end just past the crossing returned.
+    /// as a length in `[0, left]` (in sub-steps): the Illinois root finder of the platen's
+    /// events ([`crate::event::locate_zero_velocity`]), bracketed until the bracket is a few
+    /// ulps wide, the end just past the crossing returned; 0 when the storey starts on its
+    /// boundary (just after the opposite event).
     fn crossing(&self, i: usize, h: f64, s0: f64, left: f64, acc: &impl Fn(f64) -> f64) -> f64 {
         let g = |len: f64| self.margin(i, &self.map(&self.y, h, s0, len, acc).0);
-        let (mut lo, mut hi) = (0.0, left);
-        let (mut g_lo, mut g_hi) = (self.margin(i, &self.y), g(left));
-        if g_lo <= 0.0 {
-            // On the boundary already (just after the opposite event): the crossing is here.
+        let g0 = self.margin(i, &self.y);
+        if g0 <= 0.0 {
             return 0.0;
         }
-        let mut side = 0i8;
-        for _ in 0..200 {
-            if hi - lo <= 4.0 * f64::EPSILON * left.max(1.0) {
-                break;
-            }
-            let mut x = (lo * g_hi - hi * g_lo) / (g_hi - g_lo);
-            if !(x > lo && x < hi) {
-                x = 0.5 * (lo + hi);
-            }
-            let gx = g(x);
-            if gx < 0.0 {
-                (hi, g_hi) = (x, gx);
-                if side == -1 {
-                    g_lo *= 0.5;
-                }
-                side = -1;
-            } else {
-                (lo, g_lo) = (x, gx);
-                if side == 1 {
-                    g_hi *= 0.5;
-                }
-                side = 1;
-            }
-        }
-        hi
+        let tolerance = 4.0 * f64::EPSILON * left.max(1.0);
+        let found = locate_zero_velocity(left, g0, ((), g(left)), tolerance, |x| {
+            Ok::<_, Infallible>(((), g(x)))
+        });
+        let Ok(found) = found;
+        found.map_or(0.0, |(x, ())| x)
     }
 }

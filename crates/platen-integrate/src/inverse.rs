@@ -217,6 +217,7 @@ fn inverse_building<M: PlatenModel, S: SampleSink>(
             spec.hysteretic_force_n[j] = building.hysteretic_force_n(j, &y);
             spec.hysteretic_j[j] = y.e[j];
         }
+        spec.yield_excursions = building.yield_events;
         sink.accept(&prescribed_sample(motion, i, terms, at_rest, Some(spec)));
     }
     building

@@ -71,6 +71,9 @@ pub struct SpecimenSample {
     pub hysteretic_force_n: [f64; Specimen::MAX_STOREYS],
     /// Energy dissipated in hysteresis per storey since the start, J, bottom first.
     pub hysteretic_j: [f64; Specimen::MAX_STOREYS],
+    /// Yield excursions per storey since the start, bottom first (bilinear: yield events;
+    /// Bouc–Wen: passages of `|q|` beyond 90 % of `q_y`, once per direction of drift).
+    pub yield_excursions: [usize; Specimen::MAX_STOREYS],
 }
 
 impl SpecimenSample {
@@ -88,6 +91,7 @@ impl SpecimenSample {
             force_n: Z,
             hysteretic_force_n: Z,
             hysteretic_j: Z,
+            yield_excursions: [0; Specimen::MAX_STOREYS],
         }
     }
 }
@@ -328,6 +332,10 @@ pub struct SpecimenColumns {
     pub u_m: Vec<Vec<f64>>,
     /// Per storey, bottom first: absolute acceleration, m/s².
     pub a_m_s2: Vec<Vec<f64>>,
+    /// A specimen that yields, per storey (empty otherwise): the drift, m, the restoring force,
+    /// N, the hysteretic force, N, and the hysteretic energy, J, in the order of
+    /// [`SpecimenColumns::HYSTERETIC_NAMES`].
+    pub hysteretic: [Vec<Vec<f64>>; 4],
 }
 
 impl SpecimenColumns {
@@ -337,6 +345,15 @@ impl SpecimenColumns {
     pub const STOREY_U_NAMES: [&'static str; Specimen::MAX_STOREYS] = storey_names!("_u_m");
     /// `storey{i}_a_m_s2` for `i = 1…`[`Specimen::MAX_STOREYS`] (index `i − 1`).
     pub const STOREY_A_NAMES: [&'static str; Specimen::MAX_STOREYS] = storey_names!("_a_m_s2");
+    /// A yielding specimen's columns, after the accelerations: `storey{i}_drift_m`,
+    /// `storey{i}_force_n`, `storey{i}_hysteretic_force_n` and `storey{i}_hysteretic_j` for
+    /// every storey, each kind in turn.
+    pub const HYSTERETIC_NAMES: [[&'static str; Specimen::MAX_STOREYS]; 4] = [
+        storey_names!("_drift_m"),
+        storey_names!("_force_n"),
+        storey_names!("_hysteretic_force_n"),
+        storey_names!("_hysteretic_j"),
+    ];
 
     /// Empty columns for a specimen of `storeys` storeys.
     pub fn new(storeys: usize) -> Self {
@@ -344,6 +361,7 @@ impl SpecimenColumns {
             base_shear_n: Vec::new(),
             u_m: vec![Vec::new(); storeys],
             a_m_s2: vec![Vec::new(); storeys],
+            hysteretic: Default::default(),
         }
     }
 
@@ -378,6 +396,9 @@ impl SpecimenColumns {
                 .copied()
                 .zip(self.a_m_s2.iter().map(Vec::as_slice)),
         );
+        for (names, cols) in Self::HYSTERETIC_NAMES.iter().zip(&self.hysteretic) {
+            out.extend(names.iter().copied().zip(cols.iter().map(Vec::as_slice)));
+        }
         out
     }
 
@@ -395,6 +416,21 @@ impl SpecimenColumns {
         }
         for (col, &a) in self.a_m_s2.iter_mut().zip(&s.a_m_s2[..s.storeys]) {
             col.push(a);
+        }
+        if s.hysteretic {
+            let n = s.storeys;
+            let values = [
+                &s.drift_m,
+                &s.force_n,
+                &s.hysteretic_force_n,
+                &s.hysteretic_j,
+            ];
+            for (cols, v) in self.hysteretic.iter_mut().zip(values) {
+                cols.resize_with(n, Vec::new);
+                for (col, &x) in cols.iter_mut().zip(&v[..n]) {
+                    col.push(x);
+                }
+            }
         }
     }
 }
@@ -545,6 +581,15 @@ pub struct Peaks {
     pub drift_m: [Peak; Specimen::MAX_STOREYS],
     /// Storeys of the specimen (0 without one).
     pub storeys: usize,
+    /// Each storey's drift at the last sample, m (the residual drift of a run that has come to
+    /// rest).
+    pub last_drift_m: [f64; Specimen::MAX_STOREYS],
+    /// Whether the specimen yields: only then are `hysteretic_j` and `yield_excursions` set.
+    pub hysteretic: bool,
+    /// Each storey's hysteretic energy at the last sample, J.
+    pub hysteretic_j: [f64; Specimen::MAX_STOREYS],
+    /// Each storey's yield excursions by the last sample.
+    pub yield_excursions: [usize; Specimen::MAX_STOREYS],
 }
 
 impl SampleSink for Peaks {
@@ -565,6 +610,12 @@ impl SampleSink for Peaks {
             self.base_shear_n.update(sp.base_shear_n, s.t_s);
             for (peak, &d) in self.drift_m.iter_mut().zip(&sp.drift_m[..sp.storeys]) {
                 peak.update(d, s.t_s);
+            }
+            self.last_drift_m = sp.drift_m;
+            if sp.hysteretic {
+                self.hysteretic = true;
+                self.hysteretic_j = sp.hysteretic_j;
+                self.yield_excursions = sp.yield_excursions;
             }
         }
     }

@@ -40,9 +40,11 @@
 
 use std::collections::VecDeque;
 
-use platen_model::{PlatenModel, Specimen};
+use platen_model::{Branch, HystereticStorey, PlatenModel, Specimen};
 
-use crate::clock::GridClock;
+use crate::hysteretic::BOUC_WEN_YIELD_SHARE;
+
+use crate::clock::{Clock as _, GridClock};
 use crate::creep::creep_speed_m_s;
 use crate::error::Result;
 use crate::event::{Direction, EventKind, Mode};
@@ -122,9 +124,28 @@ pub fn forward_specimen<M: PlatenModel, S: SampleSink>(
 /// 29) and evaluates `$body` with it.
 macro_rules! with_stepper {
     ($model:expr, $specimen:expr, $grid:expr, $initial:expr, $pieces:expr, |$stepper:ident| $body:expr) => {
-        with_stepper!(@len $model, $specimen, $grid, $initial, $pieces, $stepper, $body;
-            1 => 7, 2 => 9, 3 => 11, 4 => 13, 5 => 15, 6 => 17, 7 => 19, 8 => 21,
-            9 => 23, 10 => 25, 11 => 27, 12 => 29)
+        if $specimen.is_hysteretic() {
+            // Storeys that yield: each storey adds its hysteretic state and energy.
+            with_stepper!(@hysteretic $model, $specimen, $grid, $initial, $pieces, $stepper, $body;
+                1 => 9, 2 => 13, 3 => 17, 4 => 21, 5 => 25, 6 => 29, 7 => 33, 8 => 37,
+                9 => 41, 10 => 45, 11 => 49, 12 => 53)
+        } else {
+            with_stepper!(@len $model, $specimen, $grid, $initial, $pieces, $stepper, $body;
+                1 => 7, 2 => 9, 3 => 11, 4 => 13, 5 => 15, 6 => 17, 7 => 19, 8 => 21,
+                9 => 23, 10 => 25, 11 => 27, 12 => 29)
+        }
+    };
+    (@hysteretic $model:expr, $specimen:expr, $grid:expr, $initial:expr, $pieces:expr, $stepper:ident, $body:expr;
+        $($n:literal => $len:literal),*) => {
+        match $specimen.len() {
+            $($n => {
+                #[allow(unused_mut)]
+                let mut $stepper =
+                    Stepper::<_, $len, false, true>::new($model, $specimen, $grid, $initial, $pieces);
+                $body
+            })*
+            other => unreachable!("a validated specimen has 1 to {NS} storeys, not {other}"),
+        }
     };
     (@len $model:expr, $specimen:expr, $grid:expr, $initial:expr, $pieces:expr, $stepper:ident, $body:expr;
         $($n:literal => $len:literal),*) => {
@@ -133,13 +154,13 @@ macro_rules! with_stepper {
             $($n if $specimen.is_shear_building() => {
                 #[allow(unused_mut)]
                 let mut $stepper =
-                    Stepper::<_, $len, false>::new($model, $specimen, $grid, $initial, $pieces);
+                    Stepper::<_, $len, false, false>::new($model, $specimen, $grid, $initial, $pieces);
                 $body
             })*
             $($n => {
                 #[allow(unused_mut)]
                 let mut $stepper =
-                    Stepper::<_, $len, true>::new($model, $specimen, $grid, $initial, $pieces);
+                    Stepper::<_, $len, true, false>::new($model, $specimen, $grid, $initial, $pieces);
                 $body
             })*
             other => unreachable!("a validated specimen has 1 to {NS} storeys, not {other}"),
@@ -193,8 +214,8 @@ pub(crate) fn boxed_specimen<'a, M: PlatenModel>(
 }
 
 /// A specimen run advanced a sample interval at a time.
-struct Steps<'a, M, const L: usize, const G: bool> {
-    stepper: Stepper<'a, M, L, G>,
+struct Steps<'a, M, const L: usize, const G: bool, const H: bool> {
+    stepper: Stepper<'a, M, L, G, H>,
     times: &'a [f64],
     /// Steps per sample interval.
     k: u64,
@@ -202,7 +223,9 @@ struct Steps<'a, M, const L: usize, const G: bool> {
     j: Option<usize>,
 }
 
-impl<M: PlatenModel, const L: usize, const G: bool> Steppable for Steps<'_, M, L, G> {
+impl<M: PlatenModel, const L: usize, const G: bool, const H: bool> Steppable
+    for Steps<'_, M, L, G, H>
+{
     fn advance(&mut self, out: &mut Samples) -> Result<bool> {
         let last = self.times.len() - 1;
         let j = match self.j {
@@ -301,7 +324,7 @@ fn storey_part<const L: usize>(st: &StoreyConstants, y: &Y<L>) -> StoreyPart {
 /// `G`: a general linear specimen (its matrices), whose arithmetic is the specimen's; storeys
 /// otherwise, whose arithmetic is written out here for the hot loops. A compile-time choice:
 /// a test of it at every evaluation of the rates cost the storeys' run 18 % of its speed.
-struct SpecimenPlant<'a, M, const L: usize, const G: bool> {
+struct SpecimenPlant<'a, M, const L: usize, const G: bool, const H: bool> {
     model: &'a M,
     spec: &'a Specimen,
     /// The storeys' constants in fixed-size arrays (the first `N` are live), so that the
@@ -313,13 +336,85 @@ struct SpecimenPlant<'a, M, const L: usize, const G: bool> {
     /// The actuator force's rate in the current grid interval, N/s (the force is linear
     /// between samples).
     f_rate: f64,
+    /// `H`: the storeys' hysteresis (`None` for a linear storey) and branches, and each
+    /// storey's yield excursions so far.
+    hyst: [Option<HystereticStorey>; NS],
+    branch: [Branch; NS],
+    yield_excursions: [usize; NS],
+    /// `H`: whether a Bouc–Wen storey's excursion in its current direction is counted.
+    counted: [bool; NS],
 }
 
-impl<'a, M: PlatenModel, const L: usize, const G: bool> SpecimenPlant<'a, M, L, G> {
+impl<'a, M: PlatenModel, const L: usize, const G: bool, const H: bool>
+    SpecimenPlant<'a, M, L, G, H>
+{
     /// The number of storeys.
-    const N: usize = (L - Z) / 2;
+    const N: usize = (L - Z) / if H { 4 } else { 2 };
     /// Where the storey velocities start.
     const ZD: usize = Z + Self::N;
+    /// `H`: where the storeys' hysteretic states start ([`crate::hysteretic`]).
+    const HS: usize = Z + 2 * Self::N;
+    /// `H`: where the storeys' hysteretic energies start.
+    const ES: usize = Z + 3 * Self::N;
+
+    /// `H`: storey `i`'s drift and drift rate at `y`.
+    #[inline(always)]
+    fn drifts(&self, i: usize, y: &Y<L>) -> (f64, f64) {
+        let (z, zd) = (y[Z + i], y[Self::ZD + i]);
+        if i == 0 {
+            (z - 0.0, zd - 0.0)
+        } else {
+            (z - y[Z + i - 1], zd - y[Self::ZD + i - 1])
+        }
+    }
+
+    /// `H`: storey `i`'s restoring force at `y`, N (dashpot excluded).
+    #[inline(always)]
+    fn storey_force(&self, i: usize, y: &Y<L>) -> f64 {
+        let (d, _) = self.drifts(i, y);
+        match &self.hyst[i] {
+            Some(h) => h.force_n(d, y[Self::HS + i], self.branch[i]),
+            None => self.storeys.k[i] * d,
+        }
+    }
+
+    /// `H`: the storeys' part of the rates that does not depend on the platen's acceleration,
+    /// as [`Self::storey_part`], each storey's restoring force its hysteretic one; the
+    /// hysteretic states' and energies' rates written into `dy`.
+    #[inline(always)]
+    fn hysteretic_part(&self, y: &Y<L>, dy: &mut Y<L>) -> StoreyPart {
+        let st = &self.storeys;
+        let mut part = StoreyPart {
+            q: [0.0; NS],
+            power: 0.0,
+            shear0: 0.0,
+        };
+        let mut shear_prev = 0.0;
+        for i in 0..Self::N {
+            let (d, dd) = self.drifts(i, y);
+            let spring = match &self.hyst[i] {
+                Some(h) => {
+                    let (hd, ed) = h.rates(dd, y[Self::HS + i], self.branch[i]);
+                    (dy[Self::HS + i], dy[Self::ES + i]) = (hd, ed);
+                    h.force_n(d, y[Self::HS + i], self.branch[i])
+                }
+                None => {
+                    (dy[Self::HS + i], dy[Self::ES + i]) = (0.0, 0.0);
+                    st.k[i] * d
+                }
+            };
+            let shear = spring + st.c[i] * dd;
+            part.power += st.c[i] * dd * dd;
+            if i == 0 {
+                part.shear0 = shear;
+            } else {
+                part.q[i - 1] = (shear - shear_prev) / st.m[i - 1];
+            }
+            shear_prev = shear;
+        }
+        part.q[Self::N - 1] = -shear_prev / st.m[Self::N - 1];
+        part
+    }
 
     /// The actuator force's rate between samples `j` and `j + 1`, N/s (0 past the record).
     fn force_rate(&self, j: usize) -> f64 {
@@ -333,6 +428,9 @@ impl<'a, M: PlatenModel, const L: usize, const G: bool> SpecimenPlant<'a, M, L, 
     #[inline(always)]
     fn base_shear(&self, y: &Y<L>) -> f64 {
         let st = &self.storeys;
+        if H {
+            return -(self.storey_force(0, y) + st.c[0] * y[Self::ZD]);
+        }
         if G {
             self.spec
                 .base_shear_n(&y[Z..Z + Self::N], &y[Self::ZD..Self::ZD + Self::N])
@@ -343,6 +441,24 @@ impl<'a, M: PlatenModel, const L: usize, const G: bool> SpecimenPlant<'a, M, L, 
     }
 
     fn specimen_energy(&self, y: &Y<L>) -> f64 {
+        if H {
+            // Kinetic, and each storey's recoverable energy (a yielding storey's
+            // `½·a·k·δ² + q²/(2(1 − a)k)`).
+            let mut e = 0.0;
+            for i in 0..Self::N {
+                let w = y[V] + y[Self::ZD + i];
+                let (d, _) = self.drifts(i, y);
+                let stored = match &self.hyst[i] {
+                    Some(h) => {
+                        let q = h.hysteretic_force_n(d, y[Self::HS + i], self.branch[i]);
+                        h.stored_energy_j(d, q)
+                    }
+                    None => 0.5 * self.storeys.k[i] * d * d,
+                };
+                e += 0.5 * self.storeys.m[i] * w * w + stored;
+            }
+            return e;
+        }
         let (n, zd) = (Self::N, Self::ZD);
         self.spec.energy_j(y[V], &y[Z..Z + n], &y[zd..zd + n])
     }
@@ -420,11 +536,24 @@ impl<'a, M: PlatenModel, const L: usize, const G: bool> SpecimenPlant<'a, M, L, 
         let du = 1e-6 * u.abs().max(1e-3);
         let e_u = (e_static(u + du) - e_static(u - du)) / (2.0 * du);
         let (n, zd) = (Self::N, Self::ZD);
-        let mut zdd0 = [0.0; NS];
-        self.spec
-            .storey_accelerations(0.0, &y[Z..Z + n], &y[zd..zd + n], &mut zdd0[..n]);
-        let b_rate0 = self.spec.base_shear_rate_n_s(&y[zd..zd + n], &zdd0[..n]);
-        let c_base = self.spec.base_damping_n_s_per_m();
+        let (b_rate0, c_base) = if H {
+            let mut dy = [0.0; L];
+            let part = self.hysteretic_part(y, &mut dy);
+            let force_rate = match &self.hyst[0] {
+                Some(h) => h.force_rate_n_s(y[zd], dy[Self::HS], self.branch[0]),
+                None => self.storeys.k[0] * y[zd],
+            };
+            let c0 = self.storeys.c[0];
+            (-(force_rate + c0 * part.q[0]), c0)
+        } else {
+            let mut zdd0 = [0.0; NS];
+            self.spec
+                .storey_accelerations(0.0, &y[Z..Z + n], &y[zd..zd + n], &mut zdd0[..n]);
+            (
+                self.spec.base_shear_rate_n_s(&y[zd..zd + n], &zdd0[..n]),
+                self.spec.base_damping_n_s_per_m(),
+            )
+        };
         let w_rate = (s * (self.f_rate - b_rate0) - e_u * s * w) / (e_w + c_base);
         if w_rate.is_finite() {
             s * w_rate
@@ -441,7 +570,9 @@ impl<'a, M: PlatenModel, const L: usize, const G: bool> SpecimenPlant<'a, M, L, 
     }
 }
 
-impl<'a, M: PlatenModel, const L: usize, const G: bool> Plant<L> for SpecimenPlant<'a, M, L, G> {
+impl<'a, M: PlatenModel, const L: usize, const G: bool, const H: bool> Plant<L>
+    for SpecimenPlant<'a, M, L, G, H>
+{
     type Model = M;
     /// The actuator force, N.
     type Input = f64;
@@ -458,7 +589,11 @@ impl<'a, M: PlatenModel, const L: usize, const G: bool> Plant<L> for SpecimenPla
             Mode::Slip(Direction::Negative) => return self.slip_rates::<false>(f, y, dy),
             _ => {}
         }
-        let part = self.storey_part(y);
+        let part = if H {
+            self.hysteretic_part(y, dy)
+        } else {
+            self.storey_part(y)
+        };
         let bs = -part.shear0;
         let a = match mode {
             Mode::Slip(_) => unreachable!("slip returned above"),
@@ -491,7 +626,11 @@ impl<'a, M: PlatenModel, const L: usize, const G: bool> Plant<L> for SpecimenPla
     /// (exact for ±1).
     #[inline(always)]
     fn slip_rates<const POSITIVE: bool>(&self, f: f64, y: &Y<L>, dy: &mut Y<L>) -> f64 {
-        let part = self.storey_part(y);
+        let part = if H {
+            self.hysteretic_part(y, dy)
+        } else {
+            self.storey_part(y)
+        };
         let bs = -part.shear0;
         let r = self
             .model
@@ -518,6 +657,14 @@ impl<'a, M: PlatenModel, const L: usize, const G: bool> Plant<L> for SpecimenPla
     /// `Ṅ = Ḟ_A − Ḃ = Ḟ_A + k₁ż₁ + c₁z̈₁` (`u` fixed).
     fn net_rate(&self, k: &Y<L>) -> f64 {
         let (n, zd, st) = (Self::N, Self::ZD, &self.storeys);
+        if H {
+            // Ḟ_A − Ḃ = Ḟ_A + Ḟ₁ + c₁·z̈₁, the bottom storey's force rate on its branch.
+            let force_rate = match &self.hyst[0] {
+                Some(h) => h.force_rate_n_s(k[Z], k[Self::HS], self.branch[0]),
+                None => st.k[0] * k[Z],
+            };
+            return self.f_rate + force_rate + st.c[0] * k[zd];
+        }
         if G {
             self.spec
                 .less_base_shear_rate(self.f_rate, &k[Z..Z + n], &k[zd..zd + n])
@@ -539,10 +686,97 @@ impl<'a, M: PlatenModel, const L: usize, const G: bool> Plant<L> for SpecimenPla
     /// Metres for the motion and the storeys, m/s for the velocities; the energy integrals
     /// are quadratures and not controlled.
     fn error_scale(&self, i: usize, y0: f64, y1: f64, rtol: f64, atol: f64) -> f64 {
+        let relative = rtol * y0.abs().max(y1.abs());
         match i {
             W | DI | SD => f64::INFINITY,
-            _ => atol + rtol * y0.abs().max(y1.abs()),
+            // A yielding storey's energy is a quadrature; its Bouc–Wen force is in N (the
+            // tolerance in metres times the storey's plastic stiffness), its plastic drift in m.
+            _ if H && i >= Self::ES => f64::INFINITY,
+            _ if H && i >= Self::HS => match &self.hyst[i - Self::HS] {
+                Some(h) if !h.is_bilinear() => atol * h.pk + relative,
+                _ => atol + relative,
+            },
+            _ => atol + relative,
         }
+    }
+
+    const HAS_BRANCHES: bool = H;
+
+    /// A Bouc–Wen storey's own rate: `|∂q̇/∂q| ≤ n·|δ̇|/δ_y·|q/q_y|ⁿ⁻¹`, which a fast drift over
+    /// a small yield drift makes far stiffer than the grid step (a 4 mm yield drift at 2 m/s
+    /// and n = 3: 1 500/s): the RK4 advance is cut into pieces that resolve it.
+    fn stiff_rate(&self, y: &Y<L>) -> f64 {
+        if !H {
+            return 0.0;
+        }
+        let mut rate: f64 = 0.0;
+        for i in 0..Self::N {
+            if let Some(h) = &self.hyst[i] {
+                rate = rate.max(h.own_rate_1_s(self.drifts(i, y).1, y[Self::HS + i]));
+            }
+        }
+        rate * self.clock.seconds(1.0)
+    }
+
+    /// The smallest event margin of the yielding storeys ([`HystereticStorey::event_margin`]).
+    #[inline(always)]
+    fn branch_margin(&self, y: &Y<L>) -> f64 {
+        let mut margin = f64::INFINITY;
+        for i in 0..Self::N {
+            if let Some(h) = &self.hyst[i] {
+                let (d, dd) = self.drifts(i, y);
+                margin = margin.min(h.event_margin(d, dd, y[Self::HS + i], self.branch[i]));
+            }
+        }
+        margin
+    }
+
+    /// Changes the branch of every yielding storey whose margin has fallen to zero or below
+    /// ([`HystereticStorey::after_event`]), counting a bilinear storey's yield.
+    fn branch_event(&mut self, y: &mut Y<L>, _t_s: f64) -> bool {
+        let mut changed = false;
+        for i in 0..Self::N {
+            let Some(h) = self.hyst[i] else { continue };
+            let (d, dd) = self.drifts(i, y);
+            let hs = Self::HS + i;
+            // At or past its margin (the root finder may land on the zero itself).
+            if h.event_margin(d, dd, y[hs], self.branch[i]) > 0.0 {
+                continue;
+            }
+            let (branch, state) = h.after_event(d, dd, y[hs], self.branch[i]);
+            if branch == self.branch[i] {
+                continue;
+            }
+            if h.is_bilinear() {
+                self.yield_excursions[i] += usize::from(branch != Branch::Elastic);
+            } else {
+                self.counted[i] = false;
+            }
+            (self.branch[i], y[hs]) = (branch, state);
+            changed = true;
+        }
+        changed
+    }
+
+    /// Counts a Bouc–Wen storey's excursion where its hysteretic force passes
+    /// [`BOUC_WEN_YIELD_SHARE`] of `q_y` while loading (as [`crate::hysteretic`] does).
+    fn admit(&mut self, y: &mut Y<L>, _t_s: f64) -> bool {
+        if H {
+            for i in 0..Self::N {
+                let Some(h) = &self.hyst[i] else { continue };
+                let q = y[Self::HS + i];
+                let loading = matches!(self.branch[i], Branch::Moving(d) if d * q > 0.0);
+                if !h.is_bilinear()
+                    && loading
+                    && !self.counted[i]
+                    && q.abs() >= BOUC_WEN_YIELD_SHARE * h.qy
+                {
+                    self.counted[i] = true;
+                    self.yield_excursions[i] += 1;
+                }
+            }
+        }
+        false
     }
 
     #[inline(always)]
@@ -554,11 +788,11 @@ impl<'a, M: PlatenModel, const L: usize, const G: bool> Plant<L> for SpecimenPla
 }
 
 /// A forward run with a specimen: the mode machine over the force record's grid.
-struct Stepper<'a, M, const L: usize, const G: bool> {
-    machine: Machine<SpecimenPlant<'a, M, L, G>, L>,
+struct Stepper<'a, M, const L: usize, const G: bool, const H: bool> {
+    machine: Machine<SpecimenPlant<'a, M, L, G, H>, L>,
 }
 
-impl<'a, M: PlatenModel, const L: usize, const G: bool> Stepper<'a, M, L, G> {
+impl<'a, M: PlatenModel, const L: usize, const G: bool, const H: bool> Stepper<'a, M, L, G, H> {
     fn new(
         model: &'a M,
         spec: &'a Specimen,
@@ -576,7 +810,19 @@ impl<'a, M: PlatenModel, const L: usize, const G: bool> Stepper<'a, M, L, G> {
             storeys: StoreyConstants::of(spec),
             clock: GridClock::new(grid),
             f_rate: 0.0,
+            hyst: [None; NS],
+            branch: [Branch::Elastic; NS],
+            yield_excursions: [0; NS],
+            counted: [false; NS],
         };
+        if H {
+            for i in 0..spec.len() {
+                plant.hyst[i] = spec.hysteretic_storey(i);
+                if let Some(h) = &plant.hyst[i] {
+                    plant.branch[i] = h.initial_branch();
+                }
+            }
+        }
         plant.f_rate = plant.force_rate(0);
         let f0 = plant.clock.grid.force[0];
         let mode = Mode::initial(model, y[U], y[V], f0 - plant.base_shear(&y));
@@ -598,7 +844,9 @@ impl<'a, M: PlatenModel, const L: usize, const G: bool> Stepper<'a, M, L, G> {
     }
 }
 
-impl<M: PlatenModel, const L: usize, const G: bool> GridStepper for Stepper<'_, M, L, G> {
+impl<M: PlatenModel, const L: usize, const G: bool, const H: bool> GridStepper
+    for Stepper<'_, M, L, G, H>
+{
     /// Advances from grid point `n` to `n + 1`, handling every event inside the step.
     ///
     /// A step of RK4 in slip away from rest first tries [`Machine::slip_fast`] (compiled per
@@ -609,7 +857,9 @@ impl<M: PlatenModel, const L: usize, const G: bool> GridStepper for Stepper<'_, 
         let m = &mut self.machine;
         m.plant.clock.n = n;
         m.stats.steps += 1;
-        let rk4 = m.is_rk4();
+        // A yielding specimen's steps go through the machine's advance, which looks for its
+        // branch events.
+        let rk4 = m.is_rk4() && !H;
         let committed = match m.mode {
             Mode::Slip(Direction::Positive) if rk4 && m.y[V] != 0.0 => m.slip_fast::<true>(0.0),
             Mode::Slip(Direction::Negative) if rk4 && m.y[V] != 0.0 => m.slip_fast::<false>(0.0),
@@ -625,14 +875,30 @@ impl<M: PlatenModel, const L: usize, const G: bool> GridStepper for Stepper<'_, 
     #[inline(always)]
     fn sample(&self, j: usize, t_s: f64) -> Sample {
         let (m, p) = (&self.machine, &self.machine.plant);
-        m.sample(
+        let mut sample = m.sample(
             j,
             t_s,
             p.clock.grid.force[j],
             p.base_shear(&m.y),
             Some((p.spec, G)),
             Z,
-        )
+        );
+        if H {
+            if let Some(spec) = &mut sample.specimen {
+                let y = &m.y;
+                spec.hysteretic = true;
+                for i in 0..SpecimenPlant::<M, L, G, H>::N {
+                    let (d, _) = p.drifts(i, y);
+                    let hs = y[SpecimenPlant::<M, L, G, H>::HS + i];
+                    spec.force_n[i] = p.storey_force(i, y);
+                    spec.hysteretic_force_n[i] =
+                        p.hyst[i].map_or(0.0, |h| h.hysteretic_force_n(d, hs, p.branch[i]));
+                    spec.hysteretic_j[i] = y[SpecimenPlant::<M, L, G, H>::ES + i];
+                }
+                spec.yield_excursions = p.yield_excursions;
+            }
+        }
+        sample
     }
 
     /// Closes the energy balance at the current state, the run having finished at `t_s`.
@@ -645,6 +911,14 @@ impl<M: PlatenModel, const L: usize, const G: bool> GridStepper for Stepper<'_, 
         stats.energy.close(m.plant.model, y[U], y[V], y[W], y[DI]);
         stats.energy.specimen_end_j = specimen_end_j;
         stats.energy.specimen_dissipated_j = y[SD];
+        if H {
+            // The work of the storeys' plastic parts, dissipated like the dampers'.
+            let (n, es) = (
+                SpecimenPlant::<M, L, G, H>::N,
+                SpecimenPlant::<M, L, G, H>::ES,
+            );
+            stats.energy.specimen_dissipated_j += y[es..es + n].iter().sum::<f64>();
+        }
         if rk4 {
             stats.accepted_steps = stats.steps;
         }

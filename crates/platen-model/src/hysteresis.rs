@@ -233,6 +233,31 @@ impl HystereticStorey {
         }
     }
 
+    /// The law's own rate at drift rate `δ̇` and state `h`, 1/s: Bouc–Wen's
+    /// `|∂q̇/∂q| ≤ n·|δ̇|/δ_y·|q/q_y|ⁿ⁻¹` (a fast drift over a small yield drift makes it stiff:
+    /// a fixed step must resolve it); 0 for the bilinear law, linear on each branch.
+    #[inline]
+    pub fn own_rate_1_s(&self, drift_rate_m_s: f64, h: f64) -> f64 {
+        match self.law {
+            HysteresisLaw::Bilinear => 0.0,
+            HysteresisLaw::BoucWen { exponent, .. } => {
+                let ratio = (h / self.qy).abs();
+                exponent * drift_rate_m_s.abs() / self.yield_drift_m * ratio.powf(exponent - 1.0)
+            }
+        }
+    }
+
+    /// The restoring force's rate, N/s, at drift rate `δ̇` with the state variable's rate `ḣ`
+    /// on `branch`.
+    #[inline(always)]
+    pub fn force_rate_n_s(&self, drift_rate_m_s: f64, h_rate: f64, branch: Branch) -> f64 {
+        match (self.law, branch) {
+            (HysteresisLaw::Bilinear, Branch::Yielding(_)) => self.ak * drift_rate_m_s,
+            (HysteresisLaw::Bilinear, _) => self.k * drift_rate_m_s - self.pk * h_rate,
+            (HysteresisLaw::BoucWen { .. }, _) => self.ak * drift_rate_m_s + h_rate,
+        }
+    }
+
     /// The rates `(ḣ, Ė_h)` of the state variable and of the hysteretic energy (W) at drift
     /// rate `δ̇` (m/s), state `h` on `branch` (Bouc–Wen on [`Branch::Moving`] takes
     /// `sgn(δ̇·q)` as the branch's direction times `sgn(q)`; on any other branch from `δ̇`).

@@ -65,6 +65,8 @@ pub struct Specimen {
     /// Each storey's hysteresis (`None`: linear), one per storey; empty when every storey is
     /// linear.
     hysteresis: Vec<Option<Hysteresis>>,
+    /// Each storey's height, m, where given (for drift ratios); empty when none is.
+    heights_m: Vec<Option<f64>>,
 }
 
 /// A general linear specimen along the platen's axis: its matrices row-major (`n × n`) and
@@ -143,6 +145,7 @@ impl Specimen {
             storeys,
             matrices: None,
             hysteresis: Vec::new(),
+            heights_m: Vec::new(),
         })
     }
 
@@ -205,7 +208,43 @@ impl Specimen {
                 base_damping,
             })),
             hysteresis: Vec::new(),
+            heights_m: Vec::new(),
         })
+    }
+
+    /// The shear building with storey heights (one entry per storey, bottom first; `None`
+    /// where not given), m: the drift ratios' denominators.
+    ///
+    /// # Errors
+    /// [`ModelError::InvalidParameter`] for a count that is not one per storey;
+    /// [`ModelError::InvalidStorey`] for a height that is not finite and `> 0`.
+    pub fn with_heights(mut self, heights_m: Vec<Option<f64>>) -> Result<Self> {
+        if heights_m.len() != self.len() {
+            return Err(ModelError::InvalidParameter {
+                name: "height_m",
+                value: heights_m.len() as f64,
+                expected: "one entry per storey",
+            });
+        }
+        for (i, h) in heights_m.iter().enumerate() {
+            if let Some(h) = h {
+                positive("height_m", *h).map_err(|e| ModelError::InvalidStorey {
+                    index: i,
+                    source: Box::new(e),
+                })?;
+            }
+        }
+        self.heights_m = if heights_m.iter().any(Option::is_some) {
+            heights_m
+        } else {
+            Vec::new()
+        };
+        Ok(self)
+    }
+
+    /// Storey `i`'s height, m, if given.
+    pub fn height_m(&self, i: usize) -> Option<f64> {
+        self.heights_m.get(i).copied().flatten()
     }
 
     /// The shear building with `hysteresis` laid over its storeys (one entry per storey, bottom

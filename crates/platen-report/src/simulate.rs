@@ -111,7 +111,12 @@ fn simulate_platen<T: SampleSink>(
     let mut stream = out
         .map(|p| {
             let closed_loop = matches!(scenario.run, Run::ClosedLoop { .. });
-            CsvSink::create_for(p, storeys, closed_loop)
+            let hysteretic = scenario
+                .rig
+                .specimen
+                .as_ref()
+                .is_some_and(|s| s.is_hysteretic());
+            CsvSink::create_for_specimen(p, storeys, hysteretic, closed_loop)
         })
         .transpose()?;
     // The figures' points are collected as the run goes, in memory that does not grow with it.

@@ -6,8 +6,8 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use platen_integrate::{ForwardIntegrator as _, Peaks, RunStats};
-use platen_model::STANDARD_GRAVITY_M_S2;
-use platen_scenario::{PlatenScenario, Run, RunOutput, RunSummary};
+use platen_model::{Specimen, STANDARD_GRAVITY_M_S2};
+use platen_scenario::{PlatenScenario, Run, RunOutput, RunSummary, SpecimenSummary};
 
 /// The text summary of `scenario`'s run `output` (summarised as `summary`), its CSV written
 /// to `out` if any, and the figure files `figures` written for it (none: no figure lines).
@@ -66,9 +66,10 @@ fn trimmed(x: f64) -> String {
 }
 
 /// The specimen's lines: the peak base shear, kN, and each storey's peak drift, mm, with
-/// their times (nothing without a specimen). The scenario format gives no storey heights, so
-/// the drifts are lengths, not ratios.
-fn specimen_lines(s: &mut String, peaks: &Peaks) {
+/// their times (nothing without a specimen); for a storey with a height its drift ratio, and
+/// for a storey that yields its ductility demand, residual drift, yield excursions and
+/// hysteretic energy.
+fn specimen_lines(s: &mut String, peaks: &Peaks, specimen: Option<&Specimen>) {
     if peaks.storeys == 0 {
         return;
     }
@@ -78,14 +79,31 @@ fn specimen_lines(s: &mut String, peaks: &Peaks) {
         peaks.base_shear_n.value / 1e3,
         peaks.base_shear_n.t_s
     );
-    for (i, drift) in peaks.drift_m[..peaks.storeys].iter().enumerate() {
+    let summary = SpecimenSummary::new(specimen, peaks);
+    for (i, st) in summary.storeys.iter().enumerate() {
+        let ratio = st
+            .peak_drift_ratio
+            .map(|r| format!(" ({:.2} % of its height)", r * 100.0))
+            .unwrap_or_default();
         let _ = writeln!(
             s,
-            "  peak storey {} drift {:>+8.3} mm    at {:.3} s",
+            "  peak storey {} drift {:>+8.3} mm    at {:.3} s{ratio}",
             i + 1,
-            drift.value * 1e3,
-            drift.t_s
+            st.peak_drift_m * 1e3,
+            st.peak_drift_m_t_s
         );
+        if let (Some(mu), Some(excursions), Some(e)) =
+            (st.ductility, st.yield_excursions, st.hysteretic_j)
+        {
+            let _ = writeln!(
+                s,
+                "    storey {} ductility {mu:.2}, {excursions} yield excursions, residual drift \
+                 {:+.3} mm, hysteretic energy {:.1} kJ",
+                i + 1,
+                st.residual_drift_m * 1e3,
+                e / 1e3
+            );
+        }
     }
 }
 
@@ -116,7 +134,7 @@ fn run_lines(s: &mut String, sc: &PlatenScenario, output: &RunOutput, out: Optio
         let _ = writeln!(s, "  derived {channel}: {how}");
     }
     peak_lines(s, peaks);
-    specimen_lines(s, peaks);
+    specimen_lines(s, peaks, sc.rig.specimen.as_ref());
     if let (Some(st), Run::Forward { integrator, .. }) = (stats, &sc.run) {
         forward_lines(s, st, integrator.name());
     }

@@ -91,6 +91,8 @@ pub fn system_scenario(
                     mass_kg: s.mass_kg,
                     stiffness_n_per_m: s.stiffness_n_per_m,
                     damping_n_s_per_m: s.damping_n_s_per_m,
+                    hysteresis: None,
+                    height_m: None,
                 })
                 .collect(),
             ..SpecimenSpec::default()

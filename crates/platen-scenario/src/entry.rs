@@ -337,6 +337,11 @@ impl RunResult {
                     columns.push((SpecimenColumns::BASE_SHEAR_NAME.to_owned(), sp.base_shear_n));
                     columns.extend(named(&SpecimenColumns::STOREY_U_NAMES[..n], sp.u_m));
                     columns.extend(named(&SpecimenColumns::STOREY_A_NAMES[..n], sp.a_m_s2));
+                    for (names, cols) in SpecimenColumns::HYSTERETIC_NAMES.iter().zip(sp.hysteretic)
+                    {
+                        let k = cols.len();
+                        columns.extend(named(&names[..k], cols));
+                    }
                 }
                 if let Some(sy) = system {
                     columns.extend(named(&SystemColumns::NAMES, sy.into_columns().into()));

@@ -5,7 +5,7 @@ use std::path::Path;
 use platen_integrate::{
     forward_closed_loop, forward_specimen, inverse, inverse_specimen, ForwardIntegrator,
     IntegrateError, LoopRun, LoopStats, Motion, Peak, Peaks, RunStats, Sample, SampleSink,
-    SystemColumns, TableSink, Trajectory,
+    SpecimenColumns, SystemColumns, TableSink, Trajectory,
 };
 use platen_io::series::SeriesWriter;
 use platen_io::IoError;
@@ -333,6 +333,22 @@ impl CsvSink {
     /// # Errors
     /// As [`CsvSink::create`].
     pub fn create_for(path: &Path, storeys: usize, system: bool) -> Result<Self> {
+        Self::create_for_specimen(path, storeys, false, system)
+    }
+
+    /// [`CsvSink::create_for`] for a specimen that yields (`hysteretic`): after the storeys'
+    /// `storey{i}_a_m_s2`, per storey its drift `storey{i}_drift_m`, restoring force
+    /// `storey{i}_force_n` (the dashpot excluded), hysteretic force
+    /// `storey{i}_hysteretic_force_n` and hysteretic energy `storey{i}_hysteretic_j`.
+    ///
+    /// # Errors
+    /// As [`CsvSink::create`].
+    pub fn create_for_specimen(
+        path: &Path,
+        storeys: usize,
+        hysteretic: bool,
+        system: bool,
+    ) -> Result<Self> {
         let mut names: Vec<String> = Trajectory::COLUMN_NAMES
             .iter()
             .map(|&n| n.to_owned())
@@ -341,6 +357,11 @@ impl CsvSink {
             names.push("base_shear_n".into());
             names.extend((1..=storeys).map(|i| format!("storey{i}_u_m")));
             names.extend((1..=storeys).map(|i| format!("storey{i}_a_m_s2")));
+        }
+        if hysteretic {
+            for kind in SpecimenColumns::HYSTERETIC_NAMES {
+                names.extend(kind[..storeys].iter().map(|&n| n.to_owned()));
+            }
         }
         if system {
             names.extend(SystemColumns::NAMES.iter().map(|&n| n.to_owned()));
@@ -423,9 +444,16 @@ impl SampleSink for CsvSink {
                 self.row.clear();
                 self.row.extend_from_slice(&row);
                 if let Some(sp) = sp {
+                    let n = sp.storeys;
                     self.row.push(sp.base_shear_n);
-                    self.row.extend_from_slice(&sp.u_m[..sp.storeys]);
-                    self.row.extend_from_slice(&sp.a_m_s2[..sp.storeys]);
+                    self.row.extend_from_slice(&sp.u_m[..n]);
+                    self.row.extend_from_slice(&sp.a_m_s2[..n]);
+                    if sp.hysteretic {
+                        self.row.extend_from_slice(&sp.drift_m[..n]);
+                        self.row.extend_from_slice(&sp.force_n[..n]);
+                        self.row.extend_from_slice(&sp.hysteretic_force_n[..n]);
+                        self.row.extend_from_slice(&sp.hysteretic_j[..n]);
+                    }
                 }
                 if let Some(sy) = sy {
                     self.row.extend_from_slice(&SystemColumns::row(sy));

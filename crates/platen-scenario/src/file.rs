@@ -102,6 +102,59 @@ pub struct StoreySpec {
     pub stiffness_n_per_m: f64,
     /// Storey viscous damping, N·s/m (≥ 0).
     pub damping_n_s_per_m: f64,
+    /// How the storey yields (absent: linear). The stiffness above is the elastic one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hysteresis: Option<HysteresisSpec>,
+    /// Storey height, m (> 0; optional): the summary then gives drift ratios.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub height_m: Option<f64>,
+}
+
+/// A storey's hysteresis (`specimen.storeys[i].hysteresis`): one law, by its name.
+#[derive(Debug, Clone, Deserialize, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields, rename_all = "snake_case")]
+pub enum HysteresisSpec {
+    /// Bilinear with kinematic hardening, exact about yield and unloading.
+    Bilinear(BilinearSpec),
+    /// Bouc–Wen, smooth.
+    BoucWen(BoucWenSpec),
+}
+
+/// `hysteresis.bilinear`.
+#[derive(Debug, Clone, Deserialize, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BilinearSpec {
+    /// Yield force, N (> 0).
+    pub yield_force_n: f64,
+    /// Post-yield stiffness over the elastic stiffness, in [0, 1) (default 0: elastic-perfectly
+    /// plastic).
+    #[serde(default)]
+    pub post_yield_stiffness_ratio: f64,
+}
+
+/// `hysteresis.bouc_wen`.
+#[derive(Debug, Clone, Deserialize, Serialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BoucWenSpec {
+    /// Yield force, N (> 0).
+    pub yield_force_n: f64,
+    /// Post-yield stiffness over the elastic stiffness, in [0, 1) (default 0).
+    #[serde(default)]
+    pub post_yield_stiffness_ratio: f64,
+    /// The exponent n, in [1, 64] (default 2; larger is sharper).
+    #[serde(default = "default_bouc_wen_exponent")]
+    pub exponent: f64,
+    /// β/(β + γ), in [0, 1] (default 0.5).
+    #[serde(default = "default_beta_share")]
+    pub beta_share: f64,
+}
+
+fn default_bouc_wen_exponent() -> f64 {
+    2.0
+}
+
+fn default_beta_share() -> f64 {
+    0.5
 }
 
 /// `limits`: any of the table's four limits, each a number > 0 in SI units; a limit not given

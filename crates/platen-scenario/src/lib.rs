@@ -63,6 +63,6 @@ pub use rig::{LoadedRig, LoopSettings, Rig};
 pub use scenario::{PlatenScenario, Run};
 pub use summary::{
     AxisTracking, EnergySummary, ExceedanceSummary, ForwardSummary, LimitCheck, LimitsSummary,
-    LoopMargins, RunSummary, SolverSummary,
+    LoopMargins, RunSummary, SolverSummary, SpecimenSummary, StoreySummary,
 };
 pub use system::TableSystemSpec;

@@ -40,7 +40,7 @@
 use std::path::Path;
 
 use platen_integrate::IntegrateError;
-use platen_model::ModelError;
+use platen_model::{ModelError, Specimen};
 
 use crate::ctx::Ctx;
 use crate::error::Result;
@@ -156,6 +156,21 @@ impl PlatenScenario {
             },
             (_, run) => run,
         };
+        if rig.specimen.as_ref().is_some_and(Specimen::is_hysteretic)
+            && matches!(run, Run::ClosedLoop { .. })
+        {
+            let i = file
+                .specimen
+                .as_ref()
+                .and_then(|s| s.storeys.iter().position(|st| st.hysteresis.is_some()))
+                .unwrap_or(0);
+            return Err(ctx.invalid(
+                &format!("specimen.storeys[{i}].hysteresis"),
+                "(given)",
+                "no table_system: a yielding storey runs on forward and inverse runs so \
+                 far (the closed loop takes linear storeys)",
+            ));
+        }
         Ok(Self {
             name: scenario_name(path, file.name.as_deref()),
             rig,

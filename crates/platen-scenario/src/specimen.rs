@@ -6,11 +6,11 @@
 
 use nalgebra::DMatrix;
 use platen_model::multi_axis::LinearSpecimen;
-use platen_model::{ModelError, Specimen, Storey};
+use platen_model::{Hysteresis, ModelError, Specimen, Storey};
 
 use crate::ctx::Ctx;
 use crate::error::Result;
-use crate::file::SpecimenSpec;
+use crate::file::{HysteresisSpec, SpecimenSpec};
 
 /// How far from the reference point a table's points (and a specimen's levers, a pose) may
 /// lie in a scenario, m (rad for a rotation): the largest shake tables span about 20 m, so a
@@ -43,7 +43,23 @@ pub(crate) fn table_specimen(
     };
     if !s.is_general() {
         // The storeys' reader: the same checks, each storey's value named by its path.
-        return Ok(Some(LinearSpecimen::from_storeys(&storeys(ctx, s)?)));
+        let building = storeys(ctx, s)?;
+        if let Some(i) = s.storeys.iter().position(|st| st.hysteresis.is_some()) {
+            return Err(ctx.invalid(
+                &format!("specimen.storeys[{i}].hysteresis"),
+                "(given)",
+                "no hysteresis on a multi-axis table yet: its storeys are linear (a yielding \
+                 storey runs on the uniaxial platen's inverse runs)",
+            ));
+        }
+        if let Some(i) = s.storeys.iter().position(|st| st.height_m.is_some()) {
+            return Err(ctx.invalid(
+                &format!("specimen.storeys[{i}].height_m"),
+                "(given)",
+                "no height on a multi-axis table yet: its summary gives no drift ratios",
+            ));
+        }
+        return Ok(Some(LinearSpecimen::from_storeys(&building)));
     }
     linear(ctx, s).map(Some)
 }
@@ -59,7 +75,7 @@ fn storeys(ctx: &Ctx, given: &SpecimenSpec) -> Result<Specimen> {
             damping_n_s_per_m: s.damping_n_s_per_m,
         })
         .collect();
-    Specimen::new(storeys).map_err(|e| match e {
+    let storey_error = |e: ModelError| match e {
         ModelError::InvalidStorey { index, source } => match *source {
             ModelError::InvalidParameter {
                 name,
@@ -73,6 +89,58 @@ fn storeys(ctx: &Ctx, given: &SpecimenSpec) -> Result<Specimen> {
             other => ctx.invalid(&format!("specimen.storeys[{index}]"), "", other.to_string()),
         },
         other => ctx.invalid("specimen.storeys", given.storeys.len(), other.to_string()),
+    };
+    let building = Specimen::new(storeys).map_err(storey_error)?;
+    let hysteresis = given
+        .storeys
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            s.hysteresis
+                .as_ref()
+                .map(|h| hysteresis(ctx, i, h))
+                .transpose()
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let heights = given.storeys.iter().map(|s| s.height_m).collect();
+    building
+        .with_hysteresis(hysteresis)
+        .and_then(|b| b.with_heights(heights))
+        .map_err(storey_error)
+}
+
+/// Storey `i`'s validated `hysteresis`, its errors at their JSON path.
+fn hysteresis(ctx: &Ctx, i: usize, given: &HysteresisSpec) -> Result<Hysteresis> {
+    let (law, built) = match given {
+        HysteresisSpec::Bilinear(b) => (
+            "bilinear",
+            Hysteresis::bilinear(b.yield_force_n, b.post_yield_stiffness_ratio),
+        ),
+        HysteresisSpec::BoucWen(b) => (
+            "bouc_wen",
+            Hysteresis::bouc_wen(
+                b.yield_force_n,
+                b.post_yield_stiffness_ratio,
+                b.exponent,
+                b.beta_share,
+            ),
+        ),
+    };
+    built.map_err(|e| match e {
+        ModelError::InvalidParameter {
+            name,
+            value,
+            expected,
+        } => ctx.invalid(
+            &format!("specimen.storeys[{i}].hysteresis.{law}.{name}"),
+            value,
+            expected,
+        ),
+        other => ctx.invalid(
+            &format!("specimen.storeys[{i}].hysteresis"),
+            "",
+            other.to_string(),
+        ),
     })
 }
 

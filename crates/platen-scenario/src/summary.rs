@@ -7,7 +7,7 @@ use std::path::Path;
 use serde::Serialize;
 
 use platen_integrate::{Exceedance, ForwardIntegrator, Peaks, RunStats};
-use platen_model::{PlatenModel, TableLimits};
+use platen_model::{PlatenModel, Specimen, TableLimits};
 
 use crate::rig::Rig;
 use crate::scenario::{Derived, PlatenScenario, Run};
@@ -218,14 +218,69 @@ fn linearise(
 /// The peaks of a specimen run.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SpecimenSummary {
-    /// Number of storeys.
-    pub storeys: usize,
+    /// Each storey's figures, bottom first.
+    pub storeys: Vec<StoreySummary>,
     /// Signed peak base shear (force of the platen on the specimen), N.
     pub peak_base_shear_n: f64,
     /// When it occurred, s.
     pub peak_base_shear_n_t_s: f64,
     /// Signed peak drift of each storey, m, bottom first.
     pub peak_drift_m: Vec<f64>,
+}
+
+/// One storey's figures in a specimen run's summary.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StoreySummary {
+    /// Signed peak drift, m.
+    pub peak_drift_m: f64,
+    /// When it occurred, s.
+    pub peak_drift_m_t_s: f64,
+    /// Peak drift over the storey's height (`null` without `height_m`).
+    pub peak_drift_ratio: Option<f64>,
+    /// The drift at the run's end, m: the residual drift of a specimen that has come to rest.
+    pub residual_drift_m: f64,
+    /// Ductility demand, peak |drift| over the yield drift `F_y/k` (`null` for a linear
+    /// storey).
+    pub ductility: Option<f64>,
+    /// Yield excursions (`null` for a linear storey): a bilinear storey's yield events; a
+    /// Bouc–Wen storey's passages of its hysteretic force beyond 90 % of its yield level,
+    /// once per direction of drift.
+    pub yield_excursions: Option<usize>,
+    /// Energy dissipated in hysteresis, J (`null` for a linear storey).
+    pub hysteretic_j: Option<f64>,
+}
+
+impl SpecimenSummary {
+    /// The summary of a run of `specimen` with `peaks`.
+    pub fn new(specimen: Option<&Specimen>, peaks: &Peaks) -> Self {
+        let n = peaks.storeys;
+        let storeys = (0..n)
+            .map(|i| {
+                let peak = peaks.drift_m[i];
+                let yield_drift = specimen
+                    .and_then(|s| s.hysteretic_storey(i))
+                    .map(|h| h.yield_drift_m);
+                let yielding = yield_drift.is_some() && peaks.hysteretic;
+                StoreySummary {
+                    peak_drift_m: peak.value,
+                    peak_drift_m_t_s: peak.t_s,
+                    peak_drift_ratio: specimen
+                        .and_then(|s| s.height_m(i))
+                        .map(|h| peak.value.abs() / h),
+                    residual_drift_m: peaks.last_drift_m[i],
+                    ductility: yield_drift.map(|d| peak.value.abs() / d),
+                    yield_excursions: yielding.then_some(peaks.yield_excursions[i]),
+                    hysteretic_j: yielding.then_some(peaks.hysteretic_j[i]),
+                }
+            })
+            .collect();
+        Self {
+            storeys,
+            peak_base_shear_n: peaks.base_shear_n.value,
+            peak_base_shear_n_t_s: peaks.base_shear_n.t_s,
+            peak_drift_m: peaks.drift_m[..n].iter().map(|p| p.value).collect(),
+        }
+    }
 }
 
 /// What only a forward run reports.
@@ -377,15 +432,8 @@ impl RunSummary {
             oil_column_frequency_hz: None,
             table_system: None,
             warnings: Vec::new(),
-            specimen: (peaks.storeys > 0).then(|| SpecimenSummary {
-                storeys: peaks.storeys,
-                peak_base_shear_n: peaks.base_shear_n.value,
-                peak_base_shear_n_t_s: peaks.base_shear_n.t_s,
-                peak_drift_m: peaks.drift_m[..peaks.storeys]
-                    .iter()
-                    .map(|p| p.value)
-                    .collect(),
-            }),
+            specimen: (peaks.storeys > 0)
+                .then(|| SpecimenSummary::new(rig.specimen.as_ref(), peaks)),
         }
         .with_loop(scenario, output)
         .with_stuck_platen(scenario)

@@ -150,6 +150,22 @@ pub(crate) trait Plant<const L: usize> {
     fn check(&self, _y: &Y<L>, _t_s: f64) -> Result<()> {
         Ok(())
     }
+    /// Whether the plant has branches of its own (a yielding storey's elastic and plastic
+    /// branches), whose events [`Plant::branch_margin`] and [`Plant::branch_event`] locate and
+    /// apply. `false` by default: the check is compiled out.
+    const HAS_BRANCHES: bool = false;
+    /// The smallest margin of the plant's branches at `y`: positive while every branch holds,
+    /// crossing zero at the first branch event. `+∞` by default.
+    #[inline(always)]
+    fn branch_margin(&self, _y: &Y<L>) -> f64 {
+        f64::INFINITY
+    }
+    /// At a located branch event (state `y`, just past it, at time `t_s`): changes the branches
+    /// whose margin has fallen below zero (and the state that goes with them); returns whether
+    /// anything changed.
+    fn branch_event(&mut self, _y: &mut Y<L>, _t_s: f64) -> bool {
+        false
+    }
     /// Whether a state accepted at an event gets its rates at once (and goes through
     /// [`Plant::admit`]) or only when the next mode is entered.
     const RATES_ON_COMMIT: bool;
@@ -556,6 +572,11 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
                     if !a1.is_finite() {
                         return Err(self.non_finite(tau + len));
                     }
+                    if P::HAS_BRANCHES {
+                        if let Some(at) = self.branch_event_in(tau, len, &y1, try_grading) {
+                            return Ok(at);
+                        }
+                    }
                     if self.mode == Mode::Stick {
                         self.stats.stick_time_s += self.plant.clock().seconds(len);
                     }
@@ -573,6 +594,12 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
                 if g2 <= 0.0 {
                     let x = self.locate(tau, len, i0, (y2, g2), event_grading);
                     let (x, y_event) = x.unwrap_or((0.0, self.y));
+                    if P::HAS_BRANCHES && x > 0.0 {
+                        // A branch event before the mode's: that one first.
+                        if let Some(at) = self.branch_event_in(tau, x, &y_event, event_grading) {
+                            return Ok(at);
+                        }
+                    }
                     return Ok(self.event(tau, x, rest, y_event));
                 }
             }
@@ -581,6 +608,49 @@ impl<P: Plant<L>, const L: usize> Machine<P, L> {
         // A piece of 2⁻⁶⁰ of the span still not safe: the event is here.
         let y = self.y;
         Ok(self.event(tau, 0.0, rest, y))
+    }
+
+    /// A branch event of the plant (a storey's yield or unloading) inside the piece of length
+    /// `len` from `tau` that ends at `y1`, if the plant's margin there has fallen below zero:
+    /// located by Illinois root finding on the map of `grading`'s pieces (as the mode's events
+    /// are), the state taken just past it, the branch changed there and the rates taken again.
+    /// Returns where time landed, in the driver's units; `None` without an event, or for a
+    /// graze at the piece's start that changes no branch (the piece then stands).
+    fn branch_event_in(&mut self, tau: f64, len: f64, y1: &Y<L>, grading: Grading) -> Option<f64> {
+        let g1 = self.plant.branch_margin(y1);
+        if g1 >= 0.0 || g1.is_nan() {
+            return None;
+        }
+        let g0 = self.plant.branch_margin(&self.y);
+        let (x, mut y) = if g0 <= 0.0 {
+            (0.0, self.y)
+        } else {
+            let tolerance = 4.0 * f64::EPSILON * len.max(self.plant.clock().tolerance_floor());
+            let found = locate_zero_velocity(len, g0, (*y1, g1), tolerance, |x| {
+                self.stats.root_iterations += 1;
+                let (y, _) = self.piece(tau, x, grading);
+                Ok::<_, Infallible>((y, self.plant.branch_margin(&y)))
+            });
+            // With the margin positive at the start, the root finder always brackets it.
+            let Ok(Some(found)) = found else {
+                return None;
+            };
+            found
+        };
+        let t_s = self.plant.clock().time_s(tau + x);
+        if !self.plant.branch_event(&mut y, t_s) && x == 0.0 {
+            return None;
+        }
+        if self.mode == Mode::Stick {
+            self.stats.stick_time_s += self.plant.clock().seconds(x);
+        }
+        let input = self.plant.input(tau + x);
+        self.plant.settle(self.mode, self.w_stiff, input, &mut y);
+        let mut k = [0.0; L];
+        let a = self.plant.rates(self.mode, self.w_stiff, input, &y, &mut k);
+        self.stats.rhs_evaluations += 1;
+        self.commit_with(y, k, a, input, t_s);
+        Some(self.plant.clock().reach(tau, x))
     }
 
     /// The first piece's length over the rest `rest` of a span: all of it, or for RK4 an
