@@ -61,6 +61,26 @@ fn static_reaction<M: PlatenModel>(
     }
 }
 
+/// The force terms at sample `i` of `motion` for a platen carrying a specimen whose base
+/// shear is `base_shear_n` (the actuator force adds it; at rest friction holds against it too),
+/// and whether the sample is in the rest band.
+fn specimen_terms<M: PlatenModel>(
+    model: &M,
+    motion: &Motion,
+    i: usize,
+    base_shear_n: f64,
+) -> (ForceTerms, bool) {
+    let (u, v, a) = (motion.u_m()[i], motion.v_m_s()[i], motion.a_m_s2()[i]);
+    let at_rest = motion.rest_velocity_m_s().is_some_and(|b| v.abs() <= b);
+    let mut terms = if at_rest {
+        static_reaction(model, u, a, base_shear_n)
+    } else {
+        force_terms(model, u, v, a)
+    };
+    terms.actuator_n += base_shear_n;
+    (terms, at_rest)
+}
+
 /// RK4 sub-steps of the specimen per sample interval of an inverse run. The base
 /// acceleration is linear inside an interval, so the specimen's equations are smooth there;
 /// at 1024 Hz and 8 Hz, 8 sub-steps put RK4's relative error per interval near 1e-14.
@@ -81,8 +101,7 @@ pub fn inverse_specimen<M: PlatenModel, S: SampleSink>(
         return inverse_hysteretic(model, specimen, motion, sink);
     }
     const NS: usize = Specimen::MAX_STOREYS;
-    let (t, u, v, a) = (motion.t_s(), motion.u_m(), motion.v_m_s(), motion.a_m_s2());
-    let band = motion.rest_velocity_m_s();
+    let (t, a) = (motion.t_s(), motion.a_m_s2());
     let ns = specimen.len();
     // State: z[..ns], zd[..ns].
     let (mut z, mut zd) = ([0.0; NS], [0.0; NS]);
@@ -125,13 +144,7 @@ pub fn inverse_specimen<M: PlatenModel, S: SampleSink>(
             }
         }
         let base_shear_n = specimen.base_shear_n(&z[..ns], &zd[..ns]);
-        let at_rest = band.is_some_and(|b| v[i].abs() <= b);
-        let mut terms = if at_rest {
-            static_reaction(model, u[i], a[i], base_shear_n)
-        } else {
-            force_terms(model, u[i], v[i], a[i])
-        };
-        terms.actuator_n += base_shear_n;
+        let (terms, at_rest) = specimen_terms(model, motion, i, base_shear_n);
         let mut zdd = [0.0; NS];
         rates(a[i], &z, &zd, &mut zdd);
         let mut spec = SpecimenSample::new(ns, base_shear_n);
@@ -182,8 +195,7 @@ fn inverse_building<M: PlatenModel, S: SampleSink>(
     motion: &Motion,
     sink: &mut S,
 ) -> HystereticBuilding {
-    let (t, u, v, a) = (motion.t_s(), motion.u_m(), motion.v_m_s(), motion.a_m_s2());
-    let band = motion.rest_velocity_m_s();
+    let (t, a) = (motion.t_s(), motion.a_m_s2());
     let ns = building.len();
     for i in 0..motion.len() {
         if i > 0 {
@@ -197,13 +209,7 @@ fn inverse_building<M: PlatenModel, S: SampleSink>(
         }
         let y = building.y;
         let base_shear_n = building.base_shear_n(&y);
-        let at_rest = band.is_some_and(|b| v[i].abs() <= b);
-        let mut terms = if at_rest {
-            static_reaction(model, u[i], a[i], base_shear_n)
-        } else {
-            force_terms(model, u[i], v[i], a[i])
-        };
-        terms.actuator_n += base_shear_n;
+        let (terms, at_rest) = specimen_terms(model, motion, i, base_shear_n);
         let zdd = building.relative_accelerations(a[i], &y);
         let mut spec = SpecimenSample::new(ns, base_shear_n);
         spec.hysteretic = true;

@@ -35,6 +35,17 @@
 //! stiff speed (which it is at an exact breakaway), and creep hands over to slip where it
 //! reaches that speed. The specimen starts at rest relative to the platen.
 //!
+//! # Storeys that yield
+//!
+//! A specimen with hysteretic storeys ([`platen_model::hysteresis`]) carries, per storey, its
+//! hysteretic state (bilinear: the plastic drift; Bouc–Wen: the hysteretic force) and the
+//! energy its plastic part dissipates, after the storey velocities. The storeys' branches
+//! (bilinear elastic or yielding; Bouc–Wen's direction of drift) are the plant's own
+//! ([`crate::machine`]'s branch events): a piece whose end finds a storey past its branch's
+//! margin is cut back to the located event, the branch changes there, and the step goes on. A
+//! Bouc–Wen storey under a fast drift over a small yield drift is stiff; the fixed step is then
+//! cut into pieces that resolve it.
+//!
 //! No allocation happens per step: the storey state lives in fixed-size arrays of
 //! [`Specimen::MAX_STOREYS`].
 
@@ -42,13 +53,12 @@ use std::collections::VecDeque;
 
 use platen_model::{Branch, HystereticStorey, PlatenModel, Specimen};
 
-use crate::hysteretic::BOUC_WEN_YIELD_SHARE;
-
 use crate::clock::{Clock as _, GridClock};
 use crate::creep::creep_speed_m_s;
 use crate::error::Result;
 use crate::event::{Direction, EventKind, Mode};
 use crate::grid::{drive, Grid, GridStep, GridStepper};
+use crate::hysteretic::BOUC_WEN_YIELD_SHARE;
 use crate::machine::{direction, Machine, PieceMethod, Plant, DI, SD, U, V, W};
 use crate::method::Method;
 use crate::output::{Sample, SampleSink};
